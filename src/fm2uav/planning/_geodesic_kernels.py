@@ -1,0 +1,466 @@
+"""Compiled (numba) kernel of the geodesic extraction (gradient descent on T).
+
+Private module: the public entry point is :func:`fm2uav.planning.geodesic.descend`,
+which validates the input and calls :func:`descend_kernel`. Everything here works
+on a 3D float64 array ``T[ix, iy, iz]``; a 2D field is passed as ``(nx, ny, 1)``
+so one kernel serves both. Points are continuous *index* coordinates; node ``i``
+sits at coordinate ``i`` and owns the box ``[i - 0.5, i + 0.5)`` on every axis
+(its Voronoi cell). ``T`` already carries ``inf`` on blocked nodes, so "free"
+means "finite T" throughout.
+
+Status codes returned by :func:`descend_kernel`
+------------------------------------------------
+``OK`` (0)
+    The path reached the goal; its last point is the goal.
+``STUCK`` (1)
+    Discrete descent reached a node with no free neighbour of strictly smaller
+    ``T`` that is not within one cell of the goal (a local minimum of ``T``
+    that is not the goal: the field was not made from this goal, or it has
+    plateaus without an exit). ``info`` holds that node.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+OK = 0
+STUCK = 1
+
+#: Boxes are shrunk by this much [cells] in the segment test, so a segment that
+#: only *touches* a blocked node's cell (a face, edge or corner) is not "inside".
+_EPS = 1e-9
+#: Step-length divisors tried (backtracking) before falling back to a discrete move.
+_N_BACKTRACK = 3
+
+
+# --------------------------------------------------------------------------- helpers
+@njit(cache=True, inline="always")
+def _nearest(x, n):
+    """Nearest node index of coordinate ``x`` on an axis of ``n`` nodes (half up)."""
+    i = int(math.floor(x + 0.5))
+    if i < 0:
+        return 0
+    if i > n - 1:
+        return n - 1
+    return i
+
+
+@njit(cache=True, inline="always")
+def _cell(x, n):
+    """Lower corner index and fraction of the interpolation cell holding ``x``."""
+    if n == 1:
+        return 0, 0, 0.0
+    i0 = int(math.floor(x))
+    if i0 < 0:
+        i0 = 0
+    if i0 > n - 2:
+        i0 = n - 2
+    f = x - i0
+    if f < 0.0:
+        f = 0.0
+    if f > 1.0:
+        f = 1.0
+    return i0, i0 + 1, f
+
+
+@njit(cache=True, inline="always")
+def _axis_diff(tc, tm, tp, h):
+    """Derivative [s/m] from a node value and its two axis neighbours.
+
+    Central difference when both neighbours are finite, one-sided when only one
+    is, 0 when none is.
+    """
+    fm = math.isfinite(tm)
+    fp = math.isfinite(tp)
+    if fm and fp:
+        return (tp - tm) / (2.0 * h)
+    if fp:
+        return (tp - tc) / h
+    if fm:
+        return (tc - tm) / h
+    return 0.0
+
+
+@njit(cache=True)
+def _interp_T(T, x, y, z):
+    """Trilinear T at a point, averaged over the finite corners only.
+
+    Returns ``inf`` if every corner with a non-zero weight is ``inf``.
+    """
+    nx, ny, nz = T.shape
+    i0, i1, fx = _cell(x, nx)
+    j0, j1, fy = _cell(y, ny)
+    k0, k1, fz = _cell(z, nz)
+    acc = 0.0
+    wsum = 0.0
+    for a in range(2):
+        i = i1 if a else i0
+        wa = fx if a else 1.0 - fx
+        if wa == 0.0:
+            continue
+        for b in range(2):
+            j = j1 if b else j0
+            wb = wa * (fy if b else 1.0 - fy)
+            if wb == 0.0:
+                continue
+            for c in range(2):
+                k = k1 if c else k0
+                w = wb * (fz if c else 1.0 - fz)
+                if w == 0.0:
+                    continue
+                t = T[i, j, k]
+                if math.isfinite(t):
+                    acc += w * t
+                    wsum += w
+    if wsum == 0.0:
+        return np.inf
+    return acc / wsum
+
+
+@njit(cache=True)
+def _interp_grad(T, x, y, z, hx, hy, hz):
+    """Physical gradient of T [s/m] at a point.
+
+    The gradient is computed at each corner node of the cell holding the point
+    (central differences, one-sided next to ``inf`` or the grid edge) and
+    interpolated trilinearly over the corners whose T is finite (weights
+    renormalised). Returns ``(gx, gy, gz, ok)``.
+    """
+    nx, ny, nz = T.shape
+    i0, i1, fx = _cell(x, nx)
+    j0, j1, fy = _cell(y, ny)
+    k0, k1, fz = _cell(z, nz)
+    gx = 0.0
+    gy = 0.0
+    gz = 0.0
+    wsum = 0.0
+    for a in range(2):
+        i = i1 if a else i0
+        wa = fx if a else 1.0 - fx
+        if wa == 0.0:
+            continue
+        for b in range(2):
+            j = j1 if b else j0
+            wb = wa * (fy if b else 1.0 - fy)
+            if wb == 0.0:
+                continue
+            for c in range(2):
+                k = k1 if c else k0
+                w = wb * (fz if c else 1.0 - fz)
+                if w == 0.0:
+                    continue
+                tc = T[i, j, k]
+                if not math.isfinite(tc):
+                    continue
+                tm = T[i - 1, j, k] if i > 0 else np.inf
+                tp = T[i + 1, j, k] if i < nx - 1 else np.inf
+                gx += w * _axis_diff(tc, tm, tp, hx)
+                tm = T[i, j - 1, k] if j > 0 else np.inf
+                tp = T[i, j + 1, k] if j < ny - 1 else np.inf
+                gy += w * _axis_diff(tc, tm, tp, hy)
+                tm = T[i, j, k - 1] if k > 0 else np.inf
+                tp = T[i, j, k + 1] if k < nz - 1 else np.inf
+                gz += w * _axis_diff(tc, tm, tp, hz)
+                wsum += w
+    if wsum == 0.0:
+        return 0.0, 0.0, 0.0, False
+    gx /= wsum
+    gy /= wsum
+    gz /= wsum
+    ok = math.isfinite(gx) and math.isfinite(gy) and math.isfinite(gz)
+    if ok and gx == 0.0 and gy == 0.0 and gz == 0.0:
+        ok = False
+    return gx, gy, gz, ok
+
+
+@njit(cache=True)
+def _direction(T, x, y, z, hx, hy, hz, hmin):
+    """Index-space displacement of one unit-physical-length descent step.
+
+    ``d_phys = -grad T / |grad T|`` (unit vector in metres), converted to index
+    units ``d_i = d_phys_i / h_i`` and scaled by ``hmin`` so that the caller's
+    step length ``step`` [cells] is ``step * hmin`` metres. Returns
+    ``(dx, dy, dz, ok)``.
+    """
+    gx, gy, gz, ok = _interp_grad(T, x, y, z, hx, hy, hz)
+    if not ok:
+        return 0.0, 0.0, 0.0, False
+    g = math.sqrt(gx * gx + gy * gy + gz * gz)
+    if not (g > 0.0) or not math.isfinite(g):
+        return 0.0, 0.0, 0.0, False
+    return -gx / g * hmin / hx, -gy / g * hmin / hy, -gz / g * hmin / hz, True
+
+
+@njit(cache=True, inline="always")
+def _clamp(x, n):
+    if x < 0.0:
+        return 0.0
+    if x > n - 1.0:
+        return n - 1.0
+    return x
+
+
+@njit(cache=True)
+def _segment_free(T, px, py, pz, qx, qy, qz):
+    """True if the segment p-q enters no cell (Voronoi box) of a non-finite node.
+
+    Exact: every node whose box ``[c - 0.5, c + 0.5]`` (shrunk by ``_EPS``) the
+    segment intersects is checked (slab test); touching a box only on its
+    boundary does not count.
+    """
+    nx, ny, nz = T.shape
+    dx = qx - px
+    dy = qy - py
+    dz = qz - pz
+    ia = _nearest(min(px, qx) - 0.5, nx)
+    ib = _nearest(max(px, qx) + 0.5, nx)
+    ja = _nearest(min(py, qy) - 0.5, ny)
+    jb = _nearest(max(py, qy) + 0.5, ny)
+    ka = _nearest(min(pz, qz) - 0.5, nz)
+    kb = _nearest(max(pz, qz) + 0.5, nz)
+    for i in range(ia, ib + 1):
+        for j in range(ja, jb + 1):
+            for k in range(ka, kb + 1):
+                if math.isfinite(T[i, j, k]):
+                    continue
+                # slab test of the segment against the shrunk box of node (i, j, k)
+                t0 = 0.0
+                t1 = 1.0
+                hit = True
+                for ax in range(3):
+                    if ax == 0:
+                        p, d, c = px, dx, i
+                    elif ax == 1:
+                        p, d, c = py, dy, j
+                    else:
+                        p, d, c = pz, dz, k
+                    lo = c - 0.5 + _EPS
+                    hi = c + 0.5 - _EPS
+                    if d == 0.0:
+                        if p <= lo or p >= hi:
+                            hit = False
+                            break
+                    else:
+                        ta = (lo - p) / d
+                        tb = (hi - p) / d
+                        if ta > tb:
+                            ta, tb = tb, ta
+                        if ta > t0:
+                            t0 = ta
+                        if tb < t1:
+                            t1 = tb
+                        if t0 >= t1:
+                            hit = False
+                            break
+                if hit:
+                    return False
+    return True
+
+
+@njit(cache=True)
+def _best_neighbour(T, i, j, k):
+    """Free 26-neighbour (8 in 2D) with the smallest T, strictly below ``T[i, j, k]``.
+
+    A diagonal move is allowed only if every node of the box spanned by the two
+    nodes is free (no squeezing between obstacles that touch at an edge or a
+    corner). Returns ``(bi, bj, bk, found)``.
+    """
+    nx, ny, nz = T.shape
+    best = T[i, j, k]
+    bi, bj, bk = i, j, k
+    found = False
+    for di in range(-1, 2):
+        ii = i + di
+        if ii < 0 or ii >= nx:
+            continue
+        for dj in range(-1, 2):
+            jj = j + dj
+            if jj < 0 or jj >= ny:
+                continue
+            for dk in range(-1, 2):
+                kk = k + dk
+                if kk < 0 or kk >= nz:
+                    continue
+                if di == 0 and dj == 0 and dk == 0:
+                    continue
+                t = T[ii, jj, kk]
+                if not (t < best):
+                    continue
+                if abs(di) + abs(dj) + abs(dk) > 1:
+                    clear = True
+                    for a in range(min(i, ii), max(i, ii) + 1):
+                        for b in range(min(j, jj), max(j, jj) + 1):
+                            for c in range(min(k, kk), max(k, kk) + 1):
+                                if not math.isfinite(T[a, b, c]):
+                                    clear = False
+                    if not clear:
+                        continue
+                best = t
+                bi, bj, bk = ii, jj, kk
+                found = True
+    return bi, bj, bk, found
+
+
+@njit(cache=True)
+def _push(out, n, x, y, z):
+    """Append a point to the growable buffer ``out`` holding ``n`` points."""
+    if n > 0 and out[n - 1, 0] == x and out[n - 1, 1] == y and out[n - 1, 2] == z:
+        return out, n  # never store a zero-length segment
+    if n == out.shape[0]:
+        bigger = np.empty((2 * out.shape[0], 3))
+        bigger[:n] = out[:n]
+        out = bigger
+    out[n, 0] = x
+    out[n, 1] = y
+    out[n, 2] = z
+    return out, n + 1
+
+
+@njit(cache=True)
+def _near_goal(T, px, py, pz, gx, gy, gz):
+    """Within one cell (Chebyshev, index units) of the goal, with a free segment."""
+    if abs(px - gx) > 1.0 or abs(py - gy) > 1.0 or abs(pz - gz) > 1.0:
+        return False
+    return _segment_free(T, px, py, pz, gx, gy, gz)
+
+
+@njit(cache=True)
+def _try_step(T, px, py, pz, phi, hx, hy, hz, hmin, step):
+    """One continuous descent step from p; returns ``(qx, qy, qz, T(q), ok)``.
+
+    Midpoint rule (RK2): the direction is taken at p + L/2 * d(p) (or d(p) if
+    that is invalid or turns back). The step is accepted if the interpolated T
+    at q is strictly below ``phi``, q's nearest node is free and the segment
+    p-q enters no blocked cell; otherwise the length is halved, up to
+    ``_N_BACKTRACK`` tries.
+    """
+    nx, ny, nz = T.shape
+    d1x, d1y, d1z, ok = _direction(T, px, py, pz, hx, hy, hz, hmin)
+    if not ok:
+        return px, py, pz, phi, False
+    L = step
+    for _ in range(_N_BACKTRACK):
+        mx = _clamp(px + 0.5 * L * d1x, nx)
+        my = _clamp(py + 0.5 * L * d1y, ny)
+        mz = _clamp(pz + 0.5 * L * d1z, nz)
+        d2x, d2y, d2z, ok2 = _direction(T, mx, my, mz, hx, hy, hz, hmin)
+        if not ok2 or (d1x * d2x + d1y * d2y + d1z * d2z) <= 0.0:
+            d2x, d2y, d2z = d1x, d1y, d1z
+        qx = _clamp(px + L * d2x, nx)
+        qy = _clamp(py + L * d2y, ny)
+        qz = _clamp(pz + L * d2z, nz)
+        tq = _interp_T(T, qx, qy, qz)
+        if (
+            tq < phi
+            and math.isfinite(T[_nearest(qx, nx), _nearest(qy, ny), _nearest(qz, nz)])
+            and _segment_free(T, px, py, pz, qx, qy, qz)
+        ):
+            return qx, qy, qz, tq, True
+        L *= 0.5
+    return px, py, pz, phi, False
+
+
+# --------------------------------------------------------------------------- kernel
+@njit(cache=True)
+def descend_kernel(T, start, goal, hx, hy, hz, step, max_steps):
+    """Descend ``T`` from ``start`` to ``goal``; see the module docstring.
+
+    Parameters
+    ----------
+    T : float64 array (nx, ny, nz)
+        Arrival times [s], ``inf`` on blocked / unreached nodes.
+    start, goal : float64 array (3,)
+        Continuous index coordinates; their nearest nodes are free (checked by
+        the caller).
+    hx, hy, hz : float
+        Node spacing [m].
+    step : float
+        Step length in cells: each continuous step is ``step * min(h)`` metres.
+    max_steps : int
+        Number of continuous iterations (accepted steps + fallbacks) after which
+        only discrete descent is used.
+
+    Returns
+    -------
+    path : float64 array (n, 3)
+    status : int
+        ``OK`` or ``STUCK``.
+    info : int64 array (3,)
+        The node where the descent got stuck (status ``STUCK``).
+    n_fallback : int
+        Number of discrete fallback moves made.
+    """
+    nx, ny, nz = T.shape
+    hmin = min(hx, min(hy, hz))
+    gx, gy, gz = goal[0], goal[1], goal[2]
+    px, py, pz = start[0], start[1], start[2]
+    info = np.zeros(3, dtype=np.int64)
+    out = np.empty((256, 3))
+    n = 0
+    out, n = _push(out, n, px, py, pz)
+    phi = _interp_T(T, px, py, pz)  # potential of the current point; strictly decreases
+    iters = 0
+    n_fallback = 0
+    while True:
+        if _near_goal(T, px, py, pz, gx, gy, gz):
+            out, n = _push(out, n, gx, gy, gz)
+            return out[:n].copy(), OK, info, n_fallback
+
+        if iters < max_steps:
+            iters += 1
+            # ---- continuous step: midpoint (RK2) on the interpolated gradient,
+            #      with backtracking on the step length
+            qx, qy, qz, tq, ok = _try_step(T, px, py, pz, phi, hx, hy, hz, hmin, step)
+            if ok:
+                px, py, pz = qx, qy, qz
+                phi = tq
+                out, n = _push(out, n, px, py, pz)
+                continue
+            # ---- fallback: discrete steepest descent from the nearest node of p
+            #      until the node's T is below the potential. The first move
+            #      goes straight from p to the chosen neighbour if that segment
+            #      is free, else via p's nearest node (inside its free cell).
+            moved = False
+            i = _nearest(px, nx)
+            j = _nearest(py, ny)
+            k = _nearest(pz, nz)
+            while not _near_goal(T, px, py, pz, gx, gy, gz):
+                bi, bj, bk, found = _best_neighbour(T, i, j, k)
+                if not found:
+                    break
+                if (px != i or py != j or pz != k) and not _segment_free(
+                    T, px, py, pz, float(bi), float(bj), float(bk)
+                ):
+                    out, n = _push(out, n, float(i), float(j), float(k))
+                i, j, k = bi, bj, bk
+                px, py, pz = float(i), float(j), float(k)
+                out, n = _push(out, n, px, py, pz)
+                n_fallback += 1
+                moved = True
+                if T[i, j, k] < phi:
+                    break
+            if moved:
+                phi = T[i, j, k]
+            elif not _near_goal(T, px, py, pz, gx, gy, gz):
+                info[0], info[1], info[2] = i, j, k
+                return out[:n].copy(), STUCK, info, n_fallback
+            continue
+
+        # ---- step budget used up: pure discrete descent
+        i = _nearest(px, nx)
+        j = _nearest(py, ny)
+        k = _nearest(pz, nz)
+        out, n = _push(out, n, float(i), float(j), float(k))
+        px, py, pz = float(i), float(j), float(k)
+        while not _near_goal(T, px, py, pz, gx, gy, gz):
+            bi, bj, bk, found = _best_neighbour(T, i, j, k)
+            if not found:
+                info[0], info[1], info[2] = i, j, k
+                return out[:n].copy(), STUCK, info, n_fallback
+            i, j, k = bi, bj, bk
+            px, py, pz = float(i), float(j), float(k)
+            out, n = _push(out, n, px, py, pz)
+            n_fallback += 1

@@ -1,0 +1,278 @@
+"""Geodesic extraction: descend an arrival-time field from the start to the goal.
+
+The second half of FM²: once ``T = fast_marching(W, goal)`` is known, the
+fastest path from any start is the curve of steepest descent of ``T``, which
+ends at the goal (where ``T = 0``). :func:`descend` follows it with sub-cell
+steps and falls back to discrete moves where the gradient is unusable, so it
+always terminates.
+
+Every call goes prepare (validate, pad 2D to 3D, mark blocked nodes as ``inf``)
+→ kernel (compiled, :mod:`fm2uav.planning._geodesic_kernels`) → finalise
+(trim to ``ndim`` columns, translate the kernel's status into errors).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from ..eikonal.fmm import as_spacing
+from ..errors import InputError, PlanningError, UnreachableError
+from . import _geodesic_kernels as _k
+
+__all__ = ["descend", "nearest_node", "default_max_steps"]
+
+
+def nearest_node(points: Any) -> np.ndarray:
+    """Nearest grid node of continuous index coordinates (ties round up).
+
+    Parameters
+    ----------
+    points : array_like, shape (..., ndim)
+        Continuous index coordinates [cells].
+
+    Returns
+    -------
+    ndarray of int64, same shape
+        ``floor(points + 0.5)``: the node whose cell ``[i - 0.5, i + 0.5)``
+        holds each point. This is the rule :func:`descend` uses everywhere.
+    """
+    return np.floor(np.asarray(points, dtype=float) + 0.5).astype(np.int64)
+
+
+def default_max_steps(shape: Sequence[int], spacing: Sequence[float], step: float) -> int:
+    """Default bound on the number of continuous descent iterations.
+
+    Enough steps of ``step * min(spacing)`` metres to walk a path that visits
+    every node once along cell diagonals, i.e. ``n_nodes * |h| / (step * min h)``
+    (plus a small constant). A real geodesic is far shorter; the bound only
+    matters for pathological fields, after which :func:`descend` switches to
+    pure discrete descent.
+    """
+    h = np.asarray(spacing, dtype=float)
+    n_nodes = int(np.prod(shape))
+    return int(np.ceil(n_nodes * float(np.linalg.norm(h)) / (step * float(h.min())))) + 100
+
+
+def _as_field(T: Any) -> np.ndarray:
+    arr = np.asarray(T)
+    if arr.dtype == bool or arr.dtype.kind not in "iuf":
+        raise InputError(f"T must be a numeric array of arrival times, got dtype {arr.dtype}")
+    if arr.ndim not in (2, 3):
+        raise InputError(f"T must be a 2D or 3D array, got {arr.ndim}D with shape {arr.shape}")
+    if min(arr.shape) < 1:
+        raise InputError(f"T must not be empty, got shape {arr.shape}")
+    arr = np.asarray(arr, dtype=np.float64)
+    bad = np.isnan(arr) | (arr == -np.inf)
+    if bad.any():
+        where = np.argwhere(bad)[0].tolist()
+        raise InputError(
+            f"T must hold arrival times (finite, or +inf where unreached); "
+            f"found {arr[tuple(where)]} at index {where}"
+        )
+    return arr
+
+
+def _as_point(p: Any, shape: tuple[int, ...], what: str) -> np.ndarray:
+    ndim = len(shape)
+    try:
+        arr = np.asarray(p, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise InputError(f"{what} must be {ndim} numbers (index coordinates), got {p!r}") from None
+    if arr.size != ndim:
+        raise InputError(
+            f"{what} must have {ndim} coordinates (the field is {ndim}D), got {arr.size}: {p!r}"
+        )
+    if not np.all(np.isfinite(arr)):
+        raise InputError(f"{what} must be finite, got {arr.tolist()}")
+    upper = np.asarray(shape, dtype=float) - 1.0
+    tol = 1e-9
+    if np.any(arr < -tol) or np.any(arr > upper + tol):
+        raise PlanningError(
+            f"{what} {arr.tolist()} (index coordinates) lies outside the grid, whose "
+            f"coordinates run from 0 to {upper.tolist()} on each axis; move it inside the map"
+        )
+    return np.clip(arr, 0.0, upper)
+
+
+def descend(
+    T: Any,
+    start: Any,
+    goal: Any,
+    *,
+    spacing: float | Sequence[float] = 1.0,
+    blocked: Any = None,
+    step: float = 0.5,
+    max_steps: int | None = None,
+) -> np.ndarray:
+    """Path of steepest descent of an arrival-time field, from ``start`` to ``goal``.
+
+    The path follows ``-grad T`` (the physical gradient, ``dT/dx_k = dT/di_k / h_k``)
+    with sub-cell steps, and ends exactly at ``goal``.
+
+    **Gradient.** At each corner node of the grid cell holding the point, the
+    gradient is taken with central differences, one-sided where a neighbour is
+    ``inf``/blocked or off the grid; the corner gradients (of finite-T corners
+    only, weights renormalised) are interpolated bilinearly (2D) or trilinearly
+    (3D).
+
+    **Step rule.** Each step has physical length ``step * min(spacing)`` [m]
+    (so at most ``step`` cells on every axis), integrated with the midpoint rule
+    (RK2). A step is accepted only if the interpolated ``T`` strictly decreases,
+    the new point's nearest node is free (not blocked, finite ``T``) and the
+    straight segment to it enters no blocked node's cell; otherwise the step is
+    halved (up to 3 tries).
+
+    **Fallback and termination.** If no step is accepted (zero/NaN gradient,
+    plateau, noise, obstacle ahead), the path makes discrete steepest-descent
+    moves: to the free 8-neighbour (2D) / 26-neighbour (3D) of the current
+    nearest node with the smallest ``T``, strictly below the current node's,
+    without cutting between obstacles that touch at an edge or corner. It keeps
+    moving until the node's ``T`` is below the last accepted interpolated ``T``
+    (so the descent potential keeps decreasing across fallbacks), then resumes
+    continuous steps. After ``max_steps`` continuous iterations only discrete
+    moves are made; each strictly lowers the node's ``T``, so the descent ends.
+    On a fast-marching field a lower axis neighbour exists at every reached node
+    but the source; where none exists away from the goal, PlanningError is
+    raised. As soon as the point is within one
+    cell of the goal on every axis and the straight segment to the goal is free,
+    the goal is appended exactly and the descent stops.
+
+    Parameters
+    ----------
+    T : array_like, shape (nx, ny) or (nx, ny, nz)
+        Arrival times [s] of a wave started at the nearest node of ``goal``
+        (``T = 0`` there); ``inf`` where unreached or impassable. Indexed x first.
+    start, goal : sequence of float, length ndim
+        Continuous index coordinates [cells] (node ``i`` sits at ``i``); may be
+        off-grid, e.g. ``(3.2, 7.9, 4.0)``. Must lie inside the grid
+        (``0 <= p_k <= n_k - 1``; up to 1e-9 cell outside is clipped in).
+    spacing : float or sequence of float, optional
+        Node spacing [m], one value or one per axis. Default 1.
+    blocked : array_like of bool, same shape as ``T``, optional
+        True marks obstacle nodes. No path point, and no segment between two
+        path points, enters the cell of a blocked node or of a node with
+        ``T = inf``.
+    step : float, optional
+        Step length in cells of the finest axis, ``0 < step <= 1``; each step is
+        ``step * min(spacing)`` metres. Default 0.5.
+    max_steps : int, optional
+        Bound on the continuous iterations (accepted steps and fallbacks) before
+        switching to pure discrete descent; 0 gives a purely discrete path.
+        Default :func:`default_max_steps` (grid-size based, generous).
+
+    Returns
+    -------
+    ndarray of float64, shape (N, ndim)
+        Path points in continuous index coordinates [cells]. ``path[0]`` equals
+        ``start`` and ``path[-1]`` equals ``goal`` exactly; consecutive points
+        are distinct, so ``start == goal`` gives a single point (``N == 1``).
+        Convert to metres with ``origin + path * spacing``.
+
+    Raises
+    ------
+    fm2uav.InputError
+        Bad shapes or dtypes, NaN in ``T``, ``step`` outside (0, 1], negative
+        ``max_steps``, wrong number of coordinates.
+    fm2uav.PlanningError
+        ``start`` or ``goal`` outside the grid or inside a blocked node; ``T``
+        not minimal (or ``inf``) at the goal's nearest node; the descent hit a
+        local minimum of ``T`` away from the goal (``T`` has a second source).
+    fm2uav.UnreachableError
+        The start's nearest node has ``T = inf``: the wave from the goal never
+        reached it, so no path connects them.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fm2uav.eikonal import fast_marching
+    >>> T = fast_marching(np.ones((11, 11)), [(10, 5)])
+    >>> path = descend(T, (0.0, 5.0), (10.0, 5.0))
+    >>> path[0].tolist(), path[-1].tolist()
+    ([0.0, 5.0], [10.0, 5.0])
+    """
+    field = _as_field(T)
+    shape = field.shape
+    ndim = field.ndim
+    h = as_spacing(spacing, ndim)
+    step = float(step)
+    if not (np.isfinite(step) and 0.0 < step <= 1.0):
+        raise InputError(f"step must be in (0, 1] cells, got {step!r}")
+    if max_steps is None:
+        max_steps = default_max_steps(shape, h, step)
+    elif (
+        isinstance(max_steps, bool)
+        or not isinstance(max_steps, (int, np.integer))
+        or max_steps < 0
+    ):
+        raise InputError(f"max_steps must be a non-negative integer or None, got {max_steps!r}")
+
+    s = _as_point(start, shape, "start")
+    g = _as_point(goal, shape, "goal")
+
+    if blocked is not None:
+        mask = np.asarray(blocked)
+        if mask.dtype != bool and mask.dtype.kind not in "iu":
+            raise InputError(f"blocked must be a boolean array, got dtype {mask.dtype}")
+        if mask.shape != shape:
+            raise InputError(
+                f"blocked has shape {mask.shape} but T has shape {shape}; they must match"
+            )
+        mask = mask.astype(bool, copy=False)
+        if mask.any():
+            field = field.copy()
+            field[mask] = np.inf
+    else:
+        mask = None
+
+    sn = tuple(nearest_node(s).tolist())
+    gn = tuple(nearest_node(g).tolist())
+    if mask is not None and mask[gn]:
+        raise PlanningError(
+            f"goal {g.tolist()} lies in blocked node {list(gn)}; move the goal to free space"
+        )
+    if not np.isfinite(field[gn]):
+        raise PlanningError(
+            f"goal {g.tolist()}: its nearest node {list(gn)} has T = inf, so T was not computed "
+            "from this goal; compute T with the goal's nearest node as the source"
+        )
+    t_min = float(field.min())
+    if field[gn] > t_min:
+        where = np.unravel_index(int(np.argmin(field)), shape)
+        raise PlanningError(
+            f"goal {g.tolist()}: T at its nearest node {list(gn)} is {field[gn]:g}, but T is "
+            f"lower ({t_min:g}) at node {[int(i) for i in where]}, so T was not computed from "
+            "this goal; compute T with the goal's nearest node as the source"
+        )
+    if mask is not None and mask[sn]:
+        raise PlanningError(
+            f"start {s.tolist()} lies in blocked node {list(sn)}; move the start to free space"
+        )
+    if not np.isfinite(field[sn]):
+        raise UnreachableError(
+            f"start {s.tolist()} cannot reach the goal {g.tolist()}: its nearest node {list(sn)} "
+            "was never reached by the wave from the goal (T = inf), so no free connection "
+            "joins them; move the start or the goal into the same free region, or clear "
+            "(lower the obstacles / raise the speed of) the cells that separate them"
+        )
+
+    pad = 3 - ndim
+    field3 = np.ascontiguousarray(field.reshape(shape + (1,) * pad))
+    h3 = tuple(h) + (min(h),) * pad  # keeps min(spacing) of the real axes
+    s3 = np.concatenate([s, np.zeros(pad)])
+    g3 = np.concatenate([g, np.zeros(pad)])
+    path, status, info, _ = _k.descend_kernel(field3, s3, g3, *h3, step, int(max_steps))
+    if status != _k.OK:
+        node = info[:ndim].tolist()
+        raise PlanningError(
+            f"descent from start {s.tolist()} stuck at node {node} (T = {field[tuple(node)]:g}), "
+            f"which has no free neighbour with smaller T and is not next to the goal "
+            f"{g.tolist()}; T must be the arrival times of a wave started at the goal's "
+            f"nearest node {list(gn)} (e.g. fast_marching(speed, [goal_node]))"
+        )
+    path = np.ascontiguousarray(path[:, :ndim])
+    path[0] = s
+    path[-1] = g
+    return path
