@@ -1,0 +1,282 @@
+"""Slow, readable pure-Python Fast Marching Method, used only by the tests.
+
+This module is an independent second implementation of the discretisation of
+:func:`fm2uav.eikonal.fast_marching`: same upwind stencil, same point-source
+initialisation, same ``stop_at`` semantics. It is written for clarity, not
+speed: plain Python loops over index tuples, :mod:`heapq` with lazy deletion
+for the narrow band, and numpy arrays only as storage. It works for any number
+of dimensions (the tests use 2 and 3).
+
+The discretisation, in words
+----------------------------
+Arrival times ``T`` [s] solve ``|grad T| = 1 / v`` on a node-centred grid
+(node ``i`` sits at ``i * h`` [m] along each axis, ``h`` may differ per axis).
+
+Sources
+    ``T = 0`` at every source node; source nodes are frozen. Then, for each
+    source whose bounding box of half-width ``R = 2 * max(h)`` [m] (clipped to
+    the grid, ``floor(R / h_axis)`` nodes per axis) holds no node of speed
+    ``<= 0``, every node at physical distance ``d <= R`` from it gets the
+    straight-ray time ``d * 0.5 * (1/v_source + 1/v_node)`` if that is smaller
+    than its current value. These nodes join the narrow band; they are *not*
+    frozen, so the march may still lower them.
+
+Local update of a node ``x`` with speed ``v``
+    For each axis take the frozen neighbour (``x - e`` or ``x + e``) with the
+    smaller ``T`` (the minus side wins a tie), ``T1``. With order 2, if the
+    next node in the same direction (``x -/+ 2e``) is frozen and its time
+    ``T2 <= T1``, the axis contributes ``a (T - tau)^2`` with
+    ``tau = (4 T1 - T2) / 3`` and ``a = 9 / (4 h^2)``; otherwise
+    ``tau = T1`` and ``a = 1 / h^2``. An axis with no frozen neighbour does
+    not contribute. The axes are sorted by ``tau``; the first gives
+    ``T = tau_1 + sqrt(rhs / a_1)`` with ``rhs = 1 / v^2``, and each next axis
+    joins while the current ``T`` is later than its ``tau`` and the
+    discriminant of ``sum a_m (T - tau_m)^2 = rhs`` stays ``>= 0``; the larger
+    root is taken. A node keeps the smaller of its current and the new value.
+
+March
+    Pop the band node with the smallest ``T``, freeze it, and update its
+    non-frozen neighbours of positive speed. Before the march, every
+    non-frozen neighbour of a frozen node (the sources) is updated once.
+    With ``stop_at``, the march ends as soon as all stop nodes are frozen.
+    Every node not frozen at the end is returned as ``inf``.
+"""
+
+from __future__ import annotations
+
+import heapq
+import itertools
+import math
+from collections.abc import Iterator, Sequence
+from typing import Any
+
+import numpy as np
+
+__all__ = ["fast_marching_reference"]
+
+#: Radius of the straight-ray source initialisation, in multiples of the
+#: largest grid spacing (must match the compiled solver).
+SOURCE_RADIUS_CELLS = 2.0
+
+Index = tuple[int, ...]
+
+
+def _neighbours(node: Index, shape: tuple[int, ...]) -> Iterator[Index]:
+    """Yield the (up to ``2 * ndim``) axis-aligned neighbours inside the grid."""
+    for axis in range(len(shape)):
+        for step in (-1, 1):
+            coord = node[axis] + step
+            if 0 <= coord < shape[axis]:
+                yield node[:axis] + (coord,) + node[axis + 1:]
+
+
+def _shifted(node: Index, axis: int, step: int) -> Index:
+    """Return ``node`` moved by ``step`` nodes along ``axis``."""
+    return node[:axis] + (node[axis] + step,) + node[axis + 1:]
+
+
+def _axis_term(
+    T: np.ndarray,
+    frozen: np.ndarray,
+    node: Index,
+    axis: int,
+    h: float,
+    order: int,
+) -> tuple[float, float] | None:
+    """Upwind term ``a (T - tau)^2`` of one axis.
+
+    Parameters
+    ----------
+    T : ndarray
+        Current arrival times [s].
+    frozen : ndarray of bool
+        Which nodes are accepted.
+    node : tuple of int
+        The node being updated.
+    axis : int
+        The axis.
+    h : float
+        Spacing along ``axis`` [m].
+    order : {1, 2}
+        Stencil order.
+
+    Returns
+    -------
+    (tau, a) or None
+        ``tau`` [s] and ``a`` [1/m^2]; ``None`` when neither neighbour on this
+        axis is frozen.
+    """
+    n = T.shape[axis]
+    best_step = 0
+    best_time = math.inf
+    for step in (-1, 1):  # minus side first: it wins a tie
+        coord = node[axis] + step
+        if 0 <= coord < n:
+            nb = _shifted(node, axis, step)
+            if frozen[nb] and float(T[nb]) < best_time:
+                best_time = float(T[nb])
+                best_step = step
+    if best_step == 0:
+        return None
+    if order == 2:
+        coord2 = node[axis] + 2 * best_step
+        if 0 <= coord2 < n:
+            nb2 = _shifted(node, axis, 2 * best_step)
+            if frozen[nb2] and float(T[nb2]) <= best_time:
+                t2 = float(T[nb2])
+                return (4.0 * best_time - t2) / 3.0, 9.0 / (4.0 * h * h)
+    return best_time, 1.0 / (h * h)
+
+
+def _local_solution(
+    T: np.ndarray,
+    frozen: np.ndarray,
+    speed: np.ndarray,
+    node: Index,
+    spacing: tuple[float, ...],
+    order: int,
+) -> float:
+    """Solve the upwind quadratic at ``node``; return the new time [s].
+
+    Returns ``inf`` when no axis has a frozen neighbour.
+    """
+    v = float(speed[node])
+    rhs = 1.0 / (v * v)  # [s^2/m^2]
+    terms = []
+    for axis, h in enumerate(spacing):
+        term = _axis_term(T, frozen, node, axis, h, order)
+        if term is not None:
+            terms.append(term)
+    if not terms:
+        return math.inf
+    terms.sort(key=lambda term: term[0])
+
+    tau, a = terms[0]
+    t = tau + math.sqrt(rhs / a)  # one-sided solution
+    A, B, C = a, a * tau, a * tau * tau  # sum a, sum a*tau, sum a*tau^2
+    for tau, a in terms[1:]:
+        if t <= tau:  # causality: this axis is not upwind of the solution
+            break
+        A, B, C = A + a, B + a * tau, C + a * tau * tau
+        disc = B * B - A * (C - rhs)
+        if disc < 0.0:
+            break
+        t = (B + math.sqrt(disc)) / A
+    return t
+
+
+def _as_nodes(points: Any, ndim: int) -> list[Index]:
+    """Turn one index tuple or a sequence of them into a list of int tuples."""
+    arr = np.asarray(points)
+    if arr.ndim == 1:
+        arr = arr[None, :]
+    return [tuple(int(c) for c in row) for row in arr.reshape(-1, ndim)]
+
+
+def fast_marching_reference(
+    speed: Any,
+    sources: Any,
+    *,
+    spacing: float | Sequence[float] = 1.0,
+    order: int = 2,
+    stop_at: Any = None,
+) -> np.ndarray:
+    """Arrival times by a slow pure-Python Fast Marching Method (tests only).
+
+    Same discretisation as :func:`fm2uav.eikonal.fast_marching` (see the
+    module docstring). Inputs are assumed valid: no checks beyond what is
+    needed to read them.
+
+    Parameters
+    ----------
+    speed : array_like, shape (nx, ny) or (nx, ny, nz)
+        Propagation speed at each node [m/s], ``>= 0``; 0 marks impassable
+        nodes. Indexed x first.
+    sources : sequence of int tuples or (m, ndim) int array
+        Source node indices (speed > 0), where ``T = 0`` [s].
+    spacing : float or sequence of float, optional
+        Node spacing [m], one value or one per axis. Default 1.
+    order : {1, 2}, optional
+        Upwind stencil order. Default 2.
+    stop_at : sequence of int tuples, optional
+        Stop once all these nodes are frozen; nodes not frozen by then are
+        ``inf``.
+
+    Returns
+    -------
+    ndarray of float64, same shape as ``speed``
+        Arrival time [s]; ``inf`` where unreached.
+    """
+    speed = np.asarray(speed, dtype=np.float64)
+    shape = speed.shape
+    ndim = speed.ndim
+    h = tuple(float(x) for x in np.broadcast_to(np.asarray(spacing, dtype=float), (ndim,)))
+
+    T = np.full(shape, math.inf)
+    frozen = np.zeros(shape, dtype=bool)
+    band: list[tuple[float, Index]] = []  # heap of (time, node); stale entries skipped
+
+    # ---- sources: T = 0, frozen
+    source_nodes = _as_nodes(sources, ndim)
+    for s in source_nodes:
+        T[s] = 0.0
+        frozen[s] = True
+
+    # ---- straight-ray ball around every source with an obstacle-free box
+    radius = SOURCE_RADIUS_CELLS * max(h)  # [m]
+    reach = [int(math.floor(radius / hx)) for hx in h]  # nodes per axis
+    for s in source_nodes:
+        ranges = [
+            range(max(s[ax] - reach[ax], 0), min(s[ax] + reach[ax], shape[ax] - 1) + 1)
+            for ax in range(ndim)
+        ]
+        box = list(itertools.product(*ranges))
+        if any(speed[node] <= 0.0 for node in box):
+            continue
+        v_source = float(speed[s])
+        for node in box:
+            d2 = 0.0
+            for ax in range(ndim):
+                dx = (node[ax] - s[ax]) * h[ax]
+                d2 += dx * dx
+            if d2 > radius * radius or frozen[node]:
+                continue
+            t = math.sqrt(d2) * 0.5 * (1.0 / v_source + 1.0 / float(speed[node]))
+            if t < T[node]:
+                T[node] = t
+                heapq.heappush(band, (t, node))
+
+    def relax(node: Index) -> None:
+        """Recompute a non-frozen node and push it if its time decreased."""
+        t = _local_solution(T, frozen, speed, node, h, order)
+        if t < T[node]:
+            T[node] = t
+            heapq.heappush(band, (t, node))
+
+    # ---- every free neighbour of a frozen node joins the band
+    for node in source_nodes:
+        for nb in _neighbours(node, shape):
+            if not frozen[nb] and speed[nb] > 0.0:
+                relax(nb)
+
+    # ---- stop nodes still to freeze
+    remaining: set[Index] | None = None
+    if stop_at is not None:
+        remaining = {node for node in _as_nodes(stop_at, ndim) if not frozen[node]}
+
+    # ---- the march
+    while band and (remaining is None or remaining):
+        t, node = heapq.heappop(band)
+        if frozen[node] or t != T[node]:  # stale entry (lazy deletion)
+            continue
+        frozen[node] = True
+        if remaining is not None:
+            remaining.discard(node)
+            if not remaining:
+                break
+        for nb in _neighbours(node, shape):
+            if not frozen[nb] and speed[nb] > 0.0:
+                relax(nb)
+
+    T[~frozen] = math.inf
+    return T
