@@ -251,7 +251,8 @@ class World:
                 f"{_fmt_bounds(self.bounds)} m; move the {what} inside these bounds "
                 "or build a larger world"
             )
-        idx = np.rint(self.to_index(flat)).astype(np.int64)
+        # floor(x + 0.5): the same nearest-node rule as planning.geodesic
+        idx = np.floor(self.to_index(flat) + 0.5).astype(np.int64)
         idx = np.clip(idx, 0, np.asarray(self.shape) - 1)
         cells = [tuple(int(v) for v in row) for row in idx]
         return cells[0] if p.ndim == 1 else cells

@@ -1,0 +1,168 @@
+"""The FM² velocity map: distance to the nearest obstacle, rescaled to [0, 1].
+
+Step 2 of FM² (thesis §2.2): a wave is started from every obstacle cell; its
+arrival time (the distance to the nearest obstacle) rescaled so the maximum is
+1 is the velocity map ``W``. The thesis' adjustment exponent and the Sensors
+2022 paper's saturation then shape it: ``W = min(W / saturation, 1) ** exponent``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any, Literal
+
+import numpy as np
+from scipy import ndimage
+
+from ..errors import InputError
+from .fmm import as_spacing, fast_marching
+
+__all__ = ["distance_map", "velocity_map", "normalise_distance", "shape_velocity"]
+
+Method = Literal["edt", "fmm"]
+
+
+def _as_occupancy(occupancy: Any) -> np.ndarray:
+    occ = np.asarray(occupancy)
+    if occ.dtype != bool:
+        raise InputError(
+            f"occupancy must be a boolean array (True = obstacle), got dtype {occ.dtype}; "
+            "convert with `occupancy > 0`"
+        )
+    if occ.ndim not in (2, 3) or occ.size == 0:
+        raise InputError(f"occupancy must be a non-empty 2D or 3D array, got shape {occ.shape}")
+    return occ
+
+
+def distance_map(
+    occupancy: Any,
+    *,
+    spacing: float | Sequence[float] = 1.0,
+    method: Method = "edt",
+    walls: bool = False,
+    order: int = 2,
+) -> np.ndarray:
+    """Distance from every node to the nearest obstacle node [m].
+
+    Parameters
+    ----------
+    occupancy : array_like of bool, shape (nx, ny[, nz])
+        True = obstacle.
+    spacing : float or sequence of float
+        Node spacing [m], one value or one per axis.
+    method : {"edt", "fmm"}
+        ``"edt"``: exact Euclidean distance transform (scipy). ``"fmm"``: Fast
+        Marching from every obstacle node with unit speed, as in the seeds.
+    walls : bool
+        Treat the map border as an obstacle (a ghost layer of obstacle nodes
+        one spacing outside the map).
+    order : {1, 2}
+        FMM order for ``method="fmm"``.
+
+    Returns
+    -------
+    ndarray of float64
+        Distance [m]; 0 on obstacles; ``inf`` everywhere if there is no
+        obstacle at all (and ``walls`` is False).
+    """
+    occ = _as_occupancy(occupancy)
+    h = as_spacing(spacing, occ.ndim)
+    if method not in ("edt", "fmm"):
+        raise InputError(f"method must be 'edt' or 'fmm', got {method!r}")
+    if walls:
+        occ = np.pad(occ, 1, mode="constant", constant_values=True)
+    if not occ.any():
+        return np.full(occupancy.shape if not walls else occ.shape, np.inf)
+    if method == "edt":
+        dist = ndimage.distance_transform_edt(~occ, sampling=h)
+    else:
+        # Only obstacle nodes with a free neighbour can be nearest; interior
+        # obstacle nodes are impassable (speed 0) and stay at distance 0.
+        interior = ndimage.binary_erosion(occ, border_value=1)
+        boundary = occ & ~interior
+        speed = (~interior).astype(np.float64)
+        dist = fast_marching(speed, np.argwhere(boundary), spacing=h, order=order)
+        dist[interior] = 0.0
+    if walls:
+        dist = dist[(slice(1, -1),) * occ.ndim]
+    return np.asarray(dist, dtype=np.float64)
+
+
+def normalise_distance(dist: np.ndarray) -> np.ndarray:
+    """Rescale a distance map so that its maximum is 1 (thesis §2.2, step 2).
+
+    A map with no obstacle (all ``inf``) becomes all ones.
+    """
+    finite_max = float(np.max(dist, initial=0.0, where=np.isfinite(dist)))
+    if not np.isfinite(dist).any() or finite_max <= 0.0:
+        return np.where(np.isfinite(dist), 0.0, 1.0)
+    return np.where(np.isfinite(dist), dist / finite_max, 1.0)
+
+
+def shape_velocity(W: np.ndarray, *, saturation: float = 1.0, exponent: float = 1.0) -> np.ndarray:
+    """Apply saturation α and exponent β: ``W = min(W / α, 1) ** β``.
+
+    Parameters
+    ----------
+    W : ndarray
+        Normalised velocity map in [0, 1].
+    saturation : float
+        α in (0, 1]: distances above α (as a share of the largest) get full speed.
+    exponent : float
+        β > 0: > 1 darkens the map (paths further from obstacles), < 1 lightens it.
+    """
+    if not (np.isfinite(saturation) and 0.0 < saturation <= 1.0):
+        raise InputError(f"saturation must be in (0, 1], got {saturation!r}")
+    if not (np.isfinite(exponent) and exponent > 0.0):
+        raise InputError(f"exponent must be > 0, got {exponent!r}")
+    out = W if saturation == 1.0 else np.minimum(W / saturation, 1.0)
+    if exponent != 1.0:
+        out = np.power(out, exponent)
+    elif out is W:
+        out = W.copy()
+    return out
+
+
+def velocity_map(
+    occupancy: Any,
+    *,
+    spacing: float | Sequence[float] = 1.0,
+    saturation: float = 1.0,
+    exponent: float = 1.0,
+    method: Method = "edt",
+    walls: bool = False,
+) -> np.ndarray:
+    """The FM² velocity map ``W`` in [0, 1] (0 on obstacles).
+
+    ``W = min(d / max(d) / saturation, 1) ** exponent`` where ``d`` is the
+    distance to the nearest obstacle (see :func:`distance_map`).
+
+    Parameters
+    ----------
+    occupancy : array_like of bool
+        True = obstacle.
+    spacing : float or sequence of float
+        Node spacing [m].
+    saturation : float
+        α in (0, 1]. Default 1 (no saturation).
+    exponent : float
+        β > 0. Default 1.
+    method : {"edt", "fmm"}
+        Distance computation, see :func:`distance_map`.
+    walls : bool
+        Treat the map border as an obstacle.
+
+    Returns
+    -------
+    ndarray of float64
+        W in [0, 1], same shape as ``occupancy``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> occ = np.zeros((5, 1), bool); occ[0, 0] = True
+    >>> velocity_map(occ)[:, 0].tolist()
+    [0.0, 0.25, 0.5, 0.75, 1.0]
+    """
+    dist = distance_map(occupancy, spacing=spacing, method=method, walls=walls)
+    return shape_velocity(normalise_distance(dist), saturation=saturation, exponent=exponent)
