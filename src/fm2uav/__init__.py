@@ -12,6 +12,7 @@ from .errors import (
     Fm2uavError,
     InputError,
     PlanningError,
+    PointError,
     UnreachableError,
     WorldError,
 )
@@ -33,6 +34,7 @@ __all__ = [
     "InputError",
     "WorldError",
     "PlanningError",
+    "PointError",
     "UnreachableError",
     "__version__",
 ]

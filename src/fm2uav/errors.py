@@ -12,6 +12,7 @@ __all__ = [
     "InputError",
     "WorldError",
     "PlanningError",
+    "PointError",
     "UnreachableError",
 ]
 
@@ -34,3 +35,7 @@ class PlanningError(Fm2uavError):
 
 class UnreachableError(PlanningError):
     """The goal cannot be reached from the start (no free connection between them)."""
+
+
+class PointError(PlanningError):
+    """A start, goal or waypoint lies outside the map or inside an obstacle (bad input)."""

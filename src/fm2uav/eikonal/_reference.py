@@ -12,14 +12,26 @@ The discretisation, in words
 Arrival times ``T`` [s] solve ``|grad T| = 1 / v`` on a node-centred grid
 (node ``i`` sits at ``i * h`` [m] along each axis, ``h`` may differ per axis).
 
+Speeds
+    A positive speed below ``MIN_SPEED = 1e-150`` [m/s] is raised to it, so
+    ``1 / v^2`` stays finite and such a node is merely very slow, not a wall.
+
 Sources
-    ``T = 0`` at every source node; source nodes are frozen. Then, for each
-    source whose bounding box of half-width ``R = 2 * max(h)`` [m] (clipped to
-    the grid, ``floor(R / h_axis)`` nodes per axis) holds no node of speed
-    ``<= 0``, every node at physical distance ``d <= R`` from it gets the
+    ``T = 0`` at every source node; source nodes are frozen. Then comes the
+    straight-ray *ball*, unless there are more than ``MAX_BALL_SOURCES = 64``
+    sources (then sources are plain ``T = 0`` nodes and nothing else is
+    initialised). The ball radius is
+    ``R = max(2 * max(h), 0.05 * extent)`` [m], where ``extent`` is the largest
+    physical size ``(n_axis - 1) * h_axis`` of the grid. A source is *clean* if
+    its bounding box (clipped to the grid, ``floor(R / h_axis)`` nodes either
+    side per axis) holds no node of speed ``<= 0``. Around every clean source,
+    every node at physical distance ``d <= R`` other than a source gets the
     straight-ray time ``d * 0.5 * (1/v_source + 1/v_node)`` if that is smaller
-    than its current value. These nodes join the narrow band; they are *not*
-    frozen, so the march may still lower them.
+    than its current value (so the minimum over sources wins). If *every*
+    source is clean, these ball nodes are frozen: their values are final. If
+    at least one source is not clean, the ball nodes only join the narrow band,
+    so the march may still lower them (e.g. via a nearer route past an
+    obstacle beside another source).
 
 Local update of a node ``x`` with speed ``v``
     For each axis take the frozen neighbour (``x - e`` or ``x + e``) with the
@@ -37,7 +49,8 @@ Local update of a node ``x`` with speed ``v``
 March
     Pop the band node with the smallest ``T``, freeze it, and update its
     non-frozen neighbours of positive speed. Before the march, every
-    non-frozen neighbour of a frozen node (the sources) is updated once.
+    non-frozen neighbour of a node frozen by the initialisation (the sources,
+    and the ball nodes when they are frozen) is updated once.
     With ``stop_at``, the march ends as soon as all stop nodes are frozen.
     Every node not frozen at the end is returned as ``inf``.
 """
@@ -54,9 +67,18 @@ import numpy as np
 
 __all__ = ["fast_marching_reference"]
 
-#: Radius of the straight-ray source initialisation, in multiples of the
-#: largest grid spacing (must match the compiled solver).
+# The constants of the source initialisation, written out again here rather
+# than imported, so that this stays an independent implementation; a test
+# checks that they equal those of fm2uav.eikonal.fmm.
+
+#: Ball radius: at least this many largest grid spacings ...
 SOURCE_RADIUS_CELLS = 2.0
+#: ... and at least this share of the grid's largest physical extent.
+SOURCE_RADIUS_FRACTION = 0.05
+#: With more sources than this, no ball: sources are plain T = 0 nodes.
+MAX_BALL_SOURCES = 64
+#: Positive speeds below this [m/s] are raised to it.
+MIN_SPEED = 1e-150
 
 Index = tuple[int, ...]
 
@@ -208,6 +230,7 @@ def fast_marching_reference(
         Arrival time [s]; ``inf`` where unreached.
     """
     speed = np.asarray(speed, dtype=np.float64)
+    speed = np.where((speed > 0.0) & (speed < MIN_SPEED), MIN_SPEED, speed)
     shape = speed.shape
     ndim = speed.ndim
     h = tuple(float(x) for x in np.broadcast_to(np.asarray(spacing, dtype=float), (ndim,)))
@@ -221,30 +244,43 @@ def fast_marching_reference(
     for s in source_nodes:
         T[s] = 0.0
         frozen[s] = True
+    is_source = set(source_nodes)
 
-    # ---- straight-ray ball around every source with an obstacle-free box
-    radius = SOURCE_RADIUS_CELLS * max(h)  # [m]
-    reach = [int(math.floor(radius / hx)) for hx in h]  # nodes per axis
-    for s in source_nodes:
-        ranges = [
-            range(max(s[ax] - reach[ax], 0), min(s[ax] + reach[ax], shape[ax] - 1) + 1)
-            for ax in range(ndim)
-        ]
-        box = list(itertools.product(*ranges))
-        if any(speed[node] <= 0.0 for node in box):
-            continue
-        v_source = float(speed[s])
-        for node in box:
-            d2 = 0.0
-            for ax in range(ndim):
-                dx = (node[ax] - s[ax]) * h[ax]
-                d2 += dx * dx
-            if d2 > radius * radius or frozen[node]:
+    # ---- straight-ray ball around every clean source
+    ball: dict[Index, float] = {}  # node -> smallest straight-ray time [s]
+    if len(source_nodes) <= MAX_BALL_SOURCES:  # counted with repeats, as given
+        extent = max((n - 1) * hx for n, hx in zip(shape, h))  # [m]
+        radius = max(SOURCE_RADIUS_CELLS * max(h), SOURCE_RADIUS_FRACTION * extent)  # [m]
+        reach = [int(math.floor(radius / hx)) for hx in h]  # nodes per axis
+        boxes = []
+        for s in source_nodes:
+            ranges = [
+                range(max(s[ax] - reach[ax], 0), min(s[ax] + reach[ax], shape[ax] - 1) + 1)
+                for ax in range(ndim)
+            ]
+            boxes.append(list(itertools.product(*ranges)))
+        clean = [all(speed[node] > 0.0 for node in box) for box in boxes]
+        for s, box, ok in zip(source_nodes, boxes, clean):
+            if not ok:
                 continue
-            t = math.sqrt(d2) * 0.5 * (1.0 / v_source + 1.0 / float(speed[node]))
-            if t < T[node]:
-                T[node] = t
-                heapq.heappush(band, (t, node))
+            v_source = float(speed[s])
+            for node in box:
+                d2 = 0.0
+                for ax in range(ndim):
+                    dx = (node[ax] - s[ax]) * h[ax]
+                    d2 += dx * dx
+                if d2 > radius * radius or node in is_source:
+                    continue
+                t = math.sqrt(d2) * 0.5 * (1.0 / v_source + 1.0 / float(speed[node]))
+                if t < ball.get(node, math.inf):
+                    ball[node] = t
+        freeze_ball = all(clean)
+        for node, t in ball.items():
+            T[node] = t
+            if freeze_ball:
+                frozen[node] = True  # final: never lowered
+            else:
+                heapq.heappush(band, (t, node))  # may still be lowered
 
     def relax(node: Index) -> None:
         """Recompute a non-frozen node and push it if its time decreased."""
@@ -253,8 +289,8 @@ def fast_marching_reference(
             T[node] = t
             heapq.heappush(band, (t, node))
 
-    # ---- every free neighbour of a frozen node joins the band
-    for node in source_nodes:
+    # ---- every free neighbour of a node frozen so far joins the band
+    for node in source_nodes + [node for node in ball if frozen[node]]:
         for nb in _neighbours(node, shape):
             if not frozen[nb] and speed[nb] > 0.0:
                 relax(nb)

@@ -19,7 +19,7 @@ from scipy import ndimage
 from ..analysis.clearance import clearance_profile
 from ..eikonal.fmm import fast_marching
 from ..eikonal.velocity import distance_map, normalise_distance, shape_velocity
-from ..errors import InputError, PlanningError, UnreachableError
+from ..errors import InputError, PointError, UnreachableError
 from ..world import World
 from .geodesic import descend, nearest_node
 
@@ -119,7 +119,7 @@ def _check_free(world: World, point: np.ndarray, what: str) -> tuple[int, ...]:
         if world.terrain is not None and world.ndim == 3:
             ground = float(world.terrain[cell[0], cell[1]])
             hint = f" (the ground there is at z = {ground:.1f} m; raise the {what} above it)"
-        raise PlanningError(
+        raise PointError(
             f"{what} {np.round(point, 3).tolist()} m is inside an obstacle (node {list(cell)})"
             f"{hint}; move the {what} to free space"
         )
@@ -228,7 +228,7 @@ def plan(
     t1 = time.perf_counter()
     if W[start_cell] <= 0 or W[goal_cell] <= 0:
         which = "start" if W[start_cell] <= 0 else "goal"
-        raise PlanningError(
+        raise PointError(
             f"the velocity map is 0 at the {which} node; move the {which} away from obstacles"
         )
     T = fast_marching(W, [goal_cell], spacing=world.spacing, order=order, stop_at=[start_cell])

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError, PlanningError, WorldError
+from ..errors import InputError, PointError, WorldError
 
 __all__ = ["World"]
 
@@ -246,7 +246,7 @@ class World:
         inside = np.atleast_1d(self.contains(flat))
         if not np.all(inside):
             bad = flat[~inside][0]
-            raise PlanningError(
+            raise PointError(
                 f"{what} {_fmt_point(bad)} m lies outside the map, whose bounds are "
                 f"{_fmt_bounds(self.bounds)} m; move the {what} inside these bounds "
                 "or build a larger world"

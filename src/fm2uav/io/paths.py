@@ -1,0 +1,76 @@
+"""Path files as CSV: one point a row, columns ``x_m,y_m[,z_m][,speed]``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import IO
+
+import numpy as np
+
+from ..errors import InputError
+
+__all__ = ["write_path_csv", "read_path_csv"]
+
+_AXES = ("x_m", "y_m", "z_m")
+
+
+def write_path_csv(fh: IO[str], path: np.ndarray, speed: np.ndarray | None = None) -> None:
+    """Write a path [m] (and optionally W along it) as CSV to an open text file."""
+    path = np.asarray(path, dtype=float)
+    cols = list(_AXES[: path.shape[1]])
+    data = path
+    if speed is not None:
+        cols.append("speed")
+        data = np.column_stack([path, speed])
+    fh.write(",".join(cols) + "\n")
+    np.savetxt(fh, data, delimiter=",", fmt="%.6f")
+
+
+def read_path_csv(file: str | Path) -> np.ndarray:
+    """Read a path written by :func:`write_path_csv` (or any CSV with x,y[,z] columns).
+
+    A header row is recognised when its first field is not a number; columns
+    named ``x``/``x_m``, ``y``/``y_m``, ``z``/``z_m`` are used if present,
+    otherwise the first 2 or 3 columns.
+
+    Raises
+    ------
+    InputError
+        Missing file, fewer than 2 points, non-numeric or non-finite values.
+    """
+    file = Path(file)
+    if not file.exists():
+        raise InputError(f"path file {file} does not exist")
+    lines = [ln.strip() for ln in file.read_text().splitlines() if ln.strip()]
+    if not lines:
+        raise InputError(f"path file {file} is empty")
+    header = [c.strip().lower() for c in lines[0].split(",")]
+    try:
+        float(header[0])
+        names = None
+        rows = lines
+    except ValueError:
+        names = header
+        rows = lines[1:]
+    try:
+        data = np.array([[float(v) for v in r.split(",")] for r in rows], dtype=float)
+    except ValueError as exc:
+        raise InputError(f"path file {file} has a non-numeric value: {exc}") from None
+    if data.ndim != 2 or len(data) < 2:
+        raise InputError(f"path file {file} needs at least 2 points, got {len(data)}")
+    if names is not None:
+        idx = []
+        for ax in ("x", "y", "z"):
+            for cand in (ax, f"{ax}_m"):
+                if cand in names:
+                    idx.append(names.index(cand))
+                    break
+        if len(idx) < 2:
+            idx = list(range(min(3, data.shape[1])))
+    else:
+        idx = list(range(min(3, data.shape[1])))
+    pts = data[:, idx]
+    if not np.all(np.isfinite(pts)):
+        r = int(np.argwhere(~np.isfinite(pts))[0, 0])
+        raise InputError(f"path file {file} has a non-finite coordinate in point {r}")
+    return pts
