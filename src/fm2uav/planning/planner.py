@@ -21,6 +21,7 @@ from ..eikonal.fmm import fast_marching
 from ..eikonal.velocity import distance_map, normalise_distance, shape_velocity
 from ..errors import InputError, PointError, UnreachableError
 from ..world import World
+from .flight_level import flight_level_speed
 from .geodesic import descend, nearest_node
 
 __all__ = ["Plan", "plan", "base_velocity"]
@@ -150,6 +151,11 @@ def plan(
     order: int = 2,
     method: str = "edt",
     walls: bool = False,
+    agl: float | None = None,
+    p1: float = 0.5,
+    p2: float = 1.5,
+    agl_band: float = 0.0,
+    agl_graded: bool = False,
     speed_map: np.ndarray | None = None,
     step: float = 0.5,
 ) -> Plan:
@@ -173,6 +179,17 @@ def plan(
         the seeds. Default "edt".
     walls : bool, optional
         Treat the map border as an obstacle. Default False.
+    agl : float, optional
+        Impose a flight level this many metres above the ground (thesis
+        Algorithm 2, see :mod:`fm2uav.planning.flight_level`). Default None.
+    p1, p2 : float, optional
+        Exponents on the flight-level cells and on all other cells (used with
+        ``agl``). Defaults 0.5 and 1.5.
+    agl_band : float, optional
+        Half-width [m] of the clarified band around the level. Default 0 (the
+        seeds' single layer).
+    agl_graded : bool, optional
+        Blend the exponent from p1 to p2 across the band. Default False.
     speed_map : ndarray, optional
         Use this velocity map instead of computing one (0 = impassable);
         saturation/exponent/method/walls are then ignored. This is the hook for
@@ -218,6 +235,10 @@ def plan(
             exponent=exponent,
         )
         W[world.occupancy] = 0.0
+        if agl is not None:
+            W = flight_level_speed(
+                W, world, agl, p1, p2, band=agl_band, graded=agl_graded
+            )
     else:
         W = np.asarray(speed_map, dtype=float)
         if W.shape != world.shape:
@@ -269,6 +290,9 @@ def plan(
         "walls": bool(walls),
         "custom_speed_map": speed_map is not None,
     }
+    if agl is not None and speed_map is None:
+        params.update(agl=float(agl), p1=float(p1), p2=float(p2),
+                      agl_band=float(agl_band), agl_graded=bool(agl_graded))
     return Plan(
         path=path,
         speed=speed,
