@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 FAR = np.uint8(0)
 BAND = np.uint8(1)
@@ -379,3 +379,97 @@ def init_sources(speed, T, state, nx, ny, nz, hx, hy, hz, src, radius):
                     if t < T[c]:
                         T[c] = t
                         state[c] = ball_state
+
+
+# ------------------------------------------------------- exact distance transform
+@njit(cache=True, error_model="numpy", inline="always")
+def _edt_line(f, n, w2, v, z, out):
+    """1D squared distance transform (Felzenszwalb & Huttenlocher 2012).
+
+    ``out[q] = min_p (w2 * (q - p)^2 + f[p])`` over the finite ``f[p]``: the
+    lower envelope of the parabolas rooted at the finite samples. ``w2`` is the
+    squared spacing of the axis; ``v`` (int) and ``z`` (float) are scratch of
+    length ``n`` and ``n + 1``.
+    """
+    k = -1
+    for q in range(n):
+        fq = f[q]
+        if fq == np.inf:
+            continue
+        if k < 0:
+            k = 0
+            v[0] = q
+            z[0] = -np.inf
+            z[1] = np.inf
+            continue
+        while True:
+            p = v[k]
+            s = ((fq + w2 * q * q) - (f[p] + w2 * p * p)) / (2.0 * w2 * (q - p))
+            if s <= z[k] and k > 0:
+                k -= 1
+            else:
+                break
+        if s <= z[k]:  # k == 0 and the new parabola hides the first one everywhere
+            v[0] = q
+            z[0] = -np.inf
+            z[1] = np.inf
+            continue
+        k += 1
+        v[k] = q
+        z[k] = s
+        z[k + 1] = np.inf
+    if k < 0:
+        for q in range(n):
+            out[q] = np.inf
+        return
+    k = 0
+    for q in range(n):
+        while z[k + 1] < q:
+            k += 1
+        d = q - v[k]
+        out[q] = w2 * d * d + f[v[k]]
+
+
+@njit(cache=True, error_model="numpy", parallel=True)
+def squared_edt(occ, hx, hy, hz):
+    """Exact squared Euclidean distance [m²] from every node to the nearest True node.
+
+    Separable: one 1D transform per axis (z, then y, then x), lines in parallel.
+    ``occ`` is a C-contiguous bool array of shape (nx, ny, nz); returns float64
+    of the same shape (``inf`` everywhere if ``occ`` has no True node).
+    """
+    nx, ny, nz = occ.shape
+    d = np.empty((nx, ny, nz), dtype=np.float64)
+    wz, wy, wx = hz * hz, hy * hy, hx * hx
+    nmax = max(nx, max(ny, nz))
+    for i in prange(nx):
+        f = np.empty(nmax)
+        out = np.empty(nmax)
+        v = np.empty(nmax, dtype=np.int64)
+        z = np.empty(nmax + 1)
+        for j in range(ny):
+            for k in range(nz):
+                f[k] = 0.0 if occ[i, j, k] else np.inf
+            _edt_line(f, nz, wz, v, z, out)
+            for k in range(nz):
+                d[i, j, k] = out[k]
+        if ny > 1:
+            for k in range(nz):
+                for j in range(ny):
+                    f[j] = d[i, j, k]
+                _edt_line(f, ny, wy, v, z, out)
+                for j in range(ny):
+                    d[i, j, k] = out[j]
+    if nx > 1:
+        for j in prange(ny):
+            f = np.empty(nmax)
+            out = np.empty(nmax)
+            v = np.empty(nmax, dtype=np.int64)
+            z = np.empty(nmax + 1)
+            for k in range(nz):
+                for i in range(nx):
+                    f[i] = d[i, j, k]
+                _edt_line(f, nx, wx, v, z, out)
+                for i in range(nx):
+                    d[i, j, k] = out[i]
+    return d

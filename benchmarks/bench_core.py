@@ -1,0 +1,203 @@
+"""Core benchmarks: our FMM vs scikit-fmm, FM² plans, JIT compile time.
+
+Every case runs in a fresh child process so that its peak memory (``ru_maxrss``
+minus the process' resident size before the case) is measured for our code and
+for scikit-fmm's C++ alike. Times are medians over repeats after a warm-up.
+
+Bars (issue "Foundation"): FMM ≥ 2× faster than scikit-fmm at the same order
+on 2048² and 256³ (goal ≥ 4×); FM² plan on the open field ≤ 0.1 s after
+warm-up (goal ≤ 0.05 s); 1000×1000×40 terrain plan ≤ 15 s and ≤ 2.5 GB peak.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import textwrap
+
+CHILD_PRELUDE = textwrap.dedent(
+    """
+    import json, resource, statistics, sys, time
+    import numpy as np
+
+    def rss_mb():
+        with open("/proc/self/statm") as fh:
+            return int(fh.read().split()[1]) * resource.getpagesize() / 2**20
+
+    def peak_mb():
+        return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+    def median_time(fn, repeats):
+        times = []
+        for _ in range(repeats):
+            t = time.perf_counter(); fn(); times.append(time.perf_counter() - t)
+        return statistics.median(times)
+
+    def speed_field(shape):
+        # smooth, strictly positive speed field, the same for both solvers
+        axes = np.meshgrid(*[np.linspace(0, 1, n) for n in shape], indexing="ij")
+        v = np.ones(shape)
+        for a in axes:
+            v += 0.4 * np.sin(3.0 * a)
+        return v
+    """
+)
+
+
+def _child(code: str, env: dict | None = None, timeout: float = 1800) -> dict:
+    """Run ``code`` (after the prelude) in a fresh interpreter; it prints one JSON line."""
+    full = CHILD_PRELUDE + textwrap.dedent(code)
+    res = subprocess.run(
+        [sys.executable, "-c", full],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        env={**os.environ, **(env or {})},
+    )
+    if res.returncode != 0:
+        raise RuntimeError(f"benchmark child failed:\n{res.stderr[-3000:]}")
+    return json.loads(res.stdout.strip().splitlines()[-1])
+
+
+def _ours_fmm(shape: tuple[int, ...], order: int, repeats: int) -> dict:
+    return _child(
+        f"""
+        from fm2uav import fast_marching
+        shape = {shape!r}; v = speed_field(shape); src = [tuple(n // 2 for n in shape)]
+        fast_marching(v[tuple(slice(0, 8) for _ in shape)], [tuple(4 for _ in shape)], order={order})
+        base = rss_mb()
+        t = median_time(lambda: fast_marching(v, src, order={order}), {repeats})
+        print(json.dumps({{"s": t, "peak_mb": peak_mb() - base}}))
+        """
+    )
+
+
+def _skfmm(shape: tuple[int, ...], order: int, repeats: int) -> dict:
+    return _child(
+        f"""
+        import skfmm
+        shape = {shape!r}; v = speed_field(shape)
+        # point source: the zero contour of phi is a circle of half a cell around the centre
+        axes = np.meshgrid(*[np.arange(n) - n // 2 for n in shape], indexing="ij")
+        phi = np.sqrt(sum(a.astype(float) ** 2 for a in axes)) - 0.5
+        small = np.ones(tuple(9 for _ in shape)); small[tuple(4 for _ in shape)] = -1
+        skfmm.travel_time(small, np.ones_like(small), order={order})  # warm-up
+        base = rss_mb()
+        t = median_time(lambda: skfmm.travel_time(phi, v, order={order}), {repeats})
+        print(json.dumps({{"s": t, "peak_mb": peak_mb() - base}}))
+        """
+    )
+
+
+def fmm_rows(quick: bool) -> list[dict]:
+    cases = [((256, 256), 3), ((32, 32, 32), 3)] if quick else [((2048, 2048), 5), ((256, 256, 256), 1)]
+    rows = []
+    for shape, repeats in cases:
+        for order in (1, 2):
+            ours = _ours_fmm(shape, order, repeats)
+            peer = _skfmm(shape, order, repeats)
+            rows.append(
+                {
+                    "benchmark": "fmm",
+                    "case": f"{'x'.join(map(str, shape))} order {order}",
+                    "ours_s": ours["s"],
+                    "peer": "scikit-fmm",
+                    "peer_s": peer["s"],
+                    "ratio": peer["s"] / ours["s"],
+                    "peak_mb": ours["peak_mb"],
+                    "peer_peak_mb": peer["peak_mb"],
+                    "bar": ">= 2x (goal 4x)",
+                    "notes": f"peer peak {peer['peak_mb']:.0f} MB",
+                }
+            )
+    return rows
+
+
+def plan_rows(quick: bool) -> list[dict]:
+    rows = []
+    r = _child(
+        f"""
+        import fm2uav
+        sc = fm2uav.scenarios.open_field()
+        fm2uav.plan(sc.world, sc.start, sc.goal)            # JIT warm-up (+ cache fill)
+        warm = median_time(lambda: fm2uav.plan(sc.world, sc.start, sc.goal), {3 if quick else 11})
+        def cold():
+            sc.world._cache.clear()
+            fm2uav.plan(sc.world, sc.start, sc.goal)
+        cold_t = median_time(cold, {3 if quick else 7})
+        p = fm2uav.plan(sc.world, sc.start, sc.goal)
+        print(json.dumps({{"warm": warm, "cold": cold_t, "timings": p.timings,
+                          "peak_mb": peak_mb()}}))
+        """
+    )
+    stages = ", ".join(f"{k} {v * 1e3:.1f} ms" for k, v in r["timings"].items() if k != "total")
+    rows.append({"benchmark": "plan", "case": "open field 120x90x40, cached distance map",
+                 "ours_s": r["warm"], "bar": "<= 0.1 s (goal 0.05 s)", "notes": stages})
+    rows.append({"benchmark": "plan", "case": "open field 120x90x40, distance map recomputed",
+                 "ours_s": r["cold"], "bar": "<= 0.1 s (goal 0.05 s)"})
+    n = 200 if quick else 1000
+    r = _child(
+        f"""
+        import fm2uav
+        from scipy import ndimage
+        rng = np.random.default_rng(0)
+        n, nz, cell = {n}, 40, 15.0
+        relief = ndimage.gaussian_filter(rng.standard_normal((n, n)), 25, mode="wrap")
+        heights = (relief - relief.min()) / np.ptp(relief) * 25 * cell + cell
+        base = rss_mb()
+        t0 = time.perf_counter()
+        world = fm2uav.World.from_heightmap(heights, cell, nz)
+        t_world = time.perf_counter() - t0
+        start = np.array([10 * cell, 10 * cell, 35 * cell])
+        goal = np.array([(n - 10) * cell, (n - 10) * cell, 35 * cell])
+        warm = fm2uav.World.from_heightmap(heights[:40, :40], cell, nz)
+        fm2uav.plan(warm, [5 * cell, 5 * cell, 35 * cell], [30 * cell, 30 * cell, 35 * cell])
+        t0 = time.perf_counter()
+        p = fm2uav.plan(world, start, goal)
+        t_plan = time.perf_counter() - t0
+        print(json.dumps({{"plan": t_plan, "world": t_world, "timings": p.timings,
+                          "peak_mb": peak_mb() - base, "length": p.length}}))
+        """
+    )
+    stages = ", ".join(f"{k} {v:.2f} s" for k, v in r["timings"].items() if k != "total")
+    rows.append({"benchmark": "plan", "case": f"terrain {n}x{n}x40 (15 m cells)",
+                 "ours_s": r["plan"], "peak_mb": r["peak_mb"], "bar": "<= 15 s, <= 2.5 GB",
+                 "notes": f"{stages}; world build {r['world']:.2f} s"})
+    return rows
+
+
+def jit_rows(quick: bool) -> list[dict]:
+    """Compile time with an empty numba cache, then load time from the cache."""
+    cache = tempfile.mkdtemp(prefix="fm2uav-numba-")
+    code = """
+        t = time.perf_counter()
+        import fm2uav
+        sc = fm2uav.scenarios.open_field()
+        fm2uav.plan(sc.world, sc.start, sc.goal)
+        fm2uav.fast_marching(np.ones((5, 5)), [(2, 2)], order=1)
+        print(json.dumps({"s": time.perf_counter() - t}))
+        """
+    env = {"NUMBA_CACHE_DIR": cache}
+    cold = _child(code, env)
+    warm = _child(code, env)
+    return [
+        {"benchmark": "jit", "case": "import + first plan, empty numba cache", "ours_s": cold["s"],
+         "notes": "one-off compile of the kernels"},
+        {"benchmark": "jit", "case": "import + first plan, numba cache filled", "ours_s": warm["s"],
+         "notes": "every later process"},
+    ]
+
+
+def run(quick: bool = False) -> list[dict]:
+    """All core benchmark rows (see module docstring)."""
+    # the cold-compile measurement takes ~20 s whatever the size: full runs only
+    return fmm_rows(quick) + plan_rows(quick) + ([] if quick else jit_rows(quick))
+
+
+if __name__ == "__main__":
+    import pprint
+
+    pprint.pprint(run(quick="--quick" in sys.argv))
