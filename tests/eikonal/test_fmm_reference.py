@@ -15,10 +15,21 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import ndimage
 
-from fm2uav.eikonal import fast_marching
+from fm2uav.eikonal import fast_marching, fmm
+from fm2uav.eikonal import _reference as reference
 from fm2uav.eikonal._reference import fast_marching_reference
 
 RTOL = 1e-9
+
+
+def test_reference_constants_match_the_compiled_solver():
+    # The reference repeats the constants (it is a second implementation, not a
+    # wrapper); if one side changes, the comparison tests below would fail in
+    # obscure ways, so check them directly.
+    assert reference.SOURCE_RADIUS_CELLS == fmm.SOURCE_INIT_CELLS == 2.0
+    assert reference.SOURCE_RADIUS_FRACTION == fmm.SOURCE_INIT_FRACTION == 0.05
+    assert reference.MAX_BALL_SOURCES == fmm.MAX_BALL_SOURCES == 64
+    assert reference.MIN_SPEED == fmm.MIN_SPEED == 1e-150
 
 
 def _random_case(rng: np.random.Generator, ndim: int):
@@ -60,6 +71,59 @@ def test_compiled_matches_reference_with_stop_at(seed, ndim, order):
     spacing = tuple(rng.uniform(0.2, 3.0, size=ndim))
     T = fast_marching(speed, sources, spacing=spacing, order=order, stop_at=stops)
     R = fast_marching_reference(speed, sources, spacing=spacing, order=order, stop_at=stops)
+    assert_same_field(T, R, RTOL)
+
+
+def _initially_frozen(speed, sources, spacing) -> np.ndarray:
+    """Nodes frozen before the march (sources, and the ball when frozen): stopping
+    at a source marches nothing, so exactly these come back finite."""
+    return np.isfinite(fast_marching(speed, sources, spacing=spacing, stop_at=sources[:1]))
+
+
+def _mode_case(rng: np.random.Generator, ndim: int, mode: str):
+    """Random speeds [m/s] and sources that put the ball in the given mode.
+
+    ``frozen``: no speed-0 node, 1-3 sources (every source clean). ``band``: 2-3
+    sources, the first with a speed-0 node right beside it (not clean), plus ~5%
+    speed-0 nodes. ``none``: 65-80 sources (> MAX_BALL_SOURCES), ~10% speed 0.
+    """
+    lo, hi = (10, 15) if ndim == 2 else (5, 8)
+    shape = tuple(int(n) for n in rng.integers(lo, hi, size=ndim))
+    speed = rng.uniform(0.1, 5.0, size=shape)
+    if mode != "frozen":
+        speed[rng.random(shape) < (0.05 if mode == "band" else 0.1)] = 0.0
+    k = {"frozen": int(rng.integers(1, 4)), "band": int(rng.integers(2, 4))}.get(
+        mode, int(rng.integers(65, 81))
+    )
+    free = np.argwhere(speed > 0)
+    sources = free[rng.choice(len(free), size=k, replace=False)]
+    if mode == "band":
+        first = sources[0].copy()
+        axis = int(rng.integers(ndim))
+        first[axis] += 1 if first[axis] + 1 < shape[axis] else -1
+        speed[tuple(first)] = 0.0
+        sources = np.array([s for s in sources if speed[tuple(s)] > 0])
+    return speed, sources
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("ndim", [2, 3])
+@pytest.mark.parametrize("order", [1, 2])
+@pytest.mark.parametrize("mode", ["frozen", "band", "none"])
+def test_compiled_matches_reference_in_each_ball_mode(mode, order, ndim, seed):
+    rng = np.random.default_rng([seed, ndim, order, ["frozen", "band", "none"].index(mode)])
+    speed, sources = _mode_case(rng, ndim, mode)
+    spacing = tuple(rng.uniform(0.2, 3.0, size=ndim))
+    # the case really is in that mode: a frozen ball shows as extra frozen nodes
+    n_init = int(_initially_frozen(speed, sources, spacing).sum())
+    n_src = len({tuple(s) for s in sources})
+    assert (n_init > n_src) if mode == "frozen" else (n_init == n_src)
+    stop_at = None
+    if seed % 2:
+        free = np.argwhere(speed > 0)
+        stop_at = free[rng.choice(len(free), size=2, replace=False)]
+    T = fast_marching(speed, sources, spacing=spacing, order=order, stop_at=stop_at)
+    R = fast_marching_reference(speed, sources, spacing=spacing, order=order, stop_at=stop_at)
     assert_same_field(T, R, RTOL)
 
 
@@ -126,9 +190,10 @@ def test_times_bounded_below_by_fastest_straight_ray(case):
     # No path is shorter than the straight line, none faster than max(speed):
     # T >= d / v_max. The first-order scheme respects this exactly (it only
     # overestimates a point-source field); the second-order extrapolation
-    # (4 T1 - T2) / 3 can undershoot, by up to 0.29 h on the diagonal of a
-    # constant-speed field (measured on grids up to 641^2) and 0.14 h_max in
-    # 3000 random small grids, so order 2 gets a slack of 0.5 h_max / v_max.
+    # (4 T1 - T2) / 3 can undershoot: on a constant-speed field by 0.29 h at
+    # 41^2 (ball R = 2 h), shrinking with n now that the ball has a fixed physical
+    # size (0.065 h at 161^2, 0.015 h at 641^2), and by up to 0.24 h_max in 3000
+    # random small grids like these, so order 2 gets a slack of 0.5 h_max / v_max.
     speed, source, spacing, order = case
     T = fast_marching(speed, [source], spacing=spacing, order=order)
     d = distance_from(speed.shape, spacing, source)  # [m]
@@ -170,12 +235,22 @@ def test_compiled_matches_reference_hypothesis(case, extra):
         return
     # With stop_at, nodes whose time ties exactly with the stop node's may be frozen
     # or not depending on how each heap breaks the tie (constant speed, order 1).
-    # Everything strictly earlier must be frozen in both, strictly later in neither.
-    full = fast_marching_reference(speed, sources, spacing=spacing, order=order)
-    t_stop = full[stop_at[0]]
+    # Nodes frozen before the march (sources, a frozen ball) are always returned.
+    # If the stop node is one of them, nothing is marched: exactly those come back
+    # (even nodes earlier than the stop node stay inf: ball times are not in
+    # march order). Otherwise everything strictly earlier than the stop node must
+    # be frozen in both, and nothing strictly later except the initial nodes.
+    init = _initially_frozen(speed, np.array(sources), spacing)
     both = np.isfinite(T) & np.isfinite(R)
     np.testing.assert_allclose(T[both], R[both], rtol=RTOL, atol=0.0)
+    if init[stop_at[0]]:
+        np.testing.assert_array_equal(np.isfinite(T), init)
+        np.testing.assert_array_equal(np.isfinite(R), init)
+        return
+    full = fast_marching_reference(speed, sources, spacing=spacing, order=order)
+    t_stop = full[stop_at[0]]
     for field in (T, R):
+        assert np.all(np.isfinite(field[init]))
         assert np.all(np.isfinite(field[full < t_stop]))
-        assert np.all(np.isinf(field[full > t_stop]))
+        assert np.all(np.isinf(field[(full > t_stop) & ~init]))
         assert np.isfinite(field[stop_at[0]]) or np.isinf(t_stop)

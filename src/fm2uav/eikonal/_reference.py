@@ -19,15 +19,16 @@ Speeds
 Sources
     ``T = 0`` at every source node; source nodes are frozen. Then comes the
     straight-ray *ball*, unless there are more than ``MAX_BALL_SOURCES = 64``
-    sources (then sources are plain ``T = 0`` nodes and nothing else is
-    initialised). The ball radius is
+    sources, counted as given (repeats included); then sources are plain
+    ``T = 0`` nodes and nothing else is initialised. The ball radius is
     ``R = max(2 * max(h), 0.05 * extent)`` [m], where ``extent`` is the largest
     physical size ``(n_axis - 1) * h_axis`` of the grid. A source is *clean* if
     its bounding box (clipped to the grid, ``floor(R / h_axis)`` nodes either
     side per axis) holds no node of speed ``<= 0``. Around every clean source,
     every node at physical distance ``d <= R`` other than a source gets the
     straight-ray time ``d * 0.5 * (1/v_source + 1/v_node)`` if that is smaller
-    than its current value (so the minimum over sources wins). If *every*
+    than its current value (so the minimum over sources wins); only the speeds
+    at the two ends enter, not those in between. If *every*
     source is clean, these ball nodes are frozen: their values are final. If
     at least one source is not clean, the ball nodes only join the narrow band,
     so the march may still lower them (e.g. via a nearer route past an
@@ -51,8 +52,9 @@ March
     non-frozen neighbours of positive speed. Before the march, every
     non-frozen neighbour of a node frozen by the initialisation (the sources,
     and the ball nodes when they are frozen) is updated once.
-    With ``stop_at``, the march ends as soon as all stop nodes are frozen.
-    Every node not frozen at the end is returned as ``inf``.
+    With ``stop_at``, the march ends as soon as all stop nodes are frozen; if
+    they all are frozen by the initialisation (sources, frozen ball), nothing
+    is marched. Every node not frozen at the end is returned as ``inf``.
 """
 
 from __future__ import annotations
