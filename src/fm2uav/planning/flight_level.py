@@ -2,11 +2,29 @@
 
 For every column (i, j) the terrain top layer ``Surface(i, j)`` is found; the
 cells of layer ``k = Surface(i, j) + Lf`` (``Lf = round(agl / dz)`` cells) are
-clarified ``W ** p1`` and all other cells darkened ``W ** p2``. With
-``0 < p1 < 1 < p2`` the wave from the goal runs fastest along the flight level,
+clarified with the exponent ``p1`` and all other cells darkened with ``p2``.
+With ``0 < p1 < p2`` the wave from the goal runs fastest along the flight level,
 so the FM² path follows the terrain at ``agl`` metres.
 
-Beyond the seeds (defaults keep the seeds' behaviour): ``band`` widens the
+Two readings of "the velocity map W" (``mode``):
+
+``"capped"`` (default)
+    Before the exponents, every cell of a column is capped at the value of W at
+    that column's flight-level node: ``V = min(W, W_fl)``; then ``V ** p1`` on
+    the level, ``V ** p2`` elsewhere. This makes the level the brightest cell of
+    its column, which is what the seeds state and need ("the value of the cells
+    where we want to force the planning must be close to 1"; "p2 darkens the
+    upper layers") and what their figures show.
+
+``"literal"``
+    ``W ** p1`` on the level and ``W ** p2`` elsewhere with W the normalised
+    distance map, word for word. Over an open field W grows with height up to
+    ≈ 1 near the ceiling, and ``1 ** p2 = 1`` beats ``W_fl ** p1`` for any p2:
+    the path climbs to the ceiling instead of following the terrain (0 % of the
+    points within ±1 cell of the level on the open field, see docs/tff.md). It
+    is kept for comparison.
+
+Beyond the seeds (defaults keep the single layer): ``band`` widens the
 clarified layer to all cells within ``band`` metres of the flight level, since
 a one-cell layer is brittle on steep terrain; ``graded=True`` blends the
 exponent from ``p1`` at the level to ``p2`` at the band edge.
@@ -19,7 +37,16 @@ import numpy as np
 from ..errors import InputError, PlanningError
 from ..world import World
 
-__all__ = ["flight_layer", "flight_level_speed", "exponents_from_k"]
+__all__ = [
+    "flight_layer",
+    "flight_level_speed",
+    "exponents_from_k",
+    "level_cells",
+    "FLIGHT_LEVEL_MODES",
+]
+
+#: Accepted values of ``mode`` in :func:`flight_level_speed`.
+FLIGHT_LEVEL_MODES = ("capped", "literal")
 
 
 def exponents_from_k(k: float) -> tuple[float, float]:
@@ -35,6 +62,32 @@ def exponents_from_k(k: float) -> tuple[float, float]:
     return float(k), float(1.0 - k)
 
 
+def level_cells(world: World, agl: float) -> int:
+    """``Lf = round(agl / dz)``: the flight level in vertical cells (>= 1).
+
+    Raises
+    ------
+    InputError
+        2D world, ``agl`` not finite, <= 0, or less than half a vertical cell.
+    """
+    if world.ndim != 3:
+        raise InputError("a flight level needs a 3D world (nx, ny, nz)")
+    try:
+        agl_f = float(agl)
+    except (TypeError, ValueError):
+        raise InputError(f"agl must be a height in metres, got {agl!r}") from None
+    if not np.isfinite(agl_f) or agl_f <= 0:
+        raise InputError(f"agl must be a positive height in metres, got {agl!r}")
+    dz = world.spacing[2]
+    lf = int(round(agl_f / dz))
+    if lf < 1:
+        raise InputError(
+            f"agl = {agl_f:g} m is less than half a vertical cell ({dz:g} m); "
+            f"use agl >= {dz / 2:g} m or a finer vertical spacing"
+        )
+    return lf
+
+
 def flight_layer(world: World, agl: float) -> np.ndarray:
     """Index of the flight-level layer in every column [cells].
 
@@ -45,34 +98,40 @@ def flight_layer(world: World, agl: float) -> np.ndarray:
     Raises
     ------
     InputError
-        2D world, ``agl`` not finite or < one cell.
+        2D world, ``agl`` not finite or < half a cell.
     PlanningError
         The flight level leaves the map (above the ceiling) in some column.
     """
-    if world.ndim != 3:
-        raise InputError("a flight level needs a 3D world (nx, ny, nz)")
-    if not np.isfinite(agl) or agl <= 0:
-        raise InputError(f"agl must be a positive height in metres, got {agl!r}")
+    lf = level_cells(world, agl)
     dz = world.spacing[2]
-    lf = int(round(agl / dz))
-    if lf < 1:
-        raise InputError(
-            f"agl = {agl:g} m is less than half a vertical cell ({dz:g} m); "
-            f"use agl >= {dz / 2:g} m or a finer vertical spacing"
-        )
     layer = world.surface_index().astype(np.int64) + lf
     nz = world.shape[2]
     over = layer >= nz
     if over.any():
         worst = np.unravel_index(int(np.argmax(layer)), layer.shape)
         top_m = world.origin[2] + (nz - 1) * dz
+        need = int(layer.max()) + 1
         raise PlanningError(
-            f"the flight level agl = {agl:g} m leaves the map in {int(over.sum())} column(s), "
-            f"e.g. column {[int(v) for v in worst]} needs layer {int(layer[worst])} but the "
-            f"ceiling is layer {nz - 1} (z = {top_m:g} m); lower agl or build the world with "
-            f"more height cells"
+            f"the flight level agl = {float(agl):g} m leaves the map in {int(over.sum())} "
+            f"column(s), e.g. column {[int(v) for v in worst]} needs layer {int(layer[worst])} "
+            f"but the ceiling is layer {nz - 1} (z = {top_m:g} m); lower agl to at most "
+            f"{(nz - 1 - int(world.surface_index().max())) * dz:g} m or build the world with "
+            f"at least {need} height cells"
         )
     return layer
+
+
+def _check_exponent(name: str, p: float) -> float:
+    try:
+        p = float(p)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a number > 0, got {p!r}") from None
+    if not (np.isfinite(p) and p > 0):
+        raise InputError(
+            f"{name} must be a finite exponent > 0, got {p!r} (p1 < 1 clarifies the level, "
+            "p2 > p1 darkens the rest, e.g. p1=0.5, p2=1.3)"
+        )
+    return p
 
 
 def flight_level_speed(
@@ -81,9 +140,10 @@ def flight_level_speed(
     agl: float,
     p1: float,
     p2: float,
-    *,
     band: float = 0.0,
     graded: bool = False,
+    *,
+    mode: str = "capped",
 ) -> np.ndarray:
     """Impose a flight level on a velocity map (thesis Algorithm 2).
 
@@ -98,24 +158,54 @@ def flight_level_speed(
     p1 : float
         Exponent on the flight-level cells, > 0 (< 1 clarifies).
     p2 : float
-        Exponent on all other cells, > 0 (> 1 darkens).
+        Exponent on all other cells, > 0 (> p1 darkens them relative to the
+        level).
     band : float, optional
         Half-width [m] of the clarified band around the level; 0 (default) is
         the seeds' single layer.
     graded : bool, optional
         Within the band, blend the exponent linearly from ``p1`` at the level
         to ``p2`` at the band edge. Default False (all band cells get ``p1``).
+    mode : {"capped", "literal"}, optional
+        ``"capped"`` (default): cap every cell of a column at W of its
+        flight-level node before the exponents, so the level is the brightest
+        cell of its column. ``"literal"``: exponents on W as is (does not
+        follow the terrain on open maps; see the module docstring).
 
     Returns
     -------
     ndarray
-        The shaped map (new array), still 0 on obstacles.
+        The shaped map (new array), still 0 where ``W`` is 0.
+
+    Raises
+    ------
+    InputError
+        p1/p2 <= 0 or not finite, band < 0, unknown mode, shape mismatch.
+    PlanningError
+        The flight level leaves the map.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from fm2uav import World
+    >>> w = World.from_heightmap(np.zeros((3, 3)), 1.0, 6)   # ground at layer 0
+    >>> W = np.linspace(0, 1, 6)[None, None, :].repeat(3, 0).repeat(3, 1)
+    >>> V = flight_level_speed(W, w, agl=2.0, p1=0.5, p2=2.0)
+    >>> int(np.argmax(V[1, 1]))          # the level (layer 0 + 2) is the fastest
+    2
     """
-    for name, p in (("p1", p1), ("p2", p2)):
-        if not (np.isfinite(p) and p > 0):
-            raise InputError(f"{name} must be a finite exponent > 0, got {p!r}")
+    p1 = _check_exponent("p1", p1)
+    p2 = _check_exponent("p2", p2)
+    try:
+        band = float(band)
+    except (TypeError, ValueError):
+        raise InputError(f"band must be a half-width in metres >= 0, got {band!r}") from None
     if not (np.isfinite(band) and band >= 0):
         raise InputError(f"band must be >= 0 metres, got {band!r}")
+    if mode not in FLIGHT_LEVEL_MODES:
+        raise InputError(
+            f"flight-level mode must be one of {FLIGHT_LEVEL_MODES}, got {mode!r}"
+        )
     W = np.asarray(W, dtype=float)
     if W.shape != world.shape:
         raise InputError(f"W has shape {W.shape} but the world is {world.shape}")
@@ -123,14 +213,22 @@ def flight_level_speed(
     dz = world.spacing[2]
     k = np.arange(world.shape[2])[None, None, :]
     offset_m = np.abs(k - layer[:, :, None]) * dz  # distance to the level [m]
-    half = max(band, 0.0)
-    exponent = np.full(W.shape, float(p2))
-    inside = offset_m <= half + 1e-9 * dz
-    if graded and half > 0:
-        frac = np.clip(offset_m / half, 0.0, 1.0)
+
+    if mode == "capped":
+        w_fl = np.take_along_axis(W, layer[:, :, None], axis=2)  # (nx, ny, 1)
+        # a level node with W = 0 (e.g. a wall at the ceiling) would zero the
+        # whole column: leave such columns uncapped
+        cap = np.where(w_fl > 0, w_fl, np.inf)
+        V = np.minimum(W, cap)
+    else:
+        V = W
+
+    inside = offset_m <= band + 1e-9 * dz
+    if graded and band > 0:
+        frac = np.clip(offset_m / band, 0.0, 1.0)
         exponent = np.where(inside, p1 + (p2 - p1) * frac, p2)
     else:
-        exponent[inside] = p1
-    out = np.power(W, exponent)
+        exponent = np.where(inside, p1, p2)
+    out = np.power(V, exponent)
     out[W <= 0] = 0.0
     return out

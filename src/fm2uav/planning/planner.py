@@ -156,6 +156,7 @@ def plan(
     p2: float = 1.5,
     agl_band: float = 0.0,
     agl_graded: bool = False,
+    agl_mode: str = "capped",
     speed_map: np.ndarray | None = None,
     step: float = 0.5,
 ) -> Plan:
@@ -190,6 +191,11 @@ def plan(
         seeds' single layer).
     agl_graded : bool, optional
         Blend the exponent from p1 to p2 across the band. Default False.
+    agl_mode : {"capped", "literal"}, optional
+        How Algorithm 2 reads W (see :func:`~fm2uav.planning.flight_level.flight_level_speed`):
+        "capped" (default) caps each column at W of its flight-level node so the
+        level is the brightest cell; "literal" exponentiates W as is (climbs to
+        the ceiling on open maps, kept for comparison; docs/tff.md).
     speed_map : ndarray, optional
         Use this velocity map instead of computing one (0 = impassable);
         saturation/exponent/method/walls are then ignored. This is the hook for
@@ -237,7 +243,7 @@ def plan(
         W[world.occupancy] = 0.0
         if agl is not None:
             W = flight_level_speed(
-                W, world, agl, p1, p2, band=agl_band, graded=agl_graded
+                W, world, agl, p1, p2, band=agl_band, graded=agl_graded, mode=agl_mode
             )
     else:
         W = np.asarray(speed_map, dtype=float)
@@ -292,7 +298,8 @@ def plan(
     }
     if agl is not None and speed_map is None:
         params.update(agl=float(agl), p1=float(p1), p2=float(p2),
-                      agl_band=float(agl_band), agl_graded=bool(agl_graded))
+                      agl_band=float(agl_band), agl_graded=bool(agl_graded),
+                      agl_mode=str(agl_mode))
     return Plan(
         path=path,
         speed=speed,
