@@ -28,6 +28,7 @@ from typing import Any, TypeVar
 import numpy as np
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 
 from ..errors import Fm2uavError, InputError, PlanningError, PointError, WorldError
@@ -42,6 +43,7 @@ __all__ = [
     "OutputDir",
     "parse_point",
     "print_summary",
+    "progress",
     "to_jsonable",
 ]
 
@@ -118,6 +120,13 @@ def parse_point(text: str, ndim: int, what: str) -> np.ndarray:
     return values
 
 
+def _umask_mode(path: str | os.PathLike[str]) -> None:
+    """Give a temporary file the permissions of a normally created file (0666 & ~umask)."""
+    mask = os.umask(0)
+    os.umask(mask)
+    os.chmod(path, 0o666 & ~mask)
+
+
 class OutputDir:
     """An output directory that refuses to overwrite and writes atomically.
 
@@ -157,6 +166,7 @@ class OutputDir:
         try:
             with open(tmp, mode) as fh:
                 yield fh
+            _umask_mode(tmp)
             os.replace(tmp, target)
         except BaseException:
             if os.path.exists(tmp):
@@ -178,6 +188,7 @@ class OutputDir:
     def commit(self, tmp: Path, name: str) -> Path:
         """Move a temporary file from :meth:`target` into place."""
         target = self.path / name
+        _umask_mode(tmp)
         os.replace(tmp, target)
         self.written.append(target)
         return target
@@ -204,9 +215,29 @@ def print_summary(
     table.add_column("what", style="bold")
     table.add_column("value")
     for key, value in rows.items():
-        table.add_row(key, str(value))
+        table.add_row(escape(str(key)), escape(str(value)))
     console.print(table)
     if files:
         console.print("outputs:")
         for f in files:
             console.print(f"  {f}")
+
+
+@contextmanager
+def progress(enabled: bool = True) -> Iterator[Callable[[str], None]]:
+    """Show the current stage of a long command as a rich spinner on stderr.
+
+    Yields a function ``step(message)`` that updates the spinner. Nothing is
+    shown when ``enabled`` is False (``--quiet`` / ``--json``) or when stderr
+    is not a terminal (scripts, CI), so output stays clean for pipes.
+
+    Example
+    -------
+    >>> with progress(enabled=False) as step:
+    ...     step("planning")
+    """
+    if not enabled or not err_console.is_terminal:
+        yield lambda message: None
+        return
+    with err_console.status("starting", spinner="dots") as status:
+        yield lambda message: status.update(f"[bold]{message}[/]")

@@ -10,7 +10,9 @@ import typer
 
 from ..planning import plan as plan_path
 from ..world.scenarios import SCENARIOS, get_scenario
+from ..errors import InputError
 from ._common import OutputDir, handle_errors, parse_point, print_summary, to_jsonable
+from .cmd_run import output_names, plan_outputs
 
 PLAN_FILES = ("path.csv", "plan.png", "summary.json")
 
@@ -26,6 +28,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "Examples:\n\n"
             "  fm2uav plan --scenario open-field --out out/plan\n\n"
             "  fm2uav plan --start 20,20,20 --goal 100,80,30 --cells --exponent 0.5 --out out/b\n\n"
+            "  fm2uav plan --report --export plan,wpl,geojson,kml --out out/c\n\n"
             f"Scenarios: {', '.join(SCENARIOS)}."
         ),
     )
@@ -47,11 +50,23 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
         as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
         quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
+        report: bool = typer.Option(
+            False, "--report", help="Also write report.html (interactive, self-contained)."),
+        export: str = typer.Option(
+            "", help="Also write these exports (comma list): geojson, kml, plan "
+            "(QGroundControl), wpl (MAVLink QGC WPL 110), or 'all'."),
+        anchor: str | None = typer.Option(
+            None, help="lon,lat[,alt] of world x=y=0 for the exports (worlds without CRS). "
+            "Default: -3.7649,40.3326,0 (UC3M Leganés)."),
+        thin: float = typer.Option(5.0, help="Waypoint tolerance [m] of the exports (3D "
+                                   "Douglas–Peucker)."),
     ) -> None:
         sc = get_scenario(scenario, seed=seed)
         world = sc.world
         outdir = OutputDir(out, force=force)
-        outdir.check(PLAN_FILES)
+        extra = _extra_formats(export, report)
+        export_options = _export_options(anchor, thin) if extra else None
+        outdir.check(PLAN_FILES + tuple(output_names(extra)))
 
         def point(text: str | None, default: np.ndarray, what: str) -> np.ndarray:
             if text is None:
@@ -77,6 +92,11 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         with outdir.open("path.csv") as fh:
             write_path_csv(fh, p.path, p.speed)
         outdir.commit(tmp_png, "plan.png")
+        if extra:
+            info = plan_outputs(outdir, p, extra, export_options,
+                                title=f"FM² plan — {scenario}", subtitle=sc.description)
+            summary.update(waypoints=info["waypoints"], mavlink_frame=info["mavlink_frame"],
+                           home_lat_lon_alt=info["home_lat_lon_alt"])
         with outdir.open("summary.json") as fh:
             json.dump(to_jsonable(summary), fh, indent=2)
         rows = {
@@ -88,5 +108,41 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "min W on path": f"{p.speed.min():.3f}",
             "timings [ms]": ", ".join(f"{k} {v * 1e3:.1f}" for k, v in p.timings.items()),
         }
+        if "waypoints" in summary:
+            rows["waypoints"] = f"{summary['waypoints']} (MAVLink frame {summary['mavlink_frame']})"
         print_summary("FM² plan", rows if not as_json else summary, as_json=as_json,
                       quiet=quiet, files=outdir.written)
+
+
+_EXPORTS = ("geojson", "kml", "plan", "wpl")
+
+
+def _extra_formats(export: str, report: bool) -> list[str]:
+    """Output formats asked with --export/--report beyond path.csv, plan.png, summary.json."""
+    names = [e.strip().lower() for e in export.split(",") if e.strip()]
+    if names == ["all"]:
+        names = list(_EXPORTS)
+    bad = [n for n in names if n not in _EXPORTS]
+    if bad:
+        raise InputError(f"--export {bad[0]!r} is not a known format; allowed: "
+                         f"{', '.join(_EXPORTS)} or all")
+    return list(dict.fromkeys(names)) + (["html"] if report else [])
+
+
+def _export_options(anchor: str | None, thin: float):
+    from ..io import Anchor, ExportOptions
+
+    if not np.isfinite(thin) or thin < 0:
+        raise InputError(f"--thin must be a tolerance >= 0 m, got {thin}")
+    a = None
+    if anchor is not None:
+        parts = anchor.replace(",", " ").split()
+        try:
+            v = [float(x) for x in parts]
+        except ValueError:
+            v = []
+        if len(v) not in (2, 3):
+            raise InputError(f"--anchor must be lon,lat or lon,lat,alt (degrees, degrees, "
+                             f"metres), got {anchor!r}")
+        a = Anchor(lon=v[0], lat=v[1], alt=v[2] if len(v) == 3 else 0.0)
+    return ExportOptions(tolerance=thin, anchor=a)

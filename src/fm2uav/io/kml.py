@@ -1,0 +1,95 @@
+"""KML export (3D, for Google Earth).
+
+A Document with the path as an absolute-altitude LineString (extruded to the
+ground, so the flight height is visible as a curtain), the thinned waypoints
+as a second line, and start/goal Placemarks. KML coordinates are
+``lon,lat,alt`` with alt in metres above mean sea level.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from pathlib import Path
+from typing import IO, Any
+from xml.sax.saxutils import escape
+
+import numpy as np
+
+from ..errors import InputError
+from .georef import Anchor, to_lonlat
+
+__all__ = ["kml_document", "write_kml", "read_kml_path"]
+
+_NS = "http://www.opengis.net/kml/2.2"
+
+
+def _coord_text(geo: np.ndarray) -> str:
+    return " ".join(f"{lo:.9f},{la:.9f},{al:.3f}" for lo, la, al in geo)
+
+
+def _line(name: str, style: str, geo: np.ndarray, extrude: bool) -> str:
+    return (
+        f"<Placemark><name>{escape(name)}</name><styleUrl>#{style}</styleUrl>"
+        f"<LineString><extrude>{int(extrude)}</extrude><tessellate>0</tessellate>"
+        f"<altitudeMode>absolute</altitudeMode><coordinates>{_coord_text(geo)}</coordinates>"
+        "</LineString></Placemark>"
+    )
+
+
+def _point(name: str, geo: np.ndarray) -> str:
+    return (
+        f"<Placemark><name>{escape(name)}</name><Point><altitudeMode>absolute</altitudeMode>"
+        f"<coordinates>{_coord_text(geo[None])}</coordinates></Point></Placemark>"
+    )
+
+
+def kml_document(
+    path_m: Any,
+    world: Any,
+    *,
+    anchor: Anchor | None = None,
+    waypoints_m: Any = None,
+    name: str = "fm2uav mission",
+) -> str:
+    """The KML text of a path (see the module docstring)."""
+    p = np.asarray(path_m, dtype=float)
+    if p.ndim != 2 or len(p) < 2:
+        raise InputError(f"path must be an (N, 2|3) array with N >= 2, got shape {p.shape}")
+    geo = to_lonlat(p, world, anchor=anchor)
+    parts = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        f'<kml xmlns="{_NS}"><Document><name>{escape(name)}</name>',
+        '<Style id="path"><LineStyle><color>ff1e1ee6</color><width>3</width></LineStyle>'
+        "<PolyStyle><color>401e1ee6</color></PolyStyle></Style>",
+        '<Style id="waypoints"><LineStyle><color>ff00d7ff</color><width>2</width></LineStyle>'
+        "</Style>",
+        _line("path", "path", geo, extrude=True),
+    ]
+    if waypoints_m is not None:
+        wgeo = to_lonlat(np.asarray(waypoints_m, dtype=float), world, anchor=anchor)
+        parts.append(_line("waypoints", "waypoints", wgeo, extrude=False))
+    parts += [_point("start", geo[0]), _point("goal", geo[-1]), "</Document></kml>"]
+    return "\n".join(parts) + "\n"
+
+
+def write_kml(fh: IO[str], path_m: Any, world: Any, **options: Any) -> str:
+    """Write :func:`kml_document` to an open text file; returns the text."""
+    text = kml_document(path_m, world, **options)
+    fh.write(text)
+    return text
+
+
+def read_kml_path(file: str | Path, name: str = "path") -> np.ndarray:
+    """``(N, 3)`` lon, lat, alt of the LineString Placemark called ``name``."""
+    file = Path(file)
+    try:
+        root = ET.parse(file).getroot()
+    except (OSError, ET.ParseError) as exc:
+        raise InputError(f"{file}: cannot read KML: {exc}") from None
+    ns = {"k": _NS}
+    for pm in root.iter(f"{{{_NS}}}Placemark"):
+        if pm.findtext("k:name", namespaces=ns) == name:
+            text = pm.findtext("k:LineString/k:coordinates", namespaces=ns)
+            if text:
+                return np.array([[float(v) for v in t.split(",")] for t in text.split()])
+    raise InputError(f"{file}: no LineString Placemark named {name!r}")

@@ -1,0 +1,539 @@
+"""Mission files: one YAML file describes a whole mission.
+
+Schema (pydantic v2, strict types, unknown keys rejected)::
+
+    version: 1                      # schema version (only 1)
+    name: open-field TFF            # free text
+    world:                          # exactly one of scenario / dem / buildings
+      scenario: open-field          # a built-in scenario (see `fm2uav plan --help`)
+      seed: 0                       # relief seed of the scenario
+      dem: terrain.tif              # or: a GeoTIFF DEM with a CRS (path relative to this file)
+      buildings: city.geojson       # or: building footprints (GeoJSON polygons with heights)
+      cell_size: 15                 # [m] grid cell for DEM / buildings worlds
+      height_cells: 40              # vertical nodes for DEM / buildings worlds
+      anchor: {lon: -3.7649, lat: 40.3326, alt: 0}   # where a world without CRS sits
+    start: [300, 300, 300]          # x, y, z [m]; or {x, y, agl}, {lon, lat, alt},
+    goal: {lon: -3.747, lat: 40.343, agl: 60}        # {lon, lat, agl} or {cell: [i, j, k]}
+    planner: {saturation: 1.0, exponent: 1.0, order: 2, agl: 60, p1: 0.5, p2: 1.5}
+    airframe: {type: multirotor, firmware: px4, cruise_speed: 12, hover_speed: 5}
+    outputs:
+      dir: out/my-mission           # default out/<file name>; `fm2uav run --out` overrides
+      formats: [csv, geojson, kml, plan, wpl, html, png, json]
+      thin_tolerance: 5             # [m] Douglas–Peucker tolerance of the waypoints
+      frame: auto                   # auto | relative | terrain (MAVLink frame 3 / 10)
+
+Every validation error is reported on one line naming the field, the bad
+value and what is allowed, e.g. ``planner.saturation = 1.5 is out of range;
+allowed: 0 < saturation <= 1``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, ValidationInfo
+from pydantic import field_validator, model_validator
+
+from ..errors import InputError, WorldError
+from .exports import EXPORT_FILES, ExportOptions
+from .georef import DEFAULT_ANCHOR, Anchor, from_lonlat, ground_height
+
+__all__ = [
+    "Mission",
+    "WorldSpec",
+    "PointSpec",
+    "PlannerSpec",
+    "AirframeSpec",
+    "OutputSpec",
+    "OUTPUT_FORMATS",
+    "ResolvedMission",
+    "load_mission",
+    "parse_mission",
+]
+
+#: Output formats a mission can ask for (exports + report + figure + summary).
+OUTPUT_FORMATS = (*EXPORT_FILES, "html", "png", "json")
+
+_STRICT = ConfigDict(strict=True, extra="forbid", frozen=True)
+
+
+def _num(default: Any = None, *, unit: str = "", desc: str = "", **bounds: float) -> Any:
+    return Field(default, description=desc, json_schema_extra={"unit": unit}, **bounds)
+
+
+class AnchorSpec(BaseModel):
+    """Where a world without a CRS is placed (lon/lat of world x = y = 0)."""
+
+    model_config = _STRICT
+    lon: float = _num(..., unit="deg", ge=-180, le=180, desc="longitude of world x=y=0")
+    lat: float = _num(..., unit="deg", ge=-89, le=89, desc="latitude of world x=y=0")
+    alt: float = _num(0.0, unit="m", ge=-500, le=9000, desc="altitude of world z=0 AMSL")
+
+
+class WorldSpec(BaseModel):
+    """The map: a built-in scenario, a DEM GeoTIFF or building footprints."""
+
+    model_config = _STRICT
+    scenario: str | None = Field(None, description="built-in scenario name")
+    seed: int = _num(0, ge=0, le=2**31 - 1, desc="seed of the scenario's relief")
+    dem: str | None = Field(None, description="GeoTIFF DEM path (relative to the mission file)")
+    buildings: str | None = Field(None, description="GeoJSON building footprints path")
+    cell_size: float | None = _num(None, unit="m", gt=0, le=1000, desc="grid cell size")
+    height_cells: int | None = _num(None, ge=2, le=2000, desc="number of vertical nodes")
+    anchor: AnchorSpec | None = Field(None, description="placement of a world without CRS")
+
+    @field_validator("scenario")
+    @classmethod
+    def _known_scenario(cls, v: str | None) -> str | None:
+        if v is None:
+            return v
+        from ..world.scenarios import SCENARIOS
+
+        key = v.strip().lower().replace("_", "-").replace(" ", "-")
+        if key not in SCENARIOS:
+            raise ValueError(f"unknown scenario; allowed: {', '.join(sorted(SCENARIOS))}")
+        return key
+
+    @field_validator("dem")
+    @classmethod
+    def _dem_file(cls, v: str | None, info: ValidationInfo) -> str | None:
+        if v is None:
+            return v
+        path = _resolve(v, info)
+        if not path.is_file():
+            raise ValueError(f"file not found ({path}); allowed: an existing GeoTIFF file")
+        try:
+            import rasterio
+
+            with rasterio.open(path) as ds:
+                crs = ds.crs
+        except Exception as exc:  # rasterio raises its own error types
+            raise ValueError(f"cannot be read as a raster ({type(exc).__name__}); "
+                             "allowed: a GeoTIFF DEM") from None
+        if crs is None:
+            raise ValueError(
+                "has no coordinate reference system (CRS); allowed: a GeoTIFF with a CRS "
+                "(assign one, e.g. `gdal_edit.py -a_srs EPSG:32616 dem.tif`)")
+        return str(path)
+
+    @field_validator("buildings")
+    @classmethod
+    def _buildings_file(cls, v: str | None, info: ValidationInfo) -> str | None:
+        if v is None:
+            return v
+        path = _resolve(v, info)
+        if not path.is_file():
+            raise ValueError(f"file not found ({path}); allowed: an existing GeoJSON file")
+        return str(path)
+
+    @model_validator(mode="after")
+    def _one_source(self) -> WorldSpec:
+        given = [k for k in ("scenario", "dem", "buildings") if getattr(self, k) is not None]
+        if len(given) != 1:
+            raise ValueError(
+                f"give exactly one of scenario, dem, buildings (got "
+                f"{', '.join(given) if given else 'none'})")
+        return self
+
+
+def _resolve(v: str, info: ValidationInfo) -> Path:
+    base = (info.context or {}).get("base_dir") if info is not None else None
+    p = Path(v).expanduser()
+    if not p.is_absolute() and base is not None:
+        p = Path(base) / p
+    return p
+
+
+class PointSpec(BaseModel):
+    """A start or goal: metres, lon/lat or grid cells; height as z/alt or agl."""
+
+    model_config = _STRICT
+    x: float | None = _num(None, unit="m", desc="world x")
+    y: float | None = _num(None, unit="m", desc="world y")
+    z: float | None = _num(None, unit="m", desc="world z")
+    lon: float | None = _num(None, unit="deg", ge=-180, le=180, desc="longitude")
+    lat: float | None = _num(None, unit="deg", ge=-90, le=90, desc="latitude")
+    alt: float | None = _num(None, unit="m", desc="altitude above mean sea level")
+    agl: float | None = _num(None, unit="m", gt=0, le=10000, desc="height above ground")
+    cell: list[int] | None = Field(None, min_length=3, max_length=3,
+                                   description="grid node [i, j, k]")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _from_list(cls, data: Any) -> Any:
+        if isinstance(data, (list, tuple)):
+            if len(data) != 3 or not all(
+                isinstance(v, (int, float)) and not isinstance(v, bool) for v in data
+            ):
+                raise ValueError("must be [x, y, z] (3 numbers, metres) or a mapping such as "
+                                 "{lon: .., lat: .., agl: ..}")
+            return {"x": data[0], "y": data[1], "z": data[2]}
+        return data
+
+    @model_validator(mode="after")
+    def _consistent(self) -> PointSpec:
+        xy = self.x is not None or self.y is not None
+        ll = self.lon is not None or self.lat is not None
+        cell = self.cell is not None
+        if xy + ll + cell != 1:
+            raise ValueError("give exactly one of: x and y [m], lon and lat [deg], or cell")
+        if xy and (self.x is None or self.y is None):
+            raise ValueError("give both x and y")
+        if ll and (self.lon is None or self.lat is None):
+            raise ValueError("give both lon and lat")
+        heights = [k for k in ("z", "alt", "agl") if getattr(self, k) is not None]
+        if cell:
+            if heights:
+                raise ValueError("a cell already fixes the height; drop " + heights[0])
+            return self
+        if len(heights) != 1:
+            raise ValueError("give exactly one height: z [m] (or alt for lon/lat) or agl [m]")
+        if xy and self.alt is not None:
+            raise ValueError("with x/y give the height as z or agl, not alt")
+        if ll and self.z is not None:
+            raise ValueError("with lon/lat give the height as alt or agl, not z")
+        return self
+
+
+class PlannerSpec(BaseModel):
+    """FM² parameters (see :func:`fm2uav.plan`)."""
+
+    model_config = _STRICT
+    saturation: float = _num(1.0, gt=0, le=1, desc="saturation α of W")
+    exponent: float = _num(1.0, gt=0, le=10, desc="exponent β on W")
+    order: Literal[1, 2] = Field(2, description="Fast Marching order")
+    method: Literal["edt", "fmm"] = Field("edt", description="distance to obstacles")
+    walls: bool = Field(False, description="treat the map border as an obstacle")
+    agl: float | None = _num(None, unit="m", gt=0, le=5000, desc="flight level above ground")
+    p1: float = _num(0.5, gt=0, le=10, desc="exponent on the flight-level cells")
+    p2: float = _num(1.5, gt=0, le=10, desc="exponent on the other cells")
+    agl_band: float = _num(0.0, unit="m", ge=0, le=5000, desc="half-width of the level band")
+    agl_graded: bool = Field(False, description="blend p1→p2 across the band")
+    step: float = _num(0.5, gt=0, le=5, desc="geodesic step in cells")
+
+
+class AirframeSpec(BaseModel):
+    """The aircraft, as far as the exports need it."""
+
+    model_config = _STRICT
+    type: Literal["multirotor", "fixed_wing", "vtol"] = Field("multirotor")
+    firmware: Literal["px4", "ardupilot", "generic"] = Field("px4")
+    cruise_speed: float = _num(15.0, unit="m/s", gt=0, le=100, desc="cruise speed")
+    hover_speed: float = _num(5.0, unit="m/s", gt=0, le=50, desc="multirotor speed")
+
+
+class OutputSpec(BaseModel):
+    """What to write and where."""
+
+    model_config = _STRICT
+    dir: str | None = Field(None, description="output folder")
+    formats: list[Literal[OUTPUT_FORMATS]] = Field(  # type: ignore[valid-type]
+        default_factory=lambda: list(OUTPUT_FORMATS), min_length=1)
+    thin_tolerance: float = _num(5.0, unit="m", ge=0, le=1000, desc="waypoint tolerance")
+    max_waypoints: int | None = _num(None, ge=2, le=10000, desc="cap on waypoints")
+    frame: Literal["auto", "relative", "terrain"] = Field("auto")
+    takeoff: bool = Field(True, description="start with NAV_TAKEOFF")
+
+
+class Mission(BaseModel):
+    """A whole mission file."""
+
+    model_config = _STRICT
+    version: Literal[1] = Field(1, description="schema version")
+    name: str = Field("mission", description="mission name")
+    description: str = Field("", description="free text")
+    world: WorldSpec = Field(..., description="the map: scenario, dem or buildings")
+    start: PointSpec | None = Field(None, description="start point")
+    goal: PointSpec | None = Field(None, description="goal point")
+    planner: PlannerSpec = Field(default_factory=PlannerSpec)
+    airframe: AirframeSpec = Field(default_factory=AirframeSpec)
+    outputs: OutputSpec = Field(default_factory=OutputSpec)
+
+    @model_validator(mode="after")
+    def _points_needed(self) -> Mission:
+        if self.world.scenario is None:
+            for what in ("start", "goal"):
+                if getattr(self, what) is None:
+                    raise ValueError(f"{what} is missing: a {('dem' if self.world.dem else 'buildings')}"
+                                     f" world has no default {what}; give {what}: "
+                                     "{lon: .., lat: .., agl: ..} or [x, y, z]")
+        return self
+
+    # ------------------------------------------------------------------ resolving
+    def anchor(self) -> Anchor:
+        """The :class:`Anchor` of a world without CRS (default :data:`DEFAULT_ANCHOR`)."""
+        a = self.world.anchor
+        return DEFAULT_ANCHOR if a is None else Anchor(lon=a.lon, lat=a.lat, alt=a.alt)
+
+    def export_options(self) -> ExportOptions:
+        """The :class:`ExportOptions` of this mission."""
+        o, a = self.outputs, self.airframe
+        return ExportOptions(
+            tolerance=o.thin_tolerance, max_points=o.max_waypoints, frame=o.frame,
+            anchor=self.anchor(), takeoff=o.takeoff, cruise_speed=a.cruise_speed,
+            hover_speed=a.hover_speed, vehicle=a.type, firmware=a.firmware,
+        )
+
+    def plan_kwargs(self) -> dict[str, Any]:
+        """Keyword arguments of :func:`fm2uav.plan`."""
+        return self.planner.model_dump()
+
+    def resolve(self) -> ResolvedMission:
+        """Build the world and the start/goal in world metres.
+
+        Raises
+        ------
+        WorldError, InputError
+            The world cannot be built (message names ``world.<field>``), or a
+            point cannot be placed (names ``start`` / ``goal``).
+        """
+        w = self.world
+        start_default = goal_default = None
+        if w.scenario is not None:
+            from ..world.scenarios import get_scenario
+
+            sc = get_scenario(w.scenario, seed=w.seed)
+            world, start_default, goal_default = sc.world, sc.start, sc.goal
+        elif w.dem is not None:
+            world = _build_dem(w)
+        else:
+            world = _build_buildings(w)
+        anchor = self.anchor()
+        start = (_resolve_point(self.start, world, anchor, "start")
+                 if self.start is not None else np.asarray(start_default, dtype=float))
+        goal = (_resolve_point(self.goal, world, anchor, "goal")
+                if self.goal is not None else np.asarray(goal_default, dtype=float))
+        return ResolvedMission(mission=self, world=world, start=start, goal=goal)
+
+
+@dataclass(frozen=True)
+class ResolvedMission:
+    """A validated mission with its world built and its points in metres."""
+
+    mission: Mission
+    world: Any
+    start: np.ndarray
+    goal: np.ndarray
+
+
+def _build_dem(w: WorldSpec) -> Any:
+    from ..world import World
+
+    builder = getattr(World, "from_dem", None)
+    if builder is None:
+        raise WorldError("world.dem: this version of fm2uav cannot read DEMs (World.from_dem "
+                         "is missing); use world.scenario instead")
+    kwargs: dict[str, Any] = {}
+    if w.cell_size is not None:
+        kwargs["cell_size"] = w.cell_size
+    if w.height_cells is not None:
+        kwargs["height_cells"] = w.height_cells
+    return builder(w.dem, **kwargs)
+
+
+def _build_buildings(w: WorldSpec) -> Any:
+    from ..world import World
+
+    builder = getattr(World, "from_buildings", None)
+    if builder is None:
+        raise WorldError("world.buildings: this version of fm2uav cannot read building "
+                         "footprints (World.from_buildings is missing); use world.scenario")
+    kwargs: dict[str, Any] = {}
+    if w.cell_size is not None:
+        kwargs["cell_size"] = w.cell_size
+    if w.height_cells is not None:
+        kwargs["height_cells"] = w.height_cells
+    return builder(w.buildings, **kwargs)
+
+
+def _resolve_point(p: PointSpec, world: Any, anchor: Anchor, what: str) -> np.ndarray:
+    if p.cell is not None:
+        if world.ndim != 3:
+            raise InputError(f"{what}.cell needs a 3D world")
+        return world.to_world(np.asarray(p.cell, dtype=float))
+    if p.lon is not None:
+        xy = from_lonlat([[p.lon, p.lat]], world, anchor=anchor)[0]
+        if p.alt is not None:
+            z = float(from_lonlat([[p.lon, p.lat, p.alt]], world, anchor=anchor)[0, 2])
+        else:
+            z = float(ground_height(world, xy[None])[0]) + float(p.agl)
+    else:
+        xy = np.array([p.x, p.y], dtype=float)
+        z = p.z if p.z is not None else float(ground_height(world, xy[None])[0]) + float(p.agl)
+    if world.ndim == 2:
+        return xy
+    point = np.array([xy[0], xy[1], z], dtype=float)
+    if not world.contains(point):
+        b = world.bounds
+        raise InputError(
+            f"{what} = ({point[0]:.1f}, {point[1]:.1f}, {point[2]:.1f}) m lies outside the map; "
+            f"allowed: x in [{b[0, 0]:.1f}, {b[0, 1]:.1f}], y in [{b[1, 0]:.1f}, {b[1, 1]:.1f}], "
+            f"z in [{b[2, 0]:.1f}, {b[2, 1]:.1f}] m")
+    return point
+
+
+# ---------------------------------------------------------------------- errors
+def _field_info(loc: tuple[Any, ...]) -> tuple[Any, str]:
+    """FieldInfo of the last named field of ``loc`` and its name (or (None, ""))."""
+    model: Any = Mission
+    info, name = None, ""
+    for key in loc:
+        if not isinstance(key, str):
+            continue
+        fields = getattr(model, "model_fields", None)
+        if not fields or key not in fields:
+            return info, name
+        info, name = fields[key], key
+        ann = info.annotation
+        nxt = None
+        for cand in (ann, *getattr(ann, "__args__", ())):
+            if isinstance(cand, type) and issubclass(cand, BaseModel):
+                nxt = cand
+        model = nxt
+    return info, name
+
+
+def _fmt_num(v: float) -> str:
+    return str(int(v)) if float(v).is_integer() else f"{v:g}"
+
+
+def _allowed(info: Any, name: str) -> str:
+    """Human description of what a field allows (range + unit, or the choices)."""
+    if info is None:
+        return ""
+    lo = hi = None
+    lo_op = hi_op = ""
+    for m in info.metadata:
+        for attr, op in (("gt", "<"), ("ge", "<=")):
+            if getattr(m, attr, None) is not None:
+                lo, lo_op = getattr(m, attr), op
+        for attr, op in (("lt", "<"), ("le", "<=")):
+            if getattr(m, attr, None) is not None:
+                hi, hi_op = getattr(m, attr), op
+    unit = (info.json_schema_extra or {}).get("unit", "") if isinstance(
+        info.json_schema_extra, dict) else ""
+    unit = f" {unit}" if unit else ""
+    if info.annotation in (bool, bool | None):
+        return "true or false"
+    if lo is not None or hi is not None:
+        kind = "an integer" if info.annotation in (int, int | None) else "a number"
+        left = f"{_fmt_num(lo)} {lo_op} " if lo is not None else ""
+        right = f" {hi_op} {_fmt_num(hi)}" if hi is not None else ""
+        return f"{kind}, {left}{name}{right}{unit}"
+    args = getattr(info.annotation, "__args__", ())
+    if getattr(info.annotation, "__origin__", None) is Literal:
+        return "one of " + ", ".join(repr(a) for a in args)
+    if info.description:
+        return info.description
+    return ""
+
+
+_TYPE_WORDS = {
+    "float_type": "a number", "int_type": "an integer", "string_type": "a string",
+    "bool_type": "true or false", "list_type": "a list", "tuple_type": "a list",
+    "dict_type": "a mapping", "model_type": "a mapping (key: value lines)",
+    "int_from_float": "an integer", "float_parsing": "a number", "int_parsing": "an integer",
+}
+
+
+def _show(v: Any) -> str:
+    text = repr(v)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _format_error(err: dict[str, Any]) -> str:
+    loc = tuple(err["loc"])
+    typ = err["type"]
+    ctx = err.get("ctx") or {}
+    path = "".join(f"[{k}]" if isinstance(k, int) else (("." if i else "") + str(k))
+                   for i, k in enumerate(loc)) or "mission"
+    info, name = _field_info(loc)
+    allowed = _allowed(info, name) if not any(isinstance(k, int) for k in loc) else ""
+    value = err.get("input")
+    if typ == "missing":
+        return f"{path} is missing; add it" + (f" (allowed: {allowed})" if allowed else "")
+    if typ == "extra_forbidden":
+        parent_info, _ = _field_info(loc[:-1])
+        model = Mission
+        if parent_info is not None:
+            for cand in (parent_info.annotation, *getattr(parent_info.annotation, "__args__", ())):
+                if isinstance(cand, type) and issubclass(cand, BaseModel):
+                    model = cand
+        keys = ", ".join(model.model_fields)
+        return f"{path} is not a known field; allowed fields here: {keys}"
+    if typ in ("greater_than", "greater_than_equal", "less_than", "less_than_equal"):
+        return f"{path} = {_show(value)} is out of range; allowed: {allowed}"
+    if typ == "literal_error":
+        return f"{path} = {_show(value)} is not allowed; allowed: {ctx.get('expected')}"
+    if typ in ("too_short", "too_long"):
+        n = ctx.get("actual_length")
+        lo, hi = (info.metadata if info is not None else []), None
+        lo = next((m.min_length for m in lo if getattr(m, "min_length", None) is not None), None)
+        hi = next((m.max_length for m in (info.metadata if info is not None else [])
+                   if getattr(m, "max_length", None) is not None), None)
+        want = (f"exactly {lo}" if lo == hi else
+                f"at least {lo}" if hi is None else f"{lo} to {hi}")
+        desc = f" ({info.description})" if info is not None and info.description else ""
+        return f"{path} = {_show(value)} has {n} item(s); allowed: {want} item(s){desc}"
+    if typ in _TYPE_WORDS:
+        extra = (f"; allowed: {allowed}" if allowed and allowed != _TYPE_WORDS[typ] else "")
+        return (f"{path} = {_show(value)} has the wrong type ({type(value).__name__}), "
+                f"expected {_TYPE_WORDS[typ]}{extra}")
+    if typ == "value_error":
+        msg = str(ctx.get("error", err["msg"]))
+        if isinstance(value, (str, int, float)) and not isinstance(value, bool):
+            return f"{path} = {_show(value)} {msg}" if msg.startswith(("has ", "cannot ")) \
+                else f"{path} = {_show(value)}: {msg}"
+        return f"{path}: {msg}"
+    return f"{path} = {_show(value)}: {err['msg']}"
+
+
+def parse_mission(data: Any, *, source: str = "mission", base_dir: str | Path | None = None
+                  ) -> Mission:
+    """Validate a mission given as a dict (e.g. parsed YAML).
+
+    Raises
+    ------
+    InputError
+        One line: ``<source>: <field> = <value> <problem>; allowed: <range>``
+        (the first problem; ``(+N more)`` says how many others were found).
+    """
+    if not isinstance(data, dict):
+        raise InputError(f"{source}: a mission file must be a mapping of keys (world:, start:, "
+                         f"goal:, ...), got {type(data).__name__}")
+    try:
+        return Mission.model_validate(data, context={"base_dir": base_dir})
+    except ValidationError as exc:
+        errs = exc.errors()
+        more = f" (+{len(errs) - 1} more)" if len(errs) > 1 else ""
+        raise InputError(f"{source}: {_format_error(errs[0])}{more}") from None
+
+
+def load_mission(file: str | Path) -> Mission:
+    """Read and validate a YAML mission file (paths inside are relative to it).
+
+    Raises
+    ------
+    InputError
+        Missing file, invalid YAML (line and column named) or an invalid
+        mission (see :func:`parse_mission`).
+    """
+    file = Path(file)
+    if not file.is_file():
+        raise InputError(f"mission file {file} not found; check the path")
+    try:
+        data = yaml.safe_load(file.read_text())
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise InputError(f"{file}: not valid YAML{where}: {problem}") from None
+    except UnicodeDecodeError:
+        raise InputError(f"{file}: not a text (UTF-8) file") from None
+    if data is None:
+        raise InputError(f"{file}: the mission file is empty; see examples/ for a template")
+    return parse_mission(data, source=str(file), base_dir=file.parent)

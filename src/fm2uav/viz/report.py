@@ -1,0 +1,332 @@
+"""Interactive HTML reports (plotly): one self-contained file per run.
+
+A report shows
+
+* a 3D view: the terrain surface (or, without terrain, the height of the
+  obstacles of each column, e.g. buildings), every path, its thinned
+  waypoints, start and goal — rotate/zoom with the mouse;
+* profiles along each path: altitude and ground, height above ground, and the
+  velocity map W (the admissible speed share);
+* tables of the parameters and metrics.
+
+The file is self-contained: plotly.js is inlined (about 4.7 MB), nothing is
+fetched from the network, so it opens offline and can be mailed as one file.
+Drawing only: every number comes from the caller.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["report_html", "plan_report", "write_report"]
+
+_COLOURS = ["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#e377c2",
+            "#8c564b", "#bcbd22", "#7f7f7f"]
+_CONFIG = {"displaylogo": False, "responsive": True}
+
+
+def _arc(path: np.ndarray) -> np.ndarray:
+    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])
+
+
+def _ground(world: Any, path: np.ndarray) -> np.ndarray | None:
+    if getattr(world, "terrain", None) is None or path.shape[1] != 3:
+        return None
+    from .figures import terrain_along
+
+    return np.asarray(terrain_along(world, path), dtype=float)
+
+
+def _stride(n: int, limit: int) -> int:
+    return max(1, int(np.ceil(n / limit)))
+
+
+def _surface(world: Any, limit: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, str] | None:
+    """(x, y, z(ny, nx), label) of the ground surface, subsampled to <= limit nodes/axis."""
+    if world.ndim != 3:
+        return None
+    nx, ny = world.shape[:2]
+    s = max(_stride(nx, limit), _stride(ny, limit))
+    x = world.origin[0] + np.arange(0, nx, s) * world.spacing[0]
+    y = world.origin[1] + np.arange(0, ny, s) * world.spacing[1]
+    if world.terrain is not None:
+        z = world.terrain[::s, ::s]
+        label = "terrain"
+    else:
+        top = world.surface_index().astype(float)
+        h = np.where(top >= 0, world.origin[2] + top * world.spacing[2], world.origin[2])
+        # block maximum, so thin obstacles (walls, small buildings) stay visible
+        px, py = (-nx) % s, (-ny) % s
+        hp = np.pad(h, ((0, px), (0, py)), mode="edge")
+        z = hp.reshape(hp.shape[0] // s, s, hp.shape[1] // s, s).max(axis=(1, 3))
+        label = "obstacles"
+    return x, y, np.asarray(z).T, label
+
+
+def _table(rows: Mapping[str, Any]) -> str:
+    if not rows:
+        return ""
+    body = "".join(
+        f"<tr><th>{html.escape(str(k))}</th><td>{html.escape(_fmt(v))}</td></tr>"
+        for k, v in rows.items()
+    )
+    return f"<table>{body}</table>"
+
+
+def _fmt(v: Any) -> str:
+    if isinstance(v, float):
+        return f"{v:.6g}"
+    if isinstance(v, (list, tuple, np.ndarray)):
+        return "[" + ", ".join(_fmt(x) for x in np.asarray(v).ravel().tolist()) + "]"
+    if isinstance(v, dict):
+        return ", ".join(f"{k}={_fmt(x)}" for k, x in v.items())
+    return str(v)
+
+
+def _scene_figure(world: Any, paths: Mapping[str, np.ndarray],
+                  waypoints: Mapping[str, np.ndarray], limit: int) -> Any:
+    import plotly.graph_objects as go
+
+    fig = go.Figure()
+    three_d = world.ndim == 3
+    if three_d:
+        surf = _surface(world, limit)
+        if surf is not None:
+            x, y, z, label = surf
+            fig.add_trace(go.Surface(
+                x=x, y=y, z=z, name=label, colorscale="Earth" if label == "terrain" else "Greys",
+                opacity=0.9 if label == "terrain" else 0.75, showscale=False,
+                hovertemplate="x %{x:.0f} m<br>y %{y:.0f} m<br>z %{z:.1f} m<extra>" + label
+                + "</extra>"))
+    else:
+        b = world.bounds
+        fig.add_trace(go.Heatmap(
+            z=world.occupancy.T.astype(np.uint8),
+            x0=b[0, 0], dx=world.spacing[0], y0=b[1, 0], dy=world.spacing[1],
+            colorscale=[[0, "#ffffff"], [1, "#444444"]], showscale=False, name="obstacles",
+            hoverinfo="skip"))
+    scatter = go.Scatter3d if three_d else go.Scatter
+    for i, (name, p) in enumerate(paths.items()):
+        c = _COLOURS[i % len(_COLOURS)]
+        kw = {"z": p[:, 2]} if three_d else {}
+        fig.add_trace(scatter(x=p[:, 0], y=p[:, 1], mode="lines", name=name,
+                              line={"color": c, "width": 6 if three_d else 3}, **kw))
+        if name in waypoints:
+            w = waypoints[name]
+            kw = {"z": w[:, 2]} if three_d else {}
+            fig.add_trace(scatter(x=w[:, 0], y=w[:, 1], mode="markers",
+                                  name=f"{name} waypoints ({len(w)})",
+                                  marker={"color": c, "size": 3 if three_d else 6,
+                                          "symbol": "diamond"}, **kw))
+        for label, pt, colour, sym in (("start", p[0], "#2ca02c", "circle"),
+                                        ("goal", p[-1], "#ffbf00", "diamond" if three_d else "star")):
+            kw = {"z": [pt[2]]} if three_d else {}
+            fig.add_trace(scatter(x=[pt[0]], y=[pt[1]], mode="markers", name=f"{name} {label}",
+                                  showlegend=i == 0 or len(paths) < 4,
+                                  marker={"color": colour, "size": 7 if three_d else 12,
+                                          "symbol": sym, "line": {"color": "black", "width": 1}},
+                                  **kw))
+    if three_d:
+        b = world.bounds
+        ext = b[:, 1] - b[:, 0]
+        ext = np.where(ext > 0, ext, 1.0)
+        fig.update_layout(scene={
+            "xaxis_title": "x [m]", "yaxis_title": "y [m]", "zaxis_title": "z [m]",
+            "aspectmode": "manual",
+            "aspectratio": {"x": 1.0, "y": float(ext[1] / ext[0]),
+                            "z": float(max(ext[2] / ext[0], 0.3))},
+            "camera": {"eye": {"x": -0.9, "y": -1.3, "z": 0.75}},
+        })
+    else:
+        fig.update_layout(xaxis_title="x [m]", yaxis_title="y [m]",
+                          yaxis={"scaleanchor": "x", "scaleratio": 1})
+    fig.update_layout(height=620, margin={"l": 0, "r": 0, "t": 30, "b": 0},
+                      legend={"x": 0, "y": 1}, title="3D view" if three_d else "top view")
+    return fig
+
+
+def _profile_figure(world: Any, paths: Mapping[str, np.ndarray],
+                    speeds: Mapping[str, np.ndarray], agl: float | None) -> Any:
+    import plotly.graph_objects as go
+    from plotly.subplots import make_subplots
+
+    three_d = world.ndim == 3
+    rows = (["altitude [m]", "height above ground [m]"] if three_d else []) + ["W (speed share)"]
+    fig = make_subplots(rows=len(rows), cols=1, shared_xaxes=True, vertical_spacing=0.06,
+                        subplot_titles=rows)
+    for i, (name, p) in enumerate(paths.items()):
+        c = _COLOURS[i % len(_COLOURS)]
+        s = _arc(p)
+        r = 1
+        if three_d:
+            fig.add_trace(go.Scatter(x=s, y=p[:, 2], name=f"{name} altitude", legendgroup=name,
+                                     line={"color": c}), row=1, col=1)
+            g = _ground(world, p)
+            if g is not None:
+                fig.add_trace(go.Scatter(x=s, y=g, name=f"{name} ground", legendgroup=name,
+                                         line={"color": "#8c6d31"}, fill="tozeroy",
+                                         fillcolor="rgba(140,109,49,0.25)"), row=1, col=1)
+                fig.add_trace(go.Scatter(x=s, y=p[:, 2] - g, name=f"{name} AGL",
+                                         legendgroup=name, line={"color": c}), row=2, col=1)
+            r = 3
+        if name in speeds and speeds[name] is not None:
+            fig.add_trace(go.Scatter(x=s, y=np.asarray(speeds[name], dtype=float),
+                                     name=f"{name} W", legendgroup=name,
+                                     line={"color": c, "dash": "dot"}), row=r, col=1)
+    if three_d and agl is not None:
+        fig.add_hline(y=agl, line={"color": "black", "dash": "dash", "width": 1},
+                      annotation_text=f"flight level {agl:g} m", row=2, col=1)
+    fig.update_xaxes(title_text="distance along the path [m]", row=len(rows), col=1)
+    fig.update_layout(height=260 * len(rows), margin={"l": 60, "r": 20, "t": 40, "b": 40},
+                      title="profiles")
+    return fig
+
+
+_CSS = """
+body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;margin:0;background:#fafafa;color:#222}
+header{background:#1f3b57;color:#fff;padding:14px 24px}header h1{margin:0;font-size:22px}
+header p{margin:4px 0 0;opacity:.85}main{padding:12px 24px}
+section{background:#fff;border:1px solid #ddd;border-radius:6px;margin:0 0 16px;padding:8px 12px}
+h2{font-size:17px;margin:6px 0}.cols{display:flex;gap:16px;flex-wrap:wrap}.cols>div{flex:1;min-width:300px}
+table{border-collapse:collapse;font-size:13px;width:100%}th,td{border-bottom:1px solid #eee;padding:3px 8px;text-align:left;vertical-align:top}
+th{width:38%;color:#444;font-weight:600}footer{font-size:12px;color:#666;padding:8px 24px 24px}
+"""
+
+
+def report_html(
+    world: Any,
+    paths: Mapping[str, Any],
+    *,
+    title: str = "fm2uav report",
+    subtitle: str = "",
+    speeds: Mapping[str, Any] | None = None,
+    waypoints: Mapping[str, Any] | None = None,
+    params: Mapping[str, Any] | None = None,
+    metrics: Mapping[str, Any] | None = None,
+    files: Sequence[str] = (),
+    agl: float | None = None,
+    max_surface: int = 150,
+) -> str:
+    """A self-contained interactive HTML report of paths on a world.
+
+    Parameters
+    ----------
+    world : World
+        Drawn as its terrain surface, or its obstacle heights without terrain
+        (2D worlds: the occupancy).
+    paths : mapping of str to array (N, ndim)
+        Named paths [m] (e.g. ``{"FM²": plan.path}``); several are overlaid.
+    speeds : mapping of str to array (N,), optional
+        W along each path (profile panel).
+    waypoints : mapping of str to array (n, ndim), optional
+        Thinned mission waypoints [m] drawn as markers.
+    params, metrics : mapping, optional
+        Rows of the parameter and metric tables.
+    files : sequence of str, optional
+        Names of the other files of the run (listed at the bottom).
+    agl : float, optional
+        Target flight level [m] drawn on the height-above-ground profile.
+    max_surface : int, optional
+        Nodes per axis of the drawn surface (subsampled above). Default 150.
+
+    Returns
+    -------
+    str
+        The HTML document (write it with :func:`write_report`).
+    """
+    if not paths:
+        raise ValueError("report_html needs at least one path")
+    P = {str(k): np.asarray(v, dtype=float) for k, v in paths.items()}
+    S = {str(k): np.asarray(v, dtype=float) for k, v in (speeds or {}).items() if v is not None}
+    Wp = {str(k): np.asarray(v, dtype=float) for k, v in (waypoints or {}).items()
+          if v is not None}
+    scene = _scene_figure(world, P, Wp, max_surface)
+    prof = _profile_figure(world, P, S, agl)
+    div_scene = scene.to_html(full_html=False, include_plotlyjs=True, config=_CONFIG,
+                              div_id="fm2uav-scene")
+    div_prof = prof.to_html(full_html=False, include_plotlyjs=False, config=_CONFIG,
+                            div_id="fm2uav-profiles")
+    world_rows = {
+        "name": getattr(world, "name", "") or "-",
+        "grid (nodes)": " x ".join(str(n) for n in world.shape),
+        "spacing [m]": world.spacing,
+        "origin [m]": world.origin,
+        "terrain": "yes" if world.terrain is not None else "no",
+        "CRS": world.crs or "none (local anchor)",
+    }
+    data = json.dumps({"paths": {k: int(len(v)) for k, v in P.items()}})
+    files_html = "".join(f"<li>{html.escape(f)}</li>" for f in files)
+    return f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<title>{html.escape(title)}</title><style>{_CSS}</style></head>
+<body><header><h1>{html.escape(title)}</h1><p>{html.escape(subtitle)}</p></header>
+<main>
+<section><h2>Mission</h2>{div_scene}</section>
+<section><h2>Profiles</h2>{div_prof}</section>
+<section class="cols"><div><h2>Parameters</h2>{_table(params or {})}</div>
+<div><h2>Metrics</h2>{_table(metrics or {})}</div>
+<div><h2>World</h2>{_table(world_rows)}</div></section>
+{f'<section><h2>Files</h2><ul>{files_html}</ul></section>' if files else ''}
+</main>
+<footer>fm2uav interactive report — drag to rotate, scroll to zoom, double-click to reset.
+<script type="application/json" id="fm2uav-data">{data}</script></footer>
+</body></html>
+"""
+
+
+def plan_report(
+    plans: Any,
+    *,
+    title: str = "fm2uav plan",
+    subtitle: str = "",
+    waypoints: Mapping[str, Any] | None = None,
+    params: Mapping[str, Any] | None = None,
+    metrics: Mapping[str, Any] | None = None,
+    files: Sequence[str] = (),
+    max_surface: int = 150,
+) -> str:
+    """:func:`report_html` for one :class:`~fm2uav.Plan`, a list or a name → Plan mapping.
+
+    The parameters default to the first plan's ``params`` and the metrics to
+    each plan's length, clearance and minimum W.
+    """
+    if isinstance(plans, Mapping):
+        named = dict(plans)
+    elif isinstance(plans, Sequence):
+        named = {f"path {i + 1}": p for i, p in enumerate(plans)}
+    else:
+        named = {"FM² path": plans}
+    first = next(iter(named.values()))
+    if metrics is None:
+        metrics = {}
+        for name, p in named.items():
+            pre = "" if len(named) == 1 else f"{name}: "
+            metrics[f"{pre}length [m]"] = round(float(p.length), 1)
+            metrics[f"{pre}clearance [m]"] = (round(float(p.clearance), 2)
+                                              if np.isfinite(p.clearance) else "inf")
+            metrics[f"{pre}min W"] = round(float(np.min(p.speed)), 4)
+            metrics[f"{pre}points"] = int(len(p.path))
+            metrics[f"{pre}planning time [s]"] = round(float(p.timings.get("total", 0.0)), 3)
+    agl = first.params.get("agl") if first.params else None
+    return report_html(
+        first.world,
+        {n: p.path for n, p in named.items()},
+        title=title, subtitle=subtitle,
+        speeds={n: p.speed for n, p in named.items()},
+        waypoints=waypoints, params=params if params is not None else first.params,
+        metrics=metrics, files=files, agl=agl, max_surface=max_surface,
+    )
+
+
+def write_report(file: str | Path, text: str) -> Path:
+    """Write a report string to ``file`` (UTF-8); returns the path."""
+    path = Path(file)
+    path.write_text(text, encoding="utf-8")
+    return path
