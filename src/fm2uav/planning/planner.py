@@ -79,6 +79,16 @@ class Plan:
         """Goal point [m]."""
         return self.path[-1]
 
+    def lonlat(self) -> np.ndarray:
+        """Path as WGS84 ``(lon [deg], lat [deg], alt [m])`` rows.
+
+        Needs a geo-referenced world (``world.crs`` set, e.g. ``World.from_dem``);
+        raises InputError otherwise. See :func:`fm2uav.world.geo.to_lonlat`.
+        """
+        from ..world.geo import to_lonlat
+
+        return to_lonlat(self.world, self.path)
+
     def summary(self) -> dict[str, Any]:
         """Plain-Python summary (JSON-friendly) of the plan's numbers."""
         return {

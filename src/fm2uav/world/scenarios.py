@@ -147,10 +147,18 @@ def fissure(seed: int | np.random.Generator = 0) -> Scenario:
     )
 
 
+def _jacksboro(seed: int | np.random.Generator = 0) -> Scenario:
+    """Real DEM of the Jacksboro fault (see :mod:`fm2uav.world.jacksboro`)."""
+    from .jacksboro import jacksboro
+
+    return jacksboro(seed)
+
+
 #: Scenario name → factory ``f(seed=0) -> Scenario``.
 SCENARIOS: dict[str, Callable[..., Scenario]] = {
     "open-field": open_field,
     "fissure": fissure,
+    "jacksboro": _jacksboro,
 }
 
 

@@ -370,3 +370,17 @@ class World:
             )
         occ = z[None, None, :] <= h[:, :, None]
         return cls(occupancy=occ, spacing=spacing, origin=org, terrain=h, name=name)
+
+    @classmethod
+    def from_dem(
+        cls, source: Any, cell_size: float | Sequence[float], ceiling: float | None = None,
+        **kwargs: Any,
+    ) -> World:
+        """Build a 3D world from a DEM (GeoTIFF path or array), geo-referenced.
+
+        See :func:`fm2uav.world.dem.from_dem` for the parameters (CRS handling,
+        resampling, nodata rule, ``ceiling`` altitude [m]).
+        """
+        from .dem import from_dem
+
+        return from_dem(source, cell_size, ceiling, **kwargs)
