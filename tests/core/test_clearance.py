@@ -41,3 +41,35 @@ def test_cache_is_per_world():
     b = World(occ2, spacing=1.0)
     assert clearance_profile(a, [[0.0, 1.0]])[0] == pytest.approx(1.0)
     assert clearance_profile(b, [[0.0, 1.0]])[0] == pytest.approx(np.hypot(4, 3))
+
+
+def test_column_world_search_matches_kdtree():
+    # a height-map world (solid columns) uses the ring search; compare it with
+    # brute force over all obstacle nodes at random points (some inside the
+    # terrain) and with the k-d tree of boundary nodes at the free points
+    # (the tree is exact only for free points, which paths are)
+    from fm2uav.analysis.clearance import column_surface, obstacle_tree
+
+    rng = np.random.default_rng(5)
+    heights = rng.random((23, 17)) * 9.0
+    heights[5:9, 3:6] = 0.0
+    w = World.from_heightmap(heights, (2.0, 1.5, 1.0), 14, origin=(10.0, -5.0, 0.0))
+    assert column_surface(w) is not None
+    pts = w.to_world(rng.random((300, 3)) * (np.array(w.shape) - 1))
+    obst = w.to_world(np.argwhere(w.occupancy))
+    brute = np.min(np.linalg.norm(pts[:, None] - obst[None], axis=2), axis=1)
+    got = clearance_profile(w, pts)
+    np.testing.assert_allclose(got, brute, rtol=1e-12)
+    free = ~w.occupancy[tuple(np.floor(w.to_index(pts) + 0.5).astype(int).T)]
+    tree_d, _ = obstacle_tree(w).query(pts[free])
+    np.testing.assert_allclose(got[free], tree_d, rtol=1e-12)
+
+
+def test_non_column_world_uses_tree():
+    from fm2uav.analysis.clearance import column_surface
+
+    occ = np.zeros((6, 6, 6), bool)
+    occ[2, 2, 4] = True  # a floating block: not a solid column
+    w = World(occ, spacing=1.0)
+    assert column_surface(w) is None
+    assert clearance_profile(w, [[2.0, 2.0, 1.0]])[0] == pytest.approx(3.0)

@@ -149,7 +149,8 @@ def test_central_mountain_is_the_highest_and_central():
 
 
 def test_get_scenario_and_registry():
-    assert set(SCENARIOS) == {"open-field", "fissure"}
+    # other issues register more scenarios; these two are the foundation's
+    assert {"open-field", "fissure"} <= set(SCENARIOS)
     sc = get_scenario("open-field")
     np.testing.assert_array_equal(sc.goal, open_field().goal)
     np.testing.assert_array_equal(get_scenario("Open_Field", seed=2).world.terrain,
@@ -159,9 +160,9 @@ def test_get_scenario_and_registry():
 
 def test_get_scenario_unknown_lists_valid_names():
     with pytest.raises(WorldError) as exc:
-        get_scenario("city")
+        get_scenario("atlantis")
     msg = str(exc.value)
-    assert "'city'" in msg and "open-field" in msg and "fissure" in msg
+    assert "'atlantis'" in msg and "open-field" in msg and "fissure" in msg
 
 
 def test_scenario_validates_points():
