@@ -276,7 +276,10 @@ def plan(
             f"{np.round(start_m, 3).tolist()} m: no free connection between them; move one "
             "of them into the other's free region or clear the separating obstacles"
         )
-    blocked = (W <= 0) | world.occupancy
+    # descend() never enters nodes with T = inf; obstacles have W = 0, hence
+    # T = inf, unless a custom speed map gave them a speed: only then pass the
+    # mask (it costs a copy of T, ~1 s on a 40M-node map).
+    blocked = world.occupancy if np.isfinite(T[world.occupancy]).any() else None
     path_idx = descend(
         T,
         world.to_index(start_m),
