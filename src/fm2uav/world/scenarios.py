@@ -23,6 +23,7 @@ import numpy as np
 from ..errors import WorldError
 from .terrain import OPEN_FIELD_SHAPE, open_field_heights
 from .world import World
+from .coverage_map import coverage  # noqa: E402  (coverage paper 003, thesis ch. 5)
 
 __all__ = [
     "Scenario",
@@ -158,6 +159,7 @@ def _jacksboro(seed: int | np.random.Generator = 0) -> Scenario:
 SCENARIOS: dict[str, Callable[..., Scenario]] = {
     "open-field": open_field,
     "fissure": fissure,
+    "coverage": coverage,
     "jacksboro": _jacksboro,
 }
 

@@ -1,0 +1,287 @@
+"""``fm2uav cover`` (coverage mission) and ``fm2uav reproduce coverage`` (Tables 5.1/5.2)."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+import typer
+
+from ..errors import InputError
+from ._common import OutputDir, handle_errors, print_summary, to_jsonable
+
+COVER_FILES = ("path.csv", "zigzag.csv", "bands.png", "coverage.png", "coverage.html",
+               "summary.json", "mission.plan")
+
+#: The seeds' Table 5.1 (D = 80) and 5.2 (S1): min cost, α, max cost, α, median, α, mean, α.
+SEEDS_T51 = {
+    "S1": (5446.504, 37.134, 6104.040, 11.499, 5464.316, 37.684, 5616.718, 37.214),
+    "S2": (6748.057, 2.503, 8373.462, 71.434, 6768.528, 3.389, 6870.913, 8.597),
+    "S3": (5908.607, 1.012, 7493.887, 65.506, 5980.716, 2.086, 6061.788, 9.452),
+    "S4": (7176.987, 1.349, 8223.283, 44.610, 7215.164, 2.581, 7290.188, 7.953),
+}
+SEEDS_T52 = {
+    40: (9679.496, 38.474, 10885.701, 86.879, 10150.668, 36.968, 10066.730, 33.238),
+    60: (6909.084, 37.878, 7696.142, 79.164, 6940.380, 36.990, 6982.500, 36.189),
+    80: SEEDS_T51["S1"],
+    100: (4615.506, 38.368, 5394.695, 57.202, 4658.287, 37.670, 4761.862, 29.829),
+}
+_COLS = ("min_cost", "min_alpha", "max_cost", "max_alpha", "median_cost", "median_alpha",
+         "mean_cost", "mean_alpha")
+
+
+def _camera_spacing(camera: str, agl: float, side_overlap: float) -> float:
+    from ..missions.coverage import Camera
+
+    parts = [p for p in camera.replace(",", " ").split() if p]
+    if len(parts) != 5:
+        raise InputError(
+            "--camera needs 5 numbers: sensor_width_mm,sensor_height_mm,focal_mm,"
+            f"image_width_px,image_height_px (e.g. 13.2,8.8,8.8,5472,3648); got {camera!r}"
+        )
+    try:
+        sw, sh, f, iw, ih = (float(p) for p in parts)
+    except ValueError:
+        raise InputError(f"--camera values must be numbers, got {camera!r}") from None
+    cam = Camera(sw * 1e-3, sh * 1e-3, f * 1e-3, int(iw), int(ih))
+    return cam.spacing(agl, side_overlap)
+
+
+def _load_area(area: str):
+    from ..missions.coverage import read_area
+    from ..world.coverage_map import COVERAGE_AREAS, coverage_area
+
+    if area.strip().upper() in COVERAGE_AREAS:
+        return coverage_area(area)
+    return read_area(area)
+
+
+def _write_png(outdir: OutputDir, fig, name: str) -> None:
+    import matplotlib.pyplot as plt
+
+    tmp = outdir.target(name)
+    fig.savefig(tmp, dpi=110)
+    plt.close(fig)
+    outdir.commit(tmp, name)
+
+
+def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
+    """Add ``cover`` and ``reproduce coverage``."""
+
+    @app.command(
+        "cover",
+        help=(
+            "Coverage mission: zigzag bands over an area, steering angle by Differential "
+            "Evolution, FM² along the bands at a height above the terrain. Writes path.csv, "
+            "zigzag.csv, mission.plan (QGroundControl, terrain-relative altitudes), bands.png, "
+            "coverage.png, coverage.html and summary.json.\n\n"
+            "Examples:\n\n"
+            "  fm2uav cover --area S1 --spacing 80 --agl 100 --out out/cover\n\n"
+            "  fm2uav cover --area area.geojson --spacing 80 --agl 100 --out out/cover\n\n"
+            "  fm2uav cover --area S2 --camera 13.2,8.8,8.8,5472,3648 --side-overlap 0.7 "
+            "--agl 100 --out out/cam\n\n"
+            "--area is a GeoJSON Polygon in the map's metres, or S1..S4 (the seeds' areas)."
+        ),
+    )
+    @handle_errors
+    def cover_cmd(
+        area: str = typer.Option(..., help="GeoJSON file (Polygon, metres) or S1..S4."),
+        spacing: float | None = typer.Option(None, help="Band spacing D [m]."),
+        agl: float = typer.Option(100.0, help="Flight level above the ground [m]."),
+        camera: str | None = typer.Option(
+            None, help="Compute D from a camera: sensor_w_mm,sensor_h_mm,focal_mm,img_w,img_h."),
+        side_overlap: float = typer.Option(0.0, help="Side overlap share in [0, 1) with --camera."),
+        angle: float | None = typer.Option(None, help="Steering angle [deg]; default: searched."),
+        search: str = typer.Option("de", help="Angle search: de (seeds), sweep, scipy-de."),
+        full_range: bool = typer.Option(False, "--full-range",
+                                        help="Search α in [0°, 180°) instead of [1°, 89°]."),
+        p1: float = typer.Option(0.5, help="Exponent on the flight level (seeds 0.5)."),
+        p2: float = typer.Option(1.3, help="Exponent elsewhere (seeds 1.3)."),
+        scenario: str = typer.Option("coverage", help="Built-in map to fly over."),
+        seed: int = typer.Option(0, help="Seed of the terrain and of the DE."),
+        out: Path = typer.Option(Path("out/cover"), help="Output directory."),
+        force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
+        as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
+        quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
+    ) -> None:
+        from ..io import write_path_csv
+        from ..missions.coverage import FULL_BOUNDS_DEG, plan_coverage
+        from ..viz.coverage import bands_figure, coverage_figure, coverage_html
+        from ..world.scenarios import get_scenario
+
+        if (spacing is None) == (camera is None):
+            raise InputError("give exactly one of --spacing (metres) or --camera")
+        d = spacing if spacing is not None else _camera_spacing(camera, agl, side_overlap)
+        outdir = OutputDir(out, force=force)
+        outdir.check(COVER_FILES)
+        poly = _load_area(area)
+        world = get_scenario(scenario, seed=seed).world
+        opts = {}
+        if full_range and search != "sweep":
+            opts["bounds_deg"] = FULL_BOUNDS_DEG
+        elif full_range:
+            opts["bounds_deg"] = FULL_BOUNDS_DEG
+        cp = plan_coverage(world, poly, d, agl=agl,
+                           angle=None if angle is None else np.radians(angle),
+                           search=search, search_options=opts, seed=seed, p1=p1, p2=p2)
+        summary = {"area": area, "scenario": scenario, **cp.summary()}
+        with outdir.open("path.csv") as fh:
+            write_path_csv(fh, cp.path, cp.plan.speed)
+        with outdir.open("zigzag.csv") as fh:
+            write_path_csv(fh, cp.zigzag.path())
+        _write_png(outdir, bands_figure(cp.zigzag, title=f"zigzag over {area}"), "bands.png")
+        _write_png(outdir, coverage_figure(cp, title=f"coverage of {area}"), "coverage.png")
+        with outdir.open("coverage.html") as fh:
+            fh.write(coverage_html(cp, title=f"coverage of {area}"))
+        try:
+            from ..io.qgc import write_plan
+            from ..io.waypoints import mission_waypoints
+        except ImportError:  # pragma: no cover - the exporter ships with fm2uav.io
+            summary["mission_plan"] = "not written: fm2uav.io.qgc is not available"
+        else:
+            wps = mission_waypoints(cp.path, world, frame="terrain", terrain_following=True)
+            with outdir.open("mission.plan") as fh:
+                write_plan(fh, wps)
+            summary["mission_plan_waypoints"] = len(wps)
+        with outdir.open("summary.json") as fh:
+            json.dump(to_jsonable(summary), fh, indent=2)
+        rows = {
+            "area": area,
+            "band spacing D [m]": f"{d:.1f}",
+            "steering angle [deg]": f"{cp.zigzag.angle_deg:.3f}",
+            "bands": cp.zigzag.n_bands,
+            "zigzag cost [m]": f"{cp.zigzag.cost:.1f}",
+            "FM² path length [m]": f"{cp.plan.length:.1f}",
+            "coverage (FM² path) [%]": f"{100 * cp.coverage:.2f}",
+            "|AGL error| mean/max [m]": f"{np.abs(cp.agl_error).mean():.1f} / "
+                                        f"{np.abs(cp.agl_error).max():.1f}",
+            "timings [ms]": ", ".join(f"{k} {v * 1e3:.0f}" for k, v in cp.timings.items()),
+        }
+        print_summary("coverage plan", summary if as_json else rows, as_json=as_json,
+                      quiet=quiet, files=outdir.written)
+
+    @reproduce_app.command(
+        "coverage",
+        help=(
+            "Reproduce the coverage experiments (paper 003 / thesis ch. 5): Table 5.1 (areas "
+            "S1-S4, D = 80 m) and Table 5.2 (S1 with D = 40/60/80/100 m) from the seeds' DE, "
+            "checked against a 0.1° sweep and scipy's DE, plus figures (bands, 3D path, path "
+            "vs ideal profile) of the FM² path at 100 m AGL.\n\n"
+            "Example:  fm2uav reproduce coverage --out out/coverage"
+        ),
+    )
+    @handle_errors
+    def reproduce_coverage(
+        seed: int = typer.Option(0, help="Seed of the terrain and of the DE."),
+        out: Path = typer.Option(Path("out/coverage"), help="Output directory."),
+        force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
+        as_json: bool = typer.Option(False, "--json", help="Print the tables as JSON."),
+        quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
+    ) -> None:
+        from ..missions.coverage import differential_evolution, plan_coverage, scipy_de, sweep
+        from ..viz.coverage import bands_figure, coverage_figure
+        from ..world.coverage_map import (
+            COVERAGE_AGL,
+            COVERAGE_AREAS,
+            COVERAGE_SPACING,
+            coverage_area,
+            coverage_world,
+        )
+
+        names = list(COVERAGE_AREAS)
+        files = ["table_5_1.csv", "table_5_2.csv", "tables.md", "summary.json"]
+        files += [f"bands_{n}.png" for n in names] + [f"coverage_{n}.png" for n in names]
+        files += [f"bands_S1_D{d}.png" for d in (40, 60, 100)]
+        outdir = OutputDir(out, force=force)
+        outdir.check(files)
+        world = coverage_world(seed)
+
+        def row(poly, d):
+            de = differential_evolution(poly, d, seed=seed)
+            sw = sweep(poly, d, step_deg=0.1)
+            sp = scipy_de(poly, d, seed=seed)
+            st = de.stats()
+            return de, {**{k: round(st[k], 3) for k in _COLS},
+                        "sweep_cost": round(sw.cost, 3), "sweep_alpha": round(sw.angle_deg, 3),
+                        "de_vs_sweep_pct": round(100 * (de.cost - sw.cost) / sw.cost, 4),
+                        "scipy_cost": round(sp.cost, 3), "scipy_alpha": round(sp.angle_deg, 3),
+                        "de_s": round(de.seconds, 4)}
+
+        t51, t52, cover = {}, {}, {}
+        for n in names:
+            poly = coverage_area(n)
+            de, r = row(poly, COVERAGE_SPACING)
+            cp = plan_coverage(world, poly, COVERAGE_SPACING, agl=COVERAGE_AGL,
+                               angle=de.angle)
+            r.update(coverage_pct=round(100 * cp.coverage, 3),
+                     fm2_length=round(cp.plan.length, 1),
+                     agl_err_mean=round(float(np.abs(cp.agl_error).mean()), 2),
+                     plan_s=round(cp.timings["total"] + de.seconds, 4))
+            t51[n] = r
+            cover[n] = cp
+            _write_png(outdir, bands_figure(cp.zigzag, title=f"{n}, D = 80 m"), f"bands_{n}.png")
+            _write_png(outdir, coverage_figure(cp, title=f"{n} at {COVERAGE_AGL:g} m AGL"),
+                       f"coverage_{n}.png")
+        s1 = coverage_area("S1")
+        for d in (40, 60, 80, 100):
+            de, r = row(s1, float(d))
+            t52[d] = r
+            if d != 80:
+                from ..missions.coverage import zigzag
+
+                _write_png(outdir, bands_figure(zigzag(s1, d, de.angle), title=f"S1, D = {d} m"),
+                           f"bands_S1_D{d}.png")
+
+        def table_csv(rows, key, seeds):
+            buf = io.StringIO()
+            cols = list(next(iter(rows.values())).keys())
+            w = csv.writer(buf)
+            w.writerow([key, *cols, *(f"seeds_{c}" for c in _COLS)])
+            for k, r in rows.items():
+                w.writerow([k, *(r[c] for c in cols), *seeds[k]])
+            return buf.getvalue()
+
+        def table_md(rows, key, seeds, title):
+            head = (f"### {title}\n\n| {key} | min cost (m) | α (°) | max cost (m) | α (°) | "
+                    "median cost | α | mean cost | α | 0.1° sweep best (m) | DE−sweep (%) | "
+                    "seeds min cost | seeds α |\n|" + "---|" * 13 + "\n")
+            lines = []
+            for k, r in rows.items():
+                lines.append(
+                    f"| {k} | " + " | ".join(f"{r[c]:.3f}" for c in _COLS)
+                    + f" | {r['sweep_cost']:.3f} | {r['de_vs_sweep_pct']:+.4f} | "
+                    f"{seeds[k][0]:.3f} | {seeds[k][1]:.3f} |")
+            return head + "\n".join(lines) + "\n"
+
+        with outdir.open("table_5_1.csv") as fh:
+            fh.write(table_csv(t51, "surface", SEEDS_T51))
+        with outdir.open("table_5_2.csv") as fh:
+            fh.write(table_csv(t52, "D_m", SEEDS_T52))
+        with outdir.open("tables.md") as fh:
+            fh.write(table_md(t51, "surface", SEEDS_T51,
+                              "Table 5.1 — costs and steering angles, D = 80 m (DE: Np=20, "
+                              "F=0.8, CR=0.7, 30 generations, α∈[1°,89°])"))
+            fh.write("\n")
+            fh.write(table_md(t52, "D (m)", SEEDS_T52, "Table 5.2 — S1 with different D"))
+            fh.write("\n### FM² along the bands (100 m AGL, p1=0.5, p2=1.3)\n\n"
+                     "| surface | coverage (%) | FM² length (m) | mean abs AGL error (m) | "
+                     "DE + plan time (s) |\n|---|---|---|---|---|\n")
+            for n, r in t51.items():
+                fh.write(f"| {n} | {r['coverage_pct']:.2f} | {r['fm2_length']:.0f} | "
+                         f"{r['agl_err_mean']:.2f} | {r['plan_s']:.3f} |\n")
+        payload = {"table_5_1": t51, "table_5_2": {str(k): v for k, v in t52.items()},
+                   "seeds_table_5_1": SEEDS_T51, "seeds_table_5_2": SEEDS_T52}
+        with outdir.open("summary.json") as fh:
+            json.dump(to_jsonable(payload), fh, indent=2)
+        rows = {f"{n} (D=80)": f"best {r['min_cost']:.1f} m at {r['min_alpha']:.3f}° "
+                f"(sweep {r['sweep_cost']:.1f}; seeds {SEEDS_T51[n][0]:.1f} at "
+                f"{SEEDS_T51[n][1]:.3f}°), coverage {r['coverage_pct']:.2f} %"
+                for n, r in t51.items()}
+        rows.update({f"S1 D={d}": f"best {r['min_cost']:.1f} m at {r['min_alpha']:.3f}° "
+                     f"(seeds {SEEDS_T52[d][0]:.1f} at {SEEDS_T52[d][1]:.3f}°)"
+                     for d, r in t52.items()})
+        print_summary("coverage (Tables 5.1 / 5.2)", payload if as_json else rows,
+                      as_json=as_json, quiet=quiet, files=outdir.written)

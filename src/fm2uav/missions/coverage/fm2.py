@@ -1,0 +1,305 @@
+"""FM² along the zigzag at a flight level (seeds 003 §IV, thesis §5.3).
+
+The seeds turn the best zigzag into the binary map W0 by enlarging every
+stretch of it (so the path can dodge obstacles in x-y, not only in z), run
+FM² over it and impose the flight level with p1/p2 (Algorithm 2). Here:
+
+1. corridor: ``C(x, y) = max(0, 1 - dist(x, y; zigzag) / h)`` — the FM²
+   velocity of the enlarged zigzag (distance to the corridor's edge,
+   normalised), ``h = corridor · D`` its half-width (< D/2 so that the
+   corridors of neighbouring bands never touch and the wave cannot cut
+   across them);
+2. flight level: :func:`fm2uav.planning.flight_level.flight_level_speed`
+   (Algorithm 2, optional tolerance band) applied to a uniform map of value
+   ``level_contrast`` on the free nodes: the level is clarified to
+   ``level_contrast ** p1``, all other nodes darkened to ``level_contrast ** p2``
+   — the contrast Algorithm 2 needs, independently of how open the sky is;
+3. ``W = C · W_level`` (0 on obstacles and outside the corridor), then
+   :func:`fm2uav.plan` with ``speed_map=W`` from the zigzag's first point to its
+   last, both on the flight level.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from ...errors import InputError
+from ...planning import plan as fm2_plan
+from ...planning.flight_level import flight_layer, flight_level_speed
+from ...world import World
+from .area import as_area, check_inside_world, check_spacing
+from .bands import Zigzag, zigzag
+from .optimise import AngleSearch, optimise_angle
+from .report import coverage_share
+
+__all__ = ["CoveragePlan", "corridor_speed", "coverage_speed_map", "plan_coverage"]
+
+
+def corridor_speed(world: World, path_xy: np.ndarray, half_width: float) -> np.ndarray:
+    """FM² velocity of the enlarged zigzag on the map's columns, shape (nx, ny).
+
+    ``max(0, 1 - d / half_width)`` with ``d`` the horizontal distance [m] from a
+    column to the polyline ``path_xy`` (sampled every quarter cell).
+    """
+    if not (np.isfinite(half_width) and half_width > 0):
+        raise InputError(f"corridor half-width must be > 0 metres, got {half_width!r}")
+    dx, dy = world.spacing[0], world.spacing[1]
+    step = 0.25 * min(dx, dy)
+    xy = np.asarray(path_xy, dtype=float)[:, :2]
+    seg = np.diff(xy, axis=0)
+    lens = np.linalg.norm(seg, axis=1)
+    pts = [xy[:1]]
+    for p, v, ln in zip(xy[:-1], seg, lens):
+        k = max(int(math.ceil(ln / step)), 1)
+        pts.append(p + v * (np.arange(1, k + 1)[:, None] / k))
+    dense = np.vstack(pts)
+    nx, ny = world.shape[0], world.shape[1]
+    gx = world.origin[0] + dx * np.arange(nx)
+    gy = world.origin[1] + dy * np.arange(ny)
+    X, Y = np.meshgrid(gx, gy, indexing="ij")
+    d, _ = cKDTree(dense).query(np.column_stack([X.ravel(), Y.ravel()]),
+                                distance_upper_bound=half_width)
+    c = np.clip(1.0 - d / half_width, 0.0, 1.0)
+    c[~np.isfinite(d)] = 0.0
+    return c.reshape(nx, ny)
+
+
+def coverage_speed_map(
+    world: World,
+    zz: Zigzag,
+    *,
+    agl: float,
+    p1: float = 0.5,
+    p2: float = 1.3,
+    corridor: float = 0.25,
+    level_band: float | None = None,
+    level_graded: bool = False,
+    level_contrast: float = 0.5,
+) -> np.ndarray:
+    """Velocity map W of the coverage FM² (corridor × flight level), shape of the world.
+
+    Parameters
+    ----------
+    world : World
+        3D map with terrain.
+    zz : Zigzag
+        The zigzag to follow.
+    agl : float
+        Flight level above the ground [m].
+    p1, p2 : float
+        Exponents on the level / on all other nodes (seeds: 0.5, 1.3).
+    corridor : float
+        Corridor half-width as a share of D, in (0, 0.5). Default 0.25.
+    level_band : float, optional
+        Half-width [m] of the clarified band around the level (passed to
+        ``flight_level_speed(band=)``); default one vertical cell, so that the
+        clarified layer stays face-connected where the ground slopes.
+    level_graded : bool
+        Blend the exponent across the band (``flight_level_speed(graded=)``).
+    level_contrast : float
+        Value in (0, 1) of the uniform map Algorithm 2 shapes. Default 0.5.
+    """
+    if world.ndim != 3:
+        raise InputError("coverage FM² needs a 3D world with terrain")
+    if not (0 < corridor < 0.5):
+        raise InputError(f"corridor must be a share of D in (0, 0.5), got {corridor!r}")
+    if not (0 < level_contrast < 1):
+        raise InputError(f"level_contrast must be in (0, 1), got {level_contrast!r}")
+    cell = min(world.spacing[0], world.spacing[1])
+    h = corridor * zz.spacing
+    if h < 1.0 * cell:
+        raise InputError(
+            f"the corridor half-width {h:g} m (corridor {corridor:g} x D = {zz.spacing:g} m) is "
+            f"under one cell ({cell:g} m): the bands are too close for this grid; use "
+            f"D >= {cell / corridor:g} m or a finer map"
+        )
+    band = world.spacing[2] if level_band is None else float(level_band)
+    base = np.where(world.occupancy, 0.0, float(level_contrast))
+    level = flight_level_speed(base, world, agl, p1, p2, band=band, graded=level_graded)
+    c = corridor_speed(world, zz.path(step=cell / 2.0), h)
+    return level * c[:, :, None]
+
+
+@dataclass(frozen=True, eq=False)
+class CoveragePlan:
+    """Result of :func:`plan_coverage`.
+
+    Attributes
+    ----------
+    zigzag : Zigzag
+        The bands flown.
+    search : AngleSearch or None
+        The steering-angle search (None when the angle was given).
+    plan : fm2uav.Plan
+        The FM² path along the bands (``plan.path`` is (N, 3) [m]).
+    coverage : float
+        Share of the area within D/2 of the FM² path's ground track.
+    zigzag_coverage : float
+        Same for the ideal zigzag (should be 1).
+    agl_error : ndarray
+        Height above the ground minus ``agl`` along the path [m].
+    timings : dict
+        Wall times [s]: ``angle``, ``zigzag``, ``speed_map``, ``fm2``, ``report``, ``total``.
+    params : dict
+        Settings.
+    """
+
+    zigzag: Zigzag
+    search: AngleSearch | None
+    plan: Any
+    coverage: float
+    zigzag_coverage: float
+    agl_error: np.ndarray = field(repr=False)
+    timings: dict[str, float] = field(default_factory=dict)
+    params: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def path(self) -> np.ndarray:
+        """(N, 3) FM² path [m]."""
+        return self.plan.path
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-friendly numbers."""
+        e = np.abs(self.agl_error)
+        out = {
+            "angle_deg": round(self.zigzag.angle_deg, 4),
+            "bands": self.zigzag.n_bands,
+            "extra_bands": list(self.zigzag.extra_bands),
+            "zigzag_cost_m": round(self.zigzag.cost, 3),
+            "path_length_m": round(float(self.plan.length), 3),
+            "coverage": round(self.coverage, 6),
+            "zigzag_coverage": round(self.zigzag_coverage, 6),
+            "agl_error_mean_abs_m": round(float(e.mean()), 3),
+            "agl_error_max_abs_m": round(float(e.max()), 3),
+            "timings_s": {k: round(v, 6) for k, v in self.timings.items()},
+            "params": dict(self.params),
+        }
+        if self.search is not None:
+            out["search"] = {"method": self.search.method, "evaluations": self.search.evaluations,
+                             **{k: round(v, 4) for k, v in self.search.stats().items()}}
+        return out
+
+
+def _on_level(world: World, xy: np.ndarray, layer: np.ndarray, what: str) -> np.ndarray:
+    if not world.contains(np.r_[xy, world.origin[2]]):
+        raise InputError(f"the zigzag {what} {np.round(xy, 1).tolist()} m is outside the map")
+    i, j = (int(v) for v in np.round(world.to_index(np.r_[xy, world.origin[2]])[:2]))
+    z = world.origin[2] + layer[i, j] * world.spacing[2]
+    return np.r_[xy, z]
+
+
+def plan_coverage(
+    world: World,
+    area,
+    spacing: float,
+    *,
+    agl: float,
+    angle: float | None = None,
+    search: str = "de",
+    search_options: dict[str, Any] | None = None,
+    seed: int | np.random.Generator = 0,
+    p1: float = 0.5,
+    p2: float = 1.3,
+    corridor: float = 0.25,
+    level_band: float | None = None,
+    level_graded: bool = False,
+    level_contrast: float = 0.5,
+    order: int = 2,
+) -> CoveragePlan:
+    """Coverage path: best zigzag over ``area``, then FM² along it at ``agl`` over the terrain.
+
+    Parameters
+    ----------
+    world : World
+        3D map with terrain (e.g. ``fm2uav.world.coverage_map.coverage_world()``).
+    area : Polygon, GeoJSON dict or (k, 2) vertices
+        Area to cover [m] (inside the map).
+    spacing : float
+        Band spacing D [m] (see :mod:`.camera` to derive it from a camera).
+    agl : float
+        Flight level above the ground [m].
+    angle : float, optional
+        Steering angle [rad]; default: searched with ``search``.
+    search : {"de", "sweep", "scipy-de"}
+        Angle search (default the seeds' DE).
+    search_options : dict, optional
+        Extra keywords for the search (e.g. ``bounds_deg=(0, 180)``).
+    seed : int or Generator
+        Seed of the DE.
+    p1, p2 : float
+        Flight-level exponents (seeds: 0.5 and 1.3 at level 10).
+    corridor, level_band, level_graded, level_contrast
+        See :func:`coverage_speed_map`.
+    order : {1, 2}
+        Fast Marching order.
+
+    Returns
+    -------
+    CoveragePlan
+
+    Raises
+    ------
+    InputError
+        Bad area, spacing, or the zigzag leaves the map.
+    fm2uav.PlanningError
+        The flight level leaves the map; the corridor is cut (unreachable).
+    """
+    t0 = time.perf_counter()
+    if not isinstance(world, World) or world.ndim != 3:
+        raise InputError("plan_coverage needs a 3D fm2uav.World with terrain")
+    poly = as_area(area)
+    d = check_spacing(poly, spacing)
+    check_inside_world(poly, world)
+    found = None
+    if angle is None:
+        opts = dict(search_options or {})
+        if search.lower() in ("de", "scipy-de"):
+            opts.setdefault("seed", seed)
+        found = optimise_angle(poly, d, method=search, **opts)
+        angle = found.angle
+    t1 = time.perf_counter()
+    zz = zigzag(poly, d, angle)
+    ideal = zz.path()
+    b = world.bounds
+    out = ((ideal[:, 0] < b[0, 0]) | (ideal[:, 0] > b[0, 1]) | (ideal[:, 1] < b[1, 0])
+           | (ideal[:, 1] > b[1, 1]))
+    if out.any():
+        p = ideal[np.argmax(out)]
+        raise InputError(
+            f"the zigzag (turns reach D/2 = {d / 2:g} m beyond the bands) leaves the map at "
+            f"({p[0]:.1f}, {p[1]:.1f}) m; keep the area at least D/2 from the map's edge or "
+            "use a smaller D"
+        )
+    t2 = time.perf_counter()
+    W = coverage_speed_map(world, zz, agl=agl, p1=p1, p2=p2, corridor=corridor,
+                           level_band=level_band, level_graded=level_graded,
+                           level_contrast=level_contrast)
+    layer = flight_layer(world, agl)
+    start = _on_level(world, zz.start, layer, "start")
+    goal = _on_level(world, zz.goal, layer, "end")
+    t3 = time.perf_counter()
+    fm = fm2_plan(world, start, goal, speed_map=W, order=order)
+    t4 = time.perf_counter()
+    cov = coverage_share(poly, fm.path, d / 2.0)
+    zcov = coverage_share(poly, ideal, d / 2.0)
+    from ...viz.figures import terrain_along
+
+    ground = terrain_along(world, fm.path)
+    err = fm.path[:, 2] - ground - agl
+    t5 = time.perf_counter()
+    return CoveragePlan(
+        zigzag=zz, search=found, plan=fm, coverage=cov, zigzag_coverage=zcov, agl_error=err,
+        timings={"angle": t1 - t0, "zigzag": t2 - t1, "speed_map": t3 - t2, "fm2": t4 - t3,
+                 "report": t5 - t4, "total": t5 - t0},
+        params={"spacing_m": d, "agl_m": float(agl), "p1": float(p1), "p2": float(p2),
+                "corridor": float(corridor), "level_band_m": (world.spacing[2] if level_band is None
+                                                               else float(level_band)),
+                "level_graded": bool(level_graded), "level_contrast": float(level_contrast),
+                "search": None if found is None else found.method, "order": int(order)},
+    )

@@ -1,0 +1,148 @@
+"""Figures of coverage plans: bands over the area, 3D path, path vs ideal profile.
+
+Drawing only: every number comes from a :class:`~fm2uav.missions.coverage.Zigzag`
+or :class:`~fm2uav.missions.coverage.CoveragePlan`.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.colors import LightSource  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+
+from .figures import _arc_length, terrain_along  # noqa: E402
+
+if TYPE_CHECKING:
+    from ..missions.coverage import CoveragePlan, Zigzag
+
+__all__ = ["bands_figure", "coverage_figure", "coverage_html"]
+
+
+def _draw_area(ax, area, **kw) -> None:
+    x, y = area.exterior.xy
+    ax.fill(x, y, color=kw.get("color", "tab:blue"), alpha=0.18, lw=0)
+    ax.plot(x, y, color=kw.get("color", "tab:blue"), lw=1.5, label=kw.get("label", "area"))
+    for ring in area.interiors:
+        hx, hy = ring.xy
+        ax.fill(hx, hy, color="white", alpha=0.9, lw=0)
+        ax.plot(hx, hy, color=kw.get("color", "tab:blue"), lw=1.0, ls="--")
+
+
+def _draw_zigzag(ax, zz: Zigzag, *, bands_label: str = "bands") -> None:
+    path = zz.path()
+    ax.plot(path[:, 0], path[:, 1], color="0.35", lw=1.0, ls=":", label="turns / extensions")
+    for k, seg in enumerate(zz.bands()):
+        x, y = seg.xy
+        ax.plot(x, y, color="crimson", lw=2.0, label=bands_label if k == 0 else None)
+    for i in range(zz.n_bands - 1):
+        arc = zz.arc_points(i)
+        ax.plot(arc[:, 0], arc[:, 1], color="darkorange", lw=1.5,
+                label="arcs" if i == 0 else None)
+    ax.plot(*zz.start, "o", color="limegreen", mec="k", ms=8, label="start")
+    ax.plot(*zz.goal, "*", color="gold", mec="k", ms=12, label="end")
+
+
+def bands_figure(zz: Zigzag, *, title: str | None = None) -> Figure:
+    """Top view of the zigzag over the area: bands, arcs, extensions, start/end."""
+    fig, ax = plt.subplots(figsize=(7, 6))
+    _draw_area(ax, zz.area)
+    _draw_zigzag(ax, zz)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.legend(loc="best", fontsize=8)
+    ax.grid(alpha=0.3)
+    sub = (f"α = {zz.angle_deg:.3f}°, D = {zz.spacing:g} m, {zz.n_bands} bands, "
+           f"cost {zz.cost:.1f} m")
+    ax.set_title(f"{title}\n{sub}" if title else sub, fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def coverage_figure(cp: CoveragePlan, *, title: str | None = None) -> Figure:
+    """Top view on the terrain, 3D view and altitude profile (path vs ideal) of a coverage plan."""
+    world = cp.plan.world
+    path = cp.path
+    b = world.bounds
+    fig = plt.figure(figsize=(17, 5.4))
+    ax = fig.add_subplot(1, 3, 1)
+    if world.terrain is not None:
+        ls = LightSource(azdeg=315, altdeg=45)
+        rgb = ls.shade(world.terrain.T, cmap=plt.get_cmap("gist_earth"), vert_exag=2.0,
+                       dx=world.spacing[0], dy=world.spacing[1], blend_mode="soft")
+        ax.imshow(rgb, origin="lower", extent=(b[0, 0], b[0, 1], b[1, 0], b[1, 1]))
+    _draw_area(ax, cp.zigzag.area, color="white", label="area")
+    zz = cp.zigzag.path()
+    ax.plot(zz[:, 0], zz[:, 1], color="k", lw=1.0, ls="--", label="zigzag")
+    ax.plot(path[:, 0], path[:, 1], color="crimson", lw=1.8, label="FM² path")
+    ax.set_xlim(b[0, 0], b[0, 1])
+    ax.set_ylim(b[1, 0], b[1, 1])
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.legend(loc="upper left", fontsize=7)
+    ax.set_title("top view", fontsize=10)
+
+    ax3 = fig.add_subplot(1, 3, 2, projection="3d")
+    if world.terrain is not None:
+        step = max(1, world.shape[0] // 60)
+        gx = world.origin[0] + world.spacing[0] * np.arange(world.shape[0])[::step]
+        gy = world.origin[1] + world.spacing[1] * np.arange(world.shape[1])[::step]
+        X, Y = np.meshgrid(gx, gy, indexing="ij")
+        ax3.plot_surface(X, Y, world.terrain[::step, ::step], cmap="gist_earth", alpha=0.6,
+                         linewidth=0, antialiased=False)
+    ax3.plot(path[:, 0], path[:, 1], path[:, 2], color="crimson", lw=1.5)
+    ax3.set_xlabel("x [m]")
+    ax3.set_ylabel("y [m]")
+    ax3.set_zlabel("z [m]")
+    ax3.set_title("3D view", fontsize=10)
+
+    ax2 = fig.add_subplot(1, 3, 3)
+    s = _arc_length(path)
+    ground = terrain_along(world, path)
+    agl = cp.params["agl_m"]
+    if ground is not None:
+        ax2.fill_between(s, b[2, 0], ground, color="saddlebrown", alpha=0.45, label="terrain")
+        ax2.plot(s, ground + agl, color="k", lw=1.0, ls="--", label=f"ideal ({agl:g} m AGL)")
+    ax2.plot(s, path[:, 2], color="crimson", lw=1.5, label="FM² path")
+    ax2.set_xlabel("distance along path [m]")
+    ax2.set_ylabel("altitude z [m]")
+    ax2.legend(loc="upper left", fontsize=7)
+    ax2.grid(alpha=0.3)
+    ax2.set_title("path vs ideal profile", fontsize=10)
+    e = np.abs(cp.agl_error)
+    sub = (f"α = {cp.zigzag.angle_deg:.3f}°, D = {cp.zigzag.spacing:g} m, zigzag cost "
+           f"{cp.zigzag.cost:.0f} m, FM² length {cp.plan.length:.0f} m, coverage "
+           f"{100 * cp.coverage:.2f} %, |AGL error| mean {e.mean():.1f} m / max {e.max():.1f} m")
+    fig.suptitle(f"{title}\n{sub}" if title else sub, fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+def coverage_html(cp: CoveragePlan, *, title: str = "coverage plan") -> str:
+    """Interactive 3D view (plotly) of the terrain, the area and the path, as an HTML string."""
+    import plotly.graph_objects as go
+
+    world = cp.plan.world
+    path = cp.path
+    data = []
+    if world.terrain is not None:
+        gx = world.origin[0] + world.spacing[0] * np.arange(world.shape[0])
+        gy = world.origin[1] + world.spacing[1] * np.arange(world.shape[1])
+        data.append(go.Surface(x=gx, y=gy, z=world.terrain.T, colorscale="Earth",
+                               opacity=0.85, showscale=False, name="terrain"))
+        ring = np.asarray(cp.zigzag.area.exterior.coords)
+        rz = terrain_along(world, np.column_stack([ring, np.zeros(len(ring))])) + 2.0
+        data.append(go.Scatter3d(x=ring[:, 0], y=ring[:, 1], z=rz, mode="lines",
+                                 line=dict(color="white", width=4), name="area"))
+    data.append(go.Scatter3d(x=path[:, 0], y=path[:, 1], z=path[:, 2], mode="lines",
+                             line=dict(color="crimson", width=5), name="FM² path"))
+    fig = go.Figure(data=data)
+    fig.update_layout(title=title, scene=dict(aspectmode="data", xaxis_title="x [m]",
+                                              yaxis_title="y [m]", zaxis_title="z [m]"))
+    return fig.to_html(include_plotlyjs="cdn", full_html=True)
