@@ -23,6 +23,7 @@ import numpy as np
 from ..errors import WorldError
 from .terrain import OPEN_FIELD_SHAPE, open_field_heights
 from .world import World
+from .buildings import city, city_high  # noqa: E402  (thesis ch. 3 city)
 from .coverage_map import coverage  # noqa: E402  (coverage paper 003, thesis ch. 5)
 
 __all__ = [
@@ -148,6 +149,13 @@ def fissure(seed: int | np.random.Generator = 0) -> Scenario:
     )
 
 
+def _city2d(seed: int | np.random.Generator = 0) -> Scenario:
+    """2D city map of the curvature study (see :mod:`fm2uav.world.maps2d`)."""
+    from .maps2d import city2d
+
+    return city2d(seed)
+
+
 def _jacksboro(seed: int | np.random.Generator = 0) -> Scenario:
     """Real DEM of the Jacksboro fault (see :mod:`fm2uav.world.jacksboro`)."""
     from .jacksboro import jacksboro
@@ -159,8 +167,11 @@ def _jacksboro(seed: int | np.random.Generator = 0) -> Scenario:
 SCENARIOS: dict[str, Callable[..., Scenario]] = {
     "open-field": open_field,
     "fissure": fissure,
-    "coverage": coverage,
     "jacksboro": _jacksboro,
+    "city": city,
+    "city-high": city_high,
+    "coverage": coverage,
+    "city2d": _city2d,
 }
 
 

@@ -384,3 +384,14 @@ class World:
         from .dem import from_dem
 
         return from_dem(source, cell_size, ceiling, **kwargs)
+
+    @classmethod
+    def from_buildings(cls, footprints: Any, cell_size: float | Sequence[float], **kwargs: Any) -> World:
+        """Build a 3D world from GeoJSON building footprints with heights.
+
+        See :func:`fm2uav.world.buildings.from_buildings` for the parameters
+        (``height`` [m] or ``building:levels`` x 3 m per level).
+        """
+        from .buildings import from_buildings
+
+        return from_buildings(footprints, cell_size, **kwargs)

@@ -1,0 +1,96 @@
+"""``fm2uav check``: can an airframe fly this path? (Dubins airplane / multirotor)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import typer
+
+from ._common import EXIT_PLANNING, OutputDir, handle_errors, print_summary, to_jsonable
+
+CHECK_FILES = ("report.json", "flown.csv", "check.png")
+
+
+def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
+    """Add the ``check`` command."""
+    from ..vehicles import AIRFRAMES
+
+    @app.command(
+        "check",
+        help=(
+            "Check whether an airframe can fly a path file (x_m,y_m[,z_m] CSV): simulate the "
+            "Dubins airplane (fixed-wing) or a multirotor following it, report the separation "
+            "from the plan, where the turn/climb limits saturate, a geometric check (curvature "
+            "vs 1/R, climb angle) and a verdict. Writes report.json, flown.csv and check.png.\n\n"
+            "Examples:\n\n"
+            "  fm2uav check out/plan/path.csv --airframe disco --out out/check\n\n"
+            "  fm2uav check path.csv --airframe crosswind --scenario city --tolerance 3 --json\n\n"
+            f"Airframes: {', '.join(AIRFRAMES)}."
+        ),
+    )
+    @handle_errors
+    def check_cmd(
+        path_file: Path = typer.Argument(..., help="Path CSV (as written by fm2uav plan)."),
+        airframe: str = typer.Option("disco", help="Airframe preset."),
+        scenario: str | None = typer.Option(
+            None, help="Also check collisions of the flown path in this built-in scenario."
+        ),
+        seed: int = typer.Option(0, help="Seed of the scenario."),
+        tolerance: float = typer.Option(5.0, help="Largest admissible separation [m]."),
+        lookahead: float | None = typer.Option(None, help="Carrot distance [m] (default R_min)."),
+        lookahead_points: int | None = typer.Option(
+            None, help="Or the thesis' a: look this many path points ahead."
+        ),
+        speed: float | None = typer.Option(None, help="Fixed-wing airspeed [m/s] (default cruise)."),
+        dt: float = typer.Option(0.05, help="Simulation step [s]."),
+        fail_infeasible: bool = typer.Option(
+            False, "--fail-infeasible", help="Exit with code 1 when the path is infeasible."
+        ),
+        out: Path = typer.Option(Path("out/check"), help="Output directory."),
+        force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
+        as_json: bool = typer.Option(False, "--json", help="Print the report as JSON."),
+        quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
+    ) -> None:
+        from ..io import read_path_csv, write_path_csv
+        from ..vehicles import check_feasibility, get_airframe
+        from ..viz.feasibility import tracking_figure
+        from ..world.scenarios import get_scenario
+
+        af = get_airframe(airframe)
+        path = read_path_csv(path_file)
+        world = get_scenario(scenario, seed=seed).world if scenario else None
+        outdir = OutputDir(out, force=force)
+        outdir.check(CHECK_FILES)
+        rep = check_feasibility(path, af, world=world, tolerance=tolerance, lookahead=lookahead,
+                                lookahead_points=lookahead_points, speed=speed, dt=dt)
+        summary = {"path_file": str(path_file), "scenario": scenario, **rep.summary()}
+        tmp_png = outdir.target("check.png")
+        tracking_figure(rep, world, title=path_file.name).savefig(tmp_png, dpi=100)
+        with outdir.open("flown.csv") as fh:
+            write_path_csv(fh, rep.tracking.trajectory)
+        outdir.commit(tmp_png, "check.png")
+        with outdir.open("report.json") as fh:
+            json.dump(to_jsonable(summary), fh, indent=2)
+        tr, geo = rep.tracking, rep.geometric
+        sat = ", ".join(f"{k} {v:.1f} s" for k, v in tr.saturation_time().items()) or "none"
+        rows = {
+            "verdict": "FEASIBLE" if rep.feasible else "INFEASIBLE",
+            "reason": rep.reason,
+            "airframe": f"{af.name} ({af.kind})",
+            "separation max / mean [m]": f"{tr.max_separation:.2f} / {tr.mean_separation:.2f}",
+            "limits saturated": sat,
+            "geometric check": ("ok" if geo.feasible else "violated") + f": {geo.reason}",
+            "min radius of curvature [m]": (f"{geo.min_radius:.1f}"
+                                            if math.isfinite(geo.min_radius) else "inf"),
+            "max climb / descent [deg]": (f"{np.degrees(geo.climb_angle.max()):.1f} / "
+                                          f"{np.degrees(-geo.climb_angle.min()):.1f}"),
+        }
+        if getattr(af, "kind", "") == "fixed-wing":
+            rows["R_min [m]"] = f"{af.turn_radius(rep.airframe.cruise_speed):.1f}"
+        print_summary("feasibility check", summary if as_json else rows, as_json=as_json,
+                      quiet=quiet, files=outdir.written)
+        if fail_infeasible and not rep.feasible:
+            raise typer.Exit(EXIT_PLANNING)

@@ -1,0 +1,255 @@
+"""Airframe limits: fixed-wing (Dubins airplane) and multirotor, with named presets.
+
+Fixed-wing (thesis ch. 3, Beard & McLain's Dubins airplane): constant cruise
+speed ``V``, bank angle ``|φ| <= φ_max`` (coordinated turn, so the turn rate is
+``ψ̇ = g tan φ / V`` and the minimum turn radius ``R = V² / (g tan φ_max)``),
+flight-path angle ``-γ_descent <= γ <= γ_climb``. Its admissible speed runs from
+the stall (minimum) speed, W = 0, to the maximum speed, W = 1 (thesis §3.2).
+
+Multirotor: horizontal speed ``<= v_max``, acceleration ``<= a_max`` (which
+bounds the turn: ``v² κ <= a_max``), vertical speed in ``[-v_descent, v_climb]``.
+
+Presets (:data:`AIRFRAMES`) take their numbers from ArduPilot parameter files
+and defaults, so each can be checked at its source (see docs/feasibility.md):
+
+=================  =====  =====  =====  =====  =======  =======  ==========================
+fixed-wing          V      Vmin   Vmax   φmax   γclimb   γdesc    source
+=================  =====  =====  =====  =====  =======  =======  ==========================
+``disco``           14     12     17     55°    30°      25°      ArduPilot Parrot_Disco.param
+``crosswind``       20     16     29     35°    22°      25°      ArduPilot MFD_Crosswind_VTOL.param
+``plane-jet``       40     25     80     70°    20°      25°      ArduPilot plane-jet.parm
+=================  =====  =====  =====  =====  =======  =======  ==========================
+
+(speeds m/s: AIRSPEED_CRUISE / AIRSPEED_MIN / AIRSPEED_MAX; φmax = ROLL_LIMIT_DEG;
+γ limits = PTCH_LIM_MAX_DEG / -PTCH_LIM_MIN_DEG, the pitch limits taken as
+flight-path-angle limits, i.e. zero angle of attack.)
+
+=================  =====  =====  =======  =======  ==========================
+multirotor          vmax   amax   vclimb   vdesc    source
+=================  =====  =====  =======  =======  ==========================
+``arducopter``      10     2.5    2.5      1.5      ArduCopter AC_WPNav defaults
+=================  =====  =====  =======  =======  ==========================
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Any
+
+from ..errors import InputError
+
+__all__ = [
+    "G",
+    "FixedWing",
+    "Multirotor",
+    "Airframe",
+    "AIRFRAMES",
+    "get_airframe",
+]
+
+#: Standard gravity [m/s²].
+G = 9.80665
+
+
+def _positive(name: str, value: Any, *, allow_zero: bool = False) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"airframe {name} must be a number, got {value!r}") from None
+    if not math.isfinite(v) or v < 0 or (v == 0 and not allow_zero):
+        raise InputError(
+            f"airframe {name} must be finite and {'>=' if allow_zero else '>'} 0, got {value!r}"
+        )
+    return v
+
+
+@dataclass(frozen=True)
+class FixedWing:
+    """A fixed-wing UAV flown as a Dubins airplane.
+
+    Attributes
+    ----------
+    name : str
+        Preset or user name.
+    cruise_speed : float
+        Constant airspeed of the tracking simulation [m/s].
+    min_speed : float
+        Stall (minimum) speed [m/s]; W = 0 on the speed map.
+    max_speed : float
+        Maximum speed [m/s]; W = 1.
+    max_bank : float
+        Maximum bank angle φ_max [rad], in (0, π/2).
+    max_climb : float
+        Maximum flight-path angle when climbing γ_climb [rad], in (0, π/2).
+    max_descent : float
+        Maximum flight-path angle when descending (positive number) [rad].
+    source : str
+        Where the numbers come from.
+    """
+
+    name: str
+    cruise_speed: float
+    min_speed: float
+    max_speed: float
+    max_bank: float
+    max_climb: float
+    max_descent: float
+    source: str = ""
+
+    kind = "fixed-wing"
+
+    def __post_init__(self) -> None:
+        for attr in ("cruise_speed", "min_speed", "max_speed"):
+            object.__setattr__(self, attr, _positive(attr + " [m/s]", getattr(self, attr)))
+        for attr in ("max_bank", "max_climb", "max_descent"):
+            v = _positive(attr + " [rad]", getattr(self, attr))
+            if v >= math.pi / 2:
+                raise InputError(
+                    f"airframe {attr} must be below 90 degrees, got {math.degrees(v):.3g} degrees"
+                )
+            object.__setattr__(self, attr, v)
+        if not self.min_speed <= self.cruise_speed <= self.max_speed:
+            raise InputError(
+                f"airframe speeds must satisfy min <= cruise <= max, got min {self.min_speed} "
+                f"cruise {self.cruise_speed} max {self.max_speed} m/s"
+            )
+
+    def turn_radius(self, speed: float | None = None) -> float:
+        """Minimum turn radius ``R = V² / (g tan φ_max)`` [m] at ``speed`` (default cruise)."""
+        v = self.cruise_speed if speed is None else _positive("speed [m/s]", speed)
+        return v * v / (G * math.tan(self.max_bank))
+
+    def max_turn_rate(self, speed: float | None = None) -> float:
+        """Maximum turn rate ``g tan φ_max / V`` [rad/s] at ``speed`` (default cruise)."""
+        v = self.cruise_speed if speed is None else _positive("speed [m/s]", speed)
+        return G * math.tan(self.max_bank) / v
+
+    def with_speed(self, cruise_speed: float) -> FixedWing:
+        """The same airframe flown at another cruise speed [m/s] (validated)."""
+        return replace(self, cruise_speed=cruise_speed)
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-friendly numbers, angles in degrees."""
+        return {
+            "airframe": self.name,
+            "kind": self.kind,
+            "cruise_speed_mps": self.cruise_speed,
+            "min_speed_mps": self.min_speed,
+            "max_speed_mps": self.max_speed,
+            "max_bank_deg": round(math.degrees(self.max_bank), 3),
+            "max_climb_deg": round(math.degrees(self.max_climb), 3),
+            "max_descent_deg": round(math.degrees(self.max_descent), 3),
+            "min_turn_radius_m": round(self.turn_radius(), 3),
+            "max_turn_rate_dps": round(math.degrees(self.max_turn_rate()), 3),
+            "source": self.source,
+        }
+
+
+@dataclass(frozen=True)
+class Multirotor:
+    """A multirotor UAV (point mass with bounded speed and acceleration).
+
+    Attributes
+    ----------
+    name : str
+        Preset or user name.
+    max_speed : float
+        Maximum horizontal speed [m/s]; W = 1 on the speed map (W = 0: hover).
+    max_accel : float
+        Maximum acceleration [m/s²] (horizontal and vertical).
+    max_climb_rate : float
+        Maximum vertical speed up [m/s].
+    max_descent_rate : float
+        Maximum vertical speed down (positive number) [m/s].
+    source : str
+        Where the numbers come from.
+    """
+
+    name: str
+    max_speed: float
+    max_accel: float
+    max_climb_rate: float
+    max_descent_rate: float
+    source: str = ""
+
+    kind = "multirotor"
+
+    def __post_init__(self) -> None:
+        for attr, unit in (
+            ("max_speed", "m/s"),
+            ("max_accel", "m/s²"),
+            ("max_climb_rate", "m/s"),
+            ("max_descent_rate", "m/s"),
+        ):
+            object.__setattr__(self, attr, _positive(f"{attr} [{unit}]", getattr(self, attr)))
+
+    @property
+    def cruise_speed(self) -> float:
+        """Nominal speed of the tracking simulation: ``max_speed`` [m/s]."""
+        return self.max_speed
+
+    def turn_radius(self, speed: float | None = None) -> float:
+        """Tightest turn radius ``v² / a_max`` [m] at ``speed`` (default max speed)."""
+        v = self.max_speed if speed is None else _positive("speed [m/s]", speed, allow_zero=True)
+        return v * v / self.max_accel
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-friendly numbers."""
+        return {
+            "airframe": self.name,
+            "kind": self.kind,
+            "max_speed_mps": self.max_speed,
+            "max_accel_mps2": self.max_accel,
+            "max_climb_rate_mps": self.max_climb_rate,
+            "max_descent_rate_mps": self.max_descent_rate,
+            "turn_radius_at_max_speed_m": round(self.turn_radius(), 3),
+            "source": self.source,
+        }
+
+
+Airframe = FixedWing | Multirotor
+
+_ARDU = "ArduPilot Tools/Frame_params"
+#: Named presets (see the module docstring for the sources of the numbers).
+AIRFRAMES: dict[str, Airframe] = {
+    "disco": FixedWing(
+        "disco", 14.0, 12.0, 17.0, math.radians(55.0), math.radians(30.0), math.radians(25.0),
+        source=f"Parrot Disco, {_ARDU}/Parrot_Disco/Parrot_Disco.param (AIRSPEED_CRUISE/MIN/MAX, "
+        "ROLL_LIMIT_DEG, PTCH_LIM_MAX_DEG/PTCH_LIM_MIN_DEG)",
+    ),
+    "crosswind": FixedWing(
+        "crosswind", 20.0, 16.0, 29.0, math.radians(35.0), math.radians(22.0), math.radians(25.0),
+        source=f"MFD Crosswind VTOL in plane mode, {_ARDU}/QuadPlanes/MFD_Crosswind_VTOL.param "
+        "(AIRSPEED_*, ROLL_LIMIT_DEG, PTCH_LIM_MAX_DEG); descent 25 deg as the other ArduPilot "
+        "plane files (the file leaves PTCH_LIM_MIN_DEG unset)",
+    ),
+    "plane-jet": FixedWing(
+        "plane-jet", 40.0, 25.0, 80.0, math.radians(70.0), math.radians(20.0), math.radians(25.0),
+        source="ArduPilot Tools/autotest/default_params/plane-jet.parm (AIRSPEED_*, ROLL_LIMIT_DEG, "
+        "PTCH_LIM_MAX_DEG/PTCH_LIM_MIN_DEG)",
+    ),
+    "arducopter": Multirotor(
+        "arducopter", 10.0, 2.5, 2.5, 1.5,
+        source="ArduCopter waypoint navigation defaults, libraries/AC_WPNav (WPNAV_SPEED 1000 cm/s, "
+        "WPNAV_ACCELERATION 2.5 m/s², WPNAV_SPEED_UP 250 cm/s, WPNAV_SPEED_DN 150 cm/s)",
+    ),
+}
+
+
+def get_airframe(name: str | Airframe) -> Airframe:
+    """The preset called ``name`` (an airframe object is returned unchanged).
+
+    Raises
+    ------
+    InputError
+        Unknown name (the message lists the presets).
+    """
+    if isinstance(name, (FixedWing, Multirotor)):
+        return name
+    key = str(name).strip().lower().replace("_", "-")
+    if key not in AIRFRAMES:
+        raise InputError(
+            f"unknown airframe {name!r}; valid presets are: {', '.join(sorted(AIRFRAMES))}"
+        )
+    return AIRFRAMES[key]

@@ -1,0 +1,171 @@
+"""Dubins-airplane tracking of a planned path (thesis ch. 3, eqs 3.2–3.10).
+
+Model (Beard & McLain's Dubins airplane, thesis eq. 3.2), constant speed V::
+
+    ẋ = V cos ψ cos γ,   ẏ = V sin ψ cos γ,   ż = V sin γ,
+    |ψ̇| <= g tan φ_max / V,   -γ_descent <= γ <= γ_climb.
+
+Guidance (where the thesis' eqs 3.3–3.10 are ambiguous, see docs/feasibility.md):
+a pure-pursuit carrot follower. The aircraft's position is projected on the
+planned path (monotone progress); the carrot is the path point ``lookahead``
+metres further along (the thesis' "p_{i+a}", eqs 3.5–3.6: ``lookahead_points=a``
+gives ``a`` path steps). Heading: the pure-pursuit turn rate
+``ψ̇ = 2 V cosγ sin η / L_xy`` (η = bearing of the carrot minus ψ, L_xy its
+horizontal distance; a carrot behind the aircraft commands the maximum rate),
+the thesis' proportional law ρ = K_ψ e(ψ) with gain 2V/L. Flight-path angle:
+``γ = atan2(Δz, L_xy)`` towards the carrot (the thesis' eq. 3.4 with the
+carrot), the law φ = K_γ e(γ) with an instantaneous response. Unlike the
+thesis ("the limitation of ρ and φ has not been considered") both commands are
+clipped to the airframe's limits, and every clipped step is recorded as
+saturated — without that clipping no path could be found infeasible.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from ._path import arc_length, as_path3, distance_to_polyline
+from .airframes import Airframe, FixedWing, get_airframe
+from .tracking import Carrot, Tracking, check_dt, check_lookahead
+
+__all__ = ["track_dubins"]
+
+
+def track_dubins(
+    path: Any,
+    airframe: FixedWing | str,
+    *,
+    lookahead: float | None = None,
+    lookahead_points: int | None = None,
+    speed: float | None = None,
+    dt: float = 0.05,
+    max_time: float | None = None,
+) -> Tracking:
+    """Fly a fixed-wing Dubins airplane along ``path`` and record what happens.
+
+    Parameters
+    ----------
+    path : array (N, 2|3)
+        Planned path [m], start → goal (2D: flown at z = 0).
+    airframe : FixedWing or preset name
+    lookahead : float, optional
+        Carrot distance along the path [m]. Default: the minimum turn radius
+        R_min at the flown speed (at least 2 m).
+    lookahead_points : int, optional
+        The thesis' ``a``: look ``a`` path points ahead (``a`` x median point
+        spacing metres). Exclusive with ``lookahead``.
+    speed : float, optional
+        Constant airspeed [m/s]; default the airframe's cruise speed. Must lie
+        in [min_speed, max_speed].
+    dt : float
+        Integration step [s]. Default 0.05.
+    max_time : float, optional
+        Give up after this long [s]; default ``3 x length / V + 60``.
+
+    Returns
+    -------
+    Tracking
+        ``saturated`` has ``"turn"``, ``"climb"`` and ``"descent"``;
+        ``states`` has ``heading``, ``flight_path_angle``, ``turn_rate``.
+
+    Raises
+    ------
+    InputError
+        Bad path (fewer than 2 points, NaN), airframe, speed, look-ahead or dt.
+    """
+    af: Airframe = get_airframe(airframe)
+    if not isinstance(af, FixedWing):
+        raise InputError(
+            f"track_dubins needs a fixed-wing airframe, got the {af.kind} {af.name!r}; "
+            "use fm2uav.vehicles.track_multirotor for multirotors"
+        )
+    planned = as_path3(path)
+    if speed is not None:
+        af = af.with_speed(speed)  # validates min <= speed <= max
+    V = af.cruise_speed
+    dt = check_dt(dt)
+    R = af.turn_radius()
+    L = check_lookahead(path, lookahead, lookahead_points, max(R, 2.0))
+    length = float(arc_length(planned)[-1])
+    t_max = 3.0 * length / V + 60.0 if max_time is None else float(max_time)
+    if not (math.isfinite(t_max) and t_max > 0):
+        raise InputError(f"max_time must be a positive time in seconds, got {max_time!r}")
+    ds = max(min(0.5, L / 8.0, length / 50.0), 1e-3)
+    carrot = Carrot(planned, L, ds, reach=3.0 * V * dt + L + 2 * ds)
+    rate_max = af.max_turn_rate()
+    g_up, g_dn = af.max_climb, af.max_descent
+
+    pos = planned[0].copy()
+    c0 = carrot.pts[min(carrot.n_ahead, carrot.last)] - pos
+    psi = math.atan2(c0[1], c0[0])
+    gam = min(max(math.atan2(c0[2], math.hypot(c0[0], c0[1])), -g_dn), g_up)
+    n_max = int(math.ceil(t_max / dt)) + 1
+    traj = np.empty((n_max, 3))
+    prog = np.empty(n_max)
+    heading = np.empty(n_max)
+    fpa = np.empty(n_max)
+    rate = np.empty(n_max)
+    sat_t = np.zeros(n_max, bool)
+    sat_c = np.zeros(n_max, bool)
+    sat_d = np.zeros(n_max, bool)
+    reached = False
+    k = 0
+    for k in range(n_max):
+        idx, c = carrot.update(pos)
+        if idx >= carrot.last and k > 0:
+            # abeam of / past the goal: the flight ends at the previous step
+            # (within one step V*dt of the goal), so the overshoot is not counted
+            reached = True
+            k -= 1
+            break
+        traj[k] = pos
+        prog[k] = carrot.s[idx]
+        d = c - pos
+        lxy = math.hypot(d[0], d[1])
+        # flight-path angle towards the carrot, clipped
+        g_cmd = math.atan2(d[2], lxy)
+        if g_cmd > g_up:
+            sat_c[k] = True
+            g_cmd = g_up
+        elif g_cmd < -g_dn:
+            sat_d[k] = True
+            g_cmd = -g_dn
+        # pure-pursuit turn rate, clipped
+        if lxy > 1e-9:
+            eta = (math.atan2(d[1], d[0]) - psi + math.pi) % (2 * math.pi) - math.pi
+            if abs(eta) > math.pi / 2:
+                cmd = math.copysign(math.inf, eta)
+            else:
+                cmd = 2.0 * V * math.cos(g_cmd) * math.sin(eta) / lxy
+        else:
+            cmd = 0.0
+        if abs(cmd) > rate_max * (1 + 1e-9):
+            sat_t[k] = True
+            cmd = math.copysign(rate_max, cmd)
+        heading[k], fpa[k], rate[k] = psi, g_cmd, cmd
+        # integrate (midpoint heading, constant γ over the step)
+        pm = psi + 0.5 * cmd * dt
+        cg = math.cos(g_cmd)
+        pos = pos + V * dt * np.array([math.cos(pm) * cg, math.sin(pm) * cg, math.sin(g_cmd)])
+        psi = psi + cmd * dt
+        gam = g_cmd
+    n = k + 1
+    traj = traj[:n]
+    return Tracking(
+        airframe=af,
+        planned=planned,
+        t=np.arange(n) * dt,
+        trajectory=traj,
+        progress=prog[:n],
+        separation=distance_to_polyline(traj, planned),
+        saturated={"turn": sat_t[:n], "climb": sat_c[:n], "descent": sat_d[:n]},
+        states={"heading": heading[:n], "flight_path_angle": fpa[:n], "turn_rate": rate[:n],
+                "speed": np.full(n, V)},
+        reached=reached,
+        lookahead=L,
+        dt=dt,
+    )

@@ -1,0 +1,216 @@
+"""Can this airframe fly this path? The feasibility report.
+
+:func:`check_feasibility` runs the three checks and gives one verdict:
+
+1. tracking simulation (:func:`.track_dubins` for fixed-wings,
+   :func:`.track_multirotor` for multirotors) — the thesis' check: the flown
+   ("feasible") path must reach the goal, stay within ``tolerance`` metres of
+   the planned path (the separation distance) and, with a world, never enter
+   an obstacle node nor leave the map;
+2. geometric check (:func:`.geometric_check`): curvature vs 1/R_min and
+   climb angle vs the limits, no simulation — reported, not part of the verdict
+   (a polyline corner fails it and yet may be flown within tolerance);
+3. admissible-speed profile (:func:`.speed_profile`) from W and curvature.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..analysis.clearance import clearance_profile
+from ..errors import InputError
+from ..world import World
+from ._path import as_path3
+from .airframes import Airframe, FixedWing, get_airframe
+from .dubins_airplane import track_dubins
+from .geometric import GeometricCheck, geometric_check
+from .multirotor import track_multirotor
+from .speed_profile import SpeedProfile, speed_profile
+from .tracking import Tracking
+
+__all__ = ["DEFAULT_TOLERANCE", "FeasibilityReport", "check_feasibility", "collision_check"]
+
+#: Default largest admissible separation flown ↔ planned [m]: about the
+#: horizontal accuracy of a GNSS-guided small UAV plus margin.
+DEFAULT_TOLERANCE = 5.0
+
+
+def collision_check(world: World, points: np.ndarray) -> dict[str, Any]:
+    """Whether points [m] (3D; 2D worlds use x, y) leave the map or hit an obstacle node.
+
+    Returns a dict: ``outside`` and ``inside_obstacle`` (counts), ``first`` (index
+    of the first offending point or None), ``min_clearance_m``.
+    """
+    pts = np.asarray(points, dtype=float)[:, : world.ndim]
+    inside = np.atleast_1d(world.contains(pts))
+    idx = np.floor(world.to_index(pts) + 0.5).astype(np.int64)
+    idx = np.clip(idx, 0, np.asarray(world.shape) - 1)
+    hit = world.occupancy[tuple(idx.T)] & inside
+    bad = ~inside | hit
+    clr = clearance_profile(world, pts)
+    return {
+        "outside": int(np.count_nonzero(~inside)),
+        "inside_obstacle": int(np.count_nonzero(hit)),
+        "first": int(np.flatnonzero(bad)[0]) if bad.any() else None,
+        "min_clearance_m": float(clr.min()),
+    }
+
+
+@dataclass(frozen=True, eq=False)
+class FeasibilityReport:
+    """Result of :func:`check_feasibility`.
+
+    Attributes
+    ----------
+    airframe : FixedWing or Multirotor
+    tracking : Tracking
+        The simulated flight (trajectory, separation, saturations).
+    geometric : GeometricCheck
+    speed : SpeedProfile
+    tolerance : float
+        Largest admissible separation [m].
+    collision : dict or None
+        :func:`collision_check` of the flown trajectory (None without world).
+    feasible : bool
+        The verdict (tracking-based, see the module doc).
+    reasons : list of str
+        Why (every failed condition, or what held).
+    """
+
+    airframe: Airframe
+    tracking: Tracking
+    geometric: GeometricCheck
+    speed: SpeedProfile
+    tolerance: float
+    collision: dict[str, Any] | None
+    feasible: bool
+    reasons: list[str] = field(default_factory=list)
+
+    @property
+    def reason(self) -> str:
+        """The reasons as one sentence."""
+        return "; ".join(self.reasons)
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-friendly report (angles in degrees)."""
+        return {
+            "feasible": self.feasible,
+            "reason": self.reason,
+            "airframe": self.airframe.summary(),
+            "tolerance_m": self.tolerance,
+            "tracking": self.tracking.summary(),
+            "saturation_intervals": self.tracking.saturation_intervals(),
+            "geometric": self.geometric.summary(),
+            "speed_profile": self.speed.summary(),
+            "collision": self.collision,
+        }
+
+
+def check_feasibility(
+    path: Any,
+    airframe: Airframe | str,
+    *,
+    world: World | None = None,
+    w: Any = None,
+    tolerance: float = DEFAULT_TOLERANCE,
+    lookahead: float | None = None,
+    lookahead_points: int | None = None,
+    speed: float | None = None,
+    dt: float = 0.05,
+    window: float | None = None,
+) -> FeasibilityReport:
+    """Check whether ``airframe`` can fly ``path``.
+
+    Parameters
+    ----------
+    path : array (N, 2|3)
+        Planned path [m], start → goal (e.g. ``Plan.path`` or a CSV read with
+        :func:`fm2uav.io.read_path_csv`).
+    airframe : FixedWing, Multirotor or preset name (see ``AIRFRAMES``)
+    world : World, optional
+        Also check that the flown trajectory stays in free space.
+    w : array (N,), optional
+        W along the path (``Plan.speed``), for the admissible-speed profile.
+    tolerance : float
+        Largest admissible separation flown ↔ planned [m]. Default 5.
+    lookahead, lookahead_points : optional
+        Carrot distance [m] or the thesis' ``a`` points (see the trackers).
+    speed : float, optional
+        Fixed-wing airspeed [m/s] (default cruise).
+    dt : float
+        Simulation step [s].
+    window : float, optional
+        Window of the geometric profiles [m].
+
+    Returns
+    -------
+    FeasibilityReport
+
+    Raises
+    ------
+    InputError
+        Unknown airframe, bad path (< 2 points, NaN), negative speed or tolerance.
+    """
+    af = get_airframe(airframe)
+    tol = float(tolerance)
+    if not (math.isfinite(tol) and tol > 0):
+        raise InputError(f"tolerance must be a positive distance in metres, got {tolerance!r}")
+    raw = np.asarray(path, dtype=float) if not isinstance(path, np.ndarray) else path
+    as_path3(raw)  # validate once, with the user's view of the path
+    if world is not None and not isinstance(world, World):
+        raise InputError(f"world must be a fm2uav.World, got {type(world).__name__}")
+    if world is not None and raw.shape[1] != world.ndim:
+        raise InputError(
+            f"the path has {raw.shape[1]} coordinates per point but the world is {world.ndim}D"
+        )
+    if isinstance(af, FixedWing):
+        if speed is not None:
+            af = af.with_speed(speed)
+        tr = track_dubins(raw, af, lookahead=lookahead, lookahead_points=lookahead_points, dt=dt)
+    else:
+        if speed is not None:
+            raise InputError("speed= applies to fixed-wings; a multirotor flies the W profile")
+        tr = track_multirotor(raw, af, w=w, lookahead=lookahead,
+                              lookahead_points=lookahead_points, dt=dt)
+    geo = geometric_check(raw, af, window=window)
+    prof = speed_profile(raw, af, w, window=window)
+    reasons: list[str] = []
+    ok = True
+    if not tr.reached:
+        ok = False
+        reasons.append(f"did not reach the goal within {tr.duration:.0f} s (it cannot follow the "
+                       "path: it circles or drifts away)")
+    if tr.max_separation > tol:
+        ok = False
+        i = int(np.argmax(tr.separation))
+        reasons.append(
+            f"strays {tr.max_separation:.2f} m from the planned path (tolerance {tol:g} m) at "
+            f"{tr.progress[i]:.0f} m along it"
+        )
+    col = None
+    if world is not None:
+        col = collision_check(world, tr.trajectory)
+        if col["first"] is not None:
+            ok = False
+            p = tr.trajectory[col["first"]]
+            what = "leaves the map" if col["outside"] else "enters an obstacle"
+            reasons.append(f"the flown trajectory {what} at {np.round(p, 1).tolist()} m "
+                           f"(t = {tr.t[col['first']]:.1f} s)")
+    sat = tr.saturation_time()
+    if ok:
+        msg = (f"flown within {tr.max_separation:.2f} m of the planned path (tolerance {tol:g} m, "
+               f"mean {tr.mean_separation:.2f} m) and reached the goal")
+        if col is not None:
+            msg += f", min clearance {col['min_clearance_m']:.1f} m"
+        reasons.append(msg)
+    busy = {k: v for k, v in sat.items() if v > 0}
+    if busy:
+        reasons.append("limits saturated " + ", ".join(f"{k} {v:.1f} s" for k, v in busy.items()))
+    return FeasibilityReport(
+        airframe=af, tracking=tr, geometric=geo, speed=prof, tolerance=tol, collision=col,
+        feasible=ok, reasons=reasons,
+    )

@@ -1,0 +1,145 @@
+"""Multirotor tracking of a planned path: a point mass with bounded speed and acceleration.
+
+Guidance: the same carrot as the fixed-wing (:class:`.tracking.Carrot`). The
+desired velocity points at the carrot with the admissible speed of the path
+there (:func:`.speed_profile.speed_profile`: W, curvature ``sqrt(a_max/κ)``)
+and a braking limit ``sqrt(2 a_max d_goal)`` so it stops at the goal; its
+vertical part is clipped to ``[-v_descent, v_climb]`` and its horizontal part
+to ``v_max``. The acceleration is ``(v_des - v) / τ`` (τ = 0.5 s) clipped to
+``a_max`` — clipped steps are recorded as ``"accel"`` saturation, clipped
+vertical speeds as ``"climb"`` / ``"descent"``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from ._path import arc_length, as_path3, distance_to_polyline
+from .airframes import Multirotor, get_airframe
+from .speed_profile import speed_profile
+from .tracking import Carrot, Tracking, check_dt, check_lookahead
+
+__all__ = ["track_multirotor"]
+
+_TAU = 0.5  # velocity response time constant [s]
+
+
+def track_multirotor(
+    path: Any,
+    airframe: Multirotor | str,
+    *,
+    w: Any = None,
+    lookahead: float | None = None,
+    lookahead_points: int | None = None,
+    dt: float = 0.05,
+    max_time: float | None = None,
+) -> Tracking:
+    """Fly a multirotor along ``path`` and record what happens.
+
+    Parameters
+    ----------
+    path : array (N, 2|3)
+        Planned path [m].
+    airframe : Multirotor or preset name
+    w : array (N,), optional
+        W along the path in [0, 1] (speed = W v_max); default: no W limit.
+    lookahead : float, optional
+        Largest carrot distance [m]; default ``max(v_max * 1 s, 2 m)``. The
+        carrot is ``max(v_adm * 1 s, 1 m)`` ahead, capped at this.
+    lookahead_points : int, optional
+        The thesis' ``a`` (points ahead); exclusive with ``lookahead``.
+    dt : float
+        Integration step [s].
+    max_time : float, optional
+        Give up after [s]; default ``3 x length / mean admissible speed + 60``.
+
+    Returns
+    -------
+    Tracking
+        ``saturated``: ``"accel"``, ``"climb"``, ``"descent"``; ``states``:
+        ``speed`` [m/s], ``v_ref`` [m/s].
+    """
+    af = get_airframe(airframe)
+    if not isinstance(af, Multirotor):
+        raise InputError(
+            f"track_multirotor needs a multirotor airframe, got the {af.kind} {af.name!r}; "
+            "use fm2uav.vehicles.track_dubins for fixed-wings"
+        )
+    planned = as_path3(path)
+    dt = check_dt(dt)
+    L = check_lookahead(path, lookahead, lookahead_points, max(af.max_speed * 1.0, 2.0))
+    prof = speed_profile(path, af, w)
+    s_plan = arc_length(planned)
+    length = float(s_plan[-1])
+    v_floor = 0.05 * af.max_speed  # W = 0 would never arrive: creep at 5 %
+    v_adm = np.maximum(prof.v_admissible, v_floor)
+    t_max = 3.0 * length / float(np.mean(v_adm)) + 60.0 if max_time is None else float(max_time)
+    if not (math.isfinite(t_max) and t_max > 0):
+        raise InputError(f"max_time must be a positive time in seconds, got {max_time!r}")
+    ds = max(min(0.5, L / 8.0, length / 50.0), 1e-3)
+    carrot = Carrot(planned, L, ds, reach=3.0 * af.max_speed * dt + L + 2 * ds)
+    v_at = np.interp(carrot.s, prof.s, v_adm)
+    a_max = af.max_accel
+
+    pos = planned[0].copy()
+    vel = np.zeros(3)
+    n_max = int(math.ceil(t_max / dt)) + 1
+    traj = np.empty((n_max, 3))
+    prog = np.empty(n_max)
+    spd = np.empty(n_max)
+    vref = np.empty(n_max)
+    sat_a = np.zeros(n_max, bool)
+    sat_c = np.zeros(n_max, bool)
+    sat_d = np.zeros(n_max, bool)
+    reached = False
+    k = 0
+    for k in range(n_max):
+        # look ahead ~1 s at the admissible speed (>= 1 m, <= lookahead)
+        idx, c = carrot.update(pos, ahead=max(float(v_at[carrot.idx]) * 1.0, 1.0))
+        goal_d = float(np.linalg.norm(planned[-1] - pos))
+        if (idx >= carrot.last or goal_d < 0.05) and k > 0:
+            reached = True
+            k -= 1
+            break
+        traj[k], prog[k], spd[k] = pos, carrot.s[idx], float(np.linalg.norm(vel))
+        d = c - pos
+        dn = float(np.linalg.norm(d))
+        v_ref = min(float(v_at[idx]), math.sqrt(2.0 * a_max * goal_d))
+        vref[k] = v_ref
+        v_des = d / dn * v_ref if dn > 1e-12 else np.zeros(3)
+        if v_des[2] > af.max_climb_rate:
+            sat_c[k] = True
+            v_des[2] = af.max_climb_rate
+        elif v_des[2] < -af.max_descent_rate:
+            sat_d[k] = True
+            v_des[2] = -af.max_descent_rate
+        h = math.hypot(v_des[0], v_des[1])
+        if h > af.max_speed:
+            v_des[:2] *= af.max_speed / h
+        acc = (v_des - vel) / _TAU
+        an = float(np.linalg.norm(acc))
+        if an > a_max * (1 + 1e-9):
+            sat_a[k] = True
+            acc *= a_max / an
+        new_vel = vel + acc * dt
+        pos = pos + 0.5 * (vel + new_vel) * dt
+        vel = new_vel
+    n = k + 1
+    traj = traj[:n]
+    return Tracking(
+        airframe=af,
+        planned=planned,
+        t=np.arange(n) * dt,
+        trajectory=traj,
+        progress=prog[:n],
+        separation=distance_to_polyline(traj, planned),
+        saturated={"accel": sat_a[:n], "climb": sat_c[:n], "descent": sat_d[:n]},
+        states={"speed": spd[:n], "v_ref": vref[:n]},
+        reached=reached,
+        lookahead=L,
+        dt=dt,
+    )

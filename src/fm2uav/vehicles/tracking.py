@@ -1,0 +1,164 @@
+"""The result of a path-tracking simulation, shared by the fixed-wing and multirotor models."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from ._path import as_path3, resample, runs
+from .airframes import Airframe
+
+__all__ = ["Tracking", "Carrot"]
+
+
+@dataclass(frozen=True, eq=False)
+class Tracking:
+    """A simulated flight along a planned path.
+
+    Attributes
+    ----------
+    airframe : FixedWing or Multirotor
+    planned : ndarray (N, 3)
+        The planned path [m] (2D paths get z = 0).
+    t : ndarray (K,)
+        Time [s].
+    trajectory : ndarray (K, 3)
+        Flown positions [m].
+    progress : ndarray (K,)
+        Arc length of the projection of each flown point on the planned path [m].
+    separation : ndarray (K,)
+        Distance from each flown point to the planned path (polyline) [m].
+    saturated : dict of str to ndarray of bool (K,)
+        Per limit (``"turn"``, ``"climb"``, ``"descent"``, ``"accel"``), whether
+        the command asked for more than the airframe allows at that step.
+    states : dict of str to ndarray (K,)
+        Model states: ``heading`` ψ [rad], ``flight_path_angle`` γ [rad],
+        ``speed`` [m/s], ...
+    reached : bool
+        The projection reached the end of the planned path before the time limit.
+    lookahead : float
+        Look-ahead distance of the guidance [m].
+    dt : float
+        Integration step [s].
+    """
+
+    airframe: Airframe
+    planned: np.ndarray = field(repr=False)
+    t: np.ndarray = field(repr=False)
+    trajectory: np.ndarray = field(repr=False)
+    progress: np.ndarray = field(repr=False)
+    separation: np.ndarray = field(repr=False)
+    saturated: dict[str, np.ndarray] = field(repr=False)
+    states: dict[str, np.ndarray] = field(repr=False)
+    reached: bool
+    lookahead: float
+    dt: float
+
+    @property
+    def max_separation(self) -> float:
+        """Largest distance flown → planned path [m] (the thesis' separation distance)."""
+        return float(self.separation.max())
+
+    @property
+    def mean_separation(self) -> float:
+        """Time-averaged distance flown → planned path [m]."""
+        return float(self.separation.mean())
+
+    @property
+    def duration(self) -> float:
+        """Flight time [s]."""
+        return float(self.t[-1] - self.t[0])
+
+    def saturation_intervals(self) -> list[dict[str, Any]]:
+        """Where and how long each limit saturates (time and arc length along the plan)."""
+        out = []
+        for limit, flag in self.saturated.items():
+            for i, j in runs(flag):
+                out.append({
+                    "limit": limit,
+                    "t_from_s": round(float(self.t[i]), 3),
+                    "t_to_s": round(float(self.t[j - 1] + self.dt), 3),
+                    "duration_s": round(float((j - i) * self.dt), 3),
+                    "s_from_m": round(float(self.progress[i]), 2),
+                    "s_to_m": round(float(self.progress[j - 1]), 2),
+                })
+        return sorted(out, key=lambda d: d["t_from_s"])
+
+    def saturation_time(self) -> dict[str, float]:
+        """Total time [s] each limit is saturated."""
+        return {k: float(np.count_nonzero(v) * self.dt) for k, v in self.saturated.items()}
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-friendly numbers."""
+        return {
+            "reached_goal": self.reached,
+            "flight_time_s": round(self.duration, 3),
+            "max_separation_m": round(self.max_separation, 3),
+            "mean_separation_m": round(self.mean_separation, 3),
+            "lookahead_m": round(self.lookahead, 3),
+            "dt_s": self.dt,
+            "saturated_s": {k: round(v, 3) for k, v in self.saturation_time().items()},
+            "saturation_intervals": len(self.saturation_intervals()),
+        }
+
+
+class Carrot:
+    """Projection on a planned path and the look-ahead ("carrot") point.
+
+    The path is resampled every ``ds`` metres; the projection index only moves
+    forward, searched in a window of ``reach`` metres ahead of the last one, so
+    a path that comes back near itself is not short-cut.
+    """
+
+    def __init__(self, path: np.ndarray, lookahead: float, ds: float, reach: float) -> None:
+        self.pts, self.s = resample(path, ds)
+        self.ds = float(self.s[1] - self.s[0]) if len(self.s) > 1 else ds
+        self.n_ahead = max(int(round(lookahead / self.ds)), 1)
+        self.win = max(int(math.ceil(reach / self.ds)), 2) + 1
+        self.idx = 0
+        self.last = len(self.pts) - 1
+
+    def update(self, pos: np.ndarray, ahead: float | None = None) -> tuple[int, np.ndarray]:
+        """Advance the projection of ``pos``; return (index, carrot point).
+
+        ``ahead`` [m] overrides the look-ahead for this step (at most the
+        constructor's, which sized the search window).
+        """
+        hi = min(self.idx + self.win, self.last + 1)
+        seg = self.pts[self.idx : hi]
+        d2 = np.einsum("ij,ij->i", seg - pos, seg - pos)
+        self.idx += int(np.argmin(d2))
+        n = self.n_ahead if ahead is None else min(max(int(round(ahead / self.ds)), 1), self.n_ahead)
+        return self.idx, self.pts[min(self.idx + n, self.last)]
+
+
+def check_lookahead(
+    path: np.ndarray, lookahead: float | None, lookahead_points: int | None, default: float
+) -> float:
+    """Look-ahead distance [m] from metres, or from the thesis' ``a`` points ahead."""
+    if lookahead is not None and lookahead_points is not None:
+        raise InputError("give either lookahead (metres) or lookahead_points (a), not both")
+    if lookahead_points is not None:
+        if isinstance(lookahead_points, bool) or int(lookahead_points) != lookahead_points \
+                or lookahead_points < 1:
+            raise InputError(f"lookahead_points must be an integer >= 1, got {lookahead_points!r}")
+        step = float(np.median(np.linalg.norm(np.diff(as_path3(path), axis=0), axis=1)))
+        return int(lookahead_points) * step
+    if lookahead is None:
+        return default
+    v = float(lookahead)
+    if not (math.isfinite(v) and v > 0):
+        raise InputError(f"lookahead must be a positive distance in metres, got {lookahead!r}")
+    return v
+
+
+def check_dt(dt: float) -> float:
+    """Validate the integration step [s]."""
+    v = float(dt)
+    if not (math.isfinite(v) and v > 0):
+        raise InputError(f"dt must be a positive time step in seconds, got {dt!r}")
+    return v
