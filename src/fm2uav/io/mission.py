@@ -82,8 +82,20 @@ class WorldSpec(BaseModel):
     seed: int = _num(0, ge=0, le=2**31 - 1, desc="seed of the scenario's relief")
     dem: str | None = Field(None, description="GeoTIFF DEM path (relative to the mission file)")
     buildings: str | None = Field(None, description="GeoJSON building footprints path")
-    cell_size: float | None = _num(None, unit="m", gt=0, le=1000, desc="grid cell size")
-    height_cells: int | None = _num(None, ge=2, le=2000, desc="number of vertical nodes")
+    cell_size: float | None = _num(None, unit="m", gt=0, le=5000,
+                                   desc="horizontal grid cell size (dem, buildings)")
+    dz: float | None = _num(None, unit="m", gt=0, le=1000,
+                            desc="vertical cell size (default: cell_size)")
+    ceiling: float | None = _num(None, unit="m", ge=-500, le=12000,
+                                 desc="altitude of the top node (dem; default ground max + 20 dz)")
+    nodata: Literal["error", "fill"] = Field("error", description="DEM gaps: refuse or fill")
+    height_cells: int | None = _num(None, ge=2, le=2000,
+                                    desc="number of vertical nodes (buildings)")
+    margin: float = _num(0.0, unit="m", ge=0, le=100000,
+                         desc="free border around the buildings")
+    default_height: float | None = _num(None, unit="m", gt=0, le=1000,
+                                        desc="height of buildings without one")
+    crs: str | None = Field(None, description="CRS of the building coordinates, e.g. EPSG:32630")
     anchor: AnchorSpec | None = Field(None, description="placement of a world without CRS")
 
     @field_validator("scenario")
@@ -130,6 +142,23 @@ class WorldSpec(BaseModel):
             raise ValueError(f"file not found ({path}); allowed: an existing GeoJSON file")
         return str(path)
 
+    @field_validator("crs")
+    @classmethod
+    def _crs(cls, v: str | None) -> str | None:
+        if v is None:
+            return v
+        from pyproj import CRS
+        from pyproj.exceptions import CRSError
+
+        try:
+            c = CRS.from_user_input(v)
+        except CRSError:
+            raise ValueError("is not a CRS pyproj knows; allowed: e.g. EPSG:32630") from None
+        if not c.is_projected:
+            raise ValueError("is not a projected CRS in metres; allowed: a projected CRS such "
+                             "as a UTM zone (building coordinates are metres)")
+        return v
+
     @model_validator(mode="after")
     def _one_source(self) -> WorldSpec:
         given = [k for k in ("scenario", "dem", "buildings") if getattr(self, k) is not None]
@@ -137,7 +166,28 @@ class WorldSpec(BaseModel):
             raise ValueError(
                 f"give exactly one of scenario, dem, buildings (got "
                 f"{', '.join(given) if given else 'none'})")
+        if given[0] != "scenario" and self.cell_size is None:
+            raise ValueError(f"cell_size is missing: a {given[0]} world needs the grid cell "
+                             "size in metres; allowed: 0 < cell_size <= 5000 m")
+        only = {"dem": ("ceiling", "nodata"),
+                "buildings": ("height_cells", "default_height", "crs", "margin")}
+        defaults = {"nodata": "error", "margin": 0.0}
+        for source, keys in only.items():
+            for k in keys:
+                if given[0] != source and getattr(self, k) != defaults.get(k):
+                    raise ValueError(f"{k} only applies to a {source} world, not a "
+                                     f"{given[0]} world; remove it")
+        if given[0] == "scenario":
+            for k in ("cell_size", "dz"):
+                if getattr(self, k) is not None:
+                    raise ValueError(f"{k} does not apply to a built-in scenario (its grid is "
+                                     "fixed); remove it")
         return self
+
+    def spacing(self) -> tuple[float, float, float]:
+        """(dx, dy, dz) [m] of a dem / buildings world."""
+        dx = float(self.cell_size or 0.0)
+        return (dx, dx, float(self.dz) if self.dz is not None else dx)
 
 
 def _resolve(v: str, info: ValidationInfo) -> Path:
@@ -323,31 +373,22 @@ class ResolvedMission:
 def _build_dem(w: WorldSpec) -> Any:
     from ..world import World
 
-    builder = getattr(World, "from_dem", None)
-    if builder is None:
-        raise WorldError("world.dem: this version of fm2uav cannot read DEMs (World.from_dem "
-                         "is missing); use world.scenario instead")
-    kwargs: dict[str, Any] = {}
-    if w.cell_size is not None:
-        kwargs["cell_size"] = w.cell_size
-    if w.height_cells is not None:
-        kwargs["height_cells"] = w.height_cells
-    return builder(w.dem, **kwargs)
+    try:
+        return World.from_dem(w.dem, w.spacing(), w.ceiling, nodata=w.nodata,
+                              name=Path(str(w.dem)).stem)
+    except (WorldError, InputError) as exc:
+        raise type(exc)(f"world.dem = {w.dem!r}: {exc}") from None
 
 
 def _build_buildings(w: WorldSpec) -> Any:
     from ..world import World
 
-    builder = getattr(World, "from_buildings", None)
-    if builder is None:
-        raise WorldError("world.buildings: this version of fm2uav cannot read building "
-                         "footprints (World.from_buildings is missing); use world.scenario")
-    kwargs: dict[str, Any] = {}
-    if w.cell_size is not None:
-        kwargs["cell_size"] = w.cell_size
-    if w.height_cells is not None:
-        kwargs["height_cells"] = w.height_cells
-    return builder(w.buildings, **kwargs)
+    try:
+        return World.from_buildings(
+            str(w.buildings), w.spacing(), height_cells=w.height_cells, margin=w.margin,
+            default_height=w.default_height, crs=w.crs, name=Path(str(w.buildings)).stem)
+    except (WorldError, InputError) as exc:
+        raise type(exc)(f"world.buildings = {w.buildings!r}: {exc}") from None
 
 
 def _resolve_point(p: PointSpec, world: Any, anchor: Anchor, what: str) -> np.ndarray:

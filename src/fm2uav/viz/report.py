@@ -55,12 +55,16 @@ def _surface(world: Any, limit: int) -> tuple[np.ndarray, np.ndarray, np.ndarray
     s = max(_stride(nx, limit), _stride(ny, limit))
     x = world.origin[0] + np.arange(0, nx, s) * world.spacing[0]
     y = world.origin[1] + np.arange(0, ny, s) * world.spacing[1]
-    if world.terrain is not None:
+    top = world.surface_index().astype(float)
+    h = np.where(top >= 0, world.origin[2] + top * world.spacing[2], world.origin[2])
+    # obstacles standing on the terrain (buildings) rise more than a cell above it
+    raised = world.terrain is not None and bool(np.any(h > world.terrain + world.spacing[2]))
+    if world.terrain is not None and not raised:
         z = world.terrain[::s, ::s]
         label = "terrain"
     else:
-        top = world.surface_index().astype(float)
-        h = np.where(top >= 0, world.origin[2] + top * world.spacing[2], world.origin[2])
+        if world.terrain is not None:
+            h = np.maximum(h, world.terrain)
         # block maximum, so thin obstacles (walls, small buildings) stay visible
         px, py = (-nx) % s, (-ny) % s
         hp = np.pad(h, ((0, px), (0, py)), mode="edge")

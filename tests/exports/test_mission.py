@@ -1,0 +1,239 @@
+"""Mission files: the examples run, lon/lat points resolve, and a catalogue of bad files
+each gives one specific line (field, bad value, allowed range) and exit code 2."""
+
+import json
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+import rasterio
+from rasterio.transform import from_origin
+from typer.testing import CliRunner
+
+from fm2uav.cli import app
+from fm2uav.errors import InputError
+from fm2uav.io import read_plan, read_wpl, to_lonlat, validate_plan
+from fm2uav.io.mission import load_mission, parse_mission
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+runner = CliRunner()
+
+
+def _write_dem(path, crs="EPSG:32630", size=(40, 50)):
+    rows, cols = size
+    y, x = np.mgrid[0:rows, 0:cols]
+    z = (600 + 40 * np.sin(x / 7.0) + 30 * np.cos(y / 9.0)).astype("float32")
+    prof = {"driver": "GTiff", "height": rows, "width": cols, "count": 1, "dtype": "float32",
+            "transform": from_origin(440000.0, 4471000.0, 30.0, 30.0)}
+    if crs:
+        prof["crs"] = crs
+    with rasterio.open(path, "w", **prof) as ds:
+        ds.write(z, 1)
+    return path
+
+
+@pytest.fixture(scope="module")
+def examples(tmp_path_factory):
+    """A copy of examples/ with the generated GeoTIFF (as a user makes it)."""
+    import importlib.util
+
+    d = tmp_path_factory.mktemp("examples")
+    shutil.copytree(EXAMPLES, d, dirs_exist_ok=True)
+    spec = importlib.util.spec_from_file_location("mk", d / "make_jacksboro_geotiff.py")
+    mk = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mk)
+    mk.write_geotiff(d / "jacksboro.tif")
+    return d
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in EXAMPLES.glob("*.yaml")))
+def test_every_example_validates(examples, name):
+    m = load_mission(examples / name)
+    assert m.version == 1 and m.outputs.formats
+
+
+@pytest.mark.parametrize("name", ["open_field_tff.yaml", "town_buildings.yaml",
+                                  "jacksboro_geotiff.yaml"])
+def test_examples_run_end_to_end(examples, name, tmp_path):
+    out = tmp_path / "out"
+    res = runner.invoke(app, ["run", str(examples / name), "--out", str(out), "--json"])
+    assert res.exit_code == 0, res.output
+    summary = json.loads(res.output)
+    m = load_mission(examples / name)
+    names = {"csv": "path.csv", "geojson": "path.geojson", "kml": "path.kml",
+             "plan": "mission.plan", "wpl": "mission.waypoints", "html": "report.html",
+             "png": "plan.png", "json": "summary.json"}
+    for f in m.outputs.formats:
+        assert (out / names[f]).stat().st_size > 0
+    assert 3 <= summary["waypoints"] <= 100
+    assert validate_plan(json.loads((out / "mission.plan").read_text())) == []
+    plan = read_plan(out / "mission.plan")
+    wpl = read_wpl(out / "mission.waypoints")
+    np.testing.assert_allclose(plan["lat"], wpl["lat"], atol=1e-7, rtol=0)
+    assert plan["frame"] == summary["mavlink_frame"] == (10 if m.planner.agl else 3)
+    # the file on disk says the same as the printed summary
+    assert json.loads((out / "summary.json").read_text())["waypoints"] == summary["waypoints"]
+    # no overwrite without --force; exit 2, files untouched
+    before = (out / "mission.plan").read_bytes()
+    res = runner.invoke(app, ["run", str(examples / name), "--out", str(out)])
+    assert res.exit_code == 2 and "--force" in res.output
+    assert (out / "mission.plan").read_bytes() == before
+
+
+def test_geotiff_mission_runs_with_lonlat_points(tmp_path):
+    dem = _write_dem(tmp_path / "dem.tif")
+    (tmp_path / "m.yaml").write_text(
+        "world: {dem: dem.tif, cell_size: 60, dz: 20}\n"
+        "start: {lon: -3.7033, lat: 40.3847, agl: 100}\n"
+        "goal: {lon: -3.6927, lat: 40.3785, agl: 100}\n"
+        "planner: {agl: 100}\n"
+        "outputs: {formats: [plan, wpl, json]}\n")
+    m = load_mission(tmp_path / "m.yaml")
+    rm = m.resolve()
+    assert rm.world.crs == "EPSG:32630"
+    # the resolved start is at that lon/lat (and 100 m above the DEM there)
+    lon, lat, _ = to_lonlat(rm.start[None], rm.world)[0]
+    assert (lon, lat) == pytest.approx((-3.7033, 40.3847), abs=1e-9)
+    res = runner.invoke(app, ["run", str(tmp_path / "m.yaml"), "--out", str(tmp_path / "o"),
+                              "--quiet"])
+    assert res.exit_code == 0, res.output
+    assert res.output == ""
+    wpl = read_wpl(tmp_path / "o" / "mission.waypoints")
+    assert set(wpl["frame"]) == {10}
+    assert (wpl["lat"][1], wpl["lon"][1]) == pytest.approx((40.3847, -3.7033), abs=1e-7)
+
+
+def test_lonlat_start_matches_metres_through_the_anchor():
+    base = {"world": {"scenario": "open-field", "anchor": {"lon": 2.0, "lat": 45.0}}}
+    m = parse_mission({**base, "start": [300, 300, 300]})
+    lon, lat, alt = to_lonlat([[300.0, 300.0, 300.0]], None, anchor=m.anchor())[0]
+    m2 = parse_mission({**base, "start": {"lon": lon, "lat": lat, "alt": alt}})
+    np.testing.assert_allclose(m2.resolve().start, [300, 300, 300], atol=1e-6)
+
+
+# ------------------------------------------------------------------ bad mission files
+OK_WORLD = "world: {scenario: open-field}\n"
+BAD = [
+    # (id, yaml text, [substrings the one-line message must contain])
+    ("empty", "", ["empty"]),
+    ("not-yaml", "world: [scenario: open-field\n", ["not valid YAML", "line"]),
+    ("not-mapping", "- 1\n- 2\n", ["must be a mapping"]),
+    ("missing-world", "name: x\n", ["world is missing"]),
+    ("no-source", "world: {seed: 1}\n", ["world", "exactly one of scenario, dem, buildings"]),
+    ("two-sources", "world: {scenario: open-field, dem: a.tif}\n", ["world.dem", "a.tif"]),
+    ("unknown-scenario", "world: {scenario: moon}\n",
+     ["world.scenario = 'moon'", "unknown scenario", "open-field"]),
+    ("unknown-field", OK_WORLD + "planner: {saturaton: 0.5}\n",
+     ["planner.saturaton", "not a known field", "saturation"]),
+    ("sat-range", OK_WORLD + "planner: {saturation: 1.5}\n",
+     ["planner.saturation = 1.5", "out of range", "0 < saturation <= 1"]),
+    ("sat-type", OK_WORLD + "planner: {saturation: high}\n",
+     ["planner.saturation = 'high'", "wrong type", "number", "0 < saturation <= 1"]),
+    ("order", OK_WORLD + "planner: {order: 3}\n", ["planner.order = 3", "1 or 2"]),
+    ("agl-neg", OK_WORLD + "planner: {agl: -10}\n",
+     ["planner.agl = -10", "0 < agl <= 5000 m"]),
+    ("agl-bool", OK_WORLD + "planner: {agl: yes}\n", ["planner.agl = True", "wrong type"]),
+    ("seed", "world: {scenario: open-field, seed: -1}\n", ["world.seed = -1", "0 <= seed"]),
+    ("seed-type", "world: {scenario: open-field, seed: 1.5}\n",
+     ["world.seed = 1.5", "integer"]),
+    ("speed", OK_WORLD + "airframe: {cruise_speed: 0}\n",
+     ["airframe.cruise_speed = 0", "0 < cruise_speed <= 100 m/s"]),
+    ("airframe-type", OK_WORLD + "airframe: {type: blimp}\n",
+     ["airframe.type = 'blimp'", "multirotor"]),
+    ("airframe-scalar", OK_WORLD + "airframe: fast\n", ["airframe = 'fast'", "mapping"]),
+    ("format", OK_WORLD + "outputs: {formats: [plan, pdf]}\n",
+     ["outputs.formats[1] = 'pdf'", "'wpl'"]),
+    ("tolerance", OK_WORLD + "outputs: {thin_tolerance: -1}\n",
+     ["outputs.thin_tolerance = -1", "0 <= thin_tolerance <= 1000 m"]),
+    ("frame", OK_WORLD + "outputs: {frame: amsl}\n", ["outputs.frame = 'amsl'", "'terrain'"]),
+    ("start-short", OK_WORLD + "start: [1, 2]\n", ["start", "[x, y, z]"]),
+    ("start-no-height", OK_WORLD + "start: {x: 1, y: 2}\n", ["start", "exactly one height"]),
+    ("start-lon", OK_WORLD + "start: {lon: 200, lat: 40, agl: 50}\n",
+     ["start.lon = 200", "-180 <= lon <= 180 deg"]),
+    ("start-mixed", OK_WORLD + "start: {x: 1, y: 2, lon: 3, lat: 4, agl: 5}\n",
+     ["start", "exactly one of"]),
+    ("cell-len", OK_WORLD + "goal: {cell: [1, 2]}\n", ["goal.cell = [1, 2]", "exactly 3"]),
+    ("version", "version: 2\n" + OK_WORLD, ["version = 2", "1"]),
+    ("scenario-cell-size", "world: {scenario: open-field, cell_size: 10}\n",
+     ["cell_size does not apply"]),
+    ("dem-missing-file", "world: {dem: nowhere.tif, cell_size: 30}\nstart: [0, 0, 0]\n"
+     "goal: [1, 1, 1]\n", ["world.dem = 'nowhere.tif'", "file not found"]),
+    ("dem-no-cell", "world: {dem: dem.tif}\nstart: [0, 0, 0]\ngoal: [1, 1, 1]\n",
+     ["cell_size is missing"]),
+    ("dem-no-crs", "world: {dem: nocrs.tif, cell_size: 30}\nstart: [0, 0, 0]\n"
+     "goal: [1, 1, 1]\n", ["world.dem = 'nocrs.tif'", "no coordinate reference system"]),
+    ("dem-not-raster", "world: {dem: notes.txt, cell_size: 30}\nstart: [0, 0, 0]\n"
+     "goal: [1, 1, 1]\n", ["world.dem = 'notes.txt'", "cannot be read as a raster"]),
+    ("dem-no-start", "world: {dem: dem.tif, cell_size: 30}\n", ["start is missing"]),
+    ("buildings-crs", "world: {buildings: dem.tif, cell_size: 5, crs: EPSG:4326}\n"
+     "start: [0, 0, 0]\ngoal: [1, 1, 1]\n", ["world.crs = 'EPSG:4326'", "projected"]),
+]
+
+
+@pytest.fixture
+def mission_dir(tmp_path):
+    _write_dem(tmp_path / "dem.tif")
+    _write_dem(tmp_path / "nocrs.tif", crs=None)
+    (tmp_path / "notes.txt").write_text("not a raster\n")
+    return tmp_path
+
+
+@pytest.mark.parametrize("case, text, expected", BAD, ids=[b[0] for b in BAD])
+def test_bad_mission_gives_one_specific_line(mission_dir, case, text, expected):
+    f = mission_dir / f"{case}.yaml"
+    f.write_text(text)
+    with pytest.raises(InputError) as err:
+        load_mission(f)
+    msg = str(err.value)
+    assert "\n" not in msg
+    assert msg.startswith(str(f))
+    for part in expected:
+        assert part in msg, msg
+    res = runner.invoke(app, ["run", str(f), "--out", str(mission_dir / "out")])
+    assert res.exit_code == 2, res.output
+    lines = [ln for ln in res.output.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error:"), res.output
+    assert not (mission_dir / "out").exists()
+
+
+@pytest.mark.parametrize("text, code, part", [
+    # a start inside the terrain is bad input (2), named with the ground height
+    (OK_WORLD + "start: [300, 300, 15]\n", 2, "inside an obstacle"),
+    (OK_WORLD + "goal: [99999, 0, 300]\n", 2, "goal = (99999.0, 0.0, 300.0) m lies outside"),
+    # a flight level above the ceiling cannot be planned (1)
+    (OK_WORLD + "planner: {agl: 580}\n", 1, "flight level"),
+])
+def test_resolve_and_planning_errors_exit_codes(tmp_path, text, code, part):
+    f = tmp_path / "m.yaml"
+    f.write_text(text)
+    res = runner.invoke(app, ["run", str(f), "--out", str(tmp_path / "o")])
+    assert res.exit_code == code, res.output
+    assert part in res.output and len(res.output.strip().splitlines()) == 1
+
+
+def test_missing_mission_file(tmp_path):
+    res = runner.invoke(app, ["run", str(tmp_path / "nope.yaml")])
+    assert res.exit_code == 2 and "not found" in res.output
+
+
+def test_help_shows_examples():
+    for args in (["--help"], ["run", "--help"], ["plan", "--help"]):
+        res = runner.invoke(app, args)
+        assert res.exit_code == 0 and "Example" in res.output, args
+    assert "fm2uav run examples/open_field_tff.yaml" in runner.invoke(app, ["run", "--help"]).output
+
+
+def test_plan_command_report_and_exports(tmp_path):
+    out = tmp_path / "p"
+    res = runner.invoke(app, ["plan", "--out", str(out), "--report", "--export", "all",
+                              "--anchor", "2.35,48.85,35", "--thin", "10", "--json"])
+    assert res.exit_code == 0, res.output
+    data = json.loads(res.output)
+    assert len(data["files"]) == 8 and data["waypoints"] < 60
+    plan = read_plan(out / "mission.plan")
+    assert plan["home"][:2] == pytest.approx((48.85, 2.35), abs=0.05)
+    assert (out / "report.html").stat().st_size > 1_000_000
+    res = runner.invoke(app, ["plan", "--out", str(tmp_path / "q"), "--export", "pdf"])
+    assert res.exit_code == 2 and "'pdf'" in res.output
+    assert not (tmp_path / "q").exists()
