@@ -32,6 +32,8 @@ __all__ = [
     "ground_altitude",
     "ideal_altitude",
     "transition_bounds",
+    "tff_metrics",
+    "SEED_CASES",
 ]
 
 
@@ -105,6 +107,8 @@ class FlightLevelReport:
         Share of the middle points (between the transition stretches) within
         ``tolerance`` of the ideal altitude, in [0, 1]; 0 if the path never
         reaches the level.
+    within_all : float
+        Share of all points (transitions included) within ``tolerance``.
     mean_dev_m, max_dev_m : float
         Mean and max |deviation| over the middle points [m] (nan if none).
     mean_dev_all_m, max_dev_all_m : float
@@ -127,6 +131,7 @@ class FlightLevelReport:
     """
 
     within: float
+    within_all: float
     mean_dev_m: float
     max_dev_m: float
     mean_dev_all_m: float
@@ -176,8 +181,8 @@ def flight_level_deviation(
     >>> w = World.from_heightmap(np.full((10, 4), 10.0), 5.0, 12)
     >>> path = np.array([[0, 5, 40.0], [15, 5, 30.0], [30, 5, 30.0], [45, 5, 30.0]])
     >>> r = flight_level_deviation(w, path, agl=20.0)
-    >>> r.within, r.start_transition_m
-    (1.0, 15.0)
+    >>> r.within, round(r.start_transition_m, 2)    # hypot(15, 10)
+    (1.0, 18.03)
     """
     p = np.asarray(path, dtype=float)
     if p.ndim != 2 or p.shape[1] != 3 or len(p) < 2:
@@ -206,6 +211,7 @@ def flight_level_deviation(
     length = float(s[-1]) if s[-1] > 0 else 1.0
     return FlightLevelReport(
         within=within,
+        within_all=float(ok.mean()),
         mean_dev_m=mean_d,
         max_dev_m=max_d,
         mean_dev_all_m=float(np.abs(dev).mean()),
@@ -219,3 +225,37 @@ def flight_level_deviation(
         tolerance_m=tol,
         deviation=dev,
     )
+
+
+#: The seeds' experiments (TFF paper §5, thesis §4.3): (name, level [cells], p1, p2).
+SEED_CASES: tuple[tuple[str, int, float, float], ...] = (
+    ("level 2", 2, 0.5, 2.5),
+    ("level 5", 5, 0.5, 1.5),
+    ("level 10", 10, 0.5, 1.3),
+    ("smooth p2=1.0", 10, 0.5, 1.0),
+    ("smooth p2=0.8", 10, 0.5, 0.8),
+)
+
+
+def tff_metrics(plan: Any, agl: float, *, ds: float | None = None) -> dict[str, float]:
+    """All terrain-following numbers of one plan, as a flat dict.
+
+    Flight-level deviation against terrain + agl (``within``, ``within_all``,
+    mean/max |dev|, transitions, inside terrain), mean |dev| against the
+    Algorithm-2 layer (``mean_dev_layer_m``), and the turn/climb/curvature
+    summary of :func:`fm2uav.analysis.profiles.path_profiles` (resampled every
+    ``ds`` metres, default one horizontal cell), plus length and clearance.
+    """
+    from .profiles import path_profiles
+
+    world = plan.world
+    fl = flight_level_deviation(world, plan.path, agl)
+    fl_layer = flight_level_deviation(world, plan.path, agl, reference="layer")
+    step = float(max(world.spacing[:2])) if ds is None else float(ds)
+    out: dict[str, float] = {k: v for k, v in fl.summary().items()}
+    out["mean_dev_layer_m"] = fl_layer.mean_dev_all_m
+    out["within_layer"] = fl_layer.within
+    out.update(path_profiles(plan.path, ds=step).summary())
+    out["length_m"] = float(plan.length)
+    out["clearance_m"] = float(plan.clearance)
+    return out

@@ -1,0 +1,265 @@
+"""``fm2uav reproduce tff`` (the seeds' terrain-following experiments) and
+``fm2uav tune`` (p1/p2/α/β search against airframe limits)."""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import typer
+
+from ..errors import InputError
+from ._common import OutputDir, handle_errors, parse_point, print_summary, to_jsonable
+
+TFF_FILES = (
+    "tff_table.md",
+    "tff_summary.json",
+    "tff_3d_levels.png",
+    "tff_3d_smoothness.png",
+    "tff_profile_levels.png",
+    "tff_profile_smoothness.png",
+    "tff_kinematics.png",
+)
+TUNE_FILES = ("tune_table.md", "tune.json", "tune_best_path.csv", "tune_best.png")
+
+_COLUMNS = (
+    ("case", "case", "{}"),
+    ("level [cells]", "level", "{}"),
+    ("agl [m]", "agl_m", "{:g}"),
+    ("p1", "p1", "{:g}"),
+    ("p2", "p2", "{:g}"),
+    ("p2−p1", "diff", "{:.1f}"),
+    ("within ±1 cell (between transitions)", "within", "{:.0%}"),
+    ("on level (all points)", "within_all", "{:.0%}"),
+    ("mean |dev| vs terrain+agl [m]", "mean_dev_all_m", "{:.1f}"),
+    ("mean |dev| vs layer [m]", "mean_dev_layer_m", "{:.1f}"),
+    ("max |dev| between transitions [m]", "max_dev_m", "{:.1f}"),
+    ("transitions start/end [m]", "transitions", "{}"),
+    ("points inside terrain", "inside_terrain", "{}"),
+    ("length [m]", "length_m", "{:.0f}"),
+    ("max turn [°/cell]", "turn_max_deg", "{:.1f}"),
+    ("p95 turn [°/cell]", "turn_p95_deg", "{:.1f}"),
+    ("max climb [°]", "climb_max_deg", "{:.1f}"),
+    ("p95 climb [°]", "climb_p95_deg", "{:.1f}"),
+    ("max curvature [1/m]", "curvature_max", "{:.4f}"),
+    ("p95 curvature [1/m]", "curvature_p95", "{:.4f}"),
+    ("min turn radius [m]", "min_turn_radius_m", "{:.0f}"),
+)
+
+
+def _markdown(rows: list[dict[str, Any]]) -> str:
+    head = [c[0] for c in _COLUMNS]
+    out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for r in rows:
+        out.append("| " + " | ".join(fmt.format(r[key]) for _, key, fmt in _COLUMNS) + " |")
+    return "\n".join(out)
+
+
+def run_tff(scenario: str, seed: int, mode: str) -> tuple[list[dict[str, Any]], list[Any], Any]:
+    """Plan the seeds' five cases (and the literal reading of level 10) on a scenario."""
+    from ..analysis.flight_level import SEED_CASES, tff_metrics
+    from ..planning import plan
+    from ..world.scenarios import get_scenario
+
+    sc = get_scenario(scenario, seed=seed)
+    dz = sc.world.spacing[2]
+    rows, plans = [], []
+    cases = list(SEED_CASES)
+    if mode == "capped":
+        cases.append(("level 10, literal W**p", 10, 0.5, 1.3))
+    for name, level, p1, p2 in cases:
+        case_mode = "literal" if "literal" in name else mode
+        agl = level * dz
+        t0 = time.perf_counter()
+        p = plan(sc.world, sc.start, sc.goal, agl=agl, p1=p1, p2=p2, agl_mode=case_mode)
+        m = tff_metrics(p, agl)
+        m.update(case=name, level=level, agl_m=agl, p1=p1, p2=p2, diff=p2 - p1, mode=case_mode,
+                 transitions=f"{m['start_transition_m']:.0f}/{m['end_transition_m']:.0f}",
+                 plan_s=time.perf_counter() - t0)
+        rows.append(m)
+        plans.append(p)
+    return rows, plans, sc
+
+
+def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
+    """Add ``reproduce tff`` and ``tune``."""
+
+    @reproduce_app.command(
+        "tff",
+        help=(
+            "Reproduce the terrain-following experiments (TFF paper §5 / thesis §4.3): flight "
+            "levels 2, 5, 10 cells with (p1,p2) = (0.5,2.5), (0.5,1.5), (0.5,1.3) and the "
+            "smoothness cases p2 = 1.0, 0.8 at level 10; writes the 3D views, path-vs-ideal "
+            "profiles, turn/climb/curvature profiles and tff_table.md.\n\n"
+            "Examples:\n\n"
+            "  fm2uav reproduce tff --out out/tff\n\n"
+            "  fm2uav reproduce tff --scenario jacksboro --out out/tff-jacksboro"
+        ),
+    )
+    @handle_errors
+    def reproduce_tff(
+        scenario: str = typer.Option("open-field", help="Built-in 3D scenario with terrain."),
+        seed: int = typer.Option(0, help="Seed of the scenario's random relief."),
+        mode: str = typer.Option(
+            "capped", help="Flight-level reading: 'capped' (default) or 'literal' (W**p as is)."
+        ),
+        out: Path = typer.Option(Path("out/tff"), help="Output directory."),
+        force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
+        as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
+        quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
+    ) -> None:
+        if mode not in ("capped", "literal"):
+            raise InputError(f"--mode must be 'capped' or 'literal', got {mode!r}")
+        outdir = OutputDir(out, force=force)
+        outdir.check(TFF_FILES)
+        t0 = time.perf_counter()
+        rows, plans, sc = run_tff(scenario, seed, mode)
+        from ..viz.tff import tff_3d_figure, tff_kinematics_figure, tff_profile_figure
+
+        labels = [f"{r['case']} (p1={r['p1']:g}, p2={r['p2']:g})" for r in rows]
+        agls = [r["agl_m"] for r in rows]
+        lv, sm = [0, 1, 2], [2, 3, 4]
+        figs = {
+            "tff_3d_levels.png": tff_3d_figure([plans[i] for i in lv], [labels[i] for i in lv],
+                                               title=f"Flight levels — {scenario}"),
+            "tff_3d_smoothness.png": tff_3d_figure(
+                [plans[i] for i in sm], [labels[i] for i in sm],
+                title=f"Smoothness at level 10 — {scenario}"),
+            "tff_profile_levels.png": tff_profile_figure(
+                [plans[i] for i in lv], [agls[i] for i in lv], [labels[i] for i in lv],
+                title="Path vs ideal path vs terrain"),
+            "tff_profile_smoothness.png": tff_profile_figure(
+                [plans[i] for i in sm], [agls[i] for i in sm], [labels[i] for i in sm],
+                title="Path vs ideal path vs terrain (level 10)"),
+            "tff_kinematics.png": tff_kinematics_figure(
+                [plans[i] for i in sm], [labels[i] for i in sm],
+                title="Turn, climb and curvature profiles (level 10)"),
+        }
+        import matplotlib.pyplot as plt
+
+        tmps = {}
+        for name, fig in figs.items():
+            tmp = outdir.target(name)
+            fig.savefig(tmp, dpi=100)
+            plt.close(fig)
+            tmps[name] = tmp
+        for name, tmp in tmps.items():
+            outdir.commit(tmp, name)
+        md = [
+            f"# Terrain-following flight — {scenario} (seed {seed}, flight-level mode '{mode}')",
+            "",
+            sc.description,
+            "",
+            f"start {np.round(sc.start, 1).tolist()} m, goal {np.round(sc.goal, 1).tolist()} m; "
+            f"±1 cell = ±{sc.world.spacing[2]:g} m; transitions = the start/goal stretches "
+            "before the path first reaches, and after it last leaves, ±1 cell of terrain + agl; "
+            "profiles on the path resampled every horizontal cell.",
+            "",
+            _markdown(rows),
+            "",
+        ]
+        with outdir.open("tff_table.md") as fh:
+            fh.write("\n".join(md))
+        with outdir.open("tff_summary.json") as fh:
+            json.dump(to_jsonable({"scenario": scenario, "seed": seed, "mode": mode,
+                                   "cases": rows}), fh, indent=2)
+        summary = {
+            r["case"]: f"within {r['within']:.0%}, mean|dev| {r['mean_dev_all_m']:.1f} m, "
+            f"max turn {r['turn_max_deg']:.0f}°, max climb {r['climb_max_deg']:.0f}°"
+            for r in rows
+        }
+        summary["total [s]"] = f"{time.perf_counter() - t0:.1f}"
+        print_summary("Terrain-following experiments", summary if not as_json else
+                      {"cases": rows}, as_json=as_json, quiet=quiet, files=outdir.written)
+
+    @app.command(
+        "tune",
+        help=(
+            "Search p1/p2 (and α/β) for the terrain-following path that keeps an airframe's max "
+            "climb angle and min turn radius with the least flight-level deviation; writes the "
+            "Pareto table (tune_table.md), tune.json, the best path and its figure.\n\n"
+            "Examples:\n\n"
+            "  fm2uav tune --agl 150 --max-climb 45 --min-turn-radius 60 --out out/tune\n\n"
+            "  fm2uav tune --scenario jacksboro --agl 300 --max-climb 20 --min-turn-radius 300 "
+            "--saturation 1,0.5 --out out/tune-jb"
+        ),
+    )
+    @handle_errors
+    def tune_cmd(
+        scenario: str = typer.Option("open-field", help="Built-in 3D scenario with terrain."),
+        agl: float = typer.Option(150.0, help="Flight level over the ground [m]."),
+        max_climb: float = typer.Option(45.0, help="Airframe max climb/descent angle [deg]."),
+        min_turn_radius: float = typer.Option(60.0, help="Airframe min turn radius [m]."),
+        p1: str = typer.Option("0.3,0.5,0.8", help="Values of p1 to try (comma list)."),
+        p2: str = typer.Option("0.6,0.8,1.0,1.3,1.5,2.0,2.5", help="Values of p2 to try."),
+        saturation: str = typer.Option("1.0", help="Values of α to try."),
+        exponent: str = typer.Option("1.0", help="Values of β to try."),
+        start: str | None = typer.Option(None, help="Start x,y,z [m]. Default: the scenario's."),
+        goal: str | None = typer.Option(None, help="Goal x,y,z [m]. Default: the scenario's."),
+        seed: int = typer.Option(0, help="Seed of the scenario's random relief."),
+        out: Path = typer.Option(Path("out/tune"), help="Output directory."),
+        force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
+        as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
+        quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
+    ) -> None:
+        from ..planning.tune import AirframeLimits, tune
+        from ..world.scenarios import get_scenario
+
+        def values(text: str, what: str) -> list[float]:
+            try:
+                return [float(v) for v in text.split(",") if v.strip()]
+            except ValueError:
+                raise InputError(f"--{what} must be a comma list of numbers, got {text!r}") from None
+
+        grid = {"p1": values(p1, "p1"), "p2": values(p2, "p2"),
+                "saturation": values(saturation, "saturation"),
+                "exponent": values(exponent, "exponent")}
+        limits = AirframeLimits(max_climb, min_turn_radius)
+        sc = get_scenario(scenario, seed=seed)
+        s = sc.start if start is None else parse_point(start, 3, "start")
+        g = sc.goal if goal is None else parse_point(goal, 3, "goal")
+        outdir = OutputDir(out, force=force)
+        outdir.check(TUNE_FILES)
+        res = tune(sc.world, s, g, limits, agl, grid=grid)
+        from ..io import write_path_csv
+
+        md = [f"# Auto-tuning — {scenario}, agl {agl:g} m, max climb {max_climb:g}°, "
+              f"min turn radius {min_turn_radius:g} m", "",
+              "## Pareto front (deviation ↓, max climb ↓, min turn radius ↑)", "",
+              res.table(), "", "## All candidates", "", res.table(res.rows), ""]
+        if res.best is None:
+            md.insert(2, "**No candidate keeps the limits**; the Pareto front shows the closest.\n")
+        if res.best_plan is not None:
+            import matplotlib.pyplot as plt
+
+            from ..viz.tff import tff_profile_figure
+
+            lab = f"best: p1={res.best['p1']:g}, p2={res.best['p2']:g}, α={res.best['saturation']:g}"
+            fig = tff_profile_figure([res.best_plan], [agl], [lab], title="Tuned path")
+            tmp = outdir.target("tune_best.png")
+            fig.savefig(tmp, dpi=100)
+            plt.close(fig)
+            with outdir.open("tune_best_path.csv") as fh:
+                write_path_csv(fh, res.best_plan.path, res.best_plan.speed)
+            outdir.commit(tmp, "tune_best.png")
+        with outdir.open("tune_table.md") as fh:
+            fh.write("\n".join(md))
+        payload = {"scenario": scenario, "agl_m": agl, "limits": limits.__dict__,
+                   "best": res.best, "pareto": res.pareto, "rows": res.rows}
+        with outdir.open("tune.json") as fh:
+            json.dump(to_jsonable(payload), fh, indent=2)
+        b = res.best
+        rows = {
+            "candidates": len(res.rows),
+            "feasible": sum(r["feasible"] for r in res.rows),
+            "best": ("none keeps the limits" if b is None else
+                     f"p1={b['p1']:g} p2={b['p2']:g} α={b['saturation']:g} β={b['exponent']:g}: "
+                     f"mean|dev| {b['deviation_m']:.1f} m, max climb {b['climb_max_deg']:.1f}°, "
+                     f"min turn radius {b['min_turn_radius_m']:.0f} m"),
+            "pareto front": len(res.pareto),
+        }
+        print_summary("Auto-tuning", rows if not as_json else payload, as_json=as_json,
+                      quiet=quiet, files=outdir.written)

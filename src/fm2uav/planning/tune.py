@@ -1,0 +1,275 @@
+"""Auto-tuning of the flight-level parameters against an airframe's limits.
+
+The seeds leave the choice of p1/p2 to the designer ("future work": relate the
+parameters to the UAV's kinematics). :func:`tune` searches a grid of
+``(p1, p2, α, β)``, plans each, and measures on the path
+
+* the flight-level deviation: mean |z − (terrain + agl)| over the *whole* path
+  [m] (transitions included — a path that never reaches the level is not
+  rewarded);
+* the largest climb/descent angle [deg] and the smallest horizontal turn
+  radius [m], both on the path resampled every ``ds`` metres (default two
+  horizontal cells, the scale at which an FM² path is meaningful).
+
+A candidate is *feasible* if its max climb angle is within the airframe's and
+its min turn radius is at least the airframe's. The best candidate is the
+feasible one with the smallest deviation. The report also lists the Pareto
+front of all candidates over (deviation ↓, max climb ↓, min turn radius ↑):
+the trade-off between following the terrain and flying smoothly that the seeds
+describe.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..analysis.flight_level import flight_level_deviation
+from ..analysis.profiles import path_profiles
+from ..errors import InputError, PlanningError
+from ..world import World
+from .planner import Plan, plan
+
+__all__ = ["AirframeLimits", "TuneResult", "tune", "as_limits", "DEFAULT_GRID"]
+
+#: Default search grid.
+DEFAULT_GRID: dict[str, tuple[float, ...]] = {
+    "p1": (0.3, 0.5, 0.8),
+    "p2": (0.6, 0.8, 1.0, 1.3, 1.5, 2.0, 2.5),
+    "saturation": (1.0,),
+    "exponent": (1.0,),
+}
+
+
+@dataclass(frozen=True)
+class AirframeLimits:
+    """What the airframe can fly.
+
+    Attributes
+    ----------
+    max_climb_deg : float
+        Largest climb or descent (flight-path) angle [deg], in (0, 90].
+    min_turn_radius_m : float
+        Smallest horizontal turn radius [m], >= 0.
+    """
+
+    max_climb_deg: float
+    min_turn_radius_m: float
+
+    def __post_init__(self) -> None:
+        c, r = float(self.max_climb_deg), float(self.min_turn_radius_m)
+        if not (np.isfinite(c) and 0 < c <= 90):
+            raise InputError(f"max_climb_deg must be in (0, 90] degrees, got {self.max_climb_deg!r}")
+        if not (np.isfinite(r) and r >= 0):
+            raise InputError(f"min_turn_radius_m must be >= 0 metres, got {self.min_turn_radius_m!r}")
+        object.__setattr__(self, "max_climb_deg", c)
+        object.__setattr__(self, "min_turn_radius_m", r)
+
+
+def as_limits(limits: Any) -> AirframeLimits:
+    """Accept :class:`AirframeLimits`, a mapping with ``max_climb_deg`` and
+    ``min_turn_radius_m``, a ``(max_climb_deg, min_turn_radius_m)`` pair, or an
+    airframe object with ``max_climb`` [rad] (and ``max_descent``) and
+    ``turn_radius()`` [m] (e.g. :class:`fm2uav.vehicles.airframes.FixedWing`)."""
+    if isinstance(limits, AirframeLimits):
+        return limits
+    if isinstance(limits, dict):
+        try:
+            return AirframeLimits(limits["max_climb_deg"], limits["min_turn_radius_m"])
+        except KeyError as exc:
+            raise InputError(
+                f"airframe limits need 'max_climb_deg' and 'min_turn_radius_m', missing {exc}"
+            ) from None
+    if isinstance(limits, (tuple, list)) and len(limits) == 2:
+        return AirframeLimits(*limits)
+    if hasattr(limits, "max_climb") and hasattr(limits, "turn_radius"):
+        climb = min(float(limits.max_climb), float(getattr(limits, "max_descent", limits.max_climb)))
+        return AirframeLimits(math.degrees(climb), float(limits.turn_radius()))
+    raise InputError(
+        "airframe_limits must be AirframeLimits(max_climb_deg, min_turn_radius_m), a dict with "
+        f"those keys, a (climb_deg, radius_m) pair or an airframe object, got {limits!r}"
+    )
+
+
+@dataclass
+class TuneResult:
+    """What :func:`tune` found.
+
+    Attributes
+    ----------
+    rows : list of dict
+        One row per candidate: p1, p2, saturation, exponent, deviation_m,
+        within (share of all points within one cell of the level), climb_max_deg,
+        min_turn_radius_m, length_m, feasible, error (None or why planning failed).
+    best : dict or None
+        The feasible row with the smallest deviation (None if none is feasible).
+    best_plan : Plan or None
+        Its plan.
+    pareto : list of dict
+        Non-dominated rows over (deviation ↓, climb ↓, turn radius ↑), sorted by
+        deviation.
+    limits : AirframeLimits
+    """
+
+    rows: list[dict[str, Any]]
+    best: dict[str, Any] | None
+    best_plan: Plan | None = field(repr=False)
+    pareto: list[dict[str, Any]]
+    limits: AirframeLimits
+
+    def table(self, rows: list[dict[str, Any]] | None = None) -> str:
+        """Markdown table of ``rows`` (default: the Pareto front)."""
+        rows = self.pareto if rows is None else rows
+        head = ("p1", "p2", "α", "β", "mean |dev| m", "within ±1 cell", "max climb °",
+                "min turn radius m", "feasible")
+        out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        for r in rows:
+            out.append(
+                f"| {r['p1']:g} | {r['p2']:g} | {r['saturation']:g} | {r['exponent']:g} | "
+                f"{r['deviation_m']:.1f} | {100 * r['within']:.0f} % | {r['climb_max_deg']:.1f} | "
+                f"{r['min_turn_radius_m']:.0f} | {'yes' if r['feasible'] else 'no'} |"
+            )
+        return "\n".join(out)
+
+
+def _pareto(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    ok = [r for r in rows if r["error"] is None]
+    keys = np.array([[r["deviation_m"], r["climb_max_deg"], -r["min_turn_radius_m"]] for r in ok])
+    front = []
+    for i, r in enumerate(ok):
+        dominated = np.any(np.all(keys <= keys[i], axis=1) & np.any(keys < keys[i], axis=1))
+        if not dominated:
+            front.append(r)
+    return sorted(front, key=lambda r: r["deviation_m"])
+
+
+def _grid_values(name: str, values: Any, lo: float, hi: float | None) -> tuple[float, ...]:
+    vals = tuple(float(v) for v in np.atleast_1d(np.asarray(values, dtype=float)))
+    if not vals:
+        raise InputError(f"grid '{name}' is empty")
+    for v in vals:
+        if not np.isfinite(v) or v <= lo or (hi is not None and v > hi):
+            rng = f"({lo:g}, {hi:g}]" if hi is not None else f"> {lo:g}"
+            raise InputError(f"grid '{name}' values must be {rng}, got {v!r}")
+    return vals
+
+
+def tune(
+    world: World,
+    start: Any,
+    goal: Any,
+    airframe_limits: Any,
+    agl: float,
+    *,
+    grid: dict[str, Any] | None = None,
+    ds: float | None = None,
+    **plan_kwargs: Any,
+) -> TuneResult:
+    """Search p1/p2 (and α/β) for the terrain-following path an airframe can fly.
+
+    Parameters
+    ----------
+    world : World
+        3D world.
+    start, goal : sequence of float
+        World points [m].
+    airframe_limits : AirframeLimits, dict, pair or airframe
+        Max climb angle [deg] and min turn radius [m] (see :func:`as_limits`).
+    agl : float
+        Flight level over the ground [m].
+    grid : dict, optional
+        Values to try for ``p1``, ``p2``, ``saturation``, ``exponent``; missing
+        keys take :data:`DEFAULT_GRID`. Pairs with ``p2 <= p1`` are skipped
+        (they do not clarify the level).
+    ds : float, optional
+        Resampling step of the profiles [m]; default two horizontal cells.
+    **plan_kwargs
+        Passed to :func:`~fm2uav.planning.plan` (e.g. ``agl_band``, ``agl_mode``).
+
+    Returns
+    -------
+    TuneResult
+
+    Raises
+    ------
+    InputError
+        Bad limits or grid.
+    PlanningError
+        Bad start/goal or flight level (raised by the first plan).
+
+    Examples
+    --------
+    >>> import fm2uav
+    >>> sc = fm2uav.scenarios.open_field()
+    >>> res = tune(sc.world, sc.start, sc.goal, (30.0, 60.0), 150.0,
+    ...            grid={"p1": [0.5], "p2": [0.8, 1.3]})
+    >>> len(res.rows)
+    2
+    """
+    limits = as_limits(airframe_limits)
+    g = dict(DEFAULT_GRID)
+    for k, v in (grid or {}).items():
+        if k not in DEFAULT_GRID:
+            raise InputError(f"unknown grid key {k!r}; use {sorted(DEFAULT_GRID)}")
+        g[k] = v
+    p1s = _grid_values("p1", g["p1"], 0.0, None)
+    p2s = _grid_values("p2", g["p2"], 0.0, None)
+    sats = _grid_values("saturation", g["saturation"], 0.0, 1.0)
+    exps = _grid_values("exponent", g["exponent"], 0.0, None)
+    step = float(ds) if ds is not None else 2.0 * max(world.spacing[:2])
+    if not (np.isfinite(step) and step > 0):
+        raise InputError(f"ds must be > 0 metres, got {ds!r}")
+    for bad in ("p1", "p2", "saturation", "exponent", "agl"):
+        if bad in plan_kwargs:
+            raise InputError(f"{bad} is searched or given by tune(); do not pass it in plan_kwargs")
+
+    rows: list[dict[str, Any]] = []
+    plans: list[Plan | None] = []
+    for sat, beta, p1, p2 in itertools.product(sats, exps, p1s, p2s):
+        if p2 <= p1:
+            continue
+        row: dict[str, Any] = {"p1": p1, "p2": p2, "saturation": sat, "exponent": beta}
+        try:
+            pl = plan(world, start, goal, agl=agl, p1=p1, p2=p2, saturation=sat,
+                      exponent=beta, **plan_kwargs)
+        except PlanningError as exc:
+            if not rows:  # the first plan fails: bad start/goal/agl, not the parameters
+                raise
+            row.update(error=str(exc), feasible=False, deviation_m=np.inf, within=0.0,
+                       climb_max_deg=90.0, min_turn_radius_m=0.0, length_m=np.nan)
+            rows.append(row)
+            plans.append(None)
+            continue
+        fl = flight_level_deviation(world, pl.path, agl)
+        pr = path_profiles(pl.path, ds=step).summary()
+        row.update(
+            error=None,
+            deviation_m=fl.mean_dev_all_m,
+            within=fl.within_all,
+            climb_max_deg=pr["climb_max_deg"],
+            min_turn_radius_m=pr["min_turn_radius_m"],
+            length_m=float(pl.length),
+            inside_terrain=fl.inside_terrain,
+        )
+        row["feasible"] = bool(
+            row["climb_max_deg"] <= limits.max_climb_deg + 1e-9
+            and row["min_turn_radius_m"] >= limits.min_turn_radius_m - 1e-9
+            and fl.inside_terrain == 0
+        )
+        rows.append(row)
+        plans.append(pl)
+    if not rows:
+        raise InputError("the grid has no pair with p2 > p1; widen it")
+    feas = [i for i, r in enumerate(rows) if r["feasible"]]
+    best_i = min(feas, key=lambda i: rows[i]["deviation_m"]) if feas else None
+    return TuneResult(
+        rows=rows,
+        best=rows[best_i] if best_i is not None else None,
+        best_plan=plans[best_i] if best_i is not None else None,
+        pareto=_pareto(rows),
+        limits=limits,
+    )

@@ -1,0 +1,106 @@
+"""Figures of the terrain-following experiments (TFF paper figs. 7-13).
+
+Drawing only: the caller passes plans and their agl; every number comes from
+:mod:`fm2uav.analysis` (profiles, flight-level deviation).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+
+from ..analysis.flight_level import ground_altitude, ideal_altitude  # noqa: E402
+from ..analysis.profiles import path_profiles  # noqa: E402
+
+if TYPE_CHECKING:
+    from ..planning import Plan
+
+__all__ = ["tff_3d_figure", "tff_profile_figure", "tff_kinematics_figure"]
+
+
+def _arc(path: np.ndarray) -> np.ndarray:
+    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])
+
+
+def tff_3d_figure(plans: Sequence[Plan], labels: Sequence[str], *, title: str = "") -> Figure:
+    """3D view of the terrain (from the first plan's world) with the paths."""
+    world = plans[0].world
+    fig = plt.figure(figsize=(8.5, 6.0))
+    ax = fig.add_subplot(projection="3d")
+    if world.terrain is not None:
+        step = max(1, int(max(world.shape[:2]) // 90))
+        t = world.terrain[::step, ::step]
+        xs = world.origin[0] + np.arange(world.shape[0])[::step] * world.spacing[0]
+        ys = world.origin[1] + np.arange(world.shape[1])[::step] * world.spacing[1]
+        X, Y = np.meshgrid(xs - world.origin[0], ys - world.origin[1], indexing="ij")
+        ax.plot_surface(X, Y, t, cmap="terrain", linewidth=0, alpha=0.35, antialiased=False, zorder=1)
+    for p, lab in zip(plans, labels):
+        q = p.path
+        ax.plot(q[:, 0] - world.origin[0], q[:, 1] - world.origin[1], q[:, 2], lw=2.2, label=lab, zorder=10)
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_zlabel("z [m]")
+    ax.legend(loc="upper left", fontsize=8)
+    ax.set_title(title)
+    ax.view_init(elev=28, azim=-70)
+    fig.tight_layout()
+    return fig
+
+
+def tff_profile_figure(
+    plans: Sequence[Plan], agls: Sequence[float], labels: Sequence[str], *, title: str = ""
+) -> Figure:
+    """Path vs ideal path (terrain + agl) vs terrain along the arc length, one panel per plan."""
+    n = len(plans)
+    fig, axes = plt.subplots(n, 1, figsize=(8.5, 2.3 * n + 0.6), squeeze=False)
+    for ax, p, agl, lab in zip(axes[:, 0], plans, agls, labels):
+        q = p.path
+        s = _arc(q)
+        ground = ground_altitude(p.world, q)
+        ideal = ideal_altitude(p.world, q, agl)
+        ax.fill_between(s, p.world.origin[2], ground, color="0.8", label="terrain")
+        ax.plot(s, ideal, "g--", lw=1.2, label=f"ideal (terrain + {agl:g} m)")
+        ax.plot(s, q[:, 2], "b-", lw=1.6, label="FM² path")
+        dz = p.world.spacing[2]
+        ax.fill_between(s, ideal - dz, ideal + dz, color="g", alpha=0.12, label="±1 cell")
+        lo = float(min(ground.min(), q[:, 2].min())) - 2 * dz
+        ax.set_ylim(max(lo, p.world.origin[2]), float(max(q[:, 2].max(), ideal.max())) + 2 * dz)
+        ax.set_ylabel("z [m]")
+        ax.set_title(lab, fontsize=9)
+    axes[-1, 0].set_xlabel("arc length [m]")
+    axes[0, 0].legend(fontsize=7, ncol=4, loc="upper right")
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def tff_kinematics_figure(
+    plans: Sequence[Plan], labels: Sequence[str], *, ds: float | None = None, title: str = ""
+) -> Figure:
+    """Turn angle, climb angle and curvature profiles (figs. 11-13 of the TFF paper)."""
+    fig, axes = plt.subplots(3, 1, figsize=(8.5, 7.5), sharex=True)
+    for p, lab in zip(plans, labels):
+        step = ds if ds is not None else float(max(p.world.spacing[:2]))
+        pr = path_profiles(p.path, ds=step)
+        axes[0].plot(pr.s[1:-1], np.degrees(pr.turn), lw=1.2, label=lab)
+        axes[1].plot(pr.s[:-1], np.degrees(pr.climb), lw=1.2, label=lab)
+        axes[2].plot(pr.s[1:-1], pr.curvature, lw=1.2, label=lab)
+    axes[0].set_ylabel("turn angle [deg/step]")
+    axes[1].set_ylabel("climb angle [deg]")
+    axes[2].set_ylabel("curvature [1/m]")
+    axes[2].set_xlabel("arc length [m]")
+    axes[0].legend(fontsize=8)
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig
