@@ -10,10 +10,11 @@ FM² over it and impose the flight level with p1/p2 (Algorithm 2). Here:
    corridors of neighbouring bands never touch and the wave cannot cut
    across them);
 2. flight level: :func:`fm2uav.planning.flight_level.flight_level_speed`
-   (Algorithm 2, optional tolerance band) applied to a uniform map of value
-   ``level_contrast`` on the free nodes: the level is clarified to
-   ``level_contrast ** p1``, all other nodes darkened to ``level_contrast ** p2``
-   — the contrast Algorithm 2 needs, independently of how open the sky is;
+   (Algorithm 2 as the planner applies it, with a tolerance band of one
+   vertical cell by default) on the world's FM² velocity map (normalised
+   distance to the terrain/obstacles); ``level_base="uniform"`` shapes a
+   constant map instead (the level is then ``level_contrast ** (p1 - p2)``
+   times faster everywhere, however open the sky);
 3. ``W = C · W_level`` (0 on obstacles and outside the corridor), then
    :func:`fm2uav.plan` with ``speed_map=W`` from the zigzag's first point to its
    last, both on the flight level.
@@ -30,6 +31,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ...errors import InputError
+from ...planning import base_velocity
 from ...planning import plan as fm2_plan
 from ...planning.flight_level import flight_layer, flight_level_speed
 from ...world import World
@@ -81,6 +83,7 @@ def coverage_speed_map(
     level_band: float | None = None,
     level_graded: bool = False,
     level_contrast: float = 0.5,
+    level_base: str = "world",
 ) -> np.ndarray:
     """Velocity map W of the coverage FM² (corridor × flight level), shape of the world.
 
@@ -103,7 +106,14 @@ def coverage_speed_map(
     level_graded : bool
         Blend the exponent across the band (``flight_level_speed(graded=)``).
     level_contrast : float
-        Value in (0, 1) of the uniform map Algorithm 2 shapes. Default 0.5.
+        Value in (0, 1) of the uniform map shaped with ``level_base="uniform"``.
+    level_base : {"world", "uniform"}
+        Map the flight level is imposed on: ``"world"`` (default) the
+        planner's FM² velocity of the world (normalised distance to the
+        terrain and obstacles, :func:`fm2uav.planning.base_velocity`), shaped
+        exactly as ``plan(agl=...)`` does (capped Algorithm 2); ``"uniform"``
+        a constant ``level_contrast`` on the free nodes, which gives the level
+        the same contrast everywhere however far the obstacles are.
     """
     if world.ndim != 3:
         raise InputError("coverage FM² needs a 3D world with terrain")
@@ -119,8 +129,13 @@ def coverage_speed_map(
             f"under one cell ({cell:g} m): the bands are too close for this grid; use "
             f"D >= {cell / corridor:g} m or a finer map"
         )
+    if level_base not in ("world", "uniform"):
+        raise InputError(f"level_base must be 'world' or 'uniform', got {level_base!r}")
     band = world.spacing[2] if level_band is None else float(level_band)
-    base = np.where(world.occupancy, 0.0, float(level_contrast))
+    if level_base == "world":
+        base = base_velocity(world)  # the planner's FM² map: distance to obstacles
+    else:
+        base = np.where(world.occupancy, 0.0, float(level_contrast))
     level = flight_level_speed(base, world, agl, p1, p2, band=band, graded=level_graded)
     c = corridor_speed(world, zz.path(step=cell / 2.0), h)
     return level * c[:, :, None]
@@ -210,6 +225,7 @@ def plan_coverage(
     level_band: float | None = None,
     level_graded: bool = False,
     level_contrast: float = 0.5,
+    level_base: str = "world",
     order: int = 2,
 ) -> CoveragePlan:
     """Coverage path: best zigzag over ``area``, then FM² along it at ``agl`` over the terrain.
@@ -234,7 +250,7 @@ def plan_coverage(
         Seed of the DE.
     p1, p2 : float
         Flight-level exponents (seeds: 0.5 and 1.3 at level 10).
-    corridor, level_band, level_graded, level_contrast
+    corridor, level_band, level_graded, level_contrast, level_base
         See :func:`coverage_speed_map`.
     order : {1, 2}
         Fast Marching order.
@@ -279,7 +295,7 @@ def plan_coverage(
     t2 = time.perf_counter()
     W = coverage_speed_map(world, zz, agl=agl, p1=p1, p2=p2, corridor=corridor,
                            level_band=level_band, level_graded=level_graded,
-                           level_contrast=level_contrast)
+                           level_contrast=level_contrast, level_base=level_base)
     layer = flight_layer(world, agl)
     start = _on_level(world, zz.start, layer, "start")
     goal = _on_level(world, zz.goal, layer, "end")
@@ -301,5 +317,6 @@ def plan_coverage(
                 "corridor": float(corridor), "level_band_m": (world.spacing[2] if level_band is None
                                                                else float(level_band)),
                 "level_graded": bool(level_graded), "level_contrast": float(level_contrast),
+                "level_base": level_base,
                 "search": None if found is None else found.method, "order": int(order)},
     )
