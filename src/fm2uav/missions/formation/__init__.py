@@ -1,0 +1,30 @@
+"""Leader–follower UAV formations with FM² (thesis ch. 6).
+
+``fly_formation(world, start, goal, ...)`` plans the leader with FM², then in
+every cycle re-plans every UAV locally towards its partial goal (eqs 6.1/6.2),
+with the other UAVs as obstacles. See :mod:`.mission`.
+"""
+
+from .checks import inside_terrain, min_separation, pair_distances
+from .local import StaticMaps, local_path
+from .metrics import formation_error
+from .mission import GREY_MODES, FormationResult, fly_formation, grey_levels
+from .shapes import SHAPES, FormationShape, formation_shape, slot_offsets, slot_positions
+
+__all__ = [
+    "fly_formation",
+    "FormationResult",
+    "formation_shape",
+    "FormationShape",
+    "slot_offsets",
+    "slot_positions",
+    "grey_levels",
+    "formation_error",
+    "inside_terrain",
+    "min_separation",
+    "pair_distances",
+    "StaticMaps",
+    "local_path",
+    "SHAPES",
+    "GREY_MODES",
+]

@@ -1,0 +1,302 @@
+"""Figures and animation of a leader–follower formation flight (thesis Figs 6.5–6.8).
+
+Drawing only: every number comes from a
+:class:`~fm2uav.missions.formation.FormationResult`.
+
+* :func:`formation_paths_figure` — top view of the paths on the terrain with
+  the real (red) and desired (green) triangles at regular times (Fig. 6.5 a /
+  6.7 a) and the leader's velocity map ``W`` at its flight height with the UAVs
+  as obstacles (Fig. 6.5 b / 6.7 b);
+* :func:`formation_profiles_figure` — altitude of each UAV against the ideal
+  path and the terrain profile (Figs 6.6 / 6.8);
+* :func:`formation_metrics_figure` — smallest inter-UAV distance, formation
+  shape error and grey levels over time;
+* :func:`formation_animation` — GIF (matplotlib ``PillowWriter``), or MP4 when
+  ffmpeg is installed and the file name ends in ``.mp4``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import matplotlib
+
+matplotlib.use("Agg")  # files only; never needs a display
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib import animation  # noqa: E402
+from matplotlib.colors import LightSource  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+
+from ..analysis.flight_level import ground_altitude  # noqa: E402
+
+if TYPE_CHECKING:
+    from ..missions.formation import FormationResult
+
+__all__ = [
+    "formation_paths_figure",
+    "formation_profiles_figure",
+    "formation_metrics_figure",
+    "formation_animation",
+]
+
+#: One colour per UAV (leader first).
+COLOURS = ("crimson", "royalblue", "darkorange", "seagreen", "purple", "teal", "olive")
+
+
+def _colour(i: int) -> str:
+    return COLOURS[i % len(COLOURS)]
+
+
+def _extent(world) -> tuple[float, float, float, float]:
+    b = world.bounds
+    return (b[0, 0], b[0, 1], b[1, 0], b[1, 1])
+
+
+def _terrain_background(ax, world) -> None:
+    if world.terrain is not None:
+        ls = LightSource(azdeg=315, altdeg=45)
+        rgb = ls.shade(world.terrain.T, cmap=plt.get_cmap("gist_earth"), vert_exag=2.0,
+                       dx=world.spacing[0], dy=world.spacing[1], blend_mode="soft")
+        ax.imshow(rgb, origin="lower", extent=_extent(world), aspect="equal")
+    else:
+        ax.imshow(world.occupancy.sum(axis=2).T, origin="lower", extent=_extent(world),
+                  cmap="Greys", aspect="equal")
+
+
+def _polygon(points_xy: np.ndarray) -> np.ndarray:
+    """Closed outline leader → followers → leader (x, y)."""
+    return np.vstack([points_xy, points_xy[:1]])
+
+
+def _snapshot_samples(result: FormationResult, count: int) -> np.ndarray:
+    return np.unique(np.linspace(0, len(result.times) - 1, count).round().astype(int))
+
+
+def _cycle_of_sample(result: FormationResult, k: int) -> int:
+    c = int(np.searchsorted(result.cycle_start, result.times[k], side="right")) - 1
+    return int(np.clip(c, 0, len(result.cycle_start) - 1))
+
+
+def formation_paths_figure(
+    result: FormationResult, *, snapshots: int = 8, title: str | None = None
+) -> Figure:
+    """Top view of the formation flight (thesis Fig. 6.5 / 6.7).
+
+    Parameters
+    ----------
+    result : FormationResult
+    snapshots : int
+        Number of times at which the real (red) and desired (green, the partial
+        goals) formations are drawn.
+    title : str, optional
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    world = result.world
+    pos = result.positions
+    fig, axes = plt.subplots(1, 2, figsize=(15, 5.8))
+    ax = axes[0]
+    _terrain_background(ax, world)
+    for i, name in enumerate(result.names):
+        ax.plot(pos[:, i, 0], pos[:, i, 1], color=_colour(i), lw=1.6, label=name)
+    for k in _snapshot_samples(result, snapshots):
+        c = _cycle_of_sample(result, k)
+        goal_poly = _polygon(result.partial_goals[c][:, :2])
+        real_poly = _polygon(pos[k][:, :2])
+        ax.plot(goal_poly[:, 0], goal_poly[:, 1], color="lime", lw=1.0, alpha=0.9)
+        ax.plot(real_poly[:, 0], real_poly[:, 1], color="red", lw=1.2)
+        ax.plot(*pos[k, 0, :2], "^", color="red", ms=6, mec="k")
+    ax.plot([], [], color="red", lw=1.2, label="real formation")
+    ax.plot([], [], color="lime", lw=1.0, label="partial goals")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title("(a) paths and formations over the terrain")
+    ax.legend(loc="upper left", fontsize=7)
+
+    # (b) the leader's W at its (median) height, the other UAVs as obstacles
+    ax = axes[1]
+    lp = result.leader_plan
+    kz = int(np.clip(np.round(np.median(world.to_index(pos[:, 0])[:, 2])), 0,
+                     world.shape[2] - 1))
+    Wz = lp.W[:, :, kz]
+    im = ax.imshow(Wz.T, origin="lower", extent=_extent(world), cmap="gray", vmin=0,
+                   vmax=max(float(Wz.max()), 1e-9), aspect="equal")
+    fig.colorbar(im, ax=ax, fraction=0.035, pad=0.02, label="W (leader)")
+    radius = float(result.params["safety_radius"])
+    theta = np.linspace(0, 2 * np.pi, 40)
+    for k in _snapshot_samples(result, snapshots):
+        for i in range(1, result.n_uav):
+            x, y = pos[k, i, :2]
+            ax.fill(x + radius * np.cos(theta), y + radius * np.sin(theta), color="k", alpha=0.8)
+        ax.plot(*pos[k, 0, :2], "^", color="red", ms=6, mec="w")
+    ax.plot(pos[:, 0, 0], pos[:, 0, 1], color="red", lw=1.0)
+    ax.set_xlabel("x [m]")
+    ax.set_title(f"(b) W from the leader's perspective, layer z = "
+                 f"{world.origin[2] + kz * world.spacing[2]:.0f} m (followers = obstacles)")
+    s = result.summary()
+    sub = (f"{result.shape.name}, dist {result.dist:g} m · min separation "
+           f"{s['min_separation_m']:.1f} m (bound {result.dist / 2:g}) · mission "
+           f"{s['mission_time_s']:.0f} s · computed in {s['timings_s']['total']:.2f} s")
+    fig.suptitle(f"{title}\n{sub}" if title else sub, fontsize=11)
+    fig.tight_layout()
+    return fig
+
+
+def formation_profiles_figure(result: FormationResult, *, title: str | None = None) -> Figure:
+    """Altitude of each UAV against the ideal path and the terrain (Figs 6.6 / 6.8).
+
+    The ideal path is ``terrain + agl`` for a UAV flying at a level, the
+    leader's FM² path for a free leader, and the leader's altitude at the same
+    time for a free follower.
+    """
+    world = result.world
+    pos = result.positions
+    n = result.n_uav
+    fig, axes = plt.subplots(n, 1, figsize=(10, 2.6 * n), sharex=False, squeeze=False)
+    b = world.bounds
+    for i in range(n):
+        ax = axes[i, 0]
+        p = pos[:, i, :]
+        s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
+        ground = ground_altitude(world, p)
+        ax.fill_between(s, b[2, 0], ground, color="saddlebrown", alpha=0.5, label="terrain")
+        agl = result.agl[i]
+        if agl is not None:
+            ideal, label = ground + agl, f"ideal (terrain + {agl:g} m)"
+        elif i == 0:
+            ideal, label = None, None
+            lp = result.leader_plan.path
+            sl = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(lp, axis=0), axis=1))])
+            ax.plot(sl, lp[:, 2], "--", color="k", lw=1, label="ideal (FM² plan)")
+        else:
+            ideal, label = pos[:, 0, 2], "ideal (leader's height)"
+        if ideal is not None:
+            ax.plot(s, ideal, "--", color="k", lw=1, label=label)
+        ax.plot(s, p[:, 2], color=_colour(i), lw=1.8, label=f"{result.names[i]} altitude")
+        ax.set_ylim(b[2, 0], b[2, 1])
+        ax.set_ylabel("z [m]")
+        ax.set_title(f"({chr(97 + i)}) {result.names[i]}", fontsize=10, loc="left")
+        ax.grid(alpha=0.3)
+        ax.legend(loc="upper right", fontsize=7)
+    axes[-1, 0].set_xlabel("distance flown [m]")
+    if title:
+        fig.suptitle(title, fontsize=11)
+    fig.tight_layout()
+    return fig
+
+
+def formation_metrics_figure(result: FormationResult, *, title: str | None = None) -> Figure:
+    """Smallest inter-UAV distance, shape error and grey levels over time."""
+    fig, axes = plt.subplots(3, 1, figsize=(10, 7.5), sharex=True)
+    t = result.times
+    ax = axes[0]
+    ax.plot(t, result.min_distance, color="k", lw=1.5, label="smallest inter-UAV distance")
+    ax.axhline(result.dist / 2, color="red", ls="--", lw=1, label="bound dist/2")
+    ax.axhline(2 * result.dist, color="grey", ls=":", lw=1, label="nominal 2·dist")
+    ax.set_ylabel("[m]")
+    ax.set_ylim(bottom=0)
+    ax.legend(loc="upper right", fontsize=7)
+    ax.grid(alpha=0.3)
+    ax = axes[1]
+    ax.plot(t, result.shape_error_norm, color="purple", lw=1.5)
+    ax.set_ylabel("shape error / (2·dist)")
+    ax.grid(alpha=0.3)
+    ax = axes[2]
+    for j in range(result.grey.shape[1]):
+        ax.step(result.cycle_start, result.grey[:, j], where="post", color=_colour(j + 1),
+                label=result.names[j + 1])
+    ax.set_ylabel("grey level B")
+    ax.set_ylim(-0.05, 1.05)
+    ax.set_xlabel("time [s]")
+    ax.legend(loc="lower right", fontsize=7)
+    ax.grid(alpha=0.3)
+    if title:
+        fig.suptitle(title, fontsize=11)
+    fig.tight_layout()
+    return fig
+
+
+def formation_animation(
+    result: FormationResult,
+    filename: str | Path,
+    *,
+    fps: int = 10,
+    max_frames: int = 120,
+    dpi: int = 80,
+) -> Path:
+    """Write an animation of the flight (top view, trails, real and desired formation).
+
+    Parameters
+    ----------
+    result : FormationResult
+    filename : str or Path
+        Output file; ``.gif`` (Pillow) or ``.mp4`` (needs ffmpeg).
+    fps : int
+        Frames per second.
+    max_frames : int
+        Frames are evenly spread over the flight, at most this many.
+    dpi : int
+        Resolution.
+
+    Returns
+    -------
+    Path
+        The file written.
+
+    Raises
+    ------
+    fm2uav.InputError
+        Unknown extension, or ``.mp4`` without ffmpeg.
+    """
+    from ..errors import InputError
+
+    path = Path(filename)
+    suffix = "".join(path.suffixes[-1:]).lower()
+    if suffix == ".gif":
+        writer = animation.PillowWriter(fps=fps)
+    elif suffix == ".mp4":
+        if not animation.FFMpegWriter.isAvailable():
+            raise InputError("writing .mp4 needs ffmpeg, which is not installed; use a .gif name")
+        writer = animation.FFMpegWriter(fps=fps)
+    else:
+        raise InputError(f"animation file must end in .gif or .mp4, got {path.name!r}")
+    world = result.world
+    pos = result.positions
+    frames = _snapshot_samples(result, max_frames)
+    fig, ax = plt.subplots(figsize=(7.5, 6))
+    _terrain_background(ax, world)
+    trails = [ax.plot([], [], color=_colour(i), lw=1.2)[0] for i in range(result.n_uav)]
+    goal_line, = ax.plot([], [], color="lime", lw=1.0)
+    real_line, = ax.plot([], [], color="red", lw=1.4)
+    dots = ax.scatter(pos[0, :, 0], pos[0, :, 1], c=[_colour(i) for i in range(result.n_uav)],
+                      s=30, edgecolors="k", zorder=5)
+    label = ax.text(0.02, 0.97, "", transform=ax.transAxes, va="top", fontsize=8,
+                    bbox={"facecolor": "white", "alpha": 0.8, "edgecolor": "none"})
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_title(f"{result.shape.name} formation — red: real, green: partial goals", fontsize=9)
+    fig.tight_layout()
+
+    def draw(k: int):
+        c = _cycle_of_sample(result, k)
+        for i, line in enumerate(trails):
+            line.set_data(pos[: k + 1, i, 0], pos[: k + 1, i, 1])
+        g = _polygon(result.partial_goals[c][:, :2])
+        r = _polygon(pos[k][:, :2])
+        goal_line.set_data(g[:, 0], g[:, 1])
+        real_line.set_data(r[:, 0], r[:, 1])
+        dots.set_offsets(pos[k, :, :2])
+        label.set_text(f"t = {result.times[k]:.0f} s   min distance "
+                       f"{result.min_distance[k]:.0f} m   shape error "
+                       f"{result.shape_error[k]:.0f} m")
+        return (*trails, goal_line, real_line, dots, label)
+
+    anim = animation.FuncAnimation(fig, draw, frames=frames, blit=False)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    anim.save(str(path), writer=writer, dpi=dpi)
+    plt.close(fig)
+    return path
