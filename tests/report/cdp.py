@@ -87,8 +87,9 @@ class Browser:
                 "--remote-debugging-pipe", "about:blank"]
         self._stderr = open(Path(self.profile) / "stderr.log", "wb")  # noqa: SIM115
         # the child gets our pipe ends as fds 3 (commands in) and 4 (replies out)
+        # (bash, not sh: dash only redirects single-digit descriptors)
         self.proc = subprocess.Popen(
-            ["sh", "-c", f'exec "$@" 3<&{r_cmd} 4>&{w_resp}', "sh", *args],
+            ["bash", "-c", f'exec "$@" 3<&{r_cmd} 4>&{w_resp}', "bash", *args],
             pass_fds=(r_cmd, w_resp), stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
             stderr=self._stderr, start_new_session=True,
         )
