@@ -16,7 +16,6 @@ and the FM² vs RRT comparison.
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -185,7 +184,6 @@ def rrt_comparison(
     else:
         wp, s, g = w3, scenario.start, scenario.goal
     for name in planners:
-        t0 = time.perf_counter()
         r = plan_rrt(wp, s, g, planner=name,
                      time_limit=rrtstar_time if name == "rrtstar" else time_limit, seed=seed)
         path3 = r.path if wp.ndim == 3 else np.column_stack([r.path, np.full(len(r.path), z)])
@@ -201,5 +199,4 @@ def rrt_comparison(
             "feasible": rep.feasible,
             "reason": rep.reason,
         })
-        _ = t0
     return rows, {"fm2": fm, "rrt": results}
