@@ -5,7 +5,8 @@ longitude/latitude. Two cases:
 
 * ``world.crs`` is set (a DEM or building footprints in a projected CRS):
   world ``(x, y)`` are coordinates of that CRS [m]; pyproj converts them to
-  WGS84 (EPSG:4326). World ``z`` is taken as height above the datum of the
+  WGS84 (EPSG:4326) with the transformers of :mod:`fm2uav.world.geo` (so the
+  results equal :meth:`fm2uav.Plan.lonlat`). World ``z`` is taken as height above the datum of the
   source data (for a DEM: its elevations, normally metres above mean sea level).
 * ``world.crs`` is ``None`` (synthetic scenarios): the world is placed on a
   local tangent plane at an :class:`Anchor`: world ``(x, y) = (0, 0)`` sits at
@@ -67,23 +68,25 @@ class Anchor:
 DEFAULT_ANCHOR = Anchor(lon=-3.7649, lat=40.3326, alt=0.0)
 
 
-@lru_cache(maxsize=32)
-def _transformers(src: str) -> tuple[Any, Any]:
-    from pyproj import CRS, Transformer
-    from pyproj.exceptions import CRSError
+def _crs_transformers(src: str) -> tuple[Any, Any]:
+    """Transformers world CRS → WGS84 and back (shared with :mod:`fm2uav.world.geo`)."""
+    from ..world.geo import WGS84, parse_crs, transformer
 
-    try:
-        crs = CRS.from_user_input(src)
-    except CRSError as exc:
-        raise WorldError(f"world CRS {src!r} is not understood by pyproj: {exc}") from None
+    crs = parse_crs(src)
     if crs.is_geographic:
         raise WorldError(
             f"world CRS {src!r} is geographic (degrees), but world x/y are metres; "
             "build the world in a projected CRS (e.g. the UTM zone of the area)"
         )
-    fwd = Transformer.from_crs(crs, "EPSG:4326", always_xy=True)
-    inv = Transformer.from_crs("EPSG:4326", crs, always_xy=True)
-    return fwd, inv
+    return transformer(crs, WGS84), transformer(WGS84, crs)
+
+
+@lru_cache(maxsize=32)
+def _anchor_transformers(proj: str) -> tuple[Any, Any]:
+    from pyproj import Transformer
+
+    return (Transformer.from_crs(proj, "EPSG:4326", always_xy=True),
+            Transformer.from_crs("EPSG:4326", proj, always_xy=True))
 
 
 def _anchor_crs(anchor: Anchor) -> str:
@@ -97,12 +100,12 @@ def _frame(world: Any, anchor: Anchor | None) -> tuple[Any, Any, float]:
     """(forward, inverse, altitude offset [m]) for a world."""
     crs = getattr(world, "crs", None)
     if crs:
-        fwd, inv = _transformers(str(crs))
+        fwd, inv = _crs_transformers(str(crs))
         return fwd, inv, 0.0
     a = DEFAULT_ANCHOR if anchor is None else anchor
     if not isinstance(a, Anchor):
         raise InputError(f"anchor must be a fm2uav.io.Anchor(lon, lat, alt), got {a!r}")
-    fwd, inv = _transformers(_anchor_crs(a))
+    fwd, inv = _anchor_transformers(_anchor_crs(a))
     return fwd, inv, float(a.alt)
 
 

@@ -263,7 +263,7 @@ class PlannerSpec(BaseModel):
     p2: float = _num(1.5, gt=0, le=10, desc="exponent on the other cells")
     agl_band: float = _num(0.0, unit="m", ge=0, le=5000, desc="half-width of the level band")
     agl_graded: bool = Field(False, description="blend p1→p2 across the band")
-    step: float = _num(0.5, gt=0, le=5, desc="geodesic step in cells")
+    step: float = _num(0.5, gt=0, le=1, desc="geodesic step in cells")
 
 
 class AirframeSpec(BaseModel):

@@ -62,3 +62,13 @@ def test_ground_height_is_bilinear_terrain():
     np.testing.assert_allclose(ground_height(w, [[15.0, 25.0], [0.0, 0.0]]), [10.5, 0.0])
     flat = World(np.zeros((4, 4, 4), bool), spacing=5.0, origin=(0, 0, 12.0))
     np.testing.assert_allclose(ground_height(flat, [[3.0, 3.0]]), [12.0])
+
+
+def test_same_as_plan_lonlat_on_the_real_dem():
+    from fm2uav import plan
+    from fm2uav.scenarios import get_scenario
+
+    sc = get_scenario("jacksboro")
+    w = sc.world
+    p = plan(w, sc.start, sc.goal, step=1.0)
+    np.testing.assert_allclose(to_lonlat(p.path, w), p.lonlat(), atol=1e-12)
