@@ -29,11 +29,17 @@ def test_reference_constants_match_the_compiled_solver():
     assert reference.SOURCE_RADIUS_CELLS == fmm.SOURCE_INIT_CELLS == 2.0
     assert reference.SOURCE_RADIUS_FRACTION == fmm.SOURCE_INIT_FRACTION == 0.05
     assert reference.MAX_BALL_SOURCES == fmm.MAX_BALL_SOURCES == 64
+    assert reference.BALL_MAX_SPEED_RATIO == fmm.BALL_MAX_SPEED_RATIO == 1.5
     assert reference.MIN_SPEED == fmm.MIN_SPEED == 1e-150
 
 
 def _random_case(rng: np.random.Generator, ndim: int):
-    """A small grid with random positive speeds, ~15% speed-0 nodes, 1-3 sources."""
+    """A small grid with random positive speeds, ~15% speed-0 nodes, 1-3 sources.
+
+    Speeds this rough (max/min up to 50) leave practically no source clean, so
+    this exercises the stencil without a ball; the ball modes are generated on
+    purpose by ``_mode_case`` below.
+    """
     shape = tuple(int(n) for n in rng.integers(3, 13 if ndim == 2 else 8, size=ndim))
     speed = rng.uniform(0.1, 5.0, size=shape)  # [m/s]
     speed[rng.random(shape) < 0.15] = 0.0
@@ -80,51 +86,168 @@ def _initially_frozen(speed, sources, spacing) -> np.ndarray:
     return np.isfinite(fast_marching(speed, sources, spacing=spacing, stop_at=sources[:1]))
 
 
-def _mode_case(rng: np.random.Generator, ndim: int, mode: str):
-    """Random speeds [m/s] and sources that put the ball in the given mode.
+# The ball rule written out once more for the mode checks below, with the
+# constants as literals (pinned by test_reference_constants_match_the_compiled_solver),
+# so that a changed constant cannot silently move the generated cases with it.
+BALL_CELLS, BALL_FRACTION, BALL_RATIO = 2.0, 0.05, 1.5
 
-    ``frozen``: no speed-0 node, 1-3 sources (every source clean). ``band``: 2-3
-    sources, the first with a speed-0 node right beside it (not clean), plus ~5%
-    speed-0 nodes. ``none``: 65-80 sources (> MAX_BALL_SOURCES), ~10% speed 0.
+
+def _ball_radius(shape, spacing) -> float:
+    """Ball radius R [m]: max(2 max(h), 0.05 * largest (n - 1) h)."""
+    h = np.broadcast_to(np.asarray(spacing, dtype=float), (len(shape),))
+    extent = max((n - 1) * hk for n, hk in zip(shape, h))
+    return max(BALL_CELLS * h.max(), BALL_FRACTION * extent)
+
+
+def _source_box(speed: np.ndarray, src, spacing) -> np.ndarray:
+    """Speeds in the box of a source: floor(R / h) nodes either side per axis, clipped."""
+    h = np.broadcast_to(np.asarray(spacing, dtype=float), (speed.ndim,))
+    radius = _ball_radius(speed.shape, spacing)
+    reach = [int(np.floor(radius / hk)) for hk in h]
+    return speed[tuple(slice(max(c - r, 0), c + r + 1) for c, r in zip(src, reach))]
+
+
+def _clean_sources(speed: np.ndarray, sources: np.ndarray, spacing) -> np.ndarray:
+    """Which sources are clean, recomputed here from the rule (a third, numpy
+    implementation): every speed in the box > 0 and max/min <= 1.5."""
+    clean = []
+    for src in sources:
+        box = _source_box(speed, src, spacing)
+        clean.append(box.min() > 0 and box.max() <= BALL_RATIO * box.min())
+    return np.array(clean)
+
+
+def _smooth_speed(rng: np.random.Generator, shape, spacing) -> np.ndarray:
+    """Positive speeds [m/s] that vary by at most ~1.43x within any source box.
+
+    ``v0 * exp(a . x / R) * (1 + noise)``: a smooth trend with ``sum |a_k| = 0.1``
+    (a box spans at most 2 R per axis: factor <= exp(0.2) = 1.22) times +-8 %
+    noise (factor <= 1.08 / 0.92), so max/min <= 1.43 in any box, while over the
+    whole grid (up to ~7 R wide) the speed may vary by up to ~2x.
+    """
+    h = np.broadcast_to(np.asarray(spacing, dtype=float), (len(shape),))
+    radius = _ball_radius(shape, spacing)
+    a = rng.uniform(-1.0, 1.0, size=len(shape))
+    a *= 0.1 / np.abs(a).sum()
+    x = np.meshgrid(*[np.arange(n) * hk for n, hk in zip(shape, h)], indexing="ij")
+    trend = np.exp(sum(ak * xk for ak, xk in zip(a, x)) / radius)
+    return rng.uniform(0.5, 3.0) * trend * rng.uniform(0.92, 1.08, size=shape)
+
+
+MODES = ["frozen", "band", "none", "unclean"]
+
+
+def _mode_case(rng: np.random.Generator, ndim: int, mode: str):
+    """Random speeds [m/s], sources and spacing [m] that put the ball in a mode.
+
+    ``frozen``: smooth speeds (``_smooth_speed``), no speed 0, 1-3 sources: every
+    source clean, ball frozen. ``band``: smooth speeds, 2-3 sources; next to the
+    first one a disturbance that makes it unclean (cycling: a speed-0 node, a slow
+    node at 1/4 of the speed, or a speed jump x2.5 / x0.4 over the half-space
+    beyond that neighbour), with ~3 % speed-0 nodes in the first case; drawn
+    until at least one source is still clean, so a ball exists but is banded.
+    ``none``: 65-80 sources (> MAX_BALL_SOURCES) on smooth speeds, with ~10 %
+    speed-0 nodes in half the cases: no ball though the sources may be clean.
+    ``unclean``: 1-3 sources on rough speeds (0.1 .. 5, ~5 % speed 0): every
+    source is unclean, so no ball although there are few sources.
     """
     lo, hi = (10, 15) if ndim == 2 else (5, 8)
     shape = tuple(int(n) for n in rng.integers(lo, hi, size=ndim))
-    speed = rng.uniform(0.1, 5.0, size=shape)
-    if mode != "frozen":
-        speed[rng.random(shape) < (0.05 if mode == "band" else 0.1)] = 0.0
-    k = {"frozen": int(rng.integers(1, 4)), "band": int(rng.integers(2, 4))}.get(
-        mode, int(rng.integers(65, 81))
-    )
-    free = np.argwhere(speed > 0)
-    sources = free[rng.choice(len(free), size=k, replace=False)]
-    if mode == "band":
-        first = sources[0].copy()
-        axis = int(rng.integers(ndim))
-        first[axis] += 1 if first[axis] + 1 < shape[axis] else -1
-        speed[tuple(first)] = 0.0
-        sources = np.array([s for s in sources if speed[tuple(s)] > 0])
-    return speed, sources
+    spacing = tuple(rng.uniform(0.2, 3.0, size=ndim))
+    for _ in range(1000):
+        if mode == "unclean":
+            speed = rng.uniform(0.1, 5.0, size=shape)
+            speed[rng.random(shape) < 0.05] = 0.0
+        else:
+            speed = _smooth_speed(rng, shape, spacing)
+        kind = int(rng.integers(3))
+        if (mode == "band" and kind == 0) or (mode == "none" and rng.random() < 0.5):
+            speed[rng.random(shape) < (0.03 if mode == "band" else 0.1)] = 0.0
+        k = {"band": int(rng.integers(2, 4)), "none": int(rng.integers(65, 81))}.get(
+            mode, int(rng.integers(1, 4))
+        )
+        free = np.argwhere(speed > 0)
+        if len(free) < k:
+            continue
+        sources = free[rng.choice(len(free), size=k, replace=False)]
+        if mode == "band":
+            nb = sources[0].copy()
+            axis = int(rng.integers(ndim))
+            step = 1 if nb[axis] + 1 < shape[axis] else -1
+            nb[axis] += step
+            if kind == 0:
+                speed[tuple(nb)] = 0.0
+            elif kind == 1:
+                speed[tuple(nb)] *= 0.25
+            else:
+                idx = np.arange(shape[axis]).reshape(
+                    [-1 if ax == axis else 1 for ax in range(ndim)]
+                )
+                beyond = (idx - nb[axis]) * step >= 0
+                speed = np.where(beyond, speed * (2.5 if rng.random() < 0.5 else 0.4), speed)
+            sources = np.array([s for s in sources if speed[tuple(s)] > 0])
+        clean = _clean_sources(speed, sources, spacing)
+        ok = {
+            "frozen": clean.all(),
+            "band": len(sources) >= 2 and not clean[0] and clean.any(),
+            "none": True,
+            "unclean": not clean.any(),
+        }[mode]
+        if ok:
+            return speed, sources, spacing
+    raise AssertionError(f"no {mode} case drawn")  # pragma: no cover
 
 
 @pytest.mark.parametrize("seed", range(6))
 @pytest.mark.parametrize("ndim", [2, 3])
 @pytest.mark.parametrize("order", [1, 2])
-@pytest.mark.parametrize("mode", ["frozen", "band", "none"])
+@pytest.mark.parametrize("mode", MODES)
 def test_compiled_matches_reference_in_each_ball_mode(mode, order, ndim, seed):
-    rng = np.random.default_rng([seed, ndim, order, ["frozen", "band", "none"].index(mode)])
-    speed, sources = _mode_case(rng, ndim, mode)
-    spacing = tuple(rng.uniform(0.2, 3.0, size=ndim))
-    # the case really is in that mode: a frozen ball shows as extra frozen nodes
+    rng = np.random.default_rng([seed, ndim, order, MODES.index(mode)])
+    speed, sources, spacing = _mode_case(rng, ndim, mode)
+    # The case really is in that mode. A frozen ball shows as extra frozen nodes
+    # before the march; a banded ball does not, but it changes the result (its
+    # straight-ray values undercut the stencil somewhere, e.g. on diagonals); no
+    # ball at all gives exactly the field of source_ball=False.
     n_init = int(_initially_frozen(speed, sources, spacing).sum())
     n_src = len({tuple(s) for s in sources})
     assert (n_init > n_src) if mode == "frozen" else (n_init == n_src)
+    no_ball = fast_marching(speed, sources, spacing=spacing, order=order, source_ball=False)
+    with_ball = fast_marching(speed, sources, spacing=spacing, order=order)
+    if mode in ("none", "unclean"):
+        np.testing.assert_array_equal(with_ball, no_ball)
+    else:
+        assert not np.array_equal(with_ball, no_ball)
+    if mode == "none" and _clean_sources(speed, sources[:64], spacing).all():
+        # only the count disables the ball here: 64 of these sources get one
+        assert _initially_frozen(speed, sources[:64], spacing).sum() > 64
     stop_at = None
     if seed % 2:
         free = np.argwhere(speed > 0)
         stop_at = free[rng.choice(len(free), size=2, replace=False)]
-    T = fast_marching(speed, sources, spacing=spacing, order=order, stop_at=stop_at)
-    R = fast_marching_reference(speed, sources, spacing=spacing, order=order, stop_at=stop_at)
-    assert_same_field(T, R, RTOL)
+    for ball in (True, False):
+        T = fast_marching(
+            speed, sources, spacing=spacing, order=order, stop_at=stop_at, source_ball=ball
+        )
+        R = fast_marching_reference(
+            speed, sources, spacing=spacing, order=order, stop_at=stop_at, source_ball=ball
+        )
+        assert_same_field(T, R, RTOL)
+
+
+def test_mode_cases_cover_every_band_disturbance():
+    # The band cases above cycle through a wall, a slow node and a speed jump;
+    # check that the drawn cases do show a box rejected for each reason: a speed 0,
+    # or max/min > 1.5 with all speeds positive.
+    reasons = set()
+    for seed in range(6):
+        for ndim in (2, 3):
+            for order in (1, 2):
+                rng = np.random.default_rng([seed, ndim, order, MODES.index("band")])
+                speed, sources, spacing = _mode_case(rng, ndim, "band")
+                box = _source_box(speed, sources[0], spacing)
+                reasons.add("zero" if box.min() == 0 else "ratio")
+    assert reasons == {"zero", "ratio"}
 
 
 @pytest.mark.parametrize("shape", [(15, 15), (9, 8, 7)])

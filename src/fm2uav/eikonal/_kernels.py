@@ -299,14 +299,17 @@ def march(speed, T, state, nx, ny, nz, hx, hy, hz, order, stop_mask, n_stop, hea
 
 # ------------------------------------------------------------ source initialisation
 @njit(cache=True, error_model="numpy")
-def init_sources(speed, T, state, nx, ny, nz, hx, hy, hz, src, radius):
+def init_sources(speed, T, state, nx, ny, nz, hx, hy, hz, src, radius, max_ratio):
     """Initialise point sources: T = 0 at each source (frozen) and, around each
-    source whose neighbourhood is free, the straight-ray time in a ball.
+    clean source (see below), the straight-ray time in a ball.
 
     Inside the ball of physical radius ``radius`` [m] the time is the distance
     ``d`` times the trapezoidal mean slowness ``(1/v_s + 1/v) / 2``, which is
     exact for constant speed and second-order accurate for smooth speed.
-    A source whose bounding box holds an impassable cell gets no ball. When
+    A source gets a ball only if the speed in its bounding box is positive and
+    varies by at most ``max_ratio`` (max/min): the straight ray only sees the
+    speeds at its two ends, so a slow wall or a speed jump inside the box
+    would otherwise be crossed for free. When
     every source has its ball, the ball cells are frozen (kept exact: letting
     the march lower them costs the order-2 scheme its rate, which falls to
     ~1); otherwise they only enter the narrow band.
@@ -317,6 +320,8 @@ def init_sources(speed, T, state, nx, ny, nz, hx, hy, hz, src, radius):
         Source indices.
     radius : float
         Ball radius [m]; 0 disables the ball.
+    max_ratio : float
+        Largest admissible max/min speed ratio in a source's box.
     """
     sx = ny * nz
     sy = nz
@@ -332,23 +337,23 @@ def init_sources(speed, T, state, nx, ny, nz, hx, hy, hz, src, radius):
         state[cs] = 2
     if radius <= 0:
         return
-    # A ball is used only if its bounding box is free of impassable nodes; its
-    # cells are frozen (exact, kept) when every source has a clean ball, else
-    # they only enter the band, so that a nearer route past an obstacle near
-    # another source can still lower them.
+    # A ball is used only if its bounding box holds speeds > 0 only, with
+    # max/min <= max_ratio; its cells are frozen (exact, kept) when every source
+    # has a clean ball, else they only enter the band, so that a nearer route
+    # past an obstacle near another source can still lower them.
     clean = np.ones(m, dtype=np.uint8)
     for s in range(m):
         si, sj, sk = src[s, 0], src[s, 1], src[s, 2]
+        vmin = np.inf
+        vmax = 0.0
         for i in range(max(si - ri, 0), min(si + ri, nx - 1) + 1):
             for j in range(max(sj - rj, 0), min(sj + rj, ny - 1) + 1):
                 for k in range(max(sk - rk, 0), min(sk + rk, nz - 1) + 1):
-                    if speed[i * sx + j * sy + k] <= 0.0:
-                        clean[s] = 0
-                        break
-                if clean[s] == 0:
-                    break
-            if clean[s] == 0:
-                break
+                    v = speed[i * sx + j * sy + k]
+                    vmin = min(vmin, v)
+                    vmax = max(vmax, v)
+        if not (vmin > 0.0 and vmax <= max_ratio * vmin):
+            clean[s] = 0
     all_clean = True
     for s in range(m):
         if clean[s] == 0:

@@ -24,7 +24,8 @@ Sources
     ``R = max(2 * max(h), 0.05 * extent)`` [m], where ``extent`` is the largest
     physical size ``(n_axis - 1) * h_axis`` of the grid. A source is *clean* if
     its bounding box (clipped to the grid, ``floor(R / h_axis)`` nodes either
-    side per axis) holds no node of speed ``<= 0``. Around every clean source,
+    side per axis) holds no node of speed ``<= 0`` and its largest speed is at
+    most ``BALL_MAX_SPEED_RATIO = 1.5`` times its smallest. Around every clean source,
     every node at physical distance ``d <= R`` other than a source gets the
     straight-ray time ``d * 0.5 * (1/v_source + 1/v_node)`` if that is smaller
     than its current value (so the minimum over sources wins); only the speeds
@@ -79,6 +80,8 @@ SOURCE_RADIUS_CELLS = 2.0
 SOURCE_RADIUS_FRACTION = 0.05
 #: With more sources than this, no ball: sources are plain T = 0 nodes.
 MAX_BALL_SOURCES = 64
+#: A box whose max/min speed exceeds this is not clean (no ball).
+BALL_MAX_SPEED_RATIO = 1.5
 #: Positive speeds below this [m/s] are raised to it.
 MIN_SPEED = 1e-150
 
@@ -204,6 +207,7 @@ def fast_marching_reference(
     spacing: float | Sequence[float] = 1.0,
     order: int = 2,
     stop_at: Any = None,
+    source_ball: bool = True,
 ) -> np.ndarray:
     """Arrival times by a slow pure-Python Fast Marching Method (tests only).
 
@@ -225,6 +229,9 @@ def fast_marching_reference(
     stop_at : sequence of int tuples, optional
         Stop once all these nodes are frozen; nodes not frozen by then are
         ``inf``.
+    source_ball : bool, optional
+        Use the straight-ray ball (default True); False: sources are plain
+        ``T = 0`` nodes, as with more than ``MAX_BALL_SOURCES`` sources.
 
     Returns
     -------
@@ -250,7 +257,7 @@ def fast_marching_reference(
 
     # ---- straight-ray ball around every clean source
     ball: dict[Index, float] = {}  # node -> smallest straight-ray time [s]
-    if len(source_nodes) <= MAX_BALL_SOURCES:  # counted with repeats, as given
+    if source_ball and len(source_nodes) <= MAX_BALL_SOURCES:  # counted with repeats
         extent = max((n - 1) * hx for n, hx in zip(shape, h))  # [m]
         radius = max(SOURCE_RADIUS_CELLS * max(h), SOURCE_RADIUS_FRACTION * extent)  # [m]
         reach = [int(math.floor(radius / hx)) for hx in h]  # nodes per axis
@@ -261,7 +268,10 @@ def fast_marching_reference(
                 for ax in range(ndim)
             ]
             boxes.append(list(itertools.product(*ranges)))
-        clean = [all(speed[node] > 0.0 for node in box) for box in boxes]
+        clean = []
+        for box in boxes:
+            speeds = [float(speed[node]) for node in box]
+            clean.append(min(speeds) > 0.0 and max(speeds) <= BALL_MAX_SPEED_RATIO * min(speeds))
         for s, box, ok in zip(source_nodes, boxes, clean):
             if not ok:
                 continue

@@ -27,6 +27,11 @@ SOURCE_INIT_FRACTION = 0.05
 #: Ball initialisation is for point sources: above this many sources (e.g. all
 #: obstacle nodes of a map) sources are plain T = 0 nodes.
 MAX_BALL_SOURCES = 64
+#: A source gets its ball only where the speed in the ball's box varies by at
+#: most this factor (max/min): the straight-ray time sees only the speeds at
+#: the ray's two ends, so a slow wall or a jump (e.g. a flight-level layer)
+#: inside the box would be crossed for free.
+BALL_MAX_SPEED_RATIO = 1.5
 #: Positive speeds below this are raised to it, so that ``1 / speed**2`` stays
 #: finite (smaller speeds would otherwise act as walls).
 MIN_SPEED = 1e-150
@@ -117,6 +122,7 @@ def fast_marching(
     spacing: float | Sequence[float] = 1.0,
     order: int = 2,
     stop_at: Any = None,
+    source_ball: bool = True,
 ) -> np.ndarray:
     """Arrival times of a wave started at ``sources`` over a speed field.
 
@@ -129,9 +135,10 @@ def fast_marching(
         Propagation speed at each node [m/s], ``>= 0``; 0 marks impassable nodes.
         Indexed x first.
     sources : sequence of int tuples or (m, ndim) int array
-        Grid indices where ``T = 0``. Each must have speed > 0. Around a source
-        whose neighbourhood (2 cells) is free, times are initialised with the
-        straight-ray time so errors away from the source stay small.
+        Grid indices where ``T = 0``. Each must have speed > 0. Around point
+        sources (at most 64) whose neighbourhood has a positive speed varying by
+        at most 1.5x, nodes within ``max(2 cells, 5 % of the grid extent)`` get
+        the straight-ray time, which keeps the order-2 scheme second-order.
     spacing : float or sequence of float, optional
         Node spacing [m], one value or one per axis. Default 1.
     order : {1, 2}, optional
@@ -140,6 +147,10 @@ def fast_marching(
     stop_at : sequence of int tuples, optional
         Stop as soon as all these nodes are frozen. Nodes not frozen by then are
         returned as ``inf``.
+    source_ball : bool, optional
+        Initialise the straight-ray ball around point sources (default True).
+        The ball is skipped automatically where the speed near a source is not
+        smooth (max/min > 1.5 in its box); False disables it everywhere.
 
     Returns
     -------
@@ -182,16 +193,18 @@ def fast_marching(
     state = np.zeros(flat_speed.size, dtype=np.uint8)
     extent = max((n - 1) * hk for n, hk in zip(shape, h))
     radius = max(SOURCE_INIT_CELLS * max(h), SOURCE_INIT_FRACTION * extent)
-    if src.shape[0] > MAX_BALL_SOURCES:
+    if src.shape[0] > MAX_BALL_SOURCES or not source_ball:
         radius = 0.0
-    _kernels.init_sources(flat_speed, T, state, *shape3, *h3, src3, radius)
+    _kernels.init_sources(
+        flat_speed, T, state, *shape3, *h3, src3, radius, BALL_MAX_SPEED_RATIO
+    )
 
     if stop_at is not None:
         stops = as_index_array(stop_at, shape, "stop_at")
         stop_mask = np.zeros(flat_speed.size, dtype=np.uint8)
         stop_mask[np.ravel_multi_index(tuple(stops.T), shape)] = 1
         n_stop = int(np.count_nonzero(stop_mask & (state != _kernels.FROZEN)))
-        if n_stop == 0:  # every stop node is a source: nothing else is frozen
+        if n_stop == 0:  # every stop node is frozen already (a source or its ball)
             T[state != _kernels.FROZEN] = np.inf
             return T.reshape(shape)
     else:
