@@ -9,8 +9,10 @@ Schema (pydantic v2, strict types, unknown keys rejected)::
       seed: 0                       # relief seed of the scenario
       dem: terrain.tif              # or: a GeoTIFF DEM with a CRS (path relative to this file)
       buildings: city.geojson       # or: building footprints (GeoJSON polygons with heights)
-      cell_size: 15                 # [m] grid cell for DEM / buildings worlds
-      height_cells: 40              # vertical nodes for DEM / buildings worlds
+      cell_size: 15                 # [m] horizontal grid cell (required for dem / buildings)
+      dz: 15                        # [m] vertical cell (default cell_size)
+      ceiling: 1500                 # dem: altitude of the top node [m]; nodata: error | fill
+      height_cells: 40              # buildings: vertical nodes; also margin, default_height, crs
       anchor: {lon: -3.7649, lat: 40.3326, alt: 0}   # where a world without CRS sits
     start: [300, 300, 300]          # x, y, z [m]; or {x, y, agl}, {lon, lat, alt},
     goal: {lon: -3.747, lat: 40.343, agl: 60}        # {lon, lat, agl} or {cell: [i, j, k]}
@@ -22,7 +24,8 @@ Schema (pydantic v2, strict types, unknown keys rejected)::
       thin_tolerance: 5             # [m] Douglas–Peucker tolerance of the waypoints
       frame: auto                   # auto | relative | terrain (MAVLink frame 3 / 10)
 
-Every validation error is reported on one line naming the field, the bad
+The full field reference with ranges is in docs/operator.md. Every validation
+error is reported on one line naming the field, the bad
 value and what is allowed, e.g. ``planner.saturation = 1.5 is out of range;
 allowed: 0 < saturation <= 1``.
 """
