@@ -114,7 +114,8 @@ def _rows(summary: dict[str, Any]) -> dict[str, Any]:
         "samples inside terrain": summary["inside_terrain_samples"],
         "shape error max / final [m]": f"{summary['max_shape_error_m']:.1f} / {summary['final_shape_error_m']:.1f}",
         "min grey level": summary["min_grey"],
-        "level keeping": summary["level_keeping"] or "-",
+        "on the level (±1 cell)": ", ".join(
+            f"{k} {v['within_1_cell']:.0%}" for k, v in summary["level_keeping"].items()) or "-",
         "cycle [ms] median / p95 / max": "{median} / {p95} / {max}".format(**summary["cycle_ms"]),
         "computed in [s]": summary["timings_s"]["total"],
     }

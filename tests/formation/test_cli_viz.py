@@ -1,0 +1,78 @@
+"""`fm2uav formation`: outputs, exit codes; the figures and the GIF of a flight."""
+
+import csv
+import json
+
+import numpy as np
+from typer.testing import CliRunner
+
+from fm2uav.cli import app
+from fm2uav.missions.formation import fly_formation
+from fm2uav.viz.formation import (
+    formation_animation,
+    formation_metrics_figure,
+    formation_paths_figure,
+    formation_profiles_figure,
+)
+
+runner = CliRunner()
+
+
+def test_formation_cli_writes_outputs(tmp_path):
+    out = tmp_path / "f"
+    res = runner.invoke(app, ["formation", "--level", "7", "--no-gif", "--json", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    summary = json.loads(res.output)
+    assert summary["completed"] and summary["min_separation_m"] >= 30.0
+    assert summary["inside_terrain_samples"] == 0
+    assert summary["agl_m"] == [105.0, 105.0, 105.0]
+    for name in ("trajectories.csv", "metrics.csv", "cycles.csv", "summary.json",
+                 "paths.png", "profiles.png", "metrics.png"):
+        assert (out / name).stat().st_size > 0, name
+    with open(out / "trajectories.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    assert {r["uav"] for r in rows} == {"leader", "follower 1", "follower 2"}
+    last = [r for r in rows if r["uav"] == "leader"][-1]
+    np.testing.assert_allclose([float(last[k]) for k in ("x_m", "y_m", "z_m")],
+                               [1680, 600, 450], atol=1e-3)
+    # no overwrite without --force
+    res = runner.invoke(app, ["formation", "--no-gif", "--out", str(out)])
+    assert res.exit_code == 2 and "--force" in res.output
+
+
+def test_formation_cli_bad_input_exit_codes(tmp_path):
+    res = runner.invoke(app, ["formation", "--no-gif", "--dist", "-5", "--out", str(tmp_path)])
+    assert res.exit_code == 2 and "dist" in res.output
+    res = runner.invoke(app, ["formation", "--no-gif", "--goal", "112,40,2", "--cells",
+                              "--out", str(tmp_path)])
+    assert res.exit_code == 2 and "goal" in res.output
+    res = runner.invoke(app, ["formation", "--no-gif", "--agl", "105", "--level", "7",
+                              "--out", str(tmp_path)])
+    assert res.exit_code == 2
+
+
+def test_figures_and_gif(corridor, tmp_path):
+    r = fly_formation(corridor, (50.0, 200.0, 60.0), (550.0, 200.0, 60.0), dist=20.0,
+                      leader_speed=8.0, clearance=20.0)
+    for make in (formation_paths_figure, formation_profiles_figure, formation_metrics_figure):
+        fig = make(r)
+        assert len(fig.axes) >= 2
+    gif = formation_animation(r, tmp_path / "a.gif", max_frames=4, dpi=40)
+    data = gif.read_bytes()
+    assert data[:6] in (b"GIF87a", b"GIF89a")
+
+
+def test_reproduce_formation_table(tmp_path):
+    res = runner.invoke(app, ["reproduce", "formation", "--no-gif", "--json",
+                              "--out", str(tmp_path)])
+    assert res.exit_code == 0, res.output
+    results = json.loads(res.output)
+    assert set(results) == {"case1", "case2-thesis-p", "case2"}
+    for s in results.values():
+        assert s["completed"] and s["min_separation_m"] >= 30.0
+        assert s["inside_terrain_samples"] == 0
+    # with the planner's exponents the leader keeps level 7; the formation narrows
+    assert results["case2"]["level_keeping"]["leader"]["within_1_cell"] > 0.9
+    assert results["case2"]["min_grey"] < 0.6
+    table = (tmp_path / "table.md").read_text()
+    assert "130.6" in table and "135.6" in table
