@@ -1,4 +1,4 @@
-"""``fm2uav formation`` and ``fm2uav reproduce formation``: leader–follower flights (thesis ch. 6)."""
+"""``fm2uav formation`` / ``fm2uav reproduce formation``: leader–follower flights (thesis ch. 6)."""
 
 from __future__ import annotations
 
@@ -110,9 +110,11 @@ def _rows(summary: dict[str, Any]) -> dict[str, Any]:
         "completed / settled": f"{summary['completed']} / {summary['settled']}",
         "mission time [s]": summary["mission_time_s"],
         "cycles": summary["cycles"],
-        "min separation [m]": f"{summary['min_separation_m']:.1f} (bound {summary['separation_bound_m']:g})",
+        "min separation [m]": (f"{summary['min_separation_m']:.1f} "
+                               f"(bound {summary['separation_bound_m']:g})"),
         "samples inside terrain": summary["inside_terrain_samples"],
-        "shape error max / final [m]": f"{summary['max_shape_error_m']:.1f} / {summary['final_shape_error_m']:.1f}",
+        "shape error max / final [m]": (f"{summary['max_shape_error_m']:.1f} / "
+                                        f"{summary['final_shape_error_m']:.1f}"),
         "min grey level": summary["min_grey"],
         "on the level (±1 cell)": ", ".join(
             f"{k} {v['within_1_cell']:.0%}" for k, v in summary["level_keeping"].items()) or "-",
@@ -140,20 +142,24 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
     @handle_errors
     def formation_cmd(
         scenario: str = typer.Option("fissure", help="Built-in scenario name."),
-        start: str | None = typer.Option(None, help="Leader start x,y,z [m] (cells with --cells)."),
-        goal: str | None = typer.Option(None, help="Leader goal x,y,z [m] (cells with --cells)."),
+        start: str | None = typer.Option(None, help="Leader start x,y,z (m) (cells with --cells)."),
+        goal: str | None = typer.Option(None, help="Leader goal x,y,z (m) (cells with --cells)."),
         cells: bool = typer.Option(False, "--cells", help="Read --start/--goal as grid cells."),
         shape: str = typer.Option("triangle", help="Formation: triangle, v or line."),
         followers: int = typer.Option(2, help="Number of followers."),
-        dist: float = typer.Option(60.0, help="Safety distance dist [m]; UAVs never closer than dist/2."),
-        speed: float = typer.Option(10.0, help="Leader speed [m/s]."),
-        follower_speed: float | None = typer.Option(None, help="Followers' top speed [m/s] (default 1.5 × leader)."),
-        cycle: float = typer.Option(1.0, help="Re-planning period [s]."),
-        agl: float | None = typer.Option(None, help="Flight level [m above ground] for all UAVs."),
-        level: float | None = typer.Option(None, help="Flight level in vertical cells (thesis: 7)."),
+        dist: float = typer.Option(
+            60.0, help="Safety distance dist (m); UAVs never closer than dist/2."),
+        speed: float = typer.Option(10.0, help="Leader speed (m/s)."),
+        follower_speed: float | None = typer.Option(
+            None, help="Followers' top speed (m/s) (default 1.5 × leader)."),
+        cycle: float = typer.Option(1.0, help="Re-planning period (s)."),
+        agl: float | None = typer.Option(None, help="Flight level (m above ground) for all UAVs."),
+        level: float | None = typer.Option(
+            None, help="Flight level in vertical cells (thesis: 7)."),
         p1: float = typer.Option(0.5, help="Flight-level exponent on the level (thesis ch. 6: 1)."),
         p2: float = typer.Option(1.5, help="Flight-level exponent elsewhere (thesis ch. 6: 0.5)."),
-        grey: str = typer.Option("goal", help="Grey level at the partial 'goal' or the 'follower'."),
+        grey: str = typer.Option(
+            "goal", help="Grey level at the partial 'goal' or the 'follower'."),
         seed: int = typer.Option(0, help="Seed of the scenario's random relief."),
         gif: bool = typer.Option(True, "--gif/--no-gif", help="Write the animation."),
         frames: int = typer.Option(60, help="Animation frames (at most)."),

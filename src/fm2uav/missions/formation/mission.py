@@ -529,7 +529,8 @@ def fly_formation(
         try:
             fs = np.asarray(follower_starts, dtype=float)
         except (TypeError, ValueError):
-            raise InputError("follower_starts must be numbers, shape (n_followers, 3) [m]") from None
+            raise InputError(
+                "follower_starts must be numbers, shape (n_followers, 3) [m]") from None
         if fs.shape != (nf, 3) or not np.all(np.isfinite(fs)):
             raise InputError(
                 f"follower_starts must have shape ({nf}, 3) — one (x, y, z) in metres per "
