@@ -1,5 +1,14 @@
 """Missions made of many paths: coverage (zigzag + DE + FM²), formations."""
 
-from .coverage import Zigzag, plan_coverage, zigzag
+from .coverage import CoveragePlan, Zigzag, plan_coverage, zigzag
+from .formation import FormationResult, fly_formation, formation_shape
 
-__all__ = ["Zigzag", "zigzag", "plan_coverage"]
+__all__ = [
+    "Zigzag",
+    "zigzag",
+    "plan_coverage",
+    "CoveragePlan",
+    "fly_formation",
+    "FormationResult",
+    "formation_shape",
+]
