@@ -15,10 +15,14 @@ $(STAMP): pyproject.toml
 
 install: $(STAMP)
 
-## make run: plan the default mission on the built-in open-field scenario
+## make run: the default mission — terrain-following flight (150 m above ground, the
+## TFF paper's case 3) over the built-in open-field scenario, with ground-control
+## exports and an interactive report
 run: $(STAMP)
-	$(VENV)/bin/fm2uav plan --scenario open-field --out $(OUT)/plan --force
-	@echo "outputs written to $(OUT)/plan/ (path.csv, plan.png, summary.json)"
+	$(VENV)/bin/fm2uav run examples/open_field_tff.yaml --out $(OUT)/mission --force
+	@echo ""
+	@echo "outputs written to $(OUT)/mission/ — open $(OUT)/mission/report.html in a browser;"
+	@echo "mission.plan loads in QGroundControl, mission.waypoints is a MAVLink WPL 110 file"
 
 ## make test: the whole suite
 test: $(STAMP)
