@@ -66,3 +66,14 @@ def test_help_shows_example():
     res = runner.invoke(app, ["plan", "--help"])
     assert res.exit_code == 0
     assert "fm2uav plan --scenario open-field" in res.output
+
+
+def test_flight_level_options_reach_the_planner_and_exports(tmp_path):
+    res = runner.invoke(app, ["plan", "--agl", "150", "--p1", "0.5", "--p2", "1.3", "--export", "plan",
+                              "--out", str(tmp_path), "--json"])
+    assert res.exit_code == 0, res.output
+    data = json.loads(res.output)
+    assert data["params"]["agl"] == 150.0 and data["params"]["p2"] == 1.3
+    assert data["mavlink_frame"] == 10  # terrain-relative for terrain-following plans
+    res = runner.invoke(app, ["plan", "--agl", "900", "--out", str(tmp_path / "high")])
+    assert res.exit_code == 1 and "leaves the map" in res.output

@@ -28,6 +28,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "Examples:\n\n"
             "  fm2uav plan --scenario open-field --out out/plan\n\n"
             "  fm2uav plan --start 20,20,20 --goal 100,80,30 --cells --exponent 0.5 --out out/b\n\n"
+            "  fm2uav plan --agl 150 --p1 0.5 --p2 1.3 --report --export all --out out/tff\n\n"
             "  fm2uav plan --report --export plan,wpl,geojson,kml --out out/c\n\n"
             f"Scenarios: {', '.join(SCENARIOS)}."
         ),
@@ -45,6 +46,14 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         saturation: float = typer.Option(1.0, help="Saturation α in (0, 1]."),
         exponent: float = typer.Option(1.0, help="Exponent β > 0 on W (thesis' adjustment)."),
         order: int = typer.Option(2, help="Fast Marching order, 1 or 2."),
+        agl: float | None = typer.Option(
+            None, help="Flight level [m] above the ground (terrain-following, thesis "
+            "Algorithm 2). Default: none."),
+        p1: float = typer.Option(0.5, help="Exponent on the flight-level cells (with --agl)."),
+        p2: float = typer.Option(1.5, help="Exponent on all other cells (with --agl)."),
+        agl_band: float = typer.Option(
+            0.0, help="Half-width [m] of a graded band around the flight level (with --agl; "
+            "0 = the seeds' single layer)."),
         seed: int = typer.Option(0, help="Seed of the scenario's random relief."),
         out: Path = typer.Option(Path("out/plan"), help="Output directory."),
         force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
@@ -81,6 +90,11 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             saturation=saturation,
             exponent=exponent,
             order=order,
+            agl=agl,
+            p1=p1,
+            p2=p2,
+            agl_band=agl_band,
+            agl_graded=agl_band > 0,
         )
         from ..io import write_path_csv
         from ..viz import plan_figure
