@@ -56,7 +56,9 @@ def tables_markdown(summary: dict[str, Any], result: Any) -> str:
         "",
         "References: lattice search time (compiled Dijkstra, control set cached); FM²: sum over "
         "pairs of the median `plan()` time over the grid (both Fast Marching waves, descent, "
-        "metrics).",
+        "metrics). Both are measured inside the sweep's worker processes, running side by "
+        "side on a shared machine, so the ratios are indicative; `benchmarks/bench_reference.py` "
+        "times both in one process, one after the other.",
         "",
     ]
     for metric, title, num in (("frechet", "Fréchet distance [m]", 2), ("area", "area between curves [m²]", 3)):
