@@ -30,7 +30,7 @@ test: $(STAMP)
 
 ## make bench: speed and memory against peers (writes benchmarks/results/*.json)
 bench: $(STAMP)
-	$(PY) benchmarks/run.py
+	$(PY) -m benchmarks.run
 
 clean:
 	rm -rf $(VENV) $(OUT) .pytest_cache benchmarks/results

@@ -9,17 +9,10 @@ the seeds' published times.
 
 from __future__ import annotations
 
-import statistics
-import time
+from ._timing import median_time
 
 
-def _median(fn, repeats):
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times)
+
 
 
 def run(quick: bool = False) -> list[dict]:
@@ -41,13 +34,13 @@ def run(quick: bool = False) -> list[dict]:
     for n in names:
         poly = coverage_area(n)
         f = ZigzagCost.of(poly, COVERAGE_SPACING)
-        de = _median(lambda: differential_evolution(f, seed=0), repeats)
-        sp = _median(lambda: scipy_de(f, seed=0), repeats)
+        de = median_time(lambda: differential_evolution(f, seed=0), repeats)[0]
+        sp = median_time(lambda: scipy_de(f, seed=0), repeats)[0]
         rows.append({"benchmark": "coverage_de", "case": f"{n} D=80 Np=20 G=30",
                      "ours_s": de, "peer": "scipy DE (same settings)", "peer_s": sp,
                      "ratio": sp / de, "bar": "<= 0.3 s (seeds 3.79 s)"})
-        whole = _median(lambda: plan_coverage(world, poly, COVERAGE_SPACING, agl=COVERAGE_AGL),
-                        repeats)
+        whole = median_time(lambda: plan_coverage(world, poly, COVERAGE_SPACING, agl=COVERAGE_AGL),
+                        repeats)[0]
         rows.append({"benchmark": "coverage_plan", "case": f"{n} 118x87x40 agl=100",
                      "ours_s": whole, "peer": "seeds (Matlab, DE + FM²)", "peer_s": 3.79 + 0.36,
                      "ratio": (3.79 + 0.36) / whole, "bar": "<= 1 s",

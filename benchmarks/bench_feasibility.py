@@ -9,20 +9,12 @@ how long it was given. Medians over ``repeats`` runs after one warm-up.
 
 from __future__ import annotations
 
-import statistics
-import time
+from ._timing import median_time
+
 
 import numpy as np
 
 
-def _median(fn, repeats: int) -> tuple[float, object]:
-    out = None
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times), out
 
 
 def run(quick: bool = False) -> list[dict]:
@@ -51,11 +43,11 @@ def run(quick: bool = False) -> list[dict]:
             return World(base.occupancy, spacing=base.spacing, origin=base.origin)
 
         plan(fresh(), s, g, exponent=1.0, walls=True)  # JIT warm-up
-        fm_s, p = _median(lambda: plan(fresh(), s, g, exponent=1.0, walls=True), repeats)
+        fm_s, p = median_time(lambda: plan(fresh(), s, g, exponent=1.0, walls=True), repeats)
         for name in planners:
             budget = 1.0 if name == "rrtstar" else 10.0
             plan_rrt(base, s, g, planner=name, time_limit=budget)  # warm-up
-            rr_s, r = _median(lambda: plan_rrt(base, s, g, planner=name, time_limit=budget), repeats)
+            rr_s, r = median_time(lambda: plan_rrt(base, s, g, planner=name, time_limit=budget), repeats)
             rows.append({
                 "benchmark": "feasibility/fm2-vs-rrt",
                 "case": f"{label}: FM² W^1 vs {r.planner}+shortcut",
@@ -70,7 +62,7 @@ def run(quick: bool = False) -> list[dict]:
         path3 = p.path if p.path.shape[1] == 3 else np.column_stack(
             [p.path, np.full(len(p.path), float(sc.start[2]))])
         check_feasibility(path3, "disco", world=sc.world, w=p.speed)
-        ck_s, rep = _median(lambda: check_feasibility(path3, "disco", world=sc.world, w=p.speed),
+        ck_s, rep = median_time(lambda: check_feasibility(path3, "disco", world=sc.world, w=p.speed),
                             repeats)
         rows.append({
             "benchmark": "feasibility/dubins-check",

@@ -11,17 +11,10 @@
 
 from __future__ import annotations
 
-import statistics
-import time
+from ._timing import median_time
 
 
-def _median(fn, repeats: int) -> float:
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times)
+
 
 
 def run(quick: bool = False) -> list[dict]:
@@ -46,7 +39,7 @@ def run(quick: bool = False) -> list[dict]:
             world._cache.clear()  # cold: distance maps, W and flight level recomputed
             return fly_formation(world, sc.start, sc.goal, **kw)
 
-        ours = _median(mission, repeats)
+        ours = median_time(mission, repeats)[0]
         last = r = mission()
         rows.append({
             "benchmark": "formation", "case": name, "ours_s": ours,
@@ -79,8 +72,8 @@ def run(quick: bool = False) -> list[dict]:
             local_path(maps, W, p, g, o, rad, margin=margin)
 
     replay(6)
-    win = _median(lambda: replay(6), repeats) / len(jobs)
-    full = _median(lambda: replay(10_000), 1 if quick else 2) / len(jobs)
+    win = median_time(lambda: replay(6), repeats)[0] / len(jobs)
+    full = median_time(lambda: replay(10_000), 1 if quick else 2)[0] / len(jobs)
     rows.append({
         "benchmark": "formation", "case": "re-plan one UAV (window 6 cells)", "ours_s": win,
         "peer": "same re-plan on the whole 120x90x40 map", "peer_s": full, "ratio": full / win,

@@ -13,19 +13,13 @@
 
 from __future__ import annotations
 
-import statistics
+from ._timing import median_time
+
 import time
 
 import numpy as np
 
 
-def _median_time(fn, repeats: int) -> float:
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times)
 
 
 def _table1(quick: bool) -> list[dict]:
@@ -50,7 +44,7 @@ def _table1(quick: bool) -> list[dict]:
     reference_path(tiny, (2, 2), (20, 20), model="dubins")
 
     fm2 = sum(
-        _median_time(lambda s=s, g=g: plan(world, s, g, saturation=alpha, exponent=beta), 5)
+        median_time(lambda s=s, g=g: plan(world, s, g, saturation=alpha, exponent=beta), 5)[0]
         for s, g in zip(starts, goals)
     )
     rows = []
@@ -104,14 +98,14 @@ def _frechet(quick: bool) -> list[dict]:
     P = np.c_[t, np.sin(6 * t)]
     Q = np.c_[t, np.sin(6 * t + 0.3)]
     frechet_distance(P, Q)  # JIT
-    ours = _median_time(lambda: frechet_distance(P, Q), 7)
+    ours = median_time(lambda: frechet_distance(P, Q), 7)[0]
     row = {"benchmark": "frechet", "case": f"2 curves x {n} points", "ours_s": ours}
     try:
         import similaritymeasures as sm
     except ImportError:
         row["notes"] = "similaritymeasures not installed"
         return [row]
-    peer = _median_time(lambda: sm.frechet_dist(P, Q), 1 if quick else 3)
+    peer = median_time(lambda: sm.frechet_dist(P, Q), 1 if quick else 3)[0]
     assert abs(sm.frechet_dist(P, Q) - frechet_distance(P, Q)) < 1e-12
     row.update(peer="similaritymeasures.frechet_dist", peer_s=peer, ratio=peer / ours,
                bar=">= 50x")

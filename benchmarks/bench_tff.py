@@ -7,18 +7,10 @@ Times are medians after a warm-up (JIT, cached distance map).
 
 from __future__ import annotations
 
-import statistics
-import time
+from ._timing import median_time
 
 
-def _median(fn, repeats: int) -> float:
-    fn()  # warm-up
-    times = []
-    for _ in range(repeats):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return statistics.median(times)
+
 
 
 def run(quick: bool = False) -> list[dict]:
@@ -33,10 +25,10 @@ def run(quick: bool = False) -> list[dict]:
     W = base_velocity(w)
     rows.append({
         "benchmark": "tff", "case": "flight_level_speed open-field 120x90x40 (capped)",
-        "ours_s": _median(lambda: flight_level_speed(W, w, 150.0, 0.5, 1.3), reps),
+        "ours_s": median_time(lambda: flight_level_speed(W, w, 150.0, 0.5, 1.3), reps, warmup=True)[0],
     })
-    tff = _median(lambda: fm2uav.plan(w, sc.start, sc.goal, agl=150.0, p1=0.5, p2=1.3), reps)
-    plain = _median(lambda: fm2uav.plan(w, sc.start, sc.goal), reps)
+    tff = median_time(lambda: fm2uav.plan(w, sc.start, sc.goal, agl=150.0, p1=0.5, p2=1.3), reps, warmup=True)[0]
+    plain = median_time(lambda: fm2uav.plan(w, sc.start, sc.goal), reps, warmup=True)[0]
     rows.append({
         "benchmark": "tff", "case": "plan open-field level 10 (0.5, 1.3)", "ours_s": tff,
         "peer": "plan without flight level", "peer_s": plain, "ratio": plain / tff,
@@ -49,12 +41,12 @@ def run(quick: bool = False) -> list[dict]:
     z, bounds = jacksboro_dem()
     rows.append({
         "benchmark": "tff", "case": "from_dem jacksboro 344x403 -> 194x206x49 (UTM)",
-        "ours_s": _median(lambda: from_dem(z, (150.0, 150.0, 30.0), crs="EPSG:4326",
-                                           bounds=bounds), 3),
+        "ours_s": median_time(lambda: from_dem(z, (150.0, 150.0, 30.0), crs="EPSG:4326",
+                                           bounds=bounds), 3, warmup=True)[0],
     })
     jb = fm2uav.scenarios.get_scenario("jacksboro")
-    tff = _median(lambda: fm2uav.plan(jb.world, jb.start, jb.goal, agl=300.0, p1=0.5, p2=1.3), 3)
-    plain = _median(lambda: fm2uav.plan(jb.world, jb.start, jb.goal), 3)
+    tff = median_time(lambda: fm2uav.plan(jb.world, jb.start, jb.goal, agl=300.0, p1=0.5, p2=1.3), 3, warmup=True)[0]
+    plain = median_time(lambda: fm2uav.plan(jb.world, jb.start, jb.goal), 3, warmup=True)[0]
     rows.append({
         "benchmark": "tff", "case": "plan jacksboro 194x206x49 agl 300 m (0.5, 1.3)",
         "ours_s": tff, "peer": "plan without flight level", "peer_s": plain,
@@ -64,7 +56,7 @@ def run(quick: bool = False) -> list[dict]:
 
     rows.append({
         "benchmark": "tff", "case": "reproduce tff cases (6 plans + metrics, no figures)",
-        "ours_s": _median(lambda: run_tff("open-field", 0, "capped"), 3),
+        "ours_s": median_time(lambda: run_tff("open-field", 0, "capped"), 3, warmup=True)[0],
     })
     return rows
 

@@ -2,9 +2,9 @@
 
 Usage::
 
-    python benchmarks/run.py            # full run (make bench)
-    python benchmarks/run.py --quick    # seconds, for smoke tests
-    python benchmarks/run.py core       # only bench_core.py
+    python -m benchmarks.run            # full run (make bench)
+    python -m benchmarks.run --quick    # seconds, for smoke tests
+    python -m benchmarks.run core       # only bench_core.py
 
 Each module exposes ``run(quick: bool = False) -> list[dict]``; a row has at
 least ``benchmark``, ``case`` and ``ours_s`` (median seconds), and, against a
@@ -16,7 +16,7 @@ the numbers so a reader sees whether they hold on this machine.
 from __future__ import annotations
 
 import argparse
-import importlib.util
+import importlib
 import json
 import platform
 import sys
@@ -36,11 +36,8 @@ def discover(names: list[str] | None = None) -> list[Path]:
 
 
 def load(path: Path):
-    spec = importlib.util.spec_from_file_location(path.stem, path)
-    module = importlib.util.module_from_spec(spec)
-    assert spec.loader is not None
-    spec.loader.exec_module(module)
-    return module
+    """Import ``benchmarks/<name>.py`` as ``benchmarks.<name>``."""
+    return importlib.import_module(f"{__package__ or 'benchmarks'}.{path.stem}")
 
 
 def fmt(value, digits=3) -> str:

@@ -1,0 +1,1 @@
+"""Benchmarks of fm2uav: run with ``python -m benchmarks.run`` (``make bench``)."""
