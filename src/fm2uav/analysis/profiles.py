@@ -26,7 +26,7 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["Profiles", "resample_path", "path_profiles", "menger_curvature"]
+__all__ = ["Profiles", "resample_path", "path_profiles", "menger_curvature", "circumcurvature"]
 
 
 def _as_path(path: np.ndarray) -> np.ndarray:
@@ -60,24 +60,32 @@ def resample_path(path: np.ndarray, ds: float) -> np.ndarray:
     return np.stack([np.interp(t, s, p[:, k]) for k in range(p.shape[1])], axis=1)
 
 
+def circumcurvature(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Curvature [1/m] of the circle through the points ``a[i], b[i], c[i]``.
+
+    ``2 |(b - a) x (c - b)| / (|b - a| |c - b| |c - a|)`` (Menger curvature):
+    exactly ``1/r`` for three points on a circle of radius r; 0 for collinear
+    or coincident points. Arrays are (N, 2) or (N, 3) [m].
+    """
+    ab = b - a
+    bc = c - b
+    ac = c - a
+    if a.shape[1] == 2:
+        cross = np.abs(ab[:, 0] * bc[:, 1] - ab[:, 1] * bc[:, 0])
+    else:
+        cross = np.linalg.norm(np.cross(ab, bc), axis=1)
+    den = np.linalg.norm(ab, axis=1) * np.linalg.norm(bc, axis=1) * np.linalg.norm(ac, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(den > 1e-300, 2.0 * cross / np.maximum(den, 1e-300), 0.0)
+
+
 def menger_curvature(points: np.ndarray) -> np.ndarray:
     """Curvature [1/m] of the circle through each three consecutive points.
 
     Returns ``N - 2`` values (0 for collinear points); ``points`` is (N, d).
     """
     p = np.asarray(points, dtype=float)
-    a = p[1:-1] - p[:-2]
-    b = p[2:] - p[1:-1]
-    c = p[2:] - p[:-2]
-    la, lb, lc = (np.linalg.norm(v, axis=1) for v in (a, b, c))
-    if p.shape[1] == 2:
-        cross = np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
-    else:
-        cross = np.linalg.norm(np.cross(a, b), axis=1)
-    den = la * lb * lc
-    with np.errstate(invalid="ignore", divide="ignore"):
-        k = np.where(den > 0, 2.0 * cross / den, 0.0)
-    return k
+    return circumcurvature(p[:-2], p[1:-1], p[2:])
 
 
 @dataclass(frozen=True)

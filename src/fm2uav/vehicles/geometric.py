@@ -8,8 +8,8 @@ Curvature is the Menger curvature of the three points at arc lengths
 curvature is infinite at the vertex) is judged at the scale of the airframe's
 turn: a 90° corner reads as a radius ~0.7 h.
 
-(The terrain-following issue's ``analysis/profiles`` may later provide the same
-profiles; this module is the airframe check's own, kept small on purpose.)
+The circle-through-three-points formula is :func:`fm2uav.analysis.profiles.circumcurvature`,
+shared with the path profiles; what is specific here is the airframe-scale window.
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from ..analysis.profiles import circumcurvature
 from ._path import arc_length, as_path3, runs
 from .airframes import Airframe, FixedWing, Multirotor, get_airframe
 
@@ -81,11 +82,7 @@ def curvature_profile(
     total = s[-1]
     h = min(h, total / 2.0)
     mid = np.clip(s, h, total - h)
-    a, b, c = _at(p, s, mid - h), _at(p, s, mid), _at(p, s, mid + h)
-    ab, ac, bc = b - a, c - a, c - b
-    cross = np.linalg.norm(np.cross(ab, ac), axis=1)
-    den = np.linalg.norm(ab, axis=1) * np.linalg.norm(bc, axis=1) * np.linalg.norm(ac, axis=1)
-    kappa = np.where(den > 1e-300, 2.0 * cross / np.maximum(den, 1e-300), 0.0)
+    kappa = circumcurvature(_at(p, s, mid - h), _at(p, s, mid), _at(p, s, mid + h))
     return s, kappa
 
 
