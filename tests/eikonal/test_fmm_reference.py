@@ -15,6 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import ndimage
 
+from fm2uav.eikonal import _kernels
 from fm2uav.eikonal import fast_marching, fmm
 from fm2uav.eikonal import _reference as reference
 from fm2uav.eikonal._reference import fast_marching_reference
@@ -31,6 +32,7 @@ def test_reference_constants_match_the_compiled_solver():
     assert reference.MAX_BALL_SOURCES == fmm.MAX_BALL_SOURCES == 64
     assert reference.BALL_MAX_SPEED_RATIO == fmm.BALL_MAX_SPEED_RATIO == 1.5
     assert reference.MIN_SPEED == fmm.MIN_SPEED == 1e-150
+    assert reference.ORDER2_MAX_SPEED_RATIO == _kernels.ORDER2_MAX_SPEED_RATIO == 2.0
 
 
 def _random_case(rng: np.random.Generator, ndim: int):

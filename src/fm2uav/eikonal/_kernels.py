@@ -27,6 +27,10 @@ FROZEN = np.uint8(2)
 
 _INF = np.inf
 
+#: The order-2 stencil is used only where the speed at the node and at its two
+#: upwind neighbours varies by at most this factor; elsewhere order 1.
+ORDER2_MAX_SPEED_RATIO = 2.0
+
 
 # --------------------------------------------------------------------------- heap
 @njit(cache=True, inline="always", error_model="numpy", _nrt=False)
@@ -87,12 +91,15 @@ def _pop(heap, hkey, hpos, size):
 
 # ------------------------------------------------------------------ local solver
 @njit(cache=True, inline="always", error_model="numpy", _nrt=False)
-def _axis_term(T, state, c, coord, n_axis, stride, inv_h2, order):
+def _axis_term(T, state, speed, c, coord, n_axis, stride, inv_h2, order):
     """Upwind term of one axis: returns ``(tau, a)`` for ``a (T - tau)^2``.
 
     ``a = 0`` (and ``tau = inf``) when no neighbour on this axis is frozen.
     Second order, ``a = 9/(4h^2)`` and ``tau = (4 T1 - T2)/3``, is used when the
-    next cell in the same upwind direction is frozen and not later than T1.
+    next cell in the same upwind direction is frozen, not later than T1, and
+    the speed along the three nodes varies by at most ``ORDER2_MAX_SPEED_RATIO``
+    (the stencil assumes T smooth: across a sharp speed jump, e.g. a thin slow
+    wall, it would charge only 2/3 of the crossing time).
     """
     best = _INF
     direction = 0
@@ -108,15 +115,22 @@ def _axis_term(T, state, c, coord, n_axis, stride, inv_h2, order):
         return _INF, 0.0
     if order == 2:
         if direction == -1:
-            if coord > 1 and state[c - 2 * stride] == 2:
-                t2 = T[c - 2 * stride]
-                if t2 <= best:
-                    return (4.0 * best - t2) / 3.0, 2.25 * inv_h2
+            ok = coord > 1
         else:
-            if coord < n_axis - 2 and state[c + 2 * stride] == 2:
-                t2 = T[c + 2 * stride]
+            ok = coord < n_axis - 2
+        if ok:
+            c1 = c + direction * stride
+            c2 = c1 + direction * stride
+            if state[c2] == 2:
+                t2 = T[c2]
                 if t2 <= best:
-                    return (4.0 * best - t2) / 3.0, 2.25 * inv_h2
+                    v0 = speed[c]
+                    v1 = speed[c1]
+                    v2 = speed[c2]
+                    vmax = max(v0, max(v1, v2))
+                    vmin = min(v0, min(v1, v2))
+                    if vmax <= ORDER2_MAX_SPEED_RATIO * vmin:
+                        return (4.0 * best - t2) / 3.0, 2.25 * inv_h2
     return best, inv_h2
 
 
@@ -164,9 +178,9 @@ def _combine(ta, aa, tb, ab, tc, ac, rhs):
 def _solve(T, state, speed, c, i, j, k, nx, ny, nz, sx, sy, ihx2, ihy2, ihz2, order):
     v = speed[c]
     rhs = 1.0 / (v * v)
-    ta, aa = _axis_term(T, state, c, i, nx, sx, ihx2, order)
-    tb, ab = _axis_term(T, state, c, j, ny, sy, ihy2, order)
-    tc, ac = _axis_term(T, state, c, k, nz, 1, ihz2, order)
+    ta, aa = _axis_term(T, state, speed, c, i, nx, sx, ihx2, order)
+    tb, ab = _axis_term(T, state, speed, c, j, ny, sy, ihy2, order)
+    tc, ac = _axis_term(T, state, speed, c, k, nz, 1, ihz2, order)
     return _combine(ta, aa, tb, ab, tc, ac, rhs)
 
 

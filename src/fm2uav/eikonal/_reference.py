@@ -39,7 +39,8 @@ Local update of a node ``x`` with speed ``v``
     For each axis take the frozen neighbour (``x - e`` or ``x + e``) with the
     smaller ``T`` (the minus side wins a tie), ``T1``. With order 2, if the
     next node in the same direction (``x -/+ 2e``) is frozen and its time
-    ``T2 <= T1``, the axis contributes ``a (T - tau)^2`` with
+    ``T2 <= T1``, and the speeds at ``x``, ``x -/+ e`` and ``x -/+ 2e`` differ
+    by at most a factor ``ORDER2_MAX_SPEED_RATIO = 2``, the axis contributes ``a (T - tau)^2`` with
     ``tau = (4 T1 - T2) / 3`` and ``a = 9 / (4 h^2)``; otherwise
     ``tau = T1`` and ``a = 1 / h^2``. An axis with no frozen neighbour does
     not contribute. The axes are sorted by ``tau``; the first gives
@@ -80,6 +81,8 @@ SOURCE_RADIUS_CELLS = 2.0
 SOURCE_RADIUS_FRACTION = 0.05
 #: With more sources than this, no ball: sources are plain T = 0 nodes.
 MAX_BALL_SOURCES = 64
+#: Order 2 only where max/min speed along the stencil is at most this.
+ORDER2_MAX_SPEED_RATIO = 2.0
 #: A box whose max/min speed exceeds this is not clean (no ball).
 BALL_MAX_SPEED_RATIO = 1.5
 #: Positive speeds below this [m/s] are raised to it.
@@ -105,6 +108,7 @@ def _shifted(node: Index, axis: int, step: int) -> Index:
 def _axis_term(
     T: np.ndarray,
     frozen: np.ndarray,
+    speed: np.ndarray,
     node: Index,
     axis: int,
     h: float,
@@ -118,6 +122,8 @@ def _axis_term(
         Current arrival times [s].
     frozen : ndarray of bool
         Which nodes are accepted.
+    speed : ndarray
+        Speeds [m/s] (order 2 needs a smooth speed along its stencil).
     node : tuple of int
         The node being updated.
     axis : int
@@ -149,7 +155,10 @@ def _axis_term(
         coord2 = node[axis] + 2 * best_step
         if 0 <= coord2 < n:
             nb2 = _shifted(node, axis, 2 * best_step)
-            if frozen[nb2] and float(T[nb2]) <= best_time:
+            nb1 = _shifted(node, axis, best_step)
+            speeds = [float(speed[node]), float(speed[nb1]), float(speed[nb2])]
+            smooth = max(speeds) <= ORDER2_MAX_SPEED_RATIO * min(speeds)
+            if frozen[nb2] and float(T[nb2]) <= best_time and smooth:
                 t2 = float(T[nb2])
                 return (4.0 * best_time - t2) / 3.0, 9.0 / (4.0 * h * h)
     return best_time, 1.0 / (h * h)
@@ -171,7 +180,7 @@ def _local_solution(
     rhs = 1.0 / (v * v)  # [s^2/m^2]
     terms = []
     for axis, h in enumerate(spacing):
-        term = _axis_term(T, frozen, node, axis, h, order)
+        term = _axis_term(T, frozen, speed, node, axis, h, order)
         if term is not None:
             terms.append(term)
     if not terms:

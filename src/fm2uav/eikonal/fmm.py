@@ -174,7 +174,8 @@ def fast_marching(
     shape = v.shape
     h = as_spacing(spacing, v.ndim)
     if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or order not in (1, 2):
-        raise InputError(f"order must be 1 or 2, got {order!r}")
+        shown = order.item() if isinstance(order, np.generic) else order
+        raise InputError(f"order must be 1 or 2, got {shown!r}")
     src = as_index_array(sources, shape, "sources")
     blocked = v[tuple(src.T)] <= 0
     if np.any(blocked):
