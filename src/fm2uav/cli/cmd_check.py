@@ -9,9 +9,24 @@ from pathlib import Path
 import numpy as np
 import typer
 
-from ._common import EXIT_PLANNING, OutputDir, handle_errors, print_summary, to_jsonable
+from ._common import EXIT_PLANNING, OutputDir, handle_errors, print_summary, progress, to_jsonable
 
 CHECK_FILES = ("report.json", "flown.csv", "check.png")
+REPORT = "report.html"
+
+
+def _report(rep, world, rows: dict, *, title: str, subtitle: str, params: dict) -> str:
+    """report.html of a check: the planned path and the flown track, saturation intervals."""
+    from ..viz.report import report_html
+
+    tr = rep.tracking
+    flown = f"flown ({rep.airframe.name})"
+    return report_html(
+        world, {"planned": tr.planned, flown: tr.trajectory}, title=title, subtitle=subtitle,
+        styles={flown: {"dash": "dash", "width": 4}},
+        params=params, metrics=rows,
+        tables={"Where the limits saturate": tr.saturation_intervals()},
+        files=list(CHECK_FILES))
 
 
 def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
@@ -24,9 +39,11 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "Check whether an airframe can fly a path file (x_m,y_m[,z_m] CSV): simulate the "
             "Dubins airplane (fixed-wing) or a multirotor following it, report the separation "
             "from the plan, where the turn/climb limits saturate, a geometric check (curvature "
-            "vs 1/R, climb angle) and a verdict. Writes report.json, flown.csv and check.png.\n\n"
+            "vs 1/R, climb angle) and a verdict. Writes report.json, flown.csv and check.png "
+            "(and with --report an interactive report.html: planned vs flown).\n\n"
             "Examples:\n\n"
             "  fm2uav check out/plan/path.csv --airframe disco --out out/check\n\n"
+            "  fm2uav check out/plan/path.csv --scenario open-field --report --out out/check\n\n"
             "  fm2uav check path.csv --airframe crosswind --scenario city --tolerance 3 --json\n\n"
             f"Airframes: {', '.join(AIRFRAMES)}."
         ),
@@ -39,13 +56,13 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             None, help="Also check collisions of the flown path in this built-in scenario."
         ),
         seed: int = typer.Option(0, help="Seed of the scenario."),
-        tolerance: float = typer.Option(5.0, help="Largest admissible separation [m]."),
-        lookahead: float | None = typer.Option(None, help="Carrot distance [m] (default R_min)."),
+        tolerance: float = typer.Option(5.0, help="Largest admissible separation (m)."),
+        lookahead: float | None = typer.Option(None, help="Carrot distance (m) (default R_min)."),
         lookahead_points: int | None = typer.Option(
             None, help="Or the thesis' a: look this many path points ahead."
         ),
-        speed: float | None = typer.Option(None, help="Fixed-wing airspeed [m/s] (default cruise)."),
-        dt: float = typer.Option(0.05, help="Simulation step [s]."),
+        speed: float | None = typer.Option(None, help="Fixed-wing airspeed (m/s) (default cruise)."),
+        dt: float = typer.Option(0.05, help="Simulation step (s)."),
         fail_infeasible: bool = typer.Option(
             False, "--fail-infeasible", help="Exit with code 1 when the path is infeasible."
         ),
@@ -53,6 +70,8 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
         as_json: bool = typer.Option(False, "--json", help="Print the report as JSON."),
         quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
+        report: bool = typer.Option(
+            False, "--report", help="Also write report.html (planned vs flown, interactive)."),
     ) -> None:
         from ..io import read_path_csv, write_path_csv
         from ..vehicles import check_feasibility, get_airframe
@@ -63,9 +82,12 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         path = read_path_csv(path_file)
         world = get_scenario(scenario, seed=seed).world if scenario else None
         outdir = OutputDir(out, force=force)
-        outdir.check(CHECK_FILES)
-        rep = check_feasibility(path, af, world=world, tolerance=tolerance, lookahead=lookahead,
-                                lookahead_points=lookahead_points, speed=speed, dt=dt)
+        outdir.check(CHECK_FILES + ((REPORT,) if report else ()))
+        with progress(enabled=not (quiet or as_json)) as step:
+            step(f"simulating the {af.name} along the path")
+            rep = check_feasibility(path, af, world=world, tolerance=tolerance,
+                                    lookahead=lookahead, lookahead_points=lookahead_points,
+                                    speed=speed, dt=dt)
         summary = {"path_file": str(path_file), "scenario": scenario, **rep.summary()}
         tmp_png = outdir.target("check.png")
         tracking_figure(rep, world, title=path_file.name).savefig(tmp_png, dpi=100)
@@ -90,6 +112,17 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         }
         if getattr(af, "kind", "") == "fixed-wing":
             rows["R_min [m]"] = f"{af.turn_radius(rep.airframe.cruise_speed):.1f}"
+        if report:
+            params = {"path file": path_file.name, "scenario": scenario or "none",
+                      "tolerance [m]": tolerance, "lookahead [m]": tr.lookahead,
+                      "time step [s]": dt, **{f"airframe {k}": v
+                                              for k, v in rep.airframe.summary().items()}}
+            html = _report(rep, world, rows, title=f"feasibility check — {path_file.name}",
+                           subtitle=f"{af.name} ({af.kind}): "
+                                    f"{'FEASIBLE' if rep.feasible else 'INFEASIBLE'} — "
+                                    f"{rep.reason}", params=params)
+            with outdir.open(REPORT) as fh:
+                fh.write(html)
         print_summary("feasibility check", summary if as_json else rows, as_json=as_json,
                       quiet=quiet, files=outdir.written)
         if fail_infeasible and not rep.feasible:

@@ -11,10 +11,11 @@ import numpy as np
 import typer
 
 from ..errors import InputError
-from ._common import OutputDir, handle_errors, print_summary, to_jsonable
+from ._common import OutputDir, handle_errors, print_summary, progress, to_jsonable
 
 COVER_FILES = ("path.csv", "zigzag.csv", "bands.png", "coverage.png", "coverage.html",
                "summary.json", "mission.plan")
+REPORT = "report.html"
 
 #: The seeds' Table 5.1 (D = 80) and 5.2 (S1): min cost, α, max cost, α, median, α, mean, α.
 SEEDS_T51 = {
@@ -59,6 +60,34 @@ def _load_area(area: str):
     return read_area(area)
 
 
+def _overlays(cp, prefix: str = "", colour: str = "#1a1a1a") -> dict:
+    """Scene overlays of a coverage plan: the area's rings and the bands (2D, draped)."""
+    from ..viz.report import join_polylines
+
+    area = cp.zigzag.area
+    rings = [np.asarray(area.exterior.coords)] + [np.asarray(r.coords) for r in area.interiors]
+    out = {f"{prefix}area": {"points": join_polylines(rings), "color": colour, "width": 5}}
+    bands = [np.asarray(b.coords) for b in cp.zigzag.bands()]
+    if bands:
+        out[f"{prefix}bands"] = {"points": join_polylines(bands), "color": "#ff7f0e",
+                                 "dash": "dash", "width": 2}
+    return out
+
+
+def _write_report(outdir: OutputDir, cp, *, title: str, subtitle: str, metrics: dict,
+                  waypoints=None, files=()) -> None:
+    from ..viz.report import report_html
+
+    name = "FM² path"
+    html = report_html(
+        cp.plan.world, {name: cp.path}, title=title, subtitle=subtitle,
+        speeds={name: cp.plan.speed}, ideal_agl={name: cp.params.get("agl_m")},
+        waypoints=None if waypoints is None else {name: waypoints},
+        overlays=_overlays(cp), params=cp.params, metrics=metrics, files=files)
+    with outdir.open(REPORT) as fh:
+        fh.write(html)
+
+
 def _write_png(outdir: OutputDir, fig, name: str) -> None:
     import matplotlib.pyplot as plt
 
@@ -67,6 +96,49 @@ def _write_png(outdir: OutputDir, fig, name: str) -> None:
     plt.close(fig)
     outdir.commit(tmp, name)
 
+
+def _write_cover_outputs(outdir: OutputDir, cp, area: str, *, report: bool, title: str):
+    """path.csv, zigzag.csv, PNGs, coverage.html, mission.plan and report.html."""
+    from ..io import write_path_csv
+    from ..viz.coverage import bands_figure, coverage_figure, coverage_html
+
+    world = cp.plan.world
+    with outdir.open("path.csv") as fh:
+        write_path_csv(fh, cp.path, cp.plan.speed)
+    with outdir.open("zigzag.csv") as fh:
+        write_path_csv(fh, cp.zigzag.path())
+    _write_png(outdir, bands_figure(cp.zigzag, title=f"zigzag over {area}"), "bands.png")
+    _write_png(outdir, coverage_figure(cp, title=title), "coverage.png")
+    with outdir.open("coverage.html") as fh:
+        fh.write(coverage_html(cp, title=title))
+    try:
+        from ..io.qgc import write_plan
+        from ..io.waypoints import mission_waypoints
+    except ImportError:  # pragma: no cover - the exporter ships with fm2uav.io
+        wps = None
+    else:
+        wps = mission_waypoints(cp.path, world, frame="terrain", terrain_following=True)
+        with outdir.open("mission.plan") as fh:
+            write_plan(fh, wps)
+    if report:
+        e = np.abs(cp.agl_error)
+        metrics = {
+            "steering angle [deg]": round(cp.zigzag.angle_deg, 3),
+            "band spacing D [m]": cp.zigzag.spacing,
+            "bands": cp.zigzag.n_bands,
+            "zigzag cost [m]": round(cp.zigzag.cost, 1),
+            "FM² path length [m]": round(float(cp.plan.length), 1),
+            "coverage (FM² path) [%]": round(100 * cp.coverage, 2),
+            "|AGL error| mean / max [m]": f"{e.mean():.1f} / {e.max():.1f}",
+            "mission.plan waypoints": "-" if wps is None else len(wps),
+            "planning time [s]": round(cp.timings.get("total", 0.0), 3),
+        }
+        _write_report(outdir, cp, title=title,
+                      subtitle=f"zigzag bands over {area}, FM² at "
+                               f"{cp.params.get('agl_m', 0):g} m above the terrain",
+                      metrics=metrics, waypoints=None if wps is None else wps.points_m,
+                      files=list(COVER_FILES))
+    return wps
 
 def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
     """Add ``cover`` and ``reproduce coverage``."""
@@ -77,9 +149,11 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "Coverage mission: zigzag bands over an area, steering angle by Differential "
             "Evolution, FM² along the bands at a height above the terrain. Writes path.csv, "
             "zigzag.csv, mission.plan (QGroundControl, terrain-relative altitudes), bands.png, "
-            "coverage.png, coverage.html and summary.json.\n\n"
+            "coverage.png, coverage.html and summary.json (and with --report an interactive, "
+            "self-contained report.html).\n\n"
             "Examples:\n\n"
             "  fm2uav cover --area S1 --spacing 80 --agl 100 --out out/cover\n\n"
+            "  fm2uav cover --area S3 --spacing 80 --report --out out/cover-report\n\n"
             "  fm2uav cover --area area.geojson --spacing 80 --agl 100 --out out/cover\n\n"
             "  fm2uav cover --area S2 --camera 13.2,8.8,8.8,5472,3648 --side-overlap 0.7 "
             "--agl 100 --out out/cam\n\n"
@@ -89,12 +163,12 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
     @handle_errors
     def cover_cmd(
         area: str = typer.Option(..., help="GeoJSON file (Polygon, metres) or S1..S4."),
-        spacing: float | None = typer.Option(None, help="Band spacing D [m]."),
-        agl: float = typer.Option(100.0, help="Flight level above the ground [m]."),
+        spacing: float | None = typer.Option(None, help="Band spacing D (m)."),
+        agl: float = typer.Option(100.0, help="Flight level above the ground (m)."),
         camera: str | None = typer.Option(
             None, help="Compute D from a camera: sensor_w_mm,sensor_h_mm,focal_mm,img_w,img_h."),
         side_overlap: float = typer.Option(0.0, help="Side overlap share in [0, 1) with --camera."),
-        angle: float | None = typer.Option(None, help="Steering angle [deg]; default: searched."),
+        angle: float | None = typer.Option(None, help="Steering angle (deg); default: searched."),
         search: str = typer.Option("de", help="Angle search: de (seeds), sweep, scipy-de."),
         full_range: bool = typer.Option(False, "--full-range",
                                         help="Search α in [0°, 180°) instead of [1°, 89°]."),
@@ -106,45 +180,35 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
         as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
         quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
+        report: bool = typer.Option(
+            False, "--report", help="Also write report.html (interactive, self-contained)."),
     ) -> None:
-        from ..io import write_path_csv
         from ..missions.coverage import FULL_BOUNDS_DEG, plan_coverage
-        from ..viz.coverage import bands_figure, coverage_figure, coverage_html
         from ..world.scenarios import get_scenario
 
         if (spacing is None) == (camera is None):
             raise InputError("give exactly one of --spacing (metres) or --camera")
         d = spacing if spacing is not None else _camera_spacing(camera, agl, side_overlap)
         outdir = OutputDir(out, force=force)
-        outdir.check(COVER_FILES)
+        outdir.check(COVER_FILES + ((REPORT,) if report else ()))
         poly = _load_area(area)
-        world = get_scenario(scenario, seed=seed).world
         opts = {}
-        if full_range and search != "sweep":
+        if full_range:
             opts["bounds_deg"] = FULL_BOUNDS_DEG
-        elif full_range:
-            opts["bounds_deg"] = FULL_BOUNDS_DEG
-        cp = plan_coverage(world, poly, d, agl=agl,
-                           angle=None if angle is None else np.radians(angle),
-                           search=search, search_options=opts, seed=seed, p1=p1, p2=p2)
+        with progress(enabled=not (quiet or as_json)) as step:
+            step("building the map")
+            world = get_scenario(scenario, seed=seed).world
+            step("searching the steering angle and planning FM² along the bands")
+            cp = plan_coverage(world, poly, d, agl=agl,
+                               angle=None if angle is None else np.radians(angle),
+                               search=search, search_options=opts, seed=seed, p1=p1, p2=p2)
+            step("writing the outputs")
+            wps = _write_cover_outputs(outdir, cp, area, report=report,
+                                       title=f"coverage of {area}")
         summary = {"area": area, "scenario": scenario, **cp.summary()}
-        with outdir.open("path.csv") as fh:
-            write_path_csv(fh, cp.path, cp.plan.speed)
-        with outdir.open("zigzag.csv") as fh:
-            write_path_csv(fh, cp.zigzag.path())
-        _write_png(outdir, bands_figure(cp.zigzag, title=f"zigzag over {area}"), "bands.png")
-        _write_png(outdir, coverage_figure(cp, title=f"coverage of {area}"), "coverage.png")
-        with outdir.open("coverage.html") as fh:
-            fh.write(coverage_html(cp, title=f"coverage of {area}"))
-        try:
-            from ..io.qgc import write_plan
-            from ..io.waypoints import mission_waypoints
-        except ImportError:  # pragma: no cover - the exporter ships with fm2uav.io
+        if wps is None:
             summary["mission_plan"] = "not written: fm2uav.io.qgc is not available"
         else:
-            wps = mission_waypoints(cp.path, world, frame="terrain", terrain_following=True)
-            with outdir.open("mission.plan") as fh:
-                write_plan(fh, wps)
             summary["mission_plan_waypoints"] = len(wps)
         with outdir.open("summary.json") as fh:
             json.dump(to_jsonable(summary), fh, indent=2)
@@ -169,8 +233,11 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "Reproduce the coverage experiments (paper 003 / thesis ch. 5): Table 5.1 (areas "
             "S1-S4, D = 80 m) and Table 5.2 (S1 with D = 40/60/80/100 m) from the seeds' DE, "
             "checked against a 0.1° sweep and scipy's DE, plus figures (bands, 3D path, path "
-            "vs ideal profile) of the FM² path at 100 m AGL.\n\n"
-            "Example:  fm2uav reproduce coverage --out out/coverage"
+            "vs ideal profile) of the FM² path at 100 m AGL; with --report an interactive "
+            "report.html of the four FM² paths and both tables.\n\n"
+            "Examples:\n\n"
+            "  fm2uav reproduce coverage --out out/coverage\n\n"
+            "  fm2uav reproduce coverage --report --out out/coverage-report"
         ),
     )
     @handle_errors
@@ -180,6 +247,8 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
         as_json: bool = typer.Option(False, "--json", help="Print the tables as JSON."),
         quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
+        report: bool = typer.Option(
+            False, "--report", help="Also write report.html (interactive, self-contained)."),
     ) -> None:
         from ..missions.coverage import differential_evolution, plan_coverage, scipy_de, sweep
         from ..viz.coverage import bands_figure, coverage_figure
@@ -196,44 +265,51 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         files += [f"bands_{n}.png" for n in names] + [f"coverage_{n}.png" for n in names]
         files += [f"bands_S1_D{d}.png" for d in (40, 60, 100)]
         outdir = OutputDir(out, force=force)
-        outdir.check(files)
-        world = coverage_world(seed)
+        outdir.check(files + ([REPORT] if report else []))
+        with progress(enabled=not (quiet or as_json)) as step:
+            world = coverage_world(seed)
 
-        def row(poly, d):
-            de = differential_evolution(poly, d, seed=seed)
-            sw = sweep(poly, d, step_deg=0.1)
-            sp = scipy_de(poly, d, seed=seed)
-            st = de.stats()
-            return de, {**{k: round(st[k], 3) for k in _COLS},
-                        "sweep_cost": round(sw.cost, 3), "sweep_alpha": round(sw.angle_deg, 3),
-                        "de_vs_sweep_pct": round(100 * (de.cost - sw.cost) / sw.cost, 4),
-                        "scipy_cost": round(sp.cost, 3), "scipy_alpha": round(sp.angle_deg, 3),
-                        "de_s": round(de.seconds, 4)}
+            def row(poly, d):
+                de = differential_evolution(poly, d, seed=seed)
+                sw = sweep(poly, d, step_deg=0.1)
+                sp = scipy_de(poly, d, seed=seed)
+                st = de.stats()
+                return de, {**{k: round(st[k], 3) for k in _COLS},
+                            "sweep_cost": round(sw.cost, 3),
+                            "sweep_alpha": round(sw.angle_deg, 3),
+                            "de_vs_sweep_pct": round(100 * (de.cost - sw.cost) / sw.cost, 4),
+                            "scipy_cost": round(sp.cost, 3),
+                            "scipy_alpha": round(sp.angle_deg, 3),
+                            "de_s": round(de.seconds, 4)}
 
-        t51, t52, cover = {}, {}, {}
-        for n in names:
-            poly = coverage_area(n)
-            de, r = row(poly, COVERAGE_SPACING)
-            cp = plan_coverage(world, poly, COVERAGE_SPACING, agl=COVERAGE_AGL,
-                               angle=de.angle)
-            r.update(coverage_pct=round(100 * cp.coverage, 3),
-                     fm2_length=round(cp.plan.length, 1),
-                     agl_err_mean=round(float(np.abs(cp.agl_error).mean()), 2),
-                     plan_s=round(cp.timings["total"] + de.seconds, 4))
-            t51[n] = r
-            cover[n] = cp
-            _write_png(outdir, bands_figure(cp.zigzag, title=f"{n}, D = 80 m"), f"bands_{n}.png")
-            _write_png(outdir, coverage_figure(cp, title=f"{n} at {COVERAGE_AGL:g} m AGL"),
-                       f"coverage_{n}.png")
-        s1 = coverage_area("S1")
-        for d in (40, 60, 80, 100):
-            de, r = row(s1, float(d))
-            t52[d] = r
-            if d != 80:
-                from ..missions.coverage import zigzag
+            t51, t52, cover = {}, {}, {}
+            for n in names:
+                step(f"area {n}: DE, 0.1° sweep, scipy DE and FM² along the bands")
+                poly = coverage_area(n)
+                de, r = row(poly, COVERAGE_SPACING)
+                cp = plan_coverage(world, poly, COVERAGE_SPACING, agl=COVERAGE_AGL,
+                                   angle=de.angle)
+                r.update(coverage_pct=round(100 * cp.coverage, 3),
+                         fm2_length=round(cp.plan.length, 1),
+                         agl_err_mean=round(float(np.abs(cp.agl_error).mean()), 2),
+                         plan_s=round(cp.timings["total"] + de.seconds, 4))
+                t51[n] = r
+                cover[n] = cp
+                _write_png(outdir, bands_figure(cp.zigzag, title=f"{n}, D = 80 m"),
+                           f"bands_{n}.png")
+                _write_png(outdir, coverage_figure(cp, title=f"{n} at {COVERAGE_AGL:g} m AGL"),
+                           f"coverage_{n}.png")
+            s1 = coverage_area("S1")
+            for d in (40, 60, 80, 100):
+                step(f"S1 with D = {d} m")
+                de, r = row(s1, float(d))
+                t52[d] = r
+                if d != 80:
+                    from ..missions.coverage import zigzag
 
-                _write_png(outdir, bands_figure(zigzag(s1, d, de.angle), title=f"S1, D = {d} m"),
-                           f"bands_S1_D{d}.png")
+                    _write_png(outdir, bands_figure(zigzag(s1, d, de.angle),
+                                                    title=f"S1, D = {d} m"),
+                               f"bands_S1_D{d}.png")
 
         def table_csv(rows, key, seeds):
             buf = io.StringIO()
@@ -276,6 +352,34 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
                    "seeds_table_5_1": SEEDS_T51, "seeds_table_5_2": SEEDS_T52}
         with outdir.open("summary.json") as fh:
             json.dump(to_jsonable(payload), fh, indent=2)
+        if report:
+            from ..viz.report import report_html
+
+            overlays = {}
+            for n, cp in cover.items():
+                overlays.update(_overlays(cp, prefix=f"{n} "))
+            t51_rows = [{"surface": n, **r, "seeds min cost": SEEDS_T51[n][0],
+                         "seeds α": SEEDS_T51[n][1]} for n, r in t51.items()]
+            t52_rows = [{"D [m]": d, **r, "seeds min cost": SEEDS_T52[d][0],
+                         "seeds α": SEEDS_T52[d][1]} for d, r in t52.items()]
+            html = report_html(
+                world, {f"{n} FM² path": cp.path for n, cp in cover.items()},
+                speeds={f"{n} FM² path": cp.plan.speed for n, cp in cover.items()},
+                ideal_agl={f"{n} FM² path": COVERAGE_AGL for n in cover},
+                overlays=overlays,
+                title="Coverage experiments (paper 003 / thesis ch. 5)",
+                subtitle=f"areas {', '.join(names)}, D = {COVERAGE_SPACING:g} m, FM² at "
+                         f"{COVERAGE_AGL:g} m above the terrain, steering angle from the DE",
+                params={"seed": seed, "D [m]": COVERAGE_SPACING, "agl [m]": COVERAGE_AGL,
+                        "DE": "Np=20, F=0.8, CR=0.7, 30 generations, α∈[1°,89°]"},
+                metrics={n: f"α {r['min_alpha']:.3f}°, cost {r['min_cost']:.1f} m, coverage "
+                            f"{r['coverage_pct']:.2f} %, FM² {r['fm2_length']:.0f} m"
+                         for n, r in t51.items()},
+                tables={"Table 5.1 — D = 80 m": t51_rows,
+                        "Table 5.2 — S1, different D": t52_rows},
+                files=files)
+            with outdir.open(REPORT) as fh:
+                fh.write(html)
         rows = {f"{n} (D=80)": f"best {r['min_cost']:.1f} m at {r['min_alpha']:.3f}° "
                 f"(sweep {r['sweep_cost']:.1f}; seeds {SEEDS_T51[n][0]:.1f} at "
                 f"{SEEDS_T51[n][1]:.3f}°), coverage {r['coverage_pct']:.2f} %"

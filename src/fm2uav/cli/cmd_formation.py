@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-import csv
 import json
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -11,48 +11,41 @@ import numpy as np
 import typer
 
 from ..world.scenarios import SCENARIOS, get_scenario
-from ._common import OutputDir, handle_errors, parse_point, print_summary, to_jsonable
+from ._common import (
+    EXIT_PLANNING,
+    OutputDir,
+    handle_errors,
+    parse_point,
+    print_summary,
+    progress,
+    to_jsonable,
+)
 
 FIGURES = ("paths.png", "profiles.png", "metrics.png")
 TABLES = ("trajectories.csv", "metrics.csv", "cycles.csv", "summary.json")
 ANIMATION = "formation.gif"
+REPORT = "report.html"
 
 #: Thesis ch. 6 wall times of the whole formation planning (Matlab) [s].
 THESIS_TIMES = {"case1": 130.6, "case2": 135.6}
 
 
-def _write_trajectories(fh, result) -> None:
-    w = csv.writer(fh)
-    w.writerow(["time_s", "uav", "x_m", "y_m", "z_m"])
-    for k, t in enumerate(result.times):
-        for i, name in enumerate(result.names):
-            x, y, z = result.positions[k, i]
-            w.writerow([f"{t:.3f}", name, f"{x:.3f}", f"{y:.3f}", f"{z:.3f}"])
+def _write_tables(outdir: OutputDir, result) -> None:
+    from ..io.trajectories import (
+        write_cycles_csv,
+        write_formation_metrics_csv,
+        write_trajectories_csv,
+    )
 
-
-def _write_metrics(fh, result) -> None:
-    w = csv.writer(fh)
-    w.writerow(["time_s", "min_distance_m", "shape_error_m", "shape_error_norm"])
-    for t, d, e, en in zip(result.times, result.min_distance, result.shape_error,
-                           result.shape_error_norm):
-        w.writerow([f"{t:.3f}", f"{d:.3f}", f"{e:.3f}", f"{en:.4f}"])
-
-
-def _write_cycles(fh, result) -> None:
-    w = csv.writer(fh)
-    nf = result.grey.shape[1]
-    head = ["cycle", "time_s", "compute_ms"]
-    head += [f"grey_f{j + 1}" for j in range(nf)]
-    for name in result.names:
-        tag = name.replace(" ", "")
-        head += [f"goal_{tag}_x_m", f"goal_{tag}_y_m", f"goal_{tag}_z_m", f"held_{tag}"]
-    w.writerow(head)
-    for c, t in enumerate(result.cycle_start):
-        row: list[Any] = [c, f"{t:.3f}", f"{result.compute_s[c] * 1e3:.3f}"]
-        row += [f"{b:.3f}" for b in result.grey[c]]
-        for i in range(result.n_uav):
-            row += [f"{v:.3f}" for v in result.partial_goals[c, i]] + [int(result.held[c, i])]
-        w.writerow(row)
+    r = result
+    with outdir.open("trajectories.csv") as fh:
+        write_trajectories_csv(fh, r.times, r.positions, r.names)
+    with outdir.open("metrics.csv") as fh:
+        write_formation_metrics_csv(fh, r.times, r.min_distance, r.shape_error,
+                                    r.shape_error_norm)
+    with outdir.open("cycles.csv") as fh:
+        write_cycles_csv(fh, r.cycle_start, r.compute_s, r.grey, r.partial_goals, r.held,
+                         r.names)
 
 
 def _level_keeping(result) -> dict[str, Any]:
@@ -70,9 +63,37 @@ def _level_keeping(result) -> dict[str, Any]:
     return out
 
 
-def _run_case(outdir: OutputDir, sc, *, title: str, gif: bool, frames: int, **kw: Any):
+def _outputs(gif: bool, report: bool) -> tuple[str, ...]:
+    return FIGURES + TABLES + ((ANIMATION,) if gif else ()) + ((REPORT,) if report else ())
+
+
+def _report(result, summary: dict[str, Any], *, title: str, subtitle: str,
+            files: list[str]) -> str:
+    """report.html of one formation flight: every UAV's track, the leader's FM² plan."""
+    from ..viz.report import report_html
+
+    r = result
+    paths = {name: r.positions[:, i] for i, name in enumerate(r.names)}
+    lengths = r.path_lengths()
+    per_uav = [{"uav": name, "flight level [m AGL]": "free" if agl is None else agl,
+                "flown [m]": round(float(lengths[i]), 1),
+                **summary["level_keeping"].get(name, {})}
+               for i, (name, agl) in enumerate(zip(r.names, r.agl))]
+    return report_html(
+        r.world, paths, title=title, subtitle=subtitle,
+        ideal_agl={name: agl for name, agl in zip(r.names, r.agl) if agl is not None},
+        overlays={"leader FM² plan": {"points": r.leader_plan.path, "color": "#333333",
+                                      "dash": "dot", "width": 2}},
+        params={**r.params, "shape": summary["shape"], "dist [m]": summary["dist_m"]},
+        metrics=_rows(summary), tables={"UAVs": per_uav}, files=files)
+
+
+def _run_case(outdir: OutputDir, sc, *, title: str, gif: bool, frames: int,
+              report: bool = False, subtitle: str = "",
+              step: Callable[[str], None] = lambda message: None, **kw: Any):
     from ..missions.formation import fly_formation, inside_terrain
 
+    step(f"{title}: flying the formation (FM² re-planning every cycle)")
     result = fly_formation(sc.world, sc.start, sc.goal, **kw)
     summary = result.summary()
     summary["inside_terrain_samples"] = int(inside_terrain(result.world, result.positions).sum())
@@ -86,6 +107,7 @@ def _run_case(outdir: OutputDir, sc, *, title: str, gif: bool, frames: int, **kw
 
     for name, make in zip(FIGURES, (formation_paths_figure, formation_profiles_figure,
                                     formation_metrics_figure)):
+        step(f"{title}: writing {name}")
         fig = make(result, title=title)
         tmp = outdir.target(name)
         fig.savefig(tmp, dpi=100)
@@ -93,15 +115,20 @@ def _run_case(outdir: OutputDir, sc, *, title: str, gif: bool, frames: int, **kw
 
         plt.close(fig)
         outdir.commit(tmp, name)
-    for name, writer in zip(TABLES[:3], (_write_trajectories, _write_metrics, _write_cycles)):
-        with outdir.open(name, "w") as fh:
-            writer(fh, result)
+    _write_tables(outdir, result)
     with outdir.open("summary.json") as fh:
         json.dump(to_jsonable(summary), fh, indent=2)
     if gif:
+        step(f"{title}: writing {ANIMATION}")
         tmp = outdir.target(ANIMATION)
         formation_animation(result, tmp, max_frames=frames)
         outdir.commit(tmp, ANIMATION)
+    if report:
+        step(f"{title}: writing {REPORT}")
+        html = _report(result, summary, title=title, subtitle=subtitle,
+                       files=list(_outputs(gif, False)))
+        with outdir.open(REPORT) as fh:
+            fh.write(html)
     return result, summary
 
 
@@ -131,10 +158,10 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         help=(
             "Fly a leader–follower formation with FM² (thesis ch. 6) and write trajectories.csv, "
             "metrics.csv, cycles.csv, summary.json, paths.png, profiles.png, metrics.png and "
-            "formation.gif.\n\n"
+            "formation.gif (and with --report an interactive report.html).\n\n"
             "Examples:\n\n"
             "  fm2uav formation --scenario fissure --out out/formation\n\n"
-            "  fm2uav formation --scenario fissure --level 7 --out out/formation-l7\n\n"
+            "  fm2uav formation --scenario fissure --level 7 --report --out out/formation-l7\n\n"
             "  fm2uav formation --shape v --followers 4 --dist 45 --no-gif --out out/v4\n\n"
             f"Scenarios: {', '.join(SCENARIOS)}."
         ),
@@ -167,6 +194,8 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
         as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
         quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
+        report: bool = typer.Option(
+            False, "--report", help="Also write report.html (interactive, self-contained)."),
     ) -> None:
         from ..errors import InputError
 
@@ -177,7 +206,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         if level is not None:
             agl = float(level) * world.spacing[2]
         outdir = OutputDir(out, force=force)
-        outdir.check(FIGURES + TABLES + ((ANIMATION,) if gif else ()))
+        outdir.check(_outputs(gif, report))
 
         def point(text: str | None, default: np.ndarray, what: str) -> np.ndarray:
             if text is None:
@@ -188,16 +217,18 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         sc = type(sc)(world=world, start=point(start, sc.start, "start"),
                       goal=point(goal, sc.goal, "goal"), description=sc.description)
         title = f"formation — {scenario}" + (f", flight level {agl:g} m" if agl else "")
-        result, summary = _run_case(
-            outdir, sc, title=title, gif=gif, frames=frames, n_followers=followers,
-            shape=shape, dist=dist, leader_speed=speed, follower_speed=follower_speed,
-            cycle=cycle, agl=agl, p1=p1, p2=p2, grey=grey,
-        )
+        with progress(enabled=not (quiet or as_json)) as step:
+            result, summary = _run_case(
+                outdir, sc, title=title, gif=gif, frames=frames, report=report,
+                subtitle=sc.description, step=step, n_followers=followers,
+                shape=shape, dist=dist, leader_speed=speed, follower_speed=follower_speed,
+                cycle=cycle, agl=agl, p1=p1, p2=p2, grey=grey,
+            )
         summary = {"scenario": scenario, **summary}
         print_summary("FM² formation", summary if as_json else _rows(summary), as_json=as_json,
                       quiet=quiet, files=outdir.written)
         if not result.completed:
-            raise typer.Exit(1)
+            raise typer.Exit(EXIT_PLANNING)
 
     @reproduce_app.command(
         "formation",
@@ -205,8 +236,11 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "Thesis ch. 6: the triangle formation across the fissure without (case 1) and with "
             "(case 2) the flight level 7 cells; case 2 is run with the thesis' p1 = 1, p2 = 0.5 "
             "and with the planner's p1 = 0.5, p2 = 1.5. Writes one folder per case and "
-            "table.md comparing our times with the thesis' 130.6 s / 135.6 s (Matlab).\n\n"
-            "Example:  fm2uav reproduce formation --out out/formation-thesis"
+            "table.md comparing our times with the thesis' 130.6 s / 135.6 s (Matlab); with "
+            "--report also report.html per case and one comparing the cases.\n\n"
+            "Examples:\n\n"
+            "  fm2uav reproduce formation --out out/formation-thesis\n\n"
+            "  fm2uav reproduce formation --no-gif --report --out out/formation-report"
         ),
     )
     @handle_errors
@@ -217,6 +251,8 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
         as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
         quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
+        report: bool = typer.Option(
+            False, "--report", help="Also write report.html (per case and comparing them)."),
     ) -> None:
         sc = get_scenario("fissure", seed=seed)
         dz = sc.world.spacing[2]
@@ -228,21 +264,32 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
              {"agl": 7 * dz, "p1": 0.5, "p2": 1.5}, "case2"),
         ]
         root = OutputDir(out, force=force)
-        root.check(["table.md", "summary.json"])
+        root.check(["table.md", "summary.json"] + ([REPORT] if report else []))
         for folder, *_ in cases:
-            OutputDir(out / folder, force=force).check(
-                FIGURES + TABLES + ((ANIMATION,) if gif else ()))
-        results = {}
+            OutputDir(out / folder, force=force).check(_outputs(gif, report))
+        results, flights, table = {}, {}, []
         lines = [
             "| case | our time [s] | thesis [s] | min separation [m] (≥ 30) | inside terrain | "
             "max / final shape error [m] | min grey | leader on level | cycle median [ms] |",
             "|---|---|---|---|---|---|---|---|---|",
         ]
+        with progress(enabled=not (quiet or as_json)) as step:
+            for folder, title, kw, thesis_key in cases:
+                flights[folder], results[folder] = _run_case(
+                    OutputDir(out / folder, force=force), sc, title=title, gif=gif, frames=60,
+                    report=report, subtitle=sc.description, step=step, **kw)
         for folder, title, kw, thesis_key in cases:
-            _, s = _run_case(OutputDir(out / folder, force=force), sc, title=title, gif=gif,
-                             frames=60, **kw)
-            results[folder] = s
+            s = results[folder]
             lead = s["level_keeping"].get("leader", {}).get("within_1_cell", "-")
+            table.append({
+                "case": title, "our time [s]": s["timings_s"]["total"],
+                "thesis [s]": THESIS_TIMES[thesis_key],
+                "min separation [m] (≥ 30)": s["min_separation_m"],
+                "inside terrain": s["inside_terrain_samples"],
+                "max / final shape error [m]": f"{s['max_shape_error_m']:.0f} / "
+                                               f"{s['final_shape_error_m']:.0f}",
+                "min grey": s["min_grey"], "leader on level": lead,
+                "cycle median [ms]": s["cycle_ms"]["median"], "completed": s["completed"]})
             lines.append(
                 f"| {title} | {s['timings_s']['total']:.2f} | {THESIS_TIMES[thesis_key]} | "
                 f"{s['min_separation_m']:.1f} | {s['inside_terrain_samples']} | "
@@ -253,6 +300,24 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             fh.write("\n".join(lines) + "\n")
         with root.open("summary.json") as fh:
             json.dump(to_jsonable(results), fh, indent=2)
+        if report:
+            from ..viz.report import report_html
+
+            names = {folder: title for folder, title, *_ in cases}
+            html = report_html(
+                sc.world,
+                {f"{names[f]} — leader": r.positions[:, 0] for f, r in flights.items()},
+                title="Thesis ch. 6 formations: the leaders of the three cases",
+                subtitle=f"{sc.description} — each case's own report.html is in its folder",
+                ideal_agl={f"{names[f]} — leader": r.agl[0] for f, r in flights.items()
+                           if r.agl[0] is not None},
+                params={"seed": seed, "cases": ", ".join(names)},
+                metrics={f"{f}: min separation [m]": s["min_separation_m"]
+                         for f, s in results.items()},
+                tables={"Results (thesis ch. 6)": table},
+                files=["table.md", "summary.json"] + [f"{f}/" for f in names])
+            with root.open(REPORT) as fh:
+                fh.write(html)
         if as_json:
             print_summary("", results, as_json=True, quiet=quiet)
         elif not quiet:
@@ -260,3 +325,5 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
 
             console.print("\n".join(lines))
             console.print(f"outputs in {out}/")
+        if not all(s["completed"] for s in results.values()):
+            raise typer.Exit(EXIT_PLANNING)

@@ -12,7 +12,7 @@ import numpy as np
 import typer
 
 from ..errors import InputError
-from ._common import OutputDir, handle_errors, parse_point, print_summary, to_jsonable
+from ._common import OutputDir, handle_errors, parse_point, print_summary, progress, to_jsonable
 
 TFF_FILES = (
     "tff_table.md",
@@ -24,6 +24,7 @@ TFF_FILES = (
     "tff_kinematics.png",
 )
 TUNE_FILES = ("tune_table.md", "tune.json", "tune_best_path.csv", "tune_best.png")
+REPORT = "report.html"
 
 _COLUMNS = (
     ("case", "case", "{}"),
@@ -58,6 +59,29 @@ def _markdown(rows: list[dict[str, Any]]) -> str:
     return "\n".join(out)
 
 
+def _table_rows(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The rows of tff_table.md as dicts (header → formatted value), for the HTML report."""
+    return [{head: fmt.format(r[key]) for head, key, fmt in _COLUMNS} for r in rows]
+
+
+def _tff_report(plans: list[Any], rows: list[dict[str, Any]], labels: list[str], sc, *,
+                title: str, params: dict[str, Any], files: list[str],
+                table_title: str = "Terrain-following cases",
+                extra_tables: dict[str, list[dict[str, Any]]] | None = None) -> str:
+    """report.html of terrain-following paths: each path vs its ideal level, the case table."""
+    from ..viz.report import report_html
+
+    return report_html(
+        sc.world, {lab: p.path for lab, p in zip(labels, plans)},
+        speeds={lab: p.speed for lab, p in zip(labels, plans)},
+        ideal_agl={lab: r["agl_m"] for lab, r in zip(labels, rows)},
+        title=title, subtitle=sc.description, params=params,
+        metrics={lab: f"within ±1 cell {r['within']:.0%}, mean |dev| {r['mean_dev_all_m']:.1f} m, "
+                      f"max climb {r['climb_max_deg']:.0f}°, length {r['length_m']:.0f} m"
+                 for lab, r in zip(labels, rows)},
+        tables={table_title: _table_rows(rows), **(extra_tables or {})}, files=files)
+
+
 def run_tff(scenario: str, seed: int, mode: str) -> tuple[list[dict[str, Any]], list[Any], Any]:
     """Plan the seeds' five cases (and the literal reading of level 10) on a scenario."""
     from ..analysis.flight_level import SEED_CASES, tff_metrics
@@ -84,6 +108,106 @@ def run_tff(scenario: str, seed: int, mode: str) -> tuple[list[dict[str, Any]], 
     return rows, plans, sc
 
 
+def _write_tff_outputs(outdir: OutputDir, rows, plans, sc, *, scenario: str, seed: int,
+                       mode: str, report: bool) -> None:
+    from ..viz.tff import tff_3d_figure, tff_kinematics_figure, tff_profile_figure
+
+    labels = [f"{r['case']} (p1={r['p1']:g}, p2={r['p2']:g})" for r in rows]
+    agls = [r["agl_m"] for r in rows]
+    lv, sm = [0, 1, 2], [2, 3, 4]
+    figs = {
+        "tff_3d_levels.png": tff_3d_figure([plans[i] for i in lv], [labels[i] for i in lv],
+                                           title=f"Flight levels — {scenario}"),
+        "tff_3d_smoothness.png": tff_3d_figure(
+            [plans[i] for i in sm], [labels[i] for i in sm],
+            title=f"Smoothness at level 10 — {scenario}"),
+        "tff_profile_levels.png": tff_profile_figure(
+            [plans[i] for i in lv], [agls[i] for i in lv], [labels[i] for i in lv],
+            title="Path vs ideal path vs terrain"),
+        "tff_profile_smoothness.png": tff_profile_figure(
+            [plans[i] for i in sm], [agls[i] for i in sm], [labels[i] for i in sm],
+            title="Path vs ideal path vs terrain (level 10)"),
+        "tff_kinematics.png": tff_kinematics_figure(
+            [plans[i] for i in sm], [labels[i] for i in sm],
+            title="Turn, climb and curvature profiles (level 10)"),
+    }
+    import matplotlib.pyplot as plt
+
+    tmps = {}
+    for name, fig in figs.items():
+        tmp = outdir.target(name)
+        fig.savefig(tmp, dpi=100)
+        plt.close(fig)
+        tmps[name] = tmp
+    for name, tmp in tmps.items():
+        outdir.commit(tmp, name)
+    md = [
+        f"# Terrain-following flight — {scenario} (seed {seed}, flight-level mode '{mode}')",
+        "",
+        sc.description,
+        "",
+        f"start {np.round(sc.start, 1).tolist()} m, goal {np.round(sc.goal, 1).tolist()} m; "
+        f"±1 cell = ±{sc.world.spacing[2]:g} m; transitions = the start/goal stretches "
+        "before the path first reaches, and after it last leaves, ±1 cell of terrain + agl; "
+        "profiles on the path resampled every horizontal cell.",
+        "",
+        _markdown(rows),
+        "",
+    ]
+    with outdir.open("tff_table.md") as fh:
+        fh.write("\n".join(md))
+    with outdir.open("tff_summary.json") as fh:
+        json.dump(to_jsonable({"scenario": scenario, "seed": seed, "mode": mode,
+                               "cases": rows}), fh, indent=2)
+    if report:
+        html = _tff_report(plans, rows, labels, sc,
+                           title=f"Terrain-following flight — {scenario}",
+                           params={"scenario": scenario, "seed": seed,
+                                   "flight-level mode": mode,
+                                   "start [m]": np.round(sc.start, 1),
+                                   "goal [m]": np.round(sc.goal, 1),
+                                   "vertical cell [m]": sc.world.spacing[2]},
+                           files=list(TFF_FILES))
+        with outdir.open(REPORT) as fh:
+            fh.write(html)
+
+
+def _write_tune_report(outdir: OutputDir, res, sc, s, g, *, agl: float, scenario: str,
+                       limits, grid: dict[str, list[float]]) -> None:
+    """report.html of the tuned path (or, when none keeps the limits, the closest one)."""
+    from ..analysis.flight_level import tff_metrics
+
+    if res.best_plan is not None:
+        row, p = res.best, res.best_plan
+        label = f"best: p1={row['p1']:g}, p2={row['p2']:g}, α={row['saturation']:g}"
+    else:  # nothing keeps the limits: show the Pareto candidate closest to the level
+        from ..planning import plan
+
+        row = res.pareto[0]
+        p = plan(sc.world, s, g, agl=agl, p1=row["p1"], p2=row["p2"],
+                 saturation=row["saturation"], exponent=row["exponent"])
+        label = (f"closest (breaks the limits): p1={row['p1']:g}, p2={row['p2']:g}, "
+                 f"α={row['saturation']:g}")
+    m = tff_metrics(p, agl)
+    m.update(case=label, level=round(agl / sc.world.spacing[2], 2), agl_m=agl,
+             p1=row["p1"], p2=row["p2"], diff=row["p2"] - row["p1"],
+             transitions=f"{m['start_transition_m']:.0f}/{m['end_transition_m']:.0f}")
+    keys = ("p1", "p2", "saturation", "exponent", "deviation_m", "within", "climb_max_deg",
+            "min_turn_radius_m", "length_m", "feasible")
+    pareto = [{k: (round(r[k], 3) if isinstance(r[k], float) else r[k]) for k in keys}
+              for r in res.pareto]
+    html = _tff_report(
+        [p], [m], [label], sc, title=f"Auto-tuning — {scenario}, {agl:g} m above ground",
+        params={"scenario": scenario, "agl [m]": agl,
+                "max climb [deg]": limits.max_climb_deg,
+                "min turn radius [m]": limits.min_turn_radius_m,
+                **{f"grid {k}": v for k, v in grid.items()}},
+        files=list(TUNE_FILES), table_title="The tuned path",
+        extra_tables={"Pareto front (deviation ↓, max climb ↓, min turn radius ↑)": pareto})
+    with outdir.open(REPORT) as fh:
+        fh.write(html)
+
+
 def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
     """Add ``reproduce tff`` and ``tune``."""
 
@@ -93,9 +217,11 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "Reproduce the terrain-following experiments (TFF paper §5 / thesis §4.3): flight "
             "levels 2, 5, 10 cells with (p1,p2) = (0.5,2.5), (0.5,1.5), (0.5,1.3) and the "
             "smoothness cases p2 = 1.0, 0.8 at level 10; writes the 3D views, path-vs-ideal "
-            "profiles, turn/climb/curvature profiles and tff_table.md.\n\n"
+            "profiles, turn/climb/curvature profiles and tff_table.md (and with --report an "
+            "interactive report.html: every path vs its ideal level).\n\n"
             "Examples:\n\n"
             "  fm2uav reproduce tff --out out/tff\n\n"
+            "  fm2uav reproduce tff --report --out out/tff-report\n\n"
             "  fm2uav reproduce tff --scenario jacksboro --out out/tff-jacksboro"
         ),
     )
@@ -110,62 +236,20 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
         as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
         quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
+        report: bool = typer.Option(
+            False, "--report", help="Also write report.html (interactive, self-contained)."),
     ) -> None:
         if mode not in ("capped", "literal"):
             raise InputError(f"--mode must be 'capped' or 'literal', got {mode!r}")
         outdir = OutputDir(out, force=force)
-        outdir.check(TFF_FILES)
+        outdir.check(TFF_FILES + ((REPORT,) if report else ()))
         t0 = time.perf_counter()
-        rows, plans, sc = run_tff(scenario, seed, mode)
-        from ..viz.tff import tff_3d_figure, tff_kinematics_figure, tff_profile_figure
-
-        labels = [f"{r['case']} (p1={r['p1']:g}, p2={r['p2']:g})" for r in rows]
-        agls = [r["agl_m"] for r in rows]
-        lv, sm = [0, 1, 2], [2, 3, 4]
-        figs = {
-            "tff_3d_levels.png": tff_3d_figure([plans[i] for i in lv], [labels[i] for i in lv],
-                                               title=f"Flight levels — {scenario}"),
-            "tff_3d_smoothness.png": tff_3d_figure(
-                [plans[i] for i in sm], [labels[i] for i in sm],
-                title=f"Smoothness at level 10 — {scenario}"),
-            "tff_profile_levels.png": tff_profile_figure(
-                [plans[i] for i in lv], [agls[i] for i in lv], [labels[i] for i in lv],
-                title="Path vs ideal path vs terrain"),
-            "tff_profile_smoothness.png": tff_profile_figure(
-                [plans[i] for i in sm], [agls[i] for i in sm], [labels[i] for i in sm],
-                title="Path vs ideal path vs terrain (level 10)"),
-            "tff_kinematics.png": tff_kinematics_figure(
-                [plans[i] for i in sm], [labels[i] for i in sm],
-                title="Turn, climb and curvature profiles (level 10)"),
-        }
-        import matplotlib.pyplot as plt
-
-        tmps = {}
-        for name, fig in figs.items():
-            tmp = outdir.target(name)
-            fig.savefig(tmp, dpi=100)
-            plt.close(fig)
-            tmps[name] = tmp
-        for name, tmp in tmps.items():
-            outdir.commit(tmp, name)
-        md = [
-            f"# Terrain-following flight — {scenario} (seed {seed}, flight-level mode '{mode}')",
-            "",
-            sc.description,
-            "",
-            f"start {np.round(sc.start, 1).tolist()} m, goal {np.round(sc.goal, 1).tolist()} m; "
-            f"±1 cell = ±{sc.world.spacing[2]:g} m; transitions = the start/goal stretches "
-            "before the path first reaches, and after it last leaves, ±1 cell of terrain + agl; "
-            "profiles on the path resampled every horizontal cell.",
-            "",
-            _markdown(rows),
-            "",
-        ]
-        with outdir.open("tff_table.md") as fh:
-            fh.write("\n".join(md))
-        with outdir.open("tff_summary.json") as fh:
-            json.dump(to_jsonable({"scenario": scenario, "seed": seed, "mode": mode,
-                                   "cases": rows}), fh, indent=2)
+        with progress(enabled=not (quiet or as_json)) as step:
+            step(f"planning the terrain-following cases on {scenario}")
+            rows, plans, sc = run_tff(scenario, seed, mode)
+            step("drawing the figures")
+            _write_tff_outputs(outdir, rows, plans, sc, scenario=scenario, seed=seed, mode=mode,
+                               report=report)
         summary = {
             r["case"]: f"within {r['within']:.0%}, mean|dev| {r['mean_dev_all_m']:.1f} m, "
             f"max turn {r['turn_max_deg']:.0f}°, max climb {r['climb_max_deg']:.0f}°"
@@ -180,9 +264,11 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         help=(
             "Search p1/p2 (and α/β) for the terrain-following path that keeps an airframe's max "
             "climb angle and min turn radius with the least flight-level deviation; writes the "
-            "Pareto table (tune_table.md), tune.json, the best path and its figure.\n\n"
+            "Pareto table (tune_table.md), tune.json, the best path and its figure (and with "
+            "--report an interactive report.html of the best path vs its ideal level).\n\n"
             "Examples:\n\n"
             "  fm2uav tune --agl 150 --max-climb 45 --min-turn-radius 60 --out out/tune\n\n"
+            "  fm2uav tune --p1 0.5 --p2 1.3,1.5 --report --out out/tune-report\n\n"
             "  fm2uav tune --scenario jacksboro --agl 300 --max-climb 20 --min-turn-radius 300 "
             "--saturation 1,0.5 --out out/tune-jb"
         ),
@@ -190,20 +276,22 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
     @handle_errors
     def tune_cmd(
         scenario: str = typer.Option("open-field", help="Built-in 3D scenario with terrain."),
-        agl: float = typer.Option(150.0, help="Flight level over the ground [m]."),
-        max_climb: float = typer.Option(45.0, help="Airframe max climb/descent angle [deg]."),
-        min_turn_radius: float = typer.Option(60.0, help="Airframe min turn radius [m]."),
+        agl: float = typer.Option(150.0, help="Flight level over the ground (m)."),
+        max_climb: float = typer.Option(45.0, help="Airframe max climb/descent angle (deg)."),
+        min_turn_radius: float = typer.Option(60.0, help="Airframe min turn radius (m)."),
         p1: str = typer.Option("0.3,0.5,0.8", help="Values of p1 to try (comma list)."),
         p2: str = typer.Option("0.6,0.8,1.0,1.3,1.5,2.0,2.5", help="Values of p2 to try."),
         saturation: str = typer.Option("1.0", help="Values of α to try."),
         exponent: str = typer.Option("1.0", help="Values of β to try."),
-        start: str | None = typer.Option(None, help="Start x,y,z [m]. Default: the scenario's."),
-        goal: str | None = typer.Option(None, help="Goal x,y,z [m]. Default: the scenario's."),
+        start: str | None = typer.Option(None, help="Start x,y,z (m). Default: the scenario's."),
+        goal: str | None = typer.Option(None, help="Goal x,y,z (m). Default: the scenario's."),
         seed: int = typer.Option(0, help="Seed of the scenario's random relief."),
         out: Path = typer.Option(Path("out/tune"), help="Output directory."),
         force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
         as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
         quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
+        report: bool = typer.Option(
+            False, "--report", help="Also write report.html (interactive, self-contained)."),
     ) -> None:
         from ..planning.tune import AirframeLimits, tune
         from ..world.scenarios import get_scenario
@@ -222,8 +310,11 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         s = sc.start if start is None else parse_point(start, 3, "start")
         g = sc.goal if goal is None else parse_point(goal, 3, "goal")
         outdir = OutputDir(out, force=force)
-        outdir.check(TUNE_FILES)
-        res = tune(sc.world, s, g, limits, agl, grid=grid)
+        outdir.check(TUNE_FILES + ((REPORT,) if report else ()))
+        with progress(enabled=not (quiet or as_json)) as step:
+            n = sum(1 for a in grid["p1"] for b in grid["p2"] if b > a)
+            step(f"planning {n * len(grid['saturation']) * len(grid['exponent'])} candidates")
+            res = tune(sc.world, s, g, limits, agl, grid=grid)
         from ..io import write_path_csv
 
         md = [f"# Auto-tuning — {scenario}, agl {agl:g} m, max climb {max_climb:g}°, "
@@ -251,6 +342,9 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
                    "best": res.best, "pareto": res.pareto, "rows": res.rows}
         with outdir.open("tune.json") as fh:
             json.dump(to_jsonable(payload), fh, indent=2)
+        if report:
+            _write_tune_report(outdir, res, sc, s, g, agl=agl, scenario=scenario, limits=limits,
+                               grid=grid)
         b = res.best
         rows = {
             "candidates": len(res.rows),

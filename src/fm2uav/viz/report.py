@@ -7,7 +7,13 @@ A report shows
   waypoints, start and goal — rotate/zoom with the mouse;
 * profiles along each path: altitude and ground, height above ground, and the
   velocity map W (the admissible speed share);
-* tables of the parameters and metrics.
+* tables of the parameters and metrics, and optional result tables;
+* optionally, per-path line styles (e.g. planned solid, flown dashed), the
+  ideal flight level of each path (ground + agl) on the altitude profile, and
+  scene-only overlays (area outlines, bands, flown tracks).
+
+A report without a world (e.g. ``fm2uav check`` of a bare path file) draws
+the paths alone.
 
 The file is self-contained: plotly.js is inlined (about 4.7 MB), nothing is
 fetched from the network, so it opens offline and can be mailed as one file.
@@ -24,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["report_html", "plan_report", "write_report"]
+__all__ = ["report_html", "plan_report", "write_report", "join_polylines"]
 
 _COLOURS = ["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#e377c2",
             "#8c564b", "#bcbd22", "#7f7f7f"]
@@ -36,7 +42,7 @@ def _arc(path: np.ndarray) -> np.ndarray:
 
 
 def _ground(world: Any, path: np.ndarray) -> np.ndarray | None:
-    if getattr(world, "terrain", None) is None or path.shape[1] != 3:
+    if world is None or getattr(world, "terrain", None) is None or path.shape[1] != 3:
         return None
     from .figures import terrain_along
 
@@ -83,6 +89,50 @@ def _table(rows: Mapping[str, Any]) -> str:
     return f"<table>{body}</table>"
 
 
+def _results_table(title: str, rows: Sequence[Mapping[str, Any]]) -> str:
+    """A titled table with one column per key (the union of the rows' keys, in order)."""
+    if not rows:
+        return ""
+    cols = list(dict.fromkeys(k for r in rows for k in r))
+    head = "".join(f"<th>{html.escape(str(c))}</th>" for c in cols)
+    body = "".join(
+        "<tr>" + "".join(f"<td>{html.escape(_fmt(r.get(c, '')))}</td>" for c in cols) + "</tr>"
+        for r in rows
+    )
+    return (f'<section><h2>{html.escape(title)}</h2><div style="overflow-x:auto">'
+            f'<table class="results"><tr>{head}</tr>{body}</table></div></section>')
+
+
+def join_polylines(lines: Sequence[Any]) -> np.ndarray:
+    """Several polylines as one array with a NaN row between them (drawn with gaps).
+
+    Parameters
+    ----------
+    lines : sequence of array_like (n_i, d)
+        Polylines [m] (e.g. coverage bands, the rings of an area).
+
+    Returns
+    -------
+    ndarray, shape (sum n_i + len(lines) - 1, d)
+    """
+    arrs = [np.asarray(a, dtype=float) for a in lines if len(a)]
+    if not arrs:
+        raise ValueError("join_polylines needs at least one non-empty polyline")
+    gap = np.full((1, arrs[0].shape[1]), np.nan)
+    out = [arrs[0]]
+    for a in arrs[1:]:
+        out += [gap, a]
+    return np.concatenate(out)
+
+
+def _overlay(value: Any) -> dict[str, Any]:
+    if isinstance(value, Mapping):
+        ov = dict(value)
+        ov["points"] = np.asarray(ov["points"], dtype=float)
+        return ov
+    return {"points": np.asarray(value, dtype=float)}
+
+
 def _fmt(v: Any) -> str:
     if isinstance(v, float):
         return f"{v:.6g}"
@@ -93,13 +143,58 @@ def _fmt(v: Any) -> str:
     return str(v)
 
 
+def _is_3d(world: Any, paths: Mapping[str, np.ndarray]) -> bool:
+    if world is not None:
+        return world.ndim == 3
+    return next(iter(paths.values())).shape[1] == 3
+
+
+def _densify(pts: np.ndarray, step: float) -> np.ndarray:
+    """Insert points so no segment is longer than ``step``; NaN gap rows are kept."""
+    out = [pts[:1]]
+    for a, b in zip(pts[:-1], pts[1:]):
+        n = 1
+        if np.all(np.isfinite(a)) and np.all(np.isfinite(b)):
+            n = max(1, int(np.ceil(np.linalg.norm(b - a) / step)))
+        t = np.arange(1, n + 1)[:, None] / n
+        out.append(a + t * (b - a) if n > 1 else b[None])
+    return np.concatenate(out)
+
+
+def _overlay_points(world: Any, pts: np.ndarray, three_d: bool) -> np.ndarray:
+    """Drape 2-column polylines over the ground of a 3D world; NaN rows kept as gaps.
+
+    The polyline is densified to the grid spacing and lifted half a vertical
+    cell (at least 2 m) so it stays above the drawn surface.
+    """
+    if not three_d or pts.shape[1] == 3:
+        return pts
+    if world is not None and world.terrain is not None:
+        pts = _densify(pts, float(min(world.spacing[:2])))
+    z = np.full(len(pts), np.nan)
+    ok = np.all(np.isfinite(pts), axis=1)
+    if world is not None and ok.any():
+        flat = np.column_stack([pts[ok], np.zeros(int(ok.sum()))])
+        g = _ground(world, flat)
+        lift = max(2.0, 0.5 * float(world.spacing[2]))
+        z[ok] = (g + lift) if g is not None else world.bounds[2, 0]
+    elif ok.any():
+        z[ok] = 0.0
+    return np.column_stack([pts[:, :2], z])
+
+
 def _scene_figure(world: Any, paths: Mapping[str, np.ndarray],
-                  waypoints: Mapping[str, np.ndarray], limit: int) -> Any:
+                  waypoints: Mapping[str, np.ndarray], limit: int,
+                  styles: Mapping[str, Mapping[str, Any]] | None = None,
+                  overlays: Mapping[str, Mapping[str, Any]] | None = None) -> Any:
     import plotly.graph_objects as go
 
     fig = go.Figure()
-    three_d = world.ndim == 3
-    if three_d:
+    styles = styles or {}
+    three_d = _is_3d(world, paths)
+    if world is None:
+        pass
+    elif three_d:
         surf = _surface(world, limit)
         if surf is not None:
             x, y, z, label = surf
@@ -116,11 +211,20 @@ def _scene_figure(world: Any, paths: Mapping[str, np.ndarray],
             colorscale=[[0, "#ffffff"], [1, "#444444"]], showscale=False, name="obstacles",
             hoverinfo="skip"))
     scatter = go.Scatter3d if three_d else go.Scatter
+    for j, (name, ov) in enumerate((overlays or {}).items()):
+        pts = _overlay_points(world, ov["points"], three_d)
+        kw = {"z": pts[:, 2]} if three_d else {}
+        line = {"color": ov.get("color", "#555555"), "width": ov.get("width", 3 if three_d else 2)}
+        if ov.get("dash"):
+            line["dash"] = ov["dash"]
+        fig.add_trace(scatter(x=pts[:, 0], y=pts[:, 1], mode="lines", name=name, line=line,
+                              connectgaps=False, hoverinfo="skip", **kw))
     for i, (name, p) in enumerate(paths.items()):
         c = _COLOURS[i % len(_COLOURS)]
         kw = {"z": p[:, 2]} if three_d else {}
-        fig.add_trace(scatter(x=p[:, 0], y=p[:, 1], mode="lines", name=name,
-                              line={"color": c, "width": 6 if three_d else 3}, **kw))
+        line = {"color": c, "width": 6 if three_d else 3, **styles.get(name, {})}
+        c = line["color"]
+        fig.add_trace(scatter(x=p[:, 0], y=p[:, 1], mode="lines", name=name, line=line, **kw))
         if name in waypoints:
             w = waypoints[name]
             kw = {"z": w[:, 2]} if three_d else {}
@@ -137,7 +241,11 @@ def _scene_figure(world: Any, paths: Mapping[str, np.ndarray],
                                           "symbol": sym, "line": {"color": "black", "width": 1}},
                                   **kw))
     if three_d:
-        b = world.bounds
+        if world is not None:
+            b = world.bounds
+        else:
+            allp = np.concatenate(list(paths.values()))
+            b = np.column_stack([allp.min(axis=0), allp.max(axis=0)])
         ext = b[:, 1] - b[:, 0]
         ext = np.where(ext > 0, ext, 1.0)
         fig.update_layout(scene={
@@ -156,36 +264,55 @@ def _scene_figure(world: Any, paths: Mapping[str, np.ndarray],
 
 
 def _profile_figure(world: Any, paths: Mapping[str, np.ndarray],
-                    speeds: Mapping[str, np.ndarray], agl: float | None) -> Any:
+                    speeds: Mapping[str, np.ndarray], agl: float | None,
+                    styles: Mapping[str, Mapping[str, Any]] | None = None,
+                    ideal_agl: Mapping[str, float] | None = None) -> Any:
     import plotly.graph_objects as go
     from plotly.subplots import make_subplots
 
-    three_d = world.ndim == 3
-    rows = (["altitude [m]", "height above ground [m]"] if three_d else []) + ["W (speed share)"]
+    styles = styles or {}
+    ideal_agl = ideal_agl or {}
+    three_d = _is_3d(world, paths)
+    agl_row = three_d and world is not None     # a bare path (no world) has no ground
+    w_row = bool(speeds) or not three_d
+    rows = ((["altitude [m]"] if three_d else []) + (["height above ground [m]"] if agl_row else [])
+            + (["W (speed share)"] if w_row else []))
     fig = make_subplots(rows=len(rows), cols=1, shared_xaxes=True, vertical_spacing=0.06,
                         subplot_titles=rows)
     for i, (name, p) in enumerate(paths.items()):
-        c = _COLOURS[i % len(_COLOURS)]
+        st = {k: v for k, v in styles.get(name, {}).items() if k in ("color", "dash")}
+        c = st.get("color", _COLOURS[i % len(_COLOURS)])
+        line = {"color": c, **st}
         s = _arc(p)
         r = 1
         if three_d:
             fig.add_trace(go.Scatter(x=s, y=p[:, 2], name=f"{name} altitude", legendgroup=name,
-                                     line={"color": c}), row=1, col=1)
+                                     line=line), row=1, col=1)
             g = _ground(world, p)
             if g is not None:
                 fig.add_trace(go.Scatter(x=s, y=g, name=f"{name} ground", legendgroup=name,
                                          line={"color": "#8c6d31"}, fill="tozeroy",
                                          fillcolor="rgba(140,109,49,0.25)"), row=1, col=1)
+                if name in ideal_agl and ideal_agl[name] is not None:
+                    level = float(ideal_agl[name])
+                    fig.add_trace(go.Scatter(x=s, y=g + level,
+                                             name=f"{name} ideal ({level:g} m AGL)",
+                                             legendgroup=name,
+                                             line={"color": c, "dash": "dash", "width": 1}),
+                                  row=1, col=1)
                 fig.add_trace(go.Scatter(x=s, y=p[:, 2] - g, name=f"{name} AGL",
-                                         legendgroup=name, line={"color": c}), row=2, col=1)
-            r = 3
-        if name in speeds and speeds[name] is not None:
+                                         legendgroup=name, line=line), row=2, col=1)
+            r = 3 if agl_row else 2
+        if w_row and name in speeds and speeds[name] is not None:
             fig.add_trace(go.Scatter(x=s, y=np.asarray(speeds[name], dtype=float),
                                      name=f"{name} W", legendgroup=name,
                                      line={"color": c, "dash": "dot"}), row=r, col=1)
-    if three_d and agl is not None:
-        fig.add_hline(y=agl, line={"color": "black", "dash": "dash", "width": 1},
-                      annotation_text=f"flight level {agl:g} m", row=2, col=1)
+    levels = [] if agl is None else [float(agl)]
+    levels += [float(v) for v in ideal_agl.values() if v is not None]
+    if agl_row:
+        for level in dict.fromkeys(levels):
+            fig.add_hline(y=level, line={"color": "black", "dash": "dash", "width": 1},
+                          annotation_text=f"flight level {level:g} m", row=2, col=1)
     fig.update_xaxes(title_text="distance along the path [m]", row=len(rows), col=1)
     fig.update_layout(height=260 * len(rows), margin={"l": 60, "r": 20, "t": 40, "b": 40},
                       title="profiles")
@@ -199,7 +326,8 @@ header p{margin:4px 0 0;opacity:.85}main{padding:12px 24px}
 section{background:#fff;border:1px solid #ddd;border-radius:6px;margin:0 0 16px;padding:8px 12px}
 h2{font-size:17px;margin:6px 0}.cols{display:flex;gap:16px;flex-wrap:wrap}.cols>div{flex:1;min-width:300px}
 table{border-collapse:collapse;font-size:13px;width:100%}th,td{border-bottom:1px solid #eee;padding:3px 8px;text-align:left;vertical-align:top}
-th{width:38%;color:#444;font-weight:600}footer{font-size:12px;color:#666;padding:8px 24px 24px}
+th{width:38%;color:#444;font-weight:600}
+table.results th{width:auto;white-space:nowrap}footer{font-size:12px;color:#666;padding:8px 24px 24px}
 """
 
 
@@ -216,14 +344,18 @@ def report_html(
     files: Sequence[str] = (),
     agl: float | None = None,
     max_surface: int = 150,
+    styles: Mapping[str, Mapping[str, Any]] | None = None,
+    ideal_agl: Mapping[str, float | None] | None = None,
+    overlays: Mapping[str, Any] | None = None,
+    tables: Mapping[str, Sequence[Mapping[str, Any]]] | None = None,
 ) -> str:
     """A self-contained interactive HTML report of paths on a world.
 
     Parameters
     ----------
-    world : World
+    world : World or None
         Drawn as its terrain surface, or its obstacle heights without terrain
-        (2D worlds: the occupancy).
+        (2D worlds: the occupancy). None: the paths alone (no ground profile).
     paths : mapping of str to array (N, ndim)
         Named paths [m] (e.g. ``{"FM²": plan.path}``); several are overlaid.
     speeds : mapping of str to array (N,), optional
@@ -238,6 +370,20 @@ def report_html(
         Target flight level [m] drawn on the height-above-ground profile.
     max_surface : int, optional
         Nodes per axis of the drawn surface (subsampled above). Default 150.
+    styles : mapping of str to dict, optional
+        Per-path plotly line settings, e.g. ``{"flown": {"dash": "dash"}}``
+        (``color``, ``dash``, ``width``).
+    ideal_agl : mapping of str to float, optional
+        Flight level [m above ground] of each path: its ideal altitude (ground +
+        level) is drawn on the altitude profile and the level on the
+        height-above-ground profile.
+    overlays : mapping of str to array or dict, optional
+        Scene-only polylines [m] (area outline, bands, flown tracks): an array
+        (n, 2) or (n, 3) — NaN rows split it (see :func:`join_polylines`); 2D
+        polylines in a 3D world are draped 2 m above the terrain — or a dict
+        with ``points`` and optional ``color``, ``dash``, ``width``.
+    tables : mapping of str to sequence of dict, optional
+        Titled result tables, one dict per row (e.g. a reproduced paper table).
 
     Returns
     -------
@@ -246,17 +392,21 @@ def report_html(
     """
     if not paths:
         raise ValueError("report_html needs at least one path")
+    ndims = {np.asarray(v).shape[-1] for v in paths.values()}
+    if world is None and len(ndims) != 1:
+        raise ValueError("report_html without a world needs paths of one dimension (2 or 3)")
     P = {str(k): np.asarray(v, dtype=float) for k, v in paths.items()}
     S = {str(k): np.asarray(v, dtype=float) for k, v in (speeds or {}).items() if v is not None}
     Wp = {str(k): np.asarray(v, dtype=float) for k, v in (waypoints or {}).items()
           if v is not None}
-    scene = _scene_figure(world, P, Wp, max_surface)
-    prof = _profile_figure(world, P, S, agl)
+    O = {str(k): _overlay(v) for k, v in (overlays or {}).items()}
+    scene = _scene_figure(world, P, Wp, max_surface, styles, O)
+    prof = _profile_figure(world, P, S, agl, styles, ideal_agl)
     div_scene = scene.to_html(full_html=False, include_plotlyjs=True, config=_CONFIG,
                               div_id="fm2uav-scene")
     div_prof = prof.to_html(full_html=False, include_plotlyjs=False, config=_CONFIG,
                             div_id="fm2uav-profiles")
-    world_rows = {
+    world_rows = {"world": "none given (paths only)"} if world is None else {
         "name": getattr(world, "name", "") or "-",
         "grid (nodes)": " x ".join(str(n) for n in world.shape),
         "spacing [m]": world.spacing,
@@ -264,6 +414,7 @@ def report_html(
         "terrain": "yes" if world.terrain is not None else "no",
         "CRS": world.crs or "none (local anchor)",
     }
+    tables_html = "".join(_results_table(t, rows) for t, rows in (tables or {}).items())
     data = json.dumps({"paths": {k: int(len(v)) for k, v in P.items()}})
     files_html = "".join(f"<li>{html.escape(f)}</li>" for f in files)
     return f"""<!DOCTYPE html>
@@ -277,7 +428,7 @@ def report_html(
 <section class="cols"><div><h2>Parameters</h2>{_table(params or {})}</div>
 <div><h2>Metrics</h2>{_table(metrics or {})}</div>
 <div><h2>World</h2>{_table(world_rows)}</div></section>
-{f'<section><h2>Files</h2><ul>{files_html}</ul></section>' if files else ''}
+{tables_html}{f'<section><h2>Files</h2><ul>{files_html}</ul></section>' if files else ''}
 </main>
 <footer>fm2uav interactive report — drag to rotate, scroll to zoom, double-click to reset.
 <script type="application/json" id="fm2uav-data">{data}</script></footer>

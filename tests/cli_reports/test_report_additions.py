@@ -1,0 +1,81 @@
+"""The additions to fm2uav.viz.report used by the mission commands, on tiny worlds."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import numpy as np
+import pytest
+
+from fm2uav import World
+from fm2uav.viz.report import join_polylines, report_html
+
+
+def _traces(html: str, div_id: str) -> dict[str, dict]:
+    m = re.search(r'Plotly\.newPlot\(\s*"' + div_id + r'",\s*', html)
+    data, _ = json.JSONDecoder().raw_decode(html, m.end())
+    return {t.get("name"): t for t in data}
+
+
+def _arr(v):
+    if isinstance(v, dict) and "bdata" in v:
+        import base64
+
+        return np.frombuffer(base64.b64decode(v["bdata"]), dtype=np.dtype(v["dtype"]))
+    return np.array([np.nan if x is None else x for x in v], dtype=float)
+
+
+@pytest.fixture(scope="module")
+def slope():
+    """Ground rising 0.1 m per metre in x: 21 x 11 nodes of 10 m."""
+    h = np.repeat((np.arange(21) * 1.0)[:, None], 11, axis=1)   # 0..20 m
+    return World.from_heightmap(h, 10.0, 10, name="slope")
+
+
+def test_join_polylines_exact():
+    j = join_polylines([[[0, 0], [1, 0]], [[5, 5], [6, 6], [7, 7]]])
+    assert j.shape == (6, 2)
+    np.testing.assert_array_equal(j[[0, 1, 3, 4, 5]], [[0, 0], [1, 0], [5, 5], [6, 6], [7, 7]])
+    assert np.isnan(j[2]).all()
+    with pytest.raises(ValueError):
+        join_polylines([])
+
+
+def test_ideal_level_styles_overlays_and_tables(slope):
+    p = np.column_stack([np.linspace(0, 200, 21), np.full(21, 50.0), np.full(21, 40.0)])
+    html = report_html(
+        slope, {"planned": p, "flown": p + [0, 1, 0]},
+        styles={"flown": {"dash": "dash"}}, ideal_agl={"planned": 30.0},
+        overlays={"area": [[0, 0], [100, 0], [np.nan, np.nan], [0, 100], [100, 100]]},
+        tables={"Cases": [{"case": "a", "x [m]": 1.5}, {"case": "b", "y": "<b>"}]})
+    prof = _traces(html, "fm2uav-profiles")
+    # ideal altitude = ground under the path + 30 m; ground = x / 10 on this slope
+    np.testing.assert_allclose(_arr(prof["planned ideal (30 m AGL)"]["y"]),
+                               p[:, 0] / 10.0 + 30.0, atol=1e-9)
+    np.testing.assert_allclose(_arr(prof["planned AGL"]["y"]), 40.0 - p[:, 0] / 10.0, atol=1e-9)
+    assert "flown ideal (30 m AGL)" not in prof
+    assert prof["flown altitude"]["line"]["dash"] == "dash"
+    assert "planned W" not in prof and "W (speed share)" not in html  # no speeds: no W panel
+    scene = _traces(html, "fm2uav-scene")
+    assert scene["flown"]["line"]["dash"] == "dash"
+    area = scene["area"]
+    x, y, z = (_arr(area[k]) for k in "xyz")
+    gap = np.isnan(x)
+    assert gap.sum() == 1 and np.isnan(z[gap]).all()
+    # draped: densified to the 10 m grid, lifted max(2, dz / 2) = 5 m over the ground x / 10
+    assert (~gap).sum() == 22
+    np.testing.assert_allclose(z[~gap], x[~gap] / 10.0 + 5.0, atol=1e-9)
+    # the result table: headers are the union of the keys, values escaped
+    assert "<h2>Cases</h2>" in html and "<th>x [m]</th>" in html and "&lt;b&gt;" in html
+
+
+def test_paths_without_a_world():
+    p = np.column_stack([np.linspace(0, 100, 11), np.zeros(11), np.linspace(10, 30, 11)])
+    html = report_html(None, {"planned": p}, title="bare")
+    prof = _traces(html, "fm2uav-profiles")
+    assert set(prof) == {"planned altitude"}
+    assert "terrain" not in _traces(html, "fm2uav-scene")
+    assert "none given (paths only)" in html
+    with pytest.raises(ValueError, match="one dimension"):
+        report_html(None, {"a": p, "b": p[:, :2]})
