@@ -47,12 +47,12 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         exponent: float = typer.Option(1.0, help="Exponent β > 0 on W (thesis' adjustment)."),
         order: int = typer.Option(2, help="Fast Marching order, 1 or 2."),
         agl: float | None = typer.Option(
-            None, help="Flight level [m] above the ground (terrain-following, thesis "
+            None, help="Flight level (m) above the ground (terrain-following, thesis "
             "Algorithm 2). Default: none."),
         p1: float = typer.Option(0.5, help="Exponent on the flight-level cells (with --agl)."),
         p2: float = typer.Option(1.5, help="Exponent on all other cells (with --agl)."),
         agl_band: float = typer.Option(
-            0.0, help="Half-width [m] of a graded band around the flight level (with --agl; "
+            0.0, help="Half-width (m) of a graded band around the flight level (with --agl; "
             "0 = the seeds' single layer)."),
         seed: int = typer.Option(0, help="Seed of the scenario's random relief."),
         out: Path = typer.Option(Path("out/plan"), help="Output directory."),
@@ -67,7 +67,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         anchor: str | None = typer.Option(
             None, help="lon,lat[,alt] of world x=y=0 for the exports (worlds without CRS). "
             "Default: -3.7649,40.3326,0 (UC3M Leganés)."),
-        thin: float = typer.Option(5.0, help="Waypoint tolerance [m] of the exports (3D "
+        thin: float = typer.Option(5.0, help="Waypoint tolerance (m) of the exports (3D "
                                    "Douglas–Peucker)."),
     ) -> None:
         sc = get_scenario(scenario, seed=seed)

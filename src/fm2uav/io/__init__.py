@@ -13,6 +13,12 @@ from .kml import kml_document, read_kml_path, write_kml
 from .paths import read_path_csv, write_path_csv
 from .qgc import plan_document, read_plan, validate_plan, write_plan
 from .thin import thin_indices, thin_path
+from .trajectories import (
+    read_trajectories_csv,
+    write_cycles_csv,
+    write_formation_metrics_csv,
+    write_trajectories_csv,
+)
 from .waypoints import Waypoints, mission_waypoints
 from .wpl import read_wpl, write_wpl
 
@@ -40,6 +46,10 @@ __all__ = [
     "validate_plan",
     "write_wpl",
     "read_wpl",
+    "write_trajectories_csv",
+    "read_trajectories_csv",
+    "write_formation_metrics_csv",
+    "write_cycles_csv",
     "EXPORT_FILES",
     "ExportOptions",
     "export_writers",

@@ -145,4 +145,4 @@ def coverage_html(cp: CoveragePlan, *, title: str = "coverage plan") -> str:
     fig = go.Figure(data=data)
     fig.update_layout(title=title, scene=dict(aspectmode="data", xaxis_title="x [m]",
                                               yaxis_title="y [m]", zaxis_title="z [m]"))
-    return fig.to_html(include_plotlyjs="cdn", full_html=True)
+    return fig.to_html(include_plotlyjs=True, full_html=True)
