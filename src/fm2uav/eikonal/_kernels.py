@@ -311,6 +311,24 @@ def march(speed, T, state, nx, ny, nz, hx, hy, hz, order, stop_mask, n_stop, hea
     return frozen
 
 
+# ------------------------------------------------------------------ validation
+@njit(cache=True, error_model="numpy", _nrt=False)
+def scan_speed(v, min_speed):
+    """One pass over a flat speed array.
+
+    Returns ``(bad, n_tiny)``: the flat index of the first non-finite or
+    negative speed (-1 if none) and the number of speeds in ``(0, min_speed)``.
+    """
+    n_tiny = 0
+    for c in range(v.size):
+        x = v[c]
+        if not (x >= 0.0 and x < np.inf):  # NaN, inf or negative
+            return c, n_tiny
+        if 0.0 < x < min_speed:
+            n_tiny += 1
+    return -1, n_tiny
+
+
 # ------------------------------------------------------------ source initialisation
 @njit(cache=True, error_model="numpy")
 def init_sources(speed, T, state, nx, ny, nz, hx, hy, hz, src, radius, max_ratio):

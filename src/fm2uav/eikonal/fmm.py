@@ -98,20 +98,18 @@ def _as_speed(speed: Any) -> np.ndarray:
     if min(arr.shape) < 1:
         raise InputError(f"speed must not be empty, got shape {arr.shape}")
     arr = np.ascontiguousarray(arr, dtype=np.float64)
-    finite = np.isfinite(arr)
-    if not finite.all():
-        where = np.argwhere(~finite)[0].tolist()
+    # one compiled pass instead of three numpy passes (matters on 40 M-node maps)
+    bad, n_tiny = _kernels.scan_speed(arr.reshape(-1), MIN_SPEED)
+    if bad >= 0:
+        where = [int(w) for w in np.unravel_index(bad, arr.shape)]
+        value = float(arr[tuple(where)])
+        if not np.isfinite(value):
+            raise InputError(f"speed must be finite; found {value} at index {where}")
         raise InputError(
-            f"speed must be finite; found {float(arr[tuple(where)])} at index {where}"
+            f"speed must be >= 0 (0 = impassable); found {value:g} at index {where}"
         )
-    if arr.min() < 0:
-        where = [int(w) for w in np.unravel_index(int(np.argmin(arr)), arr.shape)]
-        raise InputError(
-            f"speed must be >= 0 (0 = impassable); found {arr[tuple(where)]:g} at index {where}"
-        )
-    tiny = (arr > 0) & (arr < MIN_SPEED)
-    if tiny.any():
-        arr = np.where(tiny, MIN_SPEED, arr)
+    if n_tiny:
+        arr = np.where((arr > 0) & (arr < MIN_SPEED), MIN_SPEED, arr)
     return arr
 
 

@@ -99,12 +99,17 @@ def distance_map(
 def normalise_distance(dist: np.ndarray) -> np.ndarray:
     """Rescale a distance map so that its maximum is 1 (thesis §2.2, step 2).
 
-    A map with no obstacle (all ``inf``) becomes all ones.
+    A map with no obstacle (all ``inf``) becomes all ones; ``inf`` entries of a
+    partly infinite map become 1.
     """
-    finite_max = float(np.max(dist, initial=0.0, where=np.isfinite(dist)))
-    if not np.isfinite(dist).any() or finite_max <= 0.0:
-        return np.where(np.isfinite(dist), 0.0, 1.0)
-    return np.where(np.isfinite(dist), dist / finite_max, 1.0)
+    top = float(np.max(dist))
+    if np.isfinite(top):  # the usual case: one pass for the max, one for the division
+        return dist / top if top > 0.0 else np.zeros_like(dist)
+    finite = np.isfinite(dist)
+    finite_max = float(np.max(dist, initial=0.0, where=finite))
+    if finite_max <= 0.0:
+        return np.where(finite, 0.0, 1.0)
+    return np.where(finite, dist / finite_max, 1.0)
 
 
 def shape_velocity(W: np.ndarray, *, saturation: float = 1.0, exponent: float = 1.0) -> np.ndarray:

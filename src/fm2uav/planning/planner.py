@@ -245,12 +245,11 @@ def plan(
 
     t0 = time.perf_counter()
     if speed_map is None:
-        W = shape_velocity(
-            base_velocity(world, method=method, walls=walls),
-            saturation=saturation,
-            exponent=exponent,
-        )
-        W[world.occupancy] = 0.0
+        # 0 on obstacles already (distance 0); the cached base map is read-only
+        # and used as is when there is nothing to shape
+        W = base_velocity(world, method=method, walls=walls)
+        if saturation != 1.0 or exponent != 1.0:
+            W = shape_velocity(W, saturation=saturation, exponent=exponent)
         if agl is not None:
             W = flight_level_speed(
                 W, world, agl, p1, p2, band=agl_band, graded=agl_graded, mode=agl_mode
