@@ -22,7 +22,7 @@ from ..eikonal.velocity import distance_map, normalise_distance, shape_velocity
 from ..errors import InputError, PointError, UnreachableError
 from ..world import World
 from .flight_level import flight_level_speed
-from .geodesic import descend, nearest_node
+from .geodesic import descend
 
 __all__ = ["Plan", "plan", "base_velocity"]
 
@@ -121,10 +121,9 @@ def base_velocity(world: World, *, method: str = "edt", walls: bool = False) -> 
 
 
 def _check_free(world: World, point: np.ndarray, what: str) -> tuple[int, ...]:
-    idx = world.to_index(point)
-    cell = tuple(int(v) for v in nearest_node(idx))
-    # to_cell validates "inside the map" with a clear message
-    world.to_cell(point, what=what)
+    # World.to_cell validates "inside the map" with a clear message and uses the
+    # same nearest-node rule as the geodesic
+    cell = world.to_cell(point, what=what)
     if world.occupancy[cell]:
         hint = ""
         if world.terrain is not None and world.ndim == 3:
