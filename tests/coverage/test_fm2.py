@@ -24,12 +24,21 @@ def test_scenario_registered():
     assert set(COVERAGE_AREAS) == {"S1", "S2", "S3", "S4"}
 
 
-@pytest.mark.parametrize("name, base", [("S3", "world"), ("S2", "uniform")])
-def test_coverage_plan_end_to_end(name, base):
+@pytest.mark.parametrize("name, base, grid, bar", [("S3", "world", "corridor", 0.998),
+                                                   ("S2", "uniform", "corridor", 0.998),
+                                                   ("S1", "world", "map", 0.97)])
+def test_coverage_plan_end_to_end(name, base, grid, bar):
     world = coverage_world(0)
-    cp = plan_coverage(world, coverage_area(name), 80.0, agl=100.0, level_base=base)
+    cp = plan_coverage(world, coverage_area(name), 80.0, agl=100.0, level_base=base, grid=grid)
     assert cp.zigzag_coverage > 0.999
-    assert cp.coverage > 0.99
+    # the seeds' W0 on the map's grid drifts off the slanted bands (~98-99.6 %);
+    # the unrolled corridor keeps the ground track on the zigzag
+    assert cp.coverage >= bar
+    assert cp.params["grid"] == grid
+    assert (cp.grid is None) == (grid == "map")
+    # the Plan is on the map whatever the grid
+    assert cp.plan.world is world and cp.plan.W.shape == world.shape
+    assert cp.plan.T.shape == world.shape
     # the path keeps the flight level (10 m cells): mean error under one cell
     assert np.abs(cp.agl_error).mean() < 10.0
     ground_clear = cp.agl_error + 100.0
