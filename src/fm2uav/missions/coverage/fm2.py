@@ -26,8 +26,8 @@ extruded across the corridor) so that the flown ground track is the zigzag
 itself unless an obstacle intrudes into the corridor. Bands D apart see D/2
 each side with no overlap, so any drift off a band line is coverage lost;
 on the map's own grid (``grid="map"``, the seeds' W0) the geodesic drifts
-1–2 m off the slanted bands and covers only 99.0–99.6 % of S1–S4 (down to
-96.8 % on random polygons; docs/coverage.md has the measurements).
+1–2 m off the slanted bands and covers only 99.4–99.6 % of S1–S4 (down to
+96.6 % on random polygons; docs/coverage.md has the measurements).
 """
 
 from __future__ import annotations

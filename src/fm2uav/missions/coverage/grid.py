@@ -6,7 +6,7 @@ path off a band line leaves an uncovered sliver along the strip boundary
 (coverage loss ≈ drift / D). On the map's own grid a band crosses the node
 rows at a slant and between nodes, and the FM² geodesic drifts 1–2 m off it
 (the arrival times are only known at the nodes; the descent interpolates
-them): S1–S4 come out 99.0–99.6 % covered, random polygons down to 96.8 %
+them): S1–S4 come out 99.4–99.6 % covered, random polygons down to 96.6 %
 (docs/coverage.md). Even on a grid aligned with the bands, a level that
 varies across the corridor (sloping terrain) and the turns make the
 descent settle 0.5–1 m off the line, depending on the fine print of the
