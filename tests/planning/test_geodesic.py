@@ -157,7 +157,10 @@ def test_anisotropic_spacing_follows_physical_gradient():
     T = euclid(shape, goal, spacing=h)
     path = descend(T, (0, 0), goal, spacing=h)
     check_path(path, T, (0, 0), goal)
-    assert distance_to_line(path * ph, (0, 0), np.multiply(goal, h)).max() < 0.2  # [m]
+    # 0.24 m (0.1 cell of the 2.5 m axis), reached just before the goal in
+    # the grid's corner, where node directions take the Fast Marching upwind
+    # rule at the edge (was < 0.2 m with central / one-sided differences)
+    assert distance_to_line(path * ph, (0, 0), np.multiply(goal, h)).max() < 0.27  # [m]
     steps = np.linalg.norm(np.diff(path[:-1] * ph, axis=0), axis=1)
     assert np.allclose(steps, 0.5 * min(h))  # physical step = step * min(spacing)
 

@@ -8,6 +8,19 @@ sits at coordinate ``i`` and owns the box ``[i - 0.5, i + 0.5)`` on every axis
 (its Voronoi cell). ``T`` already carries ``inf`` on blocked nodes, so "free"
 means "finite T" throughout.
 
+Three ingredients (see :func:`fm2uav.planning.geodesic.descend` for the why):
+
+* **node direction** (:func:`_node_direction`): the unit descent direction at a
+  node, per axis a central difference where ``T`` is monotone through the node
+  and the Fast Marching upwind choice where it is not (one-sided towards the
+  smaller neighbour, 0 when no neighbour is smaller);
+* **direction field** (:func:`_direction`): those unit vectors blended with
+  cubic B-spline weights over the 4 x 4 x 4 nodes around the point (a C2 field),
+  or linearly over the cell's corners when a smooth step is blocked;
+* **potential** (:func:`_potential`): ``min(trilinear T, cone estimate)``, the
+  value that must go down for a step to be accepted (non-monotone, against the
+  largest of the last ``_WINDOW`` accepted values, with sufficient decrease).
+
 Status codes returned by :func:`descend_kernel`
 ------------------------------------------------
 ``OK`` (0)
@@ -34,6 +47,14 @@ STUCK = 1
 _EPS = 1e-9
 #: Step-length divisors tried (backtracking) before falling back to a discrete move.
 _N_BACKTRACK = 3
+#: Non-monotone acceptance: a step must bring the potential below the largest
+#: of the last ``_WINDOW`` accepted potentials (Grippo, Lampariello & Lucidi
+#: 1986), so that maximum strictly decreases every ``_WINDOW`` steps.
+_WINDOW = 8
+#: ... by at least this fraction of the nominal decrease of T over the step
+#: (step length times the local slowness), so a stalled, oscillating descent
+#: is stopped within a few steps.
+_DECREASE = 0.1
 
 
 # --------------------------------------------------------------------------- helpers
@@ -67,21 +88,152 @@ def _cell(x, n):
 
 
 @njit(cache=True, inline="always")
-def _axis_diff(tc, tm, tp, h):
-    """Derivative [s/m] from a node value and its two axis neighbours.
+def _axis_slope(tc, tm, tp, h):
+    """Derivative [s/m] of T along one axis at a free node, from its neighbours.
 
-    Central difference when both neighbours are finite, one-sided when only one
-    is, 0 when none is.
+    ``tm``/``tp`` are the lower/upper neighbours, ``inf`` if blocked,
+    unreached or off the grid. Where T is monotone through the node
+    (``tm < tc < tp`` or ``tp < tc < tm``, both finite) the central difference
+    ``(tp - tm) / 2h``. Elsewhere the node is a kink of T along the axis (or
+    next to a blocked node or the grid's edge) and the Fast Marching upwind
+    choice is used, as in :func:`fm2uav.eikonal._kernels._axis_term`: the
+    one-sided difference towards the smaller neighbour if it is below ``tc``,
+    and 0 if no neighbour is below ``tc`` (no characteristic arrives along
+    this axis: the node is a minimum along it, e.g. on a one-cell bright
+    layer, or the only lower side is blocked or off the map) or both are
+    equal (a ridge).
     """
-    fm = math.isfinite(tm)
-    fp = math.isfinite(tp)
-    if fm and fp:
+    if math.isfinite(tm) and math.isfinite(tp) and (tm < tc < tp or tp < tc < tm):
         return (tp - tm) / (2.0 * h)
-    if fp:
-        return (tp - tc) / h
-    if fm:
+    if tm < tc and tm < tp:
         return (tc - tm) / h
+    if tp < tc and tp < tm:
+        return (tp - tc) / h
     return 0.0
+
+
+@njit(cache=True)
+def _node_direction(T, i, j, k, hx, hy, hz):
+    """Unit physical gradient of T at a free node (0 vector if it vanishes).
+
+    Each component from :func:`_axis_slope`; neighbours off the grid count as
+    ``inf``. Returns ``(ux, uy, uz)``.
+    """
+    nx, ny, nz = T.shape
+    tc = T[i, j, k]
+    gx = _axis_slope(
+        tc, T[i - 1, j, k] if i > 0 else np.inf, T[i + 1, j, k] if i < nx - 1 else np.inf, hx
+    )
+    gy = _axis_slope(
+        tc, T[i, j - 1, k] if j > 0 else np.inf, T[i, j + 1, k] if j < ny - 1 else np.inf, hy
+    )
+    gz = _axis_slope(
+        tc, T[i, j, k - 1] if k > 0 else np.inf, T[i, j, k + 1] if k < nz - 1 else np.inf, hz
+    )
+    g = math.sqrt(gx * gx + gy * gy + gz * gz)
+    if not (g > 0.0) or not math.isfinite(g):
+        return 0.0, 0.0, 0.0
+    return gx / g, gy / g, gz / g
+
+
+@njit(cache=True, inline="always")
+def _smoothing(h, hmin):
+    """Share ``lam`` of the cubic B-spline in an axis' blend (the rest: linear).
+
+    The blend ``lam * cubic + (1 - lam) * linear`` has variance
+    ``(1 + lam) / 6`` cells^2, i.e. ``(1 + lam) h^2 / 6`` m^2. ``lam = 1`` on the
+    finest axis and ``2 (hmin / h)^2 - 1`` (clipped to [0, 1]) on coarser ones
+    keeps the smoothing isotropic in metres where possible, so that the blend
+    does not turn the direction of a curved field (near the goal) on
+    anisotropic grids.
+    """
+    lam = 2.0 * (hmin / h) ** 2 - 1.0
+    if lam < 0.0:
+        return 0.0
+    if lam > 1.0:
+        return 1.0
+    return lam
+
+
+@njit(cache=True, inline="always")
+def _bspline_weights(x, n, lam, w):
+    """Uniform cubic B-spline weights of the 4 nodes around ``x`` on an axis of ``n``.
+
+    Fills ``w[0:4]`` (weights of nodes ``i0 - 1 .. i0 + 2``, ``i0 = floor(x)``,
+    summing to 1) and returns ``i0 - 1``. A single-node axis gets weight 1 on
+    node 0. Nodes off the grid are skipped by the caller.
+    """
+    if n == 1:
+        w[0] = 1.0
+        w[1] = 0.0
+        w[2] = 0.0
+        w[3] = 0.0
+        return 0
+    i0 = int(math.floor(x))
+    if i0 > n - 2:
+        i0 = n - 2
+    if i0 < 0:
+        i0 = 0
+    f = x - i0
+    g = 1.0 - f
+    w[0] = lam * g * g * g / 6.0
+    w[1] = lam * (3.0 * f * f * f - 6.0 * f * f + 4.0) / 6.0 + (1.0 - lam) * g
+    w[2] = lam * (3.0 * g * g * g - 6.0 * g * g + 4.0) / 6.0 + (1.0 - lam) * f
+    w[3] = lam * f * f * f / 6.0
+    return i0 - 1
+
+
+@njit(cache=True)
+def _direction(T, x, y, z, hx, hy, hz, hmin, smooth):
+    """Index-space displacement of one unit-physical-length descent step.
+
+    The unit node directions (:func:`_node_direction`) of the free nodes among
+    the 4 x 4 x 4 around the point are blended with cubic B-spline weights
+    (renormalised over the free nodes; per axis mixed with linear weights,
+    see :func:`_smoothing`, and ``smooth = 0`` gives the plain linear blend
+    of the 2 x 2 x 2 corners). The blend is C2 in the point, and it
+    averages over about two cells, so a path following it rounds the corners
+    of a staircase (a one-cell layer over sloping terrain) instead of
+    tracing them. The physical direction ``d = -blend / |blend|`` is converted
+    to index units ``d_i / h_i`` and scaled by ``hmin`` so that the caller's
+    step length ``step`` [cells] is ``step * hmin`` metres. Returns
+    ``(dx, dy, dz, ok)``; ``ok`` is False when no free node contributes or the
+    blend vanishes.
+    """
+    nx, ny, nz = T.shape
+    wx = np.empty(4)
+    wy = np.empty(4)
+    wz = np.empty(4)
+    ia = _bspline_weights(x, nx, smooth * _smoothing(hx, hmin), wx)
+    ja = _bspline_weights(y, ny, smooth * _smoothing(hy, hmin), wy)
+    ka = _bspline_weights(z, nz, smooth * _smoothing(hz, hmin), wz)
+    gx = 0.0
+    gy = 0.0
+    gz = 0.0
+    for a in range(4):
+        i = ia + a
+        if i < 0 or i >= nx or wx[a] == 0.0:
+            continue
+        for b in range(4):
+            j = ja + b
+            if j < 0 or j >= ny or wy[b] == 0.0:
+                continue
+            wab = wx[a] * wy[b]
+            for c in range(4):
+                k = ka + c
+                if k < 0 or k >= nz or wz[c] == 0.0:
+                    continue
+                if not math.isfinite(T[i, j, k]):
+                    continue
+                w = wab * wz[c]
+                ux, uy, uz = _node_direction(T, i, j, k, hx, hy, hz)
+                gx += w * ux
+                gy += w * uy
+                gz += w * uz
+    g = math.sqrt(gx * gx + gy * gy + gz * gz)
+    if not (g > 0.0) or not math.isfinite(g):
+        return 0.0, 0.0, 0.0, False
+    return -gx / g * hmin / hx, -gy / g * hmin / hy, -gz / g * hmin / hz, True
 
 
 @njit(cache=True)
@@ -121,77 +273,75 @@ def _interp_T(T, x, y, z):
 
 
 @njit(cache=True)
-def _interp_grad(T, x, y, z, hx, hy, hz):
-    """Physical gradient of T [s/m] at a point.
+def _slowness(T, i, j, k, hx, hy, hz):
+    """Slowness estimate [s/m] at a free node: ``|grad T|`` of the upwind stencil.
 
-    The gradient is computed at each corner node of the cell holding the point
-    (central differences, one-sided next to ``inf`` or the grid edge) and
-    interpolated trilinearly over the corners whose T is finite (weights
-    renormalised). Returns ``(gx, gy, gz, ok)``.
+    Per axis ``max(T - min(neighbours), 0) / h`` (the first-order Fast Marching
+    stencil, whose norm is ``1 / speed``). At a node with no smaller neighbour
+    (the source) the smallest positive one-sided slope is used instead.
     """
     nx, ny, nz = T.shape
-    i0, i1, fx = _cell(x, nx)
-    j0, j1, fy = _cell(y, ny)
-    k0, k1, fz = _cell(z, nz)
-    gx = 0.0
-    gy = 0.0
-    gz = 0.0
-    wsum = 0.0
-    for a in range(2):
-        i = i1 if a else i0
-        wa = fx if a else 1.0 - fx
-        if wa == 0.0:
-            continue
-        for b in range(2):
-            j = j1 if b else j0
-            wb = wa * (fy if b else 1.0 - fy)
-            if wb == 0.0:
-                continue
-            for c in range(2):
-                k = k1 if c else k0
-                w = wb * (fz if c else 1.0 - fz)
-                if w == 0.0:
-                    continue
-                tc = T[i, j, k]
-                if not math.isfinite(tc):
-                    continue
-                tm = T[i - 1, j, k] if i > 0 else np.inf
-                tp = T[i + 1, j, k] if i < nx - 1 else np.inf
-                gx += w * _axis_diff(tc, tm, tp, hx)
-                tm = T[i, j - 1, k] if j > 0 else np.inf
-                tp = T[i, j + 1, k] if j < ny - 1 else np.inf
-                gy += w * _axis_diff(tc, tm, tp, hy)
-                tm = T[i, j, k - 1] if k > 0 else np.inf
-                tp = T[i, j, k + 1] if k < nz - 1 else np.inf
-                gz += w * _axis_diff(tc, tm, tp, hz)
-                wsum += w
-    if wsum == 0.0:
-        return 0.0, 0.0, 0.0, False
-    gx /= wsum
-    gy /= wsum
-    gz /= wsum
-    ok = math.isfinite(gx) and math.isfinite(gy) and math.isfinite(gz)
-    if ok and gx == 0.0 and gy == 0.0 and gz == 0.0:
-        ok = False
-    return gx, gy, gz, ok
+    tc = T[i, j, k]
+    acc = 0.0
+    low = np.inf
+    for ax in range(3):
+        if ax == 0:
+            tm = T[i - 1, j, k] if i > 0 else np.inf
+            tp = T[i + 1, j, k] if i < nx - 1 else np.inf
+            h = hx
+        elif ax == 1:
+            tm = T[i, j - 1, k] if j > 0 else np.inf
+            tp = T[i, j + 1, k] if j < ny - 1 else np.inf
+            h = hy
+        else:
+            tm = T[i, j, k - 1] if k > 0 else np.inf
+            tp = T[i, j, k + 1] if k < nz - 1 else np.inf
+            h = hz
+        u = min(tm, tp)
+        if u < tc:
+            acc += ((tc - u) / h) ** 2
+        elif math.isfinite(u) and u > tc:
+            low = min(low, (u - tc) / h)
+    if acc > 0.0:
+        return math.sqrt(acc)
+    return low if math.isfinite(low) else 0.0
 
 
 @njit(cache=True)
-def _direction(T, x, y, z, hx, hy, hz, hmin):
-    """Index-space displacement of one unit-physical-length descent step.
+def _potential(T, x, y, z, hx, hy, hz):
+    """Descent potential [s] at a point: ``min(trilinear T, cone estimate)``.
 
-    ``d_phys = -grad T / |grad T|`` (unit vector in metres), converted to index
-    units ``d_i = d_phys_i / h_i`` and scaled by ``hmin`` so that the caller's
-    step length ``step`` [cells] is ``step * hmin`` metres. Returns
-    ``(dx, dy, dz, ok)``.
+    The cone estimate is ``min_c T_c + s_c |p - c|`` over the free corners
+    ``c`` of the interpolation cell, ``s_c`` the slowness at ``c``
+    (:func:`_slowness`): the time to fly straight to ``c`` and on from there
+    (the one-step Hopf-Lax / semi-Lagrangian form of the eikonal equation).
+    Trilinear ``T`` blends in the (much larger) times of the dark nodes
+    beside a one-cell bright channel, so it rises steeply as soon as the point
+    leaves the channel's centre line; the cone grows only with the distance
+    to the next channel node (to second order across the channel). In smooth
+    regions the cone lies above ``T`` and the minimum is the trilinear value.
+    Returns ``inf`` if no corner with a non-zero weight is free.
     """
-    gx, gy, gz, ok = _interp_grad(T, x, y, z, hx, hy, hz)
-    if not ok:
-        return 0.0, 0.0, 0.0, False
-    g = math.sqrt(gx * gx + gy * gy + gz * gz)
-    if not (g > 0.0) or not math.isfinite(g):
-        return 0.0, 0.0, 0.0, False
-    return -gx / g * hmin / hx, -gy / g * hmin / hy, -gz / g * hmin / hz, True
+    t = _interp_T(T, x, y, z)
+    if not math.isfinite(t):
+        return t
+    nx, ny, nz = T.shape
+    i0, i1, _ = _cell(x, nx)
+    j0, j1, _ = _cell(y, ny)
+    k0, k1, _ = _cell(z, nz)
+    for i in (i0, i1):
+        for j in (j0, j1):
+            for k in (k0, k1):
+                tc = T[i, j, k]
+                if not (tc < t):  # also skips inf
+                    continue
+                dx = (x - i) * hx
+                dy = (y - j) * hy
+                dz = (z - k) * hz
+                v = tc + _slowness(T, i, j, k, hx, hy, hz) * math.sqrt(dx * dx + dy * dy + dz * dz)
+                if v < t:
+                    t = v
+    return t
 
 
 @njit(cache=True, inline="always")
@@ -328,39 +478,63 @@ def _near_goal(T, px, py, pz, gx, gy, gz):
 
 
 @njit(cache=True)
-def _try_step(T, px, py, pz, phi, hx, hy, hz, hmin, step):
-    """One continuous descent step from p; returns ``(qx, qy, qz, T(q), ok)``.
+def _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step):
+    """One continuous descent step from p; returns ``(qx, qy, qz, phi(q), ok)``.
 
     Midpoint rule (RK2): the direction is taken at p + L/2 * d(p) (or d(p) if
-    that is invalid or turns back). The step is accepted if the interpolated T
-    at q is strictly below ``phi``, q's nearest node is free and the segment
-    p-q enters no blocked cell; otherwise the length is halved, up to
-    ``_N_BACKTRACK`` tries.
+    that is invalid or turns back). The step is accepted if the potential at q
+    (:func:`_potential`) is below ``ref`` by at least ``_DECREASE`` times the
+    nominal decrease ``slowness * length``, q's nearest node is free and the
+    segment p-q enters no blocked cell; otherwise the length is halved, up to
+    ``_N_BACKTRACK`` tries. If all fail with the smooth (B-spline) direction
+    field, they are repeated with the linear blend (``smooth = 0``), which
+    follows the node directions tightly around the corner of a blocked cell
+    that the smooth field would cut.
     """
     nx, ny, nz = T.shape
-    d1x, d1y, d1z, ok = _direction(T, px, py, pz, hx, hy, hz, hmin)
-    if not ok:
-        return px, py, pz, phi, False
-    L = step
-    for _ in range(_N_BACKTRACK):
-        mx = _clamp(px + 0.5 * L * d1x, nx)
-        my = _clamp(py + 0.5 * L * d1y, ny)
-        mz = _clamp(pz + 0.5 * L * d1z, nz)
-        d2x, d2y, d2z, ok2 = _direction(T, mx, my, mz, hx, hy, hz, hmin)
-        if not ok2 or (d1x * d2x + d1y * d2y + d1z * d2z) <= 0.0:
-            d2x, d2y, d2z = d1x, d1y, d1z
-        qx = _clamp(px + L * d2x, nx)
-        qy = _clamp(py + L * d2y, ny)
-        qz = _clamp(pz + L * d2z, nz)
-        tq = _interp_T(T, qx, qy, qz)
-        if (
-            tq < phi
-            and math.isfinite(T[_nearest(qx, nx), _nearest(qy, ny), _nearest(qz, nz)])
-            and _segment_free(T, px, py, pz, qx, qy, qz)
-        ):
-            return qx, qy, qz, tq, True
-        L *= 0.5
-    return px, py, pz, phi, False
+    # sufficient decrease: a fraction of what a step of L cells lowers T by
+    # at the local slowness
+    slow = _slowness(T, _nearest(px, nx), _nearest(py, ny), _nearest(pz, nz), hx, hy, hz)
+    for smooth in (1.0, 0.0):
+        d1x, d1y, d1z, ok = _direction(T, px, py, pz, hx, hy, hz, hmin, smooth)
+        if not ok:
+            continue
+        L = step
+        for _ in range(_N_BACKTRACK):
+            mx = _clamp(px + 0.5 * L * d1x, nx)
+            my = _clamp(py + 0.5 * L * d1y, ny)
+            mz = _clamp(pz + 0.5 * L * d1z, nz)
+            d2x, d2y, d2z, ok2 = _direction(T, mx, my, mz, hx, hy, hz, hmin, smooth)
+            if not ok2 or (d1x * d2x + d1y * d2y + d1z * d2z) <= 0.0:
+                d2x, d2y, d2z = d1x, d1y, d1z
+            qx = _clamp(px + L * d2x, nx)
+            qy = _clamp(py + L * d2y, ny)
+            qz = _clamp(pz + L * d2z, nz)
+            bound = ref - _DECREASE * slow * L * hmin
+            # the step, then (if it enters a blocked cell) the step sliding
+            # along that cell's face: one axis component dropped
+            for drop in range(-1, 3):
+                if drop == 0:
+                    qx = px
+                elif drop == 1:
+                    qx = _clamp(px + L * d2x, nx)
+                    qy = py
+                elif drop == 2:
+                    qy = _clamp(py + L * d2y, ny)
+                    qz = pz
+                if qx == px and qy == py and qz == pz:
+                    continue
+                tq = _potential(T, qx, qy, qz, hx, hy, hz)
+                if (
+                    tq < bound
+                    and math.isfinite(T[_nearest(qx, nx), _nearest(qy, ny), _nearest(qz, nz)])
+                    and _segment_free(T, px, py, pz, qx, qy, qz)
+                ):
+                    return qx, qy, qz, tq, True
+                if drop == -1 and _segment_free(T, px, py, pz, qx, qy, qz):
+                    break  # free but not low enough: shorten, do not slide
+            L *= 0.5
+    return px, py, pz, ref, False
 
 
 # --------------------------------------------------------------------------- kernel
@@ -401,7 +575,10 @@ def descend_kernel(T, start, goal, hx, hy, hz, step, max_steps):
     out = np.empty((256, 3))
     n = 0
     out, n = _push(out, n, px, py, pz)
-    phi = _interp_T(T, px, py, pz)  # potential of the current point; strictly decreases
+    # potential of the current point, and the last _WINDOW accepted ones
+    phi = _potential(T, px, py, pz, hx, hy, hz)
+    hist = np.full(_WINDOW, phi)
+    hpos = 0
     iters = 0
     n_fallback = 0
     while True:
@@ -411,12 +588,15 @@ def descend_kernel(T, start, goal, hx, hy, hz, step, max_steps):
 
         if iters < max_steps:
             iters += 1
-            # ---- continuous step: midpoint (RK2) on the interpolated gradient,
-            #      with backtracking on the step length
-            qx, qy, qz, tq, ok = _try_step(T, px, py, pz, phi, hx, hy, hz, hmin, step)
+            # ---- continuous step: midpoint (RK2) on the direction field, with
+            #      backtracking on the step length; non-monotone acceptance
+            ref = hist.max()
+            qx, qy, qz, tq, ok = _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step)
             if ok:
                 px, py, pz = qx, qy, qz
                 phi = tq
+                hpos = (hpos + 1) % _WINDOW
+                hist[hpos] = phi
                 out, n = _push(out, n, px, py, pz)
                 continue
             # ---- fallback: discrete steepest descent from the nearest node of p
@@ -444,6 +624,7 @@ def descend_kernel(T, start, goal, hx, hy, hz, step, max_steps):
                     break
             if moved:
                 phi = T[i, j, k]
+                hist[:] = phi
             elif not _near_goal(T, px, py, pz, gx, gy, gz):
                 info[0], info[1], info[2] = i, j, k
                 return out[:n].copy(), STUCK, info, n_fallback

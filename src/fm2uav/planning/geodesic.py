@@ -3,8 +3,10 @@
 The second half of FM²: once ``T = fast_marching(W, goal)`` is known, the
 fastest path from any start is the curve of steepest descent of ``T``, which
 ends at the goal (where ``T = 0``). :func:`descend` follows it with sub-cell
-steps and falls back to discrete moves where the gradient is unusable, so it
-always terminates.
+steps along the Fast Marching upwind (characteristic) directions, smoothed
+over about two cells, also inside one-cell bright channels such as a
+terrain-following flight level, and falls back to discrete moves where the
+gradient is unusable, so it always terminates.
 
 Every call goes prepare (validate, pad 2D to 3D, mark blocked nodes as ``inf``)
 → kernel (compiled, :mod:`fm2uav.planning._geodesic_kernels`) → finalise
@@ -112,26 +114,47 @@ def descend(
     The path follows ``-grad T`` (the physical gradient, ``dT/dx_k = dT/di_k / h_k``)
     with sub-cell steps, and ends exactly at ``goal``.
 
-    **Gradient.** At each corner node of the grid cell holding the point, the
-    gradient is taken with central differences, one-sided where a neighbour is
-    ``inf``/blocked or off the grid; the corner gradients (of finite-T corners
-    only, weights renormalised) are interpolated bilinearly (2D) or trilinearly
-    (3D).
+    **Direction.** At every node a unit descent direction is taken from the
+    same stencil the Fast Marching Method solves: per axis, where ``T`` is
+    monotone through the node, the central difference; where it is not (the
+    node is a kink of ``T`` along that axis, or next to a blocked node or the
+    grid's edge), the FMM's upwind choice: the one-sided difference towards the
+    smaller neighbour, or 0 if no neighbour is smaller. So on a one-cell bright
+    layer (a terrain-following flight level) a layer node points along the
+    layer, not across it. These unit vectors are blended with cubic B-spline
+    weights over the 4 x 4 x 4 nodes around the point (free nodes only; on
+    axes coarser than the finest, partly linear weights so the smoothing is
+    isotropic in metres). The blend is a C2 field averaging over about two
+    cells, so the path rounds the staircase of a level over sloping ground
+    instead of tracing it.
 
     **Step rule.** Each step has physical length ``step * min(spacing)`` [m]
     (so at most ``step`` cells on every axis), integrated with the midpoint rule
-    (RK2). A step is accepted only if the interpolated ``T`` strictly decreases,
-    the new point's nearest node is free (not blocked, finite ``T``) and the
-    straight segment to it enters no blocked node's cell; otherwise the step is
-    halved (up to 3 tries).
+    (RK2). It is accepted if the *potential* at the new point is below the
+    largest potential of the last 8 accepted points by at least a tenth of the
+    step's nominal decrease (length times the local slowness ``|grad T|``), the
+    new point's nearest node is free (not blocked, finite ``T``) and the
+    straight segment to it enters no blocked node's cell. The potential is
+    ``min(trilinear T, min_c T_c + s_c |p - c|)`` over the corners ``c`` of the
+    interpolation cell (``s_c`` the upwind slowness at ``c``): the second term
+    is the one-step eikonal (Hopf-Lax) estimate, which, unlike trilinear ``T``,
+    does not jump by the dark nodes' times when the point leaves the centre of a
+    thin bright channel. If a step enters a blocked cell it may slide along
+    that cell's face (one axis component dropped); otherwise the step is
+    halved (up to 3 tries), and the tries are repeated with the linear blend
+    of the node directions, which follows corners tightly. The 8-step window
+    (non-monotone acceptance, Grippo et al. 1986) with sufficient decrease
+    lets the path cross the small bumps of the potential in thin channels,
+    while its maximum strictly decreases every 8 steps, so the path cannot
+    cycle.
 
-    **Fallback and termination.** If no step is accepted (zero/NaN gradient,
+    **Fallback and termination.** If no step is accepted (zero gradient,
     plateau, noise, obstacle ahead), the path makes discrete steepest-descent
     moves: to the free 8-neighbour (2D) / 26-neighbour (3D) of the current
     nearest node with the smallest ``T``, strictly below the current node's,
     without cutting between obstacles that touch at an edge or corner. It keeps
-    moving until the node's ``T`` is below the last accepted interpolated ``T``
-    (so the descent potential keeps decreasing across fallbacks), then resumes
+    moving until the node's ``T`` is below the current potential (so the
+    descent potential keeps decreasing across fallbacks), then resumes
     continuous steps. After ``max_steps`` continuous iterations only discrete
     moves are made; each strictly lowers the node's ``T``, so the descent ends.
     On a fast-marching field a lower axis neighbour exists at every reached node
