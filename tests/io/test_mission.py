@@ -82,7 +82,7 @@ def test_examples_run_end_to_end(examples, name, tmp_path):
 
 
 def test_geotiff_mission_runs_with_lonlat_points(tmp_path):
-    dem = _write_dem(tmp_path / "dem.tif")
+    _write_dem(tmp_path / "dem.tif")
     (tmp_path / "m.yaml").write_text(
         "world: {dem: dem.tif, cell_size: 60, dz: 20}\n"
         "start: {lon: -3.7033, lat: 40.3847, agl: 100}\n"

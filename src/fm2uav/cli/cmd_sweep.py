@@ -7,7 +7,6 @@ import math
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import typer
 
 from ._common import OutputDir, handle_errors, print_summary, to_jsonable

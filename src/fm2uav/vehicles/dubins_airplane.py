@@ -28,9 +28,9 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from ._path import arc_length, as_path3, distance_to_polyline
+from ._path import arc_length, as_path3
 from .airframes import Airframe, FixedWing, get_airframe
-from .tracking import Carrot, Tracking, check_dt, check_lookahead
+from .tracking import Carrot, Tracking, check_dt, check_lookahead, check_max_time, finish_tracking
 
 __all__ = ["track_dubins"]
 
@@ -91,9 +91,7 @@ def track_dubins(
     R = af.turn_radius()
     L = check_lookahead(path, lookahead, lookahead_points, max(R, 2.0))
     length = float(arc_length(planned)[-1])
-    t_max = 3.0 * length / V + 60.0 if max_time is None else float(max_time)
-    if not (math.isfinite(t_max) and t_max > 0):
-        raise InputError(f"max_time must be a positive time in seconds, got {max_time!r}")
+    t_max = check_max_time(max_time, length, V)
     ds = max(min(0.5, L / 8.0, length / 50.0), 1e-3)
     carrot = Carrot(planned, L, ds, reach=3.0 * V * dt + L + 2 * ds)
     rate_max = af.max_turn_rate()
@@ -102,7 +100,6 @@ def track_dubins(
     pos = planned[0].copy()
     c0 = carrot.pts[min(carrot.n_ahead, carrot.last)] - pos
     psi = math.atan2(c0[1], c0[0])
-    gam = min(max(math.atan2(c0[2], math.hypot(c0[0], c0[1])), -g_dn), g_up)
     n_max = int(math.ceil(t_max / dt)) + 1
     traj = np.empty((n_max, 3))
     prog = np.empty(n_max)
@@ -152,20 +149,9 @@ def track_dubins(
         cg = math.cos(g_cmd)
         pos = pos + V * dt * np.array([math.cos(pm) * cg, math.sin(pm) * cg, math.sin(g_cmd)])
         psi = psi + cmd * dt
-        gam = g_cmd
-    n = k + 1
-    traj = traj[:n]
-    return Tracking(
-        airframe=af,
-        planned=planned,
-        t=np.arange(n) * dt,
-        trajectory=traj,
-        progress=prog[:n],
-        separation=distance_to_polyline(traj, planned),
-        saturated={"turn": sat_t[:n], "climb": sat_c[:n], "descent": sat_d[:n]},
-        states={"heading": heading[:n], "flight_path_angle": fpa[:n], "turn_rate": rate[:n],
-                "speed": np.full(n, V)},
-        reached=reached,
-        lookahead=L,
-        dt=dt,
+    return finish_tracking(
+        af, planned, traj, prog, k + 1, dt,
+        saturated={"turn": sat_t, "climb": sat_c, "descent": sat_d},
+        states={"heading": heading, "flight_path_angle": fpa, "turn_rate": rate, "speed": np.full(len(traj), V)},
+        reached=reached, lookahead=L,
     )

@@ -18,10 +18,10 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from ._path import arc_length, as_path3, distance_to_polyline
+from ._path import arc_length, as_path3
 from .airframes import Multirotor, get_airframe
 from .speed_profile import speed_profile
-from .tracking import Carrot, Tracking, check_dt, check_lookahead
+from .tracking import Carrot, Tracking, check_dt, check_lookahead, check_max_time, finish_tracking
 
 __all__ = ["track_multirotor"]
 
@@ -77,9 +77,7 @@ def track_multirotor(
     length = float(s_plan[-1])
     v_floor = 0.05 * af.max_speed  # W = 0 would never arrive: creep at 5 %
     v_adm = np.maximum(prof.v_admissible, v_floor)
-    t_max = 3.0 * length / float(np.mean(v_adm)) + 60.0 if max_time is None else float(max_time)
-    if not (math.isfinite(t_max) and t_max > 0):
-        raise InputError(f"max_time must be a positive time in seconds, got {max_time!r}")
+    t_max = check_max_time(max_time, length, float(np.mean(v_adm)))
     ds = max(min(0.5, L / 8.0, length / 50.0), 1e-3)
     carrot = Carrot(planned, L, ds, reach=3.0 * af.max_speed * dt + L + 2 * ds)
     v_at = np.interp(carrot.s, prof.s, v_adm)
@@ -128,18 +126,9 @@ def track_multirotor(
         new_vel = vel + acc * dt
         pos = pos + 0.5 * (vel + new_vel) * dt
         vel = new_vel
-    n = k + 1
-    traj = traj[:n]
-    return Tracking(
-        airframe=af,
-        planned=planned,
-        t=np.arange(n) * dt,
-        trajectory=traj,
-        progress=prog[:n],
-        separation=distance_to_polyline(traj, planned),
-        saturated={"accel": sat_a[:n], "climb": sat_c[:n], "descent": sat_d[:n]},
-        states={"speed": spd[:n], "v_ref": vref[:n]},
-        reached=reached,
-        lookahead=L,
-        dt=dt,
+    return finish_tracking(
+        af, planned, traj, prog, k + 1, dt,
+        saturated={"accel": sat_a, "climb": sat_c, "descent": sat_d},
+        states={"speed": spd, "v_ref": vref},
+        reached=reached, lookahead=L,
     )

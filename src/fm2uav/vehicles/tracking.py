@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from ._path import as_path3, resample, runs
+from ._path import as_path3, distance_to_polyline, resample, runs
 from .airframes import Airframe
 
 __all__ = ["Tracking", "Carrot"]
@@ -162,3 +162,40 @@ def check_dt(dt: float) -> float:
     if not (math.isfinite(v) and v > 0):
         raise InputError(f"dt must be a positive time step in seconds, got {dt!r}")
     return v
+
+
+def check_max_time(max_time: float | None, length: float, speed: float) -> float:
+    """Simulation time limit [s]: ``max_time``, or ``3 x length / speed + 60`` if None."""
+    t_max = 3.0 * length / speed + 60.0 if max_time is None else float(max_time)
+    if not (math.isfinite(t_max) and t_max > 0):
+        raise InputError(f"max_time must be a positive time in seconds, got {max_time!r}")
+    return t_max
+
+
+def finish_tracking(
+    airframe: Airframe,
+    planned: np.ndarray,
+    traj: np.ndarray,
+    progress: np.ndarray,
+    n: int,
+    dt: float,
+    saturated: dict[str, np.ndarray],
+    states: dict[str, np.ndarray],
+    reached: bool,
+    lookahead: float,
+) -> Tracking:
+    """Trim the simulators' preallocated arrays to the ``n`` steps flown and build the result."""
+    flown = traj[:n]
+    return Tracking(
+        airframe=airframe,
+        planned=planned,
+        t=np.arange(n) * dt,
+        trajectory=flown,
+        progress=progress[:n],
+        separation=distance_to_polyline(flown, planned),
+        saturated={k: v[:n] for k, v in saturated.items()},
+        states={k: v[:n] for k, v in states.items()},
+        reached=reached,
+        lookahead=lookahead,
+        dt=dt,
+    )

@@ -21,7 +21,6 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
-import shapely
 from shapely.geometry import LineString, Polygon
 
 from ...errors import InputError
