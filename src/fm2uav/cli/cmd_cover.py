@@ -57,6 +57,12 @@ def _load_area(area: str):
 
     if area.strip().upper() in COVERAGE_AREAS:
         return coverage_area(area)
+    if not Path(area).exists():
+        raise InputError(
+            f"--area {area!r} is neither an existing GeoJSON file nor a built-in area "
+            f"({', '.join(COVERAGE_AREAS)}); give a path to a GeoJSON Polygon in the map's "
+            "metres or one of those names"
+        )
     return read_area(area)
 
 
