@@ -17,7 +17,7 @@ from ._timing import median_time
 
 def run(quick: bool = False) -> list[dict]:
     from fm2uav.missions.coverage import ZigzagCost, differential_evolution, plan_coverage, scipy_de
-    from fm2uav.world.coverage_map import (
+    from fm2uav.scenarios.coverage import (
         COVERAGE_AGL,
         COVERAGE_AREAS,
         COVERAGE_SPACING,

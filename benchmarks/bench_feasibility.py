@@ -19,8 +19,8 @@ import numpy as np
 
 def run(quick: bool = False) -> list[dict]:
     from fm2uav import World, plan
-    from fm2uav.analysis.feasibility_compare import city_missions, horizontal_slice
-    from fm2uav.analysis.rrt import plan_rrt
+    from fm2uav.experiments.city import city_missions, horizontal_slice
+    from fm2uav.baselines.rrt import plan_rrt
     from fm2uav.vehicles import check_feasibility
 
     repeats = 1 if quick else 5

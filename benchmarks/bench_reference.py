@@ -23,11 +23,11 @@ import numpy as np
 
 
 def _table1(quick: bool) -> list[dict]:
-    from fm2uav.analysis.reference import build_primitives, dubins_length, reference_path
-    from fm2uav.analysis.reference.lattice import DEFAULT_XI, default_radius
+    from fm2uav.baselines.reference import build_primitives, dubins_length, reference_path
+    from fm2uav.baselines.reference.lattice import DEFAULT_XI, default_radius
     from fm2uav.planning import plan
     from fm2uav.world import World
-    from fm2uav.world.maps2d import city2d_pairs, city2d_world
+    from fm2uav.scenarios.city2d import city2d_pairs, city2d_world
 
     world = city2d_world()
     n = 2 if quick else 24

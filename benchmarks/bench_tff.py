@@ -35,7 +35,7 @@ def run(quick: bool = False) -> list[dict]:
     })
     if quick:
         return rows
-    from fm2uav.world.jacksboro import jacksboro_dem
+    from fm2uav.scenarios.jacksboro import jacksboro_dem
     from fm2uav.world.dem import from_dem
 
     z, bounds = jacksboro_dem()

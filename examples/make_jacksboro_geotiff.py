@@ -18,7 +18,7 @@ import numpy as np
 import rasterio
 from rasterio.transform import from_bounds
 
-from fm2uav.world.jacksboro import jacksboro_dem
+from fm2uav.scenarios.jacksboro import jacksboro_dem
 
 
 def write_geotiff(target: Path) -> Path:

@@ -5,14 +5,17 @@ grid (node ``i`` at ``origin + i * spacing``); API points are world coordinates
 in metres; SI units inside; occupancy True = obstacle; speed 0 = impassable;
 unreached arrival time = ``inf``.
 
-The pipeline: ``world`` (maps, scenarios) → ``eikonal`` (fast_marching,
-velocity_map) → ``planning`` (plan, flight levels, tune) → ``missions``
-(coverage, formations) → ``vehicles`` / ``analysis`` (feasibility, metrics,
-comparisons) → ``io`` / ``viz`` (exports, figures, reports) → ``cli``.
+Layers, bottom to top (each imports only from those below; see
+docs/architecture.md): ``errors``, ``geometry`` → ``eikonal`` → ``world`` →
+``planning`` → ``missions`` → ``vehicles`` → ``analysis`` → ``baselines`` →
+``scenarios`` → ``experiments`` → ``io`` → ``viz`` → ``cli``.
 """
 
-from . import analysis, io, missions, scenarios, vehicles, viz
+import importlib
+from typing import TYPE_CHECKING, Any
+
 from .analysis import flight_level_deviation, path_profiles
+from .analysis.tune import AirframeLimits, tune
 from .eikonal import distance_map, fast_marching, velocity_map
 from .errors import (
     Fm2uavError,
@@ -24,9 +27,27 @@ from .errors import (
 )
 from .missions import CoveragePlan, FormationResult, fly_formation, plan_coverage, zigzag
 from .planning import Plan, plan
-from .planning.tune import AirframeLimits, tune
+from .scenarios import Scenario
 from .vehicles import AIRFRAMES, FeasibilityReport, check_feasibility, get_airframe
-from .world import Scenario, World
+from .world import World
+
+if TYPE_CHECKING:  # loaded on first attribute access (PEP 562), see __getattr__
+    from . import baselines, experiments, io, viz
+
+#: Subpackages imported on first use: ``viz`` (matplotlib, plotly), ``experiments``
+#: (Dask, Parquet), ``io`` and ``baselines`` (OMPL) stay unloaded by ``import fm2uav``.
+_LAZY_SUBMODULES = ("baselines", "experiments", "io", "viz")
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY_SUBMODULES:
+        return importlib.import_module(f".{name}", __name__)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY_SUBMODULES))
+
 
 __version__ = "0.1.0"
 
@@ -59,8 +80,12 @@ __all__ = [
     "path_profiles",
     # subpackages
     "analysis",
+    "baselines",
+    "experiments",
+    "geometry",
     "io",
     "missions",
+    "scenarios",
     "vehicles",
     "viz",
     # errors

@@ -9,8 +9,9 @@ import pytest
 
 from fm2uav import World
 from fm2uav.errors import WorldError
-from fm2uav.world import get_scenario
-from fm2uav.world.buildings import METRES_PER_LEVEL, building_height, city_buildings
+from fm2uav.scenarios import get_scenario
+from fm2uav.scenarios.city import city_buildings
+from fm2uav.world.buildings import METRES_PER_LEVEL, building_height
 
 
 def _sq(x0, y0, w, props):

@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 
 from fm2uav import World
-from fm2uav.analysis.feasibility_compare import (
+from fm2uav.experiments.city import (
     THESIS_TABLE_3_1,
     city_table,
     horizontal_slice,
 )
-from fm2uav.analysis.rrt import plan_rrt
+from fm2uav.baselines.rrt import plan_rrt
 from fm2uav.errors import InputError, PointError, UnreachableError
 
 

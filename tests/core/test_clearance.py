@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from fm2uav import World
-from fm2uav.analysis import clearance_profile
+from fm2uav.world import clearance_profile
 
 
 def test_single_obstacle_node_exact():
@@ -48,7 +48,7 @@ def test_column_world_search_matches_kdtree():
     # brute force over all obstacle nodes at random points (some inside the
     # terrain) and with the k-d tree of boundary nodes at the free points
     # (the tree is exact only for free points, which paths are)
-    from fm2uav.analysis.clearance import column_surface, obstacle_tree
+    from fm2uav.world.clearance import column_surface, obstacle_tree
 
     rng = np.random.default_rng(5)
     heights = rng.random((23, 17)) * 9.0
@@ -66,7 +66,7 @@ def test_column_world_search_matches_kdtree():
 
 
 def test_non_column_world_uses_tree():
-    from fm2uav.analysis.clearance import column_surface
+    from fm2uav.world.clearance import column_surface
 
     occ = np.zeros((6, 6, 6), bool)
     occ[2, 2, 4] = True  # a floating block: not a solid column

@@ -5,7 +5,7 @@ import pytest
 
 import fm2uav
 from fm2uav import InputError, Plan, PlanningError, PointError, UnreachableError, World, plan
-from fm2uav.analysis import clearance_profile
+from fm2uav.world import clearance_profile
 
 
 @pytest.fixture(scope="module")
@@ -96,7 +96,7 @@ def test_open_field_path_is_safe(order):
     nodes = _nearest_nodes(sc.world, p.path)
     assert not sc.world.occupancy[tuple(nodes.T)].any()
     # every point is above the terrain
-    from fm2uav.viz.figures import terrain_along
+    from fm2uav.world.ground import terrain_along
 
     assert np.all(p.path[:, 2] > terrain_along(sc.world, p.path))
     assert p.clearance > 15.0  # at least one cell away from the ground

@@ -10,7 +10,7 @@ from shapely.geometry import Polygon
 from fm2uav import InputError, World
 from fm2uav.missions.coverage import plan_coverage, zigzag
 from fm2uav.missions.coverage.grid import corridor_grid
-from fm2uav.world.coverage_map import coverage_world
+from fm2uav.scenarios.coverage import coverage_world
 
 RECT = [(100, 100), (500, 100), (500, 260), (100, 260)]
 

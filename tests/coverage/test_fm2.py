@@ -5,8 +5,8 @@ from typer.testing import CliRunner
 from fm2uav import World
 from fm2uav.cli import app
 from fm2uav.missions.coverage import corridor_speed, plan_coverage, zigzag
-from fm2uav.world.coverage_map import COVERAGE_AREAS, coverage_area, coverage_world
-from fm2uav.world.scenarios import get_scenario
+from fm2uav.scenarios.coverage import COVERAGE_AREAS, coverage_area, coverage_world
+from fm2uav.scenarios import get_scenario
 
 
 def test_corridor_speed_exact():

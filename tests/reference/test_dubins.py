@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from fm2uav.analysis.reference import dubins_length
+from fm2uav.baselines.reference import dubins_length
 from fm2uav.errors import InputError
 
 

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from fm2uav import World
-from fm2uav.analysis.profiles import menger_curvature, resample_path
-from fm2uav.analysis.reference import build_primitives, dubins_length, lattice_headings, reference_path
-from fm2uav.analysis.reference.primitives import biarc
+from fm2uav.geometry import menger_curvature, resample_path
+from fm2uav.baselines.reference import build_primitives, dubins_length, lattice_headings, reference_path
+from fm2uav.baselines.reference.primitives import biarc
 from fm2uav.errors import InputError, PointError, UnreachableError
 
 XI = 5.0  # metres = cells on a 1 m grid (the city default: 10 m on 2 m nodes)

@@ -4,7 +4,7 @@ import numpy as np
 from scipy import ndimage
 
 from fm2uav.scenarios import get_scenario
-from fm2uav.world.maps2d import city2d_pairs, city2d_world
+from fm2uav.scenarios.city2d import city2d_pairs, city2d_world
 
 
 def test_city_map():

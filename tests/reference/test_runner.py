@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from fm2uav.analysis.runner import load_config, make_config, run_sweep
+from fm2uav.experiments.runner import load_config, make_config, run_sweep
 from fm2uav.errors import InputError
-from fm2uav.world.maps2d import city2d_pairs
+from fm2uav.scenarios.city2d import city2d_pairs
 
 BAD = [200.0, 150.0]  # inside the Centre Pompidou
 

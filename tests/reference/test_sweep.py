@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from fm2uav.analysis.sweep import (
+from fm2uav.experiments.sweep import (
     best_parameters,
     curvature_profile,
     distance_matrix,
@@ -15,7 +15,7 @@ from fm2uav.analysis.sweep import (
     valley,
 )
 from fm2uav.errors import InputError
-from fm2uav.world.maps2d import city2d_pairs, city2d_world
+from fm2uav.scenarios.city2d import city2d_pairs, city2d_world
 
 
 def test_parameter_grid_matches_matlab():

@@ -10,9 +10,9 @@ from typer.testing import CliRunner
 
 import fm2uav
 from fm2uav.analysis import flight_level_deviation, path_profiles
-from fm2uav.analysis.profiles import menger_curvature, resample_path
+from fm2uav.geometry import menger_curvature, resample_path
 from fm2uav.errors import InputError
-from fm2uav.planning.tune import AirframeLimits, as_limits, tune
+from fm2uav.analysis.tune import AirframeLimits, as_limits, tune
 
 
 def test_resample_keeps_ends_and_step():

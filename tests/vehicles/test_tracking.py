@@ -104,12 +104,12 @@ def test_multirotor_follows_a_tight_circle():
 def test_collision_with_world_makes_it_infeasible():
     # an L-shaped path turning 90 deg 2.8 m from the corner of a block inside the
     # turn: the Dubins airplane cuts the corner by ~3 m and clips the block
-    from fm2uav.vehicles._path import resample
+    from fm2uav.geometry import resample_uniform
 
     occ = np.zeros((201, 201), bool)
     occ[0:99, 52:201] = True
     w = World(occ, spacing=1.0)
-    path, _ = resample(np.array([[0.0, 50.0], [100.0, 50.0], [100.0, 150.0]]), 1.0)
+    path, _ = resample_uniform(np.array([[0.0, 50.0], [100.0, 50.0], [100.0, 150.0]]), 1.0)
     rep = check_feasibility(path, DISCO, world=w, tolerance=100.0)
     assert rep.collision["inside_obstacle"] > 0
     assert not rep.feasible and "enters an obstacle" in rep.reason

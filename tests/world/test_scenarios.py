@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 from fm2uav.errors import WorldError
-from fm2uav.world import SCENARIOS, Scenario, World, fissure, get_scenario, open_field
-from fm2uav.world.scenarios import _open_field_world_uncached
+from fm2uav.scenarios import SCENARIOS, Scenario, fissure, get_scenario, open_field
+from fm2uav.world import World
+from fm2uav.scenarios.open_field import _open_field_world_uncached
 from fm2uav.world.terrain import FISSURE_Y, open_field_heights
 
 CELL = 15.0

@@ -24,68 +24,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError
+from ..geometry import as_path, menger_curvature, resample_path, segment_angles, turn_angles
 
-__all__ = ["Profiles", "resample_path", "path_profiles", "menger_curvature", "circumcurvature"]
-
-
-def _as_path(path: np.ndarray) -> np.ndarray:
-    p = np.asarray(path, dtype=float)
-    if p.ndim != 2 or p.shape[1] not in (2, 3) or len(p) < 2:
-        raise InputError(
-            f"path must be an (N, 2) or (N, 3) array of N >= 2 points in metres, got shape {p.shape}"
-        )
-    if not np.all(np.isfinite(p)):
-        raise InputError("path has non-finite coordinates")
-    return p
-
-
-def resample_path(path: np.ndarray, ds: float) -> np.ndarray:
-    """Points at arc-length steps of ``ds`` [m] along ``path`` (linear), both ends kept.
-
-    The last step is shorter when the length is not a multiple of ``ds``.
-    """
-    p = _as_path(path)
-    if not (np.isfinite(ds) and ds > 0):
-        raise InputError(f"ds must be a step > 0 metres, got {ds!r}")
-    seg = np.linalg.norm(np.diff(p, axis=0), axis=1)
-    keep = np.concatenate([[True], seg > 0])
-    p = p[keep]
-    s = np.concatenate([[0.0], np.cumsum(seg[seg > 0])])
-    if len(p) < 2:
-        return p
-    n = max(int(np.ceil(s[-1] / ds - 1e-9)), 1)
-    t = np.minimum(np.arange(n + 1) * ds, s[-1])
-    t[-1] = s[-1]
-    return np.stack([np.interp(t, s, p[:, k]) for k in range(p.shape[1])], axis=1)
-
-
-def circumcurvature(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
-    """Curvature [1/m] of the circle through the points ``a[i], b[i], c[i]``.
-
-    ``2 |(b - a) x (c - b)| / (|b - a| |c - b| |c - a|)`` (Menger curvature):
-    exactly ``1/r`` for three points on a circle of radius r; 0 for collinear
-    or coincident points. Arrays are (N, 2) or (N, 3) [m].
-    """
-    ab = b - a
-    bc = c - b
-    ac = c - a
-    if a.shape[1] == 2:
-        cross = np.abs(ab[:, 0] * bc[:, 1] - ab[:, 1] * bc[:, 0])
-    else:
-        cross = np.linalg.norm(np.cross(ab, bc), axis=1)
-    den = np.linalg.norm(ab, axis=1) * np.linalg.norm(bc, axis=1) * np.linalg.norm(ac, axis=1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(den > 1e-300, 2.0 * cross / np.maximum(den, 1e-300), 0.0)
-
-
-def menger_curvature(points: np.ndarray) -> np.ndarray:
-    """Curvature [1/m] of the circle through each three consecutive points.
-
-    Returns ``N - 2`` values (0 for collinear points); ``points`` is (N, d).
-    """
-    p = np.asarray(points, dtype=float)
-    return circumcurvature(p[:-2], p[1:-1], p[2:])
+__all__ = ["Profiles", "path_profiles"]
 
 
 @dataclass(frozen=True)
@@ -158,7 +99,7 @@ def path_profiles(path: np.ndarray, ds: float | None = None) -> Profiles:
     >>> round(float(np.median(pr.curvature_h)) * 100, 2)     # 1 / radius
     1.0
     """
-    p = _as_path(path)
+    p = as_path(path)
     if ds is None:
         seg = np.linalg.norm(np.diff(p, axis=0), axis=1)
         ds = max(2.0 * float(np.median(seg[seg > 0])) if np.any(seg > 0) else 1.0, 1.0)
@@ -166,13 +107,8 @@ def path_profiles(path: np.ndarray, ds: float | None = None) -> Profiles:
     if q.shape[1] == 2:
         q = np.concatenate([q, np.zeros((len(q), 1))], axis=1)
     d = np.diff(q, axis=0)
-    heading = np.arctan2(d[:, 1], d[:, 0])
-    horiz = np.hypot(d[:, 0], d[:, 1])
-    climb = np.arctan2(d[:, 2], horiz)
-    turn = (np.diff(heading) + np.pi) % (2 * np.pi) - np.pi
-    # a segment with no horizontal motion has no heading: no turn there
-    still = (horiz[1:] < 1e-9) | (horiz[:-1] < 1e-9)
-    turn = np.where(still, 0.0, turn)
+    heading, climb, horiz = segment_angles(q)
+    turn = turn_angles(heading, horiz)
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(d, axis=1))])
     return Profiles(
         points=q,

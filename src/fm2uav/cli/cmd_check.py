@@ -76,7 +76,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         from ..io import read_path_csv, write_path_csv
         from ..vehicles import check_feasibility, get_airframe
         from ..viz.feasibility import tracking_figure
-        from ..world.scenarios import get_scenario
+        from ..scenarios import get_scenario
 
         af = get_airframe(airframe)
         path = read_path_csv(path_file)

@@ -84,7 +84,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         report: bool = typer.Option(
             False, "--report", help="Also write report.html (interactive, self-contained)."),
     ) -> None:
-        from ..analysis.feasibility_compare import (
+        from ..experiments.city import (
             THESIS_TIMES_S,
             city_missions,
             city_table,

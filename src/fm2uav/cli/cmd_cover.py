@@ -53,7 +53,7 @@ def _camera_spacing(camera: str, agl: float, side_overlap: float) -> float:
 
 def _load_area(area: str):
     from ..missions.coverage import read_area
-    from ..world.coverage_map import COVERAGE_AREAS, coverage_area
+    from ..scenarios.coverage import COVERAGE_AREAS, coverage_area
 
     if area.strip().upper() in COVERAGE_AREAS:
         return coverage_area(area)
@@ -190,7 +190,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             False, "--report", help="Also write report.html (interactive, self-contained)."),
     ) -> None:
         from ..missions.coverage import FULL_BOUNDS_DEG, plan_coverage
-        from ..world.scenarios import get_scenario
+        from ..scenarios import get_scenario
 
         if (spacing is None) == (camera is None):
             raise InputError("give exactly one of --spacing (metres) or --camera")
@@ -258,7 +258,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
     ) -> None:
         from ..missions.coverage import differential_evolution, plan_coverage, scipy_de, sweep
         from ..viz.coverage import bands_figure, coverage_figure
-        from ..world.coverage_map import (
+        from ..scenarios.coverage import (
             COVERAGE_AGL,
             COVERAGE_AREAS,
             COVERAGE_SPACING,

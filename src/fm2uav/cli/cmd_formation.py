@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import typer
 
-from ..world.scenarios import SCENARIOS, get_scenario
+from ..scenarios import SCENARIOS, get_scenario
 from ._common import (
     EXIT_PLANNING,
     OutputDir,

@@ -9,7 +9,7 @@ import numpy as np
 import typer
 
 from ..planning import plan as plan_path
-from ..world.scenarios import SCENARIOS, get_scenario
+from ..scenarios import SCENARIOS, get_scenario
 from ..errors import InputError
 from ._common import OutputDir, handle_errors, parse_point, print_summary, to_jsonable
 from .cmd_run import output_names, plan_outputs

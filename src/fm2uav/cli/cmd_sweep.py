@@ -116,8 +116,8 @@ def _progress(quiet: bool):
 def run_and_report(config, out: Path, *, force: bool, scheduler: str | None, workers: int | None,
                    retry_failed: bool, as_json: bool, quiet: bool, title: str) -> None:
     """Run (or resume) a sweep, then write tables and figures into ``out``."""
-    from ..analysis.runner import run_sweep, sweep_world
-    from ..analysis.sweep import summarise_sweep
+    from ..experiments.runner import run_sweep, sweep_world
+    from ..experiments.sweep import summarise_sweep
 
     cfg_file = out / "config.json"
     same = cfg_file.exists() and json.loads(cfg_file.read_text()) == json.loads(
@@ -216,7 +216,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
         quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
     ) -> None:
-        from ..analysis.runner import load_config
+        from ..experiments.runner import load_config
 
         cfg = load_config(config)
         run_and_report(cfg, out, force=force, scheduler=scheduler, workers=workers,
@@ -251,7 +251,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
         quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
     ) -> None:
-        from ..analysis.runner import make_config
+        from ..experiments.runner import make_config
 
         s = 0.02 if full else float(step)
         grid = {"start": s, "stop": 1.0, "step": s}

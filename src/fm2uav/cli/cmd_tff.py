@@ -86,7 +86,7 @@ def run_tff(scenario: str, seed: int, mode: str) -> tuple[list[dict[str, Any]], 
     """Plan the seeds' five cases (and the literal reading of level 10) on a scenario."""
     from ..analysis.flight_level import SEED_CASES, tff_metrics
     from ..planning import plan
-    from ..world.scenarios import get_scenario
+    from ..scenarios import get_scenario
 
     sc = get_scenario(scenario, seed=seed)
     dz = sc.world.spacing[2]
@@ -293,8 +293,8 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         report: bool = typer.Option(
             False, "--report", help="Also write report.html (interactive, self-contained)."),
     ) -> None:
-        from ..planning.tune import AirframeLimits, tune
-        from ..world.scenarios import get_scenario
+        from ..analysis.tune import AirframeLimits, tune
+        from ..scenarios import get_scenario
 
         def values(text: str, what: str) -> list[float]:
             try:

@@ -174,7 +174,7 @@ def ground_height(world: Any, points_m: Any) -> np.ndarray:
     """
     p = _points(points_m, "points_m")
     if getattr(world, "terrain", None) is not None:
-        from ..viz.figures import terrain_along
+        from ..world.ground import terrain_along
 
         full = np.zeros((len(p), world.ndim))
         full[:, :2] = p[:, :2]

@@ -106,7 +106,7 @@ class WorldSpec(BaseModel):
     def _known_scenario(cls, v: str | None) -> str | None:
         if v is None:
             return v
-        from ..world.scenarios import SCENARIOS
+        from ..scenarios import SCENARIOS
 
         key = v.strip().lower().replace("_", "-").replace(" ", "-")
         if key not in SCENARIOS:
@@ -347,7 +347,7 @@ class Mission(BaseModel):
         w = self.world
         start_default = goal_default = None
         if w.scenario is not None:
-            from ..world.scenarios import get_scenario
+            from ..scenarios import get_scenario
 
             sc = get_scenario(w.scenario, seed=w.seed)
             world, start_default, goal_default = sc.world, sc.start, sc.goal

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from scipy import ndimage
 
-from ..analysis.clearance import clearance_profile
+from ..world.clearance import clearance_profile
 from ..eikonal.fmm import fast_marching
 from ..eikonal.velocity import distance_map, normalise_distance, shape_velocity
 from ..errors import InputError, PointError, UnreachableError

@@ -21,10 +21,10 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.clearance import clearance_profile
+from ..world.clearance import clearance_profile
 from ..errors import InputError
 from ..world import World
-from ._path import as_path3
+from ..geometry import as_path3
 from .airframes import Airframe, FixedWing, get_airframe
 from .dubins_airplane import track_dubins
 from .geometric import GeometricCheck, geometric_check

@@ -8,7 +8,7 @@ Curvature is the Menger curvature of the three points at arc lengths
 curvature is infinite at the vertex) is judged at the scale of the airframe's
 turn: a 90° corner reads as a radius ~0.7 h.
 
-The circle-through-three-points formula is :func:`fm2uav.analysis.profiles.circumcurvature`,
+The circle-through-three-points formula is :func:`fm2uav.geometry.circumcurvature`,
 shared with the path profiles; what is specific here is the airframe-scale window.
 """
 
@@ -21,8 +21,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from ..analysis.profiles import circumcurvature
-from ._path import arc_length, as_path3, runs
+from ..geometry import arc_length, as_path3, circumcurvature, runs
 from .airframes import Airframe, FixedWing, Multirotor, get_airframe
 
 __all__ = [

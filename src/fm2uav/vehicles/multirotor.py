@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from ._path import arc_length, as_path3
+from ..geometry import arc_length, as_path3
 from .airframes import Multirotor, get_airframe
 from .speed_profile import speed_profile
 from .tracking import Carrot, Tracking, check_dt, check_lookahead, check_max_time, finish_tracking

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from ._path import as_path3, runs
+from ..geometry import as_path3, runs
 from .airframes import G, Airframe, FixedWing, get_airframe
 from .geometric import curvature_profile, default_window
 

@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from ._path import as_path3, distance_to_polyline, resample, runs
+from ..geometry import as_path3, distance_to_polyline, resample_uniform, runs
 from .airframes import Airframe
 
 __all__ = ["Tracking", "Carrot"]
@@ -115,7 +115,7 @@ class Carrot:
     """
 
     def __init__(self, path: np.ndarray, lookahead: float, ds: float, reach: float) -> None:
-        self.pts, self.s = resample(path, ds)
+        self.pts, self.s = resample_uniform(path, ds)
         self.ds = float(self.s[1] - self.s[0]) if len(self.s) > 1 else ds
         self.n_ahead = max(int(round(lookahead / self.ds)), 1)
         self.win = max(int(math.ceil(reach / self.ds)), 2) + 1

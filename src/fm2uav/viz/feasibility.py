@@ -16,7 +16,7 @@ import numpy as np  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
 if TYPE_CHECKING:
-    from ..analysis.rrt import RRTResult
+    from ..baselines.rrt import RRTResult
     from ..vehicles import FeasibilityReport
     from ..world import World
 

@@ -12,20 +12,12 @@ import numpy as np  # noqa: E402
 from matplotlib.colors import LightSource  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
+from ..world.ground import terrain_along  # noqa: E402
+
 if TYPE_CHECKING:
     from ..planning import Plan
 
 __all__ = ["plan_figure", "terrain_along"]
-
-
-def terrain_along(world, path: np.ndarray) -> np.ndarray | None:
-    """Ground height [m] under each path point (bilinear), or None without terrain."""
-    if world.terrain is None:
-        return None
-    from scipy import ndimage
-
-    idx = world.to_index(path)[:, :2]
-    return ndimage.map_coordinates(world.terrain, idx.T, order=1, mode="nearest")
 
 
 def _arc_length(path: np.ndarray) -> np.ndarray:

@@ -1,6 +1,6 @@
 """Figures of the α–β sweep (seed 004, Figs 8/12, 9/13 and 10/14).
 
-Drawing only: every number comes from :func:`fm2uav.analysis.sweep.summarise_sweep`.
+Drawing only: every number comes from :func:`fm2uav.experiments.sweep.summarise_sweep`.
 """
 
 from __future__ import annotations

@@ -1,15 +1,14 @@
-"""Worlds: occupancy grids in metres, builders and the built-in scenarios."""
+"""Worlds: occupancy grids in metres, their builders, and world questions (clearance).
 
-from .scenarios import SCENARIOS, Scenario, fissure, get_scenario, open_field
+The built-in worlds of the papers live in :mod:`fm2uav.scenarios`.
+"""
+
+from .clearance import clearance_profile
 from .terrain import open_field_heights
 from .world import World
 
 __all__ = [
     "World",
-    "Scenario",
-    "open_field",
-    "fissure",
-    "get_scenario",
-    "SCENARIOS",
+    "clearance_profile",
     "open_field_heights",
 ]

@@ -40,12 +40,13 @@ from typing import Any
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ...analysis import clearance_profile
 from ...errors import InputError, PlanningError
 from ...planning import Plan, base_velocity
 from ...planning import plan as fm2_plan
 from ...planning.flight_level import flight_layer, flight_level_speed
 from ...world import World
+from ...world.clearance import clearance_profile
+from ...world.ground import terrain_along
 from .area import as_area, check_inside_world, check_spacing
 from .bands import Zigzag, zigzag
 from .grid import CorridorGrid, corridor_grid
@@ -328,7 +329,7 @@ def plan_coverage(
     Parameters
     ----------
     world : World
-        3D map with terrain (e.g. ``fm2uav.world.coverage_map.coverage_world()``).
+        3D map with terrain (e.g. ``fm2uav.scenarios.coverage.coverage_world()``).
     area : Polygon, GeoJSON dict or (k, 2) vertices
         Area to cover [m] (inside the map).
     spacing : float
@@ -424,8 +425,6 @@ def plan_coverage(
     t4 = time.perf_counter()
     cov = coverage_share(poly, fm.path, d / 2.0)
     zcov = coverage_share(poly, ideal, d / 2.0)
-    from ...viz.figures import terrain_along
-
     ground = terrain_along(world, fm.path)
     err = fm.path[:, 2] - ground - agl
     t5 = time.perf_counter()

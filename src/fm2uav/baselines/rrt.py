@@ -34,7 +34,7 @@ import numpy as np
 
 from ..errors import InputError, PointError, UnreachableError
 from ..world import World
-from .clearance import clearance_profile
+from ..world.clearance import clearance_profile
 
 __all__ = ["RRT_PLANNERS", "RRTResult", "plan_rrt"]
 

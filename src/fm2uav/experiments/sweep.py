@@ -9,7 +9,7 @@ distance transform is computed once per map (``plan`` reuses
 and the second wave (T) change across the sweep.
 
 Pure functions over arrays; the parallel runner lives in
-:mod:`fm2uav.analysis.runner`, the figures in :mod:`fm2uav.viz.sweep`.
+:mod:`fm2uav.experiments.runner`, the figures in :mod:`fm2uav.viz.sweep`.
 """
 
 from __future__ import annotations
@@ -25,9 +25,9 @@ from scipy import fft, optimize
 from ..errors import Fm2uavError, InputError
 from ..planning import plan
 from ..world import World
-from .clearance import clearance_profile
-from .profiles import menger_curvature, resample_path
-from .similarity import area_between_curves, frechet_distance
+from ..analysis.similarity import area_between_curves, frechet_distance
+from ..geometry import menger_curvature, resample_path
+from ..world.clearance import clearance_profile
 
 __all__ = [
     "parameter_grid",

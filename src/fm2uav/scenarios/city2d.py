@@ -24,7 +24,8 @@ from scipy import ndimage
 from shapely.geometry import LineString, Polygon, box
 
 from ..errors import WorldError
-from .world import World
+from ..world import World
+from .scenario import Scenario
 
 __all__ = [
     "CITY2D_SIZE",
@@ -184,8 +185,6 @@ def city2d(seed: int | np.random.Generator = 0):
 
     The map is fixed; ``seed`` draws the pair (see :func:`city2d_pairs`).
     """
-    from .scenarios import Scenario
-
     world = city2d_world()
     starts, goals = city2d_pairs(1, seed, world=world)
     return Scenario(

@@ -1,6 +1,6 @@
 """Sweep runner: the α–β sweep on local processes or a Dask cluster.
 
-``run_sweep(config, out_dir)`` does the sweep of :mod:`fm2uav.analysis.sweep`
+``run_sweep(config, out_dir)`` does the sweep of :mod:`fm2uav.experiments.sweep`
 at scale:
 
 1. the reference paths (one lattice search per pair and model) are computed
@@ -37,7 +37,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from ..errors import InputError
 from ..world import World
-from .reference import MODELS, reference_path
+from ..baselines.reference import MODELS, reference_path
 from .sweep import METRICS, parameter_grid, sweep_alpha_row
 
 __all__ = ["GridSpec", "SweepConfig", "SweepResult", "load_config", "run_sweep", "sweep_world"]
@@ -154,14 +154,14 @@ def make_config(data: dict[str, Any], where: str = "config") -> SweepConfig:
 
 @lru_cache(maxsize=4)
 def _world_cached(scenario: str, cell: float) -> World:
-    from ..world.maps2d import city2d_world
+    from ..scenarios.city2d import city2d_world
 
     return city2d_world(cell)
 
 
 def sweep_world(config: SweepConfig) -> tuple[World, np.ndarray, np.ndarray]:
     """The map and the start/goal pairs ``(starts, goals)`` [m] of a configuration."""
-    from ..world.maps2d import city2d_pairs
+    from ..scenarios.city2d import city2d_pairs
 
     world = _world_cached(config.scenario, float(config.cell))
     if isinstance(config.pairs, int):

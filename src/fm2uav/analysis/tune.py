@@ -28,11 +28,11 @@ from typing import Any
 
 import numpy as np
 
-from ..analysis.flight_level import flight_level_deviation
-from ..analysis.profiles import path_profiles
+from .flight_level import flight_level_deviation
+from .profiles import path_profiles
 from ..errors import InputError, PlanningError
 from ..world import World
-from .planner import Plan, plan
+from ..planning.planner import Plan, plan
 
 __all__ = ["AirframeLimits", "TuneResult", "tune", "as_limits", "DEFAULT_GRID"]
 

@@ -6,7 +6,7 @@ import numpy as np
 from scipy import ndimage
 from scipy.spatial import cKDTree
 
-from ..world import World
+from .world import World
 from ._clearance_kernels import column_clearance
 
 __all__ = ["clearance_profile", "obstacle_tree", "column_surface"]

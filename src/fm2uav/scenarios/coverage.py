@@ -3,7 +3,7 @@
 "An open field map with mountainous terrain, where the surface is rather
 uneven": a 118 x 87 x 40 grid of 10 m cells, with four irregular areas S1–S4
 to cover (Fig. 5.8; the figures are lost, so the areas are redrawn). The
-terrain is the open-field relief of :mod:`.terrain` laid out on 118 x 87
+terrain is the open-field relief of :mod:`fm2uav.world.terrain` laid out on 118 x 87
 columns. The areas were drawn so that their best zigzags resemble Table 5.1
 with D = 80 m: costs 5105 / 6548 / 5334 / 6640 m at α ≈ 30.6° / 5.2° / 1.0° /
 5.2° (seeds: 5446.5 / 6748.1 / 5908.6 / 7177.0 m at 37.1° / 2.5° / 1.0° / 1.3°).
@@ -23,8 +23,12 @@ from functools import lru_cache
 import numpy as np
 from shapely.geometry import Polygon
 
-from .terrain import open_field_heights
-from .world import World
+from ..errors import WorldError
+from ..missions.coverage.bands import zigzag
+from ..missions.coverage.optimise import differential_evolution
+from ..world import World
+from ..world.terrain import open_field_heights
+from .scenario import Scenario
 
 __all__ = [
     "COVERAGE_SHAPE",
@@ -64,8 +68,6 @@ COVERAGE_AREAS: dict[str, tuple[tuple[float, float], ...]] = {
 
 def coverage_area(name: str) -> Polygon:
     """The area ``"S1"`` … ``"S4"`` as a shapely Polygon [m]."""
-    from ..errors import WorldError
-
     key = str(name).strip().upper()
     if key not in COVERAGE_AREAS:
         raise WorldError(f"unknown coverage area {name!r}; valid: {', '.join(COVERAGE_AREAS)}")
@@ -95,10 +97,6 @@ def coverage(seed: int | np.random.Generator = 0, area: str = "S1"):
     ``start``/``goal`` are the first and last points of the best (DE) zigzag of
     ``area`` with D = 80 m, 100 m above the ground.
     """
-    from ..missions.coverage.bands import zigzag
-    from ..missions.coverage.optimise import differential_evolution
-    from .scenarios import Scenario
-
     world = coverage_world(seed)
     poly = coverage_area(area)
     best = differential_evolution(poly, COVERAGE_SPACING, seed=0)

@@ -1,4 +1,4 @@
-"""Built-in scenarios from the source documents.
+"""The open-field scenarios of the terrain-following paper and the thesis.
 
 * ``"open-field"`` — terrain-following paper / thesis ch. 4: 120 x 90 x 40 cells
   of 15 m, start (20, 20, 20) and goal (100, 80, 30) in cells.
@@ -13,64 +13,21 @@ Start and goal are world coordinates in metres (node-centred grid, origin 0).
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from dataclasses import dataclass
 from functools import lru_cache
-from typing import Any
 
 import numpy as np
 
 from ..errors import WorldError
-from .terrain import OPEN_FIELD_SHAPE, open_field_heights
-from .world import World
-from .buildings import city, city_high  # noqa: E402  (thesis ch. 3 city)
-from .coverage_map import coverage  # noqa: E402  (coverage paper 003, thesis ch. 5)
+from ..world import World
+from ..world.terrain import OPEN_FIELD_SHAPE, open_field_heights
+from .scenario import Scenario
 
-__all__ = [
-    "Scenario",
-    "open_field",
-    "fissure",
-    "get_scenario",
-    "SCENARIOS",
-    "OPEN_FIELD_CELL",
-    "OPEN_FIELD_HEIGHT_CELLS",
-]
+__all__ = ["open_field", "fissure", "OPEN_FIELD_CELL", "OPEN_FIELD_HEIGHT_CELLS"]
 
 #: Cell size of the open-field map [m] (same on x, y, z).
 OPEN_FIELD_CELL = 15.0
 #: Number of vertical nodes of the open-field map.
 OPEN_FIELD_HEIGHT_CELLS = 40
-
-
-@dataclass(frozen=True)
-class Scenario:
-    """A world with a start and a goal.
-
-    Attributes
-    ----------
-    world:
-        The :class:`World`.
-    start, goal:
-        ``(ndim,)`` world coordinates [m] (read-only float arrays).
-    description:
-        One line saying where the scenario comes from.
-    """
-
-    world: World
-    start: np.ndarray
-    goal: np.ndarray
-    description: str
-
-    def __post_init__(self) -> None:
-        for attr in ("start", "goal"):
-            p = np.array(getattr(self, attr), dtype=float, copy=True)
-            if p.shape != (self.world.ndim,):
-                raise WorldError(
-                    f"Scenario {attr} must be one point with {self.world.ndim} coordinates "
-                    f"in metres, got shape {p.shape}"
-                )
-            p.setflags(write=False)
-            object.__setattr__(self, attr, p)
 
 
 def _open_field_world_uncached(seed: int | np.random.Generator) -> World:
@@ -147,42 +104,3 @@ def fissure(seed: int | np.random.Generator = 0) -> Scenario:
         "Formation mission across the fissure between the two lateral mountains of the "
         "open field: start (x=30,y=40,z=25) → goal (x=112,y=40,z=30) cells [thesis ch. 6]",
     )
-
-
-def _city2d(seed: int | np.random.Generator = 0) -> Scenario:
-    """2D city map of the curvature study (see :mod:`fm2uav.world.maps2d`)."""
-    from .maps2d import city2d
-
-    return city2d(seed)
-
-
-def _jacksboro(seed: int | np.random.Generator = 0) -> Scenario:
-    """Real DEM of the Jacksboro fault (see :mod:`fm2uav.world.jacksboro`)."""
-    from .jacksboro import jacksboro
-
-    return jacksboro(seed)
-
-
-#: Scenario name → factory ``f(seed=0) -> Scenario``.
-SCENARIOS: dict[str, Callable[..., Scenario]] = {
-    "open-field": open_field,
-    "fissure": fissure,
-    "jacksboro": _jacksboro,
-    "city": city,
-    "city-high": city_high,
-    "coverage": coverage,
-    "city2d": _city2d,
-}
-
-
-def get_scenario(name: str, seed: int | np.random.Generator = 0, **kwargs: Any) -> Scenario:
-    """Build the built-in scenario called ``name`` (see :data:`SCENARIOS`).
-
-    ``"open_field"`` and different case are accepted as ``"open-field"``.
-    """
-    key = str(name).strip().lower().replace("_", "-").replace(" ", "-")
-    if key not in SCENARIOS:
-        raise WorldError(
-            f"unknown scenario {name!r}; valid names are: {', '.join(sorted(SCENARIOS))}"
-        )
-    return SCENARIOS[key](seed=seed, **kwargs)

@@ -19,8 +19,9 @@ from functools import lru_cache
 
 import numpy as np
 
-from .dem import from_dem
-from .world import World
+from ..world import World
+from ..world.dem import from_dem
+from .scenario import Scenario
 
 __all__ = ["jacksboro", "jacksboro_world", "jacksboro_dem", "JACKSBORO_CELL", "JACKSBORO_DZ"]
 
@@ -57,8 +58,6 @@ def jacksboro(seed: int | np.random.Generator = 0):
     ``seed`` is accepted for the common scenario signature and unused (the
     terrain is real data).
     """
-    from .scenarios import Scenario
-
     w = jacksboro_world()
     pts = []
     for i, j in (_START_COLUMN, _GOAL_COLUMN):

@@ -24,8 +24,8 @@ import numpy as np
 from ..planning import Plan, plan
 from ..vehicles import FeasibilityReport, check_feasibility, get_airframe
 from ..world import World
-from ..world.scenarios import Scenario, get_scenario
-from .rrt import RRTResult, plan_rrt
+from ..scenarios import Scenario, get_scenario
+from ..baselines.rrt import RRTResult, plan_rrt
 
 __all__ = [
     "THESIS_TABLE_3_1",
