@@ -24,8 +24,10 @@ run: $(STAMP)
 	@echo "outputs written to $(OUT)/mission/ — open $(OUT)/mission/report.html in a browser;"
 	@echo "mission.plan loads in QGroundControl, mission.waypoints is a MAVLink WPL 110 file"
 
-## make test: the whole suite
+## make test: the layer contract (import-linter, [tool.importlinter] in pyproject.toml),
+## then the whole suite
 test: $(STAMP)
+	$(VENV)/bin/lint-imports
 	$(VENV)/bin/pytest -q
 
 ## make bench: speed and memory against peers (writes benchmarks/results/*.json)

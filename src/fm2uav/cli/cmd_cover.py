@@ -95,11 +95,8 @@ def _write_report(outdir: OutputDir, cp, *, title: str, subtitle: str, metrics: 
 
 
 def _write_png(outdir: OutputDir, fig, name: str) -> None:
-    import matplotlib.pyplot as plt
-
     tmp = outdir.target(name)
     fig.savefig(tmp, dpi=110)
-    plt.close(fig)
     outdir.commit(tmp, name)
 
 

@@ -111,9 +111,6 @@ def _run_case(outdir: OutputDir, sc, *, title: str, gif: bool, frames: int,
         fig = make(result, title=title)
         tmp = outdir.target(name)
         fig.savefig(tmp, dpi=100)
-        import matplotlib.pyplot as plt
-
-        plt.close(fig)
         outdir.commit(tmp, name)
     _write_tables(outdir, result)
     with outdir.open("summary.json") as fh:

@@ -116,10 +116,6 @@ def plan_outputs(
         except BaseException:
             tmp.unlink(missing_ok=True)
             raise
-        finally:
-            import matplotlib.pyplot as plt
-
-            plt.close(fig)
         outdir.commit(tmp, "plan.png")
     if "json" in formats:
         with outdir.open("summary.json") as fh:

@@ -131,13 +131,10 @@ def _write_tff_outputs(outdir: OutputDir, rows, plans, sc, *, scenario: str, see
             [plans[i] for i in sm], [labels[i] for i in sm],
             title="Turn, climb and curvature profiles (level 10)"),
     }
-    import matplotlib.pyplot as plt
-
     tmps = {}
     for name, fig in figs.items():
         tmp = outdir.target(name)
         fig.savefig(tmp, dpi=100)
-        plt.close(fig)
         tmps[name] = tmp
     for name, tmp in tmps.items():
         outdir.commit(tmp, name)
@@ -324,15 +321,12 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         if res.best is None:
             md.insert(2, "**No candidate keeps the limits**; the Pareto front shows the closest.\n")
         if res.best_plan is not None:
-            import matplotlib.pyplot as plt
-
             from ..viz.tff import tff_profile_figure
 
             lab = f"best: p1={res.best['p1']:g}, p2={res.best['p2']:g}, α={res.best['saturation']:g}"
             fig = tff_profile_figure([res.best_plan], [agl], [lab], title="Tuned path")
             tmp = outdir.target("tune_best.png")
             fig.savefig(tmp, dpi=100)
-            plt.close(fig)
             with outdir.open("tune_best_path.csv") as fh:
                 write_path_csv(fh, res.best_plan.path, res.best_plan.speed)
             outdir.commit(tmp, "tune_best.png")

@@ -9,14 +9,12 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import matplotlib
+import numpy as np
+from matplotlib.colors import LightSource
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.colors import LightSource  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
-
-from .figures import _arc_length, terrain_along  # noqa: E402
+from ..world.ground import terrain_along
+from .figures import _arc_length
 
 if TYPE_CHECKING:
     from ..missions.coverage import CoveragePlan, Zigzag
@@ -50,7 +48,8 @@ def _draw_zigzag(ax, zz: Zigzag, *, bands_label: str = "bands") -> None:
 
 def bands_figure(zz: Zigzag, *, title: str | None = None) -> Figure:
     """Top view of the zigzag over the area: bands, arcs, extensions, start/end."""
-    fig, ax = plt.subplots(figsize=(7, 6))
+    fig = Figure(figsize=(7, 6))
+    ax = fig.subplots()
     _draw_area(ax, zz.area)
     _draw_zigzag(ax, zz)
     ax.set_aspect("equal")
@@ -70,11 +69,11 @@ def coverage_figure(cp: CoveragePlan, *, title: str | None = None) -> Figure:
     world = cp.plan.world
     path = cp.path
     b = world.bounds
-    fig = plt.figure(figsize=(17, 5.4))
+    fig = Figure(figsize=(17, 5.4))
     ax = fig.add_subplot(1, 3, 1)
     if world.terrain is not None:
         ls = LightSource(azdeg=315, altdeg=45)
-        rgb = ls.shade(world.terrain.T, cmap=plt.get_cmap("gist_earth"), vert_exag=2.0,
+        rgb = ls.shade(world.terrain.T, cmap=matplotlib.colormaps["gist_earth"], vert_exag=2.0,
                        dx=world.spacing[0], dy=world.spacing[1], blend_mode="soft")
         ax.imshow(rgb, origin="lower", extent=(b[0, 0], b[0, 1], b[1, 0], b[1, 1]))
     _draw_area(ax, cp.zigzag.area, color="white", label="area")

@@ -8,12 +8,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
+import numpy as np
+from matplotlib.figure import Figure
 
 if TYPE_CHECKING:
     from ..baselines.rrt import RRTResult
@@ -42,7 +38,8 @@ def tracking_figure(report: FeasibilityReport, world: World | None = None, *,
     """Planned vs flown path (top view, altitude, separation) of one feasibility report."""
     tr = report.tracking
     planned, flown = tr.planned, tr.trajectory
-    fig, axes = plt.subplots(1, 3, figsize=(16, 5), gridspec_kw={"width_ratios": [1.1, 1.3, 1.3]})
+    fig = Figure(figsize=(16, 5))
+    axes = fig.subplots(1, 3, gridspec_kw={"width_ratios": [1.1, 1.3, 1.3]})
     ax = axes[0]
     _footprint(ax, world)
     ax.plot(planned[:, 0], planned[:, 1], color="tab:blue", lw=2, label="planned")
@@ -83,7 +80,8 @@ def speed_profiles_figure(profiles: dict[str, tuple[np.ndarray, np.ndarray]], *,
                           title: str = "velocity profiles", ylabel: str = "W (0 = stall, 1 = max)"
                           ) -> Figure:
     """Fig. 3.4 style: one curve per label, ``label -> (s [m], value)``."""
-    fig, ax = plt.subplots(figsize=(8, 4.2))
+    fig = Figure(figsize=(8, 4.2))
+    ax = fig.subplots()
     for label, (s, v) in profiles.items():
         ax.plot(s, v, lw=1.6, label=label)
     ax.set_xlabel("distance along the path [m]")
@@ -99,7 +97,8 @@ def speed_profiles_figure(profiles: dict[str, tuple[np.ndarray, np.ndarray]], *,
 def city_cases_figure(cases: Sequence[Any], world: World, *, title: str = "") -> Figure:
     """Figs. 3.2/3.3/3.7 style: per exponent, top view and altitude of planned vs flown."""
     n = len(cases)
-    fig, axes = plt.subplots(2, n, figsize=(5.2 * n, 9), squeeze=False)
+    fig = Figure(figsize=(5.2 * n, 9))
+    axes = fig.subplots(2, n, squeeze=False)
     for j, c in enumerate(cases):
         tr = c.report.tracking
         ax = axes[0, j]
@@ -129,7 +128,8 @@ def rrt_figure(world: World, results: dict[str, RRTResult], fm2_path: np.ndarray
                title: str = "FM² vs RRT") -> Figure:
     """Thesis Fig. 3.5 style: trees (black), raw paths (red), smoothed (green), FM² (blue)."""
     n = len(results)
-    fig, axes = plt.subplots(1, n, figsize=(5.5 * n, 5.5), squeeze=False)
+    fig = Figure(figsize=(5.5 * n, 5.5))
+    axes = fig.subplots(1, n, squeeze=False)
     for ax, (name, r) in zip(axes[0], results.items()):
         _footprint(ax, world)
         for e in r.tree[: 5000]:

@@ -5,19 +5,16 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import matplotlib
+import numpy as np
+from matplotlib.colors import LightSource
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")  # files only; never needs a display
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.colors import LightSource  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
-
-from ..world.ground import terrain_along  # noqa: E402
+from ..world.ground import terrain_along
 
 if TYPE_CHECKING:
     from ..planning import Plan
 
-__all__ = ["plan_figure", "terrain_along"]
+__all__ = ["plan_figure"]
 
 
 def _arc_length(path: np.ndarray) -> np.ndarray:
@@ -44,14 +41,13 @@ def plan_figure(plan: Plan, *, title: str | None = None) -> Figure:
     b = world.bounds
     extent = (b[0, 0], b[0, 1], b[1, 0], b[1, 1])
     three_d = world.ndim == 3
-    fig, axes = plt.subplots(
-        1, 2 if three_d else 1, figsize=(13 if three_d else 7, 5.2), squeeze=False,
-        gridspec_kw={"width_ratios": [1.1, 1.4]} if three_d else None,
-    )
+    fig = Figure(figsize=(13 if three_d else 7, 5.2))
+    axes = fig.subplots(1, 2 if three_d else 1, squeeze=False,
+                        gridspec_kw={"width_ratios": [1.1, 1.4]} if three_d else None)
     ax = axes[0, 0]
     if three_d and world.terrain is not None:
         ls = LightSource(azdeg=315, altdeg=45)
-        rgb = ls.shade(world.terrain.T, cmap=plt.get_cmap("gist_earth"), vert_exag=2.0,
+        rgb = ls.shade(world.terrain.T, cmap=matplotlib.colormaps["gist_earth"], vert_exag=2.0,
                        dx=world.spacing[0], dy=world.spacing[1], blend_mode="soft")
         ax.imshow(rgb, origin="lower", extent=extent, aspect="equal")
         cs = ax.contour(np.linspace(b[0, 0], b[0, 1], world.shape[0]),

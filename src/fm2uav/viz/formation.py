@@ -21,15 +21,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import matplotlib
+import numpy as np
+from matplotlib import animation
+from matplotlib.colors import LightSource
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")  # files only; never needs a display
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib import animation  # noqa: E402
-from matplotlib.colors import LightSource  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
-
-from ..analysis.flight_level import ground_altitude  # noqa: E402
+from ..analysis.flight_level import ground_altitude
 
 if TYPE_CHECKING:
     from ..missions.formation import FormationResult
@@ -57,7 +54,7 @@ def _extent(world) -> tuple[float, float, float, float]:
 def _terrain_background(ax, world) -> None:
     if world.terrain is not None:
         ls = LightSource(azdeg=315, altdeg=45)
-        rgb = ls.shade(world.terrain.T, cmap=plt.get_cmap("gist_earth"), vert_exag=2.0,
+        rgb = ls.shade(world.terrain.T, cmap=matplotlib.colormaps["gist_earth"], vert_exag=2.0,
                        dx=world.spacing[0], dy=world.spacing[1], blend_mode="soft")
         ax.imshow(rgb, origin="lower", extent=_extent(world), aspect="equal")
     else:
@@ -98,7 +95,8 @@ def formation_paths_figure(
     """
     world = result.world
     pos = result.positions
-    fig, axes = plt.subplots(1, 2, figsize=(15, 5.8))
+    fig = Figure(figsize=(15, 5.8))
+    axes = fig.subplots(1, 2)
     ax = axes[0]
     _terrain_background(ax, world)
     for i, name in enumerate(result.names):
@@ -156,7 +154,8 @@ def formation_profiles_figure(result: FormationResult, *, title: str | None = No
     world = result.world
     pos = result.positions
     n = result.n_uav
-    fig, axes = plt.subplots(n, 1, figsize=(10, 2.6 * n), sharex=False, squeeze=False)
+    fig = Figure(figsize=(10, 2.6 * n))
+    axes = fig.subplots(n, 1, sharex=False, squeeze=False)
     b = world.bounds
     for i in range(n):
         ax = axes[i, 0]
@@ -191,7 +190,8 @@ def formation_profiles_figure(result: FormationResult, *, title: str | None = No
 
 def formation_metrics_figure(result: FormationResult, *, title: str | None = None) -> Figure:
     """Smallest inter-UAV distance, shape error and grey levels over time."""
-    fig, axes = plt.subplots(3, 1, figsize=(10, 7.5), sharex=True)
+    fig = Figure(figsize=(10, 7.5))
+    axes = fig.subplots(3, 1, sharex=True)
     t = result.times
     ax = axes[0]
     ax.plot(t, result.min_distance, color="k", lw=1.5, label="smallest inter-UAV distance")
@@ -267,7 +267,8 @@ def formation_animation(
     world = result.world
     pos = result.positions
     frames = _snapshot_samples(result, max_frames)
-    fig, ax = plt.subplots(figsize=(7.5, 6))
+    fig = Figure(figsize=(7.5, 6))
+    ax = fig.subplots()
     _terrain_background(ax, world)
     trails = [ax.plot([], [], color=_colour(i), lw=1.2)[0] for i in range(result.n_uav)]
     goal_line, = ax.plot([], [], color="lime", lw=1.0)
@@ -298,5 +299,4 @@ def formation_animation(
     anim = animation.FuncAnimation(fig, draw, frames=frames, blit=False)
     path.parent.mkdir(parents=True, exist_ok=True)
     anim.save(str(path), writer=writer, dpi=dpi)
-    plt.close(fig)
     return path

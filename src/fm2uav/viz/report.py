@@ -44,7 +44,7 @@ def _arc(path: np.ndarray) -> np.ndarray:
 def _ground(world: Any, path: np.ndarray) -> np.ndarray | None:
     if world is None or getattr(world, "terrain", None) is None or path.shape[1] != 3:
         return None
-    from .figures import terrain_along
+    from ..world.ground import terrain_along
 
     return np.asarray(terrain_along(world, path), dtype=float)
 

@@ -9,15 +9,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-import matplotlib
+import numpy as np
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
-
-from ..analysis.flight_level import ground_altitude, ideal_altitude  # noqa: E402
-from ..analysis.profiles import path_profiles  # noqa: E402
+from ..analysis.flight_level import ground_altitude, ideal_altitude
+from ..analysis.profiles import path_profiles
 
 if TYPE_CHECKING:
     from ..planning import Plan
@@ -32,7 +28,7 @@ def _arc(path: np.ndarray) -> np.ndarray:
 def tff_3d_figure(plans: Sequence[Plan], labels: Sequence[str], *, title: str = "") -> Figure:
     """3D view of the terrain (from the first plan's world) with the paths."""
     world = plans[0].world
-    fig = plt.figure(figsize=(8.5, 6.0))
+    fig = Figure(figsize=(8.5, 6.0))
     ax = fig.add_subplot(projection="3d")
     if world.terrain is not None:
         step = max(1, int(max(world.shape[:2]) // 90))
@@ -59,7 +55,8 @@ def tff_profile_figure(
 ) -> Figure:
     """Path vs ideal path (terrain + agl) vs terrain along the arc length, one panel per plan."""
     n = len(plans)
-    fig, axes = plt.subplots(n, 1, figsize=(8.5, 2.3 * n + 0.6), squeeze=False)
+    fig = Figure(figsize=(8.5, 2.3 * n + 0.6))
+    axes = fig.subplots(n, 1, squeeze=False)
     for ax, p, agl, lab in zip(axes[:, 0], plans, agls, labels):
         q = p.path
         s = _arc(q)
@@ -86,7 +83,8 @@ def tff_kinematics_figure(
     plans: Sequence[Plan], labels: Sequence[str], *, ds: float | None = None, title: str = ""
 ) -> Figure:
     """Turn angle, climb angle and curvature profiles (figs. 11-13 of the TFF paper)."""
-    fig, axes = plt.subplots(3, 1, figsize=(8.5, 7.5), sharex=True)
+    fig = Figure(figsize=(8.5, 7.5))
+    axes = fig.subplots(3, 1, sharex=True)
     for p, lab in zip(plans, labels):
         step = ds if ds is not None else float(max(p.world.spacing[:2]))
         pr = path_profiles(p.path, ds=step)
