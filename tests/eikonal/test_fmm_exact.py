@@ -10,11 +10,17 @@ are frozen at 0. With at most 64 sources, each source whose box of half-width
 ``R = max(2 max(h), 0.05 * extent)`` (extent: largest ``(n - 1) h`` of the grid;
 ``floor(R / h)`` nodes either side per axis, clipped) holds only speeds > 0 with
 ``max / min <= 1.5`` (``BALL_MAX_SPEED_RATIO``) is *clean*, and nodes with
-``d <= R`` from it get the straight-ray time ``d * (1/v_s + 1/v) / 2`` (minimum
-over sources). If every source is clean these ball nodes are frozen (final);
-otherwise they start in the band and the march may lower them. The straight
-ray sees only the speeds at its two ends, hence the ratio rule: a slow wall or
-a speed jump inside the box must not be crossed for free. Positive speeds below
+``d <= R`` from it get a ball time (minimum over sources): the straight-ray time
+``d / v`` if the box's speed is constant, else the factored equation
+``T = T0 tau`` (``T0 = d / v_s``) marched on the box (``fm2uav.eikonal._sources``).
+Along a strip that is the trapezoidal rule of the slowness ``s = 1 / v``: next
+to the source ``T_1 = h (s_0 + s_1) / 2``, then (second order, ``tau_k = T_k /
+(k h s_0)``) ``(1 + 3k/2) s_0 tau_k = s_k + k s_0 (2 tau_{k-1} - tau_{k-2} / 2)``,
+so ``T_2 = h (s_0 + 2 s_1 + s_2) / 2`` (``_strip_ball`` below). If every source
+is clean these ball nodes are frozen (final); otherwise they start in the band
+and the march may lower them. The ball assumes a smooth speed, hence the ratio
+rule: a slow wall or a speed jump inside the box is left to the march (it must
+not be crossed for free). Positive speeds below
 1e-150 count as 1e-150. First-order update along one axis: ``T1 + h / v``; two
 axes with equal spacing: the root of ``(T - T1)^2 + (T - T2)^2 = (h / v)^2``.
 
@@ -24,6 +30,7 @@ On the small grids here ``0.05 * extent < 2 h`` unless said otherwise, so R = 2 
 from __future__ import annotations
 
 import math
+from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -40,6 +47,19 @@ CORNER_1ST = 1.0 + 1.0 / SQ2  # two-axis first-order update from T1 = T2 = 1, h 
 @pytest.fixture(params=sorted(SOLVERS))
 def solver(request):
     return SOLVERS[request.param]
+
+
+def _strip_ball(speeds, h: float = 1.0) -> list[float]:
+    """Ball times [s] along a strip from a source at node 0 (module docstring).
+
+    ``speeds`` [m/s] of nodes 0..K (the ball nodes), ``h`` [m]; exact fractions
+    of the recurrence, rounded to float once at the end.
+    """
+    s = [1 / Fraction(v) for v in speeds]  # slowness [s/m]
+    tau = [Fraction(1), (s[0] + s[1]) / (2 * s[0])]
+    for k in range(2, len(s)):
+        tau.append((s[k] + k * s[0] * (2 * tau[k - 1] - tau[k - 2] / 2)) / ((1 + Fraction(3, 2) * k) * s[0]))
+    return [float(k * h * s[0] * t) for k, t in enumerate(tau)]
 
 
 # ------------------------------------------------------------------ 1D-like strips
@@ -61,14 +81,15 @@ def test_strip_frozen_ball_is_kept_when_every_source_is_clean(solver):
     # speeds 1, 1.25, 1.5, 1, 0.5, 1 from the source at node 0, h = 1 (R = 2:
     # 0.05 * 5 < 2). The box is nodes 0..2, max/min = 1.5 / 1 = 1.5 <= 1.5 (the
     # limit itself is allowed), so the only source is clean and its ball frozen:
-    # node 1 = 1*(1 + 1/1.25)/2 = 0.9, node 2 = 2*(1 + 1/1.5)/2 = 5/3, although the
-    # stencil would give 0.8 and 0.8 + 2/3 = 22/15. The slower nodes 3..5 lie
-    # outside the box and do not matter. Then node 3 = 5/3 + 1 = 8/3,
-    # node 4 = 8/3 + 2 = 14/3, node 5 = 14/3 + 1 = 17/3.
+    # node 1 = (1 + 1/1.25)/2 = 0.9, node 2 = (1 + 2/1.25 + 1/1.5)/2 = 49/30,
+    # although the stencil would give 0.8 and 0.8 + 2/3 = 22/15. The slower nodes
+    # 3..5 lie outside the box and do not matter. Then node 3 = 49/30 + 1 = 79/30,
+    # node 4 = 79/30 + 2 = 139/30, node 5 = 139/30 + 1 = 169/30.
     speed = np.array([[1.0], [1.25], [1.5], [1.0], [0.5], [1.0]])
     T = solver(speed, [(0, 0)], order=1)
-    expected = np.array([[0.0], [0.9], [5 / 3], [8 / 3], [14 / 3], [17 / 3]])
+    expected = np.array([[0.0], [0.9], [49 / 30], [79 / 30], [139 / 30], [169 / 30]])
     assert_same_field(T, expected, RTOL)
+    np.testing.assert_allclose(_strip_ball([1.0, 1.25, 1.5]), expected[:3, 0], rtol=RTOL)
 
 
 @pytest.mark.parametrize(
@@ -115,22 +136,22 @@ def test_strip_band_ball_is_lowered_when_a_source_is_not_clean(solver):
 
 def test_strip_ball_value_kept_when_lower(solver):
     # speeds 1, 0.8, 0.75, 1, 1 (box 0..2: max/min = 1/0.75 = 4/3 <= 1.5, clean):
-    # the ball values 1*(1 + 1.25)/2 = 1.125 and 2*(1 + 4/3)/2 = 7/3 (frozen; they
-    # are lower than the stencil's 1/0.8 = 1.25 and 1.125 + 4/3 = 59/24 anyway);
-    # beyond R = 2 the stencil continues: 7/3 + 1 = 10/3, 10/3 + 1 = 13/3.
+    # the ball values (1 + 1.25)/2 = 1.125 and (1 + 2.5 + 4/3)/2 = 29/12 (frozen;
+    # they are lower than the stencil's 1/0.8 = 1.25 and 1.125 + 4/3 = 59/24
+    # anyway); beyond R = 2 the stencil continues: 29/12 + 1 = 41/12, + 1 = 53/12.
     speed = np.array([[1.0], [0.8], [0.75], [1.0], [1.0]])
     T = solver(speed, [(0, 0)], order=1)
-    assert_same_field(T, np.array([[0.0], [1.125], [7 / 3], [10 / 3], [13 / 3]]), RTOL)
+    assert_same_field(T, np.array([[0.0], [1.125], [29 / 12], [41 / 12], [53 / 12]]), RTOL)
 
 
 def test_strip_second_order_by_hand_frozen_ball(solver):
     # speeds 1, 1.25, 1.5, 1, h = 1, order 2 (clean: max/min = 1.5). Frozen ball:
-    # node 1 = 0.9, node 2 = 5/3.
-    # node 3: T1 = 5/3, T2 = 0.9 <= T1 -> tau = (4*5/3 - 9/10)/3 = 173/90, a = 9/4
-    #         -> 173/90 + (2/3)(1/1) = 233/90
+    # node 1 = 0.9, node 2 = 49/30.
+    # node 3: T1 = 49/30, T2 = 0.9 <= T1 -> tau = (4*49/30 - 9/10)/3 = 169/90, a = 9/4
+    #         -> 169/90 + (2/3)(1/1) = 229/90
     speed = np.array([[1.0], [1.25], [1.5], [1.0]])
     T = solver(speed, [(0, 0)], order=2)
-    assert_same_field(T, np.array([[0.0], [0.9], [5 / 3], [233 / 90]]), RTOL)
+    assert_same_field(T, np.array([[0.0], [0.9], [49 / 30], [229 / 90]]), RTOL)
 
 
 def test_strip_second_order_by_hand_band_ball(solver):
@@ -152,14 +173,18 @@ def test_strip_second_order_by_hand_band_ball(solver):
 def test_ball_radius_is_five_percent_of_the_extent(solver, n, reach, h):
     # A strip of n nodes, speed 1 at the source (node 0), 1.5 elsewhere (max/min =
     # 1.5: clean); order 1. R = max(2 h, 0.05 (n - 1) h): n = 101 -> 5 h, n = 21 ->
-    # 2 h. Ball nodes (k <= reach) are frozen at k h (1 + 1/1.5)/2 = (5/6) k h;
-    # beyond them the stencil adds h / 1.5 = (2/3) h per node.
+    # 2 h. Ball nodes (k <= reach) are frozen at the strip recurrence (module
+    # docstring): 5/6 h, 3/2 h, then (n = 101) 47/22 h, 214/77 h, ...; beyond them
+    # the stencil adds h / 1.5 = (2/3) h per node.
     speed = np.full((n, 1), 1.5)
     speed[0, 0] = 1.0
     T = solver(speed, [(0, 0)], spacing=h, order=1)
+    ball = _strip_ball(speed[: reach + 1, 0], h)
+    assert math.isclose(ball[1], 5 / 6 * h, rel_tol=RTOL)
+    assert math.isclose(ball[2], 3 / 2 * h, rel_tol=RTOL)
     k = np.arange(n, dtype=float)
     expected = np.where(
-        k <= reach, 5 / 6 * k * h, 5 / 6 * reach * h + 2 / 3 * (k - reach) * h
+        k <= reach, np.pad(ball, (0, n - reach - 1)), ball[-1] + 2 / 3 * (k - reach) * h
     )
     assert_same_field(T, expected.reshape(n, 1), RTOL)
 
@@ -413,23 +438,35 @@ def _two_source_grid(v_source: float, obstacle: float | None):
 @pytest.mark.parametrize("order", [1, 2])
 def test_ball_frozen_when_all_clean_lowered_in_band_mode(solver, order, obstacle):
     # Both boxes hold speeds 1 and 1.5 (max/min = 1.5): both sources clean. Around A
-    # the ball value is d (1/1 + 1/1.5)/2 = (5/6) d, more than the march finds
-    # (e.g. 0 + 1/1.5 = 2/3 at d = 1: the wave leaves the slow source node at once).
+    # the factored ball gives, on the axes, (1 + 1/1.5)/2 = 5/6 at d = 1 and
+    # (1 + 2/1.5 + 1/1.5)/2 = 3/2 at d = 2 (strip recurrence), and on the diagonal
+    # (d = sqrt 2, first order from the two axis neighbours, T0 = sqrt 2, tau_1 =
+    # 5/6, alpha = 1/sqrt 2 + sqrt 2, beta = 5 sqrt 2 / 6 per axis):
+    # 2 (alpha tau - beta)^2 = (2/3)^2 -> tau = 7/9, T = 7 sqrt(2) / 9. All frozen:
+    # more than the march finds (e.g. 0 + 1/1.5 = 2/3 at d = 1: the wave leaves
+    # the slow source node at once).
     d = distance_from((21, 21), (1.0, 1.0), (5, 5))
     ball = (d <= 2.0) & (d > 0)  # A's ball nodes (all nearer to A than to B)
     T_frozen = solver(*_two_source_grid(1.0, obstacle=None), order=order)
-    np.testing.assert_allclose(T_frozen[ball], 5 / 6 * d[ball], rtol=RTOL, atol=0)
+    for dist, value in [(1.0, 5 / 6), (2.0, 3 / 2), (SQ2, 7 * SQ2 / 9)]:
+        ring = ball & np.isclose(d, dist)
+        assert ring.sum() == 4
+        np.testing.assert_allclose(T_frozen[ring], value, rtol=RTOL, atol=0)
+    # the same for either order (the ball does not depend on the march's order),
+    # frozen before the march (stop at the sources: nothing else is marched)
+    init = solver(*_two_source_grid(1.0, obstacle=None), order=order, stop_at=[(5, 5), (15, 15)])
+    np.testing.assert_allclose(init[ball], T_frozen[ball], rtol=RTOL, atol=0)
     # Band mode (B's box: a wall 0, a slow node 0.5 (max/min 3) or a fast node
-    # 2.4 (1.6x the background, max/min 2.4)): the march lowers every one of A's
-    # ball nodes, by 0.040 (the diagonal, d = sqrt 2: ball 1.1785 vs stencil
-    # 2/3 (1 + 1/sqrt 2) = 1.1381) .. 1/3 s (d = 2 on an axis: 5/3 vs 4/3),
-    # measured, both orders, all three obstacles; at d = 1 to exactly 2/3.
+    # 2.4 (1.6x the background, max/min 2.4)): the march lowers A's axis nodes,
+    # at d = 1 from 5/6 to 0 + 1/1.5 = 2/3 and at d = 2 from 3/2 to 2/3 + 2/3 =
+    # 4/3 (order 2 too: (4 * 2/3 - 0)/3 + (2/3)/1.5 = 4/3, T being linear along
+    # the axis), while the diagonal keeps its ball value 7 sqrt(2)/9 =
+    # 1.0999, below the stencil's 2/3 (1 + 1/sqrt 2) = 1.1381.
     T_band = solver(*_two_source_grid(1.0, obstacle=obstacle), order=order)
-    assert np.all(T_band[ball] < 5 / 6 * d[ball] - 0.03)
-    axis_nb = ball & (d == 1.0)
-    np.testing.assert_allclose(T_band[axis_nb], 2 / 3, rtol=RTOL, atol=0)
-    diag = ball & np.isclose(d, SQ2)
-    np.testing.assert_allclose(T_band[diag], 2 / 3 * CORNER_1ST, rtol=RTOL, atol=0)
+    for dist, value in [(1.0, 2 / 3), (2.0, 4 / 3), (SQ2, 7 * SQ2 / 9)]:
+        ring = ball & np.isclose(d, dist)
+        np.testing.assert_allclose(T_band[ring], value, rtol=RTOL, atol=0)
+    assert 7 * SQ2 / 9 < 2 / 3 * CORNER_1ST
 
 
 def test_band_ball_keeps_values_lower_than_the_stencil(solver):

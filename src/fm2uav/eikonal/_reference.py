@@ -26,14 +26,33 @@ Sources
     its bounding box (clipped to the grid, ``floor(R / h_axis)`` nodes either
     side per axis) holds no node of speed ``<= 0`` and its largest speed is at
     most ``BALL_MAX_SPEED_RATIO = 1.5`` times its smallest. Around every clean source,
-    every node at physical distance ``d <= R`` other than a source gets the
-    straight-ray time ``d * 0.5 * (1/v_source + 1/v_node)`` if that is smaller
-    than its current value (so the minimum over sources wins); only the speeds
-    at the two ends enter, not those in between. If *every*
+    every node at physical distance ``d <= R`` other than a source gets a ball
+    time if that is smaller than its current value (so the minimum over
+    sources wins): if the box's speed is constant, the straight-ray time
+    ``d * 0.5 * (1/v_source + 1/v_node)``; otherwise the time of the factored
+    equation solved on the box (below). If *every*
     source is clean, these ball nodes are frozen: their values are final. If
     at least one source is not clean, the ball nodes only join the narrow band,
     so the march may still lower them (e.g. via a nearer route past an
     obstacle beside another source).
+
+Factored ball (varying speed in a clean box)
+    A separate march over the box nodes only, with ``T = T0 * tau``,
+    ``T0 = |x - x_s| / v_source`` and ``tau = 1`` at the source. A node is
+    updated from its frozen box neighbours: per axis the one with the smaller
+    ``T`` (minus side on a tie), at ``x -/+ e``; ``sigma = +1`` for the minus
+    side, ``-1`` for the plus side. If the next box node in that direction is
+    frozen with ``T2 <= T1``: ``a = 3 / (2 h)``, ``b = (4 tau_1 - tau_2) / 3``,
+    else ``a = 1 / h``, ``b = tau_1``. With ``p = dT0/dx_axis =
+    (x_axis - x_s,axis) / (v_source |x - x_s|)`` the axis gives
+    ``alpha = p + T0 sigma a`` and ``beta = T0 sigma a b``. For every
+    non-empty subset of these axes, the larger root ``tau`` of
+    ``sum (alpha tau - beta)^2 = 1 / v^2`` is a candidate if the discriminant
+    is ``>= 0`` and, on every axis of the subset,
+    ``sigma (alpha tau - beta) >= 0`` and ``T0 tau >= T1``; the node takes the
+    smallest candidate ``T0 tau`` or, if there is none, the smallest
+    ``T1 + h / v`` over its axes, when that is below its current value. The
+    box march freezes the smallest time first, until the box is done.
 
 Local update of a node ``x`` with speed ``v``
     For each axis take the frozen neighbour (``x - e`` or ``x + e``) with the
@@ -201,6 +220,105 @@ def _local_solution(
     return t
 
 
+def _factored_box_times(
+    speed: np.ndarray,
+    source: Index,
+    ranges: list[range],
+    spacing: tuple[float, ...],
+) -> dict[Index, float]:
+    """Times [s] of the factored equation on one source's box (module docstring).
+
+    Parameters
+    ----------
+    speed : ndarray
+        Speeds [m/s]; every node of the box has speed > 0.
+    source : tuple of int
+        The source node.
+    ranges : list of range
+        The box: node indices per axis.
+    spacing : tuple of float
+        Spacing per axis [m].
+
+    Returns
+    -------
+    dict
+        Box node -> arrival time [s] (0 at the source).
+    """
+    ndim = len(spacing)
+    s_source = 1.0 / float(speed[source])  # slowness at the source [s/m]
+    inside = set(itertools.product(*ranges))
+    times: dict[Index, float] = {source: 0.0}
+    factor: dict[Index, float] = {source: 1.0}  # tau = T / T0
+    done: set[Index] = set()
+    heap: list[tuple[float, Index]] = [(0.0, source)]
+
+    def offset(node: Index) -> tuple[list[float], float]:
+        x = [(node[ax] - source[ax]) * spacing[ax] for ax in range(ndim)]
+        d2 = 0.0
+        for xa in x:
+            d2 += xa * xa
+        return x, math.sqrt(d2)
+
+    def update(node: Index) -> float:
+        x, dist = offset(node)
+        t0 = s_source * dist
+        slow = 1.0 / float(speed[node])
+        axes = []  # (alpha, beta, sigma, T1, h) per upwind axis
+        for ax in range(ndim):
+            side, t1 = 0, math.inf
+            for step in (-1, 1):  # minus side first: it wins a tie
+                nb = _shifted(node, ax, step)
+                if nb in done and times[nb] < t1:
+                    side, t1 = step, times[nb]
+            if side == 0:
+                continue
+            nb1 = _shifted(node, ax, side)
+            nb2 = _shifted(node, ax, 2 * side)
+            ka, kb = 1.0 / spacing[ax], factor[nb1]
+            if nb2 in done and times[nb2] <= t1:
+                ka, kb = 1.5 / spacing[ax], (4.0 * factor[nb1] - factor[nb2]) / 3.0
+            sigma = -1.0 * side
+            alpha = s_source * x[ax] / dist + t0 * sigma * ka
+            axes.append((alpha, t0 * sigma * ka * kb, sigma, t1, spacing[ax]))
+        best = math.inf
+        for k in range(1, len(axes) + 1):
+            for subset in itertools.combinations(axes, k):
+                A = B = C = 0.0
+                for alpha, beta, *_ in subset:
+                    A += alpha * alpha
+                    B += alpha * beta
+                    C += beta * beta
+                if A <= 0.0:
+                    continue
+                disc = B * B - A * (C - slow * slow)
+                if disc < 0.0:
+                    continue
+                f = (B + math.sqrt(disc)) / A
+                t = t0 * f
+                if t < best and all(
+                    sigma * (alpha * f - beta) >= 0.0 and t >= t1
+                    for alpha, beta, sigma, t1, _ in subset
+                ):
+                    best = t
+        if best == math.inf:  # no admissible root: first-order one-sided update
+            best = min((t1 + hx * slow for *_, t1, hx in axes), default=math.inf)
+        return best
+
+    while heap:
+        t, node = heapq.heappop(heap)
+        if node in done or t != times[node]:  # stale entry
+            continue
+        done.add(node)
+        for nb in _neighbours(node, speed.shape):
+            if nb in inside and nb not in done:
+                t_new = update(nb)
+                if t_new < times.get(nb, math.inf):
+                    times[nb] = t_new
+                    factor[nb] = t_new / (s_source * offset(nb)[1])
+                    heapq.heappush(heap, (t_new, nb))
+    return times
+
+
 def _as_nodes(points: Any, ndim: int) -> list[Index]:
     """Turn one index tuple or a sequence of them into a list of int tuples."""
     arr = np.asarray(points)
@@ -239,7 +357,7 @@ def fast_marching_reference(
         Stop once all these nodes are frozen; nodes not frozen by then are
         ``inf``.
     source_ball : bool, optional
-        Use the straight-ray ball (default True); False: sources are plain
+        Use the source ball (default True); False: sources are plain
         ``T = 0`` nodes, as with more than ``MAX_BALL_SOURCES`` sources.
 
     Returns
@@ -264,27 +382,30 @@ def fast_marching_reference(
         frozen[s] = True
     is_source = set(source_nodes)
 
-    # ---- straight-ray ball around every clean source
-    ball: dict[Index, float] = {}  # node -> smallest straight-ray time [s]
+    # ---- ball around every clean source
+    ball: dict[Index, float] = {}  # node -> smallest ball time [s]
     if source_ball and len(source_nodes) <= MAX_BALL_SOURCES:  # counted with repeats
         extent = max((n - 1) * hx for n, hx in zip(shape, h))  # [m]
         radius = max(SOURCE_RADIUS_CELLS * max(h), SOURCE_RADIUS_FRACTION * extent)  # [m]
         reach = [int(math.floor(radius / hx)) for hx in h]  # nodes per axis
-        boxes = []
+        boxes, box_ranges = [], []
         for s in source_nodes:
             ranges = [
                 range(max(s[ax] - reach[ax], 0), min(s[ax] + reach[ax], shape[ax] - 1) + 1)
                 for ax in range(ndim)
             ]
+            box_ranges.append(ranges)
             boxes.append(list(itertools.product(*ranges)))
-        clean = []
+        clean, constant = [], []
         for box in boxes:
             speeds = [float(speed[node]) for node in box]
             clean.append(min(speeds) > 0.0 and max(speeds) <= BALL_MAX_SPEED_RATIO * min(speeds))
-        for s, box, ok in zip(source_nodes, boxes, clean):
+            constant.append(min(speeds) == max(speeds))
+        for s, box, ranges, ok, flat in zip(source_nodes, boxes, box_ranges, clean, constant):
             if not ok:
                 continue
             v_source = float(speed[s])
+            factored = None if flat else _factored_box_times(speed, s, ranges, h)
             for node in box:
                 d2 = 0.0
                 for ax in range(ndim):
@@ -292,7 +413,10 @@ def fast_marching_reference(
                     d2 += dx * dx
                 if d2 > radius * radius or node in is_source:
                     continue
-                t = math.sqrt(d2) * 0.5 * (1.0 / v_source + 1.0 / float(speed[node]))
+                if factored is None:  # constant speed: the exact straight ray
+                    t = math.sqrt(d2) * 0.5 * (1.0 / v_source + 1.0 / float(speed[node]))
+                else:
+                    t = factored[node]
                 if t < ball.get(node, math.inf):
                     ball[node] = t
         freeze_ball = all(clean)

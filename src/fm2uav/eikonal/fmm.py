@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from . import _kernels
+from . import _kernels, _sources
 
 __all__ = ["fast_marching", "as_spacing", "as_index_array"]
 
@@ -28,9 +28,10 @@ SOURCE_INIT_FRACTION = 0.05
 #: obstacle nodes of a map) sources are plain T = 0 nodes.
 MAX_BALL_SOURCES = 64
 #: A source gets its ball only where the speed in the ball's box varies by at
-#: most this factor (max/min): the straight-ray time sees only the speeds at
-#: the ray's two ends, so a slow wall or a jump (e.g. a flight-level layer)
-#: inside the box would be crossed for free.
+#: most this factor (max/min): the ball's times (straight ray for a constant
+#: speed, the factored eikonal equation otherwise, see ``_sources``) assume a
+#: smooth speed, so a slow wall or a jump (e.g. a flight-level layer) inside the
+#: box is left to the march and its first-order fallback across jumps.
 BALL_MAX_SPEED_RATIO = 1.5
 #: Positive speeds below this are raised to it, so that ``1 / speed**2`` stays
 #: finite (smaller speeds would otherwise act as walls).
@@ -136,7 +137,9 @@ def fast_marching(
         Grid indices where ``T = 0``. Each must have speed > 0. Around point
         sources (at most 64) whose neighbourhood has a positive speed varying by
         at most 1.5x, nodes within ``max(2 cells, 5 % of the grid extent)`` get
-        the straight-ray time, which keeps the order-2 scheme second-order.
+        accurate times before the march (the straight-ray time for a constant
+        speed, the factored eikonal equation solved on the ball's box for a
+        varying one), which keeps the order-2 scheme second-order.
     spacing : float or sequence of float, optional
         Node spacing [m], one value or one per axis. Default 1.
     order : {1, 2}, optional
@@ -146,7 +149,7 @@ def fast_marching(
         Stop as soon as all these nodes are frozen. Nodes not frozen by then are
         returned as ``inf``.
     source_ball : bool, optional
-        Initialise the straight-ray ball around point sources (default True).
+        Initialise the ball around point sources (default True).
         The ball is skipped automatically where the speed near a source is not
         smooth (max/min > 1.5 in its box); False disables it everywhere.
 
@@ -194,7 +197,9 @@ def fast_marching(
     radius = max(SOURCE_INIT_CELLS * max(h), SOURCE_INIT_FRACTION * extent)
     if src.shape[0] > MAX_BALL_SOURCES or not source_ball:
         radius = 0.0
-    _kernels.init_sources(
+    # source ball: exact straight-ray times for a constant speed, the factored
+    # eikonal equation on the ball's box otherwise (docs/eikonal.md)
+    _sources.init_sources(
         flat_speed, T, state, *shape3, *h3, src3, radius, BALL_MAX_SPEED_RATIO
     )
 
