@@ -26,7 +26,7 @@ from .errors import (
     WorldError,
 )
 from .missions import CoveragePlan, FormationResult, fly_formation, plan_coverage, zigzag
-from .planning import Plan, plan
+from .planning import FlightLevel, Plan, PlanOptions, Shaping, plan
 from .scenarios import Scenario
 from .vehicles import AIRFRAMES, FeasibilityReport, check_feasibility, get_airframe
 from .world import World
@@ -59,6 +59,9 @@ __all__ = [
     # planning
     "plan",
     "Plan",
+    "Shaping",
+    "FlightLevel",
+    "PlanOptions",
     "tune",
     "AirframeLimits",
     # world

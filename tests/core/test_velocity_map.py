@@ -117,3 +117,24 @@ def test_bad_parameters_raise_input_error(kwargs, phrase):
 def test_non_bool_occupancy_is_rejected_with_hint():
     with pytest.raises(InputError, match="occupancy > 0"):
         velocity_map(np.zeros((3, 3), int))
+
+
+def test_saturation_distance_in_metres():
+    # d = [0, 2.5, 5, 7.5, 10] m; d_sat = 5 m -> W = min(d / 5, 1) = [0, .5, 1, 1, 1];
+    # exponent 2 squares it; the same margin on a map twice as large gives the same W
+    occ = strip(5, [0])
+    W = velocity_map(occ, spacing=2.5, saturation_distance=5.0, exponent=2.0)
+    np.testing.assert_allclose(W[:, 0], [0.0, 0.25, 1.0, 1.0, 1.0])
+    W9 = velocity_map(strip(9, [0]), spacing=2.5, saturation_distance=5.0)
+    np.testing.assert_allclose(W9[:3, 0], [0.0, 0.5, 1.0])
+    assert np.all(W9[2:, 0] == 1.0)
+    # beyond the largest distance W never reaches 1: W = d / d_sat
+    far = velocity_map(occ, spacing=2.5, saturation_distance=20.0)
+    np.testing.assert_allclose(far[:, 0], [0.0, 0.125, 0.25, 0.375, 0.5])
+    # it overrides the share-of-the-largest saturation
+    np.testing.assert_allclose(velocity_map(occ, spacing=2.5, saturation=0.1,
+                                            saturation_distance=5.0)[:, 0], [0, .5, 1, 1, 1])
+    with pytest.raises(InputError, match="saturation_distance"):
+        velocity_map(occ, saturation_distance=0.0)
+    with pytest.raises(InputError, match="max_distance"):
+        shape_velocity(np.ones(3), saturation_distance=1.0)

@@ -3,7 +3,8 @@
 Step 2 of FM² (thesis §2.2): a wave is started from every obstacle cell; its
 arrival time (the distance to the nearest obstacle) rescaled so the maximum is
 1 is the velocity map ``W``. The thesis' adjustment exponent and the Sensors
-2022 paper's saturation then shape it: ``W = min(W / saturation, 1) ** exponent``.
+2022 paper's saturation then shape it: ``W = min(W / saturation, 1) ** exponent``,
+or, with a saturation distance ``d_sat`` in metres, ``W = min(d / d_sat, 1) ** exponent``.
 """
 
 from __future__ import annotations
@@ -18,7 +19,13 @@ from ..errors import InputError
 from . import _kernels
 from .fmm import as_spacing, fast_marching
 
-__all__ = ["distance_map", "velocity_map", "normalise_distance", "shape_velocity"]
+__all__ = [
+    "distance_map",
+    "velocity_map",
+    "normalise_distance",
+    "distance_scale",
+    "shape_velocity",
+]
 
 Method = Literal["edt", "fmm"]
 
@@ -112,23 +119,69 @@ def normalise_distance(dist: np.ndarray) -> np.ndarray:
     return np.where(finite, dist / finite_max, 1.0)
 
 
-def shape_velocity(W: np.ndarray, *, saturation: float = 1.0, exponent: float = 1.0) -> np.ndarray:
-    """Apply saturation α and exponent β: ``W = min(W / α, 1) ** β``.
+def distance_scale(dist: np.ndarray) -> float:
+    """The distance [m] that :func:`normalise_distance` divides by (W = 1 there).
+
+    The largest finite distance; ``inf`` when no distance is finite (a map
+    without obstacles, whose W is all ones).
+    """
+    top = float(np.max(dist))
+    if np.isfinite(top):
+        return top
+    finite = np.isfinite(dist)
+    return float(np.max(dist, initial=0.0, where=finite)) if finite.any() else np.inf
+
+
+def shape_velocity(
+    W: np.ndarray,
+    *,
+    saturation: float = 1.0,
+    exponent: float = 1.0,
+    saturation_distance: float | None = None,
+    max_distance: float | None = None,
+) -> np.ndarray:
+    """Apply saturation and exponent β: ``W = min(W / α, 1) ** β``.
 
     Parameters
     ----------
     W : ndarray
-        Normalised velocity map in [0, 1].
+        Normalised velocity map in [0, 1] (``d / max_distance``).
     saturation : float
         α in (0, 1]: distances above α (as a share of the largest) get full speed.
     exponent : float
         β > 0: > 1 darkens the map (paths further from obstacles), < 1 lightens it.
+    saturation_distance : float, optional
+        ``d_sat`` [m] > 0: distances above it get full speed,
+        ``W = min(d / d_sat, 1) ** β`` (overrides ``saturation``). Needs
+        ``max_distance``. When ``d_sat > max_distance`` W stays below 1.
+    max_distance : float, optional
+        The distance [m] ``W`` was normalised by (:func:`distance_scale`).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> W = np.array([0.0, 0.25, 0.5, 1.0])          # d / 40 m
+    >>> shape_velocity(W, saturation_distance=20.0, max_distance=40.0).tolist()
+    [0.0, 0.5, 1.0, 1.0]
     """
     if not (np.isfinite(saturation) and 0.0 < saturation <= 1.0):
         raise InputError(f"saturation must be in (0, 1], got {saturation!r}")
     if not (np.isfinite(exponent) and exponent > 0.0):
         raise InputError(f"exponent must be > 0, got {exponent!r}")
-    out = W if saturation == 1.0 else np.minimum(W / saturation, 1.0)
+    if saturation_distance is not None:
+        if not (np.isfinite(saturation_distance) and saturation_distance > 0.0):
+            raise InputError(
+                f"saturation_distance must be > 0 metres, got {saturation_distance!r}")
+        if max_distance is None or not max_distance >= 0.0:
+            raise InputError(
+                "saturation_distance needs max_distance, the distance [m] W was normalised by "
+                "(eikonal.distance_scale of the distance map)")
+        if np.isfinite(max_distance) and max_distance > 0.0:
+            out = np.minimum(W * (max_distance / saturation_distance), 1.0)
+        else:  # no obstacle (W all 1) or no free space (W all 0): nothing to saturate
+            out = W
+    else:
+        out = W if saturation == 1.0 else np.minimum(W / saturation, 1.0)
     if exponent != 1.0:
         out = np.power(out, exponent)
     elif out is W:
@@ -144,11 +197,13 @@ def velocity_map(
     exponent: float = 1.0,
     method: Method = "edt",
     walls: bool = False,
+    saturation_distance: float | None = None,
 ) -> np.ndarray:
     """The FM² velocity map ``W`` in [0, 1] (0 on obstacles).
 
     ``W = min(d / max(d) / saturation, 1) ** exponent`` where ``d`` is the
-    distance to the nearest obstacle (see :func:`distance_map`).
+    distance to the nearest obstacle (see :func:`distance_map`), or
+    ``W = min(d / saturation_distance, 1) ** exponent``.
 
     Parameters
     ----------
@@ -164,6 +219,9 @@ def velocity_map(
         Distance computation, see :func:`distance_map`.
     walls : bool
         Treat the map border as an obstacle.
+    saturation_distance : float, optional
+        ``d_sat`` [m]: full speed from this distance to the obstacles on
+        (overrides ``saturation``).
 
     Returns
     -------
@@ -178,4 +236,6 @@ def velocity_map(
     [0.0, 0.25, 0.5, 0.75, 1.0]
     """
     dist = distance_map(occupancy, spacing=spacing, method=method, walls=walls)
-    return shape_velocity(normalise_distance(dist), saturation=saturation, exponent=exponent)
+    top = distance_scale(dist) if saturation_distance is not None else None
+    return shape_velocity(normalise_distance(dist), saturation=saturation, exponent=exponent,
+                          saturation_distance=saturation_distance, max_distance=top)

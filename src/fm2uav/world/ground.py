@@ -1,17 +1,112 @@
-"""Ground height under path points, read from a world's terrain height map."""
+"""Ground and surface heights of a world, continuous in x, y.
+
+The one home of "how high is the ground here": :meth:`World.ground_height` and
+:meth:`World.surface_height` call these functions.
+
+* **Ground** (:func:`ground_height`): the world's terrain height map
+  (``World.terrain``, one height per column) interpolated bilinearly between
+  the column nodes, clamped to the edge columns outside the map. A world
+  without terrain has its ground at the **floor of the grid**: ``origin[2]``,
+  the z of the lowest node layer (``0`` for a 2D world, which has no z).
+* **Surface** (:func:`surface_height`): the ground or a roof, whichever is
+  higher. Roofs are what the occupancy grid holds above the ground: in each
+  column, the z of the topmost obstacle node when it is above the column's
+  ground; read from the nearest column (roofs have sharp edges, so they are
+  not interpolated). The grid resolves a roof to one vertical cell (the true
+  roof lies in ``[z_top, z_top + dz)``).
+"""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
+from scipy import ndimage
 
-__all__ = ["terrain_along"]
+if TYPE_CHECKING:
+    from .world import World
+
+__all__ = ["ground_height", "surface_height", "roof_heights", "terrain_along"]
 
 
-def terrain_along(world, path: np.ndarray) -> np.ndarray | None:
+def _xy(world: World, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray, bool]:
+    from ..errors import InputError
+
+    try:
+        xa, ya = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+    except (TypeError, ValueError):
+        raise InputError(
+            f"x and y must be numbers or arrays of the same shape (metres), got {x!r}, {y!r}"
+        ) from None
+    return xa, ya, xa.ndim == 0
+
+
+def _out(values: np.ndarray, scalar: bool) -> np.ndarray | float:
+    return float(values) if scalar else values
+
+
+def ground_height(world: World, x: Any, y: Any) -> np.ndarray | float:
+    """Ground height (world z [m]) at ``(x, y)`` [m]; see the module docstring.
+
+    ``x`` and ``y`` broadcast together; one number each gives a float.
+    """
+    xa, ya, scalar = _xy(world, x, y)
+    if world.terrain is None:
+        floor = float(world.origin[2]) if world.ndim == 3 else 0.0
+        return _out(np.full(xa.shape, floor), scalar)
+    ix = (xa - world.origin[0]) / world.spacing[0]
+    iy = (ya - world.origin[1]) / world.spacing[1]
+    z = ndimage.map_coordinates(
+        world.terrain, np.stack([ix.ravel(), iy.ravel()]), order=1, mode="nearest"
+    )
+    return _out(z.reshape(xa.shape), scalar)
+
+
+def roof_heights(world: World) -> np.ndarray:
+    """``(nx, ny)`` z [m] of the roof of each column, ``-inf`` where there is none.
+
+    A roof is the topmost obstacle node of a column when it is above the
+    column's ground (the terrain node height, or the floor without terrain).
+    Cached on the world; 2D worlds have no roofs.
+    """
+    key = "roof_heights"
+    cached = world._cache.get(key)
+    if cached is None:
+        if world.ndim != 3:
+            cached = np.full(world.shape, -np.inf)
+        else:
+            top = world.surface_index()
+            z_top = world.origin[2] + top * world.spacing[2]
+            ground = world.terrain if world.terrain is not None else world.origin[2]
+            tol = 1e-9 * world.spacing[2]
+            cached = np.where((top >= 0) & (z_top > ground + tol), z_top, -np.inf)
+        cached.setflags(write=False)
+        world._cache[key] = cached
+    return cached
+
+
+def surface_height(world: World, x: Any, y: Any) -> np.ndarray | float:
+    """Height (world z [m]) of the ground or a roof at ``(x, y)``, whichever is higher.
+
+    Ground as :func:`ground_height` (bilinear); roofs from the nearest column
+    (:func:`roof_heights`). ``x`` and ``y`` broadcast together.
+    """
+    xa, ya, scalar = _xy(world, x, y)
+    ground = np.asarray(ground_height(world, xa, ya), dtype=float)
+    roofs = roof_heights(world)
+    if world.ndim != 3 or not np.isfinite(roofs).any():
+        return _out(ground, scalar)
+    nx, ny = world.shape[:2]
+    # floor(i + 0.5): the nearest-node rule of World.to_cell
+    i = np.clip(np.floor((xa - world.origin[0]) / world.spacing[0] + 0.5), 0, nx - 1)
+    j = np.clip(np.floor((ya - world.origin[1]) / world.spacing[1] + 0.5), 0, ny - 1)
+    roof = roofs[i.astype(np.int64), j.astype(np.int64)]
+    return _out(np.maximum(ground, roof), scalar)
+
+
+def terrain_along(world: World, path: np.ndarray) -> np.ndarray | None:
     """Ground height [m] under each path point (bilinear), or None without terrain."""
     if world.terrain is None:
         return None
-    from scipy import ndimage
-
-    idx = world.to_index(path)[:, :2]
-    return ndimage.map_coordinates(world.terrain, idx.T, order=1, mode="nearest")
+    p = np.asarray(path, dtype=float)
+    return np.asarray(ground_height(world, p[:, 0], p[:, 1]), dtype=float)

@@ -277,6 +277,37 @@ class World:
             self._cache[key] = _readonly(np.where(has, top, -1).astype(np.int64))
         return self._cache[key]
 
+    def ground_height(self, x: Any, y: Any) -> np.ndarray | float:
+        """Ground height (world z [m]) at ``(x, y)`` [m], continuous.
+
+        The terrain (:attr:`terrain`) interpolated bilinearly between the
+        columns (edge columns outside the map). **Without terrain the ground is
+        the floor of the grid**, ``origin[2]`` (0 for a 2D world). ``x`` and
+        ``y`` broadcast together (vectorised); two numbers give a float. See
+        :mod:`fm2uav.world.ground`.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> w = World.from_heightmap(np.array([[0.0, 0.0], [10.0, 10.0]]), 5.0, 4)
+        >>> w.ground_height(2.5, 0.0)
+        5.0
+        """
+        from .ground import ground_height
+
+        return ground_height(self, x, y)
+
+    def surface_height(self, x: Any, y: Any) -> np.ndarray | float:
+        """Height (world z [m]) of the ground or a roof at ``(x, y)``, whichever is higher.
+
+        Ground as :meth:`ground_height`; roofs are the topmost obstacle nodes
+        above the ground, read from the nearest column. See
+        :mod:`fm2uav.world.ground`.
+        """
+        from .ground import surface_height
+
+        return surface_height(self, x, y)
+
     # ------------------------------------------------------------------ builders
     @classmethod
     def from_heightmap(
