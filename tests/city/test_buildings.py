@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pytest
 
@@ -44,16 +42,16 @@ def test_heights_from_levels_strings_and_default():
         building_height({"height": -3})
 
 
-def test_levels_building_and_auto_extent(tmp_path):
+def test_levels_building_and_auto_extent():
     fc = {"type": "FeatureCollection", "features": [
         _sq(10.0, 10.0, 4.0, {"building:levels": 2}),
         {"type": "Feature", "properties": {"height": 2},
          "geometry": {"type": "MultiPolygon", "coordinates": [
              [[[20, 10], [22, 10], [22, 12], [20, 12], [20, 10]]]]}},
     ]}
-    f = tmp_path / "b.geojson"
-    f.write_text(json.dumps(fc))
-    w = World.from_buildings(f, 1.0, margin=2.0)
+    # in-memory GeoJSON without a crs member: the world's own metres (a *file* without
+    # one is lon/lat per RFC 7946, see tests/world/test_geodata_vectors.py)
+    w = World.from_buildings(fc, 1.0, margin=2.0)
     assert w.origin == (8.0, 8.0, 0.0)
     i, j = w.to_cell(np.array([12.0, 12.0, 0.0]))[:2]
     top = w.surface_index()[i, j]

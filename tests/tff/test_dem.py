@@ -111,7 +111,7 @@ def test_nodata_is_refused_or_filled(tmp_path):
 def test_wrong_or_missing_crs(tmp_path):
     z = _hills()
     # metres declared as degrees
-    with pytest.raises(WorldError, match="CRS is wrong"):
+    with pytest.raises(WorldError, match="not degrees.*world.crs"):
         World.from_dem(z, 30.0, crs="EPSG:4326", transform=(30.0, 0, 440000.0, 0, -30.0, 4467000.0))
     with pytest.raises(WorldError, match="no coordinate reference system"):
         World.from_dem(z, 30.0, bounds=(0, 0, 1, 1))
@@ -120,9 +120,12 @@ def test_wrong_or_missing_crs(tmp_path):
         World.from_dem(f, 30.0)
     with pytest.raises(WorldError, match="unknown coordinate reference system"):
         World.from_dem(z, 30.0, crs="EPSG:999999", bounds=(0, 0, 1, 1))
-    # US survey feet: not metres
-    with pytest.raises(WorldError, match="metres"):
-        World.from_dem(z, 30.0, crs="EPSG:2228", transform=(100.0, 0, 6e6, 0, -100.0, 2e6))
+    # US survey feet: not metres, so reprojected to the local UTM zone
+    w = World.from_dem(z, 30.0, crs="EPSG:2228", transform=(100.0, 0, 6e6, 0, -100.0, 2e6))
+    assert w.crs == "EPSG:32610" and "feet" in w.georef.reprojection.replace("foot", "feet")
+    # 107 pixel-centre steps of 100 US ft = 3261 m across; the inner box of the (rotated)
+    # footprint in UTM is a little narrower
+    assert 3000 < w.bounds[0, 1] - w.bounds[0, 0] < 3262
 
 
 def test_bad_arguments(tmp_path):

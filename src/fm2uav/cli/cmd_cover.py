@@ -51,7 +51,7 @@ def _camera_spacing(camera: str, agl: float, side_overlap: float) -> float:
     return cam.spacing(agl, side_overlap)
 
 
-def _load_area(area: str):
+def _load_area(area: str, world=None):
     from ..missions.coverage import read_area
     from ..scenarios.coverage import COVERAGE_AREAS, coverage_area
 
@@ -59,11 +59,12 @@ def _load_area(area: str):
         return coverage_area(area)
     if not Path(area).exists():
         raise InputError(
-            f"--area {area!r} is neither an existing GeoJSON file nor a built-in area "
-            f"({', '.join(COVERAGE_AREAS)}); give a path to a GeoJSON Polygon in the map's "
-            "metres or one of those names"
+            f"--area {area!r} is neither an existing vector file nor a built-in area "
+            f"({', '.join(COVERAGE_AREAS)}); give a path to a polygon (GeoJSON in lon/lat, "
+            "GeoPackage, Shapefile, KML/KMZ; on a built-in map: GeoJSON in the map's metres) "
+            "or one of those names"
         )
-    return read_area(area)
+    return read_area(area, world)
 
 
 def _overlays(cp, prefix: str = "", colour: str = "#1a1a1a") -> dict:
@@ -194,13 +195,13 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         d = spacing if spacing is not None else _camera_spacing(camera, agl, side_overlap)
         outdir = OutputDir(out, force=force)
         outdir.check(COVER_FILES + ((REPORT,) if report else ()))
-        poly = _load_area(area)
         opts = {}
         if full_range:
             opts["bounds_deg"] = FULL_BOUNDS_DEG
         with progress(enabled=not (quiet or as_json)) as step:
             step("building the map")
             world = get_scenario(scenario, seed=seed).world
+            poly = _load_area(area, world)
             step("searching the steering angle and planning FM² along the bands")
             cp = plan_coverage(world, poly, d, agl=agl,
                                angle=None if angle is None else np.radians(angle),

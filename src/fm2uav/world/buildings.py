@@ -1,10 +1,21 @@
-"""Worlds made of buildings: GeoJSON footprints with heights.
+"""Worlds made of buildings: footprints with heights, alone or on a DEM.
 
 * :func:`from_buildings` (also ``World.from_buildings``) rasterises building
-  footprints (GeoJSON ``Polygon`` / ``MultiPolygon`` features) with a height
-  into an occupancy grid: node ``(i, j, k)`` is an obstacle iff its x-y point
-  lies inside (or on the edge of) a footprint and ``z <= ground + height``,
-  or iff it is at or below the ground.
+  footprints (``Polygon`` / ``MultiPolygon`` features of any vector file
+  :func:`fm2uav.world.vectors.read_vectors` reads — GeoJSON in lon/lat per
+  RFC 7946, GeoPackage, Shapefile, KML/KMZ — or in-memory GeoJSON) with a
+  height into an occupancy grid: node ``(i, j, k)`` is an obstacle iff its
+  column is covered by a footprint and ``z <= roof``, or iff it is at or below
+  the ground. A column is covered when its node lies inside (or on the edge
+  of) the footprint; with ``all_touched=True`` (used for real data by
+  :func:`fm2uav.world.load.load_world`) when the node's cell (node ± half a
+  cell) touches it, so that a building smaller than a cell still blocks it.
+* On flat ground the roof is ``z0 + height``. On a DEM world (``terrain=``)
+  it is the highest ground under the footprint plus the height: a building
+  on a slope is never lower than its uphill side.
+* Lon/lat data are reprojected to the local UTM zone (or to the DEM world's
+  CRS); the world records the source file with its SHA-256 and how many
+  buildings took each height rule (``World.georef``).
 * The urban case study of thesis ch. 3 built with it is
   :mod:`fm2uav.scenarios.city`.
 
@@ -14,37 +25,45 @@ A feature's height is read from its properties, first match wins:
 
 1. ``height`` — metres; a number or a string such as ``"25"``, ``"25 m"``,
    ``"25.5m"`` (OpenStreetMap ``height=*`` convention);
-2. ``building:levels`` (or ``levels``) — number of storeys, multiplied by
+2. ``building:levels`` (or ``levels``, or ``building_l`` as a Shapefile
+   truncates it) — number of storeys, multiplied by
    ``metres_per_level`` (default :data:`METRES_PER_LEVEL` = 3.0 m, the storey
    height the OpenStreetMap "Simple 3D buildings" guidance uses to derive a
    height from a level count);
-3. otherwise ``default_height`` if given, else a :class:`WorldError`.
+3. otherwise ``default_height`` if given (mission file
+   ``world.default_height``, CLI ``--default-height``), else a
+   :class:`WorldError` saying how many buildings lack a height.
+
+Heights in feet (``"40 ft"``, ``"40'"``) are converted to metres.
 """
 
 from __future__ import annotations
 
-import json
+import dataclasses
 import re
-from collections.abc import Iterable, Mapping
-from pathlib import Path
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
 import shapely
-from shapely.geometry import shape as shapely_shape
 
 from ..errors import WorldError
+from .geo import check_lonlat_bbox, check_size, make_georef
+from .vectors import read_vectors
 from .world import World
 
 __all__ = [
     "METRES_PER_LEVEL",
     "from_buildings",
     "building_height",
+    "height_and_rule",
+    "HEIGHT_RULES",
 ]
 
 #: Storey height used with ``building:levels`` [m] (OSM Simple 3D buildings).
 METRES_PER_LEVEL = 3.0
-_NUM = re.compile(r"^\s*([-+]?\d+(?:[.,]\d+)?)\s*(m|meters|metres)?\s*$", re.IGNORECASE)
+_NUM = re.compile(r"^\s*([-+]?\d+(?:[.,]\d+)?)\s*(m|meters|metres|ft|feet|')?\s*$", re.IGNORECASE)
+_FOOT = 0.3048
 
 
 def _parse_number(value: Any, what: str, idx: int) -> float:
@@ -60,6 +79,8 @@ def _parse_number(value: Any, what: str, idx: int) -> float:
                 "such as 25 or '25 m'"
             )
         v = float(m.group(1).replace(",", "."))
+        if (m.group(2) or "").lower() in ("ft", "feet", "'"):
+            v *= _FOOT
     else:
         raise WorldError(f"building {idx}: {what} must be a number, got {value!r}")
     if not np.isfinite(v) or v <= 0:
@@ -74,60 +95,97 @@ def building_height(
     default_height: float | None = None,
     index: int = 0,
 ) -> float:
-    """Height [m] of one building from its GeoJSON properties (see module doc).
+    """Height [m] of one building from its properties (see module doc).
 
     Raises
     ------
     WorldError
         No usable ``height`` / ``building:levels`` and no ``default_height``.
     """
+    return height_and_rule(properties, metres_per_level=metres_per_level,
+                           default_height=default_height, index=index)[0]
+
+
+#: The height rules, in the order they are tried.
+HEIGHT_RULES = ("height", "building:levels", "default_height")
+
+
+def _blank(v: Any) -> bool:
+    return v is None or (isinstance(v, str) and not v.strip()) or (
+        isinstance(v, float) and not np.isfinite(v))
+
+
+def height_and_rule(
+    properties: Mapping[str, Any] | None,
+    *,
+    metres_per_level: float = METRES_PER_LEVEL,
+    default_height: float | None = None,
+    index: int = 0,
+) -> tuple[float, str]:
+    """``(height [m], rule)`` of one building; ``rule`` is one of :data:`HEIGHT_RULES`.
+
+    Raises
+    ------
+    WorldError
+        No usable ``height`` / ``building:levels`` and no ``default_height``;
+        an unreadable value (names the building and the value).
+    """
     props = dict(properties or {})
-    if props.get("height") is not None:
-        return _parse_number(props["height"], "height", index)
-    for key in ("building:levels", "levels"):
-        if props.get(key) is not None:
-            return _parse_number(props[key], key, index) * float(metres_per_level)
+    if not _blank(props.get("height")):
+        return _parse_number(props["height"], "height", index), "height"
+    for key in ("building:levels", "levels", "building_l"):  # building_l: Shapefile's 10 chars
+        if not _blank(props.get(key)):
+            return _parse_number(props[key], key, index) * float(metres_per_level), \
+                "building:levels"
     if default_height is not None:
-        return _parse_number(default_height, "default_height", index)
+        return _parse_number(default_height, "default_height", index), "default_height"
     raise WorldError(
         f"building {index} has neither 'height' (m) nor 'building:levels' in its properties "
-        f"{sorted(props)}; add one or pass default_height="
+        f"{sorted(props)}; add one, or set world.default_height (CLI --default-height)"
     )
 
 
-def _features(footprints: Any) -> list[tuple[Any, Mapping[str, Any]]]:
-    """GeoJSON FeatureCollection / Feature list / file → [(geometry dict, properties)]."""
-    if isinstance(footprints, (str, Path)):
-        p = Path(footprints)
-        if not p.exists():
-            raise WorldError(f"building file {p} does not exist")
+def _cell_size(cell_size: Any) -> np.ndarray:
+    cs = np.broadcast_to(np.asarray(cell_size, dtype=float), (3,)).copy() if np.ndim(
+        cell_size) <= 1 else None
+    if cs is None or cs.shape != (3,) or not np.all(np.isfinite(cs)) or np.any(cs <= 0):
+        raise WorldError(f"world.cell_size (--cell-size) must be > 0 metres (one number or "
+                         f"dx, dy, dz), got {cell_size!r}")
+    return cs
+
+
+def _heights(props: Sequence[Mapping[str, Any]], metres_per_level: float,
+             default_height: float | None, ids: Sequence[str]) -> tuple[list[float], dict]:
+    """Heights [m] and how many took each rule; one error for all missing heights."""
+    heights, counts, missing = [], dict.fromkeys(HEIGHT_RULES, 0), []
+    for i, p in enumerate(props):
         try:
-            footprints = json.loads(p.read_text())
-        except json.JSONDecodeError as exc:
-            raise WorldError(f"building file {p} is not valid GeoJSON: {exc}") from None
-    if isinstance(footprints, Mapping):
-        if footprints.get("type") == "FeatureCollection":
-            feats: Iterable[Any] = footprints.get("features") or []
-        elif footprints.get("type") == "Feature":
-            feats = [footprints]
-        else:
-            raise WorldError(
-                "buildings must be a GeoJSON FeatureCollection, a Feature or a list of "
-                f"Features; got a mapping of type {footprints.get('type')!r}"
-            )
-    elif isinstance(footprints, Iterable):
-        feats = list(footprints)
-    else:
+            h, rule = height_and_rule(p, metres_per_level=metres_per_level,
+                                      default_height=default_height, index=i)
+        except WorldError:
+            if default_height is None and all(_blank(p.get(k)) for k in
+                                              ("height", "building:levels", "levels",
+                                               "building_l")):
+                missing.append(i)
+                heights.append(float("nan"))
+                continue
+            raise
+        heights.append(h)
+        counts[rule] += 1
+    if missing:
+        first = missing[0]
         raise WorldError(
-            f"buildings must be GeoJSON (dict, list of features or file path), got "
-            f"{type(footprints).__name__}"
-        )
-    out = []
-    for i, f in enumerate(feats):
-        if not isinstance(f, Mapping) or "geometry" not in f:
-            raise WorldError(f"building {i} is not a GeoJSON Feature with a 'geometry'")
-        out.append((f["geometry"], f.get("properties") or {}))
-    return out
+            f"{len(missing)} of {len(props)} buildings have neither 'height' nor "
+            f"'building:levels' (first: building {first}{ids[first]}); set world.default_height "
+            "(CLI --default-height) to the height in metres to assume for them")
+    return heights, counts
+
+
+def _feature_id(p: Mapping[str, Any]) -> str:
+    for k in ("@id", "osm_id", "id", "name"):
+        if not _blank(p.get(k)):
+            return f" {k}={p[k]}"
+    return ""
 
 
 def from_buildings(
@@ -141,21 +199,30 @@ def from_buildings(
     default_height: float | None = None,
     margin: float = 0.0,
     name: str = "",
-    crs: str | None = None,
+    crs: Any = None,
+    terrain: World | None = None,
+    all_touched: bool = False,
+    bbox: Sequence[float] | None = None,
+    agl: float | None = None,
+    top: float | None = None,
+    layer: str | None = None,
 ) -> World:
-    """Build a 3D world from building footprints with heights.
+    """Build a 3D world from building footprints with heights (see the module docstring).
 
     Parameters
     ----------
-    footprints : dict, list or path
-        GeoJSON ``FeatureCollection`` (dict or ``.geojson`` file) or a list of
-        ``Feature`` dicts with ``Polygon`` / ``MultiPolygon`` geometries in the
-        world's x-y coordinates [m] (project lon/lat first).
+    footprints : path, dict or list
+        A vector file (any format :func:`~fm2uav.world.vectors.read_vectors`
+        reads; GeoJSON files are lon/lat unless they declare a CRS), or
+        in-memory GeoJSON (a FeatureCollection dict or a list of Features)
+        whose coordinates are the world's x/y metres unless it has a ``crs``
+        member or ``crs`` is given.
     cell_size : float or (dx, dy, dz)
-        Node spacing [m].
+        Node spacing [m] (ignored with ``terrain``: its grid is used).
     shape : (nx, ny, nz), optional
-        Grid size. Default: the footprints' bounding box plus ``margin``, and
-        ``height_cells`` (or the tallest building + 2 nodes) vertically.
+        Grid size. Default: the footprints' bounding box plus ``margin`` (or
+        ``bbox``), and ``height_cells`` (or enough nodes for the tallest
+        roof, plus ``agl``) vertically.
     origin : (x0, y0, z0), optional
         World coordinates of node (0, 0, 0) [m]; ``z0`` is the ground level
         (the ground layer is an obstacle). Default: bounding box corner minus
@@ -168,85 +235,190 @@ def from_buildings(
         Height [m] of buildings without height information.
     margin : float
         Free border around the footprints' bounding box [m] (auto extent only).
-    name, crs : str, optional
-        Stored on the world.
+    name : str
+        World name.
+    crs : optional
+        CRS of data that declare none (e.g. an old GeoJSON in UTM metres).
+    terrain : World, optional
+        A DEM world (with ``crs`` and ``terrain``) to put the buildings on.
+    all_touched : bool
+        Cover every column whose cell touches a footprint (conservative for
+        real data) instead of the columns whose node is inside it. Default
+        False (exact on the synthetic city).
+    bbox : (west, south, east, north), optional
+        Lon/lat box [deg] that sets the extent (buildings outside are left out).
+    agl : float, optional
+        Requested height above the roofs [m]: the default grid leaves room for it.
+    top : float, optional
+        Highest requested altitude [m] (start/goal): the default grid reaches it.
+    layer : str, optional
+        Read only this layer of the file.
 
     Returns
     -------
     World
-        ``terrain`` is the flat ground ``z0`` (bare earth, buildings excluded).
+        ``terrain`` is the bare ground (flat ``z0``, or the DEM's); ``georef``
+        counts the buildings per height rule.
 
     Raises
     ------
     WorldError
-        Bad geometry, missing height, a building taller than the grid, bad sizes.
+        Bad geometry, missing heights, a building taller than the grid, bad sizes.
     """
-    cs = np.broadcast_to(np.asarray(cell_size, dtype=float), (3,)).copy() if np.ndim(
-        cell_size
-    ) <= 1 else None
-    if cs is None or cs.shape != (3,) or not np.all(np.isfinite(cs)) or np.any(cs <= 0):
-        raise WorldError(f"cell_size must be > 0 metres (one number or dx, dy, dz), got {cell_size!r}")
+    cs = _cell_size(cell_size) if terrain is None else np.asarray(terrain.spacing, dtype=float)
     if not (np.isfinite(metres_per_level) and metres_per_level > 0):
         raise WorldError(f"metres_per_level must be > 0, got {metres_per_level!r}")
-    feats = _features(footprints)
-    polys, heights = [], []
-    for i, (geom, props) in enumerate(feats):
-        try:
-            g = shapely_shape(geom)
-        except Exception as exc:  # shapely raises several types on bad GeoJSON
-            raise WorldError(f"building {i}: invalid GeoJSON geometry ({exc})") from None
-        if g.geom_type not in ("Polygon", "MultiPolygon") or g.is_empty:
-            raise WorldError(
-                f"building {i}: footprint must be a non-empty Polygon or MultiPolygon, got "
-                f"{g.geom_type}"
-            )
-        if not g.is_valid:
-            g = shapely.make_valid(g)
-        polys.append(g)
-        heights.append(
-            building_height(
-                props, metres_per_level=metres_per_level, default_height=default_height, index=i
-            )
-        )
-    if shape is None:
-        if not polys:
-            raise WorldError("no buildings given and no shape=; give the grid size (nx, ny, nz)")
-        minx, miny, maxx, maxy = shapely.total_bounds(np.array(polys, dtype=object))
-        if origin is None:
-            origin = (minx - margin, miny - margin, 0.0)
-        nx = int(np.ceil((maxx + margin - origin[0]) / cs[0])) + 1
-        ny = int(np.ceil((maxy + margin - origin[1]) / cs[1])) + 1
-        nz = height_cells if height_cells is not None else int(np.ceil(max(heights) / cs[2])) + 3
-        shape = (nx, ny, int(nz))
-    if len(shape) != 3 or any(int(n) < 1 for n in shape):
-        raise WorldError(f"shape must be three positive node counts (nx, ny, nz), got {shape!r}")
-    nx, ny, nz = (int(n) for n in shape)
-    org = np.zeros(3) if origin is None else np.asarray(origin, dtype=float)
-    if org.shape != (3,) or not np.all(np.isfinite(org)):
-        raise WorldError(f"origin must be three finite numbers (x0, y0, z0) in metres, got {origin!r}")
-    xs = org[0] + np.arange(nx) * cs[0]
-    ys = org[1] + np.arange(ny) * cs[1]
-    zs = org[2] + np.arange(nz) * cs[2]
-    X, Y = np.meshgrid(xs, ys, indexing="ij")
-    roof = np.full((nx, ny), -np.inf)
-    for i, (g, h) in enumerate(zip(polys, heights)):
-        top = org[2] + h
-        if top >= zs[-1]:
-            need = int(np.ceil(h / cs[2])) + 2
-            raise WorldError(
-                f"building {i} is {h:.6g} m tall, reaching the top node z = {zs[-1]:.6g} m of "
-                f"the grid; use at least {need} vertical nodes (shape / height_cells)"
-            )
-        inside = shapely.intersects_xy(g, X, Y)  # inside or on the edge
-        roof = np.where(inside, np.maximum(roof, top), roof)
-    ground = np.full((nx, ny), org[2])
+    if terrain is not None and (terrain.ndim != 3 or terrain.terrain is None):
+        raise WorldError("terrain= must be a 3D world with a terrain height map (a DEM world)")
+    box = None if bbox is None else check_lonlat_bbox(bbox, "world.bbox (--bbox)")
+    target = terrain.crs if terrain is not None else "auto"
+    data = read_vectors(footprints, target_crs=target, crs=crs, role="buildings", layer=layer)
+    polys = list(data.geometries)
+    if not polys and data.skipped:
+        raise WorldError(
+            f"{data.source.path}: building footprints must be Polygon or MultiPolygon features, "
+            "got only " + ", ".join(f"{n} {k}" for k, n in sorted(data.skipped.items())))
+    ids = [_feature_id(p) for p in data.properties]
+    heights, counts = _heights(data.properties, metres_per_level, default_height, ids)
+    world_crs = data.crs
+    # ---- the grid
+    if terrain is not None:
+        org = np.asarray(terrain.origin, dtype=float)
+        nx, ny = terrain.shape[:2]
+        ground = np.asarray(terrain.terrain, dtype=float)
+    else:
+        if shape is None:
+            if box is not None and world_crs is not None:
+                from .dem import _bbox_in
+
+                minx, miny, maxx, maxy = _bbox_in(world_crs, box)
+                mg = 0.0
+            elif polys:
+                minx, miny, maxx, maxy = shapely.total_bounds(np.array(polys, dtype=object))
+                mg = float(margin)
+            else:
+                raise WorldError("no buildings given and no shape=; give the grid size "
+                                 "(nx, ny, nz)")
+            if origin is None:
+                origin = (minx - mg, miny - mg, 0.0)
+            nx = int(np.ceil((maxx + mg - origin[0]) / cs[0] - 1e-9)) + 1
+            ny = int(np.ceil((maxy + mg - origin[1]) / cs[1] - 1e-9)) + 1
+        else:
+            if len(shape) != 3 or any(int(n) < 1 for n in shape):
+                raise WorldError(f"shape must be three positive node counts (nx, ny, nz), "
+                                 f"got {shape!r}")
+            nx, ny = int(shape[0]), int(shape[1])
+        org = np.zeros(3) if origin is None else np.asarray(origin, dtype=float)
+        if org.shape != (3,) or not np.all(np.isfinite(org)):
+            raise WorldError(f"origin must be three finite numbers (x0, y0, z0) in metres, got "
+                             f"{origin!r}")
+        check_size((nx, ny), cs[:2])
+        ground = np.full((nx, ny), org[2])
+    # ---- roofs
+    roof, outside, off_grid = _roofs(polys, heights, ground, org, cs, all_touched)
     surface = np.maximum(roof, ground)
+    smax = float(surface.max())
+    # ---- vertical size
+    if terrain is not None:
+        nz0 = terrain.shape[2]
+        z_top = org[2] + (nz0 - 1) * cs[2]
+        need = smax + (0.0 if agl is None else float(agl)) + (10.0 if agl is not None else 2.0) * cs[2]
+        if top is not None:
+            need = max(need, float(top) + 5 * cs[2])
+        nz = max(nz0, int(np.ceil((need - org[2]) / cs[2] - 1e-9)) + 1) if need > z_top else nz0
+    elif shape is not None:
+        nz = int(shape[2])
+    elif height_cells is not None:
+        nz = int(height_cells)
+    else:
+        rel = smax - org[2]
+        if agl is None:
+            nz = int(np.ceil(rel / cs[2])) + 3
+        else:
+            nz = int(np.ceil((rel + float(agl)) / cs[2])) + 10
+        if top is not None:
+            nz = max(nz, int(np.ceil((float(top) - org[2]) / cs[2])) + 5)
+    check_size((nx, ny, nz), cs)
+    zs = org[2] + np.arange(nz) * cs[2]
+    if smax >= zs[-1]:
+        i = int(np.nanargmax(np.where(np.isfinite(heights), heights, -1))) if heights else 0
+        need_n = int(np.ceil((smax - org[2]) / cs[2])) + 2
+        raise WorldError(
+            f"the tallest roof reaches {smax:.6g} m (building {i}{ids[i] if ids else ''}, "
+            f"{heights[i]:.6g} m tall), at or above the top node z = {zs[-1]:.6g} m of the grid; "
+            f"use at least {need_n} vertical nodes (world.height_cells / shape)")
+    if agl is not None and height_cells is not None and terrain is None and shape is None:
+        if smax + float(agl) >= zs[-1]:
+            need_n = int(np.ceil((smax + float(agl) - org[2]) / cs[2])) + 2
+            raise WorldError(
+                f"world.height_cells = {nz} leaves no room to fly {float(agl):g} m above the "
+                f"tallest roof ({smax:.1f} m); use world.height_cells >= {need_n} or leave it out "
+                "(the default follows the requested height above ground)")
     occ = zs[None, None, :] <= surface[:, :, None]
+    details = {
+        "buildings": len(polys),
+        "height_rule": counts,
+        "metres_per_level": float(metres_per_level),
+        **({"default_height": float(default_height)} if default_height is not None else {}),
+        "outside_map": outside,
+        **({"not_on_a_node": off_grid} if off_grid else {}),
+        "footprint_rule": "cells touched" if all_touched else "node inside",
+        "roof": "highest ground under the footprint + height" if terrain is not None
+        else "ground z0 + height",
+    }
+    src = dataclasses.replace(data.source, details={**data.source.details, **details})
+    georef = None
+    if terrain is not None and getattr(terrain, "georef", None) is not None:
+        georef = terrain.georef.with_sources(src)
+    elif world_crs is not None:
+        georef = make_georef(
+            world_crs, vertical=f"height above flat ground at z = {org[2]:g} m (no terrain "
+            "model: altitudes are relative to the ground, not to sea level)",
+            vertical_assumed=True, reprojection=data.source.details.get("reprojection", ""),
+            sources=(src,))
     return World(
         occupancy=occ,
         spacing=tuple(float(c) for c in cs),
         origin=tuple(float(v) for v in org),
         terrain=ground,
-        crs=crs,
-        name=name,
+        crs=world_crs,
+        name=name or (terrain.name if terrain is not None else ""),
+        filled=None if terrain is None else terrain.filled,
+        georef=georef,
     )
+
+
+def _roofs(polys: Sequence[Any], heights: Sequence[float], ground: np.ndarray, org: np.ndarray,
+           cs: np.ndarray, all_touched: bool) -> tuple[np.ndarray, int, int]:
+    """Roof altitude per column (-inf where no building), and counts outside / off-grid."""
+    nx, ny = ground.shape
+    roof = np.full((nx, ny), -np.inf)
+    outside = off_grid = 0
+    for g, h in zip(polys, heights):
+        minx, miny, maxx, maxy = g.bounds
+        i0 = max(int(np.floor((minx - org[0]) / cs[0])) - 1, 0)
+        i1 = min(int(np.ceil((maxx - org[0]) / cs[0])) + 1, nx - 1)
+        j0 = max(int(np.floor((miny - org[1]) / cs[1])) - 1, 0)
+        j1 = min(int(np.ceil((maxy - org[1]) / cs[1])) + 1, ny - 1)
+        if i0 > i1 or j0 > j1:
+            outside += 1
+            continue
+        xs = org[0] + np.arange(i0, i1 + 1) * cs[0]
+        ys = org[1] + np.arange(j0, j1 + 1) * cs[1]
+        if all_touched:
+            from affine import Affine
+            from rasterio.features import geometry_mask
+
+            t = Affine(cs[0], 0.0, xs[0] - 0.5 * cs[0], 0.0, cs[1], ys[0] - 0.5 * cs[1])
+            inside = geometry_mask([g], out_shape=(len(ys), len(xs)), transform=t,
+                                   all_touched=True, invert=True).T
+        else:
+            X, Y = np.meshgrid(xs, ys, indexing="ij")
+            inside = shapely.intersects_xy(g, X, Y)  # inside or on the edge
+        if not inside.any():
+            off_grid += 1
+            continue
+        win = (slice(i0, i1 + 1), slice(j0, j1 + 1))
+        top = float(ground[win][inside].max()) + float(h)
+        roof[win] = np.where(inside, np.maximum(roof[win], top), roof[win])
+    return roof, outside, off_grid

@@ -5,11 +5,27 @@ own if it is projected in metres, else the UTM zone of the DEM's centre) and
 stores it as :attr:`World.crs`; z is the DEM's elevation datum (normally
 metres above mean sea level). These helpers pick that CRS and convert world
 points to WGS84 longitude/latitude/altitude and back.
+
+Choosing the world's CRS (:func:`local_metric_crs`): lengths in the world must
+be true to :data:`MAX_SCALE_ERROR` (0.5 %). A projected CRS in metres is kept
+when its point scale factor (``pyproj.Proj.get_factors``, Tissot's semi-axes)
+stays within 1 ± 0.5 % over the area; otherwise (geographic degrees, Web
+Mercator away from the equator, feet, any distorting projection) the world is
+built in the UTM zone of the area's centre, or — when the area is too wide for
+that zone's 0.5 % — in a transverse Mercator centred on the area (``k = 1``).
+
+:class:`Georef` records where a world is: its horizontal CRS (EPSG code when
+there is one), the vertical reference of its z, and the source files with
+their SHA-256, so that every output can say where it is.
 """
 
 from __future__ import annotations
 
+import hashlib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from functools import lru_cache
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -17,6 +33,19 @@ import numpy as np
 from ..errors import InputError, WorldError
 
 __all__ = [
+    "Georef",
+    "SourceFile",
+    "MAX_SCALE_ERROR",
+    "MAX_NODES",
+    "check_size",
+    "sha256_file",
+    "scale_error",
+    "local_metric_crs",
+    "crs_label",
+    "check_lonlat_bbox",
+    "bounds_lonlat",
+    "check_fit",
+    "make_georef",
     "parse_crs",
     "utm_crs",
     "metric_crs",
@@ -140,3 +169,349 @@ def from_lonlat(world: Any, lonlatalt: Any) -> np.ndarray:
     x, y = transformer(WGS84, world.crs).transform(q[:, 0], q[:, 1])
     out = np.stack([np.asarray(x), np.asarray(y), q[:, 2]], axis=1)
     return out[0] if p.ndim == 1 else out
+
+
+# ---------------------------------------------------------------------- CRS choice
+#: Largest number of grid nodes a world built from data may have (a bool
+#: occupancy of this size takes 400 MB; the FM² arrays take ~20x more).
+MAX_NODES = 400_000_000
+
+
+def check_size(shape: Any, cell: Any) -> None:
+    """Refuse a grid larger than :data:`MAX_NODES` with the options that shrink it."""
+    n = int(np.prod([int(v) for v in shape], dtype=np.float64))
+    if n > MAX_NODES:
+        raise WorldError(
+            f"the world would have {' x '.join(str(int(v)) for v in shape)} = {n:.3g} nodes "
+            f"(limit {MAX_NODES:.0e}) at cells of {' x '.join(f'{float(c):g}' for c in cell)} m; "
+            "use a larger world.cell_size / world.dz (CLI --cell-size / --dz) or crop the "
+            "area with world.bbox (CLI --bbox W,S,E,N)")
+
+
+#: Largest length distortion accepted in a world's CRS (0.5 %): beyond it the
+#: data are reprojected (see :func:`local_metric_crs`).
+MAX_SCALE_ERROR = 0.005
+
+
+def crs_label(crs: Any) -> str:
+    """Short name of a CRS: ``"EPSG:32630"`` when it has an EPSG code, else its PROJ string."""
+    c = parse_crs(crs)
+    code = c.to_epsg(min_confidence=90)
+    if code is not None:
+        return f"EPSG:{code}"
+    auth = c.to_authority(min_confidence=90)
+    if auth is not None:
+        return f"{auth[0]}:{auth[1]}"
+    return c.to_proj4() or c.to_wkt()
+
+
+def _lonlat_samples(bbox: tuple[float, float, float, float], n: int = 7) -> tuple[np.ndarray, np.ndarray]:
+    w, s, e, nn = bbox
+    lon, lat = np.meshgrid(np.linspace(w, e, n), np.linspace(s, nn, n))
+    return lon.ravel(), np.clip(lat.ravel(), -89.9, 89.9)
+
+
+def scale_error(crs: Any, bbox_lonlat: tuple[float, float, float, float]) -> float:
+    """Largest length distortion ``max |k - 1|`` of a projected CRS over a lon/lat box.
+
+    ``k`` runs over Tissot's semi-axes (``pyproj.Proj.get_factors``) at 7 x 7
+    points of the box, times the CRS's unit in metres (a CRS in feet has
+    ``k ~ 3.28`` per metre). Geographic CRSs give ``inf`` (degrees are not lengths).
+    """
+    from pyproj import Proj
+
+    c = parse_crs(crs)
+    if not c.is_projected:
+        return float("inf")
+    unit = c.axis_info[0].unit_conversion_factor if c.axis_info else 1.0
+    lon, lat = _lonlat_samples(bbox_lonlat)
+    try:
+        f = Proj(c).get_factors(lon, lat)
+    except Exception:  # pyproj raises ProjError for projections without factors
+        return float("inf")
+    a = np.asarray(f.tissot_semimajor, dtype=float)
+    b = np.asarray(f.tissot_semiminor, dtype=float)
+    if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
+        return float("inf")
+    # k is dimensionless (ground length -> projected metres); a CRS in feet
+    # stores k / unit units per ground metre, which is what lengths in the
+    # world would be off by if its numbers were read as metres
+    k = np.concatenate([a, b]) / unit
+    return float(np.max(np.abs(k - 1.0)))
+
+
+def _tmerc(lon0: float, lat0: float) -> str:
+    return (f"+proj=tmerc +lat_0={lat0:.6f} +lon_0={lon0:.6f} +k=1 +x_0=0 +y_0=0 "
+            "+datum=WGS84 +units=m +no_defs +type=crs")
+
+
+def local_metric_crs(crs: Any, bbox_lonlat: tuple[float, float, float, float]
+                     ) -> tuple[str, float, str]:
+    """The CRS a world uses for data in ``crs`` covering ``bbox_lonlat`` (W, S, E, N deg).
+
+    Returns
+    -------
+    crs : str
+        The data's own CRS when it is projected and its length distortion over
+        the box is <= :data:`MAX_SCALE_ERROR`; else the UTM zone of the box
+        centre if that keeps <= 0.5 %; else a transverse Mercator centred on
+        the box (PROJ string).
+    error : float
+        Largest length distortion ``|k - 1|`` of the returned CRS over the box.
+    reason : str
+        Why this CRS (for the summary), e.g. ``"EPSG:3857 distorts lengths by
+        30.5 % here; reprojected to the local UTM zone EPSG:32630"``.
+    """
+    c = parse_crs(crs)
+    own = scale_error(c, bbox_lonlat)
+    name = crs_label(c)
+    if own <= MAX_SCALE_ERROR:
+        return c.to_string(), own, f"{name} kept (length distortion {100 * own:.2f} % here)"
+    units = {a.unit_name for a in c.axis_info[:2]}
+    if c.is_geographic:
+        why = f"{name} is geographic (degrees)"
+    elif c.is_projected and not units <= {"metre", "meter", "m"}:
+        why = f"{name} is in {', '.join(sorted(units))}, not metres"
+    elif np.isfinite(own):
+        why = f"{name} distorts lengths by {100 * own:.2f} % here"
+    else:
+        why = f"{name} has no usable scale factor"
+    w, s, e, n = bbox_lonlat
+    lon_c, lat_c = 0.5 * (w + e), 0.5 * (s + n)
+    if -80.0 <= lat_c <= 84.0:
+        utm = utm_crs(float(np.clip(lon_c, -180.0, 180.0)), lat_c)
+        err = scale_error(utm, bbox_lonlat)
+        if err <= MAX_SCALE_ERROR:
+            return utm, err, f"{why}; reprojected to the local UTM zone {utm}"
+    tm = _tmerc(lon_c, 0.0)
+    err = scale_error(tm, bbox_lonlat)
+    if not err <= 10 * MAX_SCALE_ERROR:
+        raise WorldError(
+            f"the area lon {w:.3f}..{e:.3f}, lat {s:.3f}..{n:.3f} is too wide for one metric "
+            f"grid (lengths would be off by {100 * err:.1f} % at its edges); crop it to the "
+            "mission area with world.bbox (CLI --bbox W,S,E,N)")
+    return tm, err, (f"{why}; the area is too wide for one UTM zone, so reprojected to a "
+                     f"transverse Mercator centred on lon {lon_c:.4f} (length distortion "
+                     f"{100 * err:.2f} % at the edges)")
+
+
+def bounds_lonlat(bounds: Any, crs: Any) -> tuple[float, float, float, float]:
+    """Lon/lat box (W, S, E, N) [deg] of a box ``(minx, miny, maxx, maxy)`` in ``crs``.
+
+    The box edges are densified (65 points each), so curved images of straight
+    edges are covered.
+    """
+    minx, miny, maxx, maxy = (float(v) for v in bounds)
+    t = np.linspace(0.0, 1.0, 65)
+    x = np.concatenate([minx + (maxx - minx) * t, np.full(65, maxx), maxx - (maxx - minx) * t,
+                        np.full(65, minx)])
+    y = np.concatenate([np.full(65, miny), miny + (maxy - miny) * t, np.full(65, maxy),
+                        maxy - (maxy - miny) * t])
+    lon, lat = transformer(crs, WGS84).transform(x, y)
+    lon, lat = np.asarray(lon), np.asarray(lat)
+    ok = np.isfinite(lon) & np.isfinite(lat)
+    if not ok.any():
+        raise WorldError(f"the box {bounds} cannot be converted from {crs_label(crs)} to lon/lat")
+    return (float(lon[ok].min()), float(lat[ok].min()), float(lon[ok].max()),
+            float(lat[ok].max()))
+
+
+def check_lonlat_bbox(bbox: Any, what: str = "bbox") -> tuple[float, float, float, float]:
+    """Validate a ``(west, south, east, north)`` box in lon/lat degrees.
+
+    Raises
+    ------
+    InputError
+        Not four finite numbers, out of range, or west >= east / south >= north.
+    """
+    try:
+        v = tuple(float(x) for x in bbox)
+    except (TypeError, ValueError):
+        raise InputError(f"{what} must be 4 numbers W,S,E,N in lon/lat degrees, got {bbox!r}") from None
+    if len(v) != 4 or not all(np.isfinite(v)):
+        raise InputError(f"{what} must be 4 finite numbers W,S,E,N in lon/lat degrees, got {bbox!r}")
+    w, s, e, n = v
+    if not (-180 <= w <= 180 and -180 <= e <= 180 and -90 <= s <= 90 and -90 <= n <= 90):
+        raise InputError(
+            f"{what} = {w:g},{s:g},{e:g},{n:g} is not lon/lat: longitudes must be in [-180, 180] "
+            "and latitudes in [-90, 90] degrees (order W,S,E,N)")
+    if not (e > w and n > s):
+        raise InputError(
+            f"{what} = {w:g},{s:g},{e:g},{n:g} needs west < east and south < north (order W,S,E,N); "
+            "boxes across the antimeridian are not supported")
+    return v
+
+
+def check_fit(bounds: Any, crs: Any, rule: str, where: str, hint: str) -> None:
+    """Refuse coordinates that cannot be in ``crs``.
+
+    Parameters
+    ----------
+    bounds : (minx, miny, maxx, maxy)
+        Extent of the data in ``crs`` units.
+    crs :
+        The declared or assumed CRS.
+    rule : str
+        How that CRS was known (for the message).
+    where : str
+        What the data are (for the message), e.g. "the buildings file b.geojson".
+    hint : str
+        The option that sets the CRS, e.g. "world.crs (CLI --crs)".
+
+    Raises
+    ------
+    WorldError
+        Geographic CRS with coordinates outside [-180, 180] x [-90, 90]; a
+        projected CRS whose coordinates look like degrees (all within lon/lat
+        range and less than 2 units wide) or fall outside its area of use
+        (with a 5 degree margin).
+    """
+    minx, miny, maxx, maxy = (float(v) for v in bounds)
+    c = parse_crs(crs)
+    if not all(np.isfinite([minx, miny, maxx, maxy])):
+        raise WorldError(f"{where} has non-finite coordinates; fix the file")
+    lonlat_like = (-180 <= minx and maxx <= 180 and -90 <= miny and maxy <= 90)
+    if c.is_geographic:
+        if not lonlat_like:
+            raise WorldError(
+                f"{where} is read as lon/lat degrees ({rule}: {crs_label(c)}) but its coordinates "
+                f"reach x {minx:.6g}..{maxx:.6g}, y {miny:.6g}..{maxy:.6g}, which are not degrees; "
+                f"if they are metres of a projected CRS, give it with {hint}, e.g. "
+                "EPSG:32630")
+        return
+    extent = max(maxx - minx, maxy - miny)
+    if lonlat_like and extent < 2.0:
+        raise WorldError(
+            f"{where} is read in {crs_label(c)} ({rule}), in metres, but its coordinates "
+            f"(x {minx:.6g}..{maxx:.6g}, y {miny:.6g}..{maxy:.6g}) look like lon/lat degrees; "
+            f"give the right CRS with {hint} (EPSG:4326 for lon/lat) or fix the file")
+    aou = c.area_of_use
+    if aou is None:
+        return
+    xs = np.array([minx, maxx, minx, maxx, 0.5 * (minx + maxx)])
+    ys = np.array([miny, miny, maxy, maxy, 0.5 * (miny + maxy)])
+    lon, lat = transformer(c, WGS84).transform(xs, ys)
+    lon, lat = np.asarray(lon), np.asarray(lat)
+    margin = 5.0  # degrees: data often spill a little beyond a zone's official area
+    ok = (np.all(np.isfinite(lon)) and np.all(np.isfinite(lat))
+          and np.all(lon >= aou.west - margin) and np.all(lon <= aou.east + margin)
+          and np.all(lat >= aou.south - margin) and np.all(lat <= aou.north + margin))
+    if not ok:
+        raise WorldError(
+            f"{where} is read in {crs_label(c)} ({rule}) but its coordinates "
+            f"(x {minx:.6g}..{maxx:.6g}, y {miny:.6g}..{maxy:.6g}) fall outside that CRS's area "
+            f"of use ({aou.name}); give the right CRS with {hint} or fix the file")
+
+
+
+# ---------------------------------------------------------------------- provenance
+def sha256_file(path: str | Path) -> str:
+    """Hex SHA-256 of a file's bytes."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+@dataclass(frozen=True)
+class SourceFile:
+    """One input file of a world.
+
+    Attributes
+    ----------
+    path : str
+        As given (absolute when resolved from a mission file).
+    role : str
+        ``"dem"``, ``"buildings"``, ``"area"``, ``"no-fly"``, ...
+    sha256 : str or None
+        Checksum of the file's bytes (``None`` for in-memory data).
+    crs : str or None
+        CRS the data were read in (declared by the file, given, or assumed).
+    crs_rule : str
+        How that CRS was known, e.g. ``"declared by the file"``,
+        ``"RFC 7946 (GeoJSON without a crs member: lon/lat WGS84)"``.
+    details : mapping
+        Per-role facts for summaries, e.g. buildings per height rule, filled
+        DEM cells, the reprojection.
+    """
+
+    path: str
+    role: str
+    sha256: str | None = None
+    crs: str | None = None
+    crs_rule: str = ""
+    details: Mapping[str, Any] = field(default_factory=dict)
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready dict."""
+        return {"path": self.path, "role": self.role, "sha256": self.sha256, "crs": self.crs,
+                "crs_rule": self.crs_rule, **({"details": dict(self.details)}
+                                              if self.details else {})}
+
+
+@dataclass(frozen=True)
+class Georef:
+    """Where a world is: CRS of x/y, vertical reference of z, and its sources.
+
+    Attributes
+    ----------
+    crs : str
+        Horizontal CRS of world x/y (the same string as ``World.crs``).
+    epsg : int or None
+        Its EPSG code (``None`` for a custom transverse Mercator).
+    vertical : str
+        What world z is, e.g. ``"DEM heights, EGM96 height (from the raster's
+        vertical CRS)"`` or ``"DEM heights, assumed metres above mean sea level
+        (the raster declares no vertical CRS)"``.
+    vertical_crs : str or None
+        Name of the declared vertical CRS (e.g. ``"EGM96 height"``), if any.
+    vertical_assumed : bool
+        ``True`` when :attr:`vertical` is an assumption, not read from the data.
+    reprojection : str
+        Why the world has this CRS (kept / reprojected and from what).
+    scale_error : float
+        Largest length distortion of :attr:`crs` over the world (``|k - 1|``).
+    sources : tuple of SourceFile
+    """
+
+    crs: str
+    epsg: int | None = None
+    vertical: str = ""
+    vertical_crs: str | None = None
+    vertical_assumed: bool = True
+    reprojection: str = ""
+    scale_error: float = 0.0
+    sources: tuple[SourceFile, ...] = ()
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready dict (``summary.json`` ``"georef"``; exports' metadata)."""
+        return {"crs": self.crs, "epsg": self.epsg, "vertical": self.vertical,
+                "vertical_crs": self.vertical_crs, "vertical_assumed": self.vertical_assumed,
+                "reprojection": self.reprojection,
+                "scale_error_pct": round(100.0 * float(self.scale_error), 4),
+                "sources": [s.as_dict() for s in self.sources]}
+
+    def comment(self) -> str:
+        """One line for file headers, e.g. ``"crs=EPSG:32630; z=DEM heights, ..."``."""
+        srcs = ", ".join(f"{s.role} {Path(s.path).name} sha256={s.sha256[:12] if s.sha256 else '-'}"
+                         for s in self.sources)
+        return (f"crs={self.epsg and f'EPSG:{self.epsg}' or self.crs}; z={self.vertical}"
+                + (f"; sources: {srcs}" if srcs else ""))
+
+    def with_sources(self, *more: SourceFile) -> Georef:
+        """A copy with more sources appended."""
+        import dataclasses
+
+        return dataclasses.replace(self, sources=tuple(self.sources) + tuple(more))
+
+
+def make_georef(crs: Any, *, vertical: str, vertical_crs: str | None = None,
+                vertical_assumed: bool = True, reprojection: str = "",
+                scale_error: float = 0.0, sources: tuple[SourceFile, ...] = ()) -> Georef:
+    """A :class:`Georef` for a world in ``crs`` (EPSG code looked up)."""
+    c = parse_crs(crs)
+    return Georef(crs=c.to_string() if c.to_epsg() else str(crs), epsg=c.to_epsg(),
+                  vertical=vertical, vertical_crs=vertical_crs,
+                  vertical_assumed=vertical_assumed, reprojection=reprojection,
+                  scale_error=float(scale_error), sources=tuple(sources))

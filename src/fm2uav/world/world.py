@@ -82,6 +82,15 @@ class World:
         Optional coordinate reference system of x/y (e.g. ``"EPSG:25830"``).
     name:
         Human-readable name.
+    filled:
+        Optional ``(nx, ny)`` bool array: ``True`` where the terrain height was
+        not in the source data but filled (DEM nodata with ``nodata="fill"``).
+        A start, goal or take-off there is refused (see
+        :func:`fm2uav.world.load.check_points`). Read-only copy.
+    georef:
+        Optional :class:`~fm2uav.world.geo.Georef`: CRS with EPSG code,
+        vertical reference of z, source files with SHA-256 (worlds built from
+        real data).
     _cache:
         Private scratch dictionary where other modules may cache arrays derived
         from this (immutable) world, e.g. the distance transform. It is not an
@@ -95,6 +104,8 @@ class World:
     terrain: np.ndarray | None = None
     crs: str | None = None
     name: str = ""
+    filled: np.ndarray | None = None
+    georef: Any = None
     _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     # ------------------------------------------------------------------ validation
@@ -147,7 +158,17 @@ class World:
             raise WorldError(
                 f"World crs must be a string such as 'EPSG:4326' or None, got {self.crs!r}"
             )
+        filled = self.filled
+        if filled is not None:
+            fm = np.asarray(filled)
+            if fm.dtype != bool or fm.shape != occ.shape[:2]:
+                raise WorldError(
+                    f"World filled must be a bool (nx, ny) = {occ.shape[:2]} mask of filled "
+                    f"terrain columns, got dtype {fm.dtype} and shape {fm.shape}"
+                )
+            filled = _readonly(np.array(fm, dtype=bool, copy=True))
         set_ = object.__setattr__
+        set_(self, "filled", filled)
         set_(self, "occupancy", occ)
         set_(self, "spacing", spacing)
         set_(self, "origin", origin)
@@ -158,7 +179,8 @@ class World:
         return (
             f"World(name={self.name!r}, shape={self.shape}, spacing={self.spacing}, "
             f"origin={self.origin}, obstacles={int(self.occupancy.sum())}/{self.occupancy.size}, "
-            f"terrain={'yes' if self.terrain is not None else 'no'}, crs={self.crs!r})"
+            f"terrain={'yes' if self.terrain is not None else 'no'}, crs={self.crs!r}"
+            + (f", filled={int(self.filled.sum())}" if self.filled is not None else "") + ")"
         )
 
     # ------------------------------------------------------------------ geometry
@@ -407,21 +429,38 @@ class World:
         cls, source: Any, cell_size: float | Sequence[float], ceiling: float | None = None,
         **kwargs: Any,
     ) -> World:
-        """Build a 3D world from a DEM (GeoTIFF path or array), geo-referenced.
+        """Build a 3D world from a DEM (any GDAL raster, tiles, or an array), geo-referenced.
 
         See :func:`fm2uav.world.dem.from_dem` for the parameters (CRS handling,
-        resampling, nodata rule, ``ceiling`` altitude [m]).
+        masks, ``bbox`` crop, ``sea_level``, nodata rule, ``ceiling`` altitude [m]).
         """
         from .dem import from_dem
 
         return from_dem(source, cell_size, ceiling, **kwargs)
 
     @classmethod
-    def from_buildings(cls, footprints: Any, cell_size: float | Sequence[float], **kwargs: Any) -> World:
-        """Build a 3D world from GeoJSON building footprints with heights.
+    def from_lonlat_grid(
+        cls, z: Any, lon: Any, lat: Any, cell_size: float | Sequence[float],
+        ceiling: float | None = None, **kwargs: Any,
+    ) -> World:
+        """Build a 3D world from an elevation array ``z[i_lat, i_lon]`` and lon/lat vectors.
 
+        The xarray layout (``da.values, da.lon.values, da.lat.values``):
+        longitudes 0..360 or -180..180, latitudes in either order. See
+        :func:`fm2uav.world.dem.from_lonlat_grid`.
+        """
+        from .dem import from_lonlat_grid
+
+        return from_lonlat_grid(z, lon, lat, cell_size, ceiling, **kwargs)
+
+    @classmethod
+    def from_buildings(cls, footprints: Any, cell_size: float | Sequence[float], **kwargs: Any) -> World:
+        """Build a 3D world from building footprints with heights.
+
+        ``footprints``: a vector file (GeoJSON, GeoPackage, Shapefile, KML/KMZ;
+        lon/lat per RFC 7946 unless it declares a CRS) or in-memory GeoJSON.
         See :func:`fm2uav.world.buildings.from_buildings` for the parameters
-        (``height`` [m] or ``building:levels`` x 3 m per level).
+        (``height`` [m], else ``building:levels`` x 3 m, else ``default_height``).
         """
         from .buildings import from_buildings
 

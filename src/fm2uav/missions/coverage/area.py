@@ -8,7 +8,6 @@ than the area) raises :class:`fm2uav.InputError` with what, where and how to fix
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 from typing import Any
@@ -20,7 +19,7 @@ from shapely.validation import explain_validity
 
 from ...errors import InputError
 
-__all__ = ["as_area", "read_area", "check_spacing", "check_inside_world", "exterior_edges"]
+__all__ = ["as_area", "read_area", "load_area", "check_spacing", "check_inside_world", "exterior_edges"]
 
 #: Largest number of bands accepted (guards against D given in the wrong unit).
 MAX_BANDS = 5000
@@ -129,24 +128,63 @@ def as_area(area: Any) -> Polygon:
     return shapely.normalize(geom)
 
 
-def read_area(file: str | Path) -> Polygon:
-    """Read an area from a GeoJSON file (world metres) and validate it.
+def load_area(file: str | Path, world: Any = None, *, crs: Any = None) -> tuple[Polygon, Any]:
+    """Read an area from a vector file into the world's CRS and validate it.
+
+    Any vector file :func:`fm2uav.world.vectors.read_vectors` reads works
+    (GeoJSON — lon/lat per RFC 7946 unless it declares a CRS —, GeoPackage,
+    Shapefile, KML/KMZ). On a geo-referenced world (``world.crs``) the polygon
+    is reprojected into the world's metres; on a world without a CRS (the
+    built-in synthetic maps) a file without a declared CRS is read in the
+    map's metres, and one that looks like lon/lat is refused.
+
+    Parameters
+    ----------
+    file : path
+        The area file: exactly one polygon (holes allowed).
+    world : World, optional
+        The map (its ``crs``); ``None`` reads the file in its own coordinates.
+    crs : optional
+        CRS of a file that declares none (CLI ``--crs``).
+
+    Returns
+    -------
+    (Polygon, SourceFile)
+        The area in world metres and where it came from (path, SHA-256, CRS rule).
 
     Raises
     ------
     InputError
-        Missing file, not JSON, no single polygon, invalid polygon.
+        Missing file, no single polygon, invalid polygon.
+    WorldError
+        Unreadable file, coordinates that do not fit the CRS, lon/lat on a map
+        without a CRS.
     """
+    from ...world.vectors import read_vectors
+
     file = Path(file)
     if not file.exists():
         raise InputError(f"area file {file} does not exist")
-    try:
-        obj = json.loads(file.read_text())
-    except json.JSONDecodeError as exc:
-        raise InputError(f"area file {file} is not valid JSON: {exc}") from None
-    if not isinstance(obj, dict):
-        raise InputError(f"area file {file} must hold a GeoJSON object")
-    return as_area(obj)
+    target = getattr(world, "crs", None) if world is not None else None
+    data = read_vectors(file, target_crs=target, crs=crs, role="area", repair=False)
+    if len(data.geometries) != 1:
+        skipped = (f" (left out: {', '.join(f'{n} {k}' for k, n in data.skipped.items())})"
+                   if data.skipped else "")
+        raise InputError(
+            f"the area file {file} has {len(data.geometries)} polygon features{skipped}; give "
+            "exactly one area to cover (split the file, or cover each area separately)")
+    return as_area(data.geometries[0]), data.source
+
+
+def read_area(file: str | Path, world: Any = None, *, crs: Any = None) -> Polygon:
+    """Read an area from a vector file and validate it (see :func:`load_area`).
+
+    Raises
+    ------
+    InputError
+        Missing file, no single polygon, invalid polygon.
+    """
+    return load_area(file, world, crs=crs)[0]
 
 
 def check_spacing(area: Polygon, spacing: float) -> float:
