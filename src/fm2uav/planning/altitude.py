@@ -1,0 +1,424 @@
+"""Final altitude profile of a terrain-following plan: the height above ground that holds.
+
+FM² finds the *route*; its heights sit on the grid's flight layer, up to one
+vertical cell off the request and blind to the ground between nodes. The
+flown heights are therefore set afterwards, along the route, from the
+continuous ground (:meth:`World.surface_height`: the DEM interpolated
+bilinearly, roofs of buildings):
+
+1. the route is resampled every ``ds`` metres of horizontal arc length (a
+   quarter of the horizontal cell by default) and the surface is read at each
+   sample and at the midpoints of the chords to its neighbours; ``S_max`` /
+   ``S_min`` are the highest / lowest of the three (what the straight leg
+   between samples passes over);
+2. per sample, three bounds [m, world z]:
+
+   * target ``L_t = S_max + agl`` — where the profile wants to be;
+   * floor ``L_h = S_max + max(agl - tolerance, min_agl)`` — never below;
+   * ceiling ``U = G_min + max_agl`` with ``G_min`` the lowest *ground* (not
+     roof) under the sample and its chords, and the world's top node;
+
+   no-fly zones with a floor or ceiling add their own lower / upper bound where
+   the route crosses their (buffered) footprint (over them or under them, on
+   the side FM² chose);
+3. the airframe limits ``-tan(max_descent) <= dz/ds <= tan(max_climb)`` are
+   imposed by *slope envelopes*: ``up(L)`` is the lowest slope-limited profile
+   that stays at or above ``L`` (a forward pass ``z_i = max(L_i, z_{i-1} -
+   tan(descent) ds)`` and a backward pass ``z_i = max(z_i, z_{i+1} - tan(climb)
+   ds)``: the upper envelope of ``L`` under the slope cones), ``down(U)`` the
+   highest one at or below ``U``. The cruise profile is
+   ``z_c = max(up(L_h), min(up(L_t), down(U)))``: it follows the target where
+   the airframe can, dips no lower than the floor where the ceiling forces it
+   and never crosses the ceiling; if ``up(L_h) > down(U)`` somewhere, no profile
+   exists and a :class:`~fm2uav.errors.PlanningError` names the place and the
+   fix (``planner.max_agl`` / ``--max-agl``);
+4. **climb-out and descent**: from the start the profile is clipped to the
+   cone ``z_start - tan(descent) s <= z <= z_start + tan(climb) s`` (and the
+   mirror cone at the goal); the part before the profile first meets ``z_c`` is
+   the climb-out, the part after it last leaves ``z_c`` the descent, the rest is
+   the cruise. If the cone from the start would pass closer to the ground than
+   ``min_agl`` (or, without ``min_agl``, than the start's own height, at most
+   ``agl - tolerance``), or above the ceiling, the start gets a *vertical*
+   climb/descent first, to the lowest height from which the cone clears
+   (reported as ``vertical_start_m``; the same at the goal). The take-off and
+   landing points themselves are exempt from ``min_agl``.
+
+The result is a slope-limited polyline; the sampling is denser than the grid,
+so between samples the ground can only rise by the curvature of the bilinear
+surface over a quarter cell (a few centimetres on real DEMs), which the
+tolerance absorbs. What the profile cannot see is what the surface model does
+not hold: ground finer than the DEM, obstacles not in the world.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError, PlanningError
+from .params import FlightLevel
+
+__all__ = [
+    "AltitudeProfile",
+    "floor_agl",
+    "envelope_above",
+    "envelope_below",
+    "resample_route",
+    "solve_profile",
+    "height_figures",
+]
+
+
+def _tan(deg: float) -> float:
+    """tan of a flight-path angle [deg]; 90 deg (vertical) is a very large slope."""
+    return math.tan(math.radians(min(float(deg), 89.999)))
+
+
+def floor_agl(level: FlightLevel) -> float:
+    """Cruise floor above the surface [m]: ``max(agl - tolerance, min_agl)``."""
+    f = level.agl - level.tolerance
+    return f if level.min_agl is None else max(f, float(level.min_agl))
+
+
+# ---------------------------------------------------------------------- envelopes
+def _steps(s: np.ndarray) -> np.ndarray:
+    s = np.asarray(s, dtype=float)
+    if s.ndim != 1 or len(s) < 1 or np.any(np.diff(s) < 0) or not np.all(np.isfinite(s)):
+        raise InputError("s must be a finite, non-decreasing 1D array of arc lengths [m]")
+    return np.diff(s)
+
+
+def envelope_above(s: Any, lower: Any, tan_climb: float, tan_descent: float) -> np.ndarray:
+    """Lowest profile ``z >= lower`` with ``-tan_descent <= dz/ds <= tan_climb``.
+
+    Parameters
+    ----------
+    s : array_like, shape (N,)
+        Horizontal arc length [m], non-decreasing.
+    lower : array_like, shape (N,)
+        Lower bound [m] (``-inf`` allowed).
+    tan_climb, tan_descent : float
+        Largest rise / drop per metre (> 0).
+
+    Returns
+    -------
+    ndarray, shape (N,)
+        ``z_i = max_j (lower_j - c |s_i - s_j|)`` with ``c = tan_climb`` for
+        ``j > i`` and ``tan_descent`` for ``j < i`` (two passes, O(N)).
+
+    Examples
+    --------
+    >>> envelope_above([0, 1, 2, 3, 4], [0, 0, 10, 0, 0], 5.0, 2.0).tolist()
+    [0.0, 5.0, 10.0, 8.0, 6.0]
+    """
+    d = _steps(s)
+    z = np.array(lower, dtype=float)
+    for i in range(1, len(z)):
+        z[i] = max(z[i], z[i - 1] - tan_descent * d[i - 1])
+    for i in range(len(z) - 2, -1, -1):
+        z[i] = max(z[i], z[i + 1] - tan_climb * d[i])
+    return z
+
+
+def envelope_below(s: Any, upper: Any, tan_climb: float, tan_descent: float) -> np.ndarray:
+    """Highest profile ``z <= upper`` with ``-tan_descent <= dz/ds <= tan_climb``.
+
+    The mirror of :func:`envelope_above` (``+inf`` allowed in ``upper``).
+
+    Examples
+    --------
+    >>> envelope_below([0, 1, 2, 3, 4], [9, 9, 0, 9, 9], 2.0, 5.0).tolist()
+    [9.0, 5.0, 0.0, 2.0, 4.0]
+    """
+    d = _steps(s)
+    z = np.array(upper, dtype=float)
+    for i in range(1, len(z)):
+        z[i] = min(z[i], z[i - 1] + tan_climb * d[i - 1])
+    for i in range(len(z) - 2, -1, -1):
+        z[i] = min(z[i], z[i + 1] + tan_descent * d[i])
+    return z
+
+
+# ---------------------------------------------------------------------- route
+def resample_route(path: Any, ds: float) -> tuple[np.ndarray, np.ndarray]:
+    """The horizontal route of a path, every ``ds`` metres of horizontal arc length.
+
+    Parameters
+    ----------
+    path : array_like, shape (N, 2) or (N, 3)
+        The planned path [m] (its z is ignored).
+    ds : float
+        Largest horizontal spacing of the samples [m] (> 0).
+
+    Returns
+    -------
+    xy : ndarray, shape (M, 2)
+        Samples, the first and last exactly the path's ends; ``M >= 2``
+        (``M = 2`` when the route has no horizontal length).
+    s : ndarray, shape (M,)
+        Horizontal arc length of each sample [m].
+    """
+    p = np.asarray(path, dtype=float)
+    if p.ndim != 2 or p.shape[1] not in (2, 3) or len(p) < 2 or not np.all(np.isfinite(p)):
+        raise InputError(f"path must be a finite (N, 2|3) array with N >= 2, got {p.shape}")
+    if not (np.isfinite(ds) and ds > 0):
+        raise InputError(f"ds must be a spacing > 0 m, got {ds!r}")
+    xy = p[:, :2]
+    seg = np.linalg.norm(np.diff(xy, axis=0), axis=1)
+    keep = np.concatenate([[True], seg > 1e-9])
+    xy, cum = xy[keep], np.concatenate([[0.0], np.cumsum(seg[seg > 1e-9])])
+    total = float(cum[-1])
+    if len(xy) < 2 or total <= 0:
+        return np.array([p[0, :2], p[-1, :2]]), np.array([0.0, 0.0])
+    n = max(int(math.ceil(total / ds)), 1)
+    s = np.linspace(0.0, total, n + 1)
+    out = np.column_stack([np.interp(s, cum, xy[:, 0]), np.interp(s, cum, xy[:, 1])])
+    out[0], out[-1] = p[0, :2], p[-1, :2]
+    return out, s
+
+
+def _window(values_at_samples: np.ndarray, values_at_mids: np.ndarray, fn: Callable) -> np.ndarray:
+    """max/min of each sample and the chord midpoints on either side of it."""
+    out = values_at_samples.copy()
+    if len(values_at_mids):
+        out[:-1] = fn(out[:-1], values_at_mids)
+        out[1:] = fn(out[1:], values_at_mids)
+    return out
+
+
+# ---------------------------------------------------------------------- the profile
+@dataclass(frozen=True)
+class AltitudeProfile:
+    """The flown profile along the route and how it was obtained.
+
+    Attributes
+    ----------
+    path : ndarray, shape (M, 3)
+        The flown path [m]: the start, an optional vertical leg, the route
+        samples at their final heights, an optional vertical leg, the goal.
+    s : ndarray, shape (M,)
+        Horizontal arc length of each point [m] (vertical legs repeat it).
+    surface : ndarray, shape (M,)
+        Surface height (ground or roof) under each point [m].
+    phase : ndarray of str, shape (M,)
+        ``"climb-out"``, ``"cruise"`` or ``"descent"`` per point.
+    level : FlightLevel
+        The request (agl, tolerance, min/max_agl, climb/descent limits).
+    vertical_start_m, vertical_goal_m : float
+        Length of the vertical legs at the start / goal [m] (+ = climb at the
+        start, descent at the goal).
+    climb_out_m, descent_m : float
+        Horizontal length of the climb-out / descent [m].
+    lifted_m : float
+        Largest amount the cruise sits above the target ``surface + agl`` because
+        the airframe cannot follow the ground more tightly [m].
+    """
+
+    path: np.ndarray = field(repr=False)
+    s: np.ndarray = field(repr=False)
+    surface: np.ndarray = field(repr=False)
+    phase: np.ndarray = field(repr=False)
+    level: FlightLevel
+    vertical_start_m: float = 0.0
+    vertical_goal_m: float = 0.0
+    climb_out_m: float = 0.0
+    descent_m: float = 0.0
+    lifted_m: float = 0.0
+
+    @property
+    def cruise(self) -> np.ndarray:
+        """Bool mask of the cruise points."""
+        return self.phase == "cruise"
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-friendly description (method, limits, phases)."""
+        lim = self.level
+        return {
+            "method": "route from FM², heights = continuous surface + agl under slope limits",
+            "agl_m": lim.agl, "tolerance_m": lim.tolerance, "min_agl_m": lim.min_agl,
+            "max_agl_m": lim.max_agl, "max_climb_deg": lim.max_climb,
+            "max_descent_deg": lim.max_descent,
+            "vertical_start_m": round(self.vertical_start_m, 3),
+            "vertical_goal_m": round(self.vertical_goal_m, 3),
+            "climb_out_m": round(self.climb_out_m, 3), "descent_m": round(self.descent_m, 3),
+            "max_lift_above_target_m": round(self.lifted_m, 3),
+        }
+
+
+def _where(s: float, xy: np.ndarray | None, i: int) -> str:
+    if xy is None:
+        return f"at {s:.0f} m along the route"
+    return f"at {s:.0f} m along the route (x = {xy[i, 0]:.1f}, y = {xy[i, 1]:.1f} m)"
+
+
+def solve_profile(
+    s: Any,
+    surf_max: Any,
+    ground_min: Any,
+    level: FlightLevel,
+    *,
+    z_start: float,
+    z_goal: float,
+    ground_start: float,
+    ground_goal: float,
+    extra_lower: Any = None,
+    extra_upper: Any = None,
+    top: float = math.inf,
+    xy: np.ndarray | None = None,
+) -> dict[str, Any]:
+    """The profile along sampled route positions (the array core of :func:`final_profile`).
+
+    Parameters
+    ----------
+    s : array_like, shape (M,)
+        Horizontal arc length of the samples [m].
+    surf_max : array_like, shape (M,)
+        Highest surface (ground or roof) under each sample and its chords [m]:
+        the floor and the target are measured from it.
+    ground_min : array_like, shape (M,)
+        Lowest ground under each sample and its chords [m]: the ``max_agl``
+        ceiling is measured from it.
+    level : FlightLevel
+        agl, tolerance, min_agl, max_agl, max_climb, max_descent.
+    z_start, z_goal : float
+        Heights of the start and goal [m].
+    ground_start, ground_goal : float
+        Surface under them [m].
+    extra_lower, extra_upper : array_like, optional
+        More bounds per sample (no-fly zones): ``-inf`` / ``+inf`` where none.
+    top : float, optional
+        Highest admissible altitude (the world's top node) [m].
+    xy : ndarray, optional
+        Sample positions, for error messages.
+
+    Returns
+    -------
+    dict
+        ``z`` (M,), ``cruise_z`` (M,), ``z_start_eff``, ``z_goal_eff``,
+        ``phase`` (M,), ``lifted_m``.
+
+    Raises
+    ------
+    PlanningError
+        No profile meets the floor, the ceiling and the slope limits.
+    """
+    s = np.asarray(s, dtype=float)
+    smax = np.asarray(surf_max, dtype=float)
+    gmin = np.asarray(ground_min, dtype=float)
+    m = len(s)
+    lim = level
+    tc, td = _tan(lim.max_climb), _tan(lim.max_descent)
+    lo_x = np.full(m, -np.inf) if extra_lower is None else np.asarray(extra_lower, dtype=float)
+    up_x = np.full(m, np.inf) if extra_upper is None else np.asarray(extra_upper, dtype=float)
+    target = np.maximum(smax + lim.agl, lo_x)
+    floor = np.maximum(smax + floor_agl(lim), lo_x)
+    ceil = np.minimum(gmin + (np.inf if lim.max_agl is None else float(lim.max_agl)), up_x)
+    ceil = np.minimum(ceil, top)
+    a = envelope_above(s, floor, tc, td)
+    c = envelope_below(s, ceil, tc, td)
+    bad = np.flatnonzero(a > c + 1e-6)
+    if len(bad):
+        i = int(bad[0])
+        raise PlanningError(
+            f"no flyable profile {_where(s[i], xy, i)}: keeping {floor_agl(lim):g} m above the "
+            f"ground needs z >= {a[i]:.1f} m there, but the ceiling (planner.max_agl = "
+            f"{lim.max_agl} m, no-fly zone floors, the map top) and the airframe's climb/descent "
+            f"limits ({lim.max_climb:g}/{lim.max_descent:g} deg) allow at most {c[i]:.1f} m; "
+            "raise planner.max_agl (--max-agl), lower planner.agl (--agl) or allow steeper climbs")
+    cruise_z = np.maximum(a, np.minimum(envelope_above(s, target, tc, td), c))
+    lifted = float(np.max(cruise_z - target)) if m else 0.0
+
+    total = float(s[-1] - s[0])
+    rel = s - s[0]
+
+    def cone_interval(z_end: float, ground_end: float, dist: np.ndarray, up: float,
+                      down: float, where: str) -> tuple[float, float]:
+        # heights at the end point from which the cone z_end + up*dist (above) /
+        # z_end - down*dist (below) keeps the profile within its floor and ceiling
+        own = max(z_end - ground_end, 0.0)
+        keep = lim.min_agl if lim.min_agl is not None else min(lim.agl - lim.tolerance, own)
+        low = np.maximum(smax + keep, lo_x)
+        need_lo = float(np.max(low - up * dist))
+        need_hi = float(np.min(ceil + down * dist))
+        if need_lo > need_hi + 1e-6:
+            raise PlanningError(
+                f"the {where} cannot be joined to the route within the altitude limits "
+                f"(needs {need_lo:.1f} m, ceiling allows {need_hi:.1f} m); move the {where} or "
+                "raise planner.max_agl (--max-agl)")
+        return need_lo, need_hi
+
+    # start cone: going forward z rises at most tc and drops at most td per metre
+    lo_s, hi_s = cone_interval(z_start, ground_start, rel, tc, td, "start")
+    zs = min(max(z_start, lo_s), hi_s)
+    lo_g, hi_g = cone_interval(z_goal, ground_goal, total - rel, td, tc, "goal")
+    # the goal's effective height must also be reachable from the start's
+    lo_g, hi_g = max(lo_g, zs - td * total), min(hi_g, zs + tc * total)
+    if lo_g > hi_g + 1e-6:
+        raise PlanningError(
+            f"start and goal are {total:.0f} m apart horizontally but need heights "
+            f"{zs:.1f} m and {z_goal:.1f} m: more than the climb/descent limits "
+            f"({lim.max_climb:g}/{lim.max_descent:g} deg) allow; move them or allow steeper climbs")
+    zg = min(max(z_goal, lo_g), hi_g)
+    lo = np.maximum(zs - td * rel, zg - tc * (total - rel))
+    hi = np.minimum(zs + tc * rel, zg + td * (total - rel))
+    z = np.minimum(np.maximum(cruise_z, lo), hi)
+    on = np.abs(z - cruise_z) <= 1e-6
+    phase = np.full(m, "cruise", dtype=object)
+    if on.any():
+        i0, i1 = int(np.argmax(on)), int(m - 1 - np.argmax(on[::-1]))
+        phase[:i0] = "climb-out"
+        phase[i1 + 1:] = "descent"
+    else:  # the cones never let the profile reach the cruise: all transition
+        half = int(np.searchsorted(rel, total / 2.0))
+        phase[:half] = "climb-out"
+        phase[half:] = "descent"
+    return {"z": z, "cruise_z": cruise_z, "z_start_eff": zs, "z_goal_eff": zg,
+            "phase": phase.astype(str), "lifted_m": lifted}
+
+
+def height_figures(agl: Any, requested: float | None = None, *, band: float = 5.0,
+                   points: Any = None, s: Any = None) -> dict[str, Any]:
+    """Figures of a height-above-ground series: min, p5, median, max, share within ±band.
+
+    Parameters
+    ----------
+    agl : array_like, shape (N,)
+        Height above the ground/surface [m].
+    requested : float, optional
+        The requested height [m] (gives ``within_band``).
+    band : float, optional
+        Half-width [m] of the band around ``requested``. Default 5.
+    points : array_like, shape (N, 3), optional
+        The points, for ``lowest_point_m``.
+    s : array_like, shape (N,), optional
+        Arc length [m] of each point, for ``lowest_at_m``.
+
+    Returns
+    -------
+    dict
+        ``n``, ``min_m``, ``p5_m``, ``median_m``, ``max_m``, ``within_band``
+        (share in [0, 1], or None), ``band_m``, and the lowest point.
+    """
+    h = np.asarray(agl, dtype=float).ravel()
+    if len(h) == 0:
+        return {"n": 0}
+    i = int(np.argmin(h))
+    out: dict[str, Any] = {
+        "n": int(len(h)),
+        "min_m": round(float(h[i]), 3),
+        "p5_m": round(float(np.percentile(h, 5)), 3),
+        "median_m": round(float(np.median(h)), 3),
+        "max_m": round(float(np.max(h)), 3),
+        "band_m": float(band),
+        "within_band": (None if requested is None else
+                        round(float(np.mean(np.abs(h - float(requested)) <= band)), 4)),
+    }
+    if points is not None:
+        out["lowest_point_m"] = [round(float(v), 3) for v in np.asarray(points)[i]]
+    if s is not None:
+        out["lowest_at_m"] = round(float(np.asarray(s)[i]), 3)
+    return out
