@@ -202,8 +202,21 @@ def _vertical_note(driver: str) -> str:
             "declares no vertical CRS")
 
 
+def _rect_in(rect: tuple[float, float, float, float], rect_crs: Any, crs: Any
+             ) -> tuple[float, float, float, float]:
+    """Outer bounds in ``crs`` of a rectangle given in ``rect_crs`` (edges densified)."""
+    x0, y0, x1, y1 = rect
+    t = np.linspace(0.0, 1.0, 65)
+    x = np.concatenate([x0 + (x1 - x0) * t, np.full(65, x1), x1 - (x1 - x0) * t, np.full(65, x0)])
+    y = np.concatenate([np.full(65, y0), y0 + (y1 - y0) * t, np.full(65, y1), y1 - (y1 - y0) * t])
+    u, v = transformer(rect_crs, crs).transform(x, y)
+    u, v = np.asarray(u), np.asarray(v)
+    ok = np.isfinite(u) & np.isfinite(v)
+    return float(u[ok].min()), float(v[ok].min()), float(u[ok].max()), float(v[ok].max())
+
+
 def _read_files(paths: list[Path], crs: Any, nodata: float | None,
-                bbox: tuple[float, float, float, float] | None
+                bbox: tuple[float, float, float, float] | None, window_crs: Any = None
                 ) -> tuple[np.ndarray, tuple[float, ...], Any, str | None, str, list[SourceFile]]:
     import rasterio
     from rasterio.errors import RasterioIOError
@@ -253,7 +266,10 @@ def _read_files(paths: list[Path], crs: Any, nodata: float | None,
         first = datasets[0]
         window_bounds = None
         if bbox is not None:
-            bx = _bbox_in(h_crs, bbox)
+            # the world's rectangle is the bbox's outer box in the world's CRS: read the
+            # source window that covers all of it (a rotated rectangle in the source CRS)
+            bx = (_bbox_in(h_crs, bbox) if window_crs is None
+                  else _rect_in(_bbox_in(window_crs, bbox), window_crs, h_crs))
             res = max(abs(first.transform.a), abs(first.transform.e))
             window_bounds = (bx[0] - 2 * res, bx[1] - 2 * res, bx[2] + 2 * res, bx[3] + 2 * res)
         if len(datasets) == 1:
@@ -272,6 +288,7 @@ def _read_files(paths: list[Path], crs: Any, nodata: float | None,
             band = first.read(1, masked=True, window=win, out_dtype="float64")
             t = first.window_transform(win) if win is not None else first.transform
             z = np.ma.filled(band, np.nan)
+            z = _apply_alpha(first, z, win)
         else:
             kw = {"bounds": window_bounds} if window_bounds is not None else {}
             try:
@@ -309,6 +326,17 @@ def _read_files(paths: list[Path], crs: Any, nodata: float | None,
             ds.close()
 
 
+def _apply_alpha(ds: Any, z: np.ndarray, win: Any) -> np.ndarray:
+    """Mask pixels whose alpha band is 0 when GDAL does not (alpha of a float type)."""
+    from rasterio.enums import ColorInterp, MaskFlags
+
+    alpha = [i + 1 for i, c in enumerate(ds.colorinterp) if c == ColorInterp.alpha]
+    if not alpha or MaskFlags.alpha in ds.mask_flag_enums[0]:
+        return z
+    a = ds.read(alpha[0], window=win)
+    return np.where(a == 0, np.nan, z)
+
+
 def _no_overlap(bbox: Any, crs: Any, bounds: tuple[float, float, float, float]) -> str:
     lon, lat = transformer(crs, WGS84).transform(
         [bounds[0], bounds[2], bounds[0], bounds[2]], [bounds[1], bounds[1], bounds[3], bounds[3]])
@@ -326,6 +354,7 @@ def read_dem(
     bounds: Any = None,
     nodata: float | None = None,
     bbox: Sequence[float] | None = None,
+    window_crs: Any = None,
 ) -> DemRaster:
     """Read a DEM into a :class:`DemRaster` (masked pixels → NaN).
 
@@ -347,6 +376,9 @@ def read_dem(
         own nodata, mask and alpha bands, and NaN).
     bbox : (west, south, east, north), optional
         Lon/lat degrees: read only the window covering this box (files).
+    window_crs : optional
+        The CRS the box will be used in (the world's): the window then covers
+        the box's outer rectangle in that CRS.
 
     Raises
     ------
@@ -367,7 +399,7 @@ def read_dem(
     note = ""
     sources: list[SourceFile] = []
     if paths is not None:
-        z, t, h_crs, vname, note, sources = _read_files(paths, crs, nodata, box)
+        z, t, h_crs, vname, note, sources = _read_files(paths, crs, nodata, box, window_crs)
         if transform is not None:
             t = _affine(transform)
         where = f"the DEM {paths[0]}" + (f" (+{len(paths) - 1} tiles)" if len(paths) > 1 else "")
@@ -442,6 +474,26 @@ def _footprint_lonlat(dem: DemRaster) -> tuple[float, float, float, float]:
     lon, lat = transformer(dem.crs, WGS84).transform(x, y)
     lon, lat = np.asarray(lon), np.asarray(lat)
     return float(lon.min()), float(lat.min()), float(lon.max()), float(lat.max())
+
+
+def _source_crs(source: Any, crs: Any) -> Any:
+    """Horizontal CRS of a DEM source before reading its pixels (None if unknown)."""
+    first = source[0] if isinstance(source, (list, tuple)) and source and isinstance(
+        source[0], (str, PathLike)) else source
+    if isinstance(first, (str, PathLike)):
+        import rasterio
+        from rasterio.errors import RasterioIOError
+
+        try:
+            with rasterio.open(first) as ds:
+                c = ds.crs.to_wkt() if ds.crs is not None else crs
+        except RasterioIOError:
+            return None  # read_dem reports it
+    else:
+        c = crs
+    if c is None:
+        return None
+    return _split_crs(c)[0]
 
 
 def _intersect(a: tuple[float, ...], b: tuple[float, ...]) -> tuple[float, float, float, float]:
@@ -521,8 +573,15 @@ def from_dem(
         raise InputError(f"world.sea_level (--sea-level) must be an altitude in metres, e.g. 0, "
                          f"got {sea_level!r}")
     box = None if bbox is None else check_lonlat_bbox(bbox, "world.bbox (--bbox)")
+    pre = None
+    if box is not None:
+        # the area of interest is the bbox: choose the world's CRS from it first, so that
+        # the window read covers the bbox's rectangle in that CRS
+        src0 = _source_crs(source, crs)
+        if src0 is not None:
+            pre = local_metric_crs(src0, box)
     dem = read_dem(source, crs=crs, transform=transform, bounds=bounds, nodata=nodata_value,
-                   bbox=box)
+                   bbox=box, window_crs=None if pre is None else pre[0])
     rows, cols = dem.z.shape
     a, b, c, d, e, f = dem.transform
     src = parse_crs(dem.crs)
@@ -536,7 +595,7 @@ def from_dem(
                 f"bbox {','.join(f'{v:g}' for v in box)} does not overlap the DEM, which covers "
                 f"lon {full_ll[0]:.4f}..{full_ll[2]:.4f}, lat {full_ll[1]:.4f}..{full_ll[3]:.4f}; "
                 "fix world.bbox (CLI --bbox W,S,E,N, lon/lat)")
-    dst, err, reason = local_metric_crs(src, area_ll)
+    dst, err, reason = pre if pre is not None else local_metric_crs(src, area_ll)
     if err > MAX_SCALE_ERROR:
         warnings.warn(f"{reason}; crop the DEM with world.bbox (CLI --bbox) for true lengths",
                       GeodataWarning, stacklevel=2)
@@ -612,7 +671,11 @@ def from_dem(
     hmin, hmax = float(heights.min()), float(heights.max())
     z0 = (np.floor(hmin / dz) - 1.0) * dz
     top_alt = _ceiling(ceiling, hmax, dz, agl, top)
-    nz = int(np.floor((top_alt - z0) / dz + 1e-9)) + 1
+    if ceiling is None and (agl is not None or top is not None):
+        # the default follows the request: the top node reaches it
+        nz = int(np.ceil((top_alt - z0) / dz - 1e-9)) + 1
+    else:  # a given ceiling (or the plain default) is a maximum: the top node stays under it
+        nz = int(np.floor((top_alt - z0) / dz + 1e-9)) + 1
     check_size((nx, ny, nz), (dx, dy, dz))
     w = World.from_heightmap(heights, (dx, dy, dz), nz, origin=(west, south, z0), name=name)
     details = {"world_nodes": [nx, ny, nz], "filled_nodes": int(filled.sum()),
