@@ -73,3 +73,152 @@ def column_clearance(points, surf, hx, hy, hz, ox, oy, oz):
                     j += step
         out[p] = math.sqrt(best2)
     return out
+
+
+@njit(cache=True, inline="always")
+def _tri_dist2(px, py, pz, ax, ay, az, bx, by, bz, cx, cy, cz):
+    """Squared distance from p to triangle abc (Ericson, Real-Time Collision Detection 5.1.5)."""
+    abx, aby, abz = bx - ax, by - ay, bz - az
+    acx, acy, acz = cx - ax, cy - ay, cz - az
+    apx, apy, apz = px - ax, py - ay, pz - az
+    d1 = abx * apx + aby * apy + abz * apz
+    d2 = acx * apx + acy * apy + acz * apz
+    if d1 <= 0.0 and d2 <= 0.0:
+        qx, qy, qz = ax, ay, az
+    else:
+        bpx, bpy, bpz = px - bx, py - by, pz - bz
+        d3 = abx * bpx + aby * bpy + abz * bpz
+        d4 = acx * bpx + acy * bpy + acz * bpz
+        if d3 >= 0.0 and d4 <= d3:
+            qx, qy, qz = bx, by, bz
+        else:
+            vc = d1 * d4 - d3 * d2
+            if vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
+                v = d1 / (d1 - d3)
+                qx, qy, qz = ax + v * abx, ay + v * aby, az + v * abz
+            else:
+                cpx, cpy, cpz = px - cx, py - cy, pz - cz
+                d5 = abx * cpx + aby * cpy + abz * cpz
+                d6 = acx * cpx + acy * cpy + acz * cpz
+                if d6 >= 0.0 and d5 <= d6:
+                    qx, qy, qz = cx, cy, cz
+                else:
+                    vb = d5 * d2 - d1 * d6
+                    if vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
+                        w = d2 / (d2 - d6)
+                        qx, qy, qz = ax + w * acx, ay + w * acy, az + w * acz
+                    else:
+                        va = d3 * d6 - d5 * d4
+                        if va <= 0.0 and (d4 - d3) >= 0.0 and (d5 - d6) >= 0.0:
+                            w = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+                            qx = bx + w * (cx - bx)
+                            qy = by + w * (cy - by)
+                            qz = bz + w * (cz - bz)
+                        else:
+                            den = 1.0 / (va + vb + vc)
+                            v = vb * den
+                            w = vc * den
+                            qx = ax + abx * v + acx * w
+                            qy = ay + aby * v + acy * w
+                            qz = az + abz * v + acz * w
+    dx, dy, dz = px - qx, py - qy, pz - qz
+    return dx * dx + dy * dy + dz * dz
+
+
+@njit(cache=True, error_model="numpy")
+def surface_distance(points, start, heights, ox, oy, hx, hy, roofs, rox, roy, rhx, rhy):
+    """Distance from each point to a terrain surface with box-shaped buildings on it.
+
+    The terrain is the height grid ``heights`` (node ``(i, j)`` at ``(ox + i hx,
+    oy + j hy)``) with each cell split into four triangles around its centre
+    (centre height = mean of the corners, equal to the bilinear surface there;
+    the triangles coincide with the bilinear surface on every cell edge).
+    Buildings are the columns of ``roofs`` with a finite height: boxes
+    ``[x_i ± rhx/2] x [y_j ± rhy/2]`` up to the roof.
+
+    Parameters
+    ----------
+    points : ndarray (N, 3)
+        World coordinates [m].
+    start : ndarray (N,)
+        An upper bound of each distance (the height above the surface right
+        below the point) [m]; the search radius. Points with ``start <= 0`` are
+        returned as ``start`` (at or below the surface).
+
+    Returns
+    -------
+    ndarray (N,)
+        Distance [m].
+    """
+    n = points.shape[0]
+    mx, my = heights.shape
+    nx, ny = roofs.shape
+    out = np.empty(n)
+    for p in range(n):
+        x = points[p, 0]
+        y = points[p, 1]
+        z = points[p, 2]
+        best = start[p]
+        if not best > 0.0:
+            out[p] = best
+            continue
+        best2 = best * best
+        r = best
+        i0 = max(int(math.floor((x - r - ox) / hx)), 0)
+        i1 = min(int(math.floor((x + r - ox) / hx)), mx - 2)
+        j0 = max(int(math.floor((y - r - oy) / hy)), 0)
+        j1 = min(int(math.floor((y + r - oy) / hy)), my - 2)
+        for i in range(i0, i1 + 1):
+            xa = ox + i * hx
+            xb = xa + hx
+            gx = 0.0 if xa <= x <= xb else min(abs(x - xa), abs(x - xb))
+            for j in range(j0, j1 + 1):
+                ya = oy + j * hy
+                yb = ya + hy
+                gy = 0.0 if ya <= y <= yb else min(abs(y - ya), abs(y - yb))
+                if gx * gx + gy * gy >= best2:
+                    continue
+                h00 = heights[i, j]
+                h10 = heights[i + 1, j]
+                h01 = heights[i, j + 1]
+                h11 = heights[i + 1, j + 1]
+                lo = min(min(h00, h10), min(h01, h11))
+                if z > lo:
+                    dzmin = 0.0 if z <= max(max(h00, h10), max(h01, h11)) else \
+                        z - max(max(h00, h10), max(h01, h11))
+                else:
+                    dzmin = lo - z
+                if gx * gx + gy * gy + dzmin * dzmin >= best2:
+                    continue
+                xc = xa + 0.5 * hx
+                yc = ya + 0.5 * hy
+                hc = 0.25 * (h00 + h10 + h01 + h11)
+                d2 = _tri_dist2(x, y, z, xc, yc, hc, xa, ya, h00, xb, ya, h10)
+                d2 = min(d2, _tri_dist2(x, y, z, xc, yc, hc, xb, ya, h10, xb, yb, h11))
+                d2 = min(d2, _tri_dist2(x, y, z, xc, yc, hc, xb, yb, h11, xa, yb, h01))
+                d2 = min(d2, _tri_dist2(x, y, z, xc, yc, hc, xa, yb, h01, xa, ya, h00))
+                if d2 < best2:
+                    best2 = d2
+        if nx > 0:
+            r = math.sqrt(best2)
+            i0 = max(int(math.floor((x - r - rox) / rhx + 0.5)) - 1, 0)
+            i1 = min(int(math.floor((x + r - rox) / rhx + 0.5)) + 1, nx - 1)
+            j0 = max(int(math.floor((y - r - roy) / rhy + 0.5)) - 1, 0)
+            j1 = min(int(math.floor((y + r - roy) / rhy + 0.5)) + 1, ny - 1)
+            for i in range(i0, i1 + 1):
+                xa = rox + (i - 0.5) * rhx
+                xb = xa + rhx
+                gx = 0.0 if xa <= x <= xb else min(abs(x - xa), abs(x - xb))
+                for j in range(j0, j1 + 1):
+                    top = roofs[i, j]
+                    if not top > -1e300:
+                        continue
+                    ya = roy + (j - 0.5) * rhy
+                    yb = ya + rhy
+                    gy = 0.0 if ya <= y <= yb else min(abs(y - ya), abs(y - yb))
+                    gz = z - top if z > top else 0.0
+                    d2 = gx * gx + gy * gy + gz * gz
+                    if d2 < best2:
+                        best2 = d2
+        out[p] = math.sqrt(best2)
+    return out

@@ -1,4 +1,17 @@
-"""Clearance: distance from path points to the nearest obstacle node."""
+"""Clearance: distance from path points to obstacles.
+
+Two questions:
+
+* :func:`surface_clearance` — the **honest** one: distance [m] from each point
+  to the continuous terrain/building surface (terrain = the bilinear ground of
+  :meth:`World.ground_height`, triangulated four triangles per cell around the
+  cell centre; buildings = their columns as boxes up to the roof of
+  :meth:`World.surface_height`). No-fly zones are not surfaces and do not
+  count (see :mod:`fm2uav.world.zones`). Worlds that are not made of solid
+  columns (and 2D worlds) measure to their obstacle *cells* as boxes.
+* :func:`clearance_profile` — distance to the nearest obstacle *node* (the
+  grid's view, including zone nodes); kept for the FM² internals and tests.
+"""
 
 from __future__ import annotations
 
@@ -7,9 +20,97 @@ from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from .world import World
-from ._clearance_kernels import column_clearance
+from ._clearance_kernels import column_clearance, surface_distance
 
-__all__ = ["clearance_profile", "obstacle_tree", "column_surface"]
+__all__ = ["clearance_profile", "obstacle_tree", "column_surface", "surface_clearance",
+           "base_occupancy"]
+
+
+def base_occupancy(world: World) -> np.ndarray:
+    """The world's terrain/building obstacles: ``occupancy`` without no-fly-zone nodes."""
+    from .zones import zone_voxels
+
+    mask = zone_voxels(world)
+    return world.occupancy if mask is None else world.occupancy & ~mask
+
+
+def _is_columns(world: World) -> bool:
+    """True if the non-zone obstacles are solid columns (terrain, extruded buildings)."""
+    key = "base_is_columns"
+    if key not in world._cache:
+        occ = base_occupancy(world)
+        ok = False
+        if world.ndim == 3:
+            has = occ.any(axis=2)
+            nz = occ.shape[2]
+            top = np.where(has, nz - 1 - np.argmax(occ[:, :, ::-1], axis=2), -1)
+            k = np.arange(nz)
+            ok = bool(np.array_equal(occ, k[None, None, :] <= top[:, :, None]))
+        world._cache[key] = ok
+    return world._cache[key]
+
+
+def _ground_grid(world: World) -> tuple[np.ndarray, float, float, float, float]:
+    """Height grid [m], origin and spacing of the ground the surface is made of."""
+    if world.terrain is not None:
+        return (np.ascontiguousarray(world.terrain, dtype=float), world.origin[0],
+                world.origin[1], world.spacing[0], world.spacing[1])
+    b = world.bounds
+    hx = max(float(b[0, 1] - b[0, 0]), world.spacing[0])
+    hy = max(float(b[1, 1] - b[1, 0]), world.spacing[1])
+    return np.full((2, 2), float(world.origin[2])), float(b[0, 0]), float(b[1, 0]), hx, hy
+
+
+def _cell_box_clearance(world: World, pts: np.ndarray) -> np.ndarray:
+    """Distance to the nearest obstacle cell (box of one spacing around its node)."""
+    occ = base_occupancy(world)
+    if not occ.any():
+        return np.full(len(pts), np.inf)
+    key = "box_tree"
+    if key not in world._cache:
+        interior = ndimage.binary_erosion(occ, border_value=1)
+        nodes = np.argwhere(occ & ~interior)
+        world._cache[key] = (cKDTree(world.to_world(nodes)), world.to_world(nodes))
+    tree, centres = world._cache[key]
+    h = np.asarray(world.spacing, dtype=float)
+    half_diag = 0.5 * float(np.linalg.norm(h))
+    d_node, _ = tree.query(pts)
+    out = np.empty(len(pts))
+    for k, (p, d) in enumerate(zip(pts, d_node)):
+        idx = tree.query_ball_point(p, d + half_diag)
+        gap = np.maximum(np.abs(centres[idx] - p) - 0.5 * h, 0.0)
+        out[k] = float(np.sqrt((gap * gap).sum(axis=1)).min())
+    return out
+
+
+def surface_clearance(world: World, points: np.ndarray) -> np.ndarray:
+    """Distance [m] from each point to the terrain / building surface (continuous).
+
+    See the module docstring for the surface model. Negative values are
+    points below the surface (minus their depth under it, measured vertically).
+
+    Parameters
+    ----------
+    world : World
+    points : ndarray, shape (N, ndim)
+        World coordinates [m].
+
+    Returns
+    -------
+    ndarray, shape (N,)
+        ``inf`` for a world without obstacles and without terrain.
+    """
+    pts = np.atleast_2d(np.asarray(points, dtype=float))
+    if world.ndim == 2 or not _is_columns(world):
+        return _cell_box_clearance(world, pts)
+    above = pts[:, 2] - np.asarray(world.surface_height(pts[:, 0], pts[:, 1]), dtype=float)
+    from .ground import roof_heights
+
+    heights, ox, oy, hx, hy = _ground_grid(world)
+    roofs = np.ascontiguousarray(roof_heights(world), dtype=float)
+    return surface_distance(np.ascontiguousarray(pts), np.ascontiguousarray(above), heights,
+                            ox, oy, hx, hy, roofs, world.origin[0], world.origin[1],
+                            world.spacing[0], world.spacing[1])
 
 
 def column_surface(world: World) -> np.ndarray | None:

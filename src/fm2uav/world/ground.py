@@ -66,7 +66,8 @@ def roof_heights(world: World) -> np.ndarray:
     """``(nx, ny)`` z [m] of the roof of each column, ``-inf`` where there is none.
 
     A roof is the topmost obstacle node of a column when it is above the
-    column's ground (the terrain node height, or the floor without terrain).
+    column's ground (the terrain node height, or the floor without terrain);
+    nodes of no-fly zones (``World.zones``) do not count.
     Cached on the world; 2D worlds have no roofs.
     """
     key = "roof_heights"
@@ -75,7 +76,9 @@ def roof_heights(world: World) -> np.ndarray:
         if world.ndim != 3:
             cached = np.full(world.shape, -np.inf)
         else:
-            top = world.surface_index()
+            from .zones import terrain_surface_index
+
+            top = terrain_surface_index(world)  # no-fly zone nodes are not roofs
             z_top = world.origin[2] + top * world.spacing[2]
             ground = world.terrain if world.terrain is not None else world.origin[2]
             tol = 1e-9 * world.spacing[2]

@@ -91,6 +91,10 @@ class World:
         Optional :class:`~fm2uav.world.geo.Georef`: CRS with EPSG code,
         vertical reference of z, source files with SHA-256 (worlds built from
         real data).
+    zones:
+        No-fly zones and operating areas (:class:`fm2uav.world.zones.Zone`)
+        whose nodes are part of ``occupancy``; build with
+        :func:`fm2uav.world.zones.with_zones`. Default ``()``.
     _cache:
         Private scratch dictionary where other modules may cache arrays derived
         from this (immutable) world, e.g. the distance transform. It is not an
@@ -106,6 +110,7 @@ class World:
     name: str = ""
     filled: np.ndarray | None = None
     georef: Any = None
+    zones: tuple = ()
     _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     # ------------------------------------------------------------------ validation
@@ -169,6 +174,7 @@ class World:
             filled = _readonly(np.array(fm, dtype=bool, copy=True))
         set_ = object.__setattr__
         set_(self, "filled", filled)
+        set_(self, "zones", tuple(self.zones or ()))
         set_(self, "occupancy", occ)
         set_(self, "spacing", spacing)
         set_(self, "origin", origin)
