@@ -1,0 +1,421 @@
+"""One way in for real data: :class:`WorldSpec` → :func:`load_world` → a :class:`World`.
+
+The mission file's ``world:`` section and the CLI's world options (``--dem``,
+``--buildings``, ``--bbox``, ``--sea-level``, ... defined once in
+:mod:`fm2uav.cli.options`) both become a :class:`WorldSpec`; :func:`load_world`
+builds the world from it:
+
+* ``dem`` only: :func:`fm2uav.world.dem.from_dem` (any GDAL raster or tiles);
+* ``buildings`` only: :func:`fm2uav.world.buildings.from_buildings` on flat
+  ground (footprints' cells *touched*, so small buildings still block);
+* both: the buildings on the DEM (roof = highest ground under the footprint +
+  height), in the DEM world's CRS and grid.
+
+**A world sized for the request.** ``load_world(spec, agl=..., top=...)`` is
+told the highest requested height above ground (the planner's ``agl`` and the
+points' ``agl``) and the highest requested altitude:
+
+* ``cell_size`` default: the DEM's pixel size on the ground, coarsened so that
+  the map has at most :data:`AUTO_COLUMNS` columns (buildings-only: 2 m, same
+  rule), rounded down to a round number;
+* ``dz`` default: ``cell_size``, and with an ``agl`` at most ``agl / 6``
+  (rounded down to a round number), so the flight level is >= 6 cells above
+  the ground;
+* ``ceiling`` default: the highest ground (or roof) + ``max(20 dz, agl + 10 dz)``
+  (``agl`` given) and at least ``top + 5 dz``, so a 120 m request always has sky.
+
+Every error names the mission-file key (``world.<key>``) and the CLI flag.
+
+:func:`check_points` refuses a start, goal or take-off over a *filled* DEM
+cell (``World.filled``, nodata filled with ``nodata: fill``): its ground height
+was invented. ``allow_filled`` (CLI ``--allow-filled``) turns that into a warning.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator
+
+from ..errors import InputError, PointError, WorldError
+from .dem import GeodataWarning
+from .world import World
+
+__all__ = [
+    "WorldSpec",
+    "load_world",
+    "check_points",
+    "world_summary",
+    "round_down",
+    "AUTO_COLUMNS",
+]
+
+#: Largest number of map columns (nx * ny) of an automatic cell size.
+AUTO_COLUMNS = 250_000
+_ROUND = (1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0)
+
+
+def round_down(v: float) -> float:
+    """``v`` rounded down to 1, 1.5, 2, 2.5, 3, 4, 5, 6 or 8 times a power of ten."""
+    if not (np.isfinite(v) and v > 0):
+        raise InputError(f"cannot round {v!r}: give a positive number")
+    e = math.floor(math.log10(v))
+    m = v / 10.0**e
+    best = max(r for r in _ROUND if r <= m + 1e-9)
+    return float(f"{best:g}e{e}")
+
+
+def _resolve(v: str, info: ValidationInfo | None) -> Path:
+    base = (info.context or {}).get("base_dir") if info is not None and info.context else None
+    p = Path(v).expanduser()
+    if not p.is_absolute() and base is not None:
+        p = Path(base) / p
+    return p
+
+
+_STRICT = ConfigDict(strict=True, extra="forbid", frozen=True)
+
+
+def _num(default: Any = None, *, unit: str = "", desc: str = "", **bounds: float) -> Any:
+    return Field(default, description=desc, json_schema_extra={"unit": unit}, **bounds)
+
+
+class WorldSpec(BaseModel):
+    """The real-data part of a world: DEM, buildings, crop, sea, grid (see the module docstring).
+
+    Paths are resolved against ``context={"base_dir": ...}`` when validated
+    (the mission file's folder).
+    """
+
+    model_config = _STRICT
+    dem: str | list[str] | None = Field(
+        None, description="DEM raster file(s) GDAL reads (GeoTIFF, VRT, .hgt); several = tiles")
+    buildings: str | None = Field(
+        None, description="building footprints: GeoJSON (lon/lat), GeoPackage, Shapefile, KML/KMZ")
+    bbox: list[float] | None = Field(
+        None, min_length=4, max_length=4, description="crop: west, south, east, north [deg]")
+    sea_level: float | None = _num(None, unit="m", ge=-500, le=9000,
+                                   desc="water surface: ground = max(DEM, sea_level)")
+    cell_size: float | None = _num(None, unit="m", gt=0, le=5000,
+                                   desc="horizontal grid cell (default: from the data)")
+    dz: float | None = _num(None, unit="m", gt=0, le=1000,
+                            desc="vertical cell (default: cell_size, at most agl/6)")
+    ceiling: float | None = _num(None, unit="m", ge=-500, le=12000,
+                                 desc="altitude of the top node (default: follows agl)")
+    nodata: Literal["error", "fill"] = Field("error", description="DEM gaps: refuse or fill")
+    nodata_value: float | None = _num(None, unit="m", desc="an undeclared DEM nodata value")
+    crs: str | None = Field(None, description="CRS of input files that declare none")
+    default_height: float | None = _num(None, unit="m", gt=0, le=1000,
+                                        desc="height of buildings without one")
+    metres_per_level: float = _num(3.0, unit="m", gt=0, le=20,
+                                   desc="storey height for building:levels")
+    height_cells: int | None = _num(None, ge=2, le=2000,
+                                    desc="number of vertical nodes (buildings on flat ground)")
+    margin: float = _num(0.0, unit="m", ge=0, le=100000,
+                         desc="free border around the buildings (no DEM, no bbox)")
+    allow_filled: bool = Field(False, description="start/goal on filled nodata: warn only")
+
+    @field_validator("dem")
+    @classmethod
+    def _dem_files(cls, v: Any, info: ValidationInfo) -> Any:
+        if v is None:
+            return v
+        items = [v] if isinstance(v, str) else list(v)
+        if not items:
+            raise ValueError("is empty; allowed: a raster file or a list of tiles")
+        out = []
+        for item in items:
+            path = _resolve(item, info)
+            if not path.is_file():
+                raise ValueError(f"file not found ({path}); allowed: an existing raster file "
+                                 "(GeoTIFF, VRT, .hgt, ...)")
+            try:
+                import rasterio
+
+                with rasterio.open(path) as ds:
+                    crs = ds.crs
+            except Exception as exc:  # rasterio raises its own error types
+                raise ValueError(f"cannot be read as a raster ({type(exc).__name__}); "
+                                 "allowed: a raster file GDAL reads (GeoTIFF, VRT, .hgt)") from None
+            if crs is None and (info.data or {}).get("crs") is None:
+                raise ValueError(
+                    f"{path.name} has no coordinate reference system (CRS); allowed: a raster "
+                    "with a CRS (assign one: gdal_edit.py -a_srs EPSG:32616 FILE), or give it "
+                    "with world.crs")
+            out.append(str(path))
+        return out[0] if isinstance(v, str) else out
+
+    @field_validator("buildings")
+    @classmethod
+    def _buildings_file(cls, v: str | None, info: ValidationInfo) -> str | None:
+        if v is None:
+            return v
+        path = _resolve(v, info)
+        if not path.exists():
+            raise ValueError(f"file not found ({path}); allowed: an existing vector file "
+                             "(GeoJSON, GeoPackage, Shapefile, KML/KMZ)")
+        return str(path)
+
+    @field_validator("bbox")
+    @classmethod
+    def _bbox(cls, v: list[float] | None) -> list[float] | None:
+        if v is None:
+            return v
+        from .geo import check_lonlat_bbox
+
+        try:
+            return list(check_lonlat_bbox(v, "bbox"))
+        except InputError as exc:
+            raise ValueError(str(exc).removeprefix("bbox = ")) from None
+
+    @field_validator("crs")
+    @classmethod
+    def _crs(cls, v: str | None) -> str | None:
+        if v is None:
+            return v
+        from pyproj import CRS
+        from pyproj.exceptions import CRSError
+
+        try:
+            CRS.from_user_input(v)
+        except CRSError:
+            raise ValueError("is not a CRS pyproj knows; allowed: e.g. EPSG:4326 (lon/lat) or "
+                             "EPSG:32630") from None
+        return v
+
+    @property
+    def has_data(self) -> bool:
+        """Whether the spec names a DEM or a buildings file."""
+        return self.dem is not None or self.buildings is not None
+
+    def describe(self) -> str:
+        """Short text of the sources, for titles (e.g. ``"dem.tif + town.geojson"``)."""
+        parts = []
+        if self.dem is not None:
+            dems = [self.dem] if isinstance(self.dem, str) else self.dem
+            parts.append(Path(dems[0]).name + (f" (+{len(dems) - 1} tiles)" if len(dems) > 1
+                                               else ""))
+        if self.buildings is not None:
+            parts.append(Path(self.buildings).name)
+        return " + ".join(parts)
+
+
+def _pixel_ground_size(path: str) -> tuple[float, float]:
+    """(pixel size on the ground [m], footprint area [m²]) of a raster from its metadata."""
+    import rasterio
+
+    from .geo import bounds_lonlat, parse_crs
+
+    with rasterio.open(path) as ds:
+        crs = parse_crs(ds.crs.to_wkt()) if ds.crs is not None else None
+        res = max(abs(ds.transform.a), abs(ds.transform.e))
+        b = ds.bounds
+        if crs is None:
+            return res, (b.right - b.left) * (b.top - b.bottom)
+        ll = bounds_lonlat((b.left, b.bottom, b.right, b.top), crs)
+    from pyproj import Geod
+
+    lat_c = 0.5 * (ll[1] + ll[3])
+    geod = Geod(ellps="WGS84")
+    width = geod.inv(ll[0], lat_c, ll[2], lat_c)[2]
+    height = geod.inv(ll[0], ll[1], ll[0], ll[3])[2]
+    if crs.is_geographic:
+        pix = res * 111320.0 * max(math.cos(math.radians(lat_c)), 0.05)
+    else:
+        unit = crs.axis_info[0].unit_conversion_factor if crs.axis_info else 1.0
+        pix = res * unit
+    return float(pix), float(width * height)
+
+
+def _bbox_area(bbox: Any) -> float:
+    from pyproj import Geod
+
+    w, s, e, n = bbox
+    return abs(Geod(ellps="WGS84").polygon_area_perimeter([w, e, e, w], [s, s, n, n])[0])
+
+
+def _auto_cell(spec: WorldSpec) -> tuple[float, str]:
+    """Default horizontal cell [m] and how it was chosen."""
+    if spec.dem is not None:
+        first = spec.dem if isinstance(spec.dem, str) else spec.dem[0]
+        pix, area = _pixel_ground_size(first)
+        if spec.bbox is not None:
+            area = _bbox_area(spec.bbox)
+        elif isinstance(spec.dem, list):
+            area *= len(spec.dem)  # tiles of about one size
+        cap = math.sqrt(area / AUTO_COLUMNS)
+        cell = round_down(max(pix, cap))
+        why = (f"auto: DEM pixel {pix:.1f} m on the ground" if pix >= cap else
+               f"auto: at most {AUTO_COLUMNS} map columns over {area / 1e6:.1f} km²")
+        return cell, why
+    from .vectors import read_vectors
+
+    data = read_vectors(spec.buildings, target_crs="auto", crs=spec.crs, role="buildings")
+    if spec.bbox is not None:
+        area = _bbox_area(spec.bbox)
+    elif data.geometries:
+        import shapely
+
+        x0, y0, x1, y1 = shapely.total_bounds(np.asarray(data.geometries, dtype=object))
+        area = (x1 - x0 + 2 * spec.margin) * (y1 - y0 + 2 * spec.margin)
+    else:
+        area = 0.0
+    cap = math.sqrt(max(area, 1.0) / AUTO_COLUMNS)
+    cell = round_down(max(2.0, cap))
+    return cell, ("auto: 2 m for buildings" if cap <= 2.0 else
+                  f"auto: at most {AUTO_COLUMNS} map columns over {area / 1e6:.2f} km²")
+
+
+def _requested(v: float | None, what: str) -> float | None:
+    if v is None:
+        return None
+    f = float(v)
+    if not np.isfinite(f) or f <= 0:
+        raise InputError(f"{what} must be a positive height in metres, got {v!r}")
+    return f
+
+
+def load_world(spec: WorldSpec, *, agl: float | None = None, top: float | None = None,
+               name: str = "") -> World:
+    """Build the world a :class:`WorldSpec` describes, sized for the request.
+
+    Parameters
+    ----------
+    spec : WorldSpec
+        With ``dem`` and/or ``buildings``.
+    agl : float, optional
+        Highest requested height above the ground [m] (planner ``agl``, points'
+        ``agl``): sets the default ``dz`` (<= agl / 6) and ceiling.
+    top : float, optional
+        Highest requested altitude [m] (points given with ``alt`` / ``z``).
+    name : str
+        World name (default: the source file's stem).
+
+    Returns
+    -------
+    World
+        With ``crs``, ``georef`` (sources with SHA-256, the cell choices in the
+        DEM source's ``details``) and, for DEMs, ``filled``.
+
+    Raises
+    ------
+    InputError, WorldError
+        One line naming the mission-file key and the CLI flag.
+    """
+    from .buildings import from_buildings
+    from .dem import from_dem
+
+    if not spec.has_data:
+        raise InputError("the world needs world.dem (CLI --dem) and/or world.buildings "
+                         "(CLI --buildings)")
+    agl = _requested(agl, "planner.agl (--agl)")
+    if spec.cell_size is not None:
+        dx, why_dx = float(spec.cell_size), "given (world.cell_size)"
+    else:
+        dx, why_dx = _auto_cell(spec)
+    if spec.dz is not None:
+        dz, why_dz = float(spec.dz), "given (world.dz)"
+    elif agl is not None and agl / 6.0 < dx:
+        dz, why_dz = round_down(agl / 6.0), f"auto: at most agl / 6 = {agl / 6.0:.3g} m"
+    else:
+        dz, why_dz = dx, "auto: = cell_size"
+    if agl is not None and agl < dz / 2.0:
+        raise InputError(
+            f"world.dz (--dz) = {dz:g} m is more than twice the requested height above ground "
+            f"{agl:g} m: the flight level would round to the ground; use world.dz <= {agl / 6:g}")
+    stem = name
+    if not stem:
+        first = spec.dem if isinstance(spec.dem, str) else (spec.dem or [spec.buildings])[0]
+        stem = Path(str(first)).stem
+    grid = {"cell_size": dx, "cell_size_rule": why_dx, "dz": dz, "dz_rule": why_dz}
+    world = None
+    if spec.dem is not None:
+        world = from_dem(spec.dem, (dx, dx, dz), spec.ceiling, crs=spec.crs, nodata=spec.nodata,
+                         nodata_value=spec.nodata_value, bbox=spec.bbox,
+                         sea_level=spec.sea_level, agl=agl, top=top, name=stem)
+    if spec.buildings is not None:
+        world = from_buildings(
+            spec.buildings, (dx, dx, dz), height_cells=spec.height_cells,
+            metres_per_level=spec.metres_per_level, default_height=spec.default_height,
+            margin=spec.margin, name=stem, crs=spec.crs, terrain=world, all_touched=True,
+            bbox=spec.bbox if world is None else None, agl=agl, top=top)
+        if spec.ceiling is not None and world.bounds[2, 1] > spec.ceiling + 1e-6 and \
+                spec.dem is not None:
+            raise WorldError(
+                f"world.ceiling (--ceiling) = {spec.ceiling:g} m is below the roofs plus the "
+                f"requested height; raise it to at least {world.bounds[2, 1]:.0f} m or leave "
+                "it out")
+    if world.georef is not None:
+        import dataclasses
+
+        srcs = list(world.georef.sources)
+        srcs[0] = dataclasses.replace(srcs[0], details={**srcs[0].details, **grid})
+        world = dataclasses.replace(world, georef=dataclasses.replace(world.georef,
+                                                                      sources=tuple(srcs)))
+    return world
+
+
+def check_points(world: World, points: dict[str, Any], *, allow_filled: bool = False) -> None:
+    """Refuse named points (``{"start": p, "goal": q}``) over filled DEM cells.
+
+    Parameters
+    ----------
+    world : World
+    points : dict
+        Name → world point [m] (x, y[, z]).
+    allow_filled : bool
+        Warn (:class:`~fm2uav.world.dem.GeodataWarning`) instead of raising.
+
+    Raises
+    ------
+    PointError
+        A point whose nearest column has a filled (invented) ground height;
+        the message names ``--allow-filled`` / ``world.allow_filled``.
+    """
+    filled = getattr(world, "filled", None)
+    if filled is None or not filled.any():
+        return
+    for what, p in points.items():
+        q = np.asarray(p, dtype=float)
+        cell = world.to_cell(q, what=what)
+        if filled[cell[0], cell[1]]:
+            lonlat = ""
+            if world.crs is not None:
+                from .geo import to_lonlat
+
+                ll = to_lonlat(world, [q[0], q[1], 0.0])
+                lonlat = f" (lon {ll[0]:.5f}, lat {ll[1]:.5f})"
+            msg = (f"the {what}{lonlat} lies over a DEM gap whose ground height was filled "
+                   "(world.nodata: fill), so its altitude above ground is invented; move the "
+                   f"{what} onto real data, or accept it with --allow-filled "
+                   "(mission file: world.allow_filled: true)")
+            if not allow_filled:
+                raise PointError(msg)
+            warnings.warn(msg.split("; move")[0] + " (allowed by --allow-filled)",
+                          GeodataWarning, stacklevel=2)
+
+
+def world_summary(world: World) -> dict[str, Any]:
+    """What a summary says about a world: CRS, vertical reference, sources, counts.
+
+    JSON-ready; ``{"crs": None, ...}`` for worlds without a CRS.
+    """
+    g = getattr(world, "georef", None)
+    out: dict[str, Any] = {"name": world.name, "shape": list(world.shape),
+                           "spacing_m": list(world.spacing), "crs": world.crs}
+    if g is not None:
+        out["georef"] = g.as_dict()
+        for s in g.sources:
+            d = dict(s.details)
+            if s.role == "buildings":
+                out["buildings"] = {"count": d.get("buildings"),
+                                    "height_rule": d.get("height_rule"),
+                                    "skipped": d.get("skipped", {}),
+                                    "outside_map": d.get("outside_map", 0)}
+    if getattr(world, "filled", None) is not None:
+        out["filled_nodes"] = int(world.filled.sum())
+    return out
