@@ -52,7 +52,7 @@ def run(quick: bool = False) -> list[dict]:
         "ours_s": tff, "peer": "plan without flight level", "peer_s": plain,
         "ratio": plain / tff,
     })
-    from fm2uav.cli.cmd_tff import run_tff
+    from fm2uav.experiments.tff import run_tff
 
     rows.append({
         "benchmark": "tff", "case": "reproduce tff cases (6 plans + metrics, no figures)",

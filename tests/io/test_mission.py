@@ -159,15 +159,22 @@ BAD = [
      ["cell_size does not apply"]),
     ("dem-missing-file", "world: {dem: nowhere.tif, cell_size: 30}\nstart: [0, 0, 0]\n"
      "goal: [1, 1, 1]\n", ["world.dem = 'nowhere.tif'", "file not found"]),
-    ("dem-no-cell", "world: {dem: dem.tif}\nstart: [0, 0, 0]\ngoal: [1, 1, 1]\n",
-     ["cell_size is missing"]),
+    ("dem-bbox", "world: {dem: dem.tif, bbox: [-3.69, 40.37, -3.71, 40.39]}\nstart: [0, 0, 0]\n"
+     "goal: [1, 1, 1]\n", ["world.bbox", "west < east", "W,S,E,N"]),
+    ("dem-bbox-len", "world: {dem: dem.tif, bbox: [-3.69, 40.37]}\n", ["world.bbox", "4"]),
     ("dem-no-crs", "world: {dem: nocrs.tif, cell_size: 30}\nstart: [0, 0, 0]\n"
      "goal: [1, 1, 1]\n", ["world.dem = 'nocrs.tif'", "no coordinate reference system"]),
     ("dem-not-raster", "world: {dem: notes.txt, cell_size: 30}\nstart: [0, 0, 0]\n"
      "goal: [1, 1, 1]\n", ["world.dem = 'notes.txt'", "cannot be read as a raster"]),
     ("dem-no-start", "world: {dem: dem.tif, cell_size: 30}\n", ["start is missing"]),
-    ("buildings-crs", "world: {buildings: dem.tif, cell_size: 5, crs: EPSG:4326}\n"
-     "start: [0, 0, 0]\ngoal: [1, 1, 1]\n", ["world.crs = 'EPSG:4326'", "projected"]),
+    ("crs-unknown", "world: {buildings: dem.tif, cell_size: 5, crs: EPSG:999999}\n"
+     "start: [0, 0, 0]\ngoal: [1, 1, 1]\n", ["world.crs = 'EPSG:999999'", "not a CRS"]),
+    ("sea-level-scenario", "world: {scenario: open-field, sea_level: 0}\n",
+     ["sea_level does not apply to a built-in scenario"]),
+    ("scenario-and-dem", "world: {scenario: open-field, dem: dem.tif}\n",
+     ["either scenario or real data"]),
+    ("heights-on-dem", "world: {dem: dem.tif, height_cells: 30}\nstart: [0, 0, 0]\n"
+     "goal: [1, 1, 1]\n", ["height_cells only applies to a world with buildings"]),
 ]
 
 

@@ -33,7 +33,6 @@ __all__ = [
     "ideal_altitude",
     "transition_bounds",
     "tff_metrics",
-    "SEED_CASES",
 ]
 
 
@@ -225,16 +224,6 @@ def flight_level_deviation(
         tolerance_m=tol,
         deviation=dev,
     )
-
-
-#: The seeds' experiments (TFF paper §5, thesis §4.3): (name, level [cells], p1, p2).
-SEED_CASES: tuple[tuple[str, int, float, float], ...] = (
-    ("level 2", 2, 0.5, 2.5),
-    ("level 5", 5, 0.5, 1.5),
-    ("level 10", 10, 0.5, 1.3),
-    ("smooth p2=1.0", 10, 0.5, 1.0),
-    ("smooth p2=0.8", 10, 0.5, 0.8),
-)
 
 
 def tff_metrics(plan: Any, agl: float, *, ds: float | None = None) -> dict[str, float]:

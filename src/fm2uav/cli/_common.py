@@ -40,6 +40,7 @@ __all__ = [
     "console",
     "err_console",
     "handle_errors",
+    "warning_lines",
     "OutputDir",
     "parse_point",
     "print_summary",
@@ -79,13 +80,39 @@ def _fail(message: str, code: int) -> None:
     raise typer.Exit(code)
 
 
+@contextmanager
+def warning_lines() -> Iterator[None]:
+    """Show fm2uav's warnings (e.g. a DEM below sea level) as one ``warning:`` line each."""
+    import warnings
+
+    original = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001
+        if str(getattr(category, "__module__", "")).startswith("fm2uav"):
+            err_console.print(f"[bold yellow]warning:[/] {escape(str(message))}",
+                              highlight=False, soft_wrap=True)
+        else:
+            original(message, category, filename, lineno, file, line)
+
+    warnings.showwarning = show
+    try:
+        yield
+    finally:
+        warnings.showwarning = original
+
+
 def handle_errors(func: F) -> F:
-    """Map fm2uav errors to one-line messages and exit codes 1 (planning) / 2 (input)."""
+    """Map fm2uav errors to one-line messages and exit codes 1 (planning) / 2 (input).
+
+    Warnings of fm2uav (:class:`fm2uav.world.dem.GeodataWarning`, ...) are shown
+    as one ``warning:`` line each on stderr.
+    """
 
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
-            return func(*args, **kwargs)
+            with warning_lines():
+                return func(*args, **kwargs)
         except typer.Exit:
             raise
         except PointError as exc:

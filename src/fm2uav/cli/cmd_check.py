@@ -10,6 +10,22 @@ import numpy as np
 import typer
 
 from ._common import EXIT_PLANNING, OutputDir, handle_errors, print_summary, progress, to_jsonable
+from .options import (
+    AllowFilledOpt,
+    BboxOpt,
+    BuildingsOpt,
+    CeilingOpt,
+    CellSizeOpt,
+    CrsOpt,
+    DefaultHeightOpt,
+    DemOpt,
+    DzOpt,
+    NodataOpt,
+    NodataValueOpt,
+    SeaLevelOpt,
+    world_rows,
+    world_spec,
+)
 
 CHECK_FILES = ("report.json", "flown.csv", "check.png")
 REPORT = "report.html"
@@ -45,6 +61,8 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "  fm2uav check out/plan/path.csv --airframe disco --out out/check\n\n"
             "  fm2uav check out/plan/path.csv --scenario open-field --report --out out/check\n\n"
             "  fm2uav check path.csv --airframe crosswind --scenario city --tolerance 3 --json\n\n"
+            "  fm2uav check out/dem/path.csv --dem dem.tif --bbox 10.05,45.54,10.2,45.66 "
+            "--out out/check-dem   (the world of the plan: same DEM options)\n\n"
             f"Airframes: {', '.join(AIRFRAMES)}."
         ),
     )
@@ -72,6 +90,18 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
         report: bool = typer.Option(
             False, "--report", help="Also write report.html (planned vs flown, interactive)."),
+        dem: DemOpt = None,
+        buildings: BuildingsOpt = None,
+        bbox: BboxOpt = None,
+        sea_level: SeaLevelOpt = None,
+        cell_size: CellSizeOpt = None,
+        dz: DzOpt = None,
+        ceiling: CeilingOpt = None,
+        nodata: NodataOpt = "error",
+        nodata_value: NodataValueOpt = None,
+        crs: CrsOpt = None,
+        default_height: DefaultHeightOpt = None,
+        allow_filled: AllowFilledOpt = False,
     ) -> None:
         from ..io import read_path_csv, write_path_csv
         from ..vehicles import check_feasibility, get_airframe
@@ -80,7 +110,22 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
 
         af = get_airframe(airframe)
         path = read_path_csv(path_file)
-        world = get_scenario(scenario, seed=seed).world if scenario else None
+        spec = world_spec(dem=dem, buildings=buildings, bbox=bbox, sea_level=sea_level,
+                          cell_size=cell_size, dz=dz, ceiling=ceiling, nodata=nodata,
+                          nodata_value=nodata_value, crs=crs, default_height=default_height,
+                          allow_filled=allow_filled)
+        if spec is not None and scenario is not None:
+            from ..errors import InputError
+
+            raise InputError("give either --scenario or --dem/--buildings, not both")
+        if spec is not None:
+            from ..world.load import load_world
+
+            # the world the path was planned on: give the same world options as to plan
+            top = float(path[:, 2].max()) if path.shape[1] == 3 else None
+            world = load_world(spec, top=top)
+        else:
+            world = get_scenario(scenario, seed=seed).world if scenario else None
         outdir = OutputDir(out, force=force)
         outdir.check(CHECK_FILES + ((REPORT,) if report else ()))
         with progress(enabled=not (quiet or as_json)) as step:
@@ -89,14 +134,20 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
                                     lookahead=lookahead, lookahead_points=lookahead_points,
                                     speed=speed, dt=dt)
         summary = {"path_file": str(path_file), "scenario": scenario, **rep.summary()}
+        if world is not None and getattr(world, "georef", None) is not None:
+            from ..world.load import world_summary
+
+            summary["world"] = world_summary(world)
         tmp_png = outdir.target("check.png")
         tracking_figure(rep, world, title=path_file.name).savefig(tmp_png, dpi=100)
         with outdir.open("flown.csv") as fh:
-            write_path_csv(fh, rep.tracking.trajectory)
+            g = getattr(world, "georef", None)
+            write_path_csv(fh, rep.tracking.trajectory, comment=g.comment() if g else None)
         outdir.commit(tmp_png, "check.png")
         with outdir.open("report.json") as fh:
             json.dump(to_jsonable(summary), fh, indent=2)
         tr, geo = rep.tracking, rep.geometric
+        wrows = world_rows(world) if world is not None else {}
         sat = ", ".join(f"{k} {v:.1f} s" for k, v in tr.saturation_time().items()) or "none"
         rows = {
             "verdict": "FEASIBLE" if rep.feasible else "INFEASIBLE",
@@ -110,6 +161,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "max climb / descent [deg]": (f"{np.degrees(geo.climb_angle.max()):.1f} / "
                                           f"{np.degrees(-geo.climb_angle.min()):.1f}"),
         }
+        rows.update(wrows)
         if getattr(af, "kind", "") == "fixed-wing":
             rows["R_min [m]"] = f"{af.turn_radius(rep.airframe.cruise_speed):.1f}"
         if report:

@@ -6,7 +6,6 @@ import csv
 import json
 from pathlib import Path
 
-import numpy as np
 import typer
 
 from ._common import OutputDir, handle_errors, print_summary, progress, to_jsonable
@@ -20,37 +19,53 @@ CITY_FILES = (
 REPORT = "report.html"
 
 
-def _report(cases, rrt_paths: dict, rows: list[dict], rrt_rows: list[dict], *, af,
-            seed: int, tolerance: float, files: list[str]) -> str:
-    """report.html: FM² paths of both missions, their Dubins-flown tracks, the RRT paths."""
-    from ..viz.report import join_polylines, report_html
-
-    paths = {f"FM² {c.mission} W^{c.exponent:g}": c.path3 for c in cases}
-    speeds = {f"FM² {c.mission} W^{c.exponent:g}": c.plan.speed for c in cases}
-    paths.update(rrt_paths)
-    flown = join_polylines([c.report.tracking.trajectory for c in cases])
-    cols = ["mission", "exponent", "safety_m", "thesis_safety_m", "separation_max_m",
-            "thesis_separation_m", "length_m", "plan_s", "feasible"]
-    return report_html(
-        cases[0].world3, paths, speeds=speeds,
-        title="Thesis ch. 3: FM² in the city, Dubins-flown, vs RRT",
-        subtitle=f"low- and high-altitude missions with W^1, W^1/2, W^1/4 flown by the "
-                 f"{af.name}; OMPL planners on the low mission",
-        overlays={f"flown tracks ({af.name})": {"points": flown, "color": "#222222",
-                                               "dash": "dash", "width": 2}},
-        params={"seed": seed, "airframe": af.name, "tolerance [m]": tolerance},
-        metrics={f"{r['mission']} W^{r['exponent']:g}": (
-            f"safety {r['safety_m']} m, separation {r['separation_max_m']} m, "
-            f"{'feasible' if r['feasible'] else 'INFEASIBLE'}") for r in rows},
-        tables={"Safety and separation distances (Tables 3.1/3.2)":
-                [{c: r[c] for c in cols} for r in rows],
-                "FM² vs RRT, low altitude": rrt_rows},
-        files=files)
+def _write_png(outdir: OutputDir, fig, name: str, dpi: int) -> None:
+    tmp = outdir.target(name)
+    fig.savefig(tmp, dpi=dpi)
+    outdir.commit(tmp, name)
 
 
-def _md_table(rows: list[dict], cols: list[str]) -> str:
-    head = "| " + " | ".join(cols) + " |\n|" + "---|" * len(cols) + "\n"
-    return head + "".join("| " + " | ".join(str(r[c]) for c in cols) + " |\n" for r in rows)
+def _write_city_outputs(outdir: OutputDir, run, *, report: bool) -> None:
+    """Path CSVs, table.csv/.md, rrt.csv, the figures (and report.html) of a city run."""
+    from ..experiments.city import city_markdown, horizontal_slice
+    from ..io import write_path_csv
+    from ..viz.feasibility import city_cases_figure, rrt_figure, speed_profiles_figure
+
+    rows = run.rows
+    for c in run.cases:
+        with outdir.open(f"{c.mission}_W{c.exponent:g}.csv") as fh:
+            write_path_csv(fh, c.path3, c.plan.speed)
+    _write_csv(outdir, "table.csv", rows)
+    for mission in ("low", "high"):
+        mc = [c for c in run.cases if c.mission == mission]
+        fig = city_cases_figure(
+            mc, mc[0].world3,
+            title=f"city, {mission} altitude — FM² planned vs Dubins flown ({run.airframe.name})")
+        _write_png(outdir, fig, f"{mission}_paths.png", 90)
+    fig = speed_profiles_figure(run.speed_profiles(),
+                                title="velocity profiles along the paths (Fig. 3.4)")
+    _write_png(outdir, fig, "speed_profiles.png", 100)
+    if run.rrt is not None:
+        _write_csv(outdir, "rrt.csv", run.rrt_rows)
+        sc = run.missions["low"]
+        fig = rrt_figure(horizontal_slice(sc.world, float(sc.start[2])), run.rrt["rrt"],
+                         run.rrt["fm2"].plan.path,
+                         title="low-altitude mission: FM² vs OMPL (Fig. 3.5)")
+        _write_png(outdir, fig, "rrt.png", 90)
+    with outdir.open("table.md") as fh:
+        fh.write(city_markdown(run))
+    if report:
+        from ..viz.feasibility import city_report_html
+
+        with outdir.open(REPORT) as fh:
+            fh.write(city_report_html(run, list(CITY_FILES)))
+
+
+def _write_csv(outdir: OutputDir, name: str, rows: list[dict]) -> None:
+    with outdir.open(name) as fh:
+        wr = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        wr.writeheader()
+        wr.writerows(rows)
 
 
 def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
@@ -84,93 +99,21 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         report: bool = typer.Option(
             False, "--report", help="Also write report.html (interactive, self-contained)."),
     ) -> None:
-        from ..experiments.city import (
-            THESIS_TIMES_S,
-            city_missions,
-            city_table,
-            horizontal_slice,
-            rrt_comparison,
-        )
-        from ..io import write_path_csv
+        from ..experiments.city import city_summary, reproduce_city
         from ..vehicles import get_airframe
-        from ..viz.feasibility import city_cases_figure, rrt_figure, speed_profiles_figure
 
-        af = get_airframe(airframe)
+        af = get_airframe(airframe)  # a bad --airframe fails before anything is checked
         outdir = OutputDir(out, force=force)
         outdir.check(CITY_FILES + ((REPORT,) if report else ()))
         with progress(enabled=not (quiet or as_json)) as step:
-            step("planning both missions with W^1, W^1/2, W^1/4 and flying them")
-            cases = city_table(seed, af, tolerance=tolerance)
-            rows = [c.row() for c in cases]
-            missions = city_missions(seed)
-            for c in cases:
-                with outdir.open(f"{c.mission}_W{c.exponent:g}.csv") as fh:
-                    write_path_csv(fh, c.path3, c.plan.speed)
-            cols = list(rows[0])
-            with outdir.open("table.csv") as fh:
-                wr = csv.DictWriter(fh, fieldnames=cols)
-                wr.writeheader()
-                wr.writerows(rows)
-            md_cols = ["mission", "exponent", "safety_m", "thesis_safety_m", "separation_max_m",
-                       "thesis_separation_m", "separation_mean_m", "length_m", "plan_s",
-                       "feasible"]
-            text = ("## Safety and separation distances (Tables 3.1/3.2)\n\n"
-                    + _md_table(rows, md_cols))
-            step("drawing the figures")
-            for mission in ("low", "high"):
-                mc = [c for c in cases if c.mission == mission]
-                fig = city_cases_figure(
-                    mc, mc[0].world3,
-                    title=f"city, {mission} altitude — FM² planned vs Dubins flown ({af.name})")
-                tmp = outdir.target(f"{mission}_paths.png")
-                fig.savefig(tmp, dpi=90)
-                outdir.commit(tmp, f"{mission}_paths.png")
-            prof = {f"{c.mission} W^{c.exponent:g}": (
-                np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(c.path3, axis=0),
-                                                                axis=1))]),
-                c.plan.speed) for c in cases}
-            fig = speed_profiles_figure(prof, title="velocity profiles along the paths (Fig. 3.4)")
-            tmp = outdir.target("speed_profiles.png")
-            fig.savefig(tmp, dpi=100)
-            outdir.commit(tmp, "speed_profiles.png")
-            rrt_rows: list[dict] = []
-            rrt_paths: dict[str, np.ndarray] = {}
-            if rrt:
-                step("FM² vs OMPL RRT / RRT-Connect / RRT* (low mission)")
-                rrt_rows, art = rrt_comparison(missions["low"], "low", af, time_limit=rrt_time,
-                                               rrtstar_time=rrtstar_time, tolerance=tolerance,
-                                               seed=seed)
-                with outdir.open("rrt.csv") as fh:
-                    wr = csv.DictWriter(fh, fieldnames=list(rrt_rows[0]))
-                    wr.writeheader()
-                    wr.writerows(rrt_rows)
-                sc = missions["low"]
-                fig = rrt_figure(horizontal_slice(sc.world, float(sc.start[2])), art["rrt"],
-                                 art["fm2"].plan.path,
-                                 title="low-altitude mission: FM² vs OMPL (Fig. 3.5)")
-                tmp = outdir.target("rrt.png")
-                fig.savefig(tmp, dpi=90)
-                outdir.commit(tmp, "rrt.png")
-                text += ("\n## FM² vs RRT, low altitude (thesis: FM² 1.2 s, RRT 5 s)\n\n"
-                         + _md_table(rrt_rows, ["planner", "time_s", "length_m", "clearance_m",
-                                                "min_radius_m", "separation_max_m", "feasible"]))
-                z = float(sc.start[2])
-                for r in art["rrt"].values():
-                    p = r.path if r.path.shape[1] == 3 else np.column_stack(
-                        [r.path, np.full(len(r.path), z)])
-                    rrt_paths[f"{r.planner} low (+ shortcut)"] = p
-            with outdir.open("table.md") as fh:
-                fh.write(text)
-            if report:
-                step("writing report.html")
-                html = _report(cases, rrt_paths, rows, rrt_rows, af=af, seed=seed,
-                               tolerance=tolerance, files=list(CITY_FILES))
-                with outdir.open(REPORT) as fh:
-                    fh.write(html)
-        summary = {"seed": seed, "airframe": af.summary(), "table": rows, "rrt": rrt_rows,
-                   "thesis_times_s": THESIS_TIMES_S}
+            run = reproduce_city(seed, af, tolerance=tolerance, rrt=rrt, rrt_time=rrt_time,
+                                 rrtstar_time=rrtstar_time, on_step=step)
+            step("writing the tables and figures")
+            _write_city_outputs(outdir, run, report=report)
+        summary = city_summary(run)
         with outdir.open("summary.json") as fh:
             json.dump(to_jsonable(summary), fh, indent=2)
+        rows, rrt_rows = run.rows, run.rrt_rows
         show = {
             f"{r['mission']} W^{r['exponent']:g}": (
                 f"safety {r['safety_m']:.1f} m (thesis {r['thesis_safety_m']}), separation "

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 from pathlib import Path
 
@@ -16,23 +14,6 @@ from ._common import OutputDir, handle_errors, print_summary, progress, to_jsona
 COVER_FILES = ("path.csv", "zigzag.csv", "bands.png", "coverage.png", "coverage.html",
                "summary.json", "mission.plan")
 REPORT = "report.html"
-
-#: The seeds' Table 5.1 (D = 80) and 5.2 (S1): min cost, α, max cost, α, median, α, mean, α.
-SEEDS_T51 = {
-    "S1": (5446.504, 37.134, 6104.040, 11.499, 5464.316, 37.684, 5616.718, 37.214),
-    "S2": (6748.057, 2.503, 8373.462, 71.434, 6768.528, 3.389, 6870.913, 8.597),
-    "S3": (5908.607, 1.012, 7493.887, 65.506, 5980.716, 2.086, 6061.788, 9.452),
-    "S4": (7176.987, 1.349, 8223.283, 44.610, 7215.164, 2.581, 7290.188, 7.953),
-}
-SEEDS_T52 = {
-    40: (9679.496, 38.474, 10885.701, 86.879, 10150.668, 36.968, 10066.730, 33.238),
-    60: (6909.084, 37.878, 7696.142, 79.164, 6940.380, 36.990, 6982.500, 36.189),
-    80: SEEDS_T51["S1"],
-    100: (4615.506, 38.368, 5394.695, 57.202, 4658.287, 37.670, 4761.862, 29.829),
-}
-_COLS = ("min_cost", "min_alpha", "max_cost", "max_alpha", "median_cost", "median_alpha",
-         "mean_cost", "mean_alpha")
-
 
 def _camera_spacing(camera: str, agl: float, side_overlap: float) -> float:
     from ..missions.coverage import Camera
@@ -67,22 +48,9 @@ def _load_area(area: str, world=None):
     return read_area(area, world)
 
 
-def _overlays(cp, prefix: str = "", colour: str = "#1a1a1a") -> dict:
-    """Scene overlays of a coverage plan: the area's rings and the bands (2D, draped)."""
-    from ..viz.report import join_polylines
-
-    area = cp.zigzag.area
-    rings = [np.asarray(area.exterior.coords)] + [np.asarray(r.coords) for r in area.interiors]
-    out = {f"{prefix}area": {"points": join_polylines(rings), "color": colour, "width": 5}}
-    bands = [np.asarray(b.coords) for b in cp.zigzag.bands()]
-    if bands:
-        out[f"{prefix}bands"] = {"points": join_polylines(bands), "color": "#ff7f0e",
-                                 "dash": "dash", "width": 2}
-    return out
-
-
 def _write_report(outdir: OutputDir, cp, *, title: str, subtitle: str, metrics: dict,
                   waypoints=None, files=()) -> None:
+    from ..viz.coverage import coverage_overlays
     from ..viz.report import report_html
 
     name = "FM² path"
@@ -90,7 +58,7 @@ def _write_report(outdir: OutputDir, cp, *, title: str, subtitle: str, metrics: 
         cp.plan.world, {name: cp.path}, title=title, subtitle=subtitle,
         speeds={name: cp.plan.speed}, ideal_agl={name: cp.params.get("agl_m")},
         waypoints=None if waypoints is None else {name: waypoints},
-        overlays=_overlays(cp), params=cp.params, metrics=metrics, files=files)
+        overlays=coverage_overlays(cp), params=cp.params, metrics=metrics, files=files)
     with outdir.open(REPORT) as fh:
         fh.write(html)
 
@@ -143,6 +111,23 @@ def _write_cover_outputs(outdir: OutputDir, cp, area: str, *, report: bool, titl
                       metrics=metrics, waypoints=None if wps is None else wps.points_m,
                       files=list(COVER_FILES))
     return wps
+
+def _write_coverage_figures(outdir: OutputDir, run) -> None:
+    """bands_<area>.png, coverage_<area>.png and bands_S1_D<d>.png of a coverage run."""
+    from ..missions.coverage import zigzag
+    from ..scenarios.coverage import COVERAGE_AGL, coverage_area
+    from ..viz.coverage import bands_figure, coverage_figure
+
+    for n, cp in run.plans.items():
+        _write_png(outdir, bands_figure(cp.zigzag, title=f"{n}, D = 80 m"), f"bands_{n}.png")
+        _write_png(outdir, coverage_figure(cp, title=f"{n} at {COVERAGE_AGL:g} m AGL"),
+                   f"coverage_{n}.png")
+    s1 = coverage_area("S1")
+    for d, angle in run.s1_angles.items():
+        if d != 80:
+            _write_png(outdir, bands_figure(zigzag(s1, d, angle), title=f"S1, D = {d} m"),
+                       f"bands_S1_D{d}.png")
+
 
 def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
     """Add ``cover`` and ``reproduce coverage``."""
@@ -254,15 +239,15 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         report: bool = typer.Option(
             False, "--report", help="Also write report.html (interactive, self-contained)."),
     ) -> None:
-        from ..missions.coverage import differential_evolution, plan_coverage, scipy_de, sweep
-        from ..viz.coverage import bands_figure, coverage_figure
-        from ..scenarios.coverage import (
-            COVERAGE_AGL,
-            COVERAGE_AREAS,
-            COVERAGE_SPACING,
-            coverage_area,
-            coverage_world,
+        from ..experiments.coverage import (
+            SEEDS_T51,
+            SEEDS_T52,
+            coverage_payload,
+            reproduce_coverage,
+            table_csv,
+            tables_markdown,
         )
+        from ..scenarios.coverage import COVERAGE_AREAS
 
         names = list(COVERAGE_AREAS)
         files = ["table_5_1.csv", "table_5_2.csv", "tables.md", "summary.json"]
@@ -271,125 +256,29 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         outdir = OutputDir(out, force=force)
         outdir.check(files + ([REPORT] if report else []))
         with progress(enabled=not (quiet or as_json)) as step:
-            world = coverage_world(seed)
-
-            def row(poly, d):
-                de = differential_evolution(poly, d, seed=seed)
-                sw = sweep(poly, d, step_deg=0.1)
-                sp = scipy_de(poly, d, seed=seed)
-                st = de.stats()
-                return de, {**{k: round(st[k], 3) for k in _COLS},
-                            "sweep_cost": round(sw.cost, 3),
-                            "sweep_alpha": round(sw.angle_deg, 3),
-                            "de_vs_sweep_pct": round(100 * (de.cost - sw.cost) / sw.cost, 4),
-                            "scipy_cost": round(sp.cost, 3),
-                            "scipy_alpha": round(sp.angle_deg, 3),
-                            "de_s": round(de.seconds, 4)}
-
-            t51, t52, cover = {}, {}, {}
-            for n in names:
-                step(f"area {n}: DE, 0.1° sweep, scipy DE and FM² along the bands")
-                poly = coverage_area(n)
-                de, r = row(poly, COVERAGE_SPACING)
-                cp = plan_coverage(world, poly, COVERAGE_SPACING, agl=COVERAGE_AGL,
-                                   angle=de.angle)
-                r.update(coverage_pct=round(100 * cp.coverage, 3),
-                         fm2_length=round(cp.plan.length, 1),
-                         agl_err_mean=round(float(np.abs(cp.agl_error).mean()), 2),
-                         plan_s=round(cp.timings["total"] + de.seconds, 4))
-                t51[n] = r
-                cover[n] = cp
-                _write_png(outdir, bands_figure(cp.zigzag, title=f"{n}, D = 80 m"),
-                           f"bands_{n}.png")
-                _write_png(outdir, coverage_figure(cp, title=f"{n} at {COVERAGE_AGL:g} m AGL"),
-                           f"coverage_{n}.png")
-            s1 = coverage_area("S1")
-            for d in (40, 60, 80, 100):
-                step(f"S1 with D = {d} m")
-                de, r = row(s1, float(d))
-                t52[d] = r
-                if d != 80:
-                    from ..missions.coverage import zigzag
-
-                    _write_png(outdir, bands_figure(zigzag(s1, d, de.angle),
-                                                    title=f"S1, D = {d} m"),
-                               f"bands_S1_D{d}.png")
-
-        def table_csv(rows, key, seeds):
-            buf = io.StringIO()
-            cols = list(next(iter(rows.values())).keys())
-            w = csv.writer(buf)
-            w.writerow([key, *cols, *(f"seeds_{c}" for c in _COLS)])
-            for k, r in rows.items():
-                w.writerow([k, *(r[c] for c in cols), *seeds[k]])
-            return buf.getvalue()
-
-        def table_md(rows, key, seeds, title):
-            head = (f"### {title}\n\n| {key} | min cost (m) | α (°) | max cost (m) | α (°) | "
-                    "median cost | α | mean cost | α | 0.1° sweep best (m) | DE−sweep (%) | "
-                    "seeds min cost | seeds α |\n|" + "---|" * 13 + "\n")
-            lines = []
-            for k, r in rows.items():
-                lines.append(
-                    f"| {k} | " + " | ".join(f"{r[c]:.3f}" for c in _COLS)
-                    + f" | {r['sweep_cost']:.3f} | {r['de_vs_sweep_pct']:+.4f} | "
-                    f"{seeds[k][0]:.3f} | {seeds[k][1]:.3f} |")
-            return head + "\n".join(lines) + "\n"
-
+            run = reproduce_coverage(seed, on_step=step)
+            step("drawing the figures")
+            _write_coverage_figures(outdir, run)
         with outdir.open("table_5_1.csv") as fh:
-            fh.write(table_csv(t51, "surface", SEEDS_T51))
+            fh.write(table_csv(run.table_5_1, "surface", SEEDS_T51))
         with outdir.open("table_5_2.csv") as fh:
-            fh.write(table_csv(t52, "D_m", SEEDS_T52))
+            fh.write(table_csv(run.table_5_2, "D_m", SEEDS_T52))
         with outdir.open("tables.md") as fh:
-            fh.write(table_md(t51, "surface", SEEDS_T51,
-                              "Table 5.1 — costs and steering angles, D = 80 m (DE: Np=20, "
-                              "F=0.8, CR=0.7, 30 generations, α∈[1°,89°])"))
-            fh.write("\n")
-            fh.write(table_md(t52, "D (m)", SEEDS_T52, "Table 5.2 — S1 with different D"))
-            fh.write("\n### FM² along the bands (100 m AGL, p1=0.5, p2=1.3)\n\n"
-                     "| surface | coverage (%) | FM² length (m) | mean abs AGL error (m) | "
-                     "DE + plan time (s) |\n|---|---|---|---|---|\n")
-            for n, r in t51.items():
-                fh.write(f"| {n} | {r['coverage_pct']:.2f} | {r['fm2_length']:.0f} | "
-                         f"{r['agl_err_mean']:.2f} | {r['plan_s']:.3f} |\n")
-        payload = {"table_5_1": t51, "table_5_2": {str(k): v for k, v in t52.items()},
-                   "seeds_table_5_1": SEEDS_T51, "seeds_table_5_2": SEEDS_T52}
+            fh.write(tables_markdown(run))
+        payload = coverage_payload(run)
         with outdir.open("summary.json") as fh:
             json.dump(to_jsonable(payload), fh, indent=2)
         if report:
-            from ..viz.report import report_html
+            from ..viz.coverage import coverage_tables_report
 
-            overlays = {}
-            for n, cp in cover.items():
-                overlays.update(_overlays(cp, prefix=f"{n} "))
-            t51_rows = [{"surface": n, **r, "seeds min cost": SEEDS_T51[n][0],
-                         "seeds α": SEEDS_T51[n][1]} for n, r in t51.items()]
-            t52_rows = [{"D [m]": d, **r, "seeds min cost": SEEDS_T52[d][0],
-                         "seeds α": SEEDS_T52[d][1]} for d, r in t52.items()]
-            html = report_html(
-                world, {f"{n} FM² path": cp.path for n, cp in cover.items()},
-                speeds={f"{n} FM² path": cp.plan.speed for n, cp in cover.items()},
-                ideal_agl={f"{n} FM² path": COVERAGE_AGL for n in cover},
-                overlays=overlays,
-                title="Coverage experiments (paper 003 / thesis ch. 5)",
-                subtitle=f"areas {', '.join(names)}, D = {COVERAGE_SPACING:g} m, FM² at "
-                         f"{COVERAGE_AGL:g} m above the terrain, steering angle from the DE",
-                params={"seed": seed, "D [m]": COVERAGE_SPACING, "agl [m]": COVERAGE_AGL,
-                        "DE": "Np=20, F=0.8, CR=0.7, 30 generations, α∈[1°,89°]"},
-                metrics={n: f"α {r['min_alpha']:.3f}°, cost {r['min_cost']:.1f} m, coverage "
-                            f"{r['coverage_pct']:.2f} %, FM² {r['fm2_length']:.0f} m"
-                         for n, r in t51.items()},
-                tables={"Table 5.1 — D = 80 m": t51_rows,
-                        "Table 5.2 — S1, different D": t52_rows},
-                files=files)
             with outdir.open(REPORT) as fh:
-                fh.write(html)
+                fh.write(coverage_tables_report(run, files))
         rows = {f"{n} (D=80)": f"best {r['min_cost']:.1f} m at {r['min_alpha']:.3f}° "
                 f"(sweep {r['sweep_cost']:.1f}; seeds {SEEDS_T51[n][0]:.1f} at "
                 f"{SEEDS_T51[n][1]:.3f}°), coverage {r['coverage_pct']:.2f} %"
-                for n, r in t51.items()}
+                for n, r in run.table_5_1.items()}
         rows.update({f"S1 D={d}": f"best {r['min_cost']:.1f} m at {r['min_alpha']:.3f}° "
                      f"(seeds {SEEDS_T52[d][0]:.1f} at {SEEDS_T52[d][1]:.3f}°)"
-                     for d, r in t52.items()})
+                     for d, r in run.table_5_2.items()})
         print_summary("coverage (Tables 5.1 / 5.2)", payload if as_json else rows,
                       as_json=as_json, quiet=quiet, files=outdir.written)

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 from typing import Any
 
@@ -21,79 +20,6 @@ REPORT_FILES = (
     "curvature_frechet.png",
     "curvature_area.png",
 )
-_NAMES = {"dubins": "Dubins", "elastica": "Euler–Mumford elastica", "rs": "Reeds–Shepp forward"}
-
-
-def _fmt(v: Any, digits: int = 3) -> str:
-    if v is None or (isinstance(v, float) and not math.isfinite(v)):
-        return "–"
-    return f"{v:.{digits}g}" if isinstance(v, float) else str(v)
-
-
-def tables_markdown(summary: dict[str, Any], result: Any) -> str:
-    """Tables 1–4 of the seed as Markdown."""
-    cfg = result.config
-    models = [m for m in cfg.models]
-    a, b = result.alphas, result.betas
-    lines = [
-        "# FM² vs curvature-penalised references (seed 004)",
-        "",
-        f"Map: {cfg.scenario} ({cfg.cell} m nodes), {len(result.starts)} start/goal pairs "
-        f"(seed {cfg.pair_seed}), ξ = {cfg.xi} m, lattice headings max_int={cfg.max_int}. "
-        f"Grid: α = {a[0]:g}:{cfg.alpha.step:g}:{a[-1]:g} ({len(a)}), "
-        f"β = {b[0]:g}:{cfg.beta.step:g}:{b[-1]:g} ({len(b)}) → {len(a) * len(b)} (α, β) × "
-        f"{len(result.starts)} pairs = {len(a) * len(b) * len(result.starts)} FM² runs. "
-        f"Distances are means over the pairs, curves resampled every {cfg.ds} m.",
-        "",
-        "## Table 1 — computation time of all pairs [s]",
-        "",
-        "| " + " | ".join(_NAMES[m] for m in models) + " | FM² |",
-        "|" + "---|" * (len(models) + 1),
-        "| " + " | ".join(_fmt(summary["timing"].get(f"{m}_s"), 4) for m in models)
-        + f" | {_fmt(summary['timing']['fm2_s'], 4)} |",
-        "| " + " | ".join(f"×{_fmt(summary['timing'].get(f'{m}_ratio'), 4)}" for m in models) + " | 1 |",
-        "",
-        "References: lattice search time (compiled Dijkstra, control set cached); FM²: sum over "
-        "pairs of the median `plan()` time over the grid (both Fast Marching waves, descent, "
-        "metrics). Both are measured inside the sweep's worker processes, running side by "
-        "side on a shared machine, so the ratios are indicative; `benchmarks/bench_reference.py` "
-        "times both in one process, one after the other.",
-        "",
-    ]
-    for metric, title, num in (("frechet", "Fréchet distance [m]", 2), ("area", "area between curves [m²]", 3)):
-        best = summary["best"].get(metric, {})
-        val = summary["valley"].get(metric, {})
-        lines += [
-            f"## Table {num} — best α, β and {title}",
-            "",
-            "| | " + " | ".join(_NAMES[m] for m in models) + " |",
-            "|---|" + "---|" * len(models),
-            "| α | " + " | ".join(_fmt(best.get(m, {}).get("alpha")) for m in models) + " |",
-            "| β | " + " | ".join(_fmt(best.get(m, {}).get("beta")) for m in models) + " |",
-            f"| {metric} | " + " | ".join(_fmt(best.get(m, {}).get("value"), 4) for m in models) + " |",
-            "| valley: Spearman(α, best β) | "
-            + " | ".join(_fmt(val.get(m, {}).get("spearman"), 2) for m in models) + " |",
-            "",
-        ]
-    clear = summary["clearance"]
-    lines += [
-        "## Table 4 — distance to the obstacles [m] (mean over pairs of each path's minimum; "
-        "best area match)",
-        "",
-        "| | " + " | ".join(_NAMES[m] for m in models) + " |",
-        "|---|" + "---|" * len(models),
-        "| α | " + " | ".join(_fmt(clear.get(m, {}).get("alpha")) for m in models) + " |",
-        "| β | " + " | ".join(_fmt(clear.get(m, {}).get("beta")) for m in models) + " |",
-        "| reference | " + " | ".join(_fmt(clear.get(m, {}).get("reference_m"), 3) for m in models) + " |",
-        "| FM² approximation | " + " | ".join(_fmt(clear.get(m, {}).get("fm2_m"), 3) for m in models) + " |",
-        "",
-        f"Cases: {result.cases_run} run now, {result.cases_skipped} resumed, "
-        f"{result.cases_failed} failed.",
-        "",
-    ]
-    return "\n".join(lines)
-
-
 def _progress(quiet: bool):
     if quiet:
         return None, None
@@ -116,8 +42,8 @@ def _progress(quiet: bool):
 def run_and_report(config, out: Path, *, force: bool, scheduler: str | None, workers: int | None,
                    retry_failed: bool, as_json: bool, quiet: bool, title: str) -> None:
     """Run (or resume) a sweep, then write tables and figures into ``out``."""
-    from ..experiments.runner import run_sweep, sweep_world
-    from ..experiments.sweep import summarise_sweep
+    from ..experiments.curvature import summarise_run, sweep_payload, tables_markdown
+    from ..experiments.runner import run_sweep
 
     cfg_file = out / "config.json"
     same = cfg_file.exists() and json.loads(cfg_file.read_text()) == json.loads(
@@ -134,9 +60,7 @@ def run_and_report(config, out: Path, *, force: bool, scheduler: str | None, wor
     finally:
         if prog is not None:
             prog.stop()
-    world, starts, goals = sweep_world(config)
-    summary = summarise_sweep(world, starts, goals, result.columns, result.alphas, result.betas,
-                              config.models, result.references, ds=config.ds, order=config.order)
+    world, summary = summarise_run(config, result)
     from ..viz.sweep import best_paths_figure, curvature_figure, heatmap_figure
 
     for metric in ("frechet", "area"):
@@ -154,20 +78,7 @@ def run_and_report(config, out: Path, *, force: bool, scheduler: str | None, wor
             outdir.commit(tmp, name)
     with outdir.open("tables.md") as fh:
         fh.write(tables_markdown(summary, result))
-    payload = {
-        "best": summary["best"],
-        "valley_spearman": {m: {k: v["spearman"] for k, v in d.items()}
-                            for m, d in summary["valley"].items()},
-        "timing_s": summary["timing"],
-        "clearance_m": summary["clearance"],
-        "grid": {"alpha": [float(result.alphas[0]), config.alpha.step, float(result.alphas[-1])],
-                 "beta": [float(result.betas[0]), config.beta.step, float(result.betas[-1])]},
-        "pairs": len(result.starts),
-        "cases": {"run": result.cases_run, "resumed": result.cases_skipped,
-                  "failed": result.cases_failed},
-        "wall_s": result.wall_s,
-        "results_file": str(out / config.results),
-    }
+    payload = sweep_payload(summary, result, config, out)
     with outdir.open("summary.json") as fh:
         json.dump(to_jsonable(payload), fh, indent=2)
     rows: dict[str, Any] = {
@@ -251,12 +162,9 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
         quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
     ) -> None:
-        from ..experiments.runner import make_config
+        from ..experiments.curvature import curvature_config
 
-        s = 0.02 if full else float(step)
-        grid = {"start": s, "stop": 1.0, "step": s}
-        cfg = make_config({"pairs": pairs, "alpha": grid, "beta": grid, "xi": xi},
-                          where="reproduce curvature")
+        cfg = curvature_config(step=None if full else step, pairs=pairs, xi=xi)
         run_and_report(cfg, out, force=force, scheduler=scheduler, workers=workers,
                        retry_failed=False, as_json=as_json, quiet=quiet,
                        title="Seed 004: FM² vs curvature-penalised references")

@@ -6,7 +6,6 @@ from __future__ import annotations
 import json
 import time
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import typer
@@ -26,145 +25,33 @@ TFF_FILES = (
 TUNE_FILES = ("tune_table.md", "tune.json", "tune_best_path.csv", "tune_best.png")
 REPORT = "report.html"
 
-_COLUMNS = (
-    ("case", "case", "{}"),
-    ("level [cells]", "level", "{}"),
-    ("agl [m]", "agl_m", "{:g}"),
-    ("p1", "p1", "{:g}"),
-    ("p2", "p2", "{:g}"),
-    ("p2−p1", "diff", "{:.1f}"),
-    ("within ±1 cell (between transitions)", "within", "{:.0%}"),
-    ("on level (all points)", "within_all", "{:.0%}"),
-    ("mean |dev| vs terrain+agl [m]", "mean_dev_all_m", "{:.1f}"),
-    ("mean |dev| vs layer [m]", "mean_dev_layer_m", "{:.1f}"),
-    ("max |dev| between transitions [m]", "max_dev_m", "{:.1f}"),
-    ("transitions start/end [m]", "transitions", "{}"),
-    ("points inside terrain", "inside_terrain", "{}"),
-    ("length [m]", "length_m", "{:.0f}"),
-    ("max turn [°/cell]", "turn_max_deg", "{:.1f}"),
-    ("p95 turn [°/cell]", "turn_p95_deg", "{:.1f}"),
-    ("max climb [°]", "climb_max_deg", "{:.1f}"),
-    ("p95 climb [°]", "climb_p95_deg", "{:.1f}"),
-    ("max curvature [1/m]", "curvature_max", "{:.4f}"),
-    ("p95 curvature [1/m]", "curvature_p95", "{:.4f}"),
-    ("min turn radius [m]", "min_turn_radius_m", "{:.0f}"),
-)
+def _write_tff_outputs(outdir: OutputDir, run, *, report: bool) -> None:
+    """The figures, tff_table.md, tff_summary.json (and report.html) of a TFF run."""
+    from ..experiments.tff import tff_markdown
+    from ..viz.tff import tff_figures, tff_report_html
 
-
-def _markdown(rows: list[dict[str, Any]]) -> str:
-    head = [c[0] for c in _COLUMNS]
-    out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-    for r in rows:
-        out.append("| " + " | ".join(fmt.format(r[key]) for _, key, fmt in _COLUMNS) + " |")
-    return "\n".join(out)
-
-
-def _table_rows(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """The rows of tff_table.md as dicts (header → formatted value), for the HTML report."""
-    return [{head: fmt.format(r[key]) for head, key, fmt in _COLUMNS} for r in rows]
-
-
-def _tff_report(plans: list[Any], rows: list[dict[str, Any]], labels: list[str], sc, *,
-                title: str, params: dict[str, Any], files: list[str],
-                table_title: str = "Terrain-following cases",
-                extra_tables: dict[str, list[dict[str, Any]]] | None = None) -> str:
-    """report.html of terrain-following paths: each path vs its ideal level, the case table."""
-    from ..viz.report import report_html
-
-    return report_html(
-        sc.world, {lab: p.path for lab, p in zip(labels, plans)},
-        speeds={lab: p.speed for lab, p in zip(labels, plans)},
-        ideal_agl={lab: r["agl_m"] for lab, r in zip(labels, rows)},
-        title=title, subtitle=sc.description, params=params,
-        metrics={lab: f"within ±1 cell {r['within']:.0%}, mean |dev| {r['mean_dev_all_m']:.1f} m, "
-                      f"max climb {r['climb_max_deg']:.0f}°, length {r['length_m']:.0f} m"
-                 for lab, r in zip(labels, rows)},
-        tables={table_title: _table_rows(rows), **(extra_tables or {})}, files=files)
-
-
-def run_tff(scenario: str, seed: int, mode: str) -> tuple[list[dict[str, Any]], list[Any], Any]:
-    """Plan the seeds' five cases (and the literal reading of level 10) on a scenario."""
-    from ..analysis.flight_level import SEED_CASES, tff_metrics
-    from ..planning import plan
-    from ..scenarios import get_scenario
-
-    sc = get_scenario(scenario, seed=seed)
-    dz = sc.world.spacing[2]
-    rows, plans = [], []
-    cases = list(SEED_CASES)
-    if mode == "capped":
-        cases.append(("level 10, literal W**p", 10, 0.5, 1.3))
-    for name, level, p1, p2 in cases:
-        case_mode = "literal" if "literal" in name else mode
-        agl = level * dz
-        t0 = time.perf_counter()
-        p = plan(sc.world, sc.start, sc.goal, agl=agl, p1=p1, p2=p2, agl_mode=case_mode)
-        m = tff_metrics(p, agl)
-        m.update(case=name, level=level, agl_m=agl, p1=p1, p2=p2, diff=p2 - p1, mode=case_mode,
-                 transitions=f"{m['start_transition_m']:.0f}/{m['end_transition_m']:.0f}",
-                 plan_s=time.perf_counter() - t0)
-        rows.append(m)
-        plans.append(p)
-    return rows, plans, sc
-
-
-def _write_tff_outputs(outdir: OutputDir, rows, plans, sc, *, scenario: str, seed: int,
-                       mode: str, report: bool) -> None:
-    from ..viz.tff import tff_3d_figure, tff_kinematics_figure, tff_profile_figure
-
-    labels = [f"{r['case']} (p1={r['p1']:g}, p2={r['p2']:g})" for r in rows]
-    agls = [r["agl_m"] for r in rows]
-    lv, sm = [0, 1, 2], [2, 3, 4]
-    figs = {
-        "tff_3d_levels.png": tff_3d_figure([plans[i] for i in lv], [labels[i] for i in lv],
-                                           title=f"Flight levels — {scenario}"),
-        "tff_3d_smoothness.png": tff_3d_figure(
-            [plans[i] for i in sm], [labels[i] for i in sm],
-            title=f"Smoothness at level 10 — {scenario}"),
-        "tff_profile_levels.png": tff_profile_figure(
-            [plans[i] for i in lv], [agls[i] for i in lv], [labels[i] for i in lv],
-            title="Path vs ideal path vs terrain"),
-        "tff_profile_smoothness.png": tff_profile_figure(
-            [plans[i] for i in sm], [agls[i] for i in sm], [labels[i] for i in sm],
-            title="Path vs ideal path vs terrain (level 10)"),
-        "tff_kinematics.png": tff_kinematics_figure(
-            [plans[i] for i in sm], [labels[i] for i in sm],
-            title="Turn, climb and curvature profiles (level 10)"),
-    }
     tmps = {}
-    for name, fig in figs.items():
+    for name, fig in tff_figures(run).items():
         tmp = outdir.target(name)
         fig.savefig(tmp, dpi=100)
         tmps[name] = tmp
     for name, tmp in tmps.items():
         outdir.commit(tmp, name)
-    md = [
-        f"# Terrain-following flight — {scenario} (seed {seed}, flight-level mode '{mode}')",
-        "",
-        sc.description,
-        "",
-        f"start {np.round(sc.start, 1).tolist()} m, goal {np.round(sc.goal, 1).tolist()} m; "
-        f"±1 cell = ±{sc.world.spacing[2]:g} m; transitions = the start/goal stretches "
-        "before the path first reaches, and after it last leaves, ±1 cell of terrain + agl; "
-        "profiles on the path resampled every horizontal cell.",
-        "",
-        _markdown(rows),
-        "",
-    ]
     with outdir.open("tff_table.md") as fh:
-        fh.write("\n".join(md))
+        fh.write(tff_markdown(run))
     with outdir.open("tff_summary.json") as fh:
-        json.dump(to_jsonable({"scenario": scenario, "seed": seed, "mode": mode,
-                               "cases": rows}), fh, indent=2)
+        json.dump(to_jsonable({"scenario": run.scenario_name, "seed": run.seed,
+                               "mode": run.mode, "cases": run.rows}), fh, indent=2)
     if report:
-        html = _tff_report(plans, rows, labels, sc,
-                           title=f"Terrain-following flight — {scenario}",
-                           params={"scenario": scenario, "seed": seed,
-                                   "flight-level mode": mode,
-                                   "start [m]": np.round(sc.start, 1),
-                                   "goal [m]": np.round(sc.goal, 1),
-                                   "vertical cell [m]": sc.world.spacing[2]},
-                           files=list(TFF_FILES))
+        sc = run.scenario
+        html = tff_report_html(run.plans, run.rows, run.labels, sc,
+                               title=f"Terrain-following flight — {run.scenario_name}",
+                               params={"scenario": run.scenario_name, "seed": run.seed,
+                                       "flight-level mode": run.mode,
+                                       "start [m]": np.round(sc.start, 1),
+                                       "goal [m]": np.round(sc.goal, 1),
+                                       "vertical cell [m]": sc.world.spacing[2]},
+                               files=list(TFF_FILES))
         with outdir.open(REPORT) as fh:
             fh.write(html)
 
@@ -193,7 +80,9 @@ def _write_tune_report(outdir: OutputDir, res, sc, s, g, *, agl: float, scenario
             "min_turn_radius_m", "length_m", "feasible")
     pareto = [{k: (round(r[k], 3) if isinstance(r[k], float) else r[k]) for k in keys}
               for r in res.pareto]
-    html = _tff_report(
+    from ..viz.tff import tff_report_html
+
+    html = tff_report_html(
         [p], [m], [label], sc, title=f"Auto-tuning — {scenario}, {agl:g} m above ground",
         params={"scenario": scenario, "agl [m]": agl,
                 "max climb [deg]": limits.max_climb_deg,
@@ -236,17 +125,18 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         report: bool = typer.Option(
             False, "--report", help="Also write report.html (interactive, self-contained)."),
     ) -> None:
-        if mode not in ("capped", "literal"):
-            raise InputError(f"--mode must be 'capped' or 'literal', got {mode!r}")
+        from ..experiments.tff import run_tff, tff_cases
+
+        tff_cases(mode)  # bad --mode fails before anything is written
         outdir = OutputDir(out, force=force)
         outdir.check(TFF_FILES + ((REPORT,) if report else ()))
         t0 = time.perf_counter()
         with progress(enabled=not (quiet or as_json)) as step:
             step(f"planning the terrain-following cases on {scenario}")
-            rows, plans, sc = run_tff(scenario, seed, mode)
+            run = run_tff(scenario, seed, mode)
             step("drawing the figures")
-            _write_tff_outputs(outdir, rows, plans, sc, scenario=scenario, seed=seed, mode=mode,
-                               report=report)
+            _write_tff_outputs(outdir, run, report=report)
+        rows = run.rows
         summary = {
             r["case"]: f"within {r['within']:.0%}, mean|dev| {r['mean_dev_all_m']:.1f} m, "
             f"max turn {r['turn_max_deg']:.0f}°, max climb {r['climb_max_deg']:.0f}°"

@@ -38,6 +38,13 @@ __all__ = [
     "run_city_case",
     "city_table",
     "rrt_comparison",
+    "CityRun",
+    "reproduce_city",
+    "CITY_TABLE_COLUMNS",
+    "RRT_TABLE_COLUMNS",
+    "markdown_table",
+    "city_markdown",
+    "city_summary",
 ]
 
 #: Thesis Table 3.1 (low altitude): exponent → (safety distance m, separation m).
@@ -200,3 +207,100 @@ def rrt_comparison(
             "reason": rep.reason,
         })
     return rows, {"fm2": fm, "rrt": results}
+
+
+#: Columns of the safety/separation table in table.md (Tables 3.1/3.2).
+CITY_TABLE_COLUMNS = ("mission", "exponent", "safety_m", "thesis_safety_m", "separation_max_m",
+                      "thesis_separation_m", "separation_mean_m", "length_m", "plan_s",
+                      "feasible")
+#: Columns of the FM² vs RRT table in table.md.
+RRT_TABLE_COLUMNS = ("planner", "time_s", "length_m", "clearance_m", "min_radius_m",
+                     "separation_max_m", "feasible")
+
+
+@dataclass(eq=False)
+class CityRun:
+    """``reproduce city``: both missions x all exponents, and the RRT comparison.
+
+    ``rrt_rows`` is empty and ``rrt`` None when the comparison was not run;
+    ``rrt_paths`` are the OMPL paths in 3D (the low mission at its altitude).
+    """
+
+    seed: int
+    airframe: Any
+    tolerance: float
+    cases: list[CityCase]
+    missions: dict[str, Scenario]
+    rrt_rows: list[dict[str, Any]] = field(default_factory=list)
+    rrt: dict[str, Any] | None = None
+    rrt_paths: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @property
+    def rows(self) -> list[dict[str, Any]]:
+        """One Tables 3.1/3.2 row per case."""
+        return [c.row() for c in self.cases]
+
+    def speed_profiles(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """``label -> (arc length [m], W along the path)`` of every case (Fig. 3.4)."""
+        return {f"{c.mission} W^{c.exponent:g}": (
+            np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(c.path3, axis=0),
+                                                            axis=1))]),
+            c.plan.speed) for c in self.cases}
+
+
+def reproduce_city(seed: int = 0, airframe: Any = "disco", *, tolerance: float = 5.0,
+                   rrt: bool = True, rrt_time: float = 5.0, rrtstar_time: float = 1.0,
+                   on_step: Any = lambda message: None) -> CityRun:
+    """Thesis ch. 3: :func:`city_table` and (``rrt``) :func:`rrt_comparison` on the low mission.
+
+    Parameters
+    ----------
+    seed : int
+        Seed of the city layout and of OMPL.
+    airframe : str or Airframe
+        The airframe that flies every path.
+    tolerance : float
+        Largest admissible separation [m].
+    rrt_time, rrtstar_time : float
+        Time cap of RRT / RRT-Connect and planning time of RRT* [s].
+    on_step : callable
+        Called with a one-line description before each stage.
+    """
+    af = get_airframe(airframe)
+    on_step("planning both missions with W^1, W^1/2, W^1/4 and flying them")
+    run = CityRun(seed=seed, airframe=af, tolerance=tolerance,
+                  cases=city_table(seed, af, tolerance=tolerance), missions=city_missions(seed))
+    if rrt:
+        on_step("FM² vs OMPL RRT / RRT-Connect / RRT* (low mission)")
+        sc = run.missions["low"]
+        run.rrt_rows, run.rrt = rrt_comparison(sc, "low", af, time_limit=rrt_time,
+                                               rrtstar_time=rrtstar_time, tolerance=tolerance,
+                                               seed=seed)
+        z = float(sc.start[2])
+        for r in run.rrt["rrt"].values():
+            p = r.path if r.path.shape[1] == 3 else np.column_stack(
+                [r.path, np.full(len(r.path), z)])
+            run.rrt_paths[f"{r.planner} low (+ shortcut)"] = p
+    return run
+
+
+def markdown_table(rows: list[dict[str, Any]], cols: tuple[str, ...] | list[str]) -> str:
+    """``rows`` as a Markdown table of the columns ``cols``."""
+    head = "| " + " | ".join(cols) + " |\n|" + "---|" * len(cols) + "\n"
+    return head + "".join("| " + " | ".join(str(r[c]) for c in cols) + " |\n" for r in rows)
+
+
+def city_markdown(run: CityRun) -> str:
+    """``table.md``: the safety/separation table and (when run) FM² vs RRT."""
+    text = ("## Safety and separation distances (Tables 3.1/3.2)\n\n"
+            + markdown_table(run.rows, CITY_TABLE_COLUMNS))
+    if run.rrt is not None:
+        text += ("\n## FM² vs RRT, low altitude (thesis: FM² 1.2 s, RRT 5 s)\n\n"
+                 + markdown_table(run.rrt_rows, RRT_TABLE_COLUMNS))
+    return text
+
+
+def city_summary(run: CityRun) -> dict[str, Any]:
+    """``summary.json`` of a run: airframe, both tables and the thesis' times."""
+    return {"seed": run.seed, "airframe": run.airframe.summary(), "table": run.rows,
+            "rrt": run.rrt_rows, "thesis_times_s": THESIS_TIMES_S}

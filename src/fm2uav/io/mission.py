@@ -4,15 +4,19 @@ Schema (pydantic v2, strict types, unknown keys rejected)::
 
     version: 1                      # schema version (only 1)
     name: open-field TFF            # free text
-    world:                          # exactly one of scenario / dem / buildings
+    world:                          # a scenario, or dem and/or buildings (real data)
       scenario: open-field          # a built-in scenario (see `fm2uav plan --help`)
       seed: 0                       # relief seed of the scenario
-      dem: terrain.tif              # or: a GeoTIFF DEM with a CRS (path relative to this file)
-      buildings: city.geojson       # or: building footprints (GeoJSON polygons with heights)
-      cell_size: 15                 # [m] horizontal grid cell (required for dem / buildings)
-      dz: 15                        # [m] vertical cell (default cell_size)
-      ceiling: 1500                 # dem: altitude of the top node [m]; nodata: error | fill
-      height_cells: 40              # buildings: vertical nodes; also margin, default_height, crs
+      dem: terrain.tif              # or: any GDAL raster with a CRS, or [tile1.tif, tile2.tif]
+      buildings: osm.geojson        # and/or: footprints (GeoJSON lon/lat, GPKG, SHP, KML/KMZ)
+      bbox: [-3.78, 40.33, -3.74, 40.35]   # crop, lon/lat W, S, E, N
+      sea_level: 0                  # [m] ground = max(DEM, sea_level) (topo-bathymetry)
+      cell_size: 15                 # [m] horizontal grid cell (default: from the data)
+      dz: 15                        # [m] vertical cell (default cell_size, <= planner.agl / 6)
+      ceiling: 1500                 # [m] top node (default: highest ground + agl + margin)
+      nodata: error                 # DEM gaps: error | fill; nodata_value: -9999 if undeclared
+      default_height: 10            # buildings without height/building:levels; crs, margin,
+                                    # height_cells, metres_per_level, allow_filled
       anchor: {lon: -3.7649, lat: 40.3326, alt: 0}   # where a world without CRS sits
     start: [300, 300, 300]          # x, y, z [m]; or {x, y, agl}, {lon, lat, alt},
     goal: {lon: -3.747, lat: 40.343, agl: 60}        # {lon, lat, agl} or {cell: [i, j, k]}
@@ -38,10 +42,12 @@ from typing import Any, Literal
 
 import numpy as np
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, ValidationInfo
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from pydantic import field_validator, model_validator
 
-from ..errors import InputError, WorldError
+from ..errors import InputError
+from ..world.load import WorldSpec as DataWorldSpec
+from ..world.load import check_points, load_world
 from .exports import EXPORT_FILES, ExportOptions
 from .georef import DEFAULT_ANCHOR, Anchor, from_lonlat, ground_height
 
@@ -54,6 +60,7 @@ __all__ = [
     "OutputSpec",
     "OUTPUT_FORMATS",
     "ResolvedMission",
+    "resolve_point",
     "load_mission",
     "parse_mission",
 ]
@@ -77,28 +84,20 @@ class AnchorSpec(BaseModel):
     alt: float = _num(0.0, unit="m", ge=-500, le=9000, desc="altitude of world z=0 AMSL")
 
 
-class WorldSpec(BaseModel):
-    """The map: a built-in scenario, a DEM GeoTIFF or building footprints."""
+class WorldSpec(DataWorldSpec):
+    """The map: a built-in scenario, or real data (DEM and/or buildings).
+
+    The real-data keys (``dem``, ``buildings``, ``bbox``, ``sea_level``,
+    ``cell_size``, ``dz``, ``ceiling``, ``nodata``, ``nodata_value``, ``crs``,
+    ``default_height``, ``metres_per_level``, ``height_cells``, ``margin``,
+    ``allow_filled``) are :class:`fm2uav.world.load.WorldSpec`'s, shared with
+    the CLI's world options; this adds the built-in ``scenario`` with its
+    ``seed``, and the ``anchor`` of worlds without a CRS.
+    """
 
     model_config = _STRICT
     scenario: str | None = Field(None, description="built-in scenario name")
     seed: int = _num(0, ge=0, le=2**31 - 1, desc="seed of the scenario's relief")
-    dem: str | None = Field(None, description="GeoTIFF DEM path (relative to the mission file)")
-    buildings: str | None = Field(None, description="GeoJSON building footprints path")
-    cell_size: float | None = _num(None, unit="m", gt=0, le=5000,
-                                   desc="horizontal grid cell size (dem, buildings)")
-    dz: float | None = _num(None, unit="m", gt=0, le=1000,
-                            desc="vertical cell size (default: cell_size)")
-    ceiling: float | None = _num(None, unit="m", ge=-500, le=12000,
-                                 desc="altitude of the top node (dem; default ground max + 20 dz)")
-    nodata: Literal["error", "fill"] = Field("error", description="DEM gaps: refuse or fill")
-    height_cells: int | None = _num(None, ge=2, le=2000,
-                                    desc="number of vertical nodes (buildings)")
-    margin: float = _num(0.0, unit="m", ge=0, le=100000,
-                         desc="free border around the buildings")
-    default_height: float | None = _num(None, unit="m", gt=0, le=1000,
-                                        desc="height of buildings without one")
-    crs: str | None = Field(None, description="CRS of the building coordinates, e.g. EPSG:32630")
     anchor: AnchorSpec | None = Field(None, description="placement of a world without CRS")
 
     @field_validator("scenario")
@@ -113,92 +112,39 @@ class WorldSpec(BaseModel):
             raise ValueError(f"unknown scenario; allowed: {', '.join(sorted(SCENARIOS))}")
         return key
 
-    @field_validator("dem")
-    @classmethod
-    def _dem_file(cls, v: str | None, info: ValidationInfo) -> str | None:
-        if v is None:
-            return v
-        path = _resolve(v, info)
-        if not path.is_file():
-            raise ValueError(f"file not found ({path}); allowed: an existing GeoTIFF file")
-        try:
-            import rasterio
-
-            with rasterio.open(path) as ds:
-                crs = ds.crs
-        except Exception as exc:  # rasterio raises its own error types
-            raise ValueError(f"cannot be read as a raster ({type(exc).__name__}); "
-                             "allowed: a GeoTIFF DEM") from None
-        if crs is None:
-            raise ValueError(
-                "has no coordinate reference system (CRS); allowed: a GeoTIFF with a CRS "
-                "(assign one, e.g. `gdal_edit.py -a_srs EPSG:32616 dem.tif`)")
-        return str(path)
-
-    @field_validator("buildings")
-    @classmethod
-    def _buildings_file(cls, v: str | None, info: ValidationInfo) -> str | None:
-        if v is None:
-            return v
-        path = _resolve(v, info)
-        if not path.is_file():
-            raise ValueError(f"file not found ({path}); allowed: an existing GeoJSON file")
-        return str(path)
-
-    @field_validator("crs")
-    @classmethod
-    def _crs(cls, v: str | None) -> str | None:
-        if v is None:
-            return v
-        from pyproj import CRS
-        from pyproj.exceptions import CRSError
-
-        try:
-            c = CRS.from_user_input(v)
-        except CRSError:
-            raise ValueError("is not a CRS pyproj knows; allowed: e.g. EPSG:32630") from None
-        if not c.is_projected:
-            raise ValueError("is not a projected CRS in metres; allowed: a projected CRS such "
-                             "as a UTM zone (building coordinates are metres)")
-        return v
-
     @model_validator(mode="after")
     def _one_source(self) -> WorldSpec:
-        given = [k for k in ("scenario", "dem", "buildings") if getattr(self, k) is not None]
-        if len(given) != 1:
-            raise ValueError(
-                f"give exactly one of scenario, dem, buildings (got "
-                f"{', '.join(given) if given else 'none'})")
-        if given[0] != "scenario" and self.cell_size is None:
-            raise ValueError(f"cell_size is missing: a {given[0]} world needs the grid cell "
-                             "size in metres; allowed: 0 < cell_size <= 5000 m")
-        only = {"dem": ("ceiling", "nodata"),
-                "buildings": ("height_cells", "default_height", "crs", "margin")}
-        defaults = {"nodata": "error", "margin": 0.0}
-        for source, keys in only.items():
-            for k in keys:
-                if given[0] != source and getattr(self, k) != defaults.get(k):
-                    raise ValueError(f"{k} only applies to a {source} world, not a "
-                                     f"{given[0]} world; remove it")
-        if given[0] == "scenario":
-            for k in ("cell_size", "dz"):
-                if getattr(self, k) is not None:
+        data = [k for k in ("dem", "buildings") if getattr(self, k) is not None]
+        if self.scenario is not None and data:
+            raise ValueError(f"give either scenario or real data (dem and/or buildings), not "
+                             f"both (got scenario and {' and '.join(data)})")
+        if self.scenario is None and not data:
+            raise ValueError("give exactly one of scenario, dem, buildings (or dem and "
+                             "buildings together); got none")
+        defaults = DataWorldSpec()
+        if self.scenario is not None:
+            for k in DataWorldSpec.model_fields:
+                if getattr(self, k) != getattr(defaults, k):
                     raise ValueError(f"{k} does not apply to a built-in scenario (its grid is "
                                      "fixed); remove it")
+            return self
+        only = {"dem": ("ceiling", "nodata", "nodata_value", "sea_level", "allow_filled"),
+                "buildings": ("height_cells", "default_height", "metres_per_level", "margin")}
+        for source, keys in only.items():
+            if getattr(self, source) is None:
+                for k in keys:
+                    if getattr(self, k) != getattr(defaults, k):
+                        raise ValueError(f"{k} only applies to a world with {source}, not a "
+                                         f"{' and '.join(data)} world; remove it")
+        if self.dem is not None and (self.height_cells is not None or self.margin):
+            raise ValueError("height_cells and margin apply to buildings on flat ground; on a "
+                             "DEM the grid follows the DEM (use ceiling, bbox); remove them")
         return self
 
-    def spacing(self) -> tuple[float, float, float]:
-        """(dx, dy, dz) [m] of a dem / buildings world."""
-        dx = float(self.cell_size or 0.0)
-        return (dx, dx, float(self.dz) if self.dz is not None else dx)
-
-
-def _resolve(v: str, info: ValidationInfo) -> Path:
-    base = (info.context or {}).get("base_dir") if info is not None else None
-    p = Path(v).expanduser()
-    if not p.is_absolute() and base is not None:
-        p = Path(base) / p
-    return p
+    def data_spec(self) -> DataWorldSpec:
+        """The real-data part, as :func:`fm2uav.world.load.load_world` takes it."""
+        return DataWorldSpec.model_construct(
+            **{k: getattr(self, k) for k in DataWorldSpec.model_fields})
 
 
 class PointSpec(BaseModel):
@@ -253,20 +199,62 @@ class PointSpec(BaseModel):
 
 
 class PlannerSpec(BaseModel):
-    """FM² parameters (see :func:`fm2uav.plan`)."""
+    """FM² parameters: the fields of :class:`~fm2uav.Shaping`, :class:`~fm2uav.FlightLevel`
+    and :class:`~fm2uav.PlanOptions`, one spelling (see :func:`fm2uav.plan`).
+
+    Flight-level keys need ``agl``. With ``agl`` and no ``p2`` the mission file
+    keeps its historical default :data:`MISSION_P2` = 1.5 (the Python
+    ``FlightLevel`` default is 1.3).
+    """
 
     model_config = _STRICT
     saturation: float = _num(1.0, gt=0, le=1, desc="saturation α of W")
     exponent: float = _num(1.0, gt=0, le=10, desc="exponent β on W")
+    saturation_distance: float | None = _num(None, unit="m", gt=0, le=100000,
+                                             desc="distance from obstacles with W = 1")
     order: Literal[1, 2] = Field(2, description="Fast Marching order")
     method: Literal["edt", "fmm"] = Field("edt", description="distance to obstacles")
     walls: bool = Field(False, description="treat the map border as an obstacle")
     agl: float | None = _num(None, unit="m", gt=0, le=5000, desc="flight level above ground")
-    p1: float = _num(0.5, gt=0, le=10, desc="exponent on the flight-level cells")
-    p2: float = _num(1.5, gt=0, le=10, desc="exponent on the other cells")
-    agl_band: float = _num(0.0, unit="m", ge=0, le=5000, desc="half-width of the level band")
-    agl_graded: bool = Field(False, description="blend p1→p2 across the band")
+    p1: float | None = _num(None, gt=0, le=10, desc="exponent on the flight-level cells (0.5)")
+    p2: float | None = _num(None, gt=0, le=10, desc="exponent on the other cells (1.5)")
+    band: float | None = _num(None, unit="m", ge=0, le=5000,
+                              desc="half-width of the level band (0)")
+    graded: bool | None = Field(None, description="blend p1→p2 across the band (false)")
+    mode: Literal["capped", "literal"] | None = Field(
+        None, description="reading of Algorithm 2 (capped)")
+    tolerance: float | None = _num(None, unit="m", ge=0, le=1000,
+                                   desc="cruise never below agl - tolerance (2)")
+    min_agl: float | None = _num(None, unit="m", ge=0, le=5000, desc="hard floor above ground")
+    max_agl: float | None = _num(None, unit="m", gt=0, le=5000, desc="hard ceiling above ground")
+    max_climb: float | None = _num(None, unit="deg", gt=0, le=90, desc="steepest climb (45)")
+    max_descent: float | None = _num(None, unit="deg", gt=0, le=90,
+                                     desc="steepest descent (45)")
     step: float = _num(0.5, gt=0, le=1, desc="geodesic step in cells")
+
+    @model_validator(mode="after")
+    def _objects(self) -> PlannerSpec:
+        # the objects check what the ranges cannot (agl <= max_agl, level keys need agl)
+        from ..planning.params import planner_objects
+
+        try:
+            planner_objects(_planner_values(self))
+        except InputError as exc:
+            raise ValueError(str(exc)) from None
+        return self
+
+
+#: ``planner.p2`` of a mission file with ``agl`` and no ``p2`` (the value mission
+#: files have always had; ``FlightLevel`` defaults to 1.3).
+MISSION_P2 = 1.5
+
+
+def _planner_values(spec: PlannerSpec) -> dict[str, Any]:
+    """The given planner keys (None = not given), ``p2`` defaulted with ``agl``."""
+    out = {k: v for k, v in spec.model_dump().items() if v is not None}
+    if "agl" in out:
+        out.setdefault("p2", MISSION_P2)
+    return out
 
 
 class AirframeSpec(BaseModel):
@@ -311,7 +299,7 @@ class Mission(BaseModel):
         if self.world.scenario is None:
             for what in ("start", "goal"):
                 if getattr(self, what) is None:
-                    raise ValueError(f"{what} is missing: a {('dem' if self.world.dem else 'buildings')}"
+                    raise ValueError(f"{what} is missing: a {self.world.describe() or 'data'}"
                                      f" world has no default {what}; give {what}: "
                                      "{lon: .., lat: .., agl: ..} or [x, y, z]")
         return self
@@ -332,8 +320,39 @@ class Mission(BaseModel):
         )
 
     def plan_kwargs(self) -> dict[str, Any]:
-        """Keyword arguments of :func:`fm2uav.plan`."""
-        return self.planner.model_dump()
+        """The ``planner:`` section as one flat dict of the given keys (defaults filled
+        in, ``p2`` = :data:`MISSION_P2` with ``agl``), for
+        :func:`fm2uav.planning.params.planner_objects`."""
+        return _planner_values(self.planner)
+
+    def plan_objects(self) -> tuple[Any, Any, Any]:
+        """``(Shaping, FlightLevel or None, PlanOptions)`` of the ``planner:`` section.
+
+        Raises
+        ------
+        InputError
+            A flight-level key without ``agl``, or values the objects refuse
+            together (e.g. ``agl`` above ``max_agl``), naming ``planner.<key>``.
+        """
+        from ..planning.params import planner_objects
+
+        return planner_objects(self.plan_kwargs())
+
+    def _points(self) -> list[PointSpec]:
+        return [p for p in (self.start, self.goal, *getattr(self, "via", ())) if p is not None]
+
+    def requested_agl(self) -> float | None:
+        """Highest height above ground asked for [m]: ``planner.agl`` and the points' ``agl``."""
+        v = [float(p.agl) for p in self._points() if p.agl is not None]
+        if self.planner.agl is not None:
+            v.append(float(self.planner.agl))
+        return max(v) if v else None
+
+    def requested_top(self) -> float | None:
+        """Highest altitude asked for [m]: the points' ``alt`` / ``z``."""
+        v = [float(p.alt if p.alt is not None else p.z) for p in self._points()
+             if p.alt is not None or p.z is not None]
+        return max(v) if v else None
 
     def resolve(self) -> ResolvedMission:
         """Build the world and the start/goal in world metres.
@@ -351,15 +370,14 @@ class Mission(BaseModel):
 
             sc = get_scenario(w.scenario, seed=w.seed)
             world, start_default, goal_default = sc.world, sc.start, sc.goal
-        elif w.dem is not None:
-            world = _build_dem(w)
         else:
-            world = _build_buildings(w)
+            world = load_world(w.data_spec(), agl=self.requested_agl(), top=self.requested_top())
         anchor = self.anchor()
         start = (_resolve_point(self.start, world, anchor, "start")
                  if self.start is not None else np.asarray(start_default, dtype=float))
         goal = (_resolve_point(self.goal, world, anchor, "goal")
                 if self.goal is not None else np.asarray(goal_default, dtype=float))
+        check_points(world, {"start": start, "goal": goal}, allow_filled=w.allow_filled)
         return ResolvedMission(mission=self, world=world, start=start, goal=goal)
 
 
@@ -373,28 +391,8 @@ class ResolvedMission:
     goal: np.ndarray
 
 
-def _build_dem(w: WorldSpec) -> Any:
-    from ..world import World
-
-    try:
-        return World.from_dem(w.dem, w.spacing(), w.ceiling, nodata=w.nodata,
-                              name=Path(str(w.dem)).stem)
-    except (WorldError, InputError) as exc:
-        raise type(exc)(f"world.dem = {w.dem!r}: {exc}") from None
-
-
-def _build_buildings(w: WorldSpec) -> Any:
-    from ..world import World
-
-    try:
-        return World.from_buildings(
-            str(w.buildings), w.spacing(), height_cells=w.height_cells, margin=w.margin,
-            default_height=w.default_height, crs=w.crs, name=Path(str(w.buildings)).stem)
-    except (WorldError, InputError) as exc:
-        raise type(exc)(f"world.buildings = {w.buildings!r}: {exc}") from None
-
-
 def _resolve_point(p: PointSpec, world: Any, anchor: Anchor, what: str) -> np.ndarray:
+    """A start/goal/via point in world metres (see :func:`resolve_point`)."""
     if p.cell is not None:
         if world.ndim != 3:
             raise InputError(f"{what}.cell needs a 3D world")
@@ -418,6 +416,23 @@ def _resolve_point(p: PointSpec, world: Any, anchor: Anchor, what: str) -> np.nd
             f"allowed: x in [{b[0, 0]:.1f}, {b[0, 1]:.1f}], y in [{b[1, 0]:.1f}, {b[1, 1]:.1f}], "
             f"z in [{b[2, 0]:.1f}, {b[2, 1]:.1f}] m")
     return point
+
+
+def resolve_point(p: PointSpec, world: Any, anchor: Anchor | None = None,
+                  what: str = "point") -> np.ndarray:
+    """A point given like a mission's ``start`` (metres, lon/lat, cell; z, alt or agl) → metres.
+
+    Used by the mission file and the CLI (``--start LON,LAT,AGL --lonlat``).
+    Lon/lat go through the world's CRS, or through ``anchor`` (default
+    :data:`~fm2uav.io.georef.DEFAULT_ANCHOR`) for a world without one; ``agl``
+    is added to the ground height there (bilinear).
+
+    Raises
+    ------
+    InputError
+        The point lies outside the map (names ``what`` and the map's bounds).
+    """
+    return _resolve_point(p, world, DEFAULT_ANCHOR if anchor is None else anchor, what)
 
 
 # ---------------------------------------------------------------------- errors
@@ -557,8 +572,13 @@ def parse_mission(data: Any, *, source: str = "mission", base_dir: str | Path | 
         raise InputError(f"{source}: {_format_error(errs[0])}{more}") from None
 
 
-def load_mission(file: str | Path) -> Mission:
+def load_mission(file: str | Path, *, world_overrides: dict[str, Any] | None = None) -> Mission:
     """Read and validate a YAML mission file (paths inside are relative to it).
+
+    ``world_overrides`` (the CLI's world options of ``fm2uav run``: ``dem``,
+    ``buildings``, ``bbox``, ``sea_level``, ...) replace the file's ``world:``
+    keys; their paths are taken as given (relative to the working directory),
+    and a ``dem``/``buildings`` override drops the file's ``scenario``/``seed``.
 
     Raises
     ------
@@ -580,4 +600,15 @@ def load_mission(file: str | Path) -> Mission:
         raise InputError(f"{file}: not a text (UTF-8) file") from None
     if data is None:
         raise InputError(f"{file}: the mission file is empty; see examples/ for a template")
+    if world_overrides and isinstance(data, dict):
+        over = {k: v for k, v in world_overrides.items() if v is not None}
+        for k in ("dem", "buildings"):
+            if k in over:
+                over[k] = ([str(Path(v).resolve()) for v in over[k]] if isinstance(over[k], list)
+                           else str(Path(over[k]).resolve()))
+        world = dict(data.get("world") or {}) if isinstance(data.get("world"), dict) else {}
+        if "dem" in over or "buildings" in over:
+            for k in ("scenario", "seed"):
+                world.pop(k, None)
+        data = {**data, "world": {**world, **over}}
     return parse_mission(data, source=str(file), base_dir=file.parent)

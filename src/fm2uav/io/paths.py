@@ -1,4 +1,9 @@
-"""Path files as CSV: one point a row, columns ``x_m,y_m[,z_m][,speed]``."""
+"""Path files as CSV: one point a row, columns ``x_m,y_m[,z_m][,speed]``.
+
+A path on a geo-referenced world starts with a comment line saying where it is,
+``# crs=EPSG:32632; z=DEM heights, ...; sources: dem x.tif sha256=...``
+(:meth:`fm2uav.world.geo.Georef.comment`); readers skip lines starting with ``#``.
+"""
 
 from __future__ import annotations
 
@@ -14,9 +19,15 @@ __all__ = ["write_path_csv", "read_path_csv"]
 _AXES = ("x_m", "y_m", "z_m")
 
 
-def write_path_csv(fh: IO[str], path: np.ndarray, speed: np.ndarray | None = None) -> None:
-    """Write a path [m] (and optionally W along it) as CSV to an open text file."""
+def write_path_csv(fh: IO[str], path: np.ndarray, speed: np.ndarray | None = None,
+                   *, comment: str | None = None) -> None:
+    """Write a path [m] (and optionally W along it) as CSV to an open text file.
+
+    ``comment`` (e.g. ``world.georef.comment()``) is written first as a ``# `` line.
+    """
     path = np.asarray(path, dtype=float)
+    if comment:
+        fh.write("# " + " ".join(str(comment).split()) + "\n")
     cols = list(_AXES[: path.shape[1]])
     data = path
     if speed is not None:
@@ -29,7 +40,8 @@ def write_path_csv(fh: IO[str], path: np.ndarray, speed: np.ndarray | None = Non
 def read_path_csv(file: str | Path) -> np.ndarray:
     """Read a path written by :func:`write_path_csv` (or any CSV with x,y[,z] columns).
 
-    A header row is recognised when its first field is not a number; columns
+    Lines starting with ``#`` (the CRS comment) are skipped. A header row is
+    recognised when its first field is not a number; columns
     named ``x``/``x_m``, ``y``/``y_m``, ``z``/``z_m`` are used if present,
     otherwise the first 2 or 3 columns.
 
@@ -41,7 +53,8 @@ def read_path_csv(file: str | Path) -> np.ndarray:
     file = Path(file)
     if not file.exists():
         raise InputError(f"path file {file} does not exist")
-    lines = [ln.strip() for ln in file.read_text().splitlines() if ln.strip()]
+    lines = [ln.strip() for ln in file.read_text().splitlines()
+             if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:
         raise InputError(f"path file {file} is empty")
     header = [c.strip().lower() for c in lines[0].split(",")]

@@ -1,12 +1,14 @@
-"""Figures of coverage plans: bands over the area, 3D path, path vs ideal profile.
+"""Figures of coverage plans: bands over the area, 3D path, path vs ideal profile;
+the report of the coverage experiments.
 
-Drawing only: every number comes from a :class:`~fm2uav.missions.coverage.Zigzag`
-or :class:`~fm2uav.missions.coverage.CoveragePlan`.
+Drawing only: every number comes from a :class:`~fm2uav.missions.coverage.Zigzag`,
+a :class:`~fm2uav.missions.coverage.CoveragePlan` or a
+:class:`~fm2uav.experiments.coverage.CoverageRun`.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import matplotlib
 import numpy as np
@@ -17,9 +19,11 @@ from ..world.ground import terrain_along
 from .figures import _arc_length
 
 if TYPE_CHECKING:
+    from ..experiments.coverage import CoverageRun
     from ..missions.coverage import CoveragePlan, Zigzag
 
-__all__ = ["bands_figure", "coverage_figure", "coverage_html"]
+__all__ = ["bands_figure", "coverage_figure", "coverage_html", "coverage_overlays",
+           "coverage_tables_report"]
 
 
 def _draw_area(ax, area, **kw) -> None:
@@ -145,3 +149,49 @@ def coverage_html(cp: CoveragePlan, *, title: str = "coverage plan") -> str:
     fig.update_layout(title=title, scene=dict(aspectmode="data", xaxis_title="x [m]",
                                               yaxis_title="y [m]", zaxis_title="z [m]"))
     return fig.to_html(include_plotlyjs=True, full_html=True)
+
+
+def coverage_overlays(cp: CoveragePlan, prefix: str = "", colour: str = "#1a1a1a") -> dict:
+    """Scene overlays of a coverage plan for :func:`~fm2uav.viz.report.report_html`: the
+    area's rings and the bands (2D, draped on the terrain)."""
+    from .report import join_polylines
+
+    area = cp.zigzag.area
+    rings = [np.asarray(area.exterior.coords)] + [np.asarray(r.coords) for r in area.interiors]
+    out = {f"{prefix}area": {"points": join_polylines(rings), "color": colour, "width": 5}}
+    bands = [np.asarray(b.coords) for b in cp.zigzag.bands()]
+    if bands:
+        out[f"{prefix}bands"] = {"points": join_polylines(bands), "color": "#ff7f0e",
+                                 "dash": "dash", "width": 2}
+    return out
+
+
+def coverage_tables_report(run: CoverageRun, files: list[str]) -> str:
+    """report.html of the coverage experiments: the four FM² paths and Tables 5.1 / 5.2."""
+    from ..experiments.coverage import DE_SETTINGS, SEEDS_T51, SEEDS_T52
+    from ..scenarios.coverage import COVERAGE_AGL, COVERAGE_SPACING
+    from .report import report_html
+
+    overlays: dict[str, Any] = {}
+    for n, cp in run.plans.items():
+        overlays.update(coverage_overlays(cp, prefix=f"{n} "))
+    t51_rows = [{"surface": n, **r, "seeds min cost": SEEDS_T51[n][0],
+                 "seeds α": SEEDS_T51[n][1]} for n, r in run.table_5_1.items()]
+    t52_rows = [{"D [m]": d, **r, "seeds min cost": SEEDS_T52[d][0],
+                 "seeds α": SEEDS_T52[d][1]} for d, r in run.table_5_2.items()]
+    return report_html(
+        run.world, {f"{n} FM² path": cp.path for n, cp in run.plans.items()},
+        speeds={f"{n} FM² path": cp.plan.speed for n, cp in run.plans.items()},
+        ideal_agl={f"{n} FM² path": COVERAGE_AGL for n in run.plans},
+        overlays=overlays,
+        title="Coverage experiments (paper 003 / thesis ch. 5)",
+        subtitle=f"areas {', '.join(run.plans)}, D = {COVERAGE_SPACING:g} m, FM² at "
+                 f"{COVERAGE_AGL:g} m above the terrain, steering angle from the DE",
+        params={"seed": run.seed, "D [m]": COVERAGE_SPACING, "agl [m]": COVERAGE_AGL,
+                "DE": DE_SETTINGS},
+        metrics={n: f"α {r['min_alpha']:.3f}°, cost {r['min_cost']:.1f} m, coverage "
+                    f"{r['coverage_pct']:.2f} %, FM² {r['fm2_length']:.0f} m"
+                 for n, r in run.table_5_1.items()},
+        tables={"Table 5.1 — D = 80 m": t51_rows,
+                "Table 5.2 — S1, different D": t52_rows},
+        files=files)

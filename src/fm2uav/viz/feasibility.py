@@ -13,10 +13,12 @@ from matplotlib.figure import Figure
 
 if TYPE_CHECKING:
     from ..baselines.rrt import RRTResult
+    from ..experiments.city import CityRun
     from ..vehicles import FeasibilityReport
     from ..world import World
 
-__all__ = ["tracking_figure", "speed_profiles_figure", "city_cases_figure", "rrt_figure"]
+__all__ = ["tracking_figure", "speed_profiles_figure", "city_cases_figure", "rrt_figure",
+           "city_report_html"]
 
 
 def _footprint(ax: Any, world: World | None) -> None:
@@ -145,3 +147,32 @@ def rrt_figure(world: World, results: dict[str, RRTResult], fm2_path: np.ndarray
     fig.suptitle(title)
     fig.tight_layout()
     return fig
+
+
+def city_report_html(run: CityRun, files: list[str]) -> str:
+    """report.html of ``reproduce city``: FM² paths of both missions, their Dubins-flown
+    tracks, the RRT paths and both tables."""
+    from .report import join_polylines, report_html
+
+    cases, af, rows = run.cases, run.airframe, run.rows
+    paths = {f"FM² {c.mission} W^{c.exponent:g}": c.path3 for c in cases}
+    speeds = {f"FM² {c.mission} W^{c.exponent:g}": c.plan.speed for c in cases}
+    paths.update(run.rrt_paths)
+    flown = join_polylines([c.report.tracking.trajectory for c in cases])
+    cols = ["mission", "exponent", "safety_m", "thesis_safety_m", "separation_max_m",
+            "thesis_separation_m", "length_m", "plan_s", "feasible"]
+    return report_html(
+        cases[0].world3, paths, speeds=speeds,
+        title="Thesis ch. 3: FM² in the city, Dubins-flown, vs RRT",
+        subtitle=f"low- and high-altitude missions with W^1, W^1/2, W^1/4 flown by the "
+                 f"{af.name}; OMPL planners on the low mission",
+        overlays={f"flown tracks ({af.name})": {"points": flown, "color": "#222222",
+                                               "dash": "dash", "width": 2}},
+        params={"seed": run.seed, "airframe": af.name, "tolerance [m]": run.tolerance},
+        metrics={f"{r['mission']} W^{r['exponent']:g}": (
+            f"safety {r['safety_m']} m, separation {r['separation_max_m']} m, "
+            f"{'feasible' if r['feasible'] else 'INFEASIBLE'}") for r in rows},
+        tables={"Safety and separation distances (Tables 3.1/3.2)":
+                [{c: r[c] for c in cols} for r in rows],
+                "FM² vs RRT, low altitude": run.rrt_rows},
+        files=files)

@@ -18,7 +18,7 @@ Drawing only: every number comes from a
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import matplotlib
 import numpy as np
@@ -29,6 +29,7 @@ from matplotlib.figure import Figure
 from ..analysis.flight_level import ground_altitude
 
 if TYPE_CHECKING:
+    from ..experiments.formation import ThesisRun
     from ..missions.formation import FormationResult
 
 __all__ = [
@@ -36,6 +37,8 @@ __all__ = [
     "formation_profiles_figure",
     "formation_metrics_figure",
     "formation_animation",
+    "formation_report_html",
+    "thesis_report_html",
 ]
 
 #: One colour per UAV (leader first).
@@ -300,3 +303,49 @@ def formation_animation(
     path.parent.mkdir(parents=True, exist_ok=True)
     anim.save(str(path), writer=writer, dpi=dpi)
     return path
+
+
+def formation_report_html(result: FormationResult, summary: dict[str, Any], *, title: str,
+                          subtitle: str, files: list[str]) -> str:
+    """report.html of one formation flight: every UAV's track, the leader's FM² plan.
+
+    ``summary`` is :func:`fm2uav.experiments.formation.fly_and_summarise`'s.
+    """
+    from ..experiments.formation import summary_rows
+    from .report import report_html
+
+    r = result
+    paths = {name: r.positions[:, i] for i, name in enumerate(r.names)}
+    lengths = r.path_lengths()
+    per_uav = [{"uav": name, "flight level [m AGL]": "free" if agl is None else agl,
+                "flown [m]": round(float(lengths[i]), 1),
+                **summary["level_keeping"].get(name, {})}
+               for i, (name, agl) in enumerate(zip(r.names, r.agl))]
+    return report_html(
+        r.world, paths, title=title, subtitle=subtitle,
+        ideal_agl={name: agl for name, agl in zip(r.names, r.agl) if agl is not None},
+        overlays={"leader FM² plan": {"points": r.leader_plan.path, "color": "#333333",
+                                      "dash": "dot", "width": 2}},
+        params={**r.params, "shape": summary["shape"], "dist [m]": summary["dist_m"]},
+        metrics=summary_rows(summary), tables={"UAVs": per_uav}, files=files)
+
+
+def thesis_report_html(run: ThesisRun, files: list[str]) -> str:
+    """report.html comparing the thesis' formation cases: the three leaders and the table."""
+    from ..experiments.formation import thesis_table
+    from .report import report_html
+
+    sc = run.scenario
+    names = {c.folder: c.title for c in run.cases}
+    return report_html(
+        sc.world,
+        {f"{names[f]} — leader": r.positions[:, 0] for f, r in run.flights.items()},
+        title="Thesis ch. 6 formations: the leaders of the three cases",
+        subtitle=f"{sc.description} — each case's own report.html is in its folder",
+        ideal_agl={f"{names[f]} — leader": r.agl[0] for f, r in run.flights.items()
+                   if r.agl[0] is not None},
+        params={"seed": run.seed, "cases": ", ".join(names)},
+        metrics={f"{f}: min separation [m]": s["min_separation_m"]
+                 for f, s in run.summaries.items()},
+        tables={"Results (thesis ch. 6)": thesis_table(run)},
+        files=files)

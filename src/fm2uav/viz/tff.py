@@ -1,13 +1,15 @@
-"""Figures of the terrain-following experiments (TFF paper figs. 7-13).
+"""Figures and reports of the terrain-following experiments (TFF paper figs. 7-13).
 
-Drawing only: the caller passes plans and their agl; every number comes from
-:mod:`fm2uav.analysis` (profiles, flight-level deviation).
+Drawing only: the caller passes plans and their agl (or a
+:class:`~fm2uav.experiments.tff.TffRun`); every number comes from
+:mod:`fm2uav.analysis` (profiles, flight-level deviation) and
+:mod:`fm2uav.experiments.tff`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -16,9 +18,12 @@ from ..analysis.flight_level import ground_altitude, ideal_altitude
 from ..analysis.profiles import path_profiles
 
 if TYPE_CHECKING:
+    from ..experiments.tff import TffRun
     from ..planning import Plan
+    from ..scenarios import Scenario
 
-__all__ = ["tff_3d_figure", "tff_profile_figure", "tff_kinematics_figure"]
+__all__ = ["tff_3d_figure", "tff_profile_figure", "tff_kinematics_figure", "tff_figures",
+           "tff_report_html"]
 
 
 def _arc(path: np.ndarray) -> np.ndarray:
@@ -102,3 +107,52 @@ def tff_kinematics_figure(
         fig.suptitle(title)
     fig.tight_layout()
     return fig
+
+
+def tff_figures(run: TffRun) -> dict[str, Figure]:
+    """The five figures of ``reproduce tff``, by file name: 3D views, path-vs-ideal
+    profiles (flight levels; smoothness at level 10) and turn/climb/curvature profiles."""
+    from ..experiments.tff import LEVEL_CASES, SMOOTH_CASES
+
+    plans, labels = run.plans, run.labels
+    agls = [r["agl_m"] for r in run.rows]
+    lv, sm = LEVEL_CASES, SMOOTH_CASES
+    name = run.scenario_name
+    return {
+        "tff_3d_levels.png": tff_3d_figure([plans[i] for i in lv], [labels[i] for i in lv],
+                                           title=f"Flight levels — {name}"),
+        "tff_3d_smoothness.png": tff_3d_figure(
+            [plans[i] for i in sm], [labels[i] for i in sm],
+            title=f"Smoothness at level 10 — {name}"),
+        "tff_profile_levels.png": tff_profile_figure(
+            [plans[i] for i in lv], [agls[i] for i in lv], [labels[i] for i in lv],
+            title="Path vs ideal path vs terrain"),
+        "tff_profile_smoothness.png": tff_profile_figure(
+            [plans[i] for i in sm], [agls[i] for i in sm], [labels[i] for i in sm],
+            title="Path vs ideal path vs terrain (level 10)"),
+        "tff_kinematics.png": tff_kinematics_figure(
+            [plans[i] for i in sm], [labels[i] for i in sm],
+            title="Turn, climb and curvature profiles (level 10)"),
+    }
+
+
+def tff_report_html(plans: Sequence[Plan], rows: list[dict[str, Any]], labels: Sequence[str],
+                    sc: Scenario, *, title: str, params: dict[str, Any], files: list[str],
+                    table_title: str = "Terrain-following cases",
+                    extra_tables: dict[str, list[dict[str, Any]]] | None = None) -> str:
+    """report.html of terrain-following paths: each path vs its ideal level, the case table.
+
+    ``rows`` are :func:`fm2uav.experiments.tff.run_tff` rows (or rows with the same keys).
+    """
+    from ..experiments.tff import tff_table_rows
+    from .report import report_html
+
+    return report_html(
+        sc.world, {lab: p.path for lab, p in zip(labels, plans)},
+        speeds={lab: p.speed for lab, p in zip(labels, plans)},
+        ideal_agl={lab: r["agl_m"] for lab, r in zip(labels, rows)},
+        title=title, subtitle=sc.description, params=params,
+        metrics={lab: f"within ±1 cell {r['within']:.0%}, mean |dev| {r['mean_dev_all_m']:.1f} m, "
+                      f"max climb {r['climb_max_deg']:.0f}°, length {r['length_m']:.0f} m"
+                 for lab, r in zip(labels, rows)},
+        tables={table_title: tff_table_rows(rows), **(extra_tables or {})}, files=files)

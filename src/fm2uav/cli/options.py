@@ -1,0 +1,284 @@
+"""The world and point options every planning command shares, defined once.
+
+Each planning command (``plan``, ``cover``, ``check``, ``tune``, ``formation``,
+``run``) declares these typer ``Annotated`` aliases in its signature, then calls
+:func:`world_spec` (→ :class:`fm2uav.world.load.WorldSpec`, the same object a
+mission file's ``world:`` section becomes), :func:`build_world` and
+:func:`cli_point`:
+
+* ``--dem FILE`` (repeatable: tiles), ``--buildings FILE``, ``--bbox W,S,E,N``,
+  ``--sea-level M``, ``--cell-size``, ``--dz``, ``--ceiling``, ``--nodata``,
+  ``--nodata-value``, ``--crs``, ``--default-height``, ``--allow-filled``;
+* ``--lonlat``: read ``--start``/``--goal`` as ``LON,LAT[,AGL]`` (degrees,
+  degrees, metres above the ground; without AGL the command's ``--agl``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import numpy as np
+import typer
+
+from ..errors import InputError
+
+__all__ = [
+    "DemOpt", "BuildingsOpt", "BboxOpt", "SeaLevelOpt", "CellSizeOpt", "DzOpt", "CeilingOpt",
+    "NodataOpt", "NodataValueOpt", "CrsOpt", "DefaultHeightOpt", "AllowFilledOpt", "LonLatOpt",
+    "ScenarioOpt", "WORLD_FLAGS", "world_spec", "build_world", "cli_point", "world_rows",
+    "requested_heights",
+]
+
+_P = "World (real data)"
+
+DemOpt = Annotated[list[Path] | None, typer.Option(
+    "--dem", show_default=False, rich_help_panel=_P, metavar="FILE",
+    help="DEM raster, any GDAL format (GeoTIFF, VRT, SRTM .hgt); repeat for tiles. "
+         "Geographic/Web Mercator DEMs are reprojected to the local UTM zone.")]
+BuildingsOpt = Annotated[Path | None, typer.Option(
+    "--buildings", show_default=False, rich_help_panel=_P, metavar="FILE",
+    help="Building footprints: GeoJSON (lon/lat, RFC 7946), GeoPackage, Shapefile, KML/KMZ; "
+         "heights from height, else building:levels x 3 m, else --default-height.")]
+BboxOpt = Annotated[str | None, typer.Option(
+    "--bbox", show_default=False, rich_help_panel=_P, metavar="W,S,E,N",
+    help="Crop the world to W,S,E,N (lon/lat degrees).")]
+SeaLevelOpt = Annotated[float | None, typer.Option(
+    "--sea-level", show_default=False, rich_help_panel=_P,
+    help="Water surface (m): ground = max(DEM, sea level), e.g. 0 for a topo-bathymetric DEM.")]
+CellSizeOpt = Annotated[float | None, typer.Option(
+    "--cell-size", show_default=False, rich_help_panel=_P,
+    help="Horizontal grid cell (m) of a --dem/--buildings world. Default: the DEM pixel "
+         "(at most 250k columns), 2 m for buildings.")]
+DzOpt = Annotated[float | None, typer.Option(
+    "--dz", show_default=False, rich_help_panel=_P,
+    help="Vertical cell (m). Default: the cell size, at most agl / 6.")]
+CeilingOpt = Annotated[float | None, typer.Option(
+    "--ceiling", show_default=False, rich_help_panel=_P,
+    help="Altitude (m) of the top of the grid. Default: highest ground + agl + margin.")]
+NodataOpt = Annotated[str, typer.Option(
+    "--nodata", rich_help_panel=_P,
+    help="DEM gaps under the map: 'error' or 'fill' (nearest valid elevation, marked as "
+         "filled).")]
+NodataValueOpt = Annotated[float | None, typer.Option(
+    "--nodata-value", show_default=False, rich_help_panel=_P,
+    help="An elevation value meaning 'no data' that the DEM file does not declare "
+         "(e.g. -9999).")]
+CrsOpt = Annotated[str | None, typer.Option(
+    "--crs", show_default=False, rich_help_panel=_P,
+    help="CRS of input files that declare none (e.g. EPSG:32630 for an old GeoJSON in UTM "
+         "metres).")]
+DefaultHeightOpt = Annotated[float | None, typer.Option(
+    "--default-height", show_default=False, rich_help_panel=_P,
+    help="Height (m) of buildings without height or building:levels.")]
+AllowFilledOpt = Annotated[bool, typer.Option(
+    "--allow-filled", rich_help_panel=_P,
+    help="Only warn when the start/goal lies over filled DEM nodata.")]
+LonLatOpt = Annotated[bool, typer.Option(
+    "--lonlat", help="Read --start/--goal as LON,LAT[,AGL] (degrees, degrees, metres above "
+                     "the ground; default AGL: --agl).")]
+ScenarioOpt = Annotated[str | None, typer.Option(
+    "--scenario", show_default=False,
+    help="Built-in scenario (when no --dem/--buildings is given).")]
+
+#: WorldSpec field -> CLI flag (for one-line errors that name the flag).
+WORLD_FLAGS = {
+    "dem": "--dem", "buildings": "--buildings", "bbox": "--bbox", "sea_level": "--sea-level",
+    "cell_size": "--cell-size", "dz": "--dz", "ceiling": "--ceiling", "nodata": "--nodata",
+    "nodata_value": "--nodata-value", "crs": "--crs", "default_height": "--default-height",
+    "allow_filled": "--allow-filled",
+}
+
+
+def _bbox(text: str) -> list[float]:
+    parts = [p for p in text.replace(",", " ").split() if p]
+    try:
+        v = [float(p) for p in parts]
+    except ValueError:
+        v = []
+    if len(v) != 4:
+        raise InputError(f"--bbox must be 4 numbers W,S,E,N in lon/lat degrees (e.g. "
+                         f"-3.78,40.33,-3.74,40.35), got {text!r}")
+    return v
+
+
+def world_spec(
+    *,
+    dem: list[Path] | None = None,
+    buildings: Path | None = None,
+    bbox: str | None = None,
+    sea_level: float | None = None,
+    cell_size: float | None = None,
+    dz: float | None = None,
+    ceiling: float | None = None,
+    nodata: str = "error",
+    nodata_value: float | None = None,
+    crs: str | None = None,
+    default_height: float | None = None,
+    allow_filled: bool = False,
+) -> Any:
+    """The :class:`~fm2uav.world.load.WorldSpec` of the world options, or None without data.
+
+    Raises
+    ------
+    InputError
+        One line naming the flag (``--bbox = ...: west < east ...``), also for
+        data-only flags given without ``--dem``/``--buildings``.
+    """
+    from pydantic import ValidationError
+
+    from ..world.load import WorldSpec
+
+    values = {"dem": [str(p) for p in dem] if dem else None,
+              "buildings": None if buildings is None else str(buildings),
+              "bbox": None if bbox is None else _bbox(bbox), "sea_level": sea_level,
+              "cell_size": cell_size, "dz": dz, "ceiling": ceiling, "nodata": nodata,
+              "nodata_value": nodata_value, "crs": crs, "default_height": default_height,
+              "allow_filled": allow_filled}
+    if values["dem"] is not None and len(values["dem"]) == 1:
+        values["dem"] = values["dem"][0]
+    if values["dem"] is None and values["buildings"] is None:
+        given = [WORLD_FLAGS[k] for k, v in values.items()
+                 if v is not None and v is not False and not (k == "nodata" and v == "error")]
+        if given:
+            raise InputError(f"{given[0]} needs real data: give --dem FILE and/or --buildings "
+                             "FILE (built-in scenarios have a fixed grid)")
+        return None
+    try:
+        return WorldSpec.model_validate({k: v for k, v in values.items() if v is not None})
+    except ValidationError as exc:
+        err = exc.errors()[0]
+        key = str(err["loc"][0]) if err["loc"] else "dem"
+        msg = str(err.get("ctx", {}).get("error", err["msg"])).removeprefix("Value error, ")
+        if err["type"] in ("greater_than", "greater_than_equal", "less_than",
+                           "less_than_equal", "literal_error"):
+            msg = err["msg"]
+        raise InputError(f"{WORLD_FLAGS.get(key, '--' + key)} = {err.get('input')!r}: "
+                         f"{msg}") from None
+
+
+def build_world(spec: Any, *, scenario: str | None, seed: int = 0, agl: float | None = None,
+                top: float | None = None, default: str = "open-field") -> tuple[Any, Any, str]:
+    """``(world, scenario or None, description)`` from a spec, else a built-in scenario.
+
+    ``agl`` / ``top`` size a data world (see :func:`fm2uav.world.load.load_world`).
+    Warnings of the data (below sea level, distortion) are shown by
+    :func:`~fm2uav.cli._common.handle_errors` as one-line ``warning:`` lines.
+
+    Raises
+    ------
+    InputError
+        Both ``--scenario`` and ``--dem``/``--buildings`` given.
+    """
+    from ..world.load import load_world
+
+    if spec is None:
+        from ..scenarios import get_scenario
+
+        sc = get_scenario(scenario or default, seed=seed)
+        return sc.world, sc, scenario or default
+    if scenario is not None:
+        raise InputError("give either --scenario or --dem/--buildings, not both")
+    world = load_world(spec, agl=agl, top=top)
+    return world, None, spec.describe()
+
+
+def cli_point(text: str | None, what: str, world: Any, *, lonlat: bool = False,
+              cells: bool = False, agl: float | None = None, default: Any = None,
+              anchor: Any = None) -> np.ndarray:
+    """A ``--start``/``--goal`` value in world metres.
+
+    ``x,y[,z]`` metres (default), ``i,j[,k]`` cells (``cells``), or
+    ``LON,LAT[,AGL]`` (``lonlat``: through the world's CRS, or ``anchor`` for a
+    built-in scenario; AGL in metres above the ground, default ``agl``).
+
+    Raises
+    ------
+    InputError
+        Wrong count of numbers, a lon/lat point without a height, both
+        ``--lonlat`` and ``--cells``.
+    """
+    from ._common import parse_point
+
+    if text is None:
+        if default is None:
+            raise InputError(f"--{what} is missing: a --dem/--buildings world has no default "
+                             f"{what}; give --{what} LON,LAT,AGL --lonlat (or x,y,z metres)")
+        return np.asarray(default, dtype=float)
+    if lonlat and cells:
+        raise InputError("give --lonlat or --cells, not both")
+    if lonlat:
+        from ..io.mission import PointSpec, resolve_point
+
+        parts = [p for p in text.replace(",", " ").split() if p]
+        try:
+            v = [float(p) for p in parts]
+        except ValueError:
+            v = []
+        if len(v) not in (2, 3):
+            raise InputError(f"--{what} with --lonlat must be LON,LAT or LON,LAT,AGL (degrees, "
+                             f"degrees, metres above the ground), got {text!r}")
+        if not (-180 <= v[0] <= 180 and -90 <= v[1] <= 90):
+            raise InputError(f"--{what} = {text!r}: longitude must be in [-180, 180] and "
+                             "latitude in [-90, 90] degrees (order LON,LAT)")
+        h = v[2] if len(v) == 3 else agl
+        if h is None:
+            raise InputError(f"--{what} {text!r} has no height: add ,AGL (metres above the "
+                             "ground) or give --agl")
+        if h <= 0:
+            raise InputError(f"--{what}: the height above ground must be > 0 m, got {h:g}")
+        return resolve_point(PointSpec(lon=v[0], lat=v[1], agl=float(h)), world, anchor, what)
+    p = parse_point(text, world.ndim, what)
+    return world.to_world(p) if cells else p
+
+
+def requested_heights(*texts: str | None, lonlat: bool, agl: float | None
+                      ) -> tuple[float | None, float | None]:
+    """``(highest agl, highest altitude)`` asked for by ``--agl`` and the points' text.
+
+    Lets :func:`build_world` size a data world before the points are placed.
+    """
+    agls = [] if agl is None else [float(agl)]
+    tops: list[float] = []
+    for t in texts:
+        if t is None:
+            continue
+        parts = [p for p in t.replace(",", " ").split() if p]
+        try:
+            v = [float(p) for p in parts]
+        except ValueError:
+            continue  # cli_point reports it
+        if len(v) == 3:
+            (agls if lonlat else tops).append(v[2])
+    return (max(agls) if agls else None), (max(tops) if tops else None)
+
+
+def world_rows(world: Any) -> dict[str, str]:
+    """Printed summary rows about a data world (nothing for a built-in scenario)."""
+    g = getattr(world, "georef", None)
+    if g is None:
+        return {}
+    rows = {"CRS": f"{g.crs}" + (f" — {g.reprojection}" if g.reprojection else ""),
+            "vertical": g.vertical}
+    for s in g.sources:
+        d = s.details
+        if s.role == "dem":
+            rows["grid"] = (f"{' x '.join(str(n) for n in world.shape)} nodes, cells "
+                            f"{d.get('cell_size', world.spacing[0]):g} m ({d.get('cell_size_rule', '')}), "
+                            f"dz {d.get('dz', world.spacing[2]):g} m ({d.get('dz_rule', '')})")
+            if d.get("filled_nodes"):
+                rows["filled nodata"] = f"{d['filled_nodes']} columns"
+        if s.role == "buildings":
+            hr = d.get("height_rule", {})
+            rows["buildings"] = (
+                f"{d.get('buildings', 0)}: {hr.get('height', 0)} from height, "
+                f"{hr.get('building:levels', 0)} from building:levels x "
+                f"{d.get('metres_per_level', 3.0):g} m, {hr.get('default_height', 0)} from "
+                f"--default-height" + (f"; left out: {d['skipped']}" if d.get("skipped") else "")
+                + (f"; {d['outside_map']} outside the map" if d.get("outside_map") else ""))
+            if "grid" not in rows:
+                rows["grid"] = (f"{' x '.join(str(n) for n in world.shape)} nodes, cells "
+                                f"{world.spacing[0]:g} m, dz {world.spacing[2]:g} m")
+    rows["sources"] = ", ".join(f"{Path(s.path).name} (sha256 {s.sha256[:12]})"
+                                for s in g.sources if s.sha256)
+    return rows

@@ -1,0 +1,185 @@
+"""The terrain-following experiments of the TFF paper (§5) and the thesis (§4.3).
+
+Flight levels 2, 5 and 10 cells with (p1, p2) = (0.5, 2.5), (0.5, 1.5), (0.5, 1.3),
+and the smoothness cases p2 = 1.0 and 0.8 at level 10 (:data:`SEED_CASES`); with
+the capped flight-level reading, level 10 is also planned with the literal
+``W**p`` reading for comparison. :func:`run_tff` plans every case on a built-in
+scenario and measures it (:func:`fm2uav.analysis.flight_level.tff_metrics`);
+:func:`tff_markdown` renders ``tff_table.md``.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Any, Literal
+
+import numpy as np
+
+from ..analysis.flight_level import tff_metrics
+from ..errors import InputError
+from ..planning import Plan, plan
+from ..scenarios import Scenario, get_scenario
+
+__all__ = [
+    "FlightLevelMode",
+    "SEED_CASES",
+    "LEVEL_CASES",
+    "SMOOTH_CASES",
+    "TffCase",
+    "TffRun",
+    "tff_cases",
+    "run_tff",
+    "TFF_COLUMNS",
+    "tff_table_markdown",
+    "tff_table_rows",
+    "tff_markdown",
+]
+
+#: Flight-level reading of ``plan(agl_mode=...)``.
+FlightLevelMode = Literal["capped", "literal"]
+MODES: tuple[FlightLevelMode, ...] = ("capped", "literal")
+
+
+@dataclass(frozen=True)
+class TffCase:
+    """One terrain-following case: a flight level [cells] and the exponents p1, p2."""
+
+    name: str
+    level: int
+    p1: float
+    p2: float
+    mode: FlightLevelMode
+
+
+#: The seeds' experiments (TFF paper §5, thesis §4.3): (name, level [cells], p1, p2).
+SEED_CASES: tuple[tuple[str, int, float, float], ...] = (
+    ("level 2", 2, 0.5, 2.5),
+    ("level 5", 5, 0.5, 1.5),
+    ("level 10", 10, 0.5, 1.3),
+    ("smooth p2=1.0", 10, 0.5, 1.0),
+    ("smooth p2=0.8", 10, 0.5, 0.8),
+)
+#: Indices of the flight-level cases and of the level-10 smoothness cases in a run.
+LEVEL_CASES = (0, 1, 2)
+SMOOTH_CASES = (2, 3, 4)
+
+
+def tff_cases(mode: FlightLevelMode = "capped") -> list[TffCase]:
+    """The seed cases read with ``mode``; with ``"capped"`` also level 10 read literally."""
+    if mode not in MODES:
+        raise InputError(f"flight-level mode must be 'capped' or 'literal' (--mode), got {mode!r}")
+    cases = [TffCase(name, level, p1, p2, mode) for name, level, p1, p2 in SEED_CASES]
+    if mode == "capped":
+        cases.append(TffCase("level 10, literal W**p", 10, 0.5, 1.3, "literal"))
+    return cases
+
+
+@dataclass
+class TffRun:
+    """The planned cases: one metrics row and one :class:`~fm2uav.planning.Plan` per case."""
+
+    scenario_name: str
+    seed: int
+    mode: FlightLevelMode
+    scenario: Scenario
+    cases: list[TffCase]
+    rows: list[dict[str, Any]]
+    plans: list[Plan]
+
+    @property
+    def labels(self) -> list[str]:
+        """One legend label per case: name and exponents."""
+        return [f"{r['case']} (p1={r['p1']:g}, p2={r['p2']:g})" for r in self.rows]
+
+
+def run_tff(scenario: str = "open-field", seed: int = 0,
+            mode: FlightLevelMode = "capped") -> TffRun:
+    """Plan and measure the seeds' cases on the built-in ``scenario`` (needs terrain).
+
+    Parameters
+    ----------
+    scenario : str
+        Built-in scenario name (:data:`fm2uav.scenarios.SCENARIOS`).
+    seed : int
+        Seed of the scenario's random relief.
+    mode : {"capped", "literal"}
+        Flight-level reading of the seed cases.
+    """
+    cases = tff_cases(mode)
+    sc = get_scenario(scenario, seed=seed)
+    dz = sc.world.spacing[2]
+    rows, plans = [], []
+    for case in cases:
+        agl = case.level * dz
+        t0 = time.perf_counter()
+        p = plan(sc.world, sc.start, sc.goal, agl=agl, p1=case.p1, p2=case.p2,
+                 agl_mode=case.mode)
+        m = tff_metrics(p, agl)
+        m.update(case=case.name, level=case.level, agl_m=agl, p1=case.p1, p2=case.p2,
+                 diff=case.p2 - case.p1, mode=case.mode,
+                 transitions=f"{m['start_transition_m']:.0f}/{m['end_transition_m']:.0f}",
+                 plan_s=time.perf_counter() - t0)
+        rows.append(m)
+        plans.append(p)
+    return TffRun(scenario, seed, mode, sc, cases, rows, plans)
+
+
+#: Columns of tff_table.md: (header, row key, format).
+TFF_COLUMNS = (
+    ("case", "case", "{}"),
+    ("level [cells]", "level", "{}"),
+    ("agl [m]", "agl_m", "{:g}"),
+    ("p1", "p1", "{:g}"),
+    ("p2", "p2", "{:g}"),
+    ("p2−p1", "diff", "{:.1f}"),
+    ("within ±1 cell (between transitions)", "within", "{:.0%}"),
+    ("on level (all points)", "within_all", "{:.0%}"),
+    ("mean |dev| vs terrain+agl [m]", "mean_dev_all_m", "{:.1f}"),
+    ("mean |dev| vs layer [m]", "mean_dev_layer_m", "{:.1f}"),
+    ("max |dev| between transitions [m]", "max_dev_m", "{:.1f}"),
+    ("transitions start/end [m]", "transitions", "{}"),
+    ("points inside terrain", "inside_terrain", "{}"),
+    ("length [m]", "length_m", "{:.0f}"),
+    ("max turn [°/cell]", "turn_max_deg", "{:.1f}"),
+    ("p95 turn [°/cell]", "turn_p95_deg", "{:.1f}"),
+    ("max climb [°]", "climb_max_deg", "{:.1f}"),
+    ("p95 climb [°]", "climb_p95_deg", "{:.1f}"),
+    ("max curvature [1/m]", "curvature_max", "{:.4f}"),
+    ("p95 curvature [1/m]", "curvature_p95", "{:.4f}"),
+    ("min turn radius [m]", "min_turn_radius_m", "{:.0f}"),
+)
+
+
+def tff_table_markdown(rows: list[dict[str, Any]]) -> str:
+    """The case table as Markdown (one line per row of :func:`run_tff`)."""
+    head = [c[0] for c in TFF_COLUMNS]
+    out = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for r in rows:
+        out.append("| " + " | ".join(fmt.format(r[key]) for _, key, fmt in TFF_COLUMNS) + " |")
+    return "\n".join(out)
+
+
+def tff_table_rows(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The rows of the case table as dicts (header → formatted value), for HTML reports."""
+    return [{head: fmt.format(r[key]) for head, key, fmt in TFF_COLUMNS} for r in rows]
+
+
+def tff_markdown(run: TffRun) -> str:
+    """``tff_table.md``: title, scenario, definitions and the case table."""
+    sc = run.scenario
+    md = [
+        f"# Terrain-following flight — {run.scenario_name} (seed {run.seed}, flight-level "
+        f"mode '{run.mode}')",
+        "",
+        sc.description,
+        "",
+        f"start {np.round(sc.start, 1).tolist()} m, goal {np.round(sc.goal, 1).tolist()} m; "
+        f"±1 cell = ±{sc.world.spacing[2]:g} m; transitions = the start/goal stretches "
+        "before the path first reaches, and after it last leaves, ±1 cell of terrain + agl; "
+        "profiles on the path resampled every horizontal cell.",
+        "",
+        tff_table_markdown(run.rows),
+        "",
+    ]
+    return "\n".join(md)
