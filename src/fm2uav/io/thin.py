@@ -177,6 +177,7 @@ def refine_legs(
         floor), ``zone_splits``, ``unresolved`` (legs of neighbouring points that
         still fail; 0 normally).
     """
+    from ..world.ground_model import sampling_step
     from ..world.zones import zone_violations
 
     p = np.asarray(flown, dtype=float)
@@ -184,7 +185,7 @@ def refine_legs(
     if p.ndim != 2 or p.shape[1] != 3 or req.shape != (len(p),):
         raise InputError(f"flown must be (N, 3) and required (N,), got {p.shape} and {req.shape}")
     if step is None:
-        step = 0.25 * float(min(world.spacing[:2]))
+        step = sampling_step(world)
     keep = set(int(i) for i in np.asarray(indices, dtype=int))
     keep |= {0, len(p) - 1}
     ground = np.asarray(world.ground_height(p[:, 0], p[:, 1]), dtype=float)

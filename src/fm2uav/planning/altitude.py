@@ -64,6 +64,7 @@ from .params import FlightLevel
 
 __all__ = [
     "AltitudeProfile",
+    "final_profile",
     "floor_agl",
     "envelope_above",
     "envelope_below",
@@ -206,6 +207,11 @@ class AltitudeProfile:
         Surface height (ground or roof) under each point [m].
     phase : ndarray of str, shape (M,)
         ``"climb-out"``, ``"cruise"`` or ``"descent"`` per point.
+    required : ndarray, shape (M,)
+        The floor the profile keeps at each point, as a height above the
+        surface [m]: ``max(agl - tolerance, min_agl)`` on the cruise, the
+        climb-out / descent floor elsewhere, ``-inf`` at the take-off and
+        landing points (what the waypoint legs must keep too).
     level : FlightLevel
         The request (agl, tolerance, min/max_agl, climb/descent limits).
     vertical_start_m, vertical_goal_m : float
@@ -222,6 +228,7 @@ class AltitudeProfile:
     s: np.ndarray = field(repr=False)
     surface: np.ndarray = field(repr=False)
     phase: np.ndarray = field(repr=False)
+    required: np.ndarray = field(repr=False)
     level: FlightLevel
     vertical_start_m: float = 0.0
     vertical_goal_m: float = 0.0
@@ -299,7 +306,8 @@ def solve_profile(
     -------
     dict
         ``z`` (M,), ``cruise_z`` (M,), ``z_start_eff``, ``z_goal_eff``,
-        ``phase`` (M,), ``lifted_m``.
+        ``phase`` (M,), ``required`` (M,: the floor above the surface kept at
+        each sample), ``lifted_m``.
 
     Raises
     ------
@@ -349,12 +357,12 @@ def solve_profile(
                 f"the {where} cannot be joined to the route within the altitude limits "
                 f"(needs {need_lo:.1f} m, ceiling allows {need_hi:.1f} m); move the {where} or "
                 "raise planner.max_agl (--max-agl)")
-        return need_lo, need_hi
+        return need_lo, need_hi, keep
 
     # start cone: going forward z rises at most tc and drops at most td per metre
-    lo_s, hi_s = cone_interval(z_start, ground_start, rel, tc, td, "start")
+    lo_s, hi_s, keep_s = cone_interval(z_start, ground_start, rel, tc, td, "start")
     zs = min(max(z_start, lo_s), hi_s)
-    lo_g, hi_g = cone_interval(z_goal, ground_goal, total - rel, td, tc, "goal")
+    lo_g, hi_g, keep_g = cone_interval(z_goal, ground_goal, total - rel, td, tc, "goal")
     # the goal's effective height must also be reachable from the start's
     lo_g, hi_g = max(lo_g, zs - td * total), min(hi_g, zs + tc * total)
     if lo_g > hi_g + 1e-6:
@@ -376,8 +384,96 @@ def solve_profile(
         half = int(np.searchsorted(rel, total / 2.0))
         phase[:half] = "climb-out"
         phase[half:] = "descent"
+    phase = phase.astype(str)
+    required = np.where(phase == "cruise", floor_agl(lim),
+                        np.where(phase == "climb-out", keep_s, keep_g)).astype(float)
     return {"z": z, "cruise_z": cruise_z, "z_start_eff": zs, "z_goal_eff": zg,
-            "phase": phase.astype(str), "lifted_m": lifted}
+            "phase": phase, "required": required, "lifted_m": lifted}
+
+
+def final_profile(world: Any, path: Any, level: FlightLevel, *, ds: float | None = None
+                  ) -> AltitudeProfile:
+    """The flown profile of an FM² path over a world (see the module docstring).
+
+    Parameters
+    ----------
+    world : World
+        3D world with :meth:`~fm2uav.World.surface_height` /
+        :meth:`~fm2uav.World.ground_height` (and optional ``zones``).
+    path : array_like, shape (N, 3)
+        The FM² path [m]: its horizontal route is kept, its heights replaced
+        (they only choose the side of zones with a floor/ceiling).
+    level : FlightLevel
+    ds : float, optional
+        Sample spacing along the route [m]; default a quarter of the smallest
+        horizontal cell.
+
+    Returns
+    -------
+    AltitudeProfile
+
+    Raises
+    ------
+    PlanningError
+        No profile meets the limits (message names the fix).
+    """
+    from ..world.ground_model import sampling_step
+    from ..world.zones import zone_bounds_along
+
+    p = np.asarray(path, dtype=float)
+    if p.ndim != 2 or p.shape[1] != 3:
+        raise InputError(f"a final altitude profile needs a 3D path (N, 3), got {p.shape}")
+    if ds is None:
+        ds = sampling_step(world)
+    xy, s = resample_route(p, ds)
+    mids = 0.5 * (xy[:-1] + xy[1:])
+
+    def surf(q: np.ndarray) -> np.ndarray:
+        return np.asarray(world.surface_height(q[:, 0], q[:, 1]), dtype=float)
+
+    def grnd(q: np.ndarray) -> np.ndarray:
+        return np.asarray(world.ground_height(q[:, 0], q[:, 1]), dtype=float)
+
+    s_at, s_mid = surf(xy), surf(mids)
+    smax = _window(s_at, s_mid, np.maximum)
+    gmin = _window(grnd(xy), grnd(mids), np.minimum)
+    # the FM² route's own height at each sample (chooses over/under a zone)
+    seg = np.linalg.norm(np.diff(p[:, :2], axis=0), axis=1)
+    cum = np.concatenate([[0.0], np.cumsum(seg)])
+    z_route = np.interp(s, cum, p[:, 2]) if cum[-1] > 0 else np.full(len(s), p[0, 2])
+    lo_x, up_x = zone_bounds_along(world, xy, z_route, mids)
+    top = float(world.bounds[2, 1])
+    out = solve_profile(s, smax, gmin, level, z_start=float(p[0, 2]), z_goal=float(p[-1, 2]),
+                        ground_start=float(s_at[0]), ground_goal=float(s_at[-1]),
+                        extra_lower=lo_x, extra_upper=up_x, top=top, xy=xy)
+    z = out["z"]
+    rows = [np.column_stack([xy, z])]
+    ss, ph, rq, sf = [s], [out["phase"]], [out["required"]], [s_at]
+    vs = float(out["z_start_eff"] - p[0, 2])
+    vg = float(out["z_goal_eff"] - p[-1, 2])
+    if abs(vs) > 1e-6:
+        rows.insert(0, p[:1])
+        ss.insert(0, s[:1]); ph.insert(0, np.array(["climb-out"]))
+        rq.insert(0, np.array([-np.inf])); sf.insert(0, s_at[:1])
+    if abs(vg) > 1e-6:
+        rows.append(p[-1:])
+        ss.append(s[-1:]); ph.append(np.array(["descent"]))
+        rq.append(np.array([-np.inf])); sf.append(s_at[-1:])
+    flown = np.concatenate(rows)
+    flown[0], flown[-1] = p[0], p[-1]
+    required = np.concatenate(rq)
+    required[0] = required[-1] = -np.inf
+    phase = np.concatenate(ph)
+    sss = np.concatenate(ss)
+    co = phase == "climb-out"
+    de = phase == "descent"
+    return AltitudeProfile(
+        path=flown, s=sss, surface=np.concatenate(sf), phase=phase, required=required,
+        level=level, vertical_start_m=vs, vertical_goal_m=vg,
+        climb_out_m=float(sss[co].max() - sss[0]) if co.any() else 0.0,
+        descent_m=float(sss[-1] - sss[de].min()) if de.any() else 0.0,
+        lifted_m=float(out["lifted_m"]),
+    )
 
 
 def height_figures(agl: Any, requested: float | None = None, *, band: float = 5.0,

@@ -5,8 +5,10 @@ Two questions:
 * :func:`surface_clearance` — the **honest** one: distance [m] from each point
   to the continuous terrain/building surface (terrain = the bilinear ground of
   :meth:`World.ground_height`, triangulated four triangles per cell around the
-  cell centre; buildings = their columns as boxes up to the roof of
-  :meth:`World.surface_height`). No-fly zones are not surfaces and do not
+  cell centre — for a world with a source-DEM ground model, that DEM sampled a
+  quarter pixel apart; buildings = their columns as boxes up to the roof of
+  :meth:`World.surface_height`). Never more than the exact vertical height
+  above the surface. No-fly zones are not surfaces and do not
   count (see :mod:`fm2uav.world.zones`). Worlds that are not made of solid
   columns (and 2D worlds) measure to their obstacle *cells* as boxes.
 * :func:`clearance_profile` — distance to the nearest obstacle *node* (the
@@ -50,8 +52,26 @@ def _is_columns(world: World) -> bool:
     return world._cache[key]
 
 
+#: Largest number of ground samples the clearance search triangulates.
+_GRID_CAP = 16_000_000
+
+
 def _ground_grid(world: World) -> tuple[np.ndarray, float, float, float, float]:
     """Height grid [m], origin and spacing of the ground the surface is made of."""
+    model = getattr(world, "ground", None)
+    if model is not None:
+        # the source DEM sampled on a world grid a quarter pixel apart (cached)
+        key = "clearance_ground_grid"
+        if key not in world._cache:
+            b = world.bounds
+            g = max(0.25 * model.pixel_m,
+                    float(np.sqrt((b[0, 1] - b[0, 0]) * (b[1, 1] - b[1, 0]) / _GRID_CAP)))
+            xs = np.arange(b[0, 0], b[0, 1] + g, g)
+            ys = np.arange(b[1, 0], b[1, 1] + g, g)
+            X, Y = np.meshgrid(xs, ys, indexing="ij")
+            h = np.ascontiguousarray(model.height(X, Y), dtype=float)
+            world._cache[key] = (h, float(xs[0]), float(ys[0]), g, g)
+        return world._cache[key]
     if world.terrain is not None:
         return (np.ascontiguousarray(world.terrain, dtype=float), world.origin[0],
                 world.origin[1], world.spacing[0], world.spacing[1])

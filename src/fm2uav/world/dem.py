@@ -688,8 +688,12 @@ def from_dem(
     georef = make_georef(dst, vertical=vertical, vertical_crs=dem.vertical_crs,
                          vertical_assumed=dem.vertical_crs is None, reprojection=reason,
                          scale_error=err, sources=sources)
+    # the DEM at its own resolution for every height-above-ground question (issue 13)
+    from .ground_model import ground_model_from_dem
+
+    ground = ground_model_from_dem(dem, src, dst, min(dx, dy), sea_level=sea_level)
     return dataclasses.replace(w, crs=crs_label(dst) if parse_crs(dst).to_epsg() else dst,
-                               name=name or "dem", filled=filled, georef=georef)
+                               name=name or "dem", filled=filled, georef=georef, ground=ground)
 
 
 def _ceiling(ceiling: float | None, hmax: float, dz: float, agl: float | None,

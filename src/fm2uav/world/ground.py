@@ -5,7 +5,9 @@ The one home of "how high is the ground here": :meth:`World.ground_height` and
 
 * **Ground** (:func:`ground_height`): the world's terrain height map
   (``World.terrain``, one height per column) interpolated bilinearly between
-  the column nodes, clamped to the edge columns outside the map. A world
+  the column nodes, clamped to the edge columns outside the map — or, for a
+  world built from a DEM finer than its cells, the DEM itself at its own
+  resolution (``World.ground``, :mod:`fm2uav.world.ground_model`). A world
   without terrain has its ground at the **floor of the grid**: ``origin[2]``,
   the z of the lowest node layer (``0`` for a 2D world, which has no z).
 * **Surface** (:func:`surface_height`): the ground or a roof, whichever is
@@ -51,6 +53,9 @@ def ground_height(world: World, x: Any, y: Any) -> np.ndarray | float:
     ``x`` and ``y`` broadcast together; one number each gives a float.
     """
     xa, ya, scalar = _xy(world, x, y)
+    model = getattr(world, "ground", None)
+    if model is not None:  # the DEM at its own resolution (world/ground_model.py)
+        return _out(np.asarray(model.height(xa, ya), dtype=float), scalar)
     if world.terrain is None:
         floor = float(world.origin[2]) if world.ndim == 3 else 0.0
         return _out(np.full(xa.shape, floor), scalar)

@@ -91,6 +91,10 @@ class World:
         Optional :class:`~fm2uav.world.geo.Georef`: CRS with EPSG code,
         vertical reference of z, source files with SHA-256 (worlds built from
         real data).
+    ground:
+        Optional :class:`~fm2uav.world.ground_model.GroundModel`: the DEM at
+        its own (finer) resolution; :meth:`ground_height` reads it instead of
+        ``terrain`` when present (FM² keeps planning on ``terrain``).
     zones:
         No-fly zones and operating areas (:class:`fm2uav.world.zones.Zone`)
         whose nodes are part of ``occupancy``; build with
@@ -110,6 +114,7 @@ class World:
     name: str = ""
     filled: np.ndarray | None = None
     georef: Any = None
+    ground: Any = None
     zones: tuple = ()
     _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 

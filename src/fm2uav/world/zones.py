@@ -541,7 +541,9 @@ def zone_violations(world: World, points: Any, *, step: float | None = None,
         return []
     p = np.asarray(points, dtype=float)
     if step is None:
-        step = 0.25 * float(min(world.spacing[:2]))
+        from .ground_model import sampling_step
+
+        step = sampling_step(world)
     dense, seg = _densify(p, step)
     ground = (np.asarray(world.ground_height(dense[:, 0], dense[:, 1]), dtype=float)
               if dense.shape[1] == 3 else None)

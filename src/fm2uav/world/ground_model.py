@@ -1,0 +1,174 @@
+"""The ground as the source DEM itself, beside the (coarser) planning grid.
+
+A world built from a DEM resamples it to its cell size (``World.terrain``, one
+height per column node), which is what FM² plans on. Between those nodes the
+real ground can rise well above the bilinear surface of the nodes: on the
+Jacksboro DEM (3″ pixels, ≈ 75 × 93 m) planned on 150 m nodes, a path flown at
+exactly 150 m above ``World.terrain`` comes down to 135 m above the source
+DEM on ridges. Every height-above-ground question (``World.ground_height``,
+the final altitude profile, the safety figures, the exports' AMSL altitudes)
+therefore reads the DEM itself.
+
+:class:`GroundModel` keeps the source raster (elevations, affine transform,
+CRS) and answers ``height(x, y)`` for world coordinates by transforming them
+into the raster's CRS (pyproj, exact) and interpolating the raster bilinearly
+between pixel centres — the DEM "interpolated bilinearly", with no second
+resampling in between. Nodata pixels are filled with the nearest valid one
+(as the world's terrain is) and ``sea_level`` clamps the ground as in the
+world. It is kept only when the DEM is finer than the planning grid and
+holds at most :data:`MAX_SAMPLES` pixels (a larger raster is not kept; the
+world's terrain answers then, and ``World.georef``'s sources still name the
+file).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from scipy import ndimage
+
+__all__ = ["GroundModel", "MAX_SAMPLES", "ground_model_from_dem", "sampling_step"]
+
+#: Largest raster (pixels) kept as a ground model (about 200 MB of float64).
+MAX_SAMPLES = 25_000_000
+
+
+@dataclass(frozen=True, eq=False)
+class GroundModel:
+    """The source DEM, interpolated bilinearly at world coordinates.
+
+    Attributes
+    ----------
+    z : ndarray, shape (rows, cols)
+        Elevations [m, world z], nodata filled with the nearest valid pixel.
+    transform : 6 floats
+        Affine ``(a, b, c, d, e, f)`` from (col, row) pixel-corner coordinates
+        to the raster's CRS.
+    crs : str
+        The raster's horizontal CRS (WKT or authority string).
+    world_crs : str
+        The world's CRS (the coordinates ``height`` is asked in).
+    pixel_m : float
+        Smaller side of a pixel in the world's metres.
+    description : str
+        One line for summaries.
+    """
+
+    z: np.ndarray = field(repr=False)
+    transform: tuple[float, ...]
+    crs: str = field(repr=False)
+    world_crs: str = field(repr=False)
+    pixel_m: float = 0.0
+    description: str = ""
+    _to_src: Any = field(default=None, init=False, repr=False, compare=False)
+    _inv: tuple[float, ...] = field(default=(), init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        from .geo import parse_crs, transformer
+
+        z = np.array(self.z, dtype=float, copy=True)
+        if z.ndim != 2 or min(z.shape) < 2 or not np.all(np.isfinite(z)):
+            raise ValueError(f"GroundModel z must be a finite (rows >= 2, cols >= 2) array, "
+                             f"got shape {z.shape}")
+        z.setflags(write=False)
+        object.__setattr__(self, "z", z)
+        a, b, c, d, e, f = (float(v) for v in self.transform)
+        det = a * e - b * d
+        if det == 0:
+            raise ValueError("GroundModel transform is singular")
+        # inverse affine: (x, y) -> (col, row)
+        inv = (e / det, -b / det, (b * f - c * e) / det, -d / det, a / det, (c * d - a * f) / det)
+        object.__setattr__(self, "_inv", inv)
+        same = parse_crs(self.crs).equals(parse_crs(self.world_crs))
+        object.__setattr__(self, "_to_src", None if same else
+                           transformer(self.world_crs, self.crs))
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """``(rows, cols)`` of the raster."""
+        return tuple(int(v) for v in self.z.shape)  # type: ignore[return-value]
+
+    def height(self, x: Any, y: Any) -> np.ndarray:
+        """Bilinear DEM height [m] at world ``(x, y)`` [m] (edge pixels outside)."""
+        xa, ya = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        xs, ys = xa.ravel(), ya.ravel()
+        if self._to_src is not None:
+            xs, ys = self._to_src.transform(xs, ys)
+            xs, ys = np.asarray(xs, dtype=float), np.asarray(ys, dtype=float)
+        ia, ib, ic, id_, ie, if_ = self._inv
+        col = ia * xs + ib * ys + ic - 0.5
+        row = id_ * xs + ie * ys + if_ - 0.5
+        out = ndimage.map_coordinates(self.z, np.stack([row, col]), order=1, mode="nearest")
+        return out.reshape(xa.shape)
+
+
+def sampling_step(world: Any) -> float:
+    """Spacing [m] at which to sample a path against the ground: a quarter of the
+    world's horizontal cell, and at most half the source DEM's pixel."""
+    step = 0.25 * float(min(world.spacing[:2]))
+    model = getattr(world, "ground", None)
+    if model is not None and model.pixel_m > 0:
+        step = min(step, 0.5 * float(model.pixel_m))
+    return step
+
+
+def _pixel_metres(dem: Any, src: Any, dst: Any) -> float:
+    """Smaller side of the DEM's centre pixel, measured in the destination CRS [m]."""
+    from .geo import transformer
+
+    rows, cols = dem.z.shape
+    a, b, c, d, e, f = dem.transform
+    r, q = rows / 2.0, cols / 2.0
+    cx = np.array([q, q + 1, q])
+    ry = np.array([r, r, r + 1])
+    xs = a * cx + b * ry + c
+    ys = d * cx + e * ry + f
+    tx, ty = transformer(src, dst).transform(xs, ys)
+    tx, ty = np.asarray(tx), np.asarray(ty)
+    side_c = float(np.hypot(tx[1] - tx[0], ty[1] - ty[0]))
+    side_r = float(np.hypot(tx[2] - tx[0], ty[2] - ty[0]))
+    return min(side_c, side_r)
+
+
+def ground_model_from_dem(dem: Any, src: Any, dst: Any, cell: float, *,
+                          sea_level: float | None = None,
+                          max_samples: int = MAX_SAMPLES) -> GroundModel | None:
+    """The ground model of a DEM, or None if it is not finer than the planning grid.
+
+    Parameters
+    ----------
+    dem : fm2uav.world.dem.DemRaster
+        The raster as read (north-up, NaN where masked).
+    src, dst : CRS
+        The DEM's CRS and the world's.
+    cell : float
+        The world's smallest horizontal cell [m].
+    sea_level : float, optional
+        ``ground = max(DEM, sea_level)`` as in the world.
+    max_samples : int
+        Largest raster kept [pixels].
+    """
+    from .geo import crs_label, parse_crs
+
+    z = np.asarray(dem.z, dtype=float)
+    if z.ndim != 2 or min(z.shape) < 2 or z.size > max_samples:
+        return None
+    pixel = _pixel_metres(dem, src, dst)
+    if not (np.isfinite(pixel) and pixel > 0) or pixel >= 0.999 * float(cell):
+        return None
+    bad = ~np.isfinite(z)
+    if bad.all():
+        return None
+    if bad.any():
+        _, (ii, jj) = ndimage.distance_transform_edt(bad, return_indices=True)
+        z = z[ii, jj]
+    if sea_level is not None:
+        z = np.maximum(z, float(sea_level))
+    src_s = parse_crs(src).to_wkt()
+    dst_s = parse_crs(dst).to_wkt()
+    desc = (f"source DEM ({z.shape[0]} x {z.shape[1]} pixels of {pixel:.1f} m, "
+            f"{crs_label(src)}), bilinear between pixel centres")
+    return GroundModel(z, tuple(float(v) for v in dem.transform), src_s, dst_s, float(pixel),
+                       desc)

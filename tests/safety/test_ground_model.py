@@ -1,0 +1,31 @@
+"""World.ground_height reads the source DEM, not the coarser planning grid."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fm2uav.world import World
+
+from .conftest import source_ground
+
+
+def test_ground_height_is_the_source_dem_bilinear(rough_tif):
+    w = World.from_dem(str(rough_tif), (250.0, 250.0, 25.0))  # pixels are ~70 x 93 m
+    assert w.ground is not None and w.ground.pixel_m < 100
+    rng = np.random.default_rng(1)
+    b = w.bounds
+    x = rng.uniform(b[0, 0], b[0, 1], 5000)
+    y = rng.uniform(b[1, 0], b[1, 1], 5000)
+    ours = w.ground_height(x, y)
+    theirs = source_ground(rough_tif, w, x, y)
+    assert np.max(np.abs(ours - theirs)) < 0.01
+    # the planning grid alone would be far off between its nodes
+    from scipy import ndimage
+    grid = ndimage.map_coordinates(w.terrain, [(x - w.origin[0]) / 250.0,
+                                               (y - w.origin[1]) / 250.0], order=1)
+    assert np.max(np.abs(grid - theirs)) > 20.0
+
+
+def test_no_ground_model_when_the_dem_is_coarser(rough_tif):
+    w = World.from_dem(str(rough_tif), (40.0, 40.0, 20.0))
+    assert w.ground is None
