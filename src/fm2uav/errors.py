@@ -14,6 +14,7 @@ __all__ = [
     "PlanningError",
     "PointError",
     "UnreachableError",
+    "MissionError",
 ]
 
 
@@ -39,3 +40,8 @@ class UnreachableError(PlanningError):
 
 class PointError(PlanningError):
     """A start, goal or waypoint lies outside the map or inside an obstacle (bad input)."""
+
+
+class MissionError(Fm2uavError):
+    """A mission cannot be exported as asked: a firmware would reject it, or a
+    required setting (frame, end, speeds, camera) is missing or contradictory."""

@@ -1,4 +1,5 @@
-"""Mission exports: QGC .plan, MAVLink WPL 110 (loaded by pymavlink), GeoJSON, KML."""
+"""Mission exports: waypoint thinning, QGC .plan structure and checker, WPL 110 (loaded by
+pymavlink), GeoJSON/KML round trips (the mission content itself: test_missions.py)."""
 
 import io
 import json
@@ -9,11 +10,10 @@ from pymavlink import mavwp
 
 from fm2uav.io import (
     EXPORT_FILES,
-    Anchor,
     ExportOptions,
+    export_mission,
     export_writers,
     from_lonlat,
-    ground_height,
     mission_waypoints,
     read_geojson_path,
     read_kml_path,
@@ -23,86 +23,98 @@ from fm2uav.io import (
     validate_plan,
 )
 from fm2uav.io.thin import segment_distances
+from fm2uav.io.waypoints import thin_with_keep
 
-ANCHOR = Anchor(lon=8.545594, lat=47.3977419, alt=488.0)
+from .mission_cases import ANCHOR, hill_free, hill_tff
 
 
 def _write_all(plan, tmp_path, **opts):
-    writers, wps = export_writers(plan, list(EXPORT_FILES), ExportOptions(anchor=ANCHOR, **opts))
-    for name, write in writers.items():
-        with open(tmp_path / name, "w") as fh:
-            write(fh)
-    return wps
+    mission, files = export_mission(plan, list(EXPORT_FILES), ExportOptions(anchor=ANCHOR, **opts))
+    for name, f in files.items():
+        with open(tmp_path / name, "wb" if f.binary else "w") as fh:
+            f.write(fh)
+    return mission
 
 
-def test_waypoints_are_few_and_within_tolerance(hill_tff):
-    wps = mission_waypoints(hill_tff.path, hill_tff.world, tolerance=2.0, anchor=ANCHOR)
-    assert 3 <= len(wps) <= 40 < len(hill_tff.path)
-    p, k = hill_tff.path, wps.indices
+def test_waypoints_are_few_and_within_tolerance():
+    p = hill_tff()
+    wps = mission_waypoints(p.path, p.world, tolerance=2.0, anchor=ANCHOR, frame="amsl", agl=60)
+    assert 3 <= len(wps) <= 40 < len(p.path)
+    flown, k = wps.points_m, wps.indices
+    # the thinned legs stay within the tolerance of the flown (ground + AGL) profile
+    from fm2uav.io.waypoints import altitude_profile
+
+    dense = altitude_profile(p.path, p.world, agl=60.0)[0]
     for a, b in zip(k[:-1], k[1:]):
         if b - a > 1:
-            assert segment_distances(p[a + 1 : b], p[a], p[b]).max() <= 2.0 + 1e-9
+            assert segment_distances(dense[a + 1:b], dense[a], dense[b]).max() <= 2.0 + 1e-9
+    np.testing.assert_array_equal(flown, dense[k])
 
 
-def test_terrain_following_uses_frame_10_with_heights_above_ground(hill_tff):
-    wps = mission_waypoints(hill_tff.path, hill_tff.world, anchor=ANCHOR, terrain_following=True)
-    assert wps.frame == 10
-    ground = ground_height(hill_tff.world, wps.points_m)
-    np.testing.assert_allclose(wps.alt, wps.points_m[:, 2] - ground, atol=1e-9)
-    np.testing.assert_allclose(wps.alt_amsl, wps.points_m[:, 2] + ANCHOR.alt, atol=1e-9)
-    # home: ground under the start, above mean sea level
-    home_ground = ground_height(hill_tff.world, hill_tff.path[:1])[0]
-    assert wps.home[2] == pytest.approx(home_ground + ANCHOR.alt)
-    assert wps.home[:2] == pytest.approx((wps.lat[0], wps.lon[0]), abs=1e-12)
+def test_forced_points_are_kept_and_pieces_thinned_alone():
+    line = np.column_stack([np.linspace(0, 100, 101), np.zeros(101), np.zeros(101)])
+    assert thin_with_keep(line, 0.5).tolist() == [0, 100]
+    assert thin_with_keep(line, 0.5, keep=[37, 80]).tolist() == [0, 37, 80, 100]
+    with pytest.raises(ValueError, match="keep indices"):
+        thin_with_keep(line, 0.5, keep=[101])
 
 
-def test_relative_frame_altitudes_are_above_home(hill_plan):
-    wps = mission_waypoints(hill_plan.path, hill_plan.world, anchor=ANCHOR)
+def test_frames_write_the_same_flown_altitude():
+    p = hill_tff()
+    got = {f: mission_waypoints(p.path, p.world, anchor=ANCHOR, frame=f, agl=60.0)
+           for f in ("terrain", "amsl", "relative")}
+    assert {f: w.frame for f, w in got.items()} == {"terrain": 10, "amsl": 0, "relative": 3}
+    np.testing.assert_allclose(got["terrain"].alt, got["terrain"].agl)
+    np.testing.assert_allclose(got["amsl"].alt, got["amsl"].alt_amsl)
+    np.testing.assert_allclose(got["relative"].alt, got["relative"].alt_amsl - got["relative"].home[2])
+    for f in ("amsl", "relative"):
+        np.testing.assert_allclose(got[f].alt_amsl, got[f].ground_amsl + got[f].agl, atol=1e-9)
+
+
+def test_relative_frame_altitudes_are_above_home():
+    p = hill_free()
+    wps = mission_waypoints(p.path, p.world, anchor=ANCHOR)
     assert wps.frame == 3
-    home_ground = ground_height(hill_plan.world, hill_plan.path[:1])[0]
+    home_ground = p.world.ground_height(*p.path[0, :2])
     np.testing.assert_allclose(wps.alt, wps.points_m[:, 2] - home_ground, atol=1e-9)
-    forced = mission_waypoints(hill_plan.path, hill_plan.world, anchor=ANCHOR, frame="terrain")
-    assert forced.frame == 10
+    np.testing.assert_allclose(wps.points_m[:, 2], p.path[wps.indices, 2])  # no level: own z
 
 
-def test_export_writers_pick_the_frame_from_the_plan(hill_plan, hill_tff, tmp_path):
-    assert export_writers(hill_plan, ["plan"])[1].frame == 3
-    assert export_writers(hill_tff, ["plan"])[1].frame == 10
-    with pytest.raises(ValueError, match="unknown export format 'pdf'"):
-        export_writers(hill_plan, ["pdf"])
+def test_export_writers_pick_the_frame_from_the_plan_and_firmware():
+    assert export_writers(hill_free(), ["plan"])[1].frame == 3
+    assert export_writers(hill_tff(), ["plan"])[1].frame == 0
+    assert export_writers(hill_tff(), ["plan"], ExportOptions(firmware="ardupilot"))[1].frame == 10
+    with pytest.raises(ValueError, match="unknown|not a known format 'pdf'|'pdf'"):
+        export_writers(hill_free(), ["pdf"])
 
 
-def test_wpl_loads_in_pymavlink_and_round_trips(hill_tff, tmp_path):
-    wps = _write_all(hill_tff, tmp_path)
-    text = (tmp_path / "mission.waypoints").read_text()
-    lines = text.splitlines()
-    assert lines[0] == "QGC WPL 110"
-    assert all(len(ln.split("\t")) == 12 for ln in lines[1:])
+def test_wpl_loads_in_pymavlink_and_round_trips(tmp_path):
+    m = _write_all(hill_tff(), tmp_path, firmware="ardupilot")
+    wps = m.waypoints
     loader = mavwp.MAVWPLoader()
     n = loader.load(str(tmp_path / "mission.waypoints"))
-    assert n == 1 + 1 + len(wps)  # home + takeoff + waypoints
+    assert n == 1 + len(m.items)
     home = loader.wp(0)
     assert (home.frame, home.command, home.current) == (0, 16, 1)
     assert (home.x, home.y) == pytest.approx(wps.home[:2], abs=1e-7)
     assert home.z == pytest.approx(wps.home[2], abs=1e-3)
     takeoff = loader.wp(1)
-    assert (takeoff.command, takeoff.frame) == (22, 10)
-    items = [loader.wp(i) for i in range(2, n)]
-    assert [w.seq for w in items] == list(range(2, n))
-    assert {w.command for w in items} == {16} and {w.frame for w in items} == {10}
-    np.testing.assert_allclose([w.x for w in items], wps.lat, atol=1e-7, rtol=0)
-    np.testing.assert_allclose([w.y for w in items], wps.lon, atol=1e-7, rtol=0)
-    np.testing.assert_allclose([w.z for w in items], wps.alt, atol=1e-3)
+    assert (takeoff.command, takeoff.frame) == (22, 3)  # ArduPilot: takeoff above home
+    route = [loader.wp(i) for i in range(2, n) if loader.wp(i).command == 16]
+    assert {w.frame for w in route} == {10}
+    np.testing.assert_allclose([w.x for w in route], wps.lat[1:], atol=1e-7, rtol=0)
+    np.testing.assert_allclose([w.y for w in route], wps.lon[1:], atol=1e-7, rtol=0)
+    np.testing.assert_allclose([w.z for w in route], wps.alt[1:], atol=1e-3)
     ours = read_wpl(tmp_path / "mission.waypoints")
-    np.testing.assert_allclose(ours["lat"][1:], wps.lat, atol=1e-9, rtol=0)
-    # back to world metres through the anchor: the waypoints themselves
-    back = from_lonlat(np.column_stack([ours["lon"][1:], ours["lat"][1:]]), hill_tff.world,
-                       anchor=ANCHOR)
-    np.testing.assert_allclose(back, wps.points_m[:, :2], atol=1e-3)
+    route_ours = ours["command"] == 16
+    back = from_lonlat(np.column_stack([ours["lon"][route_ours], ours["lat"][route_ours]]),
+                       hill_tff().world, anchor=ANCHOR)
+    np.testing.assert_allclose(back, wps.points_m[1:, :2], atol=1e-3)
 
 
-def test_plan_has_qgroundcontrol_structure_and_round_trips(hill_plan, tmp_path):
-    wps = _write_all(hill_plan, tmp_path, cruise_speed=12.0, vehicle="fixed_wing")
+def test_plan_has_qgroundcontrol_structure_and_round_trips(tmp_path):
+    m = _write_all(hill_free(), tmp_path, cruise_speed=12.0, vehicle="fixed_wing",
+                   firmware="ardupilot")
     raw = (tmp_path / "mission.plan").read_text()
 
     def no_nan(name):
@@ -110,30 +122,32 @@ def test_plan_has_qgroundcontrol_structure_and_round_trips(hill_plan, tmp_path):
 
     doc = json.loads(raw, parse_constant=no_nan)
     assert validate_plan(doc) == []
-    m = doc["mission"]
-    assert (doc["fileType"], doc["version"], m["version"]) == ("Plan", 1, 2)
-    assert (m["firmwareType"], m["vehicleType"], m["cruiseSpeed"]) == (12, 1, 12.0)
-    assert m["plannedHomePosition"] == pytest.approx(list(wps.home))
-    assert m["globalPlanAltitudeMode"] == 1
-    items = m["items"]
+    mission = doc["mission"]
+    assert (doc["fileType"], doc["version"], mission["version"]) == ("Plan", 1, 2)
+    assert (mission["firmwareType"], mission["vehicleType"], mission["cruiseSpeed"]) == (3, 1, 12.0)
+    assert mission["plannedHomePosition"] == pytest.approx(list(m.home))
+    assert mission["globalPlanAltitudeMode"] == 1
+    items = mission["items"]
     assert [it["doJumpId"] for it in items] == list(range(1, len(items) + 1))
-    assert items[0]["command"] == 22 and {it["command"] for it in items[1:]} == {16}
-    assert {it["frame"] for it in items} == {3} and {it["AltitudeMode"] for it in items} == {1}
-    assert all(len(it["params"]) == 7 and it["params"][3] is None for it in items)
+    assert items[0]["command"] == 22 and items[-1]["command"] == 20
+    pos = [it for it in items if it["frame"] != 2]
+    assert {it["frame"] for it in pos} == {3} and {it["AltitudeMode"] for it in pos} == {1}
+    assert all(len(it["params"]) == 7 for it in items)
     back = read_plan(tmp_path / "mission.plan")
-    np.testing.assert_allclose(back["lat"][1:], wps.lat, atol=1e-7, rtol=0)
-    np.testing.assert_allclose(back["lon"][1:], wps.lon, atol=1e-7, rtol=0)
-    np.testing.assert_allclose(back["alt"][1:], wps.alt, atol=1e-9)
+    route = back["command"] == 16
+    np.testing.assert_allclose(back["lat"][route], m.waypoints.lat[1:], atol=1e-7, rtol=0)
+    np.testing.assert_allclose(back["alt"][route], m.waypoints.alt[1:], atol=1e-9)
 
 
-def test_terrain_plan_uses_terrain_altitude_mode(hill_tff):
-    writers, wps = export_writers(hill_tff, ["plan"], ExportOptions(anchor=ANCHOR))
+def test_terrain_plan_uses_terrain_altitude_mode():
+    mission, files = export_mission(hill_tff(), ["plan"],
+                                    ExportOptions(anchor=ANCHOR, firmware="ardupilot"))
     buf = io.StringIO()
-    writers["mission.plan"](buf)
+    files["mission.plan"].write(buf)
     doc = json.loads(buf.getvalue())
-    assert {it["frame"] for it in doc["mission"]["items"]} == {10}
-    assert {it["AltitudeMode"] for it in doc["mission"]["items"]} == {4}
-    assert doc["mission"]["globalPlanAltitudeMode"] == 4
+    route = [it for it in doc["mission"]["items"] if it["command"] == 16]
+    assert {it["frame"] for it in route} == {10} and {it["AltitudeMode"] for it in route} == {4}
+    assert doc["mission"]["globalPlanAltitudeMode"] == 0  # mixed: takeoff above home
 
 
 @pytest.mark.parametrize(
@@ -141,42 +155,47 @@ def test_terrain_plan_uses_terrain_altitude_mode(hill_tff):
     [
         (lambda d: d.pop("fileType"), "missing key 'fileType'"),
         (lambda d: d.update(version=2), "top.version must be 1"),
-        (lambda d: d.pop("rallyPoints"), "missing key 'rallyPoints'"),
+        (lambda d: d["rallyPoints"].pop("points"), "missing key 'points'"),
+        (lambda d: d["geoFence"].update(polygons=[{"inclusion": True, "polygon": [[1, 2]]}]),
+         ">= 3 [lat, lon] points"),
         (lambda d: d["mission"].pop("plannedHomePosition"), "plannedHomePosition"),
         (lambda d: d["mission"].pop("firmwareType"), "firmwareType"),
         (lambda d: d["mission"].update(items=[]), "at least one item"),
         (lambda d: d["mission"]["items"][0].update(autoContinue=1), "autoContinue: expected bool"),
         (lambda d: d["mission"]["items"][0]["params"].pop(), "7 values"),
         (lambda d: d["mission"]["items"][1]["params"].__setitem__(4, 123.0), "valid latitude"),
-        (lambda d: d["mission"]["items"][1].update(type="ComplexItem"), "SimpleItem"),
+        (lambda d: d["mission"]["items"][1].update(type="Mystery"), "'SimpleItem' or 'ComplexItem'"),
+        (lambda d: d["mission"]["items"][1].update(type="ComplexItem"), "complexItemType"),
         (lambda d: d["mission"].update(plannedHomePosition=[1, 2]), "[lat, lon, alt]"),
     ],
 )
-def test_plan_checker_names_the_problem(hill_plan, mutate, problem):
-    writers, _ = export_writers(hill_plan, ["plan"])
+def test_plan_checker_names_the_problem(mutate, problem):
+    _, files = export_mission(hill_free(), ["plan"], ExportOptions(anchor=ANCHOR))
     buf = io.StringIO()
-    writers["mission.plan"](buf)
+    files["mission.plan"].write(buf)
     doc = json.loads(buf.getvalue())
     mutate(doc)
     problems = validate_plan(doc)
     assert problems and any(problem in p for p in problems), problems
 
 
-def test_geojson_and_kml_round_trip_coordinates(hill_tff, tmp_path):
-    wps = _write_all(hill_tff, tmp_path)
-    geo = to_lonlat(hill_tff.path, hill_tff.world, anchor=ANCHOR)
-    for reader, file in ((read_geojson_path, "path.geojson"), (read_kml_path, "path.kml")):
+def test_geojson_and_kml_round_trip_coordinates(tmp_path):
+    p = hill_tff()
+    m = _write_all(p, tmp_path)
+    geo = to_lonlat(p.path, p.world, anchor=ANCHOR)
+    for reader, file in ((read_geojson_path, "path.geojson"), (read_kml_path, "path.kml"),
+                         (read_kml_path, "path.kmz")):
         got = reader(tmp_path / file)
         assert got.shape == geo.shape
         np.testing.assert_allclose(got[:, :2], geo[:, :2], atol=1e-7, rtol=0)
         np.testing.assert_allclose(got[:, 2], geo[:, 2], atol=1e-3)
-        np.testing.assert_allclose(from_lonlat(got, hill_tff.world, anchor=ANCHOR),
-                                   hill_tff.path, atol=0.02)
+        np.testing.assert_allclose(from_lonlat(got, p.world, anchor=ANCHOR), p.path, atol=0.02)
         wp = reader(tmp_path / file, name="waypoints")
-        np.testing.assert_allclose(wp[:, 1], wps.lat, atol=1e-7, rtol=0)
+        np.testing.assert_allclose(wp[:, 1], m.waypoints.lat, atol=1e-7, rtol=0)
+        np.testing.assert_allclose(wp[:, 2], m.waypoints.alt_amsl, atol=1e-3)
     doc = json.loads((tmp_path / "path.geojson").read_text())
     names = [f["properties"]["name"] for f in doc["features"]]
     assert names == ["path", "waypoints", "start", "goal"]
-    assert doc["features"][0]["properties"]["frame"] == 10
+    assert doc["features"][0]["properties"]["frame"] == 0
     # RFC 7946 order: longitude first
     assert doc["features"][2]["geometry"]["coordinates"][0] == pytest.approx(geo[0, 0], abs=1e-8)

@@ -21,12 +21,44 @@ OUTPUT_FILES = {
     "csv": "path.csv",
     "geojson": "path.geojson",
     "kml": "path.kml",
+    "kmz": "path.kmz",
     "plan": "mission.plan",
     "wpl": "mission.waypoints",
     "html": "report.html",
     "png": "plan.png",
     "json": "summary.json",
 }
+
+
+def write_exports(outdir: OutputDir, files: dict[str, Any],
+                  step: Callable[[str], None] = lambda message: None) -> None:
+    """Write :func:`fm2uav.io.export_mission` files into ``outdir`` (atomically each)."""
+    for name, f in files.items():
+        step(f"writing {name}")
+        with outdir.open(name, mode="wb" if f.binary else "w") as fh:
+            f.write(fh)
+
+
+def mission_rows(mission: Any) -> dict[str, str]:
+    """Printed summary rows of a built mission (frame, home, end, items, flight, warnings)."""
+    s = mission.summary()
+    h = s["home"]
+    rows = {
+        "autopilot mission": f"{s['firmware']} {s['vehicle']}, {s['items']} items, "
+                             f"{s['waypoints']} waypoints, ends with {s['end']}",
+        "altitude frame": f"{s['frame']['name']} (MAVLink frame {s['frame']['mav_frame']})",
+        "home lat, lon, alt": f"{h['lat']:.7f}, {h['lon']:.7f}, {h['alt_amsl_m']:.1f} m AMSL "
+                              f"({h['source']})",
+        "flight": f"{s['flight']['flight_distance_m'] / 1000:.2f} km, "
+                  f"{s['flight']['flight_time_s'] / 60:.1f} min",
+    }
+    if s["speed_changes"]["items"]:
+        rows["speed changes"] = (f"{s['speed_changes']['items']} "
+                                 f"({', '.join(f'{v:g}' for v in s['speed_changes']['speeds_mps'])}"
+                                 " m/s)")
+    for k, w in enumerate(s["warnings"]):
+        rows[f"warning {k + 1}"] = w
+    return rows
 
 
 def output_names(formats: Sequence[str]) -> list[str]:
@@ -44,7 +76,8 @@ def plan_outputs(
     subtitle: str = "",
     summary: dict[str, Any] | None = None,
     step: Callable[[str], None] = lambda message: None,
-) -> dict[str, Any]:
+    **mission_inputs: Any,
+) -> tuple[dict[str, Any], Any]:
     """Write the requested outputs of a plan into ``outdir`` (atomically each).
 
     Parameters
@@ -59,46 +92,55 @@ def plan_outputs(
         Of the HTML report and PNG figure.
     summary : dict, optional
         Extra entries of ``summary.json``.
+    **mission_inputs
+        ``via``, ``camera``, ``fences``, ``agl`` of :func:`fm2uav.io.export_mission`.
 
     Returns
     -------
-    dict
-        The summary (plan numbers, waypoints, home, files).
+    info : dict
+        The summary (plan numbers, the autopilot mission, waypoints, home, files).
+    mission : fm2uav.io.MissionExport
+        The built mission.
     """
-    from ..io import EXPORT_FILES, export_writers
+    from ..io import EXPORT_FILES, export_mission
 
     exports = [f for f in formats if f in EXPORT_FILES]
-    step("geo-referencing and thinning waypoints")
-    writers, wps = export_writers(plan, exports, options)
+    step("building the mission (altitudes, waypoints, takeoff, end, firmware checks)")
+    mission, files = export_mission(plan, exports, options, **mission_inputs)
+    wps = mission.waypoints
     info = {
         **(summary or {}),
         **plan.summary(),
+        "autopilot": mission.summary(),
         "waypoints": len(wps),
         "mavlink_frame": wps.frame,
         "home_lat_lon_alt": [round(v, 9) for v in wps.home],
         "thin_tolerance_m": options.tolerance,
     }
-    for f in exports:
-        name = EXPORT_FILES[f]
-        step(f"writing {name}")
-        with outdir.open(name) as fh:
-            writers[name](fh)
+    write_exports(outdir, files, step)
     if "html" in formats:
         from ..viz.report import plan_report
 
         step("writing report.html")
+        ms = info["autopilot"]
         params = {**plan.params, "waypoint tolerance [m]": options.tolerance,
-                  "MAVLink frame": {3: "3 (relative to home)", 10: "10 (above terrain)"}
-                  .get(wps.frame, wps.frame)}
+                  "firmware / airframe": f"{ms['firmware']} / {ms['vehicle']}",
+                  "MAVLink frame": {0: "0 (AMSL: DEM ground + AGL)", 3: "3 (relative to home)",
+                                    10: "10 (above terrain)"}.get(wps.frame, wps.frame),
+                  "mission end": ms["end"]}
+        w_path = plan.w
         metrics = {
             "length [m]": round(float(plan.length), 1),
             "clearance [m]": (round(float(plan.clearance), 2) if np.isfinite(plan.clearance)
                               else "inf"),
-            "min W on path": round(float(plan.speed.min()), 4),
+            "min W on path": round(float(np.min(w_path)), 4),
             "path points": len(plan.path),
             "waypoints": len(wps),
-            "home (lat, lon, alt)": [round(v, 7) for v in wps.home],
+            "mission items": ms["items"],
+            "home (lat, lon, alt AMSL)": [round(v, 7) for v in wps.home],
+            "flight time [min]": round(ms["flight"]["flight_time_s"] / 60, 2),
             "planning time [s]": round(float(plan.timings.get("total", 0.0)), 3),
+            **{f"warning {k + 1}": w for k, w in enumerate(ms["warnings"])},
         }
         html = plan_report(plan, title=title, subtitle=subtitle,
                            waypoints={"FM² path": wps.points_m}, params=params,
@@ -121,7 +163,7 @@ def plan_outputs(
         with outdir.open("summary.json") as fh:
             json.dump(to_jsonable({**info, "files": [str(p.name) for p in outdir.written]
                                    + ["summary.json"]}), fh, indent=2)
-    return info
+    return info, mission
 
 
 def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
@@ -130,10 +172,13 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
     @app.command(
         "run",
         help=(
-            "Plan the mission described by a YAML file and write its outputs: path.csv, "
-            "path.geojson, path.kml, mission.plan (QGroundControl), mission.waypoints "
-            "(MAVLink QGC WPL 110), report.html (interactive), plan.png and summary.json "
-            "— as listed under outputs.formats.\n\n"
+            "Plan the mission described by a YAML file (start, via points, goal, optional "
+            "return leg) and write its outputs: path.csv, path.geojson, path.kml, path.kmz, "
+            "mission.plan (QGroundControl), mission.waypoints (MAVLink QGC WPL 110), "
+            "report.html (interactive), plan.png and summary.json — as listed under "
+            "outputs.formats. The mission starts with a takeoff and ends as outputs.end says, "
+            "in the altitude frame of outputs.frame (auto: ArduPilot terrain, PX4 AMSL), and "
+            "is checked against the firmware's rules before anything is written.\n\n"
             "Examples:\n\n"
             "  fm2uav run examples/open_field_tff.yaml\n\n"
             "  fm2uav run examples/jacksboro_tff.yaml --out out/jacksboro --force\n\n"
@@ -151,7 +196,8 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
     ) -> None:
         from ..io.mission import load_mission
-        from ..planning import plan as plan_path
+        from ..missions.route import plan_route
+        from ..planning.params import planner_objects
 
         mission = load_mission(mission_file)
         target = out or Path(mission.outputs.dir or Path("out") / mission_file.stem)
@@ -161,17 +207,22 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         with progress(enabled=not (quiet or as_json)) as step:
             step("building the world")
             rm = mission.resolve()
-            step("planning (FM²)")
-            p = plan_path(rm.world, rm.start, rm.goal, **mission.plan_kwargs())
+            step("planning (FM²)" + (f", {len(rm.via) + 1 + rm.return_to_start} legs"
+                                     if rm.via or rm.return_to_start else ""))
+            shaping, level, popts = planner_objects(mission.plan_kwargs())
+            route = plan_route(rm.world, rm.start, rm.goal, via=rm.via,
+                               return_to_start=rm.return_to_start, shaping=shaping,
+                               level=level, options=popts)
+            p = route.plan
             world_desc = (mission.world.scenario or Path(mission.world.dem or
                                                           mission.world.buildings or "").name)
-            info = plan_outputs(
+            info, built = plan_outputs(
                 outdir, p, formats, mission.export_options(),
                 title=f"{mission.name}", subtitle=f"{world_desc} — {mission.description}"
                 if mission.description else world_desc,
                 summary={"mission": mission.name, "mission_file": str(mission_file),
-                         "world": world_desc},
-                step=step,
+                         "world": world_desc, "route": route.summary()},
+                step=step, via=route.junctions[1:-1],
             )
         rows = {
             "mission": mission.name,
@@ -180,9 +231,8 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "goal [m]": np.round(p.goal, 1).tolist(),
             "length [m]": f"{p.length:.1f}",
             "clearance [m]": f"{p.clearance:.1f}",
-            "waypoints": f"{info['waypoints']} (MAVLink frame {info['mavlink_frame']})",
-            "home lat, lon, alt": ", ".join(f"{v:.7f}" for v in info["home_lat_lon_alt"][:2])
-            + f", {info['home_lat_lon_alt'][2]:.1f} m",
+            "legs": len(route.legs),
+            **mission_rows(built),
             "time [s]": f"{p.timings['total']:.2f}",
         }
         print_summary("fm2uav run", rows if not as_json else {**info, "out": str(target)},

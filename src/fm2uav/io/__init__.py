@@ -1,15 +1,30 @@
 """Reading and writing: path files, geo-referencing, mission exports, mission files.
 
 Exports (all in WGS84 lon/lat; see :mod:`fm2uav.io.georef` for how worlds
-without a CRS are placed on the Earth): CSV, GeoJSON, KML, QGroundControl
-``.plan`` and MAVLink ``QGC WPL 110``; waypoints are thinned from the dense
-path with 3D Douglas–Peucker. Mission files: :mod:`fm2uav.io.mission`.
+without a CRS are placed on the Earth): CSV, GeoJSON, KML/KMZ, QGroundControl
+``.plan`` and MAVLink ``QGC WPL 110``, all written by :func:`export_mission`
+from one list of MAVLink items (:mod:`fm2uav.io.build`: takeoff, waypoints
+thinned with 3D Douglas–Peucker, speeds, camera triggers, RTL/land/loiter),
+checked per firmware (:mod:`fm2uav.io.validate`). Mission files:
+:mod:`fm2uav.io.mission`.
 """
 
-from .exports import EXPORT_FILES, ExportOptions, export_writers
+from .build import CameraPlan, MissionExport, build_mission, speed_commands
+from .exports import (
+    EXPORT_FILES,
+    ExportFile,
+    ExportOptions,
+    export_formation,
+    export_mission,
+    export_writers,
+    parse_formats,
+)
+from .geofence import FenceCircle, FencePolygon, fences_from_world, geofence_document
+from .items import MissionItem
+from .validate import Problem, check_mission, validate_mission
 from .geojson import geojson_document, read_geojson_path, write_geojson
 from .georef import DEFAULT_ANCHOR, Anchor, from_lonlat, ground_height, to_lonlat
-from .kml import kml_document, read_kml_path, write_kml
+from .kml import kml_document, read_kml_path, write_kml, write_kmz
 from .paths import read_path_csv, write_path_csv
 from .qgc import plan_document, read_plan, validate_plan, write_plan
 from .thin import thin_indices, thin_path
@@ -19,7 +34,7 @@ from .trajectories import (
     write_formation_metrics_csv,
     write_trajectories_csv,
 )
-from .waypoints import Waypoints, mission_waypoints
+from .waypoints import Waypoints, mission_waypoints, resolve_frame
 from .wpl import read_wpl, write_wpl
 
 __all__ = [
@@ -52,5 +67,23 @@ __all__ = [
     "write_cycles_csv",
     "EXPORT_FILES",
     "ExportOptions",
+    "ExportFile",
+    "export_mission",
+    "export_formation",
     "export_writers",
+    "parse_formats",
+    "build_mission",
+    "MissionExport",
+    "CameraPlan",
+    "speed_commands",
+    "MissionItem",
+    "validate_mission",
+    "check_mission",
+    "Problem",
+    "FencePolygon",
+    "FenceCircle",
+    "fences_from_world",
+    "geofence_document",
+    "resolve_frame",
+    "write_kmz",
 ]

@@ -1,14 +1,17 @@
-"""KML export (3D, for Google Earth).
+"""KML and KMZ export (3D, for Google Earth).
 
 A Document with the path as an absolute-altitude LineString (extruded to the
 ground, so the flight height is visible as a curtain), the thinned waypoints
 as a second line, and start/goal Placemarks. KML coordinates are
-``lon,lat,alt`` with alt in metres above mean sea level.
+``lon,lat,alt`` with alt in metres above mean sea level. A KMZ is the same
+document zipped as ``doc.kml`` (the KML 2.2 convention for the main file).
 """
 
 from __future__ import annotations
 
+import io
 import xml.etree.ElementTree as ET
+import zipfile
 from pathlib import Path
 from typing import IO, Any
 from xml.sax.saxutils import escape
@@ -18,7 +21,7 @@ import numpy as np
 from ..errors import InputError
 from .georef import Anchor, to_lonlat
 
-__all__ = ["kml_document", "write_kml", "read_kml_path"]
+__all__ = ["kml_document", "write_kml", "write_kmz", "read_kml_path"]
 
 _NS = "http://www.opengis.net/kml/2.2"
 
@@ -50,15 +53,18 @@ def kml_document(
     anchor: Anchor | None = None,
     waypoints_m: Any = None,
     name: str = "fm2uav mission",
+    description: str = "",
 ) -> str:
-    """The KML text of a path (see the module docstring)."""
+    """The KML text of a path (see the module docstring); ``description`` goes into
+    the Document's ``<description>`` (mission facts, warnings)."""
     p = np.asarray(path_m, dtype=float)
     if p.ndim != 2 or len(p) < 2:
         raise InputError(f"path must be an (N, 2|3) array with N >= 2, got shape {p.shape}")
     geo = to_lonlat(p, world, anchor=anchor)
     parts = [
         '<?xml version="1.0" encoding="UTF-8"?>',
-        f'<kml xmlns="{_NS}"><Document><name>{escape(name)}</name>',
+        f'<kml xmlns="{_NS}"><Document><name>{escape(name)}</name>'
+        + (f"<description>{escape(description)}</description>" if description else ""),
         '<Style id="path"><LineStyle><color>ff1e1ee6</color><width>3</width></LineStyle>'
         "<PolyStyle><color>401e1ee6</color></PolyStyle></Style>",
         '<Style id="waypoints"><LineStyle><color>ff00d7ff</color><width>2</width></LineStyle>'
@@ -79,12 +85,29 @@ def write_kml(fh: IO[str], path_m: Any, world: Any, **options: Any) -> str:
     return text
 
 
+def write_kmz(fh: IO[bytes], path_m: Any, world: Any, **options: Any) -> str:
+    """Write :func:`kml_document` zipped as ``doc.kml`` to an open binary file."""
+    text = kml_document(path_m, world, **options)
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", compression=zipfile.ZIP_DEFLATED) as z:
+        z.writestr("doc.kml", text)
+    fh.write(buf.getvalue())
+    return text
+
+
 def read_kml_path(file: str | Path, name: str = "path") -> np.ndarray:
-    """``(N, 3)`` lon, lat, alt of the LineString Placemark called ``name``."""
+    """``(N, 3)`` lon, lat, alt of the LineString Placemark called ``name`` (KML or KMZ)."""
     file = Path(file)
     try:
-        root = ET.parse(file).getroot()
-    except (OSError, ET.ParseError) as exc:
+        if zipfile.is_zipfile(file):
+            with zipfile.ZipFile(file) as z:
+                kml = next((n for n in z.namelist() if n.lower().endswith(".kml")), None)
+                if kml is None:
+                    raise InputError(f"{file}: a KMZ without a .kml file inside")
+                root = ET.fromstring(z.read(kml))
+        else:
+            root = ET.parse(file).getroot()
+    except (OSError, ET.ParseError, zipfile.BadZipFile) as exc:
         raise InputError(f"{file}: cannot read KML: {exc}") from None
     ns = {"k": _NS}
     for pm in root.iter(f"{{{_NS}}}Placemark"):

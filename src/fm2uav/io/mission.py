@@ -20,13 +20,19 @@ Schema (pydantic v2, strict types, unknown keys rejected)::
       anchor: {lon: -3.7649, lat: 40.3326, alt: 0}   # where a world without CRS sits
     start: [300, 300, 300]          # x, y, z [m]; or {x, y, agl}, {lon, lat, alt},
     goal: {lon: -3.747, lat: 40.343, agl: 60}        # {lon, lat, agl} or {cell: [i, j, k]}
+    via: [{lon: -3.755, lat: 40.338, agl: 60}]       # points to pass in order (like start/goal)
+    return: false                   # true: plan a leg back from the goal to the start
     planner: {saturation: 1.0, exponent: 1.0, order: 2, agl: 60, p1: 0.5, p2: 1.5}
-    airframe: {type: multirotor, firmware: px4, cruise_speed: 12, hover_speed: 5}
+    airframe: {type: multirotor, firmware: px4, cruise_speed: 12, hover_speed: 5,
+               endurance: 25, reserve: 0.2}   # [min] endurance checked with a 20 % reserve
     outputs:
       dir: out/my-mission           # default out/<file name>; `fm2uav run --out` overrides
       formats: [csv, geojson, kml, plan, wpl, html, png, json]
       thin_tolerance: 5             # [m] Douglas–Peucker tolerance of the waypoints
-      frame: auto                   # auto | relative | terrain (MAVLink frame 3 / 10)
+      frame: auto                   # auto | terrain | amsl | relative (MAVLink 10 / 0 / 3);
+                                    # auto: ArduPilot terrain, PX4 amsl (DEM ground + AGL)
+      end: auto                     # auto | rtl | land | loiter (auto: airframe-aware)
+      speed_changes: false          # DO_CHANGE_SPEED from the planned speed W
 
 The full field reference with ranges is in docs/operator.md. Every validation
 error is reported on one line naming the field, the bad
@@ -265,6 +271,13 @@ class AirframeSpec(BaseModel):
     firmware: Literal["px4", "ardupilot", "generic"] = Field("px4")
     cruise_speed: float = _num(15.0, unit="m/s", gt=0, le=100, desc="cruise speed")
     hover_speed: float = _num(5.0, unit="m/s", gt=0, le=50, desc="multirotor speed")
+    min_speed: float | None = _num(None, unit="m/s", gt=0, le=100,
+                                   desc="lowest commanded speed (fixed-wing: above stall)")
+    climb_rate: float | None = _num(None, unit="m/s", gt=0, le=50, desc="climb speed")
+    descent_rate: float | None = _num(None, unit="m/s", gt=0, le=50, desc="descent speed")
+    endurance: float | None = _num(None, unit="min", gt=0, le=10000,
+                                   desc="flight endurance (battery / fuel)")
+    reserve: float = _num(0.2, ge=0, lt=1, desc="share of the endurance kept in reserve")
 
 
 class OutputSpec(BaseModel):
@@ -276,8 +289,11 @@ class OutputSpec(BaseModel):
         default_factory=lambda: list(OUTPUT_FORMATS), min_length=1)
     thin_tolerance: float = _num(5.0, unit="m", ge=0, le=1000, desc="waypoint tolerance")
     max_waypoints: int | None = _num(None, ge=2, le=10000, desc="cap on waypoints")
-    frame: Literal["auto", "relative", "terrain"] = Field("auto")
-    takeoff: bool = Field(True, description="start with NAV_TAKEOFF")
+    frame: Literal["auto", "terrain", "amsl", "relative"] = Field("auto")
+    takeoff: bool = Field(True, description="start with NAV_TAKEOFF (always true)")
+    end: Literal["auto", "rtl", "land", "loiter"] = Field("auto")
+    speed_changes: bool = Field(False, description="DO_CHANGE_SPEED from the planned speed")
+    speed_step: float = _num(1.0, unit="m/s", gt=0, le=20, desc="speed quantum")
 
 
 class Mission(BaseModel):
@@ -290,6 +306,10 @@ class Mission(BaseModel):
     world: WorldSpec = Field(..., description="the map: scenario, dem or buildings")
     start: PointSpec | None = Field(None, description="start point")
     goal: PointSpec | None = Field(None, description="goal point")
+    via: list[PointSpec] = Field(default_factory=list, max_length=100,
+                                 description="points to pass, in order")
+    return_to_start: bool = Field(False, alias="return",
+                                  description="plan a leg back to the start")
     planner: PlannerSpec = Field(default_factory=PlannerSpec)
     airframe: AirframeSpec = Field(default_factory=AirframeSpec)
     outputs: OutputSpec = Field(default_factory=OutputSpec)
@@ -316,7 +336,11 @@ class Mission(BaseModel):
         return ExportOptions(
             tolerance=o.thin_tolerance, max_points=o.max_waypoints, frame=o.frame,
             anchor=self.anchor(), takeoff=o.takeoff, cruise_speed=a.cruise_speed,
-            hover_speed=a.hover_speed, vehicle=a.type, firmware=a.firmware,
+            hover_speed=a.hover_speed, vehicle=a.type, firmware=a.firmware, end=o.end,
+            speed_changes=o.speed_changes, speed_step=o.speed_step, min_speed=a.min_speed,
+            climb_rate=a.climb_rate, descent_rate=a.descent_rate,
+            endurance_s=None if a.endurance is None else 60.0 * a.endurance,
+            reserve=a.reserve, name=self.name,
         )
 
     def plan_kwargs(self) -> dict[str, Any]:
@@ -377,8 +401,12 @@ class Mission(BaseModel):
                  if self.start is not None else np.asarray(start_default, dtype=float))
         goal = (_resolve_point(self.goal, world, anchor, "goal")
                 if self.goal is not None else np.asarray(goal_default, dtype=float))
-        check_points(world, {"start": start, "goal": goal}, allow_filled=w.allow_filled)
-        return ResolvedMission(mission=self, world=world, start=start, goal=goal)
+        via = tuple(_resolve_point(v, world, anchor, f"via[{k}]") for k, v in enumerate(self.via))
+        check_points(world, {"start": start, "goal": goal,
+                             **{f"via[{k}]": v for k, v in enumerate(via)}},
+                     allow_filled=w.allow_filled)
+        return ResolvedMission(mission=self, world=world, start=start, goal=goal, via=via,
+                               return_to_start=self.return_to_start)
 
 
 @dataclass(frozen=True)
@@ -389,6 +417,8 @@ class ResolvedMission:
     world: Any
     start: np.ndarray
     goal: np.ndarray
+    via: tuple[np.ndarray, ...] = ()
+    return_to_start: bool = False
 
 
 def _resolve_point(p: PointSpec, world: Any, anchor: Anchor, what: str) -> np.ndarray:

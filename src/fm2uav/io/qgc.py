@@ -1,21 +1,35 @@
-"""QGroundControl ``.plan`` files (JSON).
+"""QGroundControl ``.plan`` files (JSON): writer, checker and a reader for any QGC plan.
 
 The structure is the one QGroundControl writes and reads (its "Plan File
 Format" developer documentation and ``PlanMasterController`` /
-``MissionController::_loadJsonMissionFileV2`` / ``MissionItem::load``):
+``MissionController::_loadJsonMissionFileV2`` / ``SimpleMissionItem::load``):
 
 * top level: ``fileType`` = "Plan", ``version`` = 1, ``groundStation``,
-  objects ``mission``, ``geoFence`` (``circles``, ``polygons``, ``version`` 2),
-  ``rallyPoints`` (``points``, ``version`` 2);
+  ``mission``, and the optional ``geoFence`` (``circles``, ``polygons``,
+  ``version`` 2) and ``rallyPoints`` (``points``, ``version`` 2); fm2uav adds an
+  ``fm2uav`` object (frame, home and its source, CRS and vertical reference,
+  warnings), which QGroundControl ignores;
 * ``mission``: ``version`` 2, ``firmwareType`` (MAV_AUTOPILOT), ``vehicleType``
   (MAV_TYPE), ``cruiseSpeed``, ``hoverSpeed``, ``globalPlanAltitudeMode``,
   ``plannedHomePosition`` ``[lat, lon, alt AMSL]`` and ``items``;
-* each ``SimpleItem``: ``type``, ``command``, ``frame``, ``params`` (7 values,
-  NaN written as ``null``), ``autoContinue``, ``doJumpId``, ``Altitude``,
-  ``AltitudeMode`` and ``AMSLAltAboveTerrain``.
+* a ``SimpleItem``: ``type``, ``command``, ``frame``, ``params`` (7 values,
+  NaN written as ``null``), ``autoContinue``, ``doJumpId``; items with a
+  position also ``AltitudeMode``, ``Altitude`` and ``AMSLAltAboveTerrain``
+  (QGC's ``AltitudeFrame``: 1 relative, 2 absolute, 3 calculated above
+  terrain, 4 terrain frame);
+* a ``ComplexItem``: ``complexItemType`` (``survey``, ``CorridorScan``,
+  ``StructureScan``, ``fwLandingPattern``, ...) with its own keys; survey and
+  corridor scans keep the mission items they stand for in
+  ``TransectStyleComplexItem.Items``.
 
-:func:`validate_plan` checks exactly these keys and types and is used by the
-tests on every file we write.
+Altitudes in the amsl frame are written as QGC's *absolute* mode (2), not as
+"calculated above terrain" (3): QGC recomputes mode-3 altitudes from its own
+terrain server when it loads the plan, which would replace the DEM's ground
+under each waypoint with QGC's; mode 2 uploads exactly the AMSL altitude
+fm2uav computed (DEM ground + AGL).
+
+:func:`validate_plan` checks a document against these rules (used on every
+file written); :func:`read_plan` reads any plan QGC writes.
 """
 
 from __future__ import annotations
@@ -28,17 +42,13 @@ from typing import IO, Any
 import numpy as np
 
 from ..errors import InputError
-from .waypoints import (
-    CMD_NAV_TAKEOFF,
-    CMD_NAV_WAYPOINT,
-    FRAME_RELATIVE,
-    FRAME_TERRAIN,
-    Waypoints,
-)
+from .geofence import geofence_document, read_geofence
+from .items import FRAME_GLOBAL, FRAME_RELATIVE, FRAME_TERRAIN, MissionItem
 
 __all__ = [
     "FIRMWARE_TYPES",
     "VEHICLE_TYPES",
+    "ALTITUDE_MODES",
     "plan_document",
     "write_plan",
     "read_plan",
@@ -49,70 +59,59 @@ __all__ = [
 FIRMWARE_TYPES = {"generic": 0, "ardupilot": 3, "px4": 12}
 #: Airframe kind → MAV_TYPE.
 VEHICLE_TYPES = {"fixed_wing": 1, "multirotor": 2, "vtol": 22}
-#: QGroundControl's AltitudeMode enum for the MAVLink frames we write.
-_ALT_MODE = {FRAME_RELATIVE: 1, FRAME_TERRAIN: 4}
+#: MAV_FRAME of a position item → QGroundControl AltitudeFrame ("AltitudeMode").
+ALTITUDE_MODES = {FRAME_RELATIVE: 1, FRAME_GLOBAL: 2, FRAME_TERRAIN: 4}
+#: Complex items QGC writes and whether they carry their mission items.
+_TRANSECT_ITEMS = ("survey", "CorridorScan")
 
 
-def _item(seq: int, command: int, frame: int, lat: float, lon: float, alt: float,
-          param1: float = 0.0) -> dict[str, Any]:
-    return {
-        "AMSLAltAboveTerrain": None,
-        "Altitude": float(alt),
-        "AltitudeMode": _ALT_MODE[frame],
-        "autoContinue": True,
-        "command": int(command),
-        "doJumpId": int(seq),
-        "frame": int(frame),
-        "params": [float(param1), 0, 0, None, float(lat), float(lon), float(alt)],
+def _json_num(v: float) -> float | None:
+    return None if not math.isfinite(v) else float(v)
+
+
+def _item_json(it: MissionItem, jump_id: int) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    if it.has_position:
+        out.update({"AMSLAltAboveTerrain": None, "Altitude": float(it.alt),
+                    "AltitudeMode": ALTITUDE_MODES.get(it.frame, 2)})
+    out.update({
+        "autoContinue": bool(it.autocontinue),
+        "command": int(it.command),
+        "doJumpId": int(jump_id),
+        "frame": int(it.frame),
+        "params": [_json_num(v) for v in it.params],
         "type": "SimpleItem",
-    }
+    })
+    return out
 
 
-def plan_document(
-    wps: Waypoints,
-    *,
-    cruise_speed: float = 15.0,
-    hover_speed: float = 5.0,
-    vehicle: str = "multirotor",
-    firmware: str = "px4",
-) -> dict[str, Any]:
-    """The ``.plan`` JSON document of a set of waypoints (a plain dict).
+def plan_document(mission: Any) -> dict[str, Any]:
+    """The ``.plan`` JSON document of a built mission (a plain dict).
 
     Parameters
     ----------
-    wps : Waypoints
-        From :func:`fm2uav.io.mission_waypoints`.
-    cruise_speed, hover_speed : float, optional
-        Fixed-wing cruise and multirotor hover speeds [m/s].
-    vehicle : {"multirotor", "fixed_wing", "vtol"}, optional
-    firmware : {"px4", "ardupilot", "generic"}, optional
+    mission : MissionExport
+        From :func:`fm2uav.io.build_mission` (items, home, airframe, fences).
     """
-    if wps.frame not in _ALT_MODE:
-        raise InputError(f"a .plan needs frame 3 (relative) or 10 (terrain), got {wps.frame}")
-    if vehicle not in VEHICLE_TYPES:
-        raise InputError(f"vehicle must be one of {sorted(VEHICLE_TYPES)}, got {vehicle!r}")
-    if firmware not in FIRMWARE_TYPES:
-        raise InputError(f"firmware must be one of {sorted(FIRMWARE_TYPES)}, got {firmware!r}")
-    items = []
-    seq = 1
-    if wps.takeoff:
-        items.append(_item(seq, CMD_NAV_TAKEOFF, wps.frame, wps.lat[0], wps.lon[0], wps.alt[0]))
-        seq += 1
-    for lat, lon, alt in zip(wps.lat, wps.lon, wps.alt):
-        items.append(_item(seq, CMD_NAV_WAYPOINT, wps.frame, lat, lon, alt))
-        seq += 1
+    opt = mission.options
+    items = [_item_json(it, k + 1) for k, it in enumerate(mission.items)]
+    modes = {it["AltitudeMode"] for it in items if "AltitudeMode" in it}
+    info = mission.summary()
     return {
         "fileType": "Plan",
-        "geoFence": {"circles": [], "polygons": [], "version": 2},
-        "groundStation": "QGroundControl",
+        "fm2uav": {"frame": info["frame"], "home": info["home"], "crs": info["crs"],
+                   "georef": info["georef"], "vertical_reference": info["vertical_reference"],
+                   "end": info["end"], "warnings": info["warnings"]},
+        "geoFence": geofence_document(mission.fences),
+        "groundStation": "fm2uav",
         "mission": {
-            "cruiseSpeed": float(cruise_speed),
-            "firmwareType": FIRMWARE_TYPES[firmware],
-            "globalPlanAltitudeMode": _ALT_MODE[wps.frame],
-            "hoverSpeed": float(hover_speed),
+            "cruiseSpeed": float(opt.cruise_speed),
+            "firmwareType": FIRMWARE_TYPES[opt.firmware],
+            "globalPlanAltitudeMode": modes.pop() if len(modes) == 1 else 0,
+            "hoverSpeed": float(opt.hover_speed),
             "items": items,
-            "plannedHomePosition": [float(v) for v in wps.home],
-            "vehicleType": VEHICLE_TYPES[vehicle],
+            "plannedHomePosition": [float(v) for v in mission.home],
+            "vehicleType": VEHICLE_TYPES[opt.vehicle],
             "version": 2,
         },
         "rallyPoints": {"points": [], "version": 2},
@@ -120,13 +119,12 @@ def plan_document(
     }
 
 
-def write_plan(fh: IO[str], wps: Waypoints, **options: Any) -> dict[str, Any]:
+def write_plan(fh: IO[str], mission: Any) -> dict[str, Any]:
     """Write a QGroundControl ``.plan`` to an open text file; returns the document.
 
-    ``options`` are those of :func:`plan_document`. Coordinates keep full
-    double precision (QGroundControl stores them the same way).
+    Coordinates keep full double precision (QGroundControl stores them the same way).
     """
-    doc = plan_document(wps, **options)
+    doc = plan_document(mission)
     problems = validate_plan(doc)
     if problems:  # a bug, not a user error: never write a file QGC rejects
         raise AssertionError("; ".join(problems))
@@ -139,18 +137,14 @@ def _is_num(v: Any) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
-def validate_plan(doc: Any) -> list[str]:
-    """Problems that would make QGroundControl reject a ``.plan`` document ([] = valid).
+class _Checker:
+    def __init__(self) -> None:
+        self.out: list[str] = []
 
-    Checks the keys and JSON types QGroundControl requires when it loads a
-    plan file (see the module docstring), plus the ranges of coordinates and
-    that every item is a SimpleItem with 7 params.
-    """
-    out: list[str] = []
-
-    def need(obj: Any, key: str, kind: Any, where: str) -> Any:
+    def need(self, obj: Any, key: str, kind: str, where: str, optional: bool = False) -> Any:
         if not isinstance(obj, dict) or key not in obj:
-            out.append(f"{where}: missing key {key!r}")
+            if not optional:
+                self.out.append(f"{where}: missing key {key!r}")
             return None
         v = obj[key]
         ok = {
@@ -161,97 +155,189 @@ def validate_plan(doc: Any) -> list[str]:
             "dict": isinstance(v, dict),
         }[kind]
         if not ok:
-            out.append(f"{where}.{key}: expected {kind}, got {type(v).__name__}")
+            self.out.append(f"{where}.{key}: expected {kind}, got {type(v).__name__}")
             return None
         return v
 
+    def simple_item(self, it: Any, w: str) -> None:
+        self.need(it, "command", "num", w)
+        self.need(it, "frame", "num", w)
+        self.need(it, "autoContinue", "bool", w)
+        if "doJumpId" in (it or {}) and not _is_num(it["doJumpId"]):
+            self.out.append(f"{w}.doJumpId: expected num")
+        if "AltitudeMode" in (it or {}) and not _is_num(it["AltitudeMode"]):
+            self.out.append(f"{w}.AltitudeMode: expected num")
+        params = self.need(it, "params", "list", w)
+        if params is None:
+            return
+        if len(params) != 7:
+            self.out.append(f"{w}.params must hold 7 values, got {len(params)}")
+        elif not all(v is None or _is_num(v) for v in params):
+            self.out.append(f"{w}.params must be numbers or null")
+        elif it.get("frame") in (0, 3, 10) and not (
+            _is_num(params[4]) and _is_num(params[5])
+            and -90 <= params[4] <= 90 and -180 <= params[5] <= 180
+        ):
+            self.out.append(f"{w}.params[4:6] must be a valid latitude, longitude")
+
+    def complex_item(self, it: Any, w: str) -> None:
+        kind = self.need(it, "complexItemType", "str", w)
+        if kind in _TRANSECT_ITEMS:
+            ts = self.need(it, "TransectStyleComplexItem", "dict", w, optional=True)
+            sub = self.need(ts, "Items", "list", f"{w}.TransectStyleComplexItem",
+                            optional=True) if ts is not None else None
+            for j, s in enumerate(sub or []):
+                self.simple_item(s, f"{w}.TransectStyleComplexItem.Items[{j}]")
+
+
+def validate_plan(doc: Any) -> list[str]:
+    """Problems that would make QGroundControl reject a ``.plan`` document ([] = valid).
+
+    Checks the keys and JSON types QGroundControl requires when it loads a
+    plan file (see the module docstring), the ranges of coordinates, and for
+    every SimpleItem (also those inside survey/corridor complex items) its 7
+    params. ``geoFence`` and ``rallyPoints`` are optional, as in QGC.
+    """
+    c = _Checker()
     if not isinstance(doc, dict):
         return ["top level: expected a JSON object"]
-    if need(doc, "fileType", "str", "top") not in (None, "Plan"):
-        out.append("top.fileType must be 'Plan'")
-    if need(doc, "version", "num", "top") not in (None, 1):
-        out.append("top.version must be 1")
-    need(doc, "groundStation", "str", "top")
-    fence = need(doc, "geoFence", "dict", "top")
+    if c.need(doc, "fileType", "str", "top") not in (None, "Plan"):
+        c.out.append("top.fileType must be 'Plan'")
+    if c.need(doc, "version", "num", "top") not in (None, 1):
+        c.out.append("top.version must be 1")
+    fence = c.need(doc, "geoFence", "dict", "top", optional=True)
     if fence is not None:
-        need(fence, "version", "num", "geoFence")
-        need(fence, "circles", "list", "geoFence")
-        need(fence, "polygons", "list", "geoFence")
-    rally = need(doc, "rallyPoints", "dict", "top")
+        c.need(fence, "version", "num", "geoFence")
+        for key in ("circles", "polygons"):
+            for i, f in enumerate(c.need(fence, key, "list", "geoFence", optional=True) or []):
+                w = f"geoFence.{key}[{i}]"
+                c.need(f, "inclusion", "bool", w)
+                if key == "polygons":
+                    pts = c.need(f, "polygon", "list", w) or []
+                    if len(pts) < 3 or not all(isinstance(p, list) and len(p) == 2
+                                               and all(_is_num(v) for v in p) for p in pts):
+                        c.out.append(f"{w}.polygon must hold >= 3 [lat, lon] points")
+                else:
+                    circ = c.need(f, "circle", "dict", w)
+                    if circ is not None:
+                        c.need(circ, "center", "list", f"{w}.circle")
+                        c.need(circ, "radius", "num", f"{w}.circle")
+    rally = c.need(doc, "rallyPoints", "dict", "top", optional=True)
     if rally is not None:
-        need(rally, "version", "num", "rallyPoints")
-        need(rally, "points", "list", "rallyPoints")
-    m = need(doc, "mission", "dict", "top")
+        c.need(rally, "version", "num", "rallyPoints")
+        c.need(rally, "points", "list", "rallyPoints")
+    m = c.need(doc, "mission", "dict", "top")
     if m is None:
-        return out
-    if need(m, "version", "num", "mission") not in (None, 2):
-        out.append("mission.version must be 2")
-    need(m, "firmwareType", "num", "mission")
+        return c.out
+    if c.need(m, "version", "num", "mission") not in (None, 2):
+        c.out.append("mission.version must be 2")
+    c.need(m, "firmwareType", "num", "mission")
     for key in ("vehicleType", "cruiseSpeed", "hoverSpeed", "globalPlanAltitudeMode"):
         if key in m and not _is_num(m[key]):
-            out.append(f"mission.{key}: expected num")
-    home = need(m, "plannedHomePosition", "list", "mission")
+            c.out.append(f"mission.{key}: expected num")
+    home = c.need(m, "plannedHomePosition", "list", "mission")
     if home is not None:
         if len(home) != 3 or not all(_is_num(v) for v in home):
-            out.append("mission.plannedHomePosition must be [lat, lon, alt] numbers")
+            c.out.append("mission.plannedHomePosition must be [lat, lon, alt] numbers")
         elif not (-90 <= home[0] <= 90 and -180 <= home[1] <= 180):
-            out.append(f"mission.plannedHomePosition lat/lon out of range: {home[:2]}")
-    items = need(m, "items", "list", "mission")
+            c.out.append(f"mission.plannedHomePosition lat/lon out of range: {home[:2]}")
+    items = c.need(m, "items", "list", "mission")
     if items is not None and not items:
-        out.append("mission.items must hold at least one item")
+        c.out.append("mission.items must hold at least one item")
     for i, it in enumerate(items or []):
         w = f"mission.items[{i}]"
-        if need(it, "type", "str", w) not in (None, "SimpleItem"):
-            out.append(f"{w}.type must be 'SimpleItem'")
-        need(it, "command", "num", w)
-        need(it, "frame", "num", w)
-        need(it, "autoContinue", "bool", w)
-        if "doJumpId" in (it or {}) and not _is_num(it["doJumpId"]):
-            out.append(f"{w}.doJumpId: expected num")
-        if "AltitudeMode" in (it or {}) and not _is_num(it["AltitudeMode"]):
-            out.append(f"{w}.AltitudeMode: expected num")
-        params = need(it, "params", "list", w)
-        if params is not None:
-            if len(params) != 7:
-                out.append(f"{w}.params must hold 7 values, got {len(params)}")
-            elif not all(v is None or _is_num(v) for v in params):
-                out.append(f"{w}.params must be numbers or null")
-            elif it.get("frame") in (0, 3, 10) and not (
-                _is_num(params[4]) and _is_num(params[5])
-                and -90 <= params[4] <= 90 and -180 <= params[5] <= 180
-            ):
-                out.append(f"{w}.params[4:6] must be a valid latitude, longitude")
-    return out
+        kind = c.need(it, "type", "str", w)
+        if kind == "SimpleItem":
+            c.simple_item(it, w)
+        elif kind == "ComplexItem":
+            c.complex_item(it, w)
+        elif kind is not None:
+            c.out.append(f"{w}.type must be 'SimpleItem' or 'ComplexItem', got {kind!r}")
+    return c.out
+
+
+def _simple(it: dict[str, Any]) -> MissionItem:
+    params = [math.nan if v is None else float(v) for v in it["params"]]
+    agl = it.get("Altitude") if it.get("AltitudeMode") == 3 else None
+    amsl = it.get("AMSLAltAboveTerrain")
+    return MissionItem(int(it["command"]), int(it["frame"]), tuple(params),  # type: ignore[arg-type]
+                       autocontinue=bool(it.get("autoContinue", True)),
+                       agl=None if agl is None else float(agl),
+                       alt_amsl=None if amsl is None else float(amsl))
 
 
 def read_plan(file: str | Path) -> dict[str, Any]:
-    """Read a ``.plan`` written by :func:`write_plan` (or QGroundControl).
+    """Read any ``.plan`` QGroundControl writes (or :func:`write_plan`).
+
+    SimpleItems are read as they are. Survey and corridor-scan ComplexItems
+    are expanded into the mission items QGC stored for them
+    (``TransectStyleComplexItem.Items``); complex items without stored items
+    (``StructureScan``, landing patterns, surveys saved without items) are
+    refused, naming the item.
 
     Returns
     -------
     dict
-        ``home`` (lat, lon, alt), ``frame`` (of the first item), and arrays
-        ``command``, ``lat``, ``lon``, ``alt`` of the mission items.
+        ``home`` (lat, lon, alt), ``firmware_type``, ``vehicle_type``,
+        ``items`` (list of MissionItem), ``sources`` (for each item, the plan
+        item it came from, e.g. ``"items[2] survey"``), ``fences``, ``rally``,
+        and arrays ``command``, ``frame``, ``lat``, ``lon``, ``alt`` of the
+        items (``frame`` of the first item also as ``frame0``).
 
     Raises
     ------
     InputError
-        Not JSON, or not a valid plan (the first problem is named).
+        Not JSON, not a valid plan (the first problem named), or a complex item
+        fm2uav cannot expand (named with its type and position).
     """
     file = Path(file)
     try:
         doc = json.loads(file.read_text())
-    except (OSError, json.JSONDecodeError) as exc:
+    except (OSError, json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise InputError(f"{file}: cannot read a .plan JSON file: {exc}") from None
     problems = validate_plan(doc)
     if problems:
         raise InputError(f"{file}: not a valid QGroundControl plan: {problems[0]}")
-    items = doc["mission"]["items"]
+    m = doc["mission"]
+    items: list[MissionItem] = []
+    sources: list[str] = []
+    for i, it in enumerate(m["items"]):
+        if it["type"] == "SimpleItem":
+            items.append(_simple(it))
+            sources.append(f"items[{i}]")
+            continue
+        kind = it["complexItemType"]
+        sub = (it.get("TransectStyleComplexItem") or {}).get("Items")
+        if kind in _TRANSECT_ITEMS and sub:
+            for s in sub:
+                items.append(_simple(s))
+                sources.append(f"items[{i}] {kind}")
+            continue
+        if kind in _TRANSECT_ITEMS:
+            why = ("it was saved without its mission items (TransectStyleComplexItem.Items); "
+                   "open the plan in QGroundControl and save it again, which stores them")
+        else:
+            why = ("QGroundControl computes its mission items when it uploads the plan and does "
+                   "not store them in the file; remove that item (fm2uav reads SimpleItems and "
+                   "the items stored by survey and CorridorScan complex items)")
+        raise InputError(
+            f"{file}: mission item {i + 1} is a QGroundControl {kind!r} complex item, which "
+            f"fm2uav cannot read: {why}")
+    if not items:
+        raise InputError(f"{file}: the plan has no mission items")
+    fence = doc.get("geoFence") or {}
     return {
-        "home": tuple(doc["mission"]["plannedHomePosition"]),
-        "frame": int(items[0]["frame"]),
-        "command": np.array([it["command"] for it in items], dtype=int),
-        "lat": np.array([it["params"][4] for it in items], dtype=float),
-        "lon": np.array([it["params"][5] for it in items], dtype=float),
-        "alt": np.array([it["params"][6] for it in items], dtype=float),
+        "home": tuple(m["plannedHomePosition"]),
+        "firmware_type": int(m["firmwareType"]),
+        "vehicle_type": int(m.get("vehicleType", 0)),
+        "items": items,
+        "sources": sources,
+        "fences": read_geofence(fence),
+        "rally": [tuple(p) for p in (doc.get("rallyPoints") or {}).get("points", [])],
+        "frame0": items[0].frame,
+        "frame": np.array([it.frame for it in items], dtype=int),
+        "command": np.array([it.command for it in items], dtype=int),
+        "lat": np.array([it.lat for it in items], dtype=float),
+        "lon": np.array([it.lon for it in items], dtype=float),
+        "alt": np.array([it.alt for it in items], dtype=float),
     }

@@ -7,56 +7,64 @@ fields::
 
 Item 0 is the home position (frame 0 = altitude above mean sea level,
 CURRENT = 1), as QGroundControl, Mission Planner and pymavlink's ``mavwp``
-expect. The mission items follow: an optional NAV_TAKEOFF, then one
-NAV_WAYPOINT per waypoint, in frame 3 (above home) or 10 (above terrain).
-Latitude/longitude are written with 10 decimals (~0.01 mm).
+expect; the mission items follow (the same list the ``.plan`` is written from).
+Unset params are written ``nan`` — in particular the yaw (param 4) of
+waypoints, takeoffs and landings, which QGC writes as ``null`` in a ``.plan``:
+a 0 there would make a PX4 multirotor turn north at every waypoint.
+Latitude/longitude carry 10 decimals (~0.01 mm).
 """
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import IO, Any
 
 import numpy as np
 
 from ..errors import InputError
-from .waypoints import CMD_NAV_TAKEOFF, CMD_NAV_WAYPOINT, FRAME_GLOBAL, Waypoints
+from .items import CMD_NAV_WAYPOINT, FRAME_GLOBAL, MissionItem
 
-__all__ = ["write_wpl", "read_wpl"]
+__all__ = ["HEADER", "wpl_text", "write_wpl", "read_wpl"]
 
 HEADER = "QGC WPL 110"
 
 
-def _line(seq: int, current: int, frame: int, command: int, lat: float, lon: float,
-          alt: float) -> str:
-    fields = [
-        str(seq), str(current), str(frame), str(command),
-        "0", "0", "0", "0",
-        f"{lat:.10f}", f"{lon:.10f}", f"{alt:.3f}", "1",
-    ]
+def _fmt(v: float, decimals: int) -> str:
+    if not math.isfinite(v):
+        return "nan"
+    text = f"{v:.{decimals}f}"
+    return "0" if float(text) == 0 else text.rstrip("0").rstrip(".") if "." in text else text
+
+
+def _line(seq: int, current: int, it: MissionItem) -> str:
+    p = it.params
+    fields = [str(seq), str(current), str(it.frame), str(it.command),
+              *(_fmt(v, 6) for v in p[:4]), _fmt(p[4], 10), _fmt(p[5], 10), _fmt(p[6], 3),
+              "1" if it.autocontinue else "0"]
     return "\t".join(fields)
 
 
-def write_wpl(fh: IO[str], wps: Waypoints) -> int:
-    """Write waypoints as a ``QGC WPL 110`` file to an open text file.
+def wpl_text(mission: Any) -> str:
+    """The ``QGC WPL 110`` text of a built mission (home first)."""
+    home = MissionItem(CMD_NAV_WAYPOINT, FRAME_GLOBAL,
+                       (0.0, 0.0, 0.0, 0.0, *(float(v) for v in mission.home)))
+    lines = [HEADER, _line(0, 1, home)]
+    lines += [_line(k + 1, 0, it) for k, it in enumerate(mission.items)]
+    return "\n".join(lines) + "\n"
+
+
+def write_wpl(fh: IO[str], mission: Any) -> int:
+    """Write a built mission as ``QGC WPL 110`` to an open text file.
 
     Returns
     -------
     int
         Number of lines written after the header (home + items).
     """
-    lines = [HEADER, _line(0, 1, FRAME_GLOBAL, CMD_NAV_WAYPOINT, wps.home[0], wps.home[1],
-                           wps.home[2])]
-    seq = 1
-    if wps.takeoff:
-        lines.append(_line(seq, 0, wps.frame, CMD_NAV_TAKEOFF, wps.lat[0], wps.lon[0],
-                           wps.alt[0]))
-        seq += 1
-    for lat, lon, alt in zip(wps.lat, wps.lon, wps.alt):
-        lines.append(_line(seq, 0, wps.frame, CMD_NAV_WAYPOINT, lat, lon, alt))
-        seq += 1
-    fh.write("\n".join(lines) + "\n")
-    return len(lines) - 1
+    text = wpl_text(mission)
+    fh.write(text)
+    return text.count("\n") - 1
 
 
 def read_wpl(file: str | Path) -> dict[str, Any]:
@@ -65,8 +73,9 @@ def read_wpl(file: str | Path) -> dict[str, Any]:
     Returns
     -------
     dict
-        ``home`` (lat, lon, alt) from item 0 and arrays ``seq``, ``frame``,
-        ``command``, ``lat``, ``lon``, ``alt`` of the items after it.
+        ``home`` (lat, lon, alt) from item 0, ``items`` (list of MissionItem) and
+        arrays ``seq``, ``frame``, ``command``, ``params`` (n, 4), ``lat``,
+        ``lon``, ``alt`` of the items after it.
 
     Raises
     ------
@@ -77,7 +86,7 @@ def read_wpl(file: str | Path) -> dict[str, Any]:
     file = Path(file)
     try:
         lines = file.read_text().splitlines()
-    except OSError as exc:
+    except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"{file}: cannot read: {exc}") from None
     if not lines or lines[0].strip() != HEADER:
         raise InputError(f"{file}: first line must be {HEADER!r}")
@@ -97,11 +106,15 @@ def read_wpl(file: str | Path) -> dict[str, Any]:
     a = np.array(rows)
     home = (float(a[0, 8]), float(a[0, 9]), float(a[0, 10]))
     a = a[1:]
+    items = [MissionItem(int(r[3]), int(r[2]), tuple(r[4:11]), autocontinue=bool(r[11]))
+             for r in a]
     return {
         "home": home,
+        "items": items,
         "seq": a[:, 0].astype(int),
         "frame": a[:, 2].astype(int),
         "command": a[:, 3].astype(int),
+        "params": a[:, 4:8],
         "lat": a[:, 8],
         "lon": a[:, 9],
         "alt": a[:, 10],

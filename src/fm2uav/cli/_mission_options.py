@@ -1,0 +1,91 @@
+"""Mission-export options shared by every command that writes a mission, defined once.
+
+``fm2uav plan``, ``cover``, ``formation`` and ``export`` take the same flags
+(``--firmware``, ``--vehicle``, ``--frame``, ``--end``, ``--thin``,
+``--speed-changes``, ``--endurance``, ...) with the names of the mission file's
+``airframe:`` / ``outputs:`` keys. Each defaults to None = "not given", so a
+mission file's value (``fm2uav export --mission``) or the library default
+applies; :func:`export_options` builds the :class:`~fm2uav.io.ExportOptions`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Annotated, Any
+
+import typer
+
+from ..errors import InputError
+
+__all__ = [
+    "Firmware", "Vehicle", "Frame", "End", "Thin", "AnchorText", "SpeedChanges", "MinSpeed",
+    "CruiseSpeed", "HoverSpeed", "Endurance", "Reserve", "parse_anchor", "export_options",
+]
+
+Firmware = Annotated[str | None, typer.Option(
+    help="Autopilot firmware: px4, ardupilot or generic (mission file airframe.firmware). "
+    "Default px4.")]
+Vehicle = Annotated[str | None, typer.Option(
+    help="Airframe kind: multirotor, fixed_wing or vtol (airframe.type). Default multirotor.")]
+Frame = Annotated[str | None, typer.Option(
+    help="Altitude frame: auto (ArduPilot: terrain, PX4: amsl = DEM ground + AGL), terrain, "
+    "amsl or relative (outputs.frame). Default auto.")]
+End = Annotated[str | None, typer.Option(
+    help="Mission end: auto, rtl, land or loiter (outputs.end). Default auto: land for "
+    "multirotor/VTOL, rtl for fixed-wing (plus a landing at home on PX4).")]
+Thin = Annotated[float | None, typer.Option(
+    help="Waypoint tolerance (m) of the 3D Douglas–Peucker thinning (outputs.thin_tolerance). "
+    "Default 5.")]
+AnchorText = Annotated[str | None, typer.Option(
+    "--anchor", help="lon,lat[,alt] of world x=y=0 for worlds without CRS (world.anchor). "
+    "Default: -3.7649,40.3326,0 (UC3M Leganés).")]
+SpeedChanges = Annotated[bool | None, typer.Option(
+    "--speed-changes/--no-speed-changes",
+    help="Write DO_CHANGE_SPEED items from the planned speed W (outputs.speed_changes).")]
+MinSpeed = Annotated[float | None, typer.Option(
+    help="Lowest commanded speed (m/s); fixed-wing speed changes need it (airframe.min_speed).")]
+CruiseSpeed = Annotated[float | None, typer.Option(
+    help="Fixed-wing / VTOL forward speed (m/s) (airframe.cruise_speed). Default 15.")]
+HoverSpeed = Annotated[float | None, typer.Option(
+    help="Multirotor forward speed (m/s) (airframe.hover_speed). Default 5.")]
+Endurance = Annotated[float | None, typer.Option(
+    help="Airframe endurance (min): the flight time is checked against it (airframe.endurance).")]
+Reserve = Annotated[float | None, typer.Option(
+    help="Share of the endurance kept in reserve (airframe.reserve). Default 0.2.")]
+
+
+def parse_anchor(text: str | None) -> Any:
+    """``"lon,lat[,alt]"`` → :class:`~fm2uav.io.Anchor` (None → None)."""
+    if text is None:
+        return None
+    from ..io import Anchor
+
+    try:
+        v = [float(x) for x in text.replace(",", " ").split()]
+    except ValueError:
+        v = []
+    if len(v) not in (2, 3):
+        raise InputError(f"--anchor must be lon,lat or lon,lat,alt (degrees, degrees, metres), "
+                         f"got {text!r}")
+    return Anchor(lon=v[0], lat=v[1], alt=v[2] if len(v) == 3 else 0.0)
+
+
+def export_options(base: Any = None, *, firmware: str | None = None, vehicle: str | None = None,
+                   frame: str | None = None, end: str | None = None, thin: float | None = None,
+                   anchor: str | None = None, speed_changes: bool | None = None,
+                   min_speed: float | None = None, cruise_speed: float | None = None,
+                   hover_speed: float | None = None, endurance: float | None = None,
+                   reserve: float | None = None, **more: Any) -> Any:
+    """``base`` (default ``ExportOptions()``) with the flags that were given."""
+    from ..io import ExportOptions
+
+    given = {"firmware": firmware, "vehicle": vehicle, "frame": frame, "end": end,
+             "tolerance": thin, "anchor": parse_anchor(anchor), "speed_changes": speed_changes,
+             "min_speed": min_speed, "cruise_speed": cruise_speed, "hover_speed": hover_speed,
+             "endurance_s": None if endurance is None else 60.0 * float(endurance),
+             "reserve": reserve, **more}
+    if thin is not None and not thin >= 0:
+        raise InputError(f"--thin must be a tolerance >= 0 m, got {thin}")
+    if endurance is not None and not endurance > 0:
+        raise InputError(f"--endurance must be > 0 minutes, got {endurance}")
+    return replace(base or ExportOptions(), **{k: v for k, v in given.items() if v is not None})

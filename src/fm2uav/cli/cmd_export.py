@@ -1,0 +1,146 @@
+"""``fm2uav export PATH.csv``: an existing path as an autopilot mission (any format)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import typer
+
+from ..errors import InputError
+from ._common import OutputDir, handle_errors, print_summary, to_jsonable
+from ._mission_options import (
+    AnchorText,
+    CruiseSpeed,
+    End,
+    Endurance,
+    Firmware,
+    Frame,
+    HoverSpeed,
+    MinSpeed,
+    Reserve,
+    SpeedChanges,
+    Thin,
+    Vehicle,
+    export_options,
+)
+from .cmd_run import mission_rows, write_exports
+
+
+def _world(mission_file: Path | None, scenario: str | None, seed: int):
+    """(world, base ExportOptions or None, agl or None, description) of the path's world."""
+    if (mission_file is None) == (scenario is None):
+        raise InputError("give the world the path was planned on: --mission FILE.yaml (its "
+                         "world, airframe and outputs) or --scenario NAME")
+    if mission_file is not None:
+        from ..io.mission import load_mission
+
+        m = load_mission(mission_file)
+        rm = m.resolve()
+        agl = getattr(m.planner, "agl", None)
+        return rm.world, m.export_options(), agl, f"mission {mission_file}"
+    from ..scenarios import get_scenario
+
+    return get_scenario(scenario, seed=seed).world, None, None, f"scenario {scenario}"
+
+
+def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
+    """Add the ``export`` command."""
+
+    @app.command(
+        "export",
+        help=(
+            "Turn an existing path (path.csv, x_m,y_m,z_m[,speed]) into mission files: "
+            "mission.plan (QGroundControl), mission.waypoints (QGC WPL 110), path.kml, "
+            "path.kmz, path.geojson — with takeoff, end, altitude frame and firmware checks as "
+            "every command writes them. The world comes from the mission file the path was "
+            "planned with (--mission) or a built-in scenario; a path whose '# crs=' header "
+            "names another CRS than the world's is refused.\n\n"
+            "Examples:\n\n"
+            "  fm2uav export out/open_field_tff/path.csv --mission examples/open_field_tff.yaml "
+            "--format plan,waypoints --firmware ardupilot --out out/ardu\n\n"
+            "  fm2uav export out/plan/path.csv --scenario open-field --agl 150 --format kmz "
+            "--out out/kmz"
+        ),
+    )
+    @handle_errors
+    def export_cmd(
+        path_file: Path = typer.Argument(..., help="Path CSV (as written by fm2uav)."),
+        fmt: list[str] = typer.Option(
+            ["plan,waypoints"], "--format", help="Formats (repeat or comma list): plan, "
+            "waypoints (= wpl), kml, kmz, geojson, csv, or all."),
+        mission_file: Path | None = typer.Option(
+            None, "--mission", help="Mission YAML the path was planned with (world, airframe, "
+            "outputs); the flags below override its values."),
+        scenario: str | None = typer.Option(None, help="Built-in scenario the path is in."),
+        seed: int = typer.Option(0, help="Seed of the scenario's relief."),
+        agl: float | None = typer.Option(
+            None, help="Requested height above ground (m) the path was planned at (default: "
+            "the mission's planner.agl): waypoints on the level get exactly this AGL."),
+        firmware: Firmware = None,
+        vehicle: Vehicle = None,
+        frame: Frame = None,
+        end: End = None,
+        thin: Thin = None,
+        anchor: AnchorText = None,
+        speed_changes: SpeedChanges = None,
+        min_speed: MinSpeed = None,
+        cruise_speed: CruiseSpeed = None,
+        hover_speed: HoverSpeed = None,
+        endurance: Endurance = None,
+        reserve: Reserve = None,
+        out: Path = typer.Option(Path("out/export"), help="Output directory."),
+        force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
+        as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
+        quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
+    ) -> None:
+        from ..io import EXPORT_FILES, export_mission, parse_formats, read_path_csv
+        from ..io.path_header import read_path_header, read_path_w
+
+        formats = parse_formats(",".join(fmt))
+        outdir = OutputDir(out, force=force)
+        outdir.check([EXPORT_FILES[f] for f in formats] + ["summary.json"])
+        world, base, mission_agl, where = _world(mission_file, scenario, seed)
+        header = read_path_header(path_file)
+        crs = getattr(world, "crs", None)
+        if header["crs"] and crs and header["crs"] != crs:
+            raise InputError(f"{path_file} says crs={header['crs']} but the {where} world is in "
+                             f"{crs}: give the mission or scenario the path was planned on")
+        if header["crs"] and not crs:
+            raise InputError(f"{path_file} says crs={header['crs']} but the {where} world has "
+                             "no CRS: give the mission file of that DEM (--mission)")
+        path = read_path_csv(path_file)
+        if path.shape[1] != world.ndim:
+            raise InputError(f"{path_file} has {path.shape[1]} coordinates a point but the "
+                             f"{where} world is {world.ndim}D")
+        inside = world.contains(path)
+        if not np.all(inside):
+            k = int(np.argmin(inside))
+            raise InputError(f"{path_file}: point {k} {np.round(path[k], 1).tolist()} m lies "
+                             f"outside the {where} world; is this the world it was planned on?")
+        w = read_path_w(path_file)
+        options = export_options(base, firmware=firmware, vehicle=vehicle, frame=frame, end=end,
+                                 thin=thin, anchor=anchor, speed_changes=speed_changes,
+                                 min_speed=min_speed, cruise_speed=cruise_speed,
+                                 hover_speed=hover_speed, endurance=endurance, reserve=reserve)
+        if options.speed_changes and w is None:
+            raise InputError(f"--speed-changes needs W along the path: {path_file} has no "
+                             "speed column (write it with fm2uav plan / run)")
+        track = SimpleNamespace(
+            path=path, world=world, w=w, level=None, params={},
+            length=float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1))))
+        level_agl = agl if agl is not None else mission_agl
+        mission, files = export_mission(track, formats, options, agl=level_agl)
+        write_exports(outdir, files)
+        summary = {"path_file": str(path_file), "world": where, "path_crs": header["crs"],
+                   "points": len(path), "length_m": round(track.length, 3),
+                   "autopilot": mission.summary()}
+        with outdir.open("summary.json") as fh:
+            json.dump(to_jsonable({**summary, "files": [p.name for p in outdir.written]
+                                   + ["summary.json"]}), fh, indent=2)
+        rows = {"path": f"{path_file} ({len(path)} points, {track.length:.1f} m)",
+                "world": where, **mission_rows(mission)}
+        print_summary("fm2uav export", summary if as_json else rows, as_json=as_json,
+                      quiet=quiet, files=outdir.written)

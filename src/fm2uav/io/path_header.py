@@ -1,0 +1,67 @@
+"""What a ``path.csv`` says about itself: the CRS comment and the W column.
+
+``path.csv`` (:func:`fm2uav.io.write_path_csv`) may start with ``#`` comment
+lines such as ``# crs=EPSG:32630; z=DEM heights, ...`` (``World.georef.comment()``)
+and may carry W along the path in a ``speed`` (or ``w``) column. ``fm2uav
+export`` uses both: the CRS to refuse a path planned on another world, W for
+speed changes.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+
+__all__ = ["read_path_header", "read_path_w"]
+
+_CRS = re.compile(r"\bcrs\s*[=:]\s*([^;\s]+)", re.IGNORECASE)
+
+
+def _lines(file: Path) -> list[str]:
+    try:
+        return file.read_text().splitlines()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"path file {file}: cannot read: {exc}") from None
+
+
+def read_path_header(file: str | Path) -> dict[str, Any]:
+    """``{"crs": str or None, "comments": [str, ...]}`` from the leading ``#`` lines."""
+    file = Path(file)
+    comments = []
+    for ln in _lines(file):
+        s = ln.strip()
+        if not s:
+            continue
+        if not s.startswith("#"):
+            break
+        comments.append(s.lstrip("#").strip())
+    crs = None
+    for c in comments:
+        m = _CRS.search(c)
+        if m:
+            crs = m.group(1)
+            break
+    return {"crs": None if crs in (None, "none", "None") else crs, "comments": comments}
+
+
+def read_path_w(file: str | Path) -> np.ndarray | None:
+    """The ``speed`` / ``w`` column of a path CSV (W along the path), or None."""
+    file = Path(file)
+    rows = [ln.strip() for ln in _lines(file) if ln.strip() and not ln.lstrip().startswith("#")]
+    if not rows:
+        return None
+    header = [c.strip().lower() for c in rows[0].split(",")]
+    col = next((header.index(n) for n in ("speed", "w") if n in header), None)
+    if col is None:
+        return None
+    try:
+        w = np.array([float(r.split(",")[col]) for r in rows[1:]], dtype=float)
+    except (ValueError, IndexError):
+        raise InputError(f"path file {file}: the {header[col]!r} column has a non-numeric "
+                         "value") from None
+    return w

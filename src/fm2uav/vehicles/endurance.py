@@ -1,0 +1,233 @@
+"""Flight time, distance and endurance of a mission: does the battery last?
+
+The mission is flown leg by leg between its waypoints. A leg of horizontal
+length ``L`` and height change ``dz`` at commanded speed ``v`` takes
+
+``t = max(L / v, dz / v_climb, -dz / v_descent)``
+
+(the horizontal and vertical motions run at the same time, each limited by its
+own speed: a multirotor's ``WPNAV_SPEED`` / ``WPNAV_SPEED_UP`` /
+``WPNAV_SPEED_DN``, a fixed-wing's cruise speed and TECS climb / sink limits).
+Hold times add to the leg they end. The take-off climb (home → first waypoint)
+and the final descent are vertical legs; a return to launch adds the straight
+line home at cruise speed and the descent there.
+
+:func:`check_endurance` compares the total with the usable endurance,
+``endurance × (1 − reserve)``, and, when it does not last, says how far along
+the route the vehicle gets before it eats into the reserve.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+
+__all__ = ["FlightTime", "EnduranceReport", "flight_time", "check_endurance"]
+
+
+def _positive(name: str, value: Any) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a number, got {value!r}") from None
+    if not (math.isfinite(v) and v > 0):
+        raise InputError(f"{name} must be > 0, got {value!r}")
+    return v
+
+
+@dataclass(frozen=True)
+class FlightTime:
+    """Time and distance of a flight, leg by leg.
+
+    Attributes
+    ----------
+    leg_time : ndarray, shape (n - 1,)
+        Duration of each leg between waypoints [s] (holds included).
+    leg_length : ndarray, shape (n - 1,)
+        3D length of each leg [m].
+    takeoff_s, takeoff_m : float
+        Take-off climb [s] and its height [m].
+    landing_s, landing_m : float
+        Return to launch and final descent [s], and their distance [m].
+    """
+
+    leg_time: np.ndarray
+    leg_length: np.ndarray
+    takeoff_s: float
+    takeoff_m: float
+    landing_s: float
+    landing_m: float
+
+    @property
+    def time_s(self) -> float:
+        """Total flight time [s]."""
+        return float(self.takeoff_s + self.leg_time.sum() + self.landing_s)
+
+    @property
+    def distance_m(self) -> float:
+        """Total distance flown [m]."""
+        return float(self.takeoff_m + self.leg_length.sum() + self.landing_m)
+
+    def elapsed(self) -> np.ndarray:
+        """Time [s] at which each waypoint is reached (take-off included)."""
+        return self.takeoff_s + np.concatenate([[0.0], np.cumsum(self.leg_time)])
+
+
+def flight_time(
+    points: Any,
+    speeds: Any,
+    *,
+    climb_rate: float,
+    descent_rate: float,
+    takeoff_climb: float = 0.0,
+    final_descent: float = 0.0,
+    return_distance: float = 0.0,
+    return_speed: float | None = None,
+    holds: Any = None,
+) -> FlightTime:
+    """Leg-by-leg flight time of waypoints flown at the given speeds.
+
+    Parameters
+    ----------
+    points : array_like, shape (n, 3)
+        Waypoints [m] (x, y, altitude).
+    speeds : float or array_like, shape (n - 1,)
+        Commanded horizontal speed on each leg [m/s].
+    climb_rate, descent_rate : float
+        Vertical speed limits [m/s] (> 0).
+    takeoff_climb : float, optional
+        Height climbed from home to the first waypoint [m].
+    final_descent : float, optional
+        Height of the final descent to the ground [m].
+    return_distance : float, optional
+        Straight-line distance of a return to launch [m], flown at
+        ``return_speed`` (default: the last leg's speed).
+    holds : array_like, shape (n,), optional
+        Hold time at each waypoint [s].
+    """
+    p = np.asarray(points, dtype=float)
+    if p.ndim != 2 or p.shape[1] != 3 or len(p) < 1 or not np.all(np.isfinite(p)):
+        raise InputError(f"points must be a finite (n, 3) array, got shape {p.shape}")
+    up = _positive("climb_rate [m/s]", climb_rate)
+    down = _positive("descent_rate [m/s]", descent_rate)
+    d = np.diff(p, axis=0)
+    horiz = np.hypot(d[:, 0], d[:, 1])
+    v = np.broadcast_to(np.asarray(speeds, dtype=float), horiz.shape)
+    if v.size and not (np.all(np.isfinite(v)) and np.all(v > 0)):
+        raise InputError("leg speeds must be finite and > 0 m/s")
+    t = np.maximum.reduce([horiz / np.where(v > 0, v, 1.0), np.maximum(d[:, 2], 0) / up,
+                           np.maximum(-d[:, 2], 0) / down]) if len(d) else np.zeros(0)
+    if holds is not None:
+        h = np.asarray(holds, dtype=float)
+        if h.shape != (len(p),) or np.any(h < 0) or not np.all(np.isfinite(h)):
+            raise InputError(f"holds must be {len(p)} times >= 0 s")
+        t = t + h[1:]
+        takeoff_hold = float(h[0])
+    else:
+        takeoff_hold = 0.0
+    rs = return_speed if return_speed is not None else (float(v[-1]) if v.size else 1.0)
+    ret = float(return_distance) / _positive("return speed [m/s]", rs) if return_distance else 0.0
+    climb, descent = max(float(takeoff_climb), 0.0), max(float(final_descent), 0.0)
+    return FlightTime(
+        leg_time=t, leg_length=np.linalg.norm(d, axis=1),
+        takeoff_s=climb / up + takeoff_hold, takeoff_m=climb,
+        landing_s=ret + descent / down, landing_m=descent + float(return_distance),
+    )
+
+
+@dataclass(frozen=True)
+class EnduranceReport:
+    """A flight time against the airframe's endurance.
+
+    Attributes
+    ----------
+    time_s, distance_m : float
+        The whole flight [s], [m].
+    endurance_s : float or None
+        The airframe's endurance [s] (None: not given, nothing checked).
+    reserve : float
+        Share of the endurance kept in reserve.
+    usable_s : float or None
+        ``endurance × (1 − reserve)`` [s].
+    ok : bool
+        The flight fits in the usable endurance (True when not checked).
+    reach_m : float
+        Distance along the flight at which the usable endurance runs out [m]
+        (the whole distance when it lasts).
+    reach_waypoint : int
+        Last waypoint reached within the usable endurance (index).
+    """
+
+    time_s: float
+    distance_m: float
+    endurance_s: float | None
+    reserve: float
+    usable_s: float | None
+    ok: bool
+    reach_m: float
+    reach_waypoint: int
+    waypoints: int
+
+    @property
+    def warning(self) -> str | None:
+        """One line saying how far the vehicle gets, or None when it lasts."""
+        if self.ok or self.endurance_s is None or self.usable_s is None:
+            return None
+        return (f"endurance: the flight needs {self.time_s / 60:.1f} min ({self.distance_m / 1000:.2f}"
+                f" km) but {self.endurance_s / 60:.1f} min endurance with a "
+                f"{100 * self.reserve:.0f} % reserve leaves {self.usable_s / 60:.1f} min: the "
+                f"vehicle gets {self.reach_m / 1000:.2f} km along the flight (waypoint "
+                f"{self.reach_waypoint} of {self.waypoints - 1}) before it eats into the reserve")
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-friendly numbers."""
+        return {
+            "flight_time_s": round(self.time_s, 1),
+            "flight_distance_m": round(self.distance_m, 1),
+            "endurance_s": None if self.endurance_s is None else round(self.endurance_s, 1),
+            "reserve": self.reserve,
+            "usable_s": None if self.usable_s is None else round(self.usable_s, 1),
+            "ok": self.ok,
+            "reach_m": round(self.reach_m, 1),
+            "reach_waypoint": self.reach_waypoint,
+            "warning": self.warning,
+        }
+
+
+def check_endurance(ft: FlightTime, *, endurance_s: float | None, reserve: float = 0.2
+                    ) -> EnduranceReport:
+    """Compare a :class:`FlightTime` with an endurance [s] kept ``reserve`` in reserve.
+
+    Raises
+    ------
+    InputError
+        Endurance not > 0 or reserve outside [0, 1).
+    """
+    r = float(reserve)
+    if not (0.0 <= r < 1.0):
+        raise InputError(f"reserve must be a share in [0, 1) (e.g. 0.2 for 20 %), got {reserve!r}")
+    n = len(ft.leg_time) + 1
+    if endurance_s is None:
+        return EnduranceReport(ft.time_s, ft.distance_m, None, r, None, True, ft.distance_m,
+                               n - 1, n)
+    usable = _positive("endurance [s]", endurance_s) * (1.0 - r)
+    ok = ft.time_s <= usable
+    if ok:
+        return EnduranceReport(ft.time_s, ft.distance_m, float(endurance_s), r, usable, True,
+                               ft.distance_m, n - 1, n)
+    t_wp = ft.elapsed()
+    if usable <= t_wp[0]:
+        frac = usable / t_wp[0] if t_wp[0] > 0 else 0.0
+        return EnduranceReport(ft.time_s, ft.distance_m, float(endurance_s), r, usable, False,
+                               frac * ft.takeoff_m, 0, n)
+    k = min(int(np.searchsorted(t_wp, usable, side="right") - 1), n - 1)
+    reach = ft.takeoff_m + float(np.sum(ft.leg_length[:k]))
+    if k < n - 1 and ft.leg_time[k] > 0:
+        reach += ft.leg_length[k] * min((usable - t_wp[k]) / ft.leg_time[k], 1.0)
+    return EnduranceReport(ft.time_s, ft.distance_m, float(endurance_s), r, usable, False,
+                           float(reach), k, n)
