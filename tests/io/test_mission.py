@@ -13,7 +13,7 @@ from typer.testing import CliRunner
 
 from fm2uav.cli import app
 from fm2uav.errors import InputError
-from fm2uav.io import read_plan, read_wpl, to_lonlat, validate_plan
+from fm2uav.io import read_plan, read_wpl, to_lonlat, validate_mission, validate_plan
 from fm2uav.io.mission import load_mission, parse_mission
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
@@ -62,8 +62,8 @@ def test_examples_run_end_to_end(examples, name, tmp_path):
     summary = json.loads(res.output)
     m = load_mission(examples / name)
     names = {"csv": "path.csv", "geojson": "path.geojson", "kml": "path.kml",
-             "plan": "mission.plan", "wpl": "mission.waypoints", "html": "report.html",
-             "png": "plan.png", "json": "summary.json"}
+             "kmz": "path.kmz", "plan": "mission.plan", "wpl": "mission.waypoints",
+             "html": "report.html", "png": "plan.png", "json": "summary.json"}
     for f in m.outputs.formats:
         assert (out / names[f]).stat().st_size > 0
     assert 3 <= summary["waypoints"] <= 100
@@ -71,7 +71,14 @@ def test_examples_run_end_to_end(examples, name, tmp_path):
     plan = read_plan(out / "mission.plan")
     wpl = read_wpl(out / "mission.waypoints")
     np.testing.assert_allclose(plan["lat"], wpl["lat"], atol=1e-7, rtol=0)
-    assert plan["frame"] == summary["mavlink_frame"] == (10 if m.planner.agl else 3)
+    # auto frame: ArduPilot flies terrain-frame items, PX4 gets AMSL from the DEM
+    want = ({"ardupilot": 10}.get(m.airframe.firmware, 0) if m.planner.agl else 3)
+    route = plan["command"] == 16
+    assert set(plan["frame"][route]) == {summary["mavlink_frame"]} == {want}
+    assert plan["command"][0] in (22, 84) and plan["command"][-1] in (17, 20, 21, 85)
+    assert validate_mission(plan["items"], m.airframe.firmware, vehicle=m.airframe.type,
+                            home_alt=plan["home"][2]) == []
+    assert summary["autopilot"]["home"]["source"]
     # the file on disk says the same as the printed summary
     assert json.loads((out / "summary.json").read_text())["waypoints"] == summary["waypoints"]
     # no overwrite without --force; exit 2, files untouched
@@ -100,8 +107,9 @@ def test_geotiff_mission_runs_with_lonlat_points(tmp_path):
     assert res.exit_code == 0, res.output
     assert res.output == ""
     wpl = read_wpl(tmp_path / "o" / "mission.waypoints")
-    assert set(wpl["frame"]) == {10}
-    assert (wpl["lat"][1], wpl["lon"][1]) == pytest.approx((40.3847, -3.7033), abs=1e-7)
+    assert set(wpl["frame"][wpl["command"] == 16]) == {0}  # PX4: AMSL, never frame 10
+    assert (wpl["lat"][0], wpl["lon"][0]) == pytest.approx((40.3847, -3.7033), abs=1e-7)
+    assert wpl["command"][0] == 22 and wpl["command"][-1] == 21  # takeoff ... land
 
 
 def test_lonlat_start_matches_metres_through_the_anchor():
@@ -146,7 +154,12 @@ BAD = [
      ["outputs.formats[1] = 'pdf'", "'wpl'"]),
     ("tolerance", OK_WORLD + "outputs: {thin_tolerance: -1}\n",
      ["outputs.thin_tolerance = -1", "0 <= thin_tolerance <= 1000 m"]),
-    ("frame", OK_WORLD + "outputs: {frame: amsl}\n", ["outputs.frame = 'amsl'", "'terrain'"]),
+    ("frame", OK_WORLD + "outputs: {frame: msl}\n", ["outputs.frame = 'msl'", "'amsl'"]),
+    ("end", OK_WORLD + "outputs: {end: crash}\n", ["outputs.end = 'crash'", "'rtl'", "'land'"]),
+    ("via", OK_WORLD + "via: [[1, 2]]\n", ["via[0]", "3 numbers"]),
+    ("return", OK_WORLD + "return: yes please\n", ["return = 'yes please'", "true or false"]),
+    ("endurance", OK_WORLD + "airframe: {endurance: -5}\n", ["airframe.endurance = -5",
+                                                             "min"]),
     ("start-short", OK_WORLD + "start: [1, 2]\n", ["start", "[x, y, z]"]),
     ("start-no-height", OK_WORLD + "start: {x: 1, y: 2}\n", ["start", "exactly one height"]),
     ("start-lon", OK_WORLD + "start: {lon: 200, lat: 40, agl: 50}\n",
@@ -244,3 +257,70 @@ def test_plan_command_report_and_exports(tmp_path):
     res = runner.invoke(app, ["plan", "--out", str(tmp_path / "q"), "--export", "pdf"])
     assert res.exit_code == 2 and "'pdf'" in res.output
     assert not (tmp_path / "q").exists()
+
+
+def test_a_mission_file_with_two_via_points_and_a_return_leg(tmp_path):
+    f = tmp_path / "via.yaml"
+    f.write_text(
+        "world: {scenario: open-field}\n"
+        "start: {x: 300, y: 300, agl: 150}\n"
+        "via: [{x: 1400, y: 300, agl: 150}, {x: 500, y: 1100, agl: 150}]\n"
+        "goal: {x: 1500, y: 1200, agl: 150}\n"
+        "return: true\n"
+        "planner: {agl: 150}\n"
+        "airframe: {type: multirotor, firmware: ardupilot, endurance: 30}\n"
+        "outputs: {formats: [plan, wpl, json], thin_tolerance: 10}\n")
+    out = tmp_path / "o"
+    res = runner.invoke(app, ["run", str(f), "--out", str(out), "--json"])
+    assert res.exit_code == 0, res.output
+    summary = json.loads(res.output)
+    assert summary["route"]["legs"] == 4
+    m = load_mission(f)
+    rm = m.resolve()
+    plan = read_plan(out / "mission.plan")
+    geo = to_lonlat(np.array([*rm.via, rm.goal]), rm.world, anchor=m.anchor())
+    found = []
+    for lon, lat, _ in geo:  # each via (and the goal, passed on the way back) is a waypoint
+        hit = np.flatnonzero((np.abs(plan["lat"] - lat) < 1e-9) & (np.abs(plan["lon"] - lon) < 1e-9)
+                             & (plan["command"] == 16))
+        assert hit.size, (lon, lat)
+        found.append(int(hit[0]))
+    assert found == sorted(found)  # in order
+    assert plan["command"][-1] == 21  # lands where it started
+    assert (plan["lat"][-1], plan["lon"][-1]) == pytest.approx(plan["home"][:2], abs=1e-9)
+    assert summary["autopilot"]["flight"]["endurance_s"] == 1800
+
+
+def test_export_converts_an_existing_path_for_another_firmware(examples, tmp_path):
+    out = tmp_path / "run"
+    res = runner.invoke(app, ["run", str(examples / "open_field_tff.yaml"), "--out", str(out),
+                              "--quiet"])
+    assert res.exit_code == 0, res.output
+    conv = tmp_path / "conv"
+    res = runner.invoke(app, ["export", str(out / "path.csv"), "--mission",
+                              str(examples / "open_field_tff.yaml"), "--format", "plan",
+                              "--format", "waypoints,kmz", "--firmware", "ardupilot",
+                              "--end", "rtl", "--out", str(conv), "--json"])
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.output)["autopilot"]
+    assert (s["firmware"], s["frame"]["name"], s["end"]) == ("ardupilot", "terrain", "rtl")
+    assert {p.name for p in conv.iterdir()} == {"mission.plan", "mission.waypoints", "path.kmz",
+                                                "summary.json"}
+    a, b = read_plan(out / "mission.plan"), read_plan(conv / "mission.plan")
+    wa, wb = a["command"] == 16, b["command"] == 16
+    assert set(a["frame"][wa]) == {0} and set(b["frame"][wb]) == {10}
+    assert (b["lat"][wb][-1], b["lon"][wb][-1]) == (a["lat"][wa][-1], a["lon"][wa][-1])
+    # the same settings give the same mission back from path.csv (6 decimals: 1 um)
+    same = tmp_path / "same"
+    res = runner.invoke(app, ["export", str(out / "path.csv"), "--mission",
+                              str(examples / "open_field_tff.yaml"), "--out", str(same)])
+    assert res.exit_code == 0, res.output
+    c = read_plan(same / "mission.plan")
+    np.testing.assert_array_equal(c["command"], a["command"])
+    np.testing.assert_allclose(c["lat"], a["lat"], atol=1e-9)
+    np.testing.assert_allclose(c["alt"], a["alt"], atol=1e-3)
+    res = runner.invoke(app, ["export", str(out / "path.csv"), "--scenario", "city",
+                              "--out", str(tmp_path / "bad")])
+    assert res.exit_code == 2 and "outside" in res.output
+    res = runner.invoke(app, ["export", str(out / "path.csv"), "--out", str(tmp_path / "x")])
+    assert res.exit_code == 2 and "--mission" in res.output
