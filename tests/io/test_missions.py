@@ -21,6 +21,7 @@ from fm2uav.io import (
     build_mission,
     export_mission,
     fences_from_world,
+    from_lonlat,
     read_kml_path,
     read_plan,
     read_wpl,
@@ -552,3 +553,62 @@ def test_unknown_export_format_names_the_flag():
     buf = io.StringIO()
     files["mission.plan"].write(buf)
     assert json.loads(buf.getvalue())["groundStation"] == "fm2uav"
+
+
+@pytest.mark.parametrize("firmware", ["px4", "ardupilot"])
+def test_a_coverage_export_triggers_the_camera_at_the_band_ends(firmware):
+    from fm2uav import FlightLevel
+    from fm2uav.missions.coverage import Camera, plan_coverage
+    from fm2uav.missions.coverage.triggers import camera_plan
+    from fm2uav.scenarios.coverage import coverage_area, coverage_world
+
+    world = coverage_world(0)
+    cp = plan_coverage(world, coverage_area("S1"), 80.0, level=FlightLevel(agl=100.0),
+                       angle=math.radians(37.134))
+    cam = Camera(13.2e-3, 8.8e-3, 8.8e-3, 5472, 3648)
+    plan_cam = camera_plan(cp, camera=cam, front_overlap=0.7)
+    m, _ = export_mission(cp.plan, ["plan"], _opts(firmware=firmware), agl=100.0,
+                          camera=plan_cam)
+    bands = cp.zigzag.bands()
+    trig = [k for k, it in enumerate(m.items) if it.command == 206]
+    assert len(trig) == 2 * len(bands)
+    ends = np.array([np.asarray(b.coords)[[0, -1]] for b in bands]).reshape(-1, 2)
+    for n, k in enumerate(trig):
+        it = m.items[k]
+        assert it.params[0] == (plan_cam.trigger_distance if n % 2 == 0 else 0.0)
+        prev = next(m.items[j] for j in range(k - 1, -1, -1) if m.items[j].has_position)
+        xy = from_lonlat([[prev.lon, prev.lat]], world, anchor=ANCHOR)[0]
+        assert np.hypot(*(xy - ends[n])) < 5.0  # at the band's start / end (m)
+    s = m.summary()["camera"]
+    # GSD = sensor width x AGL / (focal x image width): 13.2 mm x 100 m / (8.8 mm x 5472 px)
+    assert s["gsd_cm_per_px"] == pytest.approx(100 * 13.2 * 100 / (8.8 * 5472), abs=1e-3)
+    assert s["side_overlap"] == pytest.approx(1 - 80.0 / 150.0, abs=1e-3)
+    assert plan_cam.trigger_distance == pytest.approx(100.0 * 0.3)
+
+
+def test_formation_missions_one_per_vehicle_leave_together_and_keep_their_timing(tmp_path):
+    from types import SimpleNamespace
+
+    from fm2uav.io import export_formation
+
+    world = hill()
+    t = np.linspace(0.0, 60.0, 121)
+    tracks = []
+    for k, (dy, agl) in enumerate(((0.0, 60.0), (40.0, 40.0), (-40.0, 80.0))):
+        x, y = 60 + 4.0 * t, 150 + dy + 10 * np.sin(t / 8)
+        tracks.append(np.column_stack([x, y, world.ground_height(x, y) + agl]))
+    res = SimpleNamespace(times=t, positions=np.stack(tracks, axis=1),
+                          names=("leader", "follower1", "follower2"), agl=(60.0, 40.0, 80.0),
+                          world=world)
+    opts = _opts(climb_rate=8.0, descent_rate=8.0, tolerance=1.0)
+    missions, files = export_formation(res, ["plan", "wpl"], opts)
+    assert set(files) == {f"{n}_mission.{e}" for n in res.names for e in ("plan", "waypoints")}
+    climb = [60.0 / 8, 40.0 / 8, 80.0 / 8]
+    for (name, m), c in zip(missions.items(), climb):
+        s = m.summary()
+        assert s["timing"]["start_hold_s"] == pytest.approx(max(climb) - c)
+        assert abs(s["timing"]["error_s"]) <= 0.02 * 60.0
+        assert m.items[0].command == 22 and m.items[-1].command in END_COMMANDS
+        assert sum(it.command == 178 for it in m.items) >= 1
+    _write(files, tmp_path)
+    assert read_plan(tmp_path / "follower2_mission.plan")["command"][0] == 22

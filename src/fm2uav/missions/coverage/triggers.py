@@ -136,6 +136,7 @@ def camera_plan(
     if trigger_distance is not None:
         trig = float(trigger_distance)
         info["trigger_distance_source"] = "given (--trigger-distance)"
+    trig = round(float(trig), 3)  # mm: what a mission item needs
     if not (math.isfinite(trig) and trig > 0):
         raise InputError(f"trigger distance must be > 0 m, got {trig!r}")
     bands, worst = band_indices(coverage.zigzag, coverage.path)
