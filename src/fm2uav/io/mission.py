@@ -22,7 +22,11 @@ Schema (pydantic v2, strict types, unknown keys rejected)::
     goal: {lon: -3.747, lat: 40.343, agl: 60}        # {lon, lat, agl} or {cell: [i, j, k]}
     via: [{lon: -3.755, lat: 40.338, agl: 60}]       # points to pass in order (like start/goal)
     return: false                   # true: plan a leg back from the goal to the start
-    planner: {saturation: 1.0, exponent: 1.0, order: 2, agl: 60, p1: 0.5, p2: 1.5}
+    planner: {saturation: 1.0, exponent: 1.0, order: 2, agl: 60, p1: 0.5, p2: 1.5,
+              min_agl: 30, max_agl: 120, saturation_distance: 100}   # [m]
+    no_fly_zones: [airports.geojson, {polygon: [[x, y], ...], buffer: 50, ceiling: 120,
+                   reference: agl}]   # files or inline zones (see fm2uav.io.zone_spec)
+    operating_area: area.geojson    # or {polygon: ..., lonlat: true}; the plan stays inside
     airframe: {type: multirotor, firmware: px4, cruise_speed: 12, hover_speed: 5,
                endurance: 25, reserve: 0.2}   # [min] endurance checked with a 20 % reserve
     outputs:
@@ -56,6 +60,7 @@ from ..world.load import WorldSpec as DataWorldSpec
 from ..world.load import check_points, load_world
 from .exports import EXPORT_FILES, ExportOptions
 from .georef import DEFAULT_ANCHOR, Anchor, from_lonlat, ground_height
+from .zone_spec import ZoneSpec, resolve_zones
 
 __all__ = [
     "Mission",
@@ -311,6 +316,9 @@ class Mission(BaseModel):
     return_to_start: bool = Field(False, alias="return",
                                   description="plan a leg back to the start")
     planner: PlannerSpec = Field(default_factory=PlannerSpec)
+    no_fly_zones: list[ZoneSpec] = Field(default_factory=list, max_length=10000,
+                                         description="no-fly zones: files or inline zones")
+    operating_area: ZoneSpec | None = Field(None, description="area the mission stays in")
     airframe: AirframeSpec = Field(default_factory=AirframeSpec)
     outputs: OutputSpec = Field(default_factory=OutputSpec)
 
@@ -405,6 +413,13 @@ class Mission(BaseModel):
         check_points(world, {"start": start, "goal": goal,
                              **{f"via[{k}]": v for k, v in enumerate(via)}},
                      allow_filled=w.allow_filled)
+        zones = resolve_zones(self.no_fly_zones, self.operating_area, world, anchor)
+        if zones:  # no-fly zones / operating area become obstacles of the world
+            from ..world.zones import check_points_allowed, with_zones
+
+            world = with_zones(world, zones)
+            check_points_allowed(world, {"start": start, "goal": goal,
+                                         **{f"via[{k}]": v for k, v in enumerate(via)}})
         return ResolvedMission(mission=self, world=world, start=start, goal=goal, via=via,
                                return_to_start=self.return_to_start)
 
