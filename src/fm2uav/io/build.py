@@ -427,6 +427,7 @@ def build_mission(
     camera: CameraPlan | None = None,
     fences: Any = (),
     start_hold: float = 0.0,
+    profile: Any = None,
 ) -> MissionExport:
     """Build and check the mission of a dense path (see the module docstring).
 
@@ -453,6 +454,9 @@ def build_mission(
     start_hold : float, optional
         With ``times``: wait this long [s] at the start after the takeoff (to
         leave the start at the same moment as other vehicles).
+    profile : AltitudeProfile, optional
+        The plan's final altitude profile (``Plan.profile``): the path's heights
+        are then used as they are, and its ``required`` floor checks the legs.
 
     Raises
     ------
@@ -496,9 +500,13 @@ def build_mission(
                 if t_arr[b] - t_arr[a] >= 1.0:
                     keep.setdefault(int(a), []).append(("hold", 0.0, "wait"))
                     keep.setdefault(int(b), []).append(("hold", 0.0, "wait"))
+    required = getattr(profile, "required", None)
+    if required is not None and np.shape(required) != (n_dense,):
+        required = None  # a profile of another sampling than the path: no floor to compare
     wps = mission_waypoints(p, world, frame=frame, agl=agl, tolerance=opt.tolerance,
                             anchor=opt.anchor, flight_alt=opt.flight_alt,
-                            max_points=opt.max_points, keep=sorted(keep))
+                            max_points=opt.max_points, keep=sorted(keep),
+                            snap=profile is None, required=required)
     idx = wps.indices
     geo = _Geo(world, opt.anchor, wps)
     vehicle = opt.vehicle
@@ -678,6 +686,8 @@ def build_mission(
                                                if it.command == CMD_DO_SET_CAM_TRIGG_DIST)}
     if landing:
         info["landing"] = landing
+    if wps.legs is not None:
+        info["legs"] = wps.legs
     if via_idx:
         info["via_waypoints"] = [int(np.searchsorted(idx, i)) for i in via_idx]
     if not getattr(world, "crs", None):

@@ -160,7 +160,8 @@ def export_mission(
     if speed is None:
         speed = getattr(plan, "speed", None)
     mission = build_mission(path, world, opt, w=speed, agl=agl, times=times, via=via,
-                            camera=camera, fences=fences, start_hold=start_hold)
+                            camera=camera, fences=fences, start_hold=start_hold,
+                            profile=getattr(plan, "profile", None))
     s = mission.summary()
     props = {"mission": opt.name, "length_m": round(float(getattr(plan, "length", 0.0)), 3),
              "firmware": opt.firmware, "vehicle": opt.vehicle, "frame": mission.waypoints.frame,

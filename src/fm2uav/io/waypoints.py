@@ -127,6 +127,10 @@ class Waypoints:
         Their indices in the dense path.
     requested_agl : float or None
         The plan's requested height above ground [m].
+    legs : dict or None
+        What the leg check (:func:`fm2uav.io.thin.refine_legs`) did: waypoints
+        ``added`` where a straight leg dipped below its floor or entered a zone,
+        ``lowest_margin_m`` above the floor along the legs, ...
     """
 
     lat: np.ndarray
@@ -142,14 +146,19 @@ class Waypoints:
     points_m: np.ndarray
     indices: np.ndarray
     requested_agl: float | None = None
+    legs: dict[str, Any] | None = None
 
     def __len__(self) -> int:
         return int(len(self.lat))
 
 
 def altitude_profile(path_m: Any, world: Any, *, agl: float | None = None,
-                     flight_alt: float = 30.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                     flight_alt: float = 30.0, snap: bool = True
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The flown profile of a dense path (see the module docstring).
+
+    ``snap=False`` keeps the path's own heights (a plan whose altitudes are
+    already the final profile over the continuous ground, ``Plan.profile``).
 
     Returns
     -------
@@ -170,7 +179,7 @@ def altitude_profile(path_m: Any, world: Any, *, agl: float | None = None,
     else:
         own = p[:, 2] - ground
     height = own
-    if agl is not None and p.shape[1] == 3:
+    if agl is not None and snap and p.shape[1] == 3:
         dz = float(world.spacing[2]) if getattr(world, "ndim", 3) == 3 else 0.0
         on_level = np.abs(own - float(agl)) <= dz + 1e-9
         height = np.where(on_level, float(agl), own)
@@ -228,6 +237,8 @@ def mission_waypoints(
     flight_alt: float = 30.0,
     max_points: int | None = None,
     keep: Any = (),
+    snap: bool = True,
+    required: Any = None,
 ) -> Waypoints:
     """Thin a dense path and express it as MAVLink waypoints.
 
@@ -251,15 +262,33 @@ def mission_waypoints(
         Cap on the number of waypoints.
     keep : sequence of int, optional
         Dense-path indices that must be waypoints (via points, band ends).
+    snap : bool, optional
+        Give flight-level points the requested ``agl`` (default); False keeps
+        the path's own heights (plans with a final altitude profile).
+    required : array_like, shape (N,), optional
+        Lowest admissible height above the surface at each dense point [m]
+        (``Plan.profile.required``); legs that would dip below it, or enter a
+        no-fly zone, get more waypoints (:func:`fm2uav.io.thin.refine_legs`).
+        Default: no floor (zones are still checked).
     """
     if frame not in FRAME_CODES:
         raise InputError(f"frame must be one of {', '.join(FRAME_CODES)} here, got {frame!r}")
-    flown, height, ground = altitude_profile(path_m, world, agl=agl, flight_alt=flight_alt)
+    flown, height, ground = altitude_profile(path_m, world, agl=agl, flight_alt=flight_alt,
+                                             snap=snap)
     p = np.asarray(path_m, dtype=float)
     space = flown if frame != "terrain" else np.column_stack([flown[:, :2], height])
     if p.shape[1] == 2:
         space = space[:, :2]
     idx = thin_with_keep(space, tolerance, keep=keep, max_points=max_points)
+    legs = None
+    if p.shape[1] == 3 and getattr(world, "ndim", 3) == 3:
+        from .thin import refine_legs
+
+        req = np.full(len(p), -np.inf) if required is None else np.asarray(required, dtype=float)
+        if req.shape != (len(p),):
+            raise InputError(f"required must hold one floor per path point ({len(p)}), got "
+                             f"shape {req.shape}")
+        idx, legs = refine_legs(idx, flown, world, required=req, terrain_frame=frame == "terrain")
     kept = flown[idx]
     geo = to_lonlat(kept, world, anchor=anchor)
     gnd = to_lonlat(np.column_stack([kept[:, :2], ground[idx]]), world, anchor=anchor)[:, 2]
@@ -276,5 +305,5 @@ def mission_waypoints(
         agl=height[idx], ground_amsl=gnd, frame=FRAME_CODES[frame], frame_name=frame,
         home=(float(home_geo[1]), float(home_geo[0]), float(home_geo[2])),
         home_source=_home_source(world, anchor), points_m=kept, indices=idx,
-        requested_agl=None if agl is None else float(agl),
+        requested_agl=None if agl is None else float(agl), legs=legs,
     )
