@@ -15,6 +15,24 @@ import numpy as np
 import typer
 
 from ._common import OutputDir, handle_errors, print_summary, progress, to_jsonable
+from .options import (
+    AllowFilledOpt,
+    BboxOpt,
+    BuildingsOpt,
+    CeilingOpt,
+    CellSizeOpt,
+    CrsOpt,
+    DefaultHeightOpt,
+    DemOpt,
+    DzOpt,
+    LonLatOpt,
+    NodataOpt,
+    NodataValueOpt,
+    SeaLevelOpt,
+    point_overrides,
+    world_overrides,
+    world_rows,
+)
 
 #: Output format → file name, for every format a command can write.
 OUTPUT_FILES = {
@@ -194,12 +212,36 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
         as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
         quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
+        start: str | None = typer.Option(
+            None, help="Override the mission's start: LON,LAT,AGL with --lonlat (degrees, "
+            "degrees, metres above ground), else x,y,z metres."),
+        goal: str | None = typer.Option(
+            None, help="Override the mission's goal (as --start)."),
+        lonlat: LonLatOpt = False,
+        dem: DemOpt = None,
+        buildings: BuildingsOpt = None,
+        bbox: BboxOpt = None,
+        sea_level: SeaLevelOpt = None,
+        cell_size: CellSizeOpt = None,
+        dz: DzOpt = None,
+        ceiling: CeilingOpt = None,
+        nodata: NodataOpt = "error",
+        nodata_value: NodataValueOpt = None,
+        crs: CrsOpt = None,
+        default_height: DefaultHeightOpt = None,
+        allow_filled: AllowFilledOpt = False,
     ) -> None:
         from ..io.mission import load_mission
         from ..missions.route import plan_route
         from ..planning.params import planner_objects
 
-        mission = load_mission(mission_file)
+        over = world_overrides(dem=dem, buildings=buildings, bbox=bbox, sea_level=sea_level,
+                               cell_size=cell_size, dz=dz, ceiling=ceiling, nodata=nodata,
+                               nodata_value=nodata_value, crs=crs,
+                               default_height=default_height, allow_filled=allow_filled)
+        mission = load_mission(mission_file, world_overrides=over,
+                               point_overrides=point_overrides(start=start, goal=goal,
+                                                               lonlat=lonlat))
         target = out or Path(mission.outputs.dir or Path("out") / mission_file.stem)
         outdir = OutputDir(target, force=force)
         formats = list(dict.fromkeys(mission.outputs.formats))
@@ -214,14 +256,16 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
                                return_to_start=rm.return_to_start, shaping=shaping,
                                level=level, options=popts)
             p = route.plan
-            world_desc = (mission.world.scenario or Path(mission.world.dem or
-                                                          mission.world.buildings or "").name)
+            world_desc = mission.world.scenario or mission.world.describe()
+            from ..world.load import world_summary
+
+            world_info = {**world_summary(rm.world), "name": world_desc}
             info, built = plan_outputs(
                 outdir, p, formats, mission.export_options(),
                 title=f"{mission.name}", subtitle=f"{world_desc} — {mission.description}"
                 if mission.description else world_desc,
                 summary={"mission": mission.name, "mission_file": str(mission_file),
-                         "world": world_desc, "route": route.summary()},
+                         "world": world_info, "route": route.summary()},
                 step=step, via=route.junctions[1:-1],
             )
         rows = {
@@ -234,6 +278,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "legs": len(route.legs),
             **mission_rows(built),
             "time [s]": f"{p.timings['total']:.2f}",
+            **world_rows(rm.world),
         }
         print_summary("fm2uav run", rows if not as_json else {**info, "out": str(target)},
                       as_json=as_json, quiet=quiet, files=outdir.written)

@@ -27,7 +27,7 @@ __all__ = [
     "DemOpt", "BuildingsOpt", "BboxOpt", "SeaLevelOpt", "CellSizeOpt", "DzOpt", "CeilingOpt",
     "NodataOpt", "NodataValueOpt", "CrsOpt", "DefaultHeightOpt", "AllowFilledOpt", "LonLatOpt",
     "ScenarioOpt", "WORLD_FLAGS", "world_spec", "build_world", "cli_point", "world_rows",
-    "requested_heights",
+    "requested_heights", "world_overrides", "point_overrides",
 ]
 
 _P = "World (real data)"
@@ -155,6 +155,59 @@ def world_spec(
             msg = err["msg"]
         raise InputError(f"{WORLD_FLAGS.get(key, '--' + key)} = {err.get('input')!r}: "
                          f"{msg}") from None
+
+
+def world_overrides(**options: Any) -> dict[str, Any] | None:
+    """The world options given to ``fm2uav run`` as mission-file ``world:`` keys (or None).
+
+    Takes the same keywords as :func:`world_spec`; unset options are left out,
+    so the mission file's values stay.
+    """
+    values = dict(options)
+    out: dict[str, Any] = {}
+    if values.get("dem"):
+        dems = [str(p) for p in values["dem"]]
+        out["dem"] = dems[0] if len(dems) == 1 else dems
+    if values.get("buildings") is not None:
+        out["buildings"] = str(values["buildings"])
+    if values.get("bbox") is not None:
+        out["bbox"] = _bbox(values["bbox"])
+    for k in ("sea_level", "cell_size", "dz", "ceiling", "nodata_value", "crs",
+              "default_height"):
+        if values.get(k) is not None:
+            out[k] = values[k]
+    if values.get("nodata", "error") != "error":
+        out["nodata"] = values["nodata"]
+    if values.get("allow_filled"):
+        out["allow_filled"] = True
+    return out or None
+
+
+def point_overrides(*, start: str | None, goal: str | None, lonlat: bool
+                    ) -> dict[str, Any] | None:
+    """``--start``/``--goal`` of ``fm2uav run`` as mission-file point mappings (or None).
+
+    ``LON,LAT,AGL`` with ``lonlat`` → ``{lon, lat, agl}``; else ``x,y,z`` → ``[x, y, z]``.
+
+    Raises
+    ------
+    InputError
+        Not 3 numbers (a mission point needs its height).
+    """
+    out: dict[str, Any] = {}
+    for what, text in (("start", start), ("goal", goal)):
+        if text is None:
+            continue
+        parts = [p for p in text.replace(",", " ").split() if p]
+        try:
+            v = [float(p) for p in parts]
+        except ValueError:
+            v = []
+        if len(v) != 3:
+            form = "LON,LAT,AGL (degrees, degrees, metres above ground)" if lonlat else "x,y,z (m)"
+            raise InputError(f"--{what} must be {form} for fm2uav run, got {text!r}")
+        out[what] = {"lon": v[0], "lat": v[1], "agl": v[2]} if lonlat else v
+    return out or None
 
 
 def build_world(spec: Any, *, scenario: str | None, seed: int = 0, agl: float | None = None,

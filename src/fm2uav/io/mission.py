@@ -59,7 +59,7 @@ from ..errors import InputError
 from ..world.load import WorldSpec as DataWorldSpec
 from ..world.load import check_points, load_world
 from .exports import EXPORT_FILES, ExportOptions
-from .georef import DEFAULT_ANCHOR, Anchor, from_lonlat, ground_height
+from .georef import DEFAULT_ANCHOR, Anchor, from_lonlat, ground_height, to_lonlat
 from .zone_spec import ZoneSpec, resolve_zones
 
 __all__ = [
@@ -456,10 +456,18 @@ def _resolve_point(p: PointSpec, world: Any, anchor: Anchor, what: str) -> np.nd
     point = np.array([xy[0], xy[1], z], dtype=float)
     if not world.contains(point):
         b = world.bounds
+        where = ""
+        if getattr(world, "crs", None) is not None:
+            from ..world.geo import bounds_lonlat
+
+            w_, s_, e_, n_ = bounds_lonlat((b[0, 0], b[1, 0], b[0, 1], b[1, 1]), world.crs)
+            ll = to_lonlat(point[None], world)[0]
+            where = (f" (lon {ll[0]:.5f}, lat {ll[1]:.5f}; the map covers about lon "
+                     f"{w_:.5f}..{e_:.5f}, lat {s_:.5f}..{n_:.5f})")
         raise InputError(
-            f"{what} = ({point[0]:.1f}, {point[1]:.1f}, {point[2]:.1f}) m lies outside the map; "
-            f"allowed: x in [{b[0, 0]:.1f}, {b[0, 1]:.1f}], y in [{b[1, 0]:.1f}, {b[1, 1]:.1f}], "
-            f"z in [{b[2, 0]:.1f}, {b[2, 1]:.1f}] m")
+            f"{what} = ({point[0]:.1f}, {point[1]:.1f}, {point[2]:.1f}) m{where} lies outside "
+            f"the map; allowed: x in [{b[0, 0]:.1f}, {b[0, 1]:.1f}], y in [{b[1, 0]:.1f}, "
+            f"{b[1, 1]:.1f}], z in [{b[2, 0]:.1f}, {b[2, 1]:.1f}] m")
     return point
 
 
@@ -617,13 +625,16 @@ def parse_mission(data: Any, *, source: str = "mission", base_dir: str | Path | 
         raise InputError(f"{source}: {_format_error(errs[0])}{more}") from None
 
 
-def load_mission(file: str | Path, *, world_overrides: dict[str, Any] | None = None) -> Mission:
+def load_mission(file: str | Path, *, world_overrides: dict[str, Any] | None = None,
+                 point_overrides: dict[str, Any] | None = None) -> Mission:
     """Read and validate a YAML mission file (paths inside are relative to it).
 
     ``world_overrides`` (the CLI's world options of ``fm2uav run``: ``dem``,
     ``buildings``, ``bbox``, ``sea_level``, ...) replace the file's ``world:``
     keys; their paths are taken as given (relative to the working directory),
     and a ``dem``/``buildings`` override drops the file's ``scenario``/``seed``.
+    ``point_overrides`` (``{"start": ..., "goal": ...}``, written like the
+    file's points) replace its ``start`` / ``goal``.
 
     Raises
     ------
@@ -656,4 +667,6 @@ def load_mission(file: str | Path, *, world_overrides: dict[str, Any] | None = N
             for k in ("scenario", "seed"):
                 world.pop(k, None)
         data = {**data, "world": {**world, **over}}
+    if point_overrides and isinstance(data, dict):
+        data = {**data, **point_overrides}
     return parse_mission(data, source=str(file), base_dir=file.parent)

@@ -20,7 +20,7 @@ points' ``agl``) and the highest requested altitude:
   rule), rounded down to a round number;
 * ``dz`` default: ``cell_size``, and with an ``agl`` at most ``agl / 6``
   (rounded down to a round number), so the flight level is >= 6 cells above
-  the ground;
+  the ground — unless ``height_cells`` fixes the node count (then ``cell_size``);
 * ``ceiling`` default: the highest ground (or roof) + ``max(20 dz, agl + 10 dz)``
   (``agl`` given) and at least ``top + 5 dz``, so a 120 m request always has sky.
 
@@ -226,8 +226,17 @@ def _pixel_ground_size(path: str) -> tuple[float, float]:
     if crs.is_geographic:
         pix = res * 111320.0 * max(math.cos(math.radians(lat_c)), 0.05)
     else:
+        # projected units -> ground metres: the unit, and the scale factor at the centre
+        # (Web Mercator at 45 deg stores 1.41 projected metres per ground metre)
+        from pyproj import Proj
+
         unit = crs.axis_info[0].unit_conversion_factor if crs.axis_info else 1.0
-        pix = res * unit
+        try:
+            f = Proj(crs).get_factors(0.5 * (ll[0] + ll[2]), lat_c)
+            k = math.sqrt(float(f.tissot_semimajor) * float(f.tissot_semiminor))
+        except Exception:  # projections without factors: take the units as they are
+            k = 1.0
+        pix = res * unit / (k if np.isfinite(k) and k > 0 else 1.0)
     return float(pix), float(width * height)
 
 
@@ -319,6 +328,8 @@ def load_world(spec: WorldSpec, *, agl: float | None = None, top: float | None =
         dx, why_dx = _auto_cell(spec)
     if spec.dz is not None:
         dz, why_dz = float(spec.dz), "given (world.dz)"
+    elif spec.height_cells is not None:
+        dz, why_dz = dx, "= cell_size (world.height_cells fixes the node count)"
     elif agl is not None and agl / 6.0 < dx:
         dz, why_dz = round_down(agl / 6.0), f"auto: at most agl / 6 = {agl / 6.0:.3g} m"
     else:
