@@ -190,6 +190,10 @@ class ExportOptions:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
                 raise InputError(f"export option {name} must be a number >= 0, got {v!r}")
+        for name in ("min_speed", "climb_rate", "descent_rate", "endurance_s"):
+            v = getattr(self, name)
+            if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise InputError(f"export option {name} must be a number > 0, got {v!r}")
         if self.speed_step <= 0:
             raise InputError(f"speed_step must be > 0 m/s, got {self.speed_step!r}")
         if not 0 < self.land_slope_deg <= self.max_land_slope_deg:
@@ -348,7 +352,6 @@ class _Geo:
     def __init__(self, world: Any, anchor: Anchor | None, wps: Waypoints) -> None:
         self.world, self.anchor, self.wps = world, anchor, wps
         self.home_amsl = wps.home[2]
-        self.offset = float(to_lonlat([[0.0, 0.0, 0.0]], world, anchor=anchor)[0, 2])
 
     def ground(self, xy: np.ndarray) -> np.ndarray:
         return ground_at(self.world, xy)
@@ -415,6 +418,228 @@ def _landing_pattern(geo: _Geo, touchdown: np.ndarray, heading: np.ndarray, fram
 
 
 # ---------------------------------------------------------------- building
+_Event = tuple[str, float, str]  # (kind, value, label) at a dense-path index
+
+
+def _events(p: np.ndarray, via: Any, camera: CameraPlan | None, times: Any
+            ) -> tuple[dict[int, list[_Event]], list[int]]:
+    """Dense indices that must be waypoints, with what happens there."""
+    n = len(p)
+    keep: dict[int, list[_Event]] = {}
+    via_idx = [int(i) for i in np.asarray(via, dtype=int).ravel()]
+    for k, i in enumerate(via_idx):
+        if not 0 <= i < n:
+            raise InputError(f"via index {i} outside the path (0..{n - 1})")
+        keep.setdefault(i, []).append(("via", 0.0, f"via {k + 1}"))
+    if camera is not None:
+        if not (math.isfinite(camera.trigger_distance) and camera.trigger_distance > 0):
+            raise MissionError(f"camera trigger distance must be > 0 m, got "
+                               f"{camera.trigger_distance!r}")
+        for b, (a, e) in enumerate(camera.bands):
+            if not 0 <= a < e < n:
+                raise InputError(f"band {b + 1} indices ({a}, {e}) are not increasing inside the "
+                                 f"path (0..{n - 1})")
+            keep.setdefault(int(a), []).append(("camera_on", camera.trigger_distance,
+                                                f"band {b + 1} start"))
+            keep.setdefault(int(e), []).append(("camera_off", 0.0, f"band {b + 1} end"))
+    if times is not None:  # where a timed trajectory stands still, keep both ends: a hold
+        t = np.asarray(times, dtype=float)
+        if t.shape != (n,) or not np.all(np.isfinite(t)) or not np.all(np.diff(t) > 0):
+            raise InputError(f"times must be {n} increasing finite values [s], one per path "
+                             "point")
+        seg = np.linalg.norm(np.diff(p, axis=0), axis=1) / np.diff(t)
+        for a, b in runs(seg < 0.1):
+            if t[b] - t[a] >= 1.0:
+                keep.setdefault(int(a), []).append(("hold", 0.0, "wait"))
+                keep.setdefault(int(b), []).append(("hold", 0.0, "wait"))
+    return keep, via_idx
+
+
+@dataclass(frozen=True)
+class _Speeds:
+    commanded: np.ndarray  # speed in force on each leg [m/s]
+    changes: list[tuple[int, float]]  # DO_CHANGE_SPEED (leg index, m/s)
+    holds: np.ndarray  # hold time at each waypoint [s]
+    timing: dict[str, Any] | None
+
+
+def _speeds(opt: ExportOptions, wps: Waypoints, w: Any, times: Any,
+            start_hold: float) -> _Speeds:
+    """Commanded speed of each leg (W-based or timed) and the speed items."""
+    idx = wps.indices
+    vmax = opt.forward_speed
+    floor = opt.min_speed if opt.min_speed is not None else (
+        1.0 if opt.vehicle != "fixed_wing" else None)
+    holds = np.zeros(len(idx))
+    changes: list[tuple[int, float]] = []
+    timing = None
+    if times is not None:
+        t = np.asarray(times, dtype=float)
+        lo = floor or 0.5
+        leg_v, holds = _timed_legs(t, wps.points_m, idx, lo)
+        holds[0] += float(start_hold)
+        changes = speed_commands(leg_v, current=None, step=opt.speed_step, hysteresis=0,
+                                 floor=lo, cap=float(max(leg_v.max(), lo)), rounding="nearest")
+        timing = {"planned_s": round(float(t[-1] - t[0]), 2),
+                  "start_hold_s": round(float(start_hold), 2)}
+    elif opt.speed_changes:
+        if floor is None:
+            raise MissionError("fixed-wing speed changes need airframe.min_speed (a margin "
+                               "above the stall speed; CLI --min-speed) so that no commanded "
+                               "airspeed falls below it")
+        if w is None:
+            raise MissionError("speed changes need W along the path (the plan's speed profile)")
+        wd = np.asarray(w, dtype=float)
+        if wd.shape != (idx[-1] + 1,):
+            raise InputError(f"W along the path must have {idx[-1] + 1} values, got {wd.shape}")
+        leg_v = _leg_speeds(wd, idx, vmax, floor)
+        changes = speed_commands(leg_v, current=None, step=opt.speed_step,
+                                 hysteresis=opt.speed_hysteresis, floor=floor, cap=vmax)
+    commanded = np.full(len(idx) - 1, vmax)
+    for k, v in changes:
+        commanded[k:] = v
+    return _Speeds(commanded, changes, holds, timing)
+
+
+def _takeoff(geo: _Geo, wps: Waypoints, opt: ExportOptions) -> MissionItem:
+    """The takeoff item to the start's altitude (frame 3 instead of 10, issue #20142)."""
+    frame = FRAME_RELATIVE if wps.frame == FRAME_TERRAIN else wps.frame
+    start_xy, start_z = wps.points_m[0, :2], float(wps.points_m[0, 2])
+    if wps.agl[0] < 0.5:
+        raise MissionError(f"the start is {wps.agl[0]:.2f} m above the ground: a takeoff needs "
+                           "a start above it (give start with agl, e.g. {x, y, agl: 30})")
+    if opt.vehicle == "vtol":
+        return geo.item(CMD_NAV_VTOL_TAKEOFF, frame, start_xy, start_z, label="takeoff")
+    if opt.vehicle == "fixed_wing":  # the item's position gives the climb-out course
+        leg = wps.points_m[1, :2] - start_xy
+        n = max(float(np.hypot(*leg)), 1e-9)
+        target = start_xy + leg / n * min(200.0, 0.5 * n)
+        return geo.item(CMD_NAV_TAKEOFF, frame, target, start_z,
+                        label="takeoff (climb-out course)", p1=15.0)
+    return geo.item(CMD_NAV_TAKEOFF, frame, start_xy, start_z, label="takeoff")
+
+
+def _do_items(events: list[_Event], change: float | None, speed_type: float
+              ) -> list[MissionItem]:
+    """Camera and speed items after a waypoint (camera off before on, speed last)."""
+    out = []
+    for kind, value, label in sorted(events, key=lambda e: e[0] != "camera_off"):
+        if kind == "camera_on":
+            out.append(MissionItem.do(CMD_DO_SET_CAM_TRIGG_DIST, value, 0.0, 1.0, 0.0,
+                                      label=f"{label}: camera on"))
+        elif kind == "camera_off":
+            out.append(MissionItem.do(CMD_DO_SET_CAM_TRIGG_DIST, 0.0, 0.0, 0.0, 0.0,
+                                      label=f"{label}: camera off"))
+    if change is not None:
+        out.append(MissionItem.do(CMD_DO_CHANGE_SPEED, speed_type, change, -1.0, 0.0,
+                                  label="speed change"))
+    return out
+
+
+def _route(wps: Waypoints, keep: dict[int, list[_Event]], sp: _Speeds,
+           opt: ExportOptions) -> list[MissionItem]:
+    """The waypoints after the takeoff, with their hold times and DO items."""
+    idx = wps.indices
+    change_at = dict(sp.changes)
+    speed_type = 1.0 if opt.vehicle == "multirotor" else 0.0
+
+    def waypoint(k: int, label: str) -> MissionItem:
+        return MissionItem(CMD_NAV_WAYPOINT, wps.frame,
+                           (float(sp.holds[k]), 0.0, 0.0, math.nan, float(wps.lat[k]),
+                            float(wps.lon[k]), float(wps.alt[k])),
+                           agl=float(wps.agl[k]), alt_amsl=float(wps.alt_amsl[k]), label=label)
+
+    items = [waypoint(0, "start (hold)")] if sp.holds[0] > 0 else []
+    items += _do_items(keep.get(int(idx[0]), []), change_at.get(0), speed_type)
+    last = len(wps) - 1
+    for k in range(1, last + 1):
+        vias = [lab for kind, _, lab in keep.get(int(idx[k]), []) if kind == "via"]
+        items.append(waypoint(k, ", ".join(vias) or f"waypoint {k}"))
+        events = keep.get(int(idx[k]), [])
+        if k == last:  # nothing starts at the last waypoint; a band may end there
+            events = [e for e in events if e[0] == "camera_off"]
+        items += _do_items(events, change_at.get(k) if k < last else None, speed_type)
+    return items
+
+
+def _end(geo: _Geo, wps: Waypoints, opt: ExportOptions
+         ) -> tuple[str, list[MissionItem], dict[str, Any], list[str]]:
+    """(resolved end, items, landing figures, warnings)."""
+    end = opt.end if opt.end != "auto" else ("rtl" if opt.vehicle == "fixed_wing" else "land")
+    start_xy = wps.points_m[0, :2]
+    end_xy, end_z = wps.points_m[-1, :2], float(wps.points_m[-1, 2])
+    f_route = wps.frame
+    items: list[MissionItem] = []
+    landing: dict[str, Any] = {}
+    warnings: list[str] = []
+    if end == "rtl":
+        items.append(MissionItem.do(CMD_NAV_RETURN_TO_LAUNCH, label="return to launch"))
+        if opt.firmware in ("px4", "generic") and opt.vehicle == "fixed_wing":
+            heading = -_unit_xy(wps.points_m, from_end=False)
+            pattern, landing, warnings = _landing_pattern(geo, start_xy, heading, f_route, opt,
+                                                          "home landing")
+            items += pattern
+        elif opt.firmware in ("px4", "generic") and opt.vehicle == "vtol":
+            items.append(MissionItem.do(CMD_DO_LAND_START, label="home landing start"))
+            items.append(geo.item(CMD_NAV_VTOL_LAND, FRAME_RELATIVE if f_route == FRAME_TERRAIN
+                                  else f_route, start_xy, float(geo.ground(start_xy)[0]),
+                                  label="home landing"))
+        if len(items) > 1:
+            landing["note"] = ("PX4 needs a landing in fixed-wing and VTOL missions "
+                               "(MIS_TKO_LAND_REQ = 2): the RTL item is followed by a landing at "
+                               "home, which PX4's return mode uses through DO_LAND_START")
+        line = start_xy[None, :] + np.linspace(0, 1, 50)[:, None] * (end_xy - start_xy)[None, :]
+        inside = _inside_xy(geo.world, line)
+        rise = (float((geo.ground(line[inside]) - geo.ground(start_xy)[0]).max())
+                if inside.any() else float("nan"))
+        landing["rtl_straight_line_m"] = round(float(np.hypot(*(end_xy - start_xy))), 1)
+        landing["rtl_max_ground_above_home_m"] = None if not np.isfinite(rise) else round(rise, 1)
+        warnings.append("RTL flies a straight line home at the firmware's return altitude (PX4 "
+                        "RTL_RETURN_ALT, ArduPilot RTL_ALT / ALT_HOLD_RTL); fm2uav neither plans "
+                        "nor checks it" + (f" — the ground under it rises {rise:.0f} m above home"
+                                           if np.isfinite(rise) and rise > 0 else "")
+                        + "; use return: true (--return) for a planned way back")
+    elif end == "land" and opt.vehicle == "fixed_wing":
+        heading = _unit_xy(wps.points_m, from_end=True)
+        items, landing, warnings = _landing_pattern(geo, end_xy, heading, f_route, opt, "landing")
+    elif end == "land":
+        cmd = CMD_NAV_VTOL_LAND if opt.vehicle == "vtol" else CMD_NAV_LAND
+        items.append(geo.item(cmd, f_route, end_xy, float(geo.ground(end_xy)[0]),
+                              label="landing"))
+    else:  # loiter
+        radius = 0.0 if opt.vehicle == "multirotor" else float(opt.loiter_radius)
+        items.append(geo.item(CMD_NAV_LOITER_UNLIM, f_route, end_xy, end_z,
+                              label="loiter at the end", p3=radius))
+    return end, items, landing, warnings
+
+
+def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: _Speeds, start_hold: float
+            ) -> tuple[dict[str, Any], str | None]:
+    """Flight time / endurance figures (and the endurance warning)."""
+    from ..vehicles.endurance import check_endurance, flight_time
+
+    climb = opt.climb_rate or DEFAULT_CLIMB[opt.vehicle]
+    descent = opt.descent_rate or DEFAULT_DESCENT[opt.vehicle]
+    start_xy, end_xy = wps.points_m[0, :2], wps.points_m[-1, :2]
+    ft = flight_time(wps.points_m, sp.commanded, climb_rate=climb, descent_rate=descent,
+                     takeoff_climb=float(wps.agl[0]),
+                     final_descent=0.0 if end == "loiter" else float(wps.agl[-1]),
+                     return_distance=float(np.hypot(*(end_xy - start_xy))) if end == "rtl"
+                     else 0.0, return_speed=opt.forward_speed, holds=sp.holds)
+    rep = check_endurance(ft, endurance_s=opt.endurance_s, reserve=opt.reserve)
+    info: dict[str, Any] = {"flight": {
+        **rep.summary(), "climb_rate_mps": climb, "descent_rate_mps": descent,
+        "forward_speed_mps": opt.forward_speed,
+        "note": {"loiter": "loiter end: the time until the loiter starts",
+                 "rtl": "rtl: the straight line home at the forward speed, then the descent"
+                 }.get(end, "")}}
+    if sp.timing is not None:  # the route from leaving the start (after any start hold)
+        route_t = float(ft.leg_time.sum() + sp.holds[0] - float(start_hold))
+        info["timing"] = {**sp.timing, "mission_route_s": round(route_t, 2),
+                          "error_s": round(route_t - sp.timing["planned_s"], 2)}
+    return info, rep.warning
+
+
 def build_mission(
     path_m: Any,
     world: Any,
@@ -467,216 +692,40 @@ def build_mission(
     """
     opt = options or ExportOptions()
     p = np.asarray(path_m, dtype=float)
-    n_dense = len(p)
     has_terrain = getattr(world, "terrain", None) is not None
     frame = resolve_frame(opt.frame, opt.firmware, terrain_following=agl is not None,
                           has_terrain=has_terrain)
     warnings: list[str] = []
+    if not getattr(world, "crs", None):
+        a = opt.anchor or DEFAULT_ANCHOR
+        warnings.append("synthetic world without CRS: its relief is made up and placed at the "
+                        f"anchor lon {a.lon:g}, lat {a.lat:g}, alt {a.alt:g} m (world.anchor / "
+                        "--anchor): it is not the real terrain there, so the altitudes do not "
+                        "clear the real ground — do not fly this mission as it is")
     if frame == "terrain" and not has_terrain:
         warnings.append("frame terrain on a world without a terrain map: altitudes are above "
                         "the world's flat ground")
-    keep: dict[int, list[tuple[str, float, str]]] = {}
-    via_idx = [int(i) for i in np.asarray(via, dtype=int).ravel()]
-    for k, i in enumerate(via_idx):
-        if not 0 <= i < n_dense:
-            raise InputError(f"via index {i} outside the path (0..{n_dense - 1})")
-        keep.setdefault(i, []).append(("via", 0.0, f"via {k + 1}"))
-    if camera is not None:
-        if not (math.isfinite(camera.trigger_distance) and camera.trigger_distance > 0):
-            raise MissionError(f"camera trigger distance must be > 0 m, got "
-                               f"{camera.trigger_distance!r}")
-        for b, (a, e) in enumerate(camera.bands):
-            if not 0 <= a < e < n_dense:
-                raise InputError(f"band {b + 1} indices ({a}, {e}) are not increasing inside the "
-                                 f"path (0..{n_dense - 1})")
-            keep.setdefault(int(a), []).append(("camera_on", camera.trigger_distance,
-                                                f"band {b + 1} start"))
-            keep.setdefault(int(e), []).append(("camera_off", 0.0, f"band {b + 1} end"))
-    if times is not None:  # where a timed trajectory stands still, keep both ends: a hold
-        t_arr = np.asarray(times, dtype=float)
-        if t_arr.shape == (n_dense,) and np.all(np.diff(t_arr) > 0):
-            seg = np.linalg.norm(np.diff(p, axis=0), axis=1) / np.diff(t_arr)
-            for a, b in runs(seg < 0.1):
-                if t_arr[b] - t_arr[a] >= 1.0:
-                    keep.setdefault(int(a), []).append(("hold", 0.0, "wait"))
-                    keep.setdefault(int(b), []).append(("hold", 0.0, "wait"))
+    keep, via_idx = _events(p, via, camera, times)
     required = getattr(profile, "required", None)
-    if required is not None and np.shape(required) != (n_dense,):
+    if required is not None and np.shape(required) != (len(p),):
         required = None  # a profile of another sampling than the path: no floor to compare
     wps = mission_waypoints(p, world, frame=frame, agl=agl, tolerance=opt.tolerance,
                             anchor=opt.anchor, flight_alt=opt.flight_alt,
                             max_points=opt.max_points, keep=sorted(keep),
                             snap=profile is None, required=required)
-    idx = wps.indices
     geo = _Geo(world, opt.anchor, wps)
-    vehicle = opt.vehicle
-    vmax = opt.forward_speed
-    floor = opt.min_speed if opt.min_speed is not None else (1.0 if vehicle != "fixed_wing"
-                                                             else None)
-    info: dict[str, Any] = {}
-    # ---- speeds per leg
-    holds = np.zeros(len(idx))
-    changes: list[tuple[int, float]] = []
-    leg_v = np.full(len(idx) - 1, vmax)
-    if times is not None:
-        t = np.asarray(times, dtype=float)
-        if t.shape != (n_dense,) or not np.all(np.isfinite(t)):
-            raise InputError(f"times must be {n_dense} finite values [s], one per path point")
-        lo = floor or 0.5
-        leg_v, holds = _timed_legs(t, wps.points_m, idx, lo)
-        holds[0] += float(start_hold)
-        changes = speed_commands(leg_v, current=None, step=opt.speed_step, hysteresis=0,
-                                 floor=lo, cap=float(max(leg_v.max(), lo)), rounding="nearest")
-        info["timing"] = {"planned_s": round(float(t[-1] - t[0]), 2),
-                          "start_hold_s": round(float(start_hold), 2)}
-    elif opt.speed_changes:
-        if floor is None:
-            raise MissionError("fixed-wing speed changes need airframe.min_speed (a margin "
-                               "above the stall speed; CLI --min-speed) so that no commanded "
-                               "airspeed falls below it")
-        if w is None:
-            raise MissionError("speed changes need W along the path (the plan's speed profile)")
-        wd = np.asarray(w, dtype=float)
-        if wd.shape != (n_dense,):
-            raise InputError(f"W along the path must have {n_dense} values, got {wd.shape}")
-        leg_v = _leg_speeds(wd, idx, vmax, floor)
-        changes = speed_commands(leg_v, current=None, step=opt.speed_step,
-                                 hysteresis=opt.speed_hysteresis, floor=floor, cap=vmax)
-    commanded = np.full(len(idx) - 1, vmax)
-    for k, v in changes:
-        commanded[k:] = v
-    change_at = dict(changes)
-    speed_type = 1.0 if vehicle == "multirotor" else 0.0
-    # ---- items
-    items: list[MissionItem] = []
-    f_route = wps.frame
-    f_takeoff = FRAME_RELATIVE if f_route == FRAME_TERRAIN else f_route
-    start_xy, start_z = wps.points_m[0, :2], float(wps.points_m[0, 2])
-    if wps.agl[0] < 0.5:
-        raise MissionError(f"the start is {wps.agl[0]:.2f} m above the ground: a takeoff needs "
-                           "a start above it (give start with agl, e.g. {x, y, agl: 30})")
-    if vehicle == "vtol":
-        items.append(geo.item(CMD_NAV_VTOL_TAKEOFF, f_takeoff, start_xy, start_z,
-                              label="takeoff"))
-    elif vehicle == "fixed_wing":  # the item's position gives the climb-out course
-        leg = wps.points_m[1, :2] - start_xy
-        reach = min(200.0, 0.5 * float(np.hypot(*leg)))
-        target = start_xy + leg / max(float(np.hypot(*leg)), 1e-9) * reach
-        items.append(geo.item(CMD_NAV_TAKEOFF, f_takeoff, target, start_z,
-                              label="takeoff (climb-out course)", p1=15.0))
-    else:
-        items.append(geo.item(CMD_NAV_TAKEOFF, f_takeoff, start_xy, start_z, label="takeoff"))
-
-    def events_at(k: int) -> None:
-        for kind, value, label in sorted(keep.get(int(idx[k]), []), key=lambda e: e[0] != "camera_off"):
-            if kind == "camera_on":
-                items.append(MissionItem.do(CMD_DO_SET_CAM_TRIGG_DIST, value, 0.0, 1.0, 0.0,
-                                            label=f"{label}: camera on"))
-            elif kind == "camera_off":
-                items.append(MissionItem.do(CMD_DO_SET_CAM_TRIGG_DIST, 0.0, 0.0, 0.0, 0.0,
-                                            label=f"{label}: camera off"))
-        if k in change_at:
-            items.append(MissionItem.do(CMD_DO_CHANGE_SPEED, speed_type, change_at[k], -1.0, 0.0,
-                                        label=f"speed for leg {k + 1}"))
-
-    if holds[0] > 0:  # wait at the start (over the takeoff point) before the first leg
-        items.append(MissionItem(CMD_NAV_WAYPOINT, f_route,
-                                 (float(holds[0]), 0.0, 0.0, math.nan, float(wps.lat[0]),
-                                  float(wps.lon[0]), float(wps.alt[0])),
-                                 agl=float(wps.agl[0]), alt_amsl=float(wps.alt_amsl[0]),
-                                 label="start (hold)"))
-    events_at(0)
-    labels = {int(i): [lab for kind, _, lab in ev if kind == "via"] for i, ev in keep.items()}
-    for k in range(1, len(wps)):
-        lab = ", ".join(labels.get(int(idx[k]), [])) or f"waypoint {k}"
-        it = MissionItem(CMD_NAV_WAYPOINT, f_route,
-                         (float(holds[k]) if k < len(holds) else 0.0, 0.0, 0.0, math.nan,
-                          float(wps.lat[k]), float(wps.lon[k]), float(wps.alt[k])),
-                         agl=float(wps.agl[k]), alt_amsl=float(wps.alt_amsl[k]), label=lab)
-        items.append(it)
-        if k < len(wps) - 1:
-            events_at(k)
-        else:
-            for kind, value, label in keep.get(int(idx[k]), []):
-                if kind == "camera_off":
-                    items.append(MissionItem.do(CMD_DO_SET_CAM_TRIGG_DIST, 0.0, 0.0, 0.0, 0.0,
-                                                label=f"{label}: camera off"))
-    # ---- end
-    end = opt.end
-    if end == "auto":
-        end = "rtl" if vehicle == "fixed_wing" else "land"
-    end_xy, end_z = wps.points_m[-1, :2], float(wps.points_m[-1, 2])
-    landing: dict[str, Any] = {}
-    if end == "rtl":
-        items.append(MissionItem.do(CMD_NAV_RETURN_TO_LAUNCH, label="return to launch"))
-        if opt.firmware in ("px4", "generic") and vehicle in ("fixed_wing", "vtol"):
-            if vehicle == "fixed_wing":
-                heading = -_unit_xy(wps.points_m, from_end=False)
-                pattern, landing, wl = _landing_pattern(geo, start_xy, heading, f_route, opt,
-                                                        "home landing")
-                items += pattern
-                warnings += wl
-            else:
-                items.append(MissionItem.do(CMD_DO_LAND_START, label="home landing start"))
-                items.append(geo.item(CMD_NAV_VTOL_LAND, f_takeoff, start_xy,
-                                      float(geo.ground(start_xy)[0]), label="home landing"))
-            warnings.append("PX4 return: the mission ends with a landing at home after the RTL "
-                            "item (MIS_TKO_LAND_REQ requires a landing); PX4 return mode flies to "
-                            "it when RTL_TYPE uses mission landings")
-        line = start_xy[None, :] + np.linspace(0, 1, 50)[:, None] * (end_xy - start_xy)[None, :]
-        inside = _inside_xy(world, line)
-        rise = float((geo.ground(line[inside]) - geo.ground(start_xy)[0]).max()) if inside.any() \
-            else float("nan")
-        landing["rtl_straight_line_m"] = round(float(np.hypot(*(end_xy - start_xy))), 1)
-        landing["rtl_max_ground_above_home_m"] = None if not np.isfinite(rise) else round(rise, 1)
-        warnings.append("RTL flies a straight line home at the firmware's return altitude (PX4 "
-                        "RTL_RETURN_ALT, ArduPilot RTL_ALT / ALT_HOLD_RTL); fm2uav neither plans "
-                        "nor checks it" + (f" — the ground under it rises {rise:.0f} m above home"
-                                           if np.isfinite(rise) and rise > 0 else "")
-                        + "; use return: true (--return) for a planned way back")
-    elif end == "land":
-        if vehicle == "fixed_wing":
-            heading = _unit_xy(wps.points_m, from_end=True)
-            pattern, landing, wl = _landing_pattern(geo, end_xy, heading, f_route, opt, "landing")
-            items += pattern
-            warnings += wl
-        else:
-            cmd = CMD_NAV_VTOL_LAND if vehicle == "vtol" else CMD_NAV_LAND
-            items.append(geo.item(cmd, f_route, end_xy, float(geo.ground(end_xy)[0]),
-                                  label="landing"))
-    else:  # loiter
-        radius = 0.0 if vehicle == "multirotor" else float(opt.loiter_radius)
-        items.append(geo.item(CMD_NAV_LOITER_UNLIM, f_route, end_xy, end_z,
-                              label="loiter at the end", p3=radius))
+    sp = _speeds(opt, wps, w, times, start_hold)
+    end, end_items, landing, end_warnings = _end(geo, wps, opt)
+    items = [_takeoff(geo, wps, opt), *_route(wps, keep, sp, opt), *end_items]
+    warnings += end_warnings
     fence_list = as_fences(fences)
-    check_mission(items, opt.firmware, vehicle=vehicle, home_alt=wps.home[2],
+    check_mission(items, opt.firmware, vehicle=opt.vehicle, home_alt=wps.home[2],
                   max_land_slope_deg=opt.max_land_slope_deg, fences=fence_list)
-    # ---- flight time and endurance
-    from ..vehicles.endurance import check_endurance, flight_time
-
-    climb = opt.climb_rate or DEFAULT_CLIMB[vehicle]
-    descent = opt.descent_rate or DEFAULT_DESCENT[vehicle]
-    final_descent = 0.0 if end == "loiter" else float(wps.agl[-1])
-    ret = float(np.hypot(*(end_xy - start_xy))) if end == "rtl" else 0.0
-    if end == "rtl":
-        final_descent = float(wps.agl[-1])
-    ft = flight_time(wps.points_m, commanded, climb_rate=climb, descent_rate=descent,
-                     takeoff_climb=float(wps.agl[0]), final_descent=final_descent,
-                     return_distance=ret, return_speed=vmax, holds=holds)
-    rep = check_endurance(ft, endurance_s=opt.endurance_s, reserve=opt.reserve)
-    if rep.warning:
-        warnings.append(rep.warning)
-    info["flight"] = {**rep.summary(), "climb_rate_mps": climb, "descent_rate_mps": descent,
-                      "forward_speed_mps": vmax,
-                      "note": "loiter end: time until the loiter starts" if end == "loiter"
-                      else ("rtl: straight line home at the forward speed" if end == "rtl"
-                            else "")}
-    if times is not None:  # the route from leaving the start (after any start hold)
-        route_t = float(ft.leg_time.sum() + holds[0] - float(start_hold))
-        info["timing"]["mission_route_s"] = round(route_t, 2)
-        info["timing"]["error_s"] = round(route_t - info["timing"]["planned_s"], 2)
-    info["speed_changes"] = {"items": len(changes),
-                             "speeds_mps": sorted({round(v, 3) for _, v in changes}),
+    info, endurance_warning = _flight(wps, opt, end, sp, start_hold)
+    if endurance_warning:
+        warnings.append(endurance_warning)
+    info["speed_changes"] = {"items": len(sp.changes),
+                             "speeds_mps": sorted({round(v, 3) for _, v in sp.changes}),
                              "step_mps": opt.speed_step,
                              "enabled": bool(opt.speed_changes or times is not None)}
     if camera is not None:
@@ -689,13 +738,7 @@ def build_mission(
     if wps.legs is not None:
         info["legs"] = wps.legs
     if via_idx:
-        info["via_waypoints"] = [int(np.searchsorted(idx, i)) for i in via_idx]
-    if not getattr(world, "crs", None):
-        a = opt.anchor or DEFAULT_ANCHOR
-        warnings.insert(0, "synthetic world without CRS: its relief is made up and placed at the "
-                        f"anchor lon {a.lon:g}, lat {a.lat:g}, alt {a.alt:g} m (world.anchor / "
-                        "--anchor): it is not the real terrain there, so the altitudes do not "
-                        "clear the real ground — do not fly this mission as it is")
+        info["via_waypoints"] = [int(np.searchsorted(wps.indices, i)) for i in via_idx]
     return MissionExport(items=items, waypoints=wps, options=opt, frame=frame, end=end,
                          path_m=p, world=world, warnings=warnings, info=info,
                          fences=fence_list)
