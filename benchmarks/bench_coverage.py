@@ -16,6 +16,7 @@ from ._timing import median_time
 
 
 def run(quick: bool = False) -> list[dict]:
+    from fm2uav import FlightLevel
     from fm2uav.missions.coverage import ZigzagCost, differential_evolution, plan_coverage, scipy_de
     from fm2uav.scenarios.coverage import (
         COVERAGE_AGL,
@@ -30,7 +31,8 @@ def run(quick: bool = False) -> list[dict]:
     world = coverage_world(0)
     rows = []
     # warm-up: numba kernels, shapely, the world's caches
-    plan_coverage(world, coverage_area("S1"), COVERAGE_SPACING, agl=COVERAGE_AGL)
+    level = FlightLevel(agl=COVERAGE_AGL)
+    plan_coverage(world, coverage_area("S1"), COVERAGE_SPACING, level=level)
     for n in names:
         poly = coverage_area(n)
         f = ZigzagCost.of(poly, COVERAGE_SPACING)
@@ -39,8 +41,8 @@ def run(quick: bool = False) -> list[dict]:
         rows.append({"benchmark": "coverage_de", "case": f"{n} D=80 Np=20 G=30",
                      "ours_s": de, "peer": "scipy DE (same settings)", "peer_s": sp,
                      "ratio": sp / de, "bar": "<= 0.3 s (seeds 3.79 s)"})
-        whole = median_time(lambda: plan_coverage(world, poly, COVERAGE_SPACING, agl=COVERAGE_AGL),
-                        repeats)[0]
+        whole = median_time(lambda: plan_coverage(world, poly, COVERAGE_SPACING, level=level),
+                            repeats)[0]
         rows.append({"benchmark": "coverage_plan", "case": f"{n} 118x87x40 agl=100",
                      "ours_s": whole, "peer": "seeds (Matlab, DE + FM²)", "peer_s": 3.79 + 0.36,
                      "ratio": (3.79 + 0.36) / whole, "bar": "<= 1 s",

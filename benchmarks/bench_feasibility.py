@@ -18,7 +18,7 @@ import numpy as np
 
 
 def run(quick: bool = False) -> list[dict]:
-    from fm2uav import World, plan
+    from fm2uav import Shaping, World, plan
     from fm2uav.experiments.city import city_missions, horizontal_slice
     from fm2uav.baselines.rrt import plan_rrt
     from fm2uav.vehicles import check_feasibility
@@ -42,8 +42,9 @@ def run(quick: bool = False) -> list[dict]:
         def fresh() -> World:
             return World(base.occupancy, spacing=base.spacing, origin=base.origin)
 
-        plan(fresh(), s, g, exponent=1.0, walls=True)  # JIT warm-up
-        fm_s, p = median_time(lambda: plan(fresh(), s, g, exponent=1.0, walls=True), repeats)
+        shaping = Shaping(exponent=1.0, walls=True)
+        plan(fresh(), s, g, shaping=shaping)  # JIT warm-up
+        fm_s, p = median_time(lambda: plan(fresh(), s, g, shaping=shaping), repeats)
         for name in planners:
             budget = 1.0 if name == "rrtstar" else 10.0
             plan_rrt(base, s, g, planner=name, time_limit=budget)  # warm-up
@@ -61,8 +62,8 @@ def run(quick: bool = False) -> list[dict]:
             })
         path3 = p.path if p.path.shape[1] == 3 else np.column_stack(
             [p.path, np.full(len(p.path), float(sc.start[2]))])
-        check_feasibility(path3, "disco", world=sc.world, w=p.speed)
-        ck_s, rep = median_time(lambda: check_feasibility(path3, "disco", world=sc.world, w=p.speed),
+        check_feasibility(path3, "disco", world=sc.world, w=p.w)
+        ck_s, rep = median_time(lambda: check_feasibility(path3, "disco", world=sc.world, w=p.w),
                             repeats)
         rows.append({
             "benchmark": "feasibility/dubins-check",

@@ -29,10 +29,10 @@ def run(quick: bool = False) -> list[dict]:
     repeats = 1 if quick else 3
     rows = []
     cases = [("fissure case 1 (no level)", {}, 130.6),
-             ("fissure case 2 (level 7)", {"agl": 105.0}, 135.6)]
+             ("fissure case 2 (level 7)", {"level": fm2uav.FlightLevel(agl=105.0, p2=1.5)}, 135.6)]
     if quick:
         cases = cases[1:]
-    fly_formation(world, sc.start, sc.goal, agl=105.0)  # JIT warm-up
+    fly_formation(world, sc.start, sc.goal, **cases[-1][1])  # JIT warm-up
     last = None
     for name, kw, thesis in cases:
         def mission(kw=kw):
@@ -53,10 +53,8 @@ def run(quick: bool = False) -> list[dict]:
 
     # one UAV re-plan: window vs whole map, replayed from the flight's cycles
     r = last
-    maps = StaticMaps(world, saturation=1.0, exponent=1.0, method="edt", walls=False,
-                      clearance=r.params["clearance"], p1=r.params["p1"], p2=r.params["p2"],
-                      agl_mode=r.params["agl_mode"])
-    W = maps.speed(r.agl[1])
+    maps = StaticMaps(world, fm2uav.Shaping(), clearance=r.config.clearance)
+    W = maps.speed(r.levels[1])
     step = max(1, len(r.cycle_start) // (8 if quick else 30))
     n_sub = r.params["samples_per_cycle"]
     jobs = []

@@ -25,7 +25,7 @@ import numpy as np
 def _table1(quick: bool) -> list[dict]:
     from fm2uav.baselines.reference import build_primitives, dubins_length, reference_path
     from fm2uav.baselines.reference.lattice import DEFAULT_XI, default_radius
-    from fm2uav.planning import plan
+    from fm2uav.planning import Shaping, plan
     from fm2uav.world import World
     from fm2uav.scenarios.city2d import city2d_pairs, city2d_world
 
@@ -36,7 +36,8 @@ def _table1(quick: bool) -> list[dict]:
     alpha, beta = 0.5, 0.5
 
     # warm-up: JIT of both pipelines, control sets built (cached, not timed)
-    plan(world, starts[0], goals[0], saturation=alpha, exponent=beta)
+    shaping = Shaping(saturation=alpha, exponent=beta)
+    plan(world, starts[0], goals[0], shaping=shaping)
     xi_c = DEFAULT_XI / world.spacing[0]
     for m in models:
         build_primitives(m, xi_c, max_int=4, radius=default_radius(xi_c, 4, m))
@@ -44,7 +45,7 @@ def _table1(quick: bool) -> list[dict]:
     reference_path(tiny, (2, 2), (20, 20), model="dubins")
 
     fm2 = sum(
-        median_time(lambda s=s, g=g: plan(world, s, g, saturation=alpha, exponent=beta), 5)[0]
+        median_time(lambda s=s, g=g: plan(world, s, g, shaping=shaping), 5)[0]
         for s, g in zip(starts, goals)
     )
     rows = []

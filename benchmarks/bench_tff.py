@@ -23,11 +23,12 @@ def run(quick: bool = False) -> list[dict]:
     sc = fm2uav.scenarios.open_field()
     w = sc.world
     W = base_velocity(w)
+    level = fm2uav.FlightLevel(agl=150.0, p1=0.5, p2=1.3)
     rows.append({
         "benchmark": "tff", "case": "flight_level_speed open-field 120x90x40 (capped)",
-        "ours_s": median_time(lambda: flight_level_speed(W, w, 150.0, 0.5, 1.3), reps, warmup=True)[0],
+        "ours_s": median_time(lambda: flight_level_speed(W, w, level), reps, warmup=True)[0],
     })
-    tff = median_time(lambda: fm2uav.plan(w, sc.start, sc.goal, agl=150.0, p1=0.5, p2=1.3), reps, warmup=True)[0]
+    tff = median_time(lambda: fm2uav.plan(w, sc.start, sc.goal, level=level), reps, warmup=True)[0]
     plain = median_time(lambda: fm2uav.plan(w, sc.start, sc.goal), reps, warmup=True)[0]
     rows.append({
         "benchmark": "tff", "case": "plan open-field level 10 (0.5, 1.3)", "ours_s": tff,
@@ -45,7 +46,9 @@ def run(quick: bool = False) -> list[dict]:
                                            bounds=bounds), 3, warmup=True)[0],
     })
     jb = fm2uav.scenarios.get_scenario("jacksboro")
-    tff = median_time(lambda: fm2uav.plan(jb.world, jb.start, jb.goal, agl=300.0, p1=0.5, p2=1.3), 3, warmup=True)[0]
+    jb_level = fm2uav.FlightLevel(agl=300.0, p1=0.5, p2=1.3)
+    tff = median_time(lambda: fm2uav.plan(jb.world, jb.start, jb.goal, level=jb_level), 3,
+                      warmup=True)[0]
     plain = median_time(lambda: fm2uav.plan(jb.world, jb.start, jb.goal), 3, warmup=True)[0]
     rows.append({
         "benchmark": "tff", "case": "plan jacksboro 194x206x49 agl 300 m (0.5, 1.3)",

@@ -25,7 +25,14 @@ from .errors import (
     UnreachableError,
     WorldError,
 )
-from .missions import CoveragePlan, FormationResult, fly_formation, plan_coverage, zigzag
+from .missions import (
+    CoveragePlan,
+    FormationConfig,
+    FormationResult,
+    fly_formation,
+    plan_coverage,
+    zigzag,
+)
 from .planning import FlightLevel, Plan, PlanOptions, Shaping, plan
 from .scenarios import Scenario
 from .vehicles import AIRFRAMES, FeasibilityReport, check_feasibility, get_airframe
@@ -73,6 +80,7 @@ __all__ = [
     "CoveragePlan",
     "zigzag",
     "fly_formation",
+    "FormationConfig",
     "FormationResult",
     # vehicles / analysis
     "check_feasibility",

@@ -18,6 +18,7 @@ __all__ = [
     "as_path",
     "as_path3",
     "arc_length",
+    "path_length",
     "resample_path",
     "resample_uniform",
     "circumcurvature",
@@ -83,6 +84,11 @@ def arc_length(path: np.ndarray) -> np.ndarray:
     """Cumulative arc length [m] at each point, starting at 0."""
     seg = np.linalg.norm(np.diff(path, axis=0), axis=1)
     return np.concatenate([[0.0], np.cumsum(seg)])
+
+
+def path_length(path: np.ndarray) -> float:
+    """Total length [m] of a polyline ``(N, d)`` (sum of its segment lengths)."""
+    return float(np.sum(np.linalg.norm(np.diff(np.asarray(path, dtype=float), axis=0), axis=1)))
 
 
 def resample_uniform(path: np.ndarray, ds: float) -> tuple[np.ndarray, np.ndarray]:

@@ -4,7 +4,17 @@ import numpy as np
 import pytest
 
 import fm2uav
-from fm2uav import InputError, Plan, PlanningError, PointError, UnreachableError, World, plan
+from fm2uav import (
+    InputError,
+    Plan,
+    PlanningError,
+    PlanOptions,
+    PointError,
+    Shaping,
+    UnreachableError,
+    World,
+    plan,
+)
 from fm2uav.world import clearance_profile
 
 
@@ -40,8 +50,8 @@ def test_clearance_and_speed_are_consistent(wall_world):
     p = plan(wall_world, (5.0, 5.0), (35.0, 5.0))
     assert p.clearance == pytest.approx(clearance_profile(wall_world, p.path).min())
     assert p.clearance > 0
-    assert p.speed.shape == (len(p.path),)
-    assert np.all((p.speed > 0) & (p.speed <= 1))
+    assert p.w.shape == (len(p.path),)
+    assert np.all((p.w > 0) & (p.w <= 1))
     assert set(p.timings) == {"velocity_map", "fast_marching", "geodesic", "metrics", "total"}
 
 
@@ -63,8 +73,8 @@ def test_exponent_trades_clearance_for_length():
     occ[25:35, 0:22] = True
     occ[25:35, 30:40] = True
     w = World(occ, spacing=1.0)
-    lo = plan(w, (5.0, 5.0), (55.0, 5.0), exponent=0.25)
-    hi = plan(w, (5.0, 5.0), (55.0, 5.0), exponent=4.0)
+    lo = plan(w, (5.0, 5.0), (55.0, 5.0), shaping=Shaping(exponent=0.25))
+    hi = plan(w, (5.0, 5.0), (55.0, 5.0), shaping=Shaping(exponent=4.0))
     assert lo.length < hi.length
     gap_lo = lo.path[(lo.path[:, 0] > 26) & (lo.path[:, 0] < 34)]
     gap_hi = hi.path[(hi.path[:, 0] > 26) & (hi.path[:, 0] < 34)]
@@ -77,7 +87,7 @@ def test_saturation_shortens_path():
     occ[25:35, 0:22] = True
     w = World(occ, spacing=1.0)
     full = plan(w, (5.0, 5.0), (55.0, 5.0))
-    sat = plan(w, (5.0, 5.0), (55.0, 5.0), saturation=0.2)
+    sat = plan(w, (5.0, 5.0), (55.0, 5.0), shaping=Shaping(saturation=0.2))
     assert sat.length < full.length
 
 
@@ -90,15 +100,13 @@ def test_deterministic(wall_world):
 @pytest.mark.parametrize("order", [1, 2])
 def test_open_field_path_is_safe(order):
     sc = fm2uav.scenarios.open_field()
-    p = plan(sc.world, sc.start, sc.goal, order=order)
+    p = plan(sc.world, sc.start, sc.goal, options=PlanOptions(order=order))
     np.testing.assert_allclose(p.path[0], sc.start)
     np.testing.assert_allclose(p.path[-1], sc.goal)
     nodes = _nearest_nodes(sc.world, p.path)
     assert not sc.world.occupancy[tuple(nodes.T)].any()
     # every point is above the terrain
-    from fm2uav.world.ground import terrain_along
-
-    assert np.all(p.path[:, 2] > terrain_along(sc.world, p.path))
+    assert np.all(p.path[:, 2] > sc.world.ground_height(p.path[:, 0], p.path[:, 1]))
     assert p.clearance > 15.0  # at least one cell away from the ground
     straight = np.linalg.norm(sc.goal - sc.start)
     assert straight <= p.length <= 1.5 * straight
@@ -107,10 +115,10 @@ def test_open_field_path_is_safe(order):
 def test_custom_speed_map_is_used(wall_world):
     W = np.ones(wall_world.shape)
     W[wall_world.occupancy] = 0
-    p = plan(wall_world, (5.0, 5.0), (35.0, 5.0), speed_map=W)
+    p = plan(wall_world, (5.0, 5.0), (35.0, 5.0), options=PlanOptions(speed_map=W))
     assert p.params["custom_speed_map"]
     with pytest.raises(InputError, match="speed_map has shape"):
-        plan(wall_world, (5.0, 5.0), (35.0, 5.0), speed_map=np.ones((3, 3)))
+        plan(wall_world, (5.0, 5.0), (35.0, 5.0), options=PlanOptions(speed_map=np.ones((3, 3))))
 
 
 def test_start_outside_map(wall_world):
@@ -154,3 +162,34 @@ def test_bad_points(wall_world, start, phrase):
 def test_world_type_checked():
     with pytest.raises(InputError, match="fm2uav.World"):
         plan(np.zeros((3, 3), bool), (0, 0), (1, 1))
+
+
+def test_objects_are_type_checked(wall_world):
+    with pytest.raises(InputError, match="shaping must be a fm2uav.Shaping"):
+        plan(wall_world, (5.0, 5.0), (35.0, 5.0), shaping={"exponent": 2.0})
+    with pytest.raises(InputError, match="level must be a fm2uav.FlightLevel"):
+        plan(wall_world, (5.0, 5.0), (35.0, 5.0), level=150.0)
+    with pytest.raises(InputError, match="options must be a fm2uav.PlanOptions"):
+        plan(wall_world, (5.0, 5.0), (35.0, 5.0), options=None)
+
+
+def test_plan_records_its_objects_and_w(wall_world):
+    s = Shaping(exponent=2.0)
+    p = plan(wall_world, (5.0, 5.0), (35.0, 5.0), shaping=s)
+    assert p.shaping is s and p.level is None
+    assert p.params["exponent"] == 2.0 and "agl" not in p.params
+    assert p.summary()["min_w"] == round(float(p.w.min()), 6)
+
+
+def test_saturation_distance_is_the_share_of_the_largest_distance(wall_world):
+    """W = min(d / d_sat, 1): d_sat = alpha * max(d) gives the same map as alpha."""
+    from fm2uav.planning import max_distance, shaped_velocity
+
+    top = max_distance(wall_world)
+    a = shaped_velocity(wall_world, Shaping(saturation=0.5, exponent=2.0))
+    b = shaped_velocity(wall_world, Shaping(saturation_distance=0.5 * top, exponent=2.0))
+    np.testing.assert_allclose(a, b, rtol=1e-12, atol=1e-15)
+    p = plan(wall_world, (5.0, 5.0), (35.0, 5.0), shaping=Shaping(saturation_distance=3.0))
+    q = plan(wall_world, (5.0, 5.0), (35.0, 5.0), shaping=Shaping(saturation=3.0 / top))
+    np.testing.assert_allclose(p.path, q.path, atol=1e-9)
+    assert p.params["saturation_distance"] == 3.0

@@ -7,7 +7,7 @@ import pytest
 import shapely
 from shapely.geometry import Polygon
 
-from fm2uav import InputError, World
+from fm2uav import FlightLevel, InputError, World
 from fm2uav.missions.coverage import plan_coverage, zigzag
 from fm2uav.missions.coverage.grid import corridor_grid
 from fm2uav.scenarios.coverage import coverage_world
@@ -61,7 +61,7 @@ def test_corridor_grid_geometry_exact():
 
 def test_flat_world_path_is_the_zigzag_at_the_level():
     world = _flat(50.0)
-    cp = plan_coverage(world, RECT, 80.0, agl=100.0)
+    cp = plan_coverage(world, RECT, 80.0, level=FlightLevel(agl=100.0))
     zz = shapely.LineString(cp.zigzag.path(step=1.0))
     d = shapely.distance(shapely.points(cp.path[:, :2]), zz)
     assert d.max() < 0.2  # the ground track is the zigzag (its arcs sampled)
@@ -78,7 +78,7 @@ def test_obstacle_beside_a_band_is_not_entered():
     occ = World.from_heightmap(h, 10.0, 30).occupancy.copy()
     occ[29:32, 15, :26] = True
     world = World(occ, spacing=10.0, terrain=h)
-    cp = plan_coverage(world, RECT, 80.0, agl=100.0, angle=0.0)
+    cp = plan_coverage(world, RECT, 80.0, level=FlightLevel(agl=100.0), angle=0.0)
     assert not _in_obstacle(world, cp.path).any()
     assert cp.plan.clearance > 5.0
     assert cp.coverage >= 0.995
@@ -87,9 +87,9 @@ def test_obstacle_beside_a_band_is_not_entered():
 def test_bad_grid_options():
     world = _flat()
     with pytest.raises(InputError, match="grid"):
-        plan_coverage(world, RECT, 80.0, agl=100.0, grid="bands")
+        plan_coverage(world, RECT, 80.0, level=FlightLevel(agl=100.0), grid="bands")
     with pytest.raises(InputError, match="corridor"):
-        plan_coverage(world, RECT, 80.0, agl=100.0, corridor=0.5)
+        plan_coverage(world, RECT, 80.0, level=FlightLevel(agl=100.0), corridor=0.5)
 
 
 def _map_polygon(rng, holes):
@@ -121,7 +121,7 @@ def test_random_polygons_flown_path_covers_the_area():
     for k in range(10):
         p = _map_polygon(rng, holes=k % 2 == 1)
         d = float(rng.uniform(40, 100))
-        cp = plan_coverage(world, p, d, agl=100.0, seed=k)
+        cp = plan_coverage(world, p, d, level=FlightLevel(agl=100.0), seed=k)
         worst = min(worst, cp.coverage)
         assert cp.coverage >= 0.995, (k, d, cp.coverage)
         assert cp.zigzag_coverage >= 0.999

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from fm2uav import World
+from fm2uav import FlightLevel, World
 from fm2uav.cli import app
 from fm2uav.missions.coverage import corridor_speed, plan_coverage, zigzag
 from fm2uav.scenarios.coverage import COVERAGE_AREAS, coverage_area, coverage_world
@@ -29,7 +29,8 @@ def test_scenario_registered():
                                                    ("S1", "world", "map", 0.97)])
 def test_coverage_plan_end_to_end(name, base, grid, bar):
     world = coverage_world(0)
-    cp = plan_coverage(world, coverage_area(name), 80.0, agl=100.0, level_base=base, grid=grid)
+    cp = plan_coverage(world, coverage_area(name), 80.0, level=FlightLevel(agl=100.0),
+                       level_base=base, grid=grid)
     assert cp.zigzag_coverage > 0.999
     # the seeds' W0 on the map's grid drifts off the slanted bands (~98-99.6 %);
     # the unrolled corridor keeps the ground track on the zigzag

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from shapely.geometry import MultiPolygon, Polygon
 
-from fm2uav import InputError, World
+from fm2uav import FlightLevel, InputError, World
 from fm2uav.missions.coverage import as_area, plan_coverage, zigzag
 from fm2uav.missions.coverage.area import check_inside_world
 
@@ -56,4 +56,5 @@ def test_area_outside_map():
         check_inside_world(as_area([(50, 50), (150, 50), (150, 80)]), world)
     terrain = World.from_heightmap(np.full((20, 20), 5.0), 10.0, 12)
     with pytest.raises(InputError, match="outside the map"):
-        plan_coverage(terrain, [(500, 500), (600, 500), (600, 600)], 20.0, agl=30.0)
+        plan_coverage(terrain, [(500, 500), (600, 500), (600, 600)], 20.0,
+                      level=FlightLevel(agl=30.0))

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import fm2uav
-from fm2uav import World
+from fm2uav import FlightLevel, World
 from fm2uav.missions.formation import fly_formation
 
 
@@ -34,7 +34,8 @@ def fissure():
 @pytest.fixture(scope="session")
 def fissure_level(fissure):
     """Thesis case 2 (flight level 7 cells) with the planner's p1/p2."""
-    return fly_formation(fissure.world, fissure.start, fissure.goal, agl=7 * 15.0)
+    return fly_formation(fissure.world, fissure.start, fissure.goal,
+                         level=FlightLevel(agl=7 * 15.0, p2=1.5))
 
 
 @pytest.fixture(scope="session")

@@ -7,6 +7,7 @@ import numpy as np
 from typer.testing import CliRunner
 
 from fm2uav.cli import app
+from fm2uav import FormationConfig
 from fm2uav.missions.formation import fly_formation
 from fm2uav.viz.formation import (
     formation_animation,
@@ -52,8 +53,8 @@ def test_formation_cli_bad_input_exit_codes(tmp_path):
 
 
 def test_figures_and_gif(corridor, tmp_path):
-    r = fly_formation(corridor, (50.0, 200.0, 60.0), (550.0, 200.0, 60.0), dist=20.0,
-                      leader_speed=8.0, clearance=20.0)
+    r = fly_formation(corridor, (50.0, 200.0, 60.0), (550.0, 200.0, 60.0),
+                      config=FormationConfig(dist=20.0, leader_speed=8.0, clearance=20.0))
     for make in (formation_paths_figure, formation_profiles_figure, formation_metrics_figure):
         fig = make(r)
         assert len(fig.axes) >= 2

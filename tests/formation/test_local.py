@@ -3,13 +3,12 @@
 import numpy as np
 import pytest
 
-from fm2uav import World
+from fm2uav import Shaping, World
 from fm2uav.missions.formation import StaticMaps, formation_shape, grey_levels, local_path
 
 
 def _maps(world, clearance=20.0):
-    return StaticMaps(world, saturation=1.0, exponent=1.0, method="edt", walls=False,
-                      clearance=clearance, p1=0.5, p2=1.5)
+    return StaticMaps(world, Shaping(), clearance=clearance)
 
 
 @pytest.fixture(scope="module")

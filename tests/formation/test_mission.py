@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from fm2uav import InputError, PointError, UnreachableError, World
+from fm2uav import FlightLevel, FormationConfig, InputError, PointError, UnreachableError, World
 from fm2uav.analysis.flight_level import flight_level_deviation
 from fm2uav.missions.formation import (
     fly_formation,
@@ -67,8 +67,8 @@ def test_cycles_cost_milliseconds_and_use_windows(fissure_free):
 
 
 def test_corridor_narrows_the_formation_then_it_reforms(corridor):
-    r = fly_formation(corridor, (50.0, 200.0, 60.0), (550.0, 200.0, 60.0), dist=20.0,
-                      leader_speed=8.0, clearance=20.0)
+    r = fly_formation(corridor, (50.0, 200.0, 60.0), (550.0, 200.0, 60.0),
+                      config=FormationConfig(dist=20.0, leader_speed=8.0, clearance=20.0))
     _assert_safe(r)
     x = r.positions[:, 0, 0]
     in_corridor = (x > 260) & (x < 380)
@@ -81,19 +81,21 @@ def test_corridor_narrows_the_formation_then_it_reforms(corridor):
 
 @pytest.mark.parametrize("shape,n", [("v", 4), ("line", 3), ("triangle", 3)])
 def test_other_shapes_on_the_fissure(fissure, shape, n):
-    r = fly_formation(fissure.world, fissure.start, fissure.goal, shape=shape, n_followers=n,
-                      dist=45.0, agl=105.0)
+    r = fly_formation(fissure.world, fissure.start, fissure.goal,
+                      config=FormationConfig(shape=shape, n_followers=n, dist=45.0),
+                      level=FlightLevel(agl=105.0, p2=1.5))
     _assert_safe(r)
     assert r.positions.shape[1] == n + 1
 
 
 def test_literal_grey_mode_is_safe_too(fissure):
-    r = fly_formation(fissure.world, fissure.start, fissure.goal, agl=105.0, grey="follower")
+    r = fly_formation(fissure.world, fissure.start, fissure.goal,
+                      config=FormationConfig(grey="follower"), level=FlightLevel(agl=105.0, p2=1.5))
     _assert_safe(r)
 
 
 def test_same_input_same_output(corridor):
-    kw = dict(dist=20.0, leader_speed=8.0, clearance=20.0)
+    kw = dict(config=FormationConfig(dist=20.0, leader_speed=8.0, clearance=20.0))
     a = fly_formation(corridor, (50.0, 200.0, 60.0), (550.0, 200.0, 60.0), **kw)
     b = fly_formation(corridor, (50.0, 200.0, 60.0), (550.0, 200.0, 60.0), **kw)
     np.testing.assert_array_equal(a.positions, b.positions)
@@ -128,7 +130,8 @@ def test_unreachable_goal():
     h[20:25, 20:25] = 0.0
     w = World.from_heightmap(h, 10.0, 11)
     with pytest.raises(UnreachableError):
-        fly_formation(w, (50.0, 50.0, 50.0), (220.0, 220.0, 50.0), dist=20.0, clearance=20.0)
+        fly_formation(w, (50.0, 50.0, 50.0), (220.0, 220.0, 50.0),
+                      config=FormationConfig(dist=20.0, clearance=20.0))
 
 
 def test_goal_inside_terrain(fissure):
@@ -138,17 +141,35 @@ def test_goal_inside_terrain(fissure):
         fly_formation(fissure.world, fissure.start, g)
 
 
-@pytest.mark.parametrize("kw,match", [
-    (dict(dist=0.0), "dist"),
-    (dict(cycle=-1.0), "cycle"),
-    (dict(shape="circle"), "shape"),
-    (dict(follower_starts=[[1.0, 2.0, 3.0]]), "follower_starts"),
-    (dict(grey="average"), "grey"),
-    (dict(agl=10.0), "clearance"),
+@pytest.mark.parametrize("make,match", [
+    (lambda: dict(config=FormationConfig(dist=0.0)), "dist"),
+    (lambda: dict(config=FormationConfig(cycle=-1.0)), "cycle"),
+    (lambda: dict(config=FormationConfig(shape="circle")), "shape"),
+    (lambda: dict(config=FormationConfig(window=0)), "window"),
+    (lambda: dict(config=FormationConfig(n_followers=0)), "n_followers"),
+    (lambda: dict(follower_starts=[[1.0, 2.0, 3.0]]), "follower_starts"),
+    (lambda: dict(config=FormationConfig(grey="average")), "grey"),
+    (lambda: dict(level=FlightLevel(agl=10.0)), "clearance"),
+    (lambda: dict(level=105.0), "FlightLevel"),
+    (lambda: dict(follower_levels=[FlightLevel(agl=105.0)]), "follower_levels"),
+    (lambda: dict(config={"dist": 20.0}), "FormationConfig"),
 ])
-def test_bad_parameters(fissure, kw, match):
+def test_bad_parameters(fissure, make, match):
     with pytest.raises(InputError, match=match):
-        fly_formation(fissure.world, fissure.start, fissure.goal, **kw)
+        fly_formation(fissure.world, fissure.start, fissure.goal, **make())
+
+
+def test_follower_levels_one_per_follower():
+    """A follower without a level flies at the leader's height, one with a level at its own."""
+    flat = World.from_heightmap(np.zeros((40, 30)), 10.0, 12)
+    cfg = FormationConfig(dist=20.0, leader_speed=8.0, clearance=20.0)
+    r = fly_formation(flat, (50.0, 150.0, 70.0), (350.0, 150.0, 70.0), config=cfg,
+                      follower_levels=[None, FlightLevel(agl=40.0, p2=1.5)])
+    _assert_safe(r)
+    assert r.agl == (None, None, 40.0)
+    np.testing.assert_allclose(r.partial_goals[:, 1, 2], r.partial_goals[:, 0, 2])
+    np.testing.assert_allclose(r.partial_goals[:, 2, 2], 40.0)
+    assert r.config.follower_speed == 12.0 and r.config.max_cycles is not None
 
 
 def test_2d_world_is_refused():

@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.ndimage import gaussian_filter
 
-from fm2uav import World
+from fm2uav import FlightLevel, FormationConfig, World
 from fm2uav.missions.formation import fly_formation, inside_terrain, min_separation
 
 CELL = 10.0
@@ -49,8 +49,10 @@ def test_random_terrain_flights_are_safe(seed, relief, shape, n, level, dist, sp
     world = random_world(seed, relief)
     start = (90.0, y0, _height_over(world, 90.0, y0, 40.0))
     goal = (420.0, y1, _height_over(world, 420.0, y1, 40.0))
-    r = fly_formation(world, start, goal, shape=shape, n_followers=n, agl=level, dist=dist,
-                      leader_speed=speed, clearance=20.0)
+    cfg = FormationConfig(shape=shape, n_followers=n, dist=dist, leader_speed=speed,
+                          clearance=20.0)
+    r = fly_formation(world, start, goal, config=cfg,
+                      level=None if level is None else FlightLevel(agl=level, p2=1.5))
     assert r.completed
     d, _, _ = min_separation(r.positions)
     assert d >= dist / 2

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from fm2uav import World, plan
+from fm2uav import FlightLevel, World, plan
 
 
 def hill_world(crs=None, origin=(0.0, 0.0, 0.0)) -> World:
@@ -31,4 +31,5 @@ def hill_plan(hill):
 @pytest.fixture(scope="session")
 def hill_tff(hill):
     """A terrain-following plan (60 m above ground) across the hill."""
-    return plan(hill, (20.0, 20.0, 70.0), (380.0, 280.0, 70.0), agl=60.0)
+    return plan(hill, (20.0, 20.0, 70.0), (380.0, 280.0, 70.0),
+                level=FlightLevel(agl=60.0, p2=1.5))

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from pyproj import Geod, Transformer
 
-from fm2uav import World
+from fm2uav import PlanOptions, World
 from fm2uav.errors import InputError, WorldError
 from fm2uav.io import DEFAULT_ANCHOR, Anchor, from_lonlat, ground_height, to_lonlat
 
@@ -70,5 +70,5 @@ def test_same_as_plan_lonlat_on_the_real_dem():
 
     sc = get_scenario("jacksboro")
     w = sc.world
-    p = plan(w, sc.start, sc.goal, step=1.0)
+    p = plan(w, sc.start, sc.goal, options=PlanOptions(step=1.0))
     np.testing.assert_allclose(to_lonlat(p.path, w), p.lonlat(), atol=1e-12)

@@ -165,14 +165,14 @@ def test_bspline_weights_partition_of_unity():
 
 # --------------------------------------------------------------------------- end to end
 def test_terrain_following_plan_is_smooth_and_on_the_level():
-    """plan(agl=...) on sloped, wavy terrain (one-cell level, strong p2)."""
+    """plan(level=...) on sloped, wavy terrain (one-cell level, strong p2)."""
     x = np.arange(60) * 10.0
     y = np.arange(30) * 10.0
     heights = 30.0 + 0.25 * x[:, None] + 0.1 * y[None, :] + 6.0 * np.sin(y[None, :] / 40.0)
     w = World.from_heightmap(heights, 10.0, 40)
     start = (40.0, 150.0, float(w.terrain[4, 15]) + 25.0)
     goal = (550.0, 150.0, float(w.terrain[55, 15]) + 25.0)
-    p = fm2uav.plan(w, start, goal, agl=20.0, p1=0.5, p2=2.5)
+    p = fm2uav.plan(w, start, goal, level=fm2uav.FlightLevel(agl=20.0, p1=0.5, p2=2.5))
     assert np.array_equal(p.path[0], start) and np.array_equal(p.path[-1], goal)
     r = flight_level_deviation(w, p.path, 20.0)
     assert r.inside_terrain == 0 and r.within >= 0.9, r.summary()

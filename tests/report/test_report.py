@@ -6,7 +6,7 @@ import re
 import numpy as np
 import pytest
 
-from fm2uav import World, plan
+from fm2uav import FlightLevel, World, plan
 from fm2uav.viz.report import plan_report, report_html, write_report
 
 from .cdp import Browser, find_chromium
@@ -20,7 +20,7 @@ def hill_plan():
     y = np.arange(31)[None, :] * 10.0
     h = 10.0 + 80.0 * np.exp(-((x - 200) ** 2 + (y - 150) ** 2) / (2 * 70.0**2))
     w = World.from_heightmap(h, 10.0, 24, name="hill")
-    return plan(w, (20.0, 20.0, 70.0), (380.0, 280.0, 70.0), agl=60.0)
+    return plan(w, (20.0, 20.0, 70.0), (380.0, 280.0, 70.0), level=FlightLevel(agl=60.0, p2=1.5))
 
 
 def _scripts(html):

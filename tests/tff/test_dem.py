@@ -148,7 +148,7 @@ def _plan_and_check(w, agl, start_ij, goal_ij, p1=0.5, p2=1.3, above=None):
         return np.array([w.origin[0] + i * w.spacing[0], w.origin[1] + j * w.spacing[1],
                          w.terrain[i, j] + above])
 
-    p = fm2uav.plan(w, pt(*start_ij), pt(*goal_ij), agl=agl, p1=p1, p2=p2)
+    p = fm2uav.plan(w, pt(*start_ij), pt(*goal_ij), level=fm2uav.FlightLevel(agl=agl, p1=p1, p2=p2))
     r = flight_level_deviation(w, p.path, agl)
     assert r.inside_terrain == 0
     assert r.within >= 0.8, r.summary()
@@ -172,6 +172,6 @@ def test_jacksboro_scenario_follows_the_terrain():
     assert np.all((-84.414 < ll[:, 0]) & (ll[:, 0] < -84.078))
     assert np.all((36.446 < ll[:, 1]) & (ll[:, 1] < 36.733))
     for agl, p2 in ((300.0, 1.3), (150.0, 1.5)):
-        p = fm2uav.plan(w, sc.start, sc.goal, agl=agl, p1=0.5, p2=p2)
+        p = fm2uav.plan(w, sc.start, sc.goal, level=fm2uav.FlightLevel(agl=agl, p1=0.5, p2=p2))
         r = flight_level_deviation(w, p.path, agl)
         assert r.inside_terrain == 0 and r.within >= 0.8, r.summary()

@@ -13,6 +13,7 @@ from fm2uav.analysis import flight_level_deviation, path_profiles
 from fm2uav.geometry import menger_curvature, resample_path
 from fm2uav.errors import InputError
 from fm2uav.analysis.tune import AirframeLimits, as_limits, tune
+from fm2uav import FlightLevel
 
 
 def test_resample_keeps_ends_and_step():
@@ -108,8 +109,8 @@ def open_field():
 def test_tune_trade_off(open_field):
     sc = open_field
     grid = {"p1": [0.5], "p2": [0.6, 0.8, 1.3, 2.5]}
-    loose = tune(sc.world, sc.start, sc.goal, (89.9, 0.0), 150.0, grid=grid)
-    strict = tune(sc.world, sc.start, sc.goal, (25.0, 200.0), 150.0, grid=grid)
+    loose = tune(sc.world, sc.start, sc.goal, (89.9, 0.0), FlightLevel(agl=150.0), grid=grid)
+    strict = tune(sc.world, sc.start, sc.goal, (25.0, 200.0), FlightLevel(agl=150.0), grid=grid)
     assert len(loose.rows) == 4 and all(r["error"] is None for r in loose.rows)
     # with no limits the best is the closest follower; with tight limits a smoother one
     assert loose.best["deviation_m"] == min(r["deviation_m"] for r in loose.rows)
@@ -126,9 +127,10 @@ def test_tune_trade_off(open_field):
                         and b["min_turn_radius_m"] > a["min_turn_radius_m"])
     assert "| p1 | p2 |" in strict.table()
     with pytest.raises(InputError, match="p2 > p1"):
-        tune(sc.world, sc.start, sc.goal, (30, 10), 150.0, grid={"p1": [1.0], "p2": [0.5]})
+        tune(sc.world, sc.start, sc.goal, (30, 10), FlightLevel(agl=150.0),
+             grid={"p1": [1.0], "p2": [0.5]})
     with pytest.raises(InputError, match="grid 'p1'"):
-        tune(sc.world, sc.start, sc.goal, (30, 10), 150.0, grid={"p1": [-1.0]})
+        tune(sc.world, sc.start, sc.goal, (30, 10), FlightLevel(agl=150.0), grid={"p1": [-1.0]})
 
 
 def _cli(args):

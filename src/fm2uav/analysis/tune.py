@@ -21,6 +21,7 @@ describe.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from dataclasses import dataclass, field
@@ -32,7 +33,7 @@ from .flight_level import flight_level_deviation
 from .profiles import path_profiles
 from ..errors import InputError, PlanningError
 from ..world import World
-from ..planning.planner import Plan, plan
+from ..planning import FlightLevel, Plan, PlanOptions, Shaping, plan
 
 __all__ = ["AirframeLimits", "TuneResult", "tune", "as_limits", "DEFAULT_GRID"]
 
@@ -163,11 +164,12 @@ def tune(
     start: Any,
     goal: Any,
     airframe_limits: Any,
-    agl: float,
+    level: FlightLevel,
     *,
     grid: dict[str, Any] | None = None,
     ds: float | None = None,
-    **plan_kwargs: Any,
+    shaping: Shaping = Shaping(),
+    options: PlanOptions = PlanOptions(),
 ) -> TuneResult:
     """Search p1/p2 (and α/β) for the terrain-following path an airframe can fly.
 
@@ -179,16 +181,20 @@ def tune(
         World points [m].
     airframe_limits : AirframeLimits, dict, pair or airframe
         Max climb angle [deg] and min turn radius [m] (see :func:`as_limits`).
-    agl : float
-        Flight level over the ground [m].
+    level : FlightLevel
+        The flight level; its ``p1`` and ``p2`` are replaced by the grid's
+        values, the rest (``agl``, ``band``, ``mode``, ...) is kept.
     grid : dict, optional
         Values to try for ``p1``, ``p2``, ``saturation``, ``exponent``; missing
         keys take :data:`DEFAULT_GRID`. Pairs with ``p2 <= p1`` are skipped
         (they do not clarify the level).
     ds : float, optional
         Resampling step of the profiles [m]; default two horizontal cells.
-    **plan_kwargs
-        Passed to :func:`~fm2uav.planning.plan` (e.g. ``agl_band``, ``agl_mode``).
+    shaping : Shaping, optional
+        Shaping of W; its ``saturation`` and ``exponent`` are replaced by the
+        grid's values (method, walls, saturation_distance kept).
+    options : PlanOptions, optional
+        Passed to :func:`~fm2uav.planning.plan` (order, step).
 
     Returns
     -------
@@ -197,7 +203,7 @@ def tune(
     Raises
     ------
     InputError
-        Bad limits or grid.
+        Bad limits, grid or objects.
     PlanningError
         Bad start/goal or flight level (raised by the first plan).
 
@@ -205,11 +211,17 @@ def tune(
     --------
     >>> import fm2uav
     >>> sc = fm2uav.scenarios.open_field()
-    >>> res = tune(sc.world, sc.start, sc.goal, (30.0, 60.0), 150.0,
+    >>> res = tune(sc.world, sc.start, sc.goal, (30.0, 60.0), fm2uav.FlightLevel(agl=150.0),
     ...            grid={"p1": [0.5], "p2": [0.8, 1.3]})
     >>> len(res.rows)
     2
     """
+    if not isinstance(level, FlightLevel):
+        raise InputError(f"level must be a fm2uav.FlightLevel, got {type(level).__name__}; "
+                         "e.g. FlightLevel(agl=150.0)")
+    if not isinstance(shaping, Shaping):
+        raise InputError(f"shaping must be a fm2uav.Shaping, got {type(shaping).__name__}")
+    agl = level.agl
     limits = as_limits(airframe_limits)
     g = dict(DEFAULT_GRID)
     for k, v in (grid or {}).items():
@@ -223,9 +235,6 @@ def tune(
     step = float(ds) if ds is not None else 2.0 * max(world.spacing[:2])
     if not (np.isfinite(step) and step > 0):
         raise InputError(f"ds must be > 0 metres, got {ds!r}")
-    for bad in ("p1", "p2", "saturation", "exponent", "agl"):
-        if bad in plan_kwargs:
-            raise InputError(f"{bad} is searched or given by tune(); do not pass it in plan_kwargs")
 
     rows: list[dict[str, Any]] = []
     plans: list[Plan | None] = []
@@ -234,8 +243,9 @@ def tune(
             continue
         row: dict[str, Any] = {"p1": p1, "p2": p2, "saturation": sat, "exponent": beta}
         try:
-            pl = plan(world, start, goal, agl=agl, p1=p1, p2=p2, saturation=sat,
-                      exponent=beta, **plan_kwargs)
+            pl = plan(world, start, goal,
+                      shaping=dataclasses.replace(shaping, saturation=sat, exponent=beta),
+                      level=dataclasses.replace(level, p1=p1, p2=p2), options=options)
         except PlanningError as exc:
             if not rows:  # the first plan fails: bad start/goal/agl, not the parameters
                 raise

@@ -34,7 +34,7 @@ def _write_city_outputs(outdir: OutputDir, run, *, report: bool) -> None:
     rows = run.rows
     for c in run.cases:
         with outdir.open(f"{c.mission}_W{c.exponent:g}.csv") as fh:
-            write_path_csv(fh, c.path3, c.plan.speed)
+            write_path_csv(fh, c.path3, c.plan.w)
     _write_csv(outdir, "table.csv", rows)
     for mission in ("low", "high"):
         mc = [c for c in run.cases if c.mission == mission]

@@ -56,7 +56,7 @@ def _write_report(outdir: OutputDir, cp, *, title: str, subtitle: str, metrics: 
     name = "FM² path"
     html = report_html(
         cp.plan.world, {name: cp.path}, title=title, subtitle=subtitle,
-        speeds={name: cp.plan.speed}, ideal_agl={name: cp.params.get("agl_m")},
+        speeds={name: cp.plan.w}, ideal_agl={name: cp.level.agl},
         waypoints=None if waypoints is None else {name: waypoints},
         overlays=coverage_overlays(cp), params=cp.params, metrics=metrics, files=files)
     with outdir.open(REPORT) as fh:
@@ -76,7 +76,7 @@ def _write_cover_outputs(outdir: OutputDir, cp, area: str, *, report: bool, titl
 
     world = cp.plan.world
     with outdir.open("path.csv") as fh:
-        write_path_csv(fh, cp.path, cp.plan.speed)
+        write_path_csv(fh, cp.path, cp.plan.w)
     with outdir.open("zigzag.csv") as fh:
         write_path_csv(fh, cp.zigzag.path())
     _write_png(outdir, bands_figure(cp.zigzag, title=f"zigzag over {area}"), "bands.png")
@@ -107,7 +107,7 @@ def _write_cover_outputs(outdir: OutputDir, cp, area: str, *, report: bool, titl
         }
         _write_report(outdir, cp, title=title,
                       subtitle=f"zigzag bands over {area}, FM² at "
-                               f"{cp.params.get('agl_m', 0):g} m above the terrain",
+                               f"{cp.level.agl:g} m above the terrain",
                       metrics=metrics, waypoints=None if wps is None else wps.points_m,
                       files=list(COVER_FILES))
     return wps
@@ -173,6 +173,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             False, "--report", help="Also write report.html (interactive, self-contained)."),
     ) -> None:
         from ..missions.coverage import FULL_BOUNDS_DEG, plan_coverage
+        from ..planning import FlightLevel
         from ..scenarios import get_scenario
 
         if (spacing is None) == (camera is None):
@@ -188,9 +189,9 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             world = get_scenario(scenario, seed=seed).world
             poly = _load_area(area, world)
             step("searching the steering angle and planning FM² along the bands")
-            cp = plan_coverage(world, poly, d, agl=agl,
+            cp = plan_coverage(world, poly, d, level=FlightLevel(agl=agl, p1=p1, p2=p2),
                                angle=None if angle is None else np.radians(angle),
-                               search=search, search_options=opts, seed=seed, p1=p1, p2=p2)
+                               search=search, search_options=opts, seed=seed)
             step("writing the outputs")
             wps = _write_cover_outputs(outdir, cp, area, report=report,
                                        title=f"coverage of {area}")

@@ -133,6 +133,8 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
     ) -> None:
         from ..errors import InputError
         from ..experiments.formation import fly_and_summarise, summary_rows
+        from ..missions.formation import FormationConfig
+        from ..planning import FlightLevel
 
         sc = get_scenario(scenario, seed=seed)
         world = sc.world
@@ -154,9 +156,12 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         title = f"formation — {scenario}" + (f", flight level {agl:g} m" if agl else "")
         with progress(enabled=not (quiet or as_json)) as step:
             step(f"{title}: flying the formation (FM² re-planning every cycle)")
+            config = FormationConfig(n_followers=followers, shape=shape, dist=dist,
+                                     leader_speed=speed, follower_speed=follower_speed,
+                                     cycle=cycle, grey=grey)
             result, summary = fly_and_summarise(
-                sc, n_followers=followers, shape=shape, dist=dist, leader_speed=speed,
-                follower_speed=follower_speed, cycle=cycle, agl=agl, p1=p1, p2=p2, grey=grey)
+                sc, config=config,
+                level=None if agl is None else FlightLevel(agl=agl, p1=p1, p2=p2))
             _write_case(outdir, result, summary, title=title, gif=gif, frames=frames,
                         report=report, subtitle=sc.description, step=step)
         summary = {"scenario": scenario, **summary}

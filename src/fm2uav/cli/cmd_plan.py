@@ -9,6 +9,7 @@ import numpy as np
 import typer
 
 from ..planning import plan as plan_path
+from ..planning.params import planner_objects
 from ..scenarios import SCENARIOS, get_scenario
 from ..errors import InputError
 from ._common import OutputDir, handle_errors, parse_point, print_summary, to_jsonable
@@ -44,6 +45,9 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         ),
         cells: bool = typer.Option(False, "--cells", help="Read --start/--goal as grid cells."),
         saturation: float = typer.Option(1.0, help="Saturation α in (0, 1]."),
+        saturation_distance: float | None = typer.Option(
+            None, help="Distance (m) from the obstacles beyond which W = 1 (overrides "
+            "--saturation)."),
         exponent: float = typer.Option(1.0, help="Exponent β > 0 on W (thesis' adjustment)."),
         order: int = typer.Option(2, help="Fast Marching order, 1 or 2."),
         agl: float | None = typer.Option(
@@ -51,9 +55,13 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "Algorithm 2). Default: none."),
         p1: float = typer.Option(0.5, help="Exponent on the flight-level cells (with --agl)."),
         p2: float = typer.Option(1.5, help="Exponent on all other cells (with --agl)."),
-        agl_band: float = typer.Option(
-            0.0, help="Half-width (m) of a graded band around the flight level (with --agl; "
-            "0 = the seeds' single layer)."),
+        band: float = typer.Option(
+            0.0, help="Half-width (m) of the clarified band around the flight level (with "
+            "--agl; 0 = the seeds' single layer)."),
+        graded: bool = typer.Option(
+            False, "--graded", help="Blend the exponent from p1 to p2 across --band."),
+        mode: str = typer.Option(
+            "capped", help="Flight-level reading: 'capped' or 'literal' (W**p as is)."),
         seed: int = typer.Option(0, help="Seed of the scenario's random relief."),
         out: Path = typer.Option(Path("out/plan"), help="Output directory."),
         force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
@@ -83,19 +91,13 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             p = parse_point(text, world.ndim, what)
             return world.to_world(p) if cells else p
 
-        p = plan_path(
-            world,
-            point(start, sc.start, "start"),
-            point(goal, sc.goal, "goal"),
-            saturation=saturation,
-            exponent=exponent,
-            order=order,
-            agl=agl,
-            p1=p1,
-            p2=p2,
-            agl_band=agl_band,
-            agl_graded=agl_band > 0,
-        )
+        level_keys = (dict(agl=agl, p1=p1, p2=p2, band=band, graded=graded, mode=mode)
+                      if agl is not None else {})
+        shaping, level, options = planner_objects(dict(
+            saturation=saturation, saturation_distance=saturation_distance, exponent=exponent,
+            order=order, **level_keys))
+        p = plan_path(world, point(start, sc.start, "start"), point(goal, sc.goal, "goal"),
+                      shaping=shaping, level=level, options=options)
         from ..io import write_path_csv
         from ..viz import plan_figure
 
@@ -104,7 +106,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         tmp_png = outdir.target("plan.png")
         fig.savefig(tmp_png, dpi=110)
         with outdir.open("path.csv") as fh:
-            write_path_csv(fh, p.path, p.speed)
+            write_path_csv(fh, p.path, p.w)
         outdir.commit(tmp_png, "plan.png")
         if extra:
             info = plan_outputs(outdir, p, extra, export_options,
@@ -119,7 +121,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "goal [m]": np.round(p.goal, 1).tolist(),
             "length [m]": f"{p.length:.1f}",
             "clearance [m]": f"{p.clearance:.1f}",
-            "min W on path": f"{p.speed.min():.3f}",
+            "min W on path": f"{p.w.min():.3f}",
             "timings [ms]": ", ".join(f"{k} {v * 1e3:.1f}" for k, v in p.timings.items()),
         }
         if "waypoints" in summary:

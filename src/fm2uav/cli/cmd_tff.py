@@ -65,11 +65,12 @@ def _write_tune_report(outdir: OutputDir, res, sc, s, g, *, agl: float, scenario
         row, p = res.best, res.best_plan
         label = f"best: p1={row['p1']:g}, p2={row['p2']:g}, α={row['saturation']:g}"
     else:  # nothing keeps the limits: show the Pareto candidate closest to the level
-        from ..planning import plan
+        from ..planning import FlightLevel, Shaping, plan
 
         row = res.pareto[0]
-        p = plan(sc.world, s, g, agl=agl, p1=row["p1"], p2=row["p2"],
-                 saturation=row["saturation"], exponent=row["exponent"])
+        p = plan(sc.world, s, g, shaping=Shaping(saturation=row["saturation"],
+                                                 exponent=row["exponent"]),
+                 level=FlightLevel(agl=agl, p1=row["p1"], p2=row["p2"]))
         label = (f"closest (breaks the limits): p1={row['p1']:g}, p2={row['p2']:g}, "
                  f"α={row['saturation']:g}")
     m = tff_metrics(p, agl)
@@ -181,6 +182,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             False, "--report", help="Also write report.html (interactive, self-contained)."),
     ) -> None:
         from ..analysis.tune import AirframeLimits, tune
+        from ..planning import FlightLevel
         from ..scenarios import get_scenario
 
         def values(text: str, what: str) -> list[float]:
@@ -201,7 +203,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         with progress(enabled=not (quiet or as_json)) as step:
             n = sum(1 for a in grid["p1"] for b in grid["p2"] if b > a)
             step(f"planning {n * len(grid['saturation']) * len(grid['exponent'])} candidates")
-            res = tune(sc.world, s, g, limits, agl, grid=grid)
+            res = tune(sc.world, s, g, limits, FlightLevel(agl=agl), grid=grid)
         from ..io import write_path_csv
 
         md = [f"# Auto-tuning — {scenario}, agl {agl:g} m, max climb {max_climb:g}°, "
@@ -218,7 +220,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             tmp = outdir.target("tune_best.png")
             fig.savefig(tmp, dpi=100)
             with outdir.open("tune_best_path.csv") as fh:
-                write_path_csv(fh, res.best_plan.path, res.best_plan.speed)
+                write_path_csv(fh, res.best_plan.path, res.best_plan.w)
             outdir.commit(tmp, "tune_best.png")
         with outdir.open("tune_table.md") as fh:
             fh.write("\n".join(md))

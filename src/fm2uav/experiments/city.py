@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ..planning import Plan, plan
+from ..planning import Plan, Shaping, plan
 from ..vehicles import FeasibilityReport, check_feasibility, get_airframe
 from ..world import World
 from ..scenarios import Scenario, get_scenario
@@ -125,14 +125,15 @@ def run_city_case(
     if mission == "low":
         z = float(scenario.start[2])
         w2 = horizontal_slice(w3, z)
-        p = plan(w2, scenario.start[:2], scenario.goal[:2], exponent=exponent, walls=True)
+        p = plan(w2, scenario.start[:2], scenario.goal[:2],
+                 shaping=Shaping(exponent=exponent, walls=True))
         path3 = np.column_stack([p.path, np.full(len(p.path), z)])
-        rep = check_feasibility(path3, airframe, world=w3, w=p.speed, tolerance=tolerance,
+        rep = check_feasibility(path3, airframe, world=w3, w=p.w, tolerance=tolerance,
                                 lookahead=lookahead)
     else:
-        p = plan(w3, scenario.start, scenario.goal, exponent=exponent, walls=True)
+        p = plan(w3, scenario.start, scenario.goal, shaping=Shaping(exponent=exponent, walls=True))
         path3 = p.path
-        rep = check_feasibility(path3, airframe, world=w3, w=p.speed, tolerance=tolerance,
+        rep = check_feasibility(path3, airframe, world=w3, w=p.w, tolerance=tolerance,
                                 lookahead=lookahead)
     return CityCase(mission=mission, exponent=float(exponent), plan=p, path3=path3, report=rep,
                     world3=w3)
@@ -245,7 +246,7 @@ class CityRun:
         return {f"{c.mission} W^{c.exponent:g}": (
             np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(c.path3, axis=0),
                                                             axis=1))]),
-            c.plan.speed) for c in self.cases}
+            c.plan.w) for c in self.cases}
 
 
 def reproduce_city(seed: int = 0, airframe: Any = "disco", *, tolerance: float = 5.0,

@@ -32,6 +32,7 @@ from ..scenarios.coverage import (
     coverage_area,
     coverage_world,
 )
+from ..planning import FlightLevel
 from ..world import World
 
 __all__ = [
@@ -112,7 +113,8 @@ def reproduce_coverage(seed: int = 0, *,
         on_step(f"area {n}: DE, 0.1° sweep, scipy DE and FM² along the bands")
         poly = coverage_area(n)
         de, r = angle_search_row(poly, COVERAGE_SPACING, seed)
-        cp = plan_coverage(run.world, poly, COVERAGE_SPACING, agl=COVERAGE_AGL, angle=de.angle)
+        cp = plan_coverage(run.world, poly, COVERAGE_SPACING, level=FlightLevel(agl=COVERAGE_AGL),
+                           angle=de.angle)
         r.update(coverage_pct=round(100 * cp.coverage, 3),
                  fm2_length=round(cp.plan.length, 1),
                  agl_err_mean=round(float(np.abs(cp.agl_error).mean()), 2),

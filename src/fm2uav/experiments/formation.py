@@ -15,6 +15,7 @@ from typing import Any
 
 from ..analysis.flight_level import flight_level_deviation
 from ..missions.formation import FormationResult, fly_formation, inside_terrain
+from ..planning import FlightLevel
 from ..scenarios import Scenario, get_scenario
 
 __all__ = [
@@ -46,11 +47,11 @@ class FormationCase:
     p1: float | None = None
     p2: float | None = None
 
-    def options(self, dz: float) -> dict[str, float]:
+    def options(self, dz: float) -> dict[str, Any]:
         """The ``fly_formation`` keyword arguments of this case on vertical cells of ``dz`` m."""
         if self.level is None:
             return {}
-        return {"agl": self.level * dz, "p1": self.p1, "p2": self.p2}
+        return {"level": FlightLevel(agl=self.level * dz, p1=self.p1, p2=self.p2)}
 
 
 THESIS_CASES = (

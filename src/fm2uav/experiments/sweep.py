@@ -23,7 +23,7 @@ import numpy as np
 from scipy import fft, optimize
 
 from ..errors import Fm2uavError, InputError
-from ..planning import plan
+from ..planning import PlanOptions, Shaping, plan
 from ..world import World
 from ..analysis.similarity import area_between_curves, frechet_distance
 from ..geometry import menger_curvature, resample_path
@@ -100,7 +100,9 @@ def sweep_alpha_row(
         row: dict[str, Any] = {"alpha": float(alpha), "beta": float(beta), "status": "ok", "error": ""}
         try:
             t0 = time.perf_counter()
-            p = plan(world, start, goal, saturation=float(alpha), exponent=float(beta), order=order)
+            p = plan(world, start, goal,
+                     shaping=Shaping(saturation=float(alpha), exponent=float(beta)),
+                     options=PlanOptions(order=order))
             row["fm2_time_s"] = time.perf_counter() - t0
             row["length_m"] = p.length
             row["clearance_m"] = p.clearance
@@ -305,8 +307,9 @@ def summarise_sweep(
                     pairs.append(None)
                     continue
                 try:
-                    p = plan(world, starts[k], goals[k], saturation=best["alpha"],
-                             exponent=best["beta"], order=order)
+                    p = plan(world, starts[k], goals[k],
+                             shaping=Shaping(saturation=best["alpha"], exponent=best["beta"]),
+                             options=PlanOptions(order=order))
                 except Fm2uavError:
                     pairs.append(None)
                     continue

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..analysis.flight_level import tff_metrics
 from ..errors import InputError
-from ..planning import Plan, plan
+from ..planning import FlightLevel, Plan, plan
 from ..scenarios import Scenario, get_scenario
 
 __all__ = [
@@ -36,7 +36,7 @@ __all__ = [
     "tff_markdown",
 ]
 
-#: Flight-level reading of ``plan(agl_mode=...)``.
+#: Flight-level reading (``FlightLevel.mode``).
 FlightLevelMode = Literal["capped", "literal"]
 MODES: tuple[FlightLevelMode, ...] = ("capped", "literal")
 
@@ -113,8 +113,8 @@ def run_tff(scenario: str = "open-field", seed: int = 0,
     for case in cases:
         agl = case.level * dz
         t0 = time.perf_counter()
-        p = plan(sc.world, sc.start, sc.goal, agl=agl, p1=case.p1, p2=case.p2,
-                 agl_mode=case.mode)
+        p = plan(sc.world, sc.start, sc.goal,
+                 level=FlightLevel(agl=agl, p1=case.p1, p2=case.p2, mode=case.mode))
         m = tff_metrics(p, agl)
         m.update(case=case.name, level=case.level, agl_m=agl, p1=case.p1, p2=case.p2,
                  diff=case.p2 - case.p1, mode=case.mode,

@@ -1,7 +1,7 @@
 """Missions made of many paths: coverage (zigzag + DE + FM²), formations."""
 
 from .coverage import CoveragePlan, Zigzag, plan_coverage, zigzag
-from .formation import FormationResult, fly_formation, formation_shape
+from .formation import FormationConfig, FormationResult, fly_formation, formation_shape
 
 __all__ = [
     "Zigzag",
@@ -9,6 +9,7 @@ __all__ = [
     "plan_coverage",
     "CoveragePlan",
     "fly_formation",
+    "FormationConfig",
     "FormationResult",
     "formation_shape",
 ]

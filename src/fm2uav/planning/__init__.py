@@ -2,6 +2,16 @@
 
 from .geodesic import descend
 from .params import FlightLevel, PlanOptions, Shaping
-from .planner import Plan, base_velocity, plan
+from .planner import Plan, base_velocity, max_distance, plan, shaped_velocity
 
-__all__ = ["Plan", "plan", "descend", "base_velocity", "Shaping", "FlightLevel", "PlanOptions"]
+__all__ = [
+    "Plan",
+    "plan",
+    "descend",
+    "base_velocity",
+    "shaped_velocity",
+    "max_distance",
+    "Shaping",
+    "FlightLevel",
+    "PlanOptions",
+]

@@ -36,6 +36,7 @@ import numpy as np
 
 from ..errors import InputError, PlanningError
 from ..world import World
+from .params import FLIGHT_LEVEL_MODES, FlightLevel
 
 __all__ = [
     "flight_layer",
@@ -44,9 +45,6 @@ __all__ = [
     "level_cells",
     "FLIGHT_LEVEL_MODES",
 ]
-
-#: Accepted values of ``mode`` in :func:`flight_level_speed`.
-FLIGHT_LEVEL_MODES = ("capped", "literal")
 
 
 def exponents_from_k(k: float) -> tuple[float, float]:
@@ -121,30 +119,7 @@ def flight_layer(world: World, agl: float) -> np.ndarray:
     return layer
 
 
-def _check_exponent(name: str, p: float) -> float:
-    try:
-        p = float(p)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} must be a number > 0, got {p!r}") from None
-    if not (np.isfinite(p) and p > 0):
-        raise InputError(
-            f"{name} must be a finite exponent > 0, got {p!r} (p1 < 1 clarifies the level, "
-            "p2 > p1 darkens the rest, e.g. p1=0.5, p2=1.3)"
-        )
-    return p
-
-
-def flight_level_speed(
-    W: np.ndarray,
-    world: World,
-    agl: float,
-    p1: float,
-    p2: float,
-    band: float = 0.0,
-    graded: bool = False,
-    *,
-    mode: str = "capped",
-) -> np.ndarray:
+def flight_level_speed(W: np.ndarray, world: World, level: FlightLevel) -> np.ndarray:
     """Impose a flight level on a velocity map (thesis Algorithm 2).
 
     Parameters
@@ -153,24 +128,15 @@ def flight_level_speed(
         Velocity map in [0, 1] (0 on obstacles).
     world : World
         3D world the map belongs to.
-    agl : float
-        Flight height above the ground (or roofs) [m].
-    p1 : float
-        Exponent on the flight-level cells, > 0 (< 1 clarifies).
-    p2 : float
-        Exponent on all other cells, > 0 (> p1 darkens them relative to the
-        level).
-    band : float, optional
-        Half-width [m] of the clarified band around the level; 0 (default) is
-        the seeds' single layer.
-    graded : bool, optional
-        Within the band, blend the exponent linearly from ``p1`` at the level
-        to ``p2`` at the band edge. Default False (all band cells get ``p1``).
-    mode : {"capped", "literal"}, optional
-        ``"capped"`` (default): cap every cell of a column at W of its
-        flight-level node before the exponents, so the level is the brightest
-        cell of its column. ``"literal"``: exponents on W as is (does not
-        follow the terrain on open maps; see the module docstring).
+    level : FlightLevel
+        ``agl`` [m] above the ground (or roofs); ``p1`` on the level cells and
+        ``p2`` on all others; ``band`` [m] half-width of the clarified band
+        (0: the seeds' single layer); ``graded``: blend the exponent from
+        ``p1`` at the level to ``p2`` at the band edge; ``mode``: ``"capped"``
+        caps every cell of a column at W of its flight-level node before the
+        exponents, so the level is the brightest cell of its column;
+        ``"literal"`` exponentiates W as is (does not follow the terrain on
+        open maps; see the module docstring).
 
     Returns
     -------
@@ -180,41 +146,35 @@ def flight_level_speed(
     Raises
     ------
     InputError
-        p1/p2 <= 0 or not finite, band < 0, unknown mode, shape mismatch.
+        ``level`` not a FlightLevel, shape mismatch, agl below half a cell.
     PlanningError
         The flight level leaves the map.
 
     Examples
     --------
     >>> import numpy as np
-    >>> from fm2uav import World
+    >>> from fm2uav import FlightLevel, World
     >>> w = World.from_heightmap(np.zeros((3, 3)), 1.0, 6)   # ground at layer 0
     >>> W = np.linspace(0, 1, 6)[None, None, :].repeat(3, 0).repeat(3, 1)
-    >>> V = flight_level_speed(W, w, agl=2.0, p1=0.5, p2=2.0)
+    >>> V = flight_level_speed(W, w, FlightLevel(agl=2.0, p1=0.5, p2=2.0))
     >>> int(np.argmax(V[1, 1]))          # the level (layer 0 + 2) is the fastest
     2
     """
-    p1 = _check_exponent("p1", p1)
-    p2 = _check_exponent("p2", p2)
-    try:
-        band = float(band)
-    except (TypeError, ValueError):
-        raise InputError(f"band must be a half-width in metres >= 0, got {band!r}") from None
-    if not (np.isfinite(band) and band >= 0):
-        raise InputError(f"band must be >= 0 metres, got {band!r}")
-    if mode not in FLIGHT_LEVEL_MODES:
+    if not isinstance(level, FlightLevel):
         raise InputError(
-            f"flight-level mode must be one of {FLIGHT_LEVEL_MODES}, got {mode!r}"
+            f"level must be a fm2uav.FlightLevel, got {type(level).__name__}; "
+            "e.g. FlightLevel(agl=150.0, p1=0.5, p2=1.3)"
         )
     W = np.asarray(W, dtype=float)
     if W.shape != world.shape:
         raise InputError(f"W has shape {W.shape} but the world is {world.shape}")
-    layer = flight_layer(world, agl)
+    p1, p2, band = level.p1, level.p2, level.band
+    layer = flight_layer(world, level.agl)
     dz = world.spacing[2]
     k = np.arange(world.shape[2])[None, None, :]
     offset_m = np.abs(k - layer[:, :, None]) * dz  # distance to the level [m]
 
-    if mode == "capped":
+    if level.mode == "capped":
         w_fl = np.take_along_axis(W, layer[:, :, None], axis=2)  # (nx, ny, 1)
         # a level node with W = 0 (e.g. a wall at the ceiling) would zero the
         # whole column: leave such columns uncapped
@@ -224,7 +184,7 @@ def flight_level_speed(
         V = W
 
     inside = offset_m <= band + 1e-9 * dz
-    if graded and band > 0:
+    if level.graded and band > 0:
         frac = np.clip(offset_m / band, 0.0, 1.0)
         exponent = np.where(inside, p1 + (p2 - p1) * frac, p2)
     else:

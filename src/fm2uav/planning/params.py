@@ -141,6 +141,9 @@ class FlightLevel:
     max_agl : float or None
         [m] > 0: hard ceiling above the ground (e.g. 120 m). Must be >=
         ``agl``. Default None.
+    max_climb, max_descent : float
+        [deg] in (0, 90]: steepest flight-path angle up / down of the final
+        altitude profile. Default 45.
     """
 
     agl: float
@@ -152,9 +155,14 @@ class FlightLevel:
     tolerance: float = 2.0
     min_agl: float | None = None
     max_agl: float | None = None
+    max_climb: float = 45.0
+    max_descent: float = 45.0
 
     def __post_init__(self) -> None:
         _set(self, "agl", v.positive(self.agl, "agl", unit="m", where=_where("agl")))
+        for name in ("max_climb", "max_descent"):
+            _set(self, name, v.in_range(getattr(self, name), name, 0.0, 90.0, low_open=True,
+                                        unit="deg", where=_where(name)))
         for name in ("p1", "p2"):
             _set(self, name, v.in_range(
                 getattr(self, name), name, 0.0, None, low_open=True, where=_where(name),

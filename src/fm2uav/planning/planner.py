@@ -10,21 +10,24 @@ the start gives the path.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
 from scipy import ndimage
 
-from ..world.clearance import clearance_profile
+from .. import _validate
 from ..eikonal.fmm import fast_marching
-from ..eikonal.velocity import distance_map, normalise_distance, shape_velocity
+from ..eikonal.velocity import distance_map, distance_scale, normalise_distance, shape_velocity
 from ..errors import InputError, PointError, UnreachableError
+from ..geometry import path_length
 from ..world import World
+from ..world.clearance import clearance_profile
 from .flight_level import flight_level_speed
 from .geodesic import descend
+from .params import FlightLevel, PlanOptions, Shaping
 
-__all__ = ["Plan", "plan", "base_velocity"]
+__all__ = ["Plan", "plan", "base_velocity", "shaped_velocity", "max_distance", "plan_params"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -36,9 +39,9 @@ class Plan:
     path : ndarray, shape (N, ndim)
         Path from start to goal in world coordinates [m]; ``path[0]`` is the
         start and ``path[-1]`` the goal, exactly.
-    speed : ndarray, shape (N,)
+    w : ndarray, shape (N,)
         W interpolated (linearly) at each path point: the admissible speed as a
-        share of the maximum, in [0, 1].
+        share of the maximum, in [0, 1] (dimensionless; m/s only with an airframe).
     length : float
         Path length [m].
     clearance : float
@@ -56,11 +59,17 @@ class Plan:
     world : World
         The map planned on.
     params : dict
-        The planner parameters (saturation, exponent, order, ...).
+        The planner parameters, flat and JSON-friendly (:func:`plan_params`):
+        the fields of ``shaping``, ``options`` (without the speed map) and, with
+        a flight level, of ``level``; plus ``custom_speed_map``.
+    shaping : Shaping
+        The shaping of W used (ignored with a custom speed map).
+    level : FlightLevel or None
+        The flight level imposed, None without one.
     """
 
     path: np.ndarray
-    speed: np.ndarray
+    w: np.ndarray
     length: float
     clearance: float
     timings: dict[str, float]
@@ -68,6 +77,8 @@ class Plan:
     T: np.ndarray = field(repr=False)
     world: World = field(repr=False)
     params: dict[str, Any] = field(default_factory=dict)
+    shaping: Shaping = field(default_factory=Shaping)
+    level: FlightLevel | None = None
 
     @property
     def start(self) -> np.ndarray:
@@ -97,7 +108,7 @@ class Plan:
             "points": int(len(self.path)),
             "length_m": round(float(self.length), 3),
             "clearance_m": float(self.clearance) if np.isfinite(self.clearance) else None,
-            "min_speed": round(float(self.speed.min()), 6),
+            "min_w": round(float(self.w.min()), 6),
             "params": dict(self.params),
             "timings_s": {k: round(v, 6) for k, v in self.timings.items()},
         }
@@ -108,7 +119,8 @@ def base_velocity(world: World, *, method: str = "edt", walls: bool = False) -> 
 
     ``d / max(d)`` with ``d`` the distance to the nearest obstacle; cached in
     ``world._cache`` because it depends only on the (immutable) occupancy, so
-    sweeps over saturation/exponent pay the distance transform once.
+    sweeps over saturation/exponent pay the distance transform once. The
+    normaliser ``max(d)`` [m] is cached next to it (:func:`max_distance`).
     """
     key = ("base_velocity", method, bool(walls))
     cached = world._cache.get(key)
@@ -117,7 +129,47 @@ def base_velocity(world: World, *, method: str = "edt", walls: bool = False) -> 
         cached = normalise_distance(dist)
         cached.setflags(write=False)
         world._cache[key] = cached
+        world._cache[("max_distance", method, bool(walls))] = distance_scale(dist)
     return cached
+
+
+def max_distance(world: World, shaping: Shaping = Shaping()) -> float:
+    """The distance [m] :func:`base_velocity` normalises by: the largest distance
+    from a node to an obstacle (``inf`` on a map without obstacles); cached."""
+    key = ("max_distance", shaping.method, bool(shaping.walls))
+    if key not in world._cache:
+        base_velocity(world, method=shaping.method, walls=shaping.walls)
+    return world._cache[key]
+
+
+def shaped_velocity(world: World, shaping: Shaping = Shaping()) -> np.ndarray:
+    """The FM² velocity map W of a world shaped by ``shaping`` (0 on obstacles).
+
+    The cached :func:`base_velocity` itself (read-only) when there is nothing
+    to shape, else a new array: ``min(d / d_sat, 1) ** exponent``.
+    """
+    W = base_velocity(world, method=shaping.method, walls=shaping.walls)
+    if not shaping.shapes:
+        return W
+    top = max_distance(world, shaping) if shaping.saturation_distance is not None else None
+    return shape_velocity(W, saturation=shaping.saturation, exponent=shaping.exponent,
+                          saturation_distance=shaping.saturation_distance, max_distance=top)
+
+
+def plan_params(shaping: Shaping, level: FlightLevel | None, options: PlanOptions) -> dict[str, Any]:
+    """Flat JSON-friendly record of the planner's parameters (``Plan.params``).
+
+    The field names of the objects (one spelling): ``saturation``, ...,
+    ``order``, ``step``, ``custom_speed_map`` and, with a level, ``agl``, ``p1``,
+    ``p2``, ``band``, ... ``max_descent``. With a custom speed map the level
+    was not applied and is left out.
+    """
+    custom = options.speed_map is not None
+    out: dict[str, Any] = asdict(shaping)
+    out.update(order=int(options.order), step=float(options.step), custom_speed_map=custom)
+    if level is not None and not custom:
+        out.update(asdict(level))
+    return out
 
 
 def _check_free(world: World, point: np.ndarray, what: str) -> tuple[int, ...]:
@@ -136,38 +188,14 @@ def _check_free(world: World, point: np.ndarray, what: str) -> tuple[int, ...]:
     return cell
 
 
-def _as_point(p: Any, ndim: int, what: str) -> np.ndarray:
-    try:
-        arr = np.asarray(p, dtype=float).reshape(-1)
-    except (TypeError, ValueError):
-        raise InputError(f"{what} must be {ndim} coordinates in metres, got {p!r}") from None
-    if arr.size != ndim:
-        raise InputError(
-            f"{what} must have {ndim} coordinates (metres) for this {ndim}D world, got {arr.size}"
-        )
-    if not np.all(np.isfinite(arr)):
-        raise InputError(f"{what} must be finite, got {arr.tolist()}")
-    return arr
-
-
 def plan(
     world: World,
     start: Any,
     goal: Any,
     *,
-    saturation: float = 1.0,
-    exponent: float = 1.0,
-    order: int = 2,
-    method: str = "edt",
-    walls: bool = False,
-    agl: float | None = None,
-    p1: float = 0.5,
-    p2: float = 1.5,
-    agl_band: float = 0.0,
-    agl_graded: bool = False,
-    agl_mode: str = "capped",
-    speed_map: np.ndarray | None = None,
-    step: float = 0.5,
+    shaping: Shaping = Shaping(),
+    level: FlightLevel | None = None,
+    options: PlanOptions = PlanOptions(),
 ) -> Plan:
     """Plan a path from ``start`` to ``goal`` with Fast Marching Square.
 
@@ -177,40 +205,17 @@ def plan(
         The map (occupancy True = obstacle).
     start, goal : sequence of float
         World coordinates [m].
-    saturation : float, optional
-        α in (0, 1]: ``W = min(W / α, 1)``. Default 1 (none).
-    exponent : float, optional
-        β > 0: ``W = W ** β``; < 1 lightens the map (smoother paths closer to
-        obstacles), > 1 darkens it (paths further away). Default 1.
-    order : {1, 2}, optional
-        Order of both Fast Marching runs. Default 2.
-    method : {"edt", "fmm"}, optional
-        Distance to obstacles: exact transform or FMM from the obstacles as in
-        the seeds. Default "edt".
-    walls : bool, optional
-        Treat the map border as an obstacle. Default False.
-    agl : float, optional
-        Impose a flight level this many metres above the ground (thesis
+    shaping : Shaping, optional
+        How W is made from the obstacles: saturation α (or a saturation
+        distance in metres), exponent β, distance method, walls. Default
+        ``Shaping()`` (W = d / max d).
+    level : FlightLevel, optional
+        Impose a flight level ``level.agl`` metres above the ground (thesis
         Algorithm 2, see :mod:`fm2uav.planning.flight_level`). Default None.
-    p1, p2 : float, optional
-        Exponents on the flight-level cells and on all other cells (used with
-        ``agl``). Defaults 0.5 and 1.5.
-    agl_band : float, optional
-        Half-width [m] of the clarified band around the level. Default 0 (the
-        seeds' single layer).
-    agl_graded : bool, optional
-        Blend the exponent from p1 to p2 across the band. Default False.
-    agl_mode : {"capped", "literal"}, optional
-        How Algorithm 2 reads W (see :func:`~fm2uav.planning.flight_level.flight_level_speed`):
-        "capped" (default) caps each column at W of its flight-level node so the
-        level is the brightest cell; "literal" exponentiates W as is (climbs to
-        the ceiling on open maps, kept for comparison; docs/tff.md).
-    speed_map : ndarray, optional
-        Use this velocity map instead of computing one (0 = impassable);
-        saturation/exponent/method/walls are then ignored. This is the hook for
-        extra shaping (flight levels, other UAVs).
-    step : float, optional
-        Geodesic step, in cells of the finest axis. Default 0.5.
+    options : PlanOptions, optional
+        Fast Marching order, geodesic step [cells], and a custom speed map
+        (which replaces the shaping and the flight level: the hook for extra
+        shaping such as other UAVs). Default ``PlanOptions()``.
 
     Returns
     -------
@@ -223,7 +228,7 @@ def plan(
     fm2uav.UnreachableError
         No free connection between start and goal.
     fm2uav.InputError
-        Bad parameter values.
+        Bad parameter values (the objects check themselves; here: wrong type).
 
     Examples
     --------
@@ -233,28 +238,29 @@ def plan(
     >>> p = plan(World(occ, spacing=1.0), (5.0, 5.0), (35.0, 5.0))
     >>> bool(p.path[:, 1].max() > 20)   # goes around the wall
     True
+    >>> from fm2uav import Shaping
+    >>> q = plan(World(occ, spacing=1.0), (5.0, 5.0), (35.0, 5.0), shaping=Shaping(exponent=2.0))
+    >>> bool(q.clearance >= p.clearance)  # a darker map keeps further from the wall
+    True
     """
     t_all = time.perf_counter()
     if not isinstance(world, World):
         raise InputError(f"world must be a fm2uav.World, got {type(world).__name__}")
-    start_m = _as_point(start, world.ndim, "start")
-    goal_m = _as_point(goal, world.ndim, "goal")
+    _check_objects(shaping, level, options)
+    start_m = _validate.point(start, world.ndim, "start")
+    goal_m = _validate.point(goal, world.ndim, "goal")
     start_cell = _check_free(world, start_m, "start")
     goal_cell = _check_free(world, goal_m, "goal")
 
     t0 = time.perf_counter()
-    if speed_map is None:
+    if options.speed_map is None:
         # 0 on obstacles already (distance 0); the cached base map is read-only
         # and used as is when there is nothing to shape
-        W = base_velocity(world, method=method, walls=walls)
-        if saturation != 1.0 or exponent != 1.0:
-            W = shape_velocity(W, saturation=saturation, exponent=exponent)
-        if agl is not None:
-            W = flight_level_speed(
-                W, world, agl, p1, p2, band=agl_band, graded=agl_graded, mode=agl_mode
-            )
+        W = shaped_velocity(world, shaping)
+        if level is not None:
+            W = flight_level_speed(W, world, level)
     else:
-        W = np.asarray(speed_map, dtype=float)
+        W = options.speed_map
         if W.shape != world.shape:
             raise InputError(
                 f"speed_map has shape {W.shape} but the world is {world.shape}; "
@@ -266,7 +272,8 @@ def plan(
         raise PointError(
             f"the velocity map is 0 at the {which} node; move the {which} away from obstacles"
         )
-    T = fast_marching(W, [goal_cell], spacing=world.spacing, order=order, stop_at=[start_cell])
+    T = fast_marching(W, [goal_cell], spacing=world.spacing, order=options.order,
+                      stop_at=[start_cell])
     t2 = time.perf_counter()
     if not np.isfinite(T[start_cell]):
         raise UnreachableError(
@@ -284,12 +291,12 @@ def plan(
         world.to_index(goal_m),
         spacing=world.spacing,
         blocked=blocked,
-        step=step,
+        step=options.step,
     )
     path = world.to_world(path_idx)
     t3 = time.perf_counter()
-    speed = ndimage.map_coordinates(W, path_idx.T, order=1, mode="nearest")
-    length = float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1)))
+    w = ndimage.map_coordinates(W, path_idx.T, order=1, mode="nearest")
+    length = path_length(path)
     clearance = float(clearance_profile(world, path).min())
     t4 = time.perf_counter()
     timings = {
@@ -299,26 +306,30 @@ def plan(
         "metrics": t4 - t3,
         "total": t4 - t_all,
     }
-    params = {
-        "saturation": float(saturation),
-        "exponent": float(exponent),
-        "order": int(order),
-        "method": method,
-        "walls": bool(walls),
-        "custom_speed_map": speed_map is not None,
-    }
-    if agl is not None and speed_map is None:
-        params.update(agl=float(agl), p1=float(p1), p2=float(p2),
-                      agl_band=float(agl_band), agl_graded=bool(agl_graded),
-                      agl_mode=str(agl_mode))
     return Plan(
         path=path,
-        speed=speed,
+        w=w,
         length=length,
         clearance=clearance,
         timings=timings,
         W=W,
         T=T,
         world=world,
-        params=params,
+        params=plan_params(shaping, level, options),
+        shaping=shaping,
+        level=level if options.speed_map is None else None,
     )
+
+
+def _check_objects(shaping: Any, level: Any, options: Any) -> None:
+    """InputError unless the parameter objects have the right types (one spelling)."""
+    for value, cls, name, example in (
+        (shaping, Shaping, "shaping", "shaping=Shaping(exponent=2.0)"),
+        (options, PlanOptions, "options", "options=PlanOptions(order=1)"),
+    ):
+        if not isinstance(value, cls):
+            raise InputError(f"{name} must be a fm2uav.{cls.__name__}, got "
+                             f"{type(value).__name__}; e.g. {example}")
+    if level is not None and not isinstance(level, FlightLevel):
+        raise InputError(f"level must be a fm2uav.FlightLevel or None, got "
+                         f"{type(level).__name__}; e.g. level=FlightLevel(agl=150.0)")

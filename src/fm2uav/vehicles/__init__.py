@@ -3,7 +3,7 @@
 Typical use::
 
     from fm2uav.vehicles import check_feasibility
-    report = check_feasibility(plan.path, "disco", world=plan.world, w=plan.speed)
+    report = check_feasibility(plan.path, "disco", world=plan.world, w=plan.w)
     report.feasible, report.reason, report.tracking.max_separation
 """
 

@@ -134,7 +134,7 @@ def check_feasibility(
     world : World, optional
         Also check that the flown trajectory stays in free space.
     w : array (N,), optional
-        W along the path (``Plan.speed``), for the admissible-speed profile.
+        W along the path (``Plan.w``), for the admissible-speed profile.
     tolerance : float
         Largest admissible separation flown ↔ planned [m]. Default 5.
     lookahead, lookahead_points : optional

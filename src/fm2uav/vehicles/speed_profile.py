@@ -112,7 +112,7 @@ def speed_profile(
         Points [m].
     airframe : FixedWing, Multirotor or preset name
     w : array (N,), optional
-        W at each path point (e.g. ``Plan.speed``), in [0, 1].
+        W at each path point (e.g. ``Plan.w``), in [0, 1].
     window : float, optional
         Curvature window [m] (see :mod:`.geometric`).
     """

@@ -108,7 +108,7 @@ def coverage_figure(cp: CoveragePlan, *, title: str | None = None) -> Figure:
     ax2 = fig.add_subplot(1, 3, 3)
     s = _arc_length(path)
     ground = terrain_along(world, path)
-    agl = cp.params["agl_m"]
+    agl = cp.level.agl
     if ground is not None:
         ax2.fill_between(s, b[2, 0], ground, color="saddlebrown", alpha=0.45, label="terrain")
         ax2.plot(s, ground + agl, color="k", lw=1.0, ls="--", label=f"ideal ({agl:g} m AGL)")
@@ -181,7 +181,7 @@ def coverage_tables_report(run: CoverageRun, files: list[str]) -> str:
                  "seeds α": SEEDS_T52[d][1]} for d, r in run.table_5_2.items()]
     return report_html(
         run.world, {f"{n} FM² path": cp.path for n, cp in run.plans.items()},
-        speeds={f"{n} FM² path": cp.plan.speed for n, cp in run.plans.items()},
+        speeds={f"{n} FM² path": cp.plan.w for n, cp in run.plans.items()},
         ideal_agl={f"{n} FM² path": COVERAGE_AGL for n in run.plans},
         overlays=overlays,
         title="Coverage experiments (paper 003 / thesis ch. 5)",

@@ -156,7 +156,7 @@ def city_report_html(run: CityRun, files: list[str]) -> str:
 
     cases, af, rows = run.cases, run.airframe, run.rows
     paths = {f"FM² {c.mission} W^{c.exponent:g}": c.path3 for c in cases}
-    speeds = {f"FM² {c.mission} W^{c.exponent:g}": c.plan.speed for c in cases}
+    speeds = {f"FM² {c.mission} W^{c.exponent:g}": c.plan.w for c in cases}
     paths.update(run.rrt_paths)
     flown = join_polylines([c.report.tracking.trajectory for c in cases])
     cols = ["mission", "exponent", "safety_m", "thesis_safety_m", "separation_max_m",

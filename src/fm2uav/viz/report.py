@@ -466,7 +466,7 @@ def plan_report(
             metrics[f"{pre}length [m]"] = round(float(p.length), 1)
             metrics[f"{pre}clearance [m]"] = (round(float(p.clearance), 2)
                                               if np.isfinite(p.clearance) else "inf")
-            metrics[f"{pre}min W"] = round(float(np.min(p.speed)), 4)
+            metrics[f"{pre}min W"] = round(float(np.min(p.w)), 4)
             metrics[f"{pre}points"] = int(len(p.path))
             metrics[f"{pre}planning time [s]"] = round(float(p.timings.get("total", 0.0)), 3)
     agl = first.params.get("agl") if first.params else None
@@ -474,7 +474,7 @@ def plan_report(
         first.world,
         {n: p.path for n, p in named.items()},
         title=title, subtitle=subtitle,
-        speeds={n: p.speed for n, p in named.items()},
+        speeds={n: p.w for n, p in named.items()},
         waypoints=waypoints, params=params if params is not None else first.params,
         metrics=metrics, files=files, agl=agl, max_surface=max_surface,
     )

@@ -149,7 +149,7 @@ def tff_report_html(plans: Sequence[Plan], rows: list[dict[str, Any]], labels: S
 
     return report_html(
         sc.world, {lab: p.path for lab, p in zip(labels, plans)},
-        speeds={lab: p.speed for lab, p in zip(labels, plans)},
+        speeds={lab: p.w for lab, p in zip(labels, plans)},
         ideal_agl={lab: r["agl_m"] for lab, r in zip(labels, rows)},
         title=title, subtitle=sc.description, params=params,
         metrics={lab: f"within ±1 cell {r['within']:.0%}, mean |dev| {r['mean_dev_all_m']:.1f} m, "

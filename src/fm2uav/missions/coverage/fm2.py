@@ -16,8 +16,8 @@ FM² over it and impose the flight level with p1/p2 (Algorithm 2). Here:
    constant map instead (the level is then ``level_contrast ** (p1 - p2)``
    times faster everywhere, however open the sky);
 3. ``W = C · W_level`` (0 on obstacles and outside the corridor), then
-   :func:`fm2uav.plan` with ``speed_map=W`` from the zigzag's first point to its
-   last, both on the flight level.
+   :func:`fm2uav.plan` with ``PlanOptions(speed_map=W)`` from the zigzag's first
+   point to its last, both on the flight level.
 
 Grid (``grid=``): by default (``"corridor"``) steps 1–3 run on the corridor
 unrolled along the zigzag (:mod:`.grid`): arc length × offset × height, the
@@ -32,6 +32,7 @@ on the map's own grid (``grid="map"``, the seeds' W0) the geodesic drifts
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass, field
@@ -41,12 +42,12 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ...errors import InputError, PlanningError
-from ...planning import Plan, base_velocity
+from ...geometry import path_length
+from ...planning import FlightLevel, Plan, PlanOptions, base_velocity
 from ...planning import plan as fm2_plan
 from ...planning.flight_level import flight_layer, flight_level_speed
 from ...world import World
 from ...world.clearance import clearance_profile
-from ...world.ground import terrain_along
 from .area import as_area, check_inside_world, check_spacing
 from .bands import Zigzag, zigzag
 from .grid import CorridorGrid, corridor_grid
@@ -92,13 +93,9 @@ def corridor_speed(world: World, path_xy: np.ndarray, half_width: float) -> np.n
 def coverage_speed_map(
     world: World,
     zz: Zigzag,
+    level: FlightLevel,
     *,
-    agl: float,
-    p1: float = 0.5,
-    p2: float = 1.3,
     corridor: float = 0.25,
-    level_band: float | None = None,
-    level_graded: bool = False,
     level_contrast: float = 0.5,
     level_base: str = "world",
 ) -> np.ndarray:
@@ -110,25 +107,19 @@ def coverage_speed_map(
         3D map with terrain.
     zz : Zigzag
         The zigzag to follow.
-    agl : float
-        Flight level above the ground [m].
-    p1, p2 : float
-        Exponents on the level / on all other nodes (seeds: 0.5, 1.3).
+    level : FlightLevel
+        The flight level (``agl`` [m], ``p1``/``p2``, seeds: 0.5 and 1.3). Its
+        band is widened to at least one vertical cell (:func:`coverage_level`)
+        so that the clarified layer stays face-connected where the ground slopes.
     corridor : float
         Corridor half-width as a share of D, in (0, 0.5). Default 0.25.
-    level_band : float, optional
-        Half-width [m] of the clarified band around the level (passed to
-        ``flight_level_speed(band=)``); default one vertical cell, so that the
-        clarified layer stays face-connected where the ground slopes.
-    level_graded : bool
-        Blend the exponent across the band (``flight_level_speed(graded=)``).
     level_contrast : float
         Value in (0, 1) of the uniform map shaped with ``level_base="uniform"``.
     level_base : {"world", "uniform"}
         Map the flight level is imposed on: ``"world"`` (default) the
         planner's FM² velocity of the world (normalised distance to the
         terrain and obstacles, :func:`fm2uav.planning.base_velocity`), shaped
-        exactly as ``plan(agl=...)`` does (capped Algorithm 2); ``"uniform"``
+        exactly as ``plan(level=...)`` does (capped Algorithm 2); ``"uniform"``
         a constant ``level_contrast`` on the free nodes, which gives the level
         the same contrast everywhere however far the obstacles are.
     """
@@ -141,17 +132,29 @@ def coverage_speed_map(
     else:
         base = np.where(world.occupancy, 0.0, float(level_contrast))
     c = corridor_speed(world, zz.path(step=cell / 2.0), h)
-    return _shaped(world, base, c, agl, p1, p2, level_band, level_graded)
+    return flight_level_speed(base, world, coverage_level(level, world)) * c[:, :, None]
+
+
+def coverage_level(level: FlightLevel, world: World) -> FlightLevel:
+    """The flight level the coverage FM² imposes: ``level`` with its band at least
+    one vertical cell of ``world`` (a one-cell layer breaks where the ground slopes).
+
+    Raises
+    ------
+    InputError
+        ``level`` is not a :class:`~fm2uav.FlightLevel`.
+    """
+    if not isinstance(level, FlightLevel):
+        raise InputError(f"level must be a fm2uav.FlightLevel, got {type(level).__name__}; "
+                         "e.g. level=FlightLevel(agl=100.0)")
+    dz = float(world.spacing[2])
+    return level if level.band >= dz else dataclasses.replace(level, band=dz)
 
 
 def corridor_grid_speed(
     grid: CorridorGrid,
+    level: FlightLevel,
     *,
-    agl: float,
-    p1: float = 0.5,
-    p2: float = 1.3,
-    level_band: float | None = None,
-    level_graded: bool = False,
     level_contrast: float = 0.5,
     level_base: str = "world",
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -179,13 +182,12 @@ def corridor_grid_speed(
         base = np.where(occ[:, c:c + 1, :], 0.0, float(level_contrast))
     curtain = World(occ[:, c:c + 1, :], spacing=gw.spacing,
                     origin=(gw.origin[0], 0.0, gw.origin[2]))
-    band = gw.spacing[2] if level_band is None else float(level_band)
-    level = flight_level_speed(base, curtain, agl, p1, p2, band=band, graded=level_graded)
+    speed = flight_level_speed(base, curtain, coverage_level(level, gw))
     cw = np.clip(1.0 - np.abs(grid.offsets) / grid.half_width, 0.0, 1.0)
-    W = cw[None, :, None] * level
+    W = cw[None, :, None] * speed
     W[occ] = 0.0
     W[~grid.inside] = 0.0
-    return W, flight_layer(curtain, agl)[:, 0]
+    return W, flight_layer(curtain, level.agl)[:, 0]
 
 
 def _check_level_options(level_contrast: float, level_base: str) -> None:
@@ -212,14 +214,6 @@ def _corridor_half_width(world: World, zz: Zigzag, corridor: float, level_contra
     return h
 
 
-def _shaped(world: World, base: np.ndarray, c: np.ndarray, agl: float, p1: float, p2: float,
-            level_band: float | None, level_graded: bool) -> np.ndarray:
-    """Flight level imposed on ``base``, times the corridor ``c`` (nx, ny)."""
-    band = world.spacing[2] if level_band is None else float(level_band)
-    level = flight_level_speed(base, world, agl, p1, p2, band=band, graded=level_graded)
-    return level * c[:, :, None]
-
-
 @dataclass(frozen=True, eq=False)
 class CoveragePlan:
     """Result of :func:`plan_coverage`.
@@ -242,7 +236,11 @@ class CoveragePlan:
         Wall times [s]: ``angle``, ``zigzag``, ``speed_map`` (corridor grid
         included), ``fm2``, ``report``, ``total``.
     params : dict
-        Settings.
+        Settings: ``spacing_m``, the fields of :attr:`level` (``agl``, ``p1``,
+        ``p2``, ``band``, ...), ``corridor``, ``level_contrast``,
+        ``level_base``, ``search``, ``order``, ``step``, ``grid``.
+    level : FlightLevel or None
+        The flight level flown (band widened as :func:`coverage_level` says).
     grid : CorridorGrid or None
         The corridor grid FM² ran on (None with ``grid="map"``).
     grid_plan : fm2uav.Plan or None
@@ -266,6 +264,7 @@ class CoveragePlan:
     agl_error: np.ndarray = field(repr=False)
     timings: dict[str, float] = field(default_factory=dict)
     params: dict[str, Any] = field(default_factory=dict)
+    level: FlightLevel | None = None
     grid: CorridorGrid | None = field(default=None, repr=False)
     grid_plan: Any = field(default=None, repr=False)
 
@@ -309,22 +308,18 @@ def plan_coverage(
     area,
     spacing: float,
     *,
-    agl: float,
+    level: FlightLevel,
     angle: float | None = None,
     search: str = "de",
     search_options: dict[str, Any] | None = None,
     seed: int | np.random.Generator = 0,
-    p1: float = 0.5,
-    p2: float = 1.3,
     corridor: float = 0.25,
-    level_band: float | None = None,
-    level_graded: bool = False,
     level_contrast: float = 0.5,
     level_base: str = "world",
-    order: int = 2,
+    options: PlanOptions = PlanOptions(),
     grid: str = "corridor",
 ) -> CoveragePlan:
-    """Coverage path: best zigzag over ``area``, then FM² along it at ``agl`` over the terrain.
+    """Coverage path: best zigzag over ``area``, then FM² along it at a flight level.
 
     Parameters
     ----------
@@ -334,8 +329,10 @@ def plan_coverage(
         Area to cover [m] (inside the map).
     spacing : float
         Band spacing D [m] (see :mod:`.camera` to derive it from a camera).
-    agl : float
-        Flight level above the ground [m].
+    level : FlightLevel
+        The flight level (``agl`` [m] above the ground; seeds: p1 = 0.5,
+        p2 = 1.3 at level 10, the FlightLevel defaults). Its band is widened
+        to at least one vertical cell (:func:`coverage_level`).
     angle : float, optional
         Steering angle [rad]; default: searched with ``search``.
     search : {"de", "sweep", "scipy-de"}
@@ -344,12 +341,11 @@ def plan_coverage(
         Extra keywords for the search (e.g. ``bounds_deg=(0, 180)``).
     seed : int or Generator
         Seed of the DE.
-    p1, p2 : float
-        Flight-level exponents (seeds: 0.5 and 1.3 at level 10).
-    corridor, level_band, level_graded, level_contrast, level_base
+    corridor, level_contrast, level_base
         See :func:`coverage_speed_map`.
-    order : {1, 2}
-        Fast Marching order.
+    options : PlanOptions, optional
+        Fast Marching order and geodesic step of the FM² run (its speed map
+        must be None: the coverage builds its own).
     grid : {"corridor", "map"}
         Grid FM² runs on: ``"corridor"`` (default) the corridor unrolled
         along the zigzag, with a velocity symmetric about it (the flown ground
@@ -364,7 +360,7 @@ def plan_coverage(
     Raises
     ------
     InputError
-        Bad area, spacing, or the zigzag leaves the map.
+        Bad area, spacing, objects, or the zigzag leaves the map.
     fm2uav.PlanningError
         The flight level leaves the map; the corridor is cut (unreachable); a
         path point falls in an obstacle node of the map (only possible on the
@@ -375,6 +371,10 @@ def plan_coverage(
         raise InputError(f"grid must be one of {', '.join(GRIDS)}, got {grid!r}")
     if not isinstance(world, World) or world.ndim != 3:
         raise InputError("plan_coverage needs a 3D fm2uav.World with terrain")
+    level = coverage_level(level, world)
+    if not isinstance(options, PlanOptions) or options.speed_map is not None:
+        raise InputError("options must be a fm2uav.PlanOptions without speed_map (the coverage "
+                         "FM² makes its own speed map), e.g. options=PlanOptions(order=1)")
     poly = as_area(area)
     d = check_spacing(poly, spacing)
     check_inside_world(poly, world)
@@ -399,47 +399,42 @@ def plan_coverage(
             "use a smaller D"
         )
     t2 = time.perf_counter()
-    opts = dict(agl=agl, p1=p1, p2=p2, level_band=level_band, level_graded=level_graded,
-                level_contrast=level_contrast, level_base=level_base)
+    opts = dict(level_contrast=level_contrast, level_base=level_base)
     if not (0 < corridor < 0.5):
         raise InputError(f"corridor must be a share of D in (0, 0.5), got {corridor!r}")
     cg = grid_plan = None
     if grid == "corridor":
         cg = corridor_grid(world, zz, corridor * d)
-        W, layer = corridor_grid_speed(cg, **opts)
+        W, layer = corridor_grid_speed(cg, level, **opts)
         gw = cg.world
         z = gw.origin[2] + layer[[0, -1]] * gw.spacing[2]
         start = np.array([0.0, 0.0, z[0]])
         goal = np.array([gw.origin[0] + (gw.shape[0] - 1) * gw.spacing[0], 0.0, z[1]])
         t3 = time.perf_counter()
-        grid_plan = fm2_plan(gw, start, goal, speed_map=W, order=order)
+        grid_plan = fm2_plan(gw, start, goal, options=dataclasses.replace(options, speed_map=W))
         fm = _on_map(cg, grid_plan)
     else:
-        W = coverage_speed_map(world, zz, corridor=corridor, **opts)
-        layer = flight_layer(world, agl)
+        W = coverage_speed_map(world, zz, level, corridor=corridor, **opts)
+        layer = flight_layer(world, level.agl)
         start = _on_level(world, zz.start, layer, "start")
         goal = _on_level(world, zz.goal, layer, "end")
         t3 = time.perf_counter()
-        fm = fm2_plan(world, start, goal, speed_map=W, order=order)
+        fm = fm2_plan(world, start, goal, options=dataclasses.replace(options, speed_map=W))
     _check_free(world, fm.path)
     t4 = time.perf_counter()
     cov = coverage_share(poly, fm.path, d / 2.0)
     zcov = coverage_share(poly, ideal, d / 2.0)
-    ground = terrain_along(world, fm.path)
-    err = fm.path[:, 2] - ground - agl
+    err = fm.path[:, 2] - world.ground_height(fm.path[:, 0], fm.path[:, 1]) - level.agl
     t5 = time.perf_counter()
     return CoveragePlan(
         zigzag=zz, search=found, plan=fm, coverage=cov, zigzag_coverage=zcov, agl_error=err,
         timings={"angle": t1 - t0, "zigzag": t2 - t1, "speed_map": t3 - t2, "fm2": t4 - t3,
                  "report": t5 - t4, "total": t5 - t0},
-        params={"spacing_m": d, "agl_m": float(agl), "p1": float(p1), "p2": float(p2),
-                "corridor": float(corridor), "level_band_m": (world.spacing[2] if level_band is None
-                                                               else float(level_band)),
-                "level_graded": bool(level_graded), "level_contrast": float(level_contrast),
-                "level_base": level_base,
-                "search": None if found is None else found.method, "order": int(order),
-                "grid": grid},
-        grid=cg, grid_plan=grid_plan,
+        params={"spacing_m": d, **dataclasses.asdict(level), "corridor": float(corridor),
+                "level_contrast": float(level_contrast), "level_base": level_base,
+                "search": None if found is None else found.method,
+                "order": int(options.order), "step": float(options.step), "grid": grid},
+        level=level, grid=cg, grid_plan=grid_plan,
     )
 
 
@@ -448,12 +443,11 @@ def _on_map(cg: CorridorGrid, fm: Plan) -> Plan:
     path = cg.to_map(fm.path)
     world = cg.map
     return Plan(
-        path=path, speed=fm.speed,
-        length=float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1))),
+        path=path, w=fm.w, length=path_length(path),
         clearance=float(clearance_profile(world, path).min()),
         timings=dict(fm.timings), W=cg.to_map_nodes(fm.W, 0.0),
         T=cg.to_map_nodes(fm.T, np.inf), world=world,
-        params={**fm.params, "grid": "corridor"},
+        params={**fm.params, "grid": "corridor"}, shaping=fm.shaping, level=fm.level,
     )
 
 

@@ -3,8 +3,8 @@
 Everything that does not change between cycles is computed once per mission
 (and the terrain parts once per world, cached in ``World._cache``):
 
-* the static velocity map ``W`` of the terrain (:func:`fm2uav.planning.base_velocity`,
-  saturation / exponent, then the flight-level shaping of each UAV's level);
+* the static velocity map ``W`` of the terrain (:func:`fm2uav.planning.shaped_velocity`,
+  then the flight-level shaping of each UAV's :class:`~fm2uav.FlightLevel`);
 * the terrain *clearance band*: nodes closer than ``clearance`` to the terrain
   are impassable (``W = 0``), which keeps every path point strictly above the
   ground surface, not only off the obstacle nodes (see :func:`local_path`);
@@ -30,7 +30,7 @@ from scipy import ndimage
 
 from ...eikonal.fmm import fast_marching
 from ...eikonal.velocity import distance_map, shape_velocity
-from ...planning import base_velocity
+from ...planning import FlightLevel, Shaping, max_distance, shaped_velocity
 from ...planning.flight_level import flight_layer, flight_level_speed
 from ...planning.geodesic import descend, nearest_node
 from ...world import World
@@ -80,82 +80,50 @@ class StaticMaps:
     ----------
     world : World
         3D map.
-    saturation, exponent : float
-        FM² shaping α and β of ``W`` (as in :func:`fm2uav.plan`).
-    method : {"edt", "fmm"}
-        Distance to obstacles for ``W``.
-    walls : bool
-        Treat the map border as an obstacle in ``W``.
+    shaping : Shaping
+        FM² shaping of ``W`` (as in :func:`fm2uav.plan`); also applied to the
+        distance to the other UAVs in :func:`local_path`.
     clearance : float
         Nodes closer than this to the terrain are impassable [m].
-    p1, p2 : float
-        Flight-level exponents (thesis Algorithm 2) for UAVs flying at a level.
-    agl_mode : {"capped", "literal"}
-        Reading of Algorithm 2 (:func:`fm2uav.planning.flight_level.flight_level_speed`).
     """
 
-    def __init__(
-        self,
-        world: World,
-        *,
-        saturation: float,
-        exponent: float,
-        method: str,
-        walls: bool,
-        clearance: float,
-        p1: float,
-        p2: float,
-        agl_mode: str = "capped",
-    ) -> None:
+    def __init__(self, world: World, shaping: Shaping, clearance: float) -> None:
         self.world = world
-        self.saturation = float(saturation)
-        self.exponent = float(exponent)
+        self.shaping = shaping
         self.clearance = float(clearance)
-        self.p1, self.p2 = float(p1), float(p2)
-        self.agl_mode = agl_mode
         self.spacing = np.asarray(world.spacing, dtype=float)
         self.origin = np.asarray(world.origin, dtype=float)
         self.shape = np.asarray(world.shape, dtype=np.int64)
         self.half_diagonal = 0.5 * float(np.linalg.norm(self.spacing))
-        d_terrain = terrain_distance(world)
-        self.allowed = d_terrain >= self.clearance
-        base = base_velocity(world, method=method, walls=walls)
+        self.allowed = terrain_distance(world) >= self.clearance
         # The normaliser of W (largest distance to an obstacle), for the UAV term.
-        if method == "edt" and not walls:
-            d_norm = d_terrain
-        else:
-            d_norm = distance_map(world.occupancy, spacing=world.spacing, method=method,
-                                  walls=walls)
-        finite = d_norm[np.isfinite(d_norm)]
-        dmax = float(finite.max()) if finite.size else 0.0
-        if dmax <= 0.0:
+        dmax = max_distance(world, shaping)
+        if not (np.isfinite(dmax) and dmax > 0.0):
             dmax = float(np.linalg.norm((self.shape - 1) * self.spacing)) or 1.0
         self.dmax = dmax
-        W0 = shape_velocity(base, saturation=saturation, exponent=exponent)
+        W0 = shaped_velocity(world, shaping)
+        W0 = W0.copy() if not W0.flags.writeable else W0
         W0[world.occupancy] = 0.0
         self._W0 = W0
-        self._W: dict[float | None, np.ndarray] = {}
+        self._W: dict[FlightLevel | None, np.ndarray] = {}
         self._layer: dict[float, np.ndarray] = {}
         self.hclear = horizontal_clearance(world)
 
-    def speed(self, agl: float | None) -> np.ndarray:
-        """Static ``W`` of a UAV flying at ``agl`` metres above ground (None: free).
+    def speed(self, level: FlightLevel | None) -> np.ndarray:
+        """Static ``W`` of a UAV flying at ``level`` (None: free), read-only.
 
         Flight-level shaping (:func:`fm2uav.planning.flight_level.flight_level_speed`)
         and the clearance band applied; cached per level.
         """
-        key = None if agl is None else float(agl)
-        W = self._W.get(key)
+        W = self._W.get(level)
         if W is None:
-            if key is None:
+            if level is None:
                 W = self._W0.copy()
             else:
-                W = np.array(flight_level_speed(self._W0, self.world, key, self.p1, self.p2,
-                                                mode=self.agl_mode),
-                             dtype=float)
+                W = np.array(flight_level_speed(self._W0, self.world, level), dtype=float)
             W[~self.allowed] = 0.0
             W.setflags(write=False)
-            self._W[key] = W
+            self._W[level] = W
         return W
 
     def level_z(self, agl: float, xy: np.ndarray) -> np.ndarray:
@@ -225,7 +193,7 @@ def local_path(
     ----------
     maps : StaticMaps
     W_static : ndarray
-        This UAV's static velocity map (``maps.speed(agl)``), full size.
+        This UAV's static velocity map (``maps.speed(level)``), full size.
     start, goal : ndarray, shape (3,)
         World points [m]; ``goal`` is clipped into the map.
     others : ndarray, shape (k, 3)
@@ -264,8 +232,10 @@ def local_path(
             d = np.sqrt((X - p[0]) ** 2 + (Y - p[1]) ** 2 + (Z - p[2]) ** 2)
             np.minimum(d_min, d, out=d_min)
             ball |= d < r
-        W_uav = shape_velocity(np.minimum(d_min / maps.dmax, 1.0),
-                               saturation=maps.saturation, exponent=maps.exponent)
+        sh = maps.shaping
+        W_uav = shape_velocity(np.minimum(d_min / maps.dmax, 1.0), saturation=sh.saturation,
+                               exponent=sh.exponent, saturation_distance=sh.saturation_distance,
+                               max_distance=maps.dmax)
         np.minimum(W, W_uav, out=W)
         W[ball] = 0.0
     free = W > 0.0
