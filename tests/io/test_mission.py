@@ -324,22 +324,3 @@ def test_export_converts_an_existing_path_for_another_firmware(examples, tmp_pat
     assert res.exit_code == 2 and "outside" in res.output
     res = runner.invoke(app, ["export", str(out / "path.csv"), "--out", str(tmp_path / "x")])
     assert res.exit_code == 2 and "--mission" in res.output
-
-
-def test_run_flags_override_the_mission_export_and_route(examples, tmp_path):
-    out = tmp_path / "o"
-    res = runner.invoke(app, ["run", str(examples / "open_field_tff.yaml"), "--out", str(out),
-                              "--firmware", "ardupilot", "--end", "rtl", "--frame", "relative",
-                              "--via", "1400,300,480", "--return", "--json"])
-    assert res.exit_code == 0, res.output
-    s = json.loads(res.output)
-    assert s["route"]["legs"] == 3
-    a = s["autopilot"]
-    assert (a["firmware"], a["frame"]["name"], a["end"]) == ("ardupilot", "relative", "rtl")
-    assert not any("straight line home" in w for w in a["warnings"])  # the route came back
-    res = runner.invoke(app, ["run", str(examples / "open_field_tff.yaml"), "--out",
-                              str(tmp_path / "p"), "--frame", "terrain"])
-    assert res.exit_code == 2 and "px4 would reject" in res.output and "outputs.frame" in res.output
-    res = runner.invoke(app, ["run", str(examples / "open_field_tff.yaml"), "--out",
-                              str(tmp_path / "q"), "--via", "1,2"])
-    assert res.exit_code == 2 and "--via 1 must be x,y,z" in res.output

@@ -10,6 +10,24 @@ import typer
 
 from ..errors import InputError
 from ._common import OutputDir, handle_errors, print_summary, progress, to_jsonable
+from .options import (
+    AllowFilledOpt,
+    BboxOpt,
+    BuildingsOpt,
+    CeilingOpt,
+    CellSizeOpt,
+    CrsOpt,
+    DefaultHeightOpt,
+    DemOpt,
+    DzOpt,
+    NodataOpt,
+    NodataValueOpt,
+    ScenarioOpt,
+    SeaLevelOpt,
+    build_world,
+    world_rows,
+    world_spec,
+)
 
 COVER_FILES = ("path.csv", "zigzag.csv", "bands.png", "coverage.png", "coverage.html",
                "summary.json", "mission.plan")
@@ -32,12 +50,17 @@ def _camera_spacing(camera: str, agl: float, side_overlap: float) -> float:
     return cam.spacing(agl, side_overlap)
 
 
-def _load_area(area: str, world=None):
-    from ..missions.coverage import read_area
+def _load_area(area: str, world=None, crs=None):
+    """(polygon in world metres, SourceFile or None) of --area."""
+    from ..missions.coverage.area import load_area
     from ..scenarios.coverage import COVERAGE_AREAS, coverage_area
 
     if area.strip().upper() in COVERAGE_AREAS:
-        return coverage_area(area)
+        if getattr(world, "crs", None) is not None:
+            raise InputError(f"--area {area} is a built-in area of the synthetic coverage map; "
+                             "on a --dem/--buildings world give the area as a file (GeoJSON in "
+                             "lon/lat, GeoPackage, Shapefile, KML/KMZ)")
+        return coverage_area(area), None
     if not Path(area).exists():
         raise InputError(
             f"--area {area!r} is neither an existing vector file nor a built-in area "
@@ -45,7 +68,7 @@ def _load_area(area: str, world=None):
             "GeoPackage, Shapefile, KML/KMZ; on a built-in map: GeoJSON in the map's metres) "
             "or one of those names"
         )
-    return read_area(area, world)
+    return load_area(area, world, crs=crs)
 
 
 def _write_report(outdir: OutputDir, cp, *, title: str, subtitle: str, metrics: dict,
@@ -75,10 +98,12 @@ def _write_cover_outputs(outdir: OutputDir, cp, area: str, *, report: bool, titl
     from ..viz.coverage import bands_figure, coverage_figure, coverage_html
 
     world = cp.plan.world
+    georef = getattr(world, "georef", None)
+    comment = georef.comment() if georef is not None else None
     with outdir.open("path.csv") as fh:
-        write_path_csv(fh, cp.path, cp.plan.w)
+        write_path_csv(fh, cp.path, cp.plan.w, comment=comment)
     with outdir.open("zigzag.csv") as fh:
-        write_path_csv(fh, cp.zigzag.path())
+        write_path_csv(fh, cp.zigzag.path(), comment=comment)
     _write_png(outdir, bands_figure(cp.zigzag, title=f"zigzag over {area}"), "bands.png")
     _write_png(outdir, coverage_figure(cp, title=title), "coverage.png")
     with outdir.open("coverage.html") as fh:
@@ -146,12 +171,17 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "  fm2uav cover --area area.geojson --spacing 80 --agl 100 --out out/cover\n\n"
             "  fm2uav cover --area S2 --camera 13.2,8.8,8.8,5472,3648 --side-overlap 0.7 "
             "--agl 100 --out out/cam\n\n"
-            "--area is a GeoJSON Polygon in the map's metres, or S1..S4 (the seeds' areas)."
+            "  fm2uav cover --dem dem.tif --area field.kml --spacing 60 --agl 90 "
+            "--out out/field   (KML/KMZ, GeoPackage, Shapefile, GeoJSON in lon/lat)\n\n"
+            "--area is a polygon file — on --dem/--buildings worlds in any CRS (GeoJSON: "
+            "lon/lat), on the built-in maps a GeoJSON in the map's metres — or S1..S4 (the "
+            "seeds' areas on the built-in coverage map)."
         ),
     )
     @handle_errors
     def cover_cmd(
-        area: str = typer.Option(..., help="GeoJSON file (Polygon, metres) or S1..S4."),
+        area: str = typer.Option(..., help="Polygon file (GeoJSON lon/lat, GPKG, SHP, "
+                                 "KML/KMZ) or S1..S4 (built-in map)."),
         spacing: float | None = typer.Option(None, help="Band spacing D (m)."),
         agl: float = typer.Option(100.0, help="Flight level above the ground (m)."),
         camera: str | None = typer.Option(
@@ -163,7 +193,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
                                         help="Search α in [0°, 180°) instead of [1°, 89°]."),
         p1: float = typer.Option(0.5, help="Exponent on the flight level (seeds 0.5)."),
         p2: float = typer.Option(1.3, help="Exponent elsewhere (seeds 1.3)."),
-        scenario: str = typer.Option("coverage", help="Built-in map to fly over."),
+        scenario: ScenarioOpt = None,
         seed: int = typer.Option(0, help="Seed of the terrain and of the DE."),
         out: Path = typer.Option(Path("out/cover"), help="Output directory."),
         force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
@@ -171,10 +201,21 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
         report: bool = typer.Option(
             False, "--report", help="Also write report.html (interactive, self-contained)."),
+        dem: DemOpt = None,
+        buildings: BuildingsOpt = None,
+        bbox: BboxOpt = None,
+        sea_level: SeaLevelOpt = None,
+        cell_size: CellSizeOpt = None,
+        dz: DzOpt = None,
+        ceiling: CeilingOpt = None,
+        nodata: NodataOpt = "error",
+        nodata_value: NodataValueOpt = None,
+        crs: CrsOpt = None,
+        default_height: DefaultHeightOpt = None,
+        allow_filled: AllowFilledOpt = False,
     ) -> None:
         from ..missions.coverage import FULL_BOUNDS_DEG, plan_coverage
         from ..planning import FlightLevel
-        from ..scenarios import get_scenario
 
         if (spacing is None) == (camera is None):
             raise InputError("give exactly one of --spacing (metres) or --camera")
@@ -186,8 +227,13 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             opts["bounds_deg"] = FULL_BOUNDS_DEG
         with progress(enabled=not (quiet or as_json)) as step:
             step("building the map")
-            world = get_scenario(scenario, seed=seed).world
-            poly = _load_area(area, world)
+            spec = world_spec(dem=dem, buildings=buildings, bbox=bbox, sea_level=sea_level,
+                              cell_size=cell_size, dz=dz, ceiling=ceiling, nodata=nodata,
+                              nodata_value=nodata_value, crs=crs,
+                              default_height=default_height, allow_filled=allow_filled)
+            world, _, scenario = build_world(spec, scenario=scenario, seed=seed, agl=agl,
+                                             default="coverage")
+            poly, area_source = _load_area(area, world, crs)
             step("searching the steering angle and planning FM² along the bands")
             cp = plan_coverage(world, poly, d, level=FlightLevel(agl=agl, p1=p1, p2=p2),
                                angle=None if angle is None else np.radians(angle),
@@ -195,7 +241,11 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             step("writing the outputs")
             wps = _write_cover_outputs(outdir, cp, area, report=report,
                                        title=f"coverage of {area}")
-        summary = {"area": area, "scenario": scenario, **cp.summary()}
+        from ..world.load import world_summary
+
+        summary = {"area": area, "scenario": scenario, "world": world_summary(world),
+                   **({"area_source": area_source.as_dict()} if area_source else {}),
+                   **cp.summary()}
         if wps is None:
             summary["mission_plan"] = "not written: fm2uav.io.qgc is not available"
         else:
@@ -213,6 +263,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "|AGL error| mean/max [m]": f"{np.abs(cp.agl_error).mean():.1f} / "
                                         f"{np.abs(cp.agl_error).max():.1f}",
             "timings [ms]": ", ".join(f"{k} {v * 1e3:.0f}" for k, v in cp.timings.items()),
+            **world_rows(world),
         }
         print_summary("coverage plan", summary if as_json else rows, as_json=as_json,
                       quiet=quiet, files=outdir.written)

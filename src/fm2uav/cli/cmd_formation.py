@@ -15,10 +15,30 @@ from ._common import (
     EXIT_PLANNING,
     OutputDir,
     handle_errors,
-    parse_point,
     print_summary,
     progress,
     to_jsonable,
+)
+from .options import (
+    AllowFilledOpt,
+    BboxOpt,
+    BuildingsOpt,
+    CeilingOpt,
+    CellSizeOpt,
+    CrsOpt,
+    DefaultHeightOpt,
+    DemOpt,
+    DzOpt,
+    LonLatOpt,
+    NodataOpt,
+    NodataValueOpt,
+    ScenarioOpt,
+    SeaLevelOpt,
+    build_world,
+    cli_point,
+    requested_heights,
+    world_rows,
+    world_spec,
 )
 
 FIGURES = ("paths.png", "profiles.png", "metrics.png")
@@ -97,15 +117,20 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "  fm2uav formation --scenario fissure --out out/formation\n\n"
             "  fm2uav formation --scenario fissure --level 7 --report --out out/formation-l7\n\n"
             "  fm2uav formation --shape v --followers 4 --dist 45 --no-gif --out out/v4\n\n"
+            "  fm2uav formation --dem dem.tif --bbox 10.05,45.54,10.2,45.66 --lonlat --start "
+            "10.06,45.55 --goal 10.19,45.65 --agl 120 --no-gif --out out/formation-dem\n\n"
             f"Scenarios: {', '.join(SCENARIOS)}."
         ),
     )
     @handle_errors
     def formation_cmd(
-        scenario: str = typer.Option("fissure", help="Built-in scenario name."),
-        start: str | None = typer.Option(None, help="Leader start x,y,z (m) (cells with --cells)."),
-        goal: str | None = typer.Option(None, help="Leader goal x,y,z (m) (cells with --cells)."),
+        scenario: ScenarioOpt = None,
+        start: str | None = typer.Option(None, help="Leader start x,y,z (m) (cells with --cells; "
+                                         "LON,LAT[,AGL] with --lonlat)."),
+        goal: str | None = typer.Option(None, help="Leader goal x,y,z (m) (cells with --cells; "
+                                        "LON,LAT[,AGL] with --lonlat)."),
         cells: bool = typer.Option(False, "--cells", help="Read --start/--goal as grid cells."),
+        lonlat: LonLatOpt = False,
         shape: str = typer.Option("triangle", help="Formation: triangle, v or line."),
         followers: int = typer.Option(2, help="Number of followers."),
         dist: float = typer.Option(
@@ -130,14 +155,31 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
         report: bool = typer.Option(
             False, "--report", help="Also write report.html (interactive, self-contained)."),
+        dem: DemOpt = None,
+        buildings: BuildingsOpt = None,
+        bbox: BboxOpt = None,
+        sea_level: SeaLevelOpt = None,
+        cell_size: CellSizeOpt = None,
+        dz: DzOpt = None,
+        ceiling: CeilingOpt = None,
+        nodata: NodataOpt = "error",
+        nodata_value: NodataValueOpt = None,
+        crs: CrsOpt = None,
+        default_height: DefaultHeightOpt = None,
+        allow_filled: AllowFilledOpt = False,
     ) -> None:
         from ..errors import InputError
         from ..experiments.formation import fly_and_summarise, summary_rows
         from ..missions.formation import FormationConfig
         from ..planning import FlightLevel
 
-        sc = get_scenario(scenario, seed=seed)
-        world = sc.world
+        spec = world_spec(dem=dem, buildings=buildings, bbox=bbox, sea_level=sea_level,
+                          cell_size=cell_size, dz=dz, ceiling=ceiling, nodata=nodata,
+                          nodata_value=nodata_value, crs=crs, default_height=default_height,
+                          allow_filled=allow_filled)
+        need_agl, need_top = requested_heights(start, goal, lonlat=lonlat, agl=agl)
+        world, sc, scenario = build_world(spec, scenario=scenario, seed=seed, agl=need_agl,
+                                          top=need_top, default="fissure")
         if agl is not None and level is not None:
             raise InputError("give either --agl (metres) or --level (cells), not both")
         if level is not None:
@@ -145,14 +187,18 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         outdir = OutputDir(out, force=force)
         outdir.check(_outputs(gif, report))
 
-        def point(text: str | None, default: np.ndarray, what: str) -> np.ndarray:
-            if text is None:
-                return default
-            p = parse_point(text, world.ndim, what)
-            return world.to_world(p) if cells else p
+        from ..scenarios.scenario import Scenario
+        from ..world.load import check_points, world_summary
 
-        sc = type(sc)(world=world, start=point(start, sc.start, "start"),
-                      goal=point(goal, sc.goal, "goal"), description=sc.description)
+        def point(text: str | None, default: np.ndarray | None, what: str) -> np.ndarray:
+            return cli_point(text, what, world, lonlat=lonlat, cells=cells, agl=agl,
+                             default=default)
+
+        s = point(start, sc.start if sc else None, "start")
+        g = point(goal, sc.goal if sc else None, "goal")
+        check_points(world, {"start": s, "goal": g}, allow_filled=allow_filled)
+        sc = Scenario(world=world, start=s, goal=g,
+                      description=sc.description if sc else f"real data: {scenario}")
         title = f"formation — {scenario}" + (f", flight level {agl:g} m" if agl else "")
         with progress(enabled=not (quiet or as_json)) as step:
             step(f"{title}: flying the formation (FM² re-planning every cycle)")
@@ -162,10 +208,11 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             result, summary = fly_and_summarise(
                 sc, config=config,
                 level=None if agl is None else FlightLevel(agl=agl, p1=p1, p2=p2))
+            summary = {"scenario": scenario, "world": world_summary(world), **summary}
             _write_case(outdir, result, summary, title=title, gif=gif, frames=frames,
                         report=report, subtitle=sc.description, step=step)
-        summary = {"scenario": scenario, **summary}
-        print_summary("FM² formation", summary if as_json else summary_rows(summary),
+        print_summary("FM² formation",
+                      summary if as_json else {**summary_rows(summary), **world_rows(world)},
                       as_json=as_json, quiet=quiet, files=outdir.written)
         if not result.completed:
             raise typer.Exit(EXIT_PLANNING)

@@ -10,9 +10,30 @@ import typer
 
 from ..planning import plan as plan_path
 from ..planning.params import planner_objects
-from ..scenarios import SCENARIOS, get_scenario
+from ..scenarios import SCENARIOS
 from ..errors import InputError
-from ._common import OutputDir, handle_errors, parse_point, print_summary, to_jsonable
+from ._common import OutputDir, handle_errors, print_summary, to_jsonable
+from .options import (
+    AllowFilledOpt,
+    BboxOpt,
+    BuildingsOpt,
+    CeilingOpt,
+    CellSizeOpt,
+    CrsOpt,
+    DefaultHeightOpt,
+    DemOpt,
+    DzOpt,
+    LonLatOpt,
+    NodataOpt,
+    NodataValueOpt,
+    ScenarioOpt,
+    SeaLevelOpt,
+    build_world,
+    cli_point,
+    requested_heights,
+    world_rows,
+    world_spec,
+)
 from .cmd_run import output_names, plan_outputs
 
 PLAN_FILES = ("path.csv", "plan.png", "summary.json")
@@ -24,25 +45,33 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
     @app.command(
         "plan",
         help=(
-            "Plan one FM² path on a built-in scenario and write path.csv, plan.png and "
-            "summary.json.\n\n"
+            "Plan one FM² path on a built-in scenario or on real data (--dem, --buildings) and "
+            "write path.csv, plan.png and summary.json.\n\n"
             "Examples:\n\n"
             "  fm2uav plan --scenario open-field --out out/plan\n\n"
             "  fm2uav plan --start 20,20,20 --goal 100,80,30 --cells --exponent 0.5 --out out/b\n\n"
             "  fm2uav plan --agl 150 --p1 0.5 --p2 1.3 --report --export all --out out/tff\n\n"
             "  fm2uav plan --report --export plan,wpl,geojson,kml --out out/c\n\n"
+            "  fm2uav plan --dem dem.tif --bbox 10.05,45.54,10.2,45.66 --lonlat --start "
+            "10.06,45.55 --goal 10.19,45.65 --agl 120 --out out/dem\n\n"
+            "  fm2uav plan --dem coast.tif --sea-level 0 --buildings osm.geojson "
+            "--default-height 10 --lonlat --start 10.06,45.55,60 --goal 10.19,45.65,60 "
+            "--out out/city\n\n"
             f"Scenarios: {', '.join(SCENARIOS)}."
         ),
     )
     @handle_errors
     def plan_cmd(
-        scenario: str = typer.Option("open-field", help="Built-in scenario name."),
+        scenario: ScenarioOpt = None,
         start: str | None = typer.Option(
-            None, help="Start x,y,z in metres (or cells with --cells). Default: the scenario's."
+            None, help="Start x,y,z in metres (cells with --cells; LON,LAT[,AGL] with "
+            "--lonlat). Default: the scenario's."
         ),
         goal: str | None = typer.Option(
-            None, help="Goal x,y,z in metres (or cells with --cells). Default: the scenario's."
+            None, help="Goal x,y,z in metres (cells with --cells; LON,LAT[,AGL] with "
+            "--lonlat). Default: the scenario's."
         ),
+        lonlat: LonLatOpt = False,
         cells: bool = typer.Option(False, "--cells", help="Read --start/--goal as grid cells."),
         saturation: float = typer.Option(1.0, help="Saturation α in (0, 1]."),
         saturation_distance: float | None = typer.Option(
@@ -62,6 +91,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             False, "--graded", help="Blend the exponent from p1 to p2 across --band."),
         mode: str = typer.Option(
             "capped", help="Flight-level reading: 'capped' or 'literal' (W**p as is)."),
+
         seed: int = typer.Option(0, help="Seed of the scenario's random relief."),
         out: Path = typer.Option(Path("out/plan"), help="Output directory."),
         force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
@@ -77,40 +107,62 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "Default: -3.7649,40.3326,0 (UC3M Leganés)."),
         thin: float = typer.Option(5.0, help="Waypoint tolerance (m) of the exports (3D "
                                    "Douglas–Peucker)."),
+        dem: DemOpt = None,
+        buildings: BuildingsOpt = None,
+        bbox: BboxOpt = None,
+        sea_level: SeaLevelOpt = None,
+        cell_size: CellSizeOpt = None,
+        dz: DzOpt = None,
+        ceiling: CeilingOpt = None,
+        nodata: NodataOpt = "error",
+        nodata_value: NodataValueOpt = None,
+        crs: CrsOpt = None,
+        default_height: DefaultHeightOpt = None,
+        allow_filled: AllowFilledOpt = False,
     ) -> None:
-        sc = get_scenario(scenario, seed=seed)
-        world = sc.world
+        spec = world_spec(dem=dem, buildings=buildings, bbox=bbox, sea_level=sea_level,
+                          cell_size=cell_size, dz=dz, ceiling=ceiling, nodata=nodata,
+                          nodata_value=nodata_value, crs=crs, default_height=default_height,
+                          allow_filled=allow_filled)
+        need_agl, need_top = requested_heights(start, goal, lonlat=lonlat, agl=agl)
+        world, sc, scenario = build_world(spec, scenario=scenario, seed=seed, agl=need_agl,
+                                          top=need_top)
+        description = sc.description if sc is not None else f"real data: {scenario}"
         outdir = OutputDir(out, force=force)
         extra = _extra_formats(export, report)
         export_options = _export_options(anchor, thin) if extra else None
         outdir.check(PLAN_FILES + tuple(output_names(extra)))
 
-        def point(text: str | None, default: np.ndarray, what: str) -> np.ndarray:
-            if text is None:
-                return default
-            p = parse_point(text, world.ndim, what)
-            return world.to_world(p) if cells else p
+        def point(text: str | None, default: np.ndarray | None, what: str) -> np.ndarray:
+            return cli_point(text, what, world, lonlat=lonlat, cells=cells, agl=agl,
+                             default=default, anchor=getattr(export_options, "anchor", None))
+
+        start_m = point(start, sc.start if sc else None, "start")
+        goal_m = point(goal, sc.goal if sc else None, "goal")
+        from ..world.load import check_points, world_summary
+
+        check_points(world, {"start": start_m, "goal": goal_m}, allow_filled=allow_filled)
 
         level_keys = (dict(agl=agl, p1=p1, p2=p2, band=band, graded=graded, mode=mode)
                       if agl is not None else {})
         shaping, level, options = planner_objects(dict(
             saturation=saturation, saturation_distance=saturation_distance, exponent=exponent,
             order=order, **level_keys))
-        p = plan_path(world, point(start, sc.start, "start"), point(goal, sc.goal, "goal"),
-                      shaping=shaping, level=level, options=options)
+        p = plan_path(world, start_m, goal_m, shaping=shaping, level=level, options=options)
         from ..io import write_path_csv
         from ..viz import plan_figure
 
-        summary = {"scenario": scenario, **p.summary()}
+        summary = {"scenario": scenario, "world": world_summary(world), **p.summary()}
+        georef = getattr(world, "georef", None)
         fig = plan_figure(p, title=f"FM² plan — {scenario}")
         tmp_png = outdir.target("plan.png")
         fig.savefig(tmp_png, dpi=110)
         with outdir.open("path.csv") as fh:
-            write_path_csv(fh, p.path, p.w)
+            write_path_csv(fh, p.path, p.w, comment=georef.comment() if georef else None)
         outdir.commit(tmp_png, "plan.png")
         if extra:
-            info = plan_outputs(outdir, p, extra, export_options,
-                                title=f"FM² plan — {scenario}", subtitle=sc.description)
+            info, _mission = plan_outputs(outdir, p, extra, export_options,
+                                title=f"FM² plan — {scenario}", subtitle=description)
             summary.update(waypoints=info["waypoints"], mavlink_frame=info["mavlink_frame"],
                            home_lat_lon_alt=info["home_lat_lon_alt"])
         with outdir.open("summary.json") as fh:
@@ -123,6 +175,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "clearance [m]": f"{p.clearance:.1f}",
             "min W on path": f"{p.w.min():.3f}",
             "timings [ms]": ", ".join(f"{k} {v * 1e3:.1f}" for k, v in p.timings.items()),
+            **world_rows(world),
         }
         if "waypoints" in summary:
             rows["waypoints"] = f"{summary['waypoints']} (MAVLink frame {summary['mavlink_frame']})"

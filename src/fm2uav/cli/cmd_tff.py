@@ -11,7 +11,28 @@ import numpy as np
 import typer
 
 from ..errors import InputError
-from ._common import OutputDir, handle_errors, parse_point, print_summary, progress, to_jsonable
+from ._common import OutputDir, handle_errors, print_summary, progress, to_jsonable
+from .options import (
+    AllowFilledOpt,
+    BboxOpt,
+    BuildingsOpt,
+    CeilingOpt,
+    CellSizeOpt,
+    CrsOpt,
+    DefaultHeightOpt,
+    DemOpt,
+    DzOpt,
+    LonLatOpt,
+    NodataOpt,
+    NodataValueOpt,
+    ScenarioOpt,
+    SeaLevelOpt,
+    build_world,
+    cli_point,
+    requested_heights,
+    world_rows,
+    world_spec,
+)
 
 TFF_FILES = (
     "tff_table.md",
@@ -157,13 +178,15 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "Examples:\n\n"
             "  fm2uav tune --agl 150 --max-climb 45 --min-turn-radius 60 --out out/tune\n\n"
             "  fm2uav tune --p1 0.5 --p2 1.3,1.5 --report --out out/tune-report\n\n"
+            "  fm2uav tune --dem dem.tif --bbox 10.05,45.54,10.2,45.66 --lonlat --start "
+            "10.06,45.55 --goal 10.19,45.65 --agl 120 --out out/tune-dem\n\n"
             "  fm2uav tune --scenario jacksboro --agl 300 --max-climb 20 --min-turn-radius 300 "
             "--saturation 1,0.5 --out out/tune-jb"
         ),
     )
     @handle_errors
     def tune_cmd(
-        scenario: str = typer.Option("open-field", help="Built-in 3D scenario with terrain."),
+        scenario: ScenarioOpt = None,
         agl: float = typer.Option(150.0, help="Flight level over the ground (m)."),
         max_climb: float = typer.Option(45.0, help="Airframe max climb/descent angle (deg)."),
         min_turn_radius: float = typer.Option(60.0, help="Airframe min turn radius (m)."),
@@ -171,8 +194,11 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         p2: str = typer.Option("0.6,0.8,1.0,1.3,1.5,2.0,2.5", help="Values of p2 to try."),
         saturation: str = typer.Option("1.0", help="Values of α to try."),
         exponent: str = typer.Option("1.0", help="Values of β to try."),
-        start: str | None = typer.Option(None, help="Start x,y,z (m). Default: the scenario's."),
-        goal: str | None = typer.Option(None, help="Goal x,y,z (m). Default: the scenario's."),
+        start: str | None = typer.Option(None, help="Start x,y,z (m), LON,LAT[,AGL] with "
+                                         "--lonlat. Default: the scenario's."),
+        goal: str | None = typer.Option(None, help="Goal x,y,z (m), LON,LAT[,AGL] with "
+                                        "--lonlat. Default: the scenario's."),
+        lonlat: LonLatOpt = False,
         seed: int = typer.Option(0, help="Seed of the scenario's random relief."),
         out: Path = typer.Option(Path("out/tune"), help="Output directory."),
         force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
@@ -180,10 +206,21 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
         report: bool = typer.Option(
             False, "--report", help="Also write report.html (interactive, self-contained)."),
+        dem: DemOpt = None,
+        buildings: BuildingsOpt = None,
+        bbox: BboxOpt = None,
+        sea_level: SeaLevelOpt = None,
+        cell_size: CellSizeOpt = None,
+        dz: DzOpt = None,
+        ceiling: CeilingOpt = None,
+        nodata: NodataOpt = "error",
+        nodata_value: NodataValueOpt = None,
+        crs: CrsOpt = None,
+        default_height: DefaultHeightOpt = None,
+        allow_filled: AllowFilledOpt = False,
     ) -> None:
         from ..analysis.tune import AirframeLimits, tune
         from ..planning import FlightLevel
-        from ..scenarios import get_scenario
 
         def values(text: str, what: str) -> list[float]:
             try:
@@ -195,9 +232,23 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
                 "saturation": values(saturation, "saturation"),
                 "exponent": values(exponent, "exponent")}
         limits = AirframeLimits(max_climb, min_turn_radius)
-        sc = get_scenario(scenario, seed=seed)
-        s = sc.start if start is None else parse_point(start, 3, "start")
-        g = sc.goal if goal is None else parse_point(goal, 3, "goal")
+        spec = world_spec(dem=dem, buildings=buildings, bbox=bbox, sea_level=sea_level,
+                          cell_size=cell_size, dz=dz, ceiling=ceiling, nodata=nodata,
+                          nodata_value=nodata_value, crs=crs, default_height=default_height,
+                          allow_filled=allow_filled)
+        need_agl, need_top = requested_heights(start, goal, lonlat=lonlat, agl=agl)
+        world, sc, scenario = build_world(spec, scenario=scenario, seed=seed, agl=need_agl,
+                                          top=need_top)
+        s = cli_point(start, "start", world, lonlat=lonlat, agl=agl,
+                      default=sc.start if sc else None)
+        g = cli_point(goal, "goal", world, lonlat=lonlat, agl=agl,
+                      default=sc.goal if sc else None)
+        if sc is None:
+            from ..scenarios.scenario import Scenario
+            from ..world.load import check_points
+
+            check_points(world, {"start": s, "goal": g}, allow_filled=allow_filled)
+            sc = Scenario(world=world, start=s, goal=g, description=f"real data: {scenario}")
         outdir = OutputDir(out, force=force)
         outdir.check(TUNE_FILES + ((REPORT,) if report else ()))
         with progress(enabled=not (quiet or as_json)) as step:
@@ -220,11 +271,15 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             tmp = outdir.target("tune_best.png")
             fig.savefig(tmp, dpi=100)
             with outdir.open("tune_best_path.csv") as fh:
-                write_path_csv(fh, res.best_plan.path, res.best_plan.w)
+                write_path_csv(fh, res.best_plan.path, res.best_plan.w,
+                               comment=world.georef.comment() if world.georef else None)
             outdir.commit(tmp, "tune_best.png")
         with outdir.open("tune_table.md") as fh:
             fh.write("\n".join(md))
-        payload = {"scenario": scenario, "agl_m": agl, "limits": limits.__dict__,
+        from ..world.load import world_summary
+
+        payload = {"scenario": scenario, "world": world_summary(world), "agl_m": agl,
+                   "limits": limits.__dict__,
                    "best": res.best, "pareto": res.pareto, "rows": res.rows}
         with outdir.open("tune.json") as fh:
             json.dump(to_jsonable(payload), fh, indent=2)
@@ -240,6 +295,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
                      f"mean|dev| {b['deviation_m']:.1f} m, max climb {b['climb_max_deg']:.1f}°, "
                      f"min turn radius {b['min_turn_radius_m']:.0f} m"),
             "pareto front": len(res.pareto),
+            **world_rows(world),
         }
         print_summary("Auto-tuning", rows if not as_json else payload, as_json=as_json,
                       quiet=quiet, files=outdir.written)

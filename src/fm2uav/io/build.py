@@ -592,16 +592,13 @@ def _end(geo: _Geo, wps: Waypoints, opt: ExportOptions
         inside = _inside_xy(geo.world, line)
         rise = (float((geo.ground(line[inside]) - geo.ground(start_xy)[0]).max())
                 if inside.any() else float("nan"))
-        back = float(np.hypot(*(end_xy - start_xy)))
-        landing["rtl_straight_line_m"] = round(back, 1)
+        landing["rtl_straight_line_m"] = round(float(np.hypot(*(end_xy - start_xy))), 1)
         landing["rtl_max_ground_above_home_m"] = None if not np.isfinite(rise) else round(rise, 1)
-        if back > max(10.0, opt.tolerance):  # the route did not come back home itself
-            rises = (f" — the ground under it rises {rise:.0f} m above home"
-                     if np.isfinite(rise) and rise > 0 else "")
-            warnings.append("RTL flies a straight line home at the firmware's return altitude "
-                            "(PX4 RTL_RETURN_ALT, ArduPilot RTL_ALT / ALT_HOLD_RTL); fm2uav "
-                            f"neither plans nor checks it{rises}; use return: true (--return) "
-                            "for a planned way back")
+        warnings.append("RTL flies a straight line home at the firmware's return altitude (PX4 "
+                        "RTL_RETURN_ALT, ArduPilot RTL_ALT / ALT_HOLD_RTL); fm2uav neither plans "
+                        "nor checks it" + (f" — the ground under it rises {rise:.0f} m above home"
+                                           if np.isfinite(rise) and rise > 0 else "")
+                        + "; use return: true (--return) for a planned way back")
     elif end == "land" and opt.vehicle == "fixed_wing":
         heading = _unit_xy(wps.points_m, from_end=True)
         items, landing, warnings = _landing_pattern(geo, end_xy, heading, f_route, opt, "landing")
