@@ -258,8 +258,10 @@ def test_slow_wall_inside_the_box_is_not_crossed_for_free(solver, order, column)
     # (50, 50). R = max(2, 0.05 * 100) = 5, so the box (rows 45..55) holds the wall
     # and the old rule (only speed 0 made a box unclean) gave the ball node (55, 50)
     # the straight-ray time 5 * (1 + 1)/2 = 5 and (56, 50) 6.0: the wall crossed
-    # for free. Now max/min = 1000 > 1.5: no ball, and the wall costs its
-    # crossing time h / v = 1000 s.
+    # for free. Now max/min = 1000 > 1.5: not clean at R = 5; the halved radius
+    # 2.5 (box rows 48..52, speed 1 only) is, so the ball is the 21 nodes within
+    # 2.5 of the source, exact (constant speed), and the wall costs its crossing
+    # time h / v = 1000 s.
     # Down the column y = 50 every update is one-sided (the side nodes are later):
     # order 1: 1, 2, then 2 + 1000 = 1002 on the wall, + 1 per row: 1005 at x = 56.
     # order 2: 1 (no second upwind node), (4*1 - 0)/3 + 2/3 = 2; every stencil
@@ -276,11 +278,19 @@ def test_slow_wall_inside_the_box_is_not_crossed_for_free(solver, order, column)
     np.testing.assert_allclose(T[50:57, 50], column, rtol=RTOL, atol=0)
     behind = T[54:]
     assert np.all(behind >= 1000.0)
-    assert_same_field(T, solver(speed, [(50, 50)], order=order, source_ball=False), RTOL)
-    # in front of the wall nothing changes: the wall nodes are later than every
-    # node of rows <= 52 (at most 72 s, measured), so they are never upwind there
-    free = solver(np.ones((101, 101)), [(50, 50)], order=order, source_ball=False)
-    np.testing.assert_allclose(T[:53], free[:53], rtol=RTOL, atol=0)
+    # the ball: exactly the nodes within 2.5 of the source, frozen at d / v
+    init = solver(speed, [(50, 50)], order=order, stop_at=[(50, 50)])
+    d = distance_from((101, 101), (1.0, 1.0), (50, 50))
+    np.testing.assert_array_equal(np.isfinite(init), d <= 2.5)
+    np.testing.assert_allclose(init[d <= 2.5], d[d <= 2.5], rtol=RTOL, atol=0)
+    # in front of the wall nothing depends on what lies behind it: the wall nodes
+    # are later than every node of rows <= 52 (at most 72 s, measured), so they
+    # are never upwind there; a slow half-space from row 53 on (same ball) gives
+    # the same front
+    half = speed.copy()
+    half[53:] = 1e-3
+    front = solver(half, [(50, 50)], order=order)
+    np.testing.assert_allclose(T[:53], front[:53], rtol=RTOL, atol=0)
 
 
 @pytest.mark.parametrize("order", [1, 2])

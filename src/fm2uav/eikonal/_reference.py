@@ -20,13 +20,17 @@ Sources
     ``T = 0`` at every source node; source nodes are frozen. Then comes the
     straight-ray *ball*, unless there are more than ``MAX_BALL_SOURCES = 64``
     sources, counted as given (repeats included); then sources are plain
-    ``T = 0`` nodes and nothing else is initialised. The ball radius is
-    ``R = max(2 * max(h), 0.05 * extent)`` [m], where ``extent`` is the largest
-    physical size ``(n_axis - 1) * h_axis`` of the grid. A source is *clean* if
-    its bounding box (clipped to the grid, ``floor(R / h_axis)`` nodes either
-    side per axis) holds no node of speed ``<= 0`` and its largest speed is at
-    most ``BALL_MAX_SPEED_RATIO = 1.5`` times its smallest. Around every clean source,
-    every node at physical distance ``d <= R`` other than a source gets a ball
+    ``T = 0`` nodes and nothing else is initialised. The nominal ball radius
+    is ``R = max(2 * max(h), 0.05 * extent)`` [m], where ``extent`` is the
+    largest physical size ``(n_axis - 1) * h_axis`` of the grid. A radius ``r``
+    is clean for a source if the source's bounding box of ``r`` (clipped to
+    the grid, ``floor(r / h_axis)`` nodes either side per axis) holds no node
+    of speed ``<= 0`` and its largest speed is at most
+    ``BALL_MAX_SPEED_RATIO = 1.5`` times its smallest. Each source tries
+    ``R``, then ``max(R / 2, 2 max(h))``, halving until a clean radius or the
+    try at ``2 max(h)``; a source is *clean* if one of them is. Around every
+    clean source, with its radius ``r``,
+    every node at physical distance ``d <= r`` other than a source gets a ball
     time if that is smaller than its current value (so the minimum over
     sources wins): if the box's speed is constant, the straight-ray time
     ``d * 0.5 * (1/v_source + 1/v_node)``; otherwise the time of the factored
@@ -387,21 +391,30 @@ def fast_marching_reference(
     if source_ball and len(source_nodes) <= MAX_BALL_SOURCES:  # counted with repeats
         extent = max((n - 1) * hx for n, hx in zip(shape, h))  # [m]
         radius = max(SOURCE_RADIUS_CELLS * max(h), SOURCE_RADIUS_FRACTION * extent)  # [m]
-        reach = [int(math.floor(radius / hx)) for hx in h]  # nodes per axis
-        boxes, box_ranges = [], []
+        smallest = SOURCE_RADIUS_CELLS * max(h)  # [m] the last radius tried
+        radii, boxes, box_ranges, clean, constant = [], [], [], [], []
         for s in source_nodes:
-            ranges = [
-                range(max(s[ax] - reach[ax], 0), min(s[ax] + reach[ax], shape[ax] - 1) + 1)
-                for ax in range(ndim)
-            ]
+            r = radius
+            while True:  # radius, radius / 2, ... down to 2 cells: the first clean box
+                reach = [int(math.floor(r / hx)) for hx in h]  # nodes per axis
+                ranges = [
+                    range(max(s[ax] - reach[ax], 0), min(s[ax] + reach[ax], shape[ax] - 1) + 1)
+                    for ax in range(ndim)
+                ]
+                box = list(itertools.product(*ranges))
+                speeds = [float(speed[node]) for node in box]
+                ok = min(speeds) > 0.0 and max(speeds) <= BALL_MAX_SPEED_RATIO * min(speeds)
+                if ok or r <= smallest:
+                    break
+                r = max(0.5 * r, smallest)
+            radii.append(r)
             box_ranges.append(ranges)
-            boxes.append(list(itertools.product(*ranges)))
-        clean, constant = [], []
-        for box in boxes:
-            speeds = [float(speed[node]) for node in box]
-            clean.append(min(speeds) > 0.0 and max(speeds) <= BALL_MAX_SPEED_RATIO * min(speeds))
+            boxes.append(box)
+            clean.append(ok)
             constant.append(min(speeds) == max(speeds))
-        for s, box, ranges, ok, flat in zip(source_nodes, boxes, box_ranges, clean, constant):
+        for s, r, box, ranges, ok, flat in zip(
+            source_nodes, radii, boxes, box_ranges, clean, constant
+        ):
             if not ok:
                 continue
             v_source = float(speed[s])
@@ -411,7 +424,7 @@ def fast_marching_reference(
                 for ax in range(ndim):
                     dx = (node[ax] - s[ax]) * h[ax]
                     d2 += dx * dx
-                if d2 > radius * radius or node in is_source:
+                if d2 > r * r or node in is_source:
                     continue
                 if factored is None:  # constant speed: the exact straight ray
                     t = math.sqrt(d2) * 0.5 * (1.0 / v_source + 1.0 / float(speed[node]))

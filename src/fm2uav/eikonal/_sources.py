@@ -50,12 +50,16 @@ What the ball holds
 
 The box is the source's bounding box of the ball, ``floor(R / h_k)`` nodes
 either side per axis, clipped to the grid; the ball is the nodes at distance
-``d <= R``. Only *clean* sources get a ball: every speed in the box ``> 0`` and
-``max / min <= max_ratio`` (a wall or a jump inside the box belongs to the
-march, with its first-order fallback across jumps). When every source is
-clean the ball nodes are frozen (final); otherwise they only enter the narrow
-band, so a nearer route past an obstacle near another source can lower them.
-With several sources a ball node keeps the smallest time over the sources.
+``d <= R``. A box is *clean* when every speed in it is ``> 0`` and ``max / min
+<= max_ratio`` (a wall or a jump inside the box belongs to the march, with its
+first-order fallback across jumps). Each source takes the largest radius of
+``R, R/2, R/4, ...`` whose box is clean, the last try being ``min_radius``
+(2 cells): a smooth medium that varies by more than ``max_ratio`` over the
+nominal box, or a wall or layer a few cells away, only shrinks the ball. A
+source that is not clean even then gets no ball. When every source is clean
+the ball nodes are frozen (final); otherwise they only enter the narrow band,
+so a nearer route past an obstacle near another source can lower them. With
+several sources a ball node keeps the smallest time over the sources.
 """
 
 from __future__ import annotations
@@ -279,7 +283,22 @@ def factored_box(sb, bx, by, bz, li, lj, lk, hx, hy, hz):
 
 # ------------------------------------------------------------------ the ball
 @njit(cache=True, error_model="numpy")
-def init_sources(speed, T, state, nx, ny, nz, hx, hy, hz, src, radius, max_ratio):
+def _box_range(speed, si, sj, sk, ri, rj, rk, nx, ny, nz):
+    """Smallest and largest speed [m/s] in the box of half-widths ``ri, rj, rk`` nodes."""
+    sx = ny * nz
+    vmin = np.inf
+    vmax = 0.0
+    for i in range(max(si - ri, 0), min(si + ri, nx - 1) + 1):
+        for j in range(max(sj - rj, 0), min(sj + rj, ny - 1) + 1):
+            for k in range(max(sk - rk, 0), min(sk + rk, nz - 1) + 1):
+                v = speed[i * sx + j * nz + k]
+                vmin = min(vmin, v)
+                vmax = max(vmax, v)
+    return vmin, vmax
+
+
+@njit(cache=True, error_model="numpy")
+def init_sources(speed, T, state, nx, ny, nz, hx, hy, hz, src, radius, min_radius, max_ratio):
     """Initialise point sources in place: ``T = 0`` (frozen) and the source balls.
 
     See the module docstring for the rule. Same interface as the march expects:
@@ -300,37 +319,47 @@ def init_sources(speed, T, state, nx, ny, nz, hx, hy, hz, src, radius, max_ratio
         Source indices.
     radius : float
         Ball radius [m]; 0 disables the ball.
+    min_radius : float
+        Smallest ball radius [m]: a source whose box is not clean at ``radius``
+        tries half of it, and so on, down to ``min_radius`` (the last try).
     max_ratio : float
         Largest admissible max/min speed ratio in a source's box.
     """
     sx = ny * nz
     sy = nz
     m = src.shape[0]
-    ri = int(math.floor(radius / hx)) if radius > 0 else 0
-    rj = int(math.floor(radius / hy)) if radius > 0 else 0
-    rk = int(math.floor(radius / hz)) if (radius > 0 and nz > 1) else 0
-    r2 = radius * radius
     for s in range(m):
         cs = src[s, 0] * sx + src[s, 1] * sy + src[s, 2]
         T[cs] = 0.0
         state[cs] = 2
     if radius <= 0:
         return
+    # each source's radius: the largest of radius, radius/2, ..., min_radius whose
+    # box is clean (speeds > 0, max/min <= max_ratio); none: not clean
     clean = np.ones(m, dtype=np.uint8)
     constant = np.zeros(m, dtype=np.uint8)
+    rad = np.empty(m)
+    reach = np.zeros((m, 3), dtype=np.int64)
     for s in range(m):
-        si, sj, sk = src[s, 0], src[s, 1], src[s, 2]
-        vmin = np.inf
-        vmax = 0.0
-        for i in range(max(si - ri, 0), min(si + ri, nx - 1) + 1):
-            for j in range(max(sj - rj, 0), min(sj + rj, ny - 1) + 1):
-                for k in range(max(sk - rk, 0), min(sk + rk, nz - 1) + 1):
-                    v = speed[i * sx + j * sy + k]
-                    vmin = min(vmin, v)
-                    vmax = max(vmax, v)
-        if not (vmin > 0.0 and vmax <= max_ratio * vmin):
-            clean[s] = 0
-        elif vmax == vmin:
+        r = radius
+        ri = rj = rk = 0
+        vmin = vmax = 0.0
+        while True:
+            ri = int(math.floor(r / hx))
+            rj = int(math.floor(r / hy))
+            rk = int(math.floor(r / hz)) if nz > 1 else 0
+            vmin, vmax = _box_range(speed, src[s, 0], src[s, 1], src[s, 2], ri, rj, rk, nx, ny, nz)
+            if vmin > 0.0 and vmax <= max_ratio * vmin:
+                break
+            if r <= min_radius:
+                clean[s] = 0
+                break
+            r = max(0.5 * r, min_radius)
+        rad[s] = r
+        reach[s, 0] = ri
+        reach[s, 1] = rj
+        reach[s, 2] = rk
+        if clean[s] == 1 and vmax == vmin:
             constant[s] = 1
     all_clean = True
     for s in range(m):
@@ -342,9 +371,10 @@ def init_sources(speed, T, state, nx, ny, nz, hx, hy, hz, src, radius, max_ratio
             continue
         si, sj, sk = src[s, 0], src[s, 1], src[s, 2]
         vs = speed[si * sx + sj * sy + sk]
-        i0, i1 = max(si - ri, 0), min(si + ri, nx - 1)
-        j0, j1 = max(sj - rj, 0), min(sj + rj, ny - 1)
-        k0, k1 = max(sk - rk, 0), min(sk + rk, nz - 1)
+        r2 = rad[s] * rad[s]
+        i0, i1 = max(si - reach[s, 0], 0), min(si + reach[s, 0], nx - 1)
+        j0, j1 = max(sj - reach[s, 1], 0), min(sj + reach[s, 1], ny - 1)
+        k0, k1 = max(sk - reach[s, 2], 0), min(sk + reach[s, 2], nz - 1)
         bx, by, bz = i1 - i0 + 1, j1 - j0 + 1, k1 - k0 + 1
         tb = np.empty(0)
         if constant[s] == 0:

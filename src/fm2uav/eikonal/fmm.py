@@ -31,7 +31,9 @@ MAX_BALL_SOURCES = 64
 #: most this factor (max/min): the ball's times (straight ray for a constant
 #: speed, the factored eikonal equation otherwise, see ``_sources``) assume a
 #: smooth speed, so a slow wall or a jump (e.g. a flight-level layer) inside the
-#: box is left to the march and its first-order fallback across jumps.
+#: box is left to the march and its first-order fallback across jumps. Where the
+#: nominal box fails, the radius is halved (down to ``SOURCE_INIT_CELLS`` cells)
+#: until its box passes.
 BALL_MAX_SPEED_RATIO = 1.5
 #: Positive speeds below this are raised to it, so that ``1 / speed**2`` stays
 #: finite (smaller speeds would otherwise act as walls).
@@ -135,11 +137,12 @@ def fast_marching(
         Indexed x first.
     sources : sequence of int tuples or (m, ndim) int array
         Grid indices where ``T = 0``. Each must have speed > 0. Around point
-        sources (at most 64) whose neighbourhood has a positive speed varying by
-        at most 1.5x, nodes within ``max(2 cells, 5 % of the grid extent)`` get
-        accurate times before the march (the straight-ray time for a constant
-        speed, the factored eikonal equation solved on the ball's box for a
-        varying one), which keeps the order-2 scheme second-order.
+        sources (at most 64), nodes within ``max(2 cells, 5 % of the grid
+        extent)`` get accurate times before the march (the straight-ray time for
+        a constant speed, the factored eikonal equation solved on the ball's box
+        for a varying one), which keeps the order-2 scheme second-order. The
+        ball needs a positive speed varying by at most 1.5x in its box; where
+        that fails, it is halved down to 2 cells until it holds.
     spacing : float or sequence of float, optional
         Node spacing [m], one value or one per axis. Default 1.
     order : {1, 2}, optional
@@ -200,7 +203,8 @@ def fast_marching(
     # source ball: exact straight-ray times for a constant speed, the factored
     # eikonal equation on the ball's box otherwise (docs/eikonal.md)
     _sources.init_sources(
-        flat_speed, T, state, *shape3, *h3, src3, radius, BALL_MAX_SPEED_RATIO
+        flat_speed, T, state, *shape3, *h3, src3, radius, SOURCE_INIT_CELLS * max(h),
+        BALL_MAX_SPEED_RATIO,
     )
 
     if stop_at is not None:
