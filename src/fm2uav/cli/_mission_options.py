@@ -19,7 +19,8 @@ from ..errors import InputError
 
 __all__ = [
     "Firmware", "Vehicle", "Frame", "End", "Thin", "AnchorText", "SpeedChanges", "MinSpeed",
-    "CruiseSpeed", "HoverSpeed", "Endurance", "Reserve", "parse_anchor", "export_options",
+    "CruiseSpeed", "HoverSpeed", "Endurance", "Reserve", "Via", "Return", "parse_anchor",
+    "via_points", "export_options",
 ]
 
 Firmware = Annotated[str | None, typer.Option(
@@ -52,6 +53,31 @@ Endurance = Annotated[float | None, typer.Option(
     help="Airframe endurance (min): the flight time is checked against it (airframe.endurance).")]
 Reserve = Annotated[float | None, typer.Option(
     help="Share of the endurance kept in reserve (airframe.reserve). Default 0.2.")]
+
+
+Via = Annotated[list[str] | None, typer.Option(
+    "--via", help="A point to pass on the way, in order (repeat for more): x,y,z metres, or "
+    "LON,LAT,AGL with --lonlat (mission file via:). FM² plans each leg.")]
+Return = Annotated[bool | None, typer.Option(
+    "--return/--no-return", help="Plan a leg back from the goal to the start (mission file "
+    "return:).")]
+
+
+def via_points(via: list[str] | None, *, lonlat: bool) -> list[Any] | None:
+    """``--via`` values as mission-file points (``[x, y, z]`` or ``{lon, lat, agl}``)."""
+    if not via:
+        return None
+    out: list[Any] = []
+    for k, text in enumerate(via):
+        try:
+            v = [float(p) for p in text.replace(",", " ").split() if p]
+        except ValueError:
+            v = []
+        if len(v) != 3:
+            form = "LON,LAT,AGL (degrees, degrees, metres above ground)" if lonlat else "x,y,z (m)"
+            raise InputError(f"--via {k + 1} must be {form}, got {text!r}")
+        out.append({"lon": v[0], "lat": v[1], "agl": v[2]} if lonlat else v)
+    return out
 
 
 def parse_anchor(text: str | None) -> Any:

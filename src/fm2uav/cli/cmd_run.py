@@ -15,6 +15,19 @@ import numpy as np
 import typer
 
 from ._common import OutputDir, handle_errors, print_summary, progress, to_jsonable
+from ._mission_options import (
+    End,
+    Endurance,
+    Firmware,
+    Frame,
+    Reserve,
+    Return,
+    SpeedChanges,
+    Vehicle,
+    Via,
+    export_options,
+    via_points,
+)
 from .options import (
     AllowFilledOpt,
     BboxOpt,
@@ -200,6 +213,8 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "Examples:\n\n"
             "  fm2uav run examples/open_field_tff.yaml\n\n"
             "  fm2uav run examples/jacksboro_tff.yaml --out out/jacksboro --force\n\n"
+            "  fm2uav run examples/open_field_tff.yaml --firmware ardupilot --end rtl "
+            "--via 1400,300,300 --return --out out/open_field_ardu\n\n"
             "See docs/operator.md for the mission file format."
         ),
     )
@@ -230,6 +245,15 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         crs: CrsOpt = None,
         default_height: DefaultHeightOpt = None,
         allow_filled: AllowFilledOpt = False,
+        via: Via = None,
+        return_to_start: Return = None,
+        firmware: Firmware = None,
+        vehicle: Vehicle = None,
+        frame: Frame = None,
+        end: End = None,
+        speed_changes: SpeedChanges = None,
+        endurance: Endurance = None,
+        reserve: Reserve = None,
     ) -> None:
         from ..io.mission import load_mission
         from ..missions.route import plan_route
@@ -239,9 +263,15 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
                                cell_size=cell_size, dz=dz, ceiling=ceiling, nodata=nodata,
                                nodata_value=nodata_value, crs=crs,
                                default_height=default_height, allow_filled=allow_filled)
-        mission = load_mission(mission_file, world_overrides=over,
-                               point_overrides=point_overrides(start=start, goal=goal,
-                                                               lonlat=lonlat))
+        points = point_overrides(start=start, goal=goal, lonlat=lonlat) or {}
+        if via:
+            points["via"] = via_points(via, lonlat=lonlat)
+        if return_to_start is not None:
+            points["return"] = return_to_start
+        mission = load_mission(mission_file, world_overrides=over, point_overrides=points or None)
+        options = export_options(mission.export_options(), firmware=firmware, vehicle=vehicle,
+                                 frame=frame, end=end, speed_changes=speed_changes,
+                                 endurance=endurance, reserve=reserve)
         target = out or Path(mission.outputs.dir or Path("out") / mission_file.stem)
         outdir = OutputDir(target, force=force)
         formats = list(dict.fromkeys(mission.outputs.formats))
@@ -261,7 +291,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
 
             world_info = {**world_summary(rm.world), "name": world_desc}
             info, built = plan_outputs(
-                outdir, p, formats, mission.export_options(),
+                outdir, p, formats, options,
                 title=f"{mission.name}", subtitle=f"{world_desc} — {mission.description}"
                 if mission.description else world_desc,
                 summary={"mission": mission.name, "mission_file": str(mission_file),

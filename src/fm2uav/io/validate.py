@@ -48,6 +48,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from ..errors import InputError, MissionError
 from .items import (
@@ -325,30 +326,28 @@ def _ardupilot(items: Sequence[MissionItem], vehicle: str) -> list[Problem]:
     return out
 
 
-def _fence_problems(items: Sequence[MissionItem], fences: Sequence[object]) -> list[Problem]:
+def _fence_problems(items: Sequence[MissionItem], fences: Sequence[Any]) -> list[Problem]:
     from shapely.geometry import Point, Polygon
 
     from .geofence import FenceCircle, FencePolygon
 
     out: list[Problem] = []
-    shapes = []
     for f in fences:
-        if isinstance(f, FencePolygon):
-            shapes.append((f, Polygon([(lon, lat) for lat, lon in f.points])))
-        elif isinstance(f, FenceCircle):
-            shapes.append((f, None))
-    for i, it in enumerate(items):
-        if not it.has_position:
+        if not isinstance(f, (FencePolygon, FenceCircle)):
             continue
-        for f, poly in shapes:
+        poly = (Polygon([(lon, lat) for lat, lon in f.points]) if isinstance(f, FencePolygon)
+                else None)
+        what = f"{'inclusion' if f.inclusion else 'exclusion'} fence {f.name!r}"
+        for i, it in enumerate(items):
+            if not it.has_position:
+                continue
             if poly is not None:
                 inside = poly.covers(Point(it.lon, it.lat))
             else:
-                inside = _distance_m(it.lat, it.lon, *f.center) <= f.radius  # type: ignore[attr-defined]
-            what = f"{'inclusion' if f.inclusion else 'exclusion'} fence {f.name!r}"  # type: ignore[attr-defined]
-            if f.inclusion and not inside:  # type: ignore[attr-defined]
+                inside = _distance_m(it.lat, it.lon, *f.center) <= f.radius
+            if f.inclusion and not inside:
                 out.append(Problem(i, "fence-outside", f"{it.name} lies outside the {what}"))
-            elif not f.inclusion and inside:  # type: ignore[attr-defined]
+            elif not f.inclusion and inside:
                 out.append(Problem(i, "fence-inside", f"{it.name} lies inside the {what}"))
     return out
 
@@ -360,7 +359,7 @@ def validate_mission(
     vehicle: str = "multirotor",
     home_alt: float | None = None,
     max_land_slope_deg: float = PX4_FW_LND_ANG,
-    fences: Sequence[object] = (),
+    fences: Sequence[Any] = (),
 ) -> list[Problem]:
     """Problems that would make ``firmware`` reject or misfly the mission ([] = none).
 
