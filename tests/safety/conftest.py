@@ -14,7 +14,7 @@ def rough_dem(seed: int, rows: int = 160, cols: int = 200, relief: float = 400.0
     for _ in range(6):
         kx, ky = rng.uniform(2, 9, 2)
         z += rng.uniform(0.3, 1.0) * np.sin(2 * np.pi * (kx * c + ky * r) + rng.uniform(0, 6))
-    z += 0.15 * rng.standard_normal((rows, cols))
+    z += 0.03 * rng.standard_normal((rows, cols))
     z = (z - z.min()) / (z.max() - z.min())
     return 200.0 + relief * z
 

@@ -90,8 +90,9 @@ def flight_layer(world: World, agl: float) -> np.ndarray:
     """Index of the flight-level layer in every column [cells].
 
     ``Surface(i, j) + round(agl / dz)``, where ``Surface`` is the topmost
-    obstacle node of the column (ground, or a roof). A column without any
-    obstacle has ``Surface = -1`` (ground just below the map).
+    obstacle node of the column (ground, or a roof; nodes of no-fly zones do
+    not count). A column without any obstacle has ``Surface = -1`` (ground
+    just below the map).
 
     Raises
     ------
@@ -100,9 +101,12 @@ def flight_layer(world: World, agl: float) -> np.ndarray:
     PlanningError
         The flight level leaves the map (above the ceiling) in some column.
     """
+    from ..world.zones import terrain_surface_index
+
     lf = level_cells(world, agl)
     dz = world.spacing[2]
-    layer = world.surface_index().astype(np.int64) + lf
+    surface = terrain_surface_index(world)  # no-fly zone nodes are not ground
+    layer = surface.astype(np.int64) + lf
     nz = world.shape[2]
     over = layer >= nz
     if over.any():
@@ -113,7 +117,7 @@ def flight_layer(world: World, agl: float) -> np.ndarray:
             f"the flight level agl = {float(agl):g} m leaves the map in {int(over.sum())} "
             f"column(s), e.g. column {[int(v) for v in worst]} needs layer {int(layer[worst])} "
             f"but the ceiling is layer {nz - 1} (z = {top_m:g} m); lower agl to at most "
-            f"{(nz - 1 - int(world.surface_index().max())) * dz:g} m or build the world with "
+            f"{(nz - 1 - int(surface.max())) * dz:g} m or build the world with "
             f"at least {need} height cells"
         )
     return layer

@@ -178,12 +178,20 @@ class FlightLevel:
             v.positive, self.max_agl, "max_agl", unit="m", where=_where("max_agl")))
         if self.min_agl is not None and self.min_agl > self.agl:
             raise InputError(
-                f"agl = {self.agl:g} m is below min_agl = {self.min_agl:g} m; raise agl or "
-                f"lower min_agl{v.where_text(_where('agl'))}")
+                f"agl = {self.agl:g} m is below min_agl = {self.min_agl:g} m (the altitude "
+                f"floor); raise agl or lower min_agl (mission file: planner.agl, "
+                f"planner.min_agl; CLI: --agl, --min-agl)")
         if self.max_agl is not None and self.agl > self.max_agl:
             raise InputError(
-                f"agl = {self.agl:g} m is above max_agl = {self.max_agl:g} m; lower agl to at "
-                f"most {self.max_agl:g} m or raise max_agl{v.where_text(_where('agl'))}")
+                f"agl = {self.agl:g} m is above max_agl = {self.max_agl:g} m (the altitude "
+                f"ceiling); lower agl to at most {self.max_agl:g} m or raise max_agl (mission "
+                f"file: planner.agl, planner.max_agl; CLI: --agl, --max-agl)")
+        if self.min_agl is not None and self.max_agl is not None \
+                and self.min_agl >= self.max_agl:
+            raise InputError(
+                f"min_agl = {self.min_agl:g} m is not below max_agl = {self.max_agl:g} m; "
+                "lower min_agl or raise max_agl (mission file: planner.min_agl, "
+                "planner.max_agl; CLI: --min-agl, --max-agl)")
 
 
 @dataclass(frozen=True, eq=False)

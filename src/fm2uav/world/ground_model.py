@@ -106,11 +106,11 @@ class GroundModel:
 
 def sampling_step(world: Any) -> float:
     """Spacing [m] at which to sample a path against the ground: a quarter of the
-    world's horizontal cell, and at most half the source DEM's pixel."""
+    world's horizontal cell, and at most a quarter of the source DEM's pixel."""
     step = 0.25 * float(min(world.spacing[:2]))
     model = getattr(world, "ground", None)
     if model is not None and model.pixel_m > 0:
-        step = min(step, 0.5 * float(model.pixel_m))
+        step = min(step, 0.25 * float(model.pixel_m))
     return step
 
 
