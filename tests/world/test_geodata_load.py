@@ -18,7 +18,14 @@ from fm2uav.errors import InputError, PointError, WorldError
 from fm2uav.planning import FlightLevel
 from fm2uav.world.dem import GeodataWarning
 from fm2uav.world.geo import from_lonlat
-from fm2uav.world.load import WorldSpec, check_points, load_world, round_down, world_summary
+from fm2uav.world.load import (
+    WorldSpec,
+    check_points,
+    load_world,
+    round_down,
+    round_up,
+    world_summary,
+)
 
 from . import geodata_data as gd
 
@@ -36,7 +43,9 @@ def _spec(**kw):
     return WorldSpec.model_validate(kw)
 
 
-def test_round_down():
+def test_round_numbers():
+    assert [round_up(v) for v in (64.9, 20.0, 16.7, 0.37, 1234.0)] == [80.0, 20.0, 20.0,
+                                                                        0.4, 1500.0]
     assert [round_down(v) for v in (64.9, 20.0, 16.7, 0.37, 1234.0)] == [60.0, 20.0, 15.0,
                                                                           0.3, 1000.0]
 
@@ -149,3 +158,12 @@ def test_sea_level_from_the_spec(tmp_path):
         warnings.simplefilter("error", GeodataWarning)
         w = load_world(_spec(dem=str(f), bbox=BBOX, cell_size=250.0, sea_level=0.0), agl=100.0)
     assert w.terrain.min() == 0.0
+
+
+def test_automatic_cells_keep_the_grid_small(dem):
+    from fm2uav.world.load import AUTO_NODES
+
+    w = load_world(_spec(dem=str(dem["full"])), agl=120.0)  # whole DEM, no cell size given
+    assert np.prod(w.shape) <= AUTO_NODES
+    assert "million nodes" in w.georef.sources[0].details["cell_size_rule"]
+    assert w.spacing[2] <= 20.0

@@ -16,8 +16,9 @@ told the highest requested height above ground (the planner's ``agl`` and the
 points' ``agl``) and the highest requested altitude:
 
 * ``cell_size`` default: the DEM's pixel size on the ground, coarsened so that
-  the map has at most :data:`AUTO_COLUMNS` columns (buildings-only: 2 m, same
-  rule), rounded down to a round number;
+  the map has at most :data:`AUTO_COLUMNS` columns and the grid at most
+  :data:`AUTO_NODES` nodes (the relief read from a decimated copy of the DEM),
+  rounded down to a round number (buildings-only: 2 m, columns rule);
 * ``dz`` default: ``cell_size``, and with an ``agl`` at most ``agl / 6``
   (rounded down to a round number), so the flight level is >= 6 cells above
   the ground — unless ``height_cells`` fixes the node count (then ``cell_size``);
@@ -51,11 +52,15 @@ __all__ = [
     "check_points",
     "world_summary",
     "round_down",
+    "round_up",
     "AUTO_COLUMNS",
+    "AUTO_NODES",
 ]
 
 #: Largest number of map columns (nx * ny) of an automatic cell size.
 AUTO_COLUMNS = 250_000
+#: Largest number of grid nodes (columns x layers) of an automatic DEM cell size.
+AUTO_NODES = 8_000_000
 _ROUND = (1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0)
 
 
@@ -67,6 +72,19 @@ def round_down(v: float) -> float:
     m = v / 10.0**e
     best = max(r for r in _ROUND if r <= m + 1e-9)
     return float(f"{best:g}e{e}")
+
+
+def round_up(v: float) -> float:
+    """The smallest of 1, 1.5, 2, 2.5, 3, 4, 5, 6, 8 times a power of ten that is >= ``v``."""
+    r = round_down(v)
+    if r >= v * (1 - 1e-9):
+        return r
+    e = math.floor(math.log10(v))
+    for m in (*_ROUND, 10.0):
+        c = float(f"{m:g}e{e}")
+        if c >= v * (1 - 1e-9):
+            return c
+    return float(f"1e{e + 1}")  # pragma: no cover - 10 x 10^e always matches
 
 
 def _resolve(v: str, info: ValidationInfo | None) -> Path:
@@ -247,8 +265,42 @@ def _bbox_area(bbox: Any) -> float:
     return abs(Geod(ellps="WGS84").polygon_area_perimeter([w, e, e, w], [s, s, n, n])[0])
 
 
-def _auto_cell(spec: WorldSpec) -> tuple[float, str]:
-    """Default horizontal cell [m] and how it was chosen."""
+def _relief(spec: WorldSpec) -> tuple[float, float] | None:
+    """(lowest, highest) elevation [m] of the DEM's area, from a decimated read (<= 256²)."""
+    import rasterio
+    from rasterio.windows import from_bounds
+
+    first = spec.dem if isinstance(spec.dem, str) else spec.dem[0]
+    try:
+        with rasterio.open(first) as ds:
+            win = None
+            if spec.bbox is not None and ds.crs is not None:
+                from .dem import _bbox_in
+                from .geo import parse_crs
+
+                b = _bbox_in(parse_crs(ds.crs.to_wkt()), tuple(spec.bbox))
+                win = from_bounds(*b, transform=ds.transform)
+            h = int(min(256, ds.height if win is None else max(win.height, 1)))
+            w = int(min(256, ds.width if win is None else max(win.width, 1)))
+            z = ds.read(1, masked=True, window=win, out_shape=(max(h, 1), max(w, 1)),
+                        boundless=win is not None)
+            scale, offset = float(ds.scales[0] or 1.0), float(ds.offsets[0] or 0.0)
+    except Exception:  # any read problem is reported by the real read
+        return None
+    v = np.ma.compressed(z).astype(float) * scale + offset
+    if spec.nodata_value is not None:
+        v = v[v != spec.nodata_value * scale + offset]
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return None
+    lo, hi = float(v.min()), float(v.max())
+    if spec.sea_level is not None:
+        lo = max(lo, float(spec.sea_level))
+    return lo, max(hi, lo)
+
+
+def _auto_cell(spec: WorldSpec, agl: float | None = None) -> tuple[float, str]:
+    """Default horizontal cell [m] and how it was chosen (see the module docstring)."""
     if spec.dem is not None:
         first = spec.dem if isinstance(spec.dem, str) else spec.dem[0]
         pix, area = _pixel_ground_size(first)
@@ -257,10 +309,26 @@ def _auto_cell(spec: WorldSpec) -> tuple[float, str]:
         elif isinstance(spec.dem, list):
             area *= len(spec.dem)  # tiles of about one size
         cap = math.sqrt(area / AUTO_COLUMNS)
-        cell = round_down(max(pix, cap))
-        why = (f"auto: DEM pixel {pix:.1f} m on the ground" if pix >= cap else
+        cell = max(pix, cap)
+        capped = pix < cap
+        why = (f"auto: DEM pixel {pix:.1f} m on the ground" if not capped else
                f"auto: at most {AUTO_COLUMNS} map columns over {area / 1e6:.1f} km²")
-        return cell, why
+        relief = _relief(spec)
+        if relief is not None and spec.dz is None:
+            # keep the whole grid (columns x layers) under AUTO_NODES
+            for _ in range(8):
+                dz = min(cell, agl / 6.0) if agl is not None else cell
+                top = max(20.0 * dz, (agl or 0.0) + 10.0 * dz)
+                nz = (relief[1] - relief[0] + top) / dz + 2.0
+                nodes = area / (cell * cell) * nz
+                if nodes <= 0.85 * AUTO_NODES:  # the decimated relief and area run low
+                    break
+                cell *= math.sqrt(nodes / (0.85 * AUTO_NODES))
+                capped = True
+                why = (f"auto: at most {AUTO_NODES / 1e6:g} million nodes over "
+                       f"{area / 1e6:.1f} km² and {relief[1] - relief[0]:.0f} m of relief")
+        # the pixel size rounds down (no coarser than the data); a cap rounds up (stays a cap)
+        return (round_up(cell) if capped else round_down(cell)), why
     from .vectors import read_vectors
 
     data = read_vectors(spec.buildings, target_crs="auto", crs=spec.crs, role="buildings")
@@ -274,7 +342,7 @@ def _auto_cell(spec: WorldSpec) -> tuple[float, str]:
     else:
         area = 0.0
     cap = math.sqrt(max(area, 1.0) / AUTO_COLUMNS)
-    cell = round_down(max(2.0, cap))
+    cell = round_up(cap) if cap > 2.0 else 2.0
     return cell, ("auto: 2 m for buildings" if cap <= 2.0 else
                   f"auto: at most {AUTO_COLUMNS} map columns over {area / 1e6:.2f} km²")
 
@@ -325,7 +393,7 @@ def load_world(spec: WorldSpec, *, agl: float | None = None, top: float | None =
     if spec.cell_size is not None:
         dx, why_dx = float(spec.cell_size), "given (world.cell_size)"
     else:
-        dx, why_dx = _auto_cell(spec)
+        dx, why_dx = _auto_cell(spec, agl)
     if spec.dz is not None:
         dz, why_dz = float(spec.dz), "given (world.dz)"
     elif spec.height_cells is not None:
