@@ -38,6 +38,10 @@ __all__ = [
     "choice",
     "flag",
     "point",
+    "input_file",
+    "read_text",
+    "load_yaml",
+    "load_json",
 ]
 
 #: Where a value is set: ``None``, one place (``"planner.agl"``) or
@@ -192,3 +196,158 @@ def point(value: Any, ndim: int, what: str, *, where: Where = None) -> np.ndarra
     if not np.all(np.isfinite(arr)):
         raise InputError(f"{what} must be finite, got {arr.tolist()}{where_text(where)}")
     return arr
+
+
+# ---------------------------------------------------------------------------------------
+# Files: every reader checks its input with these before opening it (issue 17)
+# ---------------------------------------------------------------------------------------
+
+def _named(what: str, path: Any) -> str:
+    return f"{what} {path}" if what else str(path)
+
+
+def input_file(path: Any, what: str, *, where: Where = None) -> Any:
+    """``path`` as a :class:`pathlib.Path` to an existing, readable, *regular* file.
+
+    Refuses directories, named pipes (FIFOs), sockets and devices up front, so a
+    reader never blocks on a pipe or fails with ``IsADirectoryError`` later.
+
+    Raises
+    ------
+    InputError
+        Missing, not a regular file, or not readable (one line naming ``what``
+        and ``where``).
+    """
+    import os
+    import stat
+    from pathlib import Path
+
+    if not isinstance(path, (str, os.PathLike)) or str(path) == "":
+        raise InputError(f"{what} must be a file path, got {path!r}{where_text(where)}")
+    p = Path(path)
+    try:
+        st = p.stat()
+    except FileNotFoundError:
+        raise InputError(f"{_named(what, p)} not found; check the path{where_text(where)}") from None
+    except OSError as exc:
+        raise InputError(f"{_named(what, p)} cannot be read ({exc.strerror or exc}); check the path "
+                         f"and its permissions{where_text(where)}") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise InputError(f"{_named(what, p)} is a directory, not a file; give the file inside it"
+                         f"{where_text(where)}")
+    if not stat.S_ISREG(st.st_mode):
+        kind = ("a named pipe (FIFO)" if stat.S_ISFIFO(st.st_mode) else
+                "a socket" if stat.S_ISSOCK(st.st_mode) else "a device")
+        raise InputError(f"{_named(what, p)} is {kind}, not a regular file; save the data to a file "
+                         f"first{where_text(where)}")
+    if not os.access(p, os.R_OK):
+        raise InputError(f"{_named(what, p)} is not readable (permission denied); fix its "
+                         f"permissions{where_text(where)}")
+    return p
+
+
+def read_text(path: Any, what: str, *, where: Where = None) -> str:
+    """The UTF-8 text of the regular file ``path`` (see :func:`input_file`).
+
+    Raises
+    ------
+    InputError
+        Not a readable regular file, or not UTF-8 text (the byte offset is named).
+    """
+    p = input_file(path, what, where=where)
+    try:
+        return p.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{_named(what, p)} is not a UTF-8 text file (byte {exc.start}: "
+                         f"{exc.reason}); give a text file{where_text(where)}") from None
+    except OSError as exc:
+        raise InputError(f"{_named(what, p)} cannot be read ({exc.strerror or exc}){where_text(where)}"
+                         ) from None
+
+
+def _unique_key_loader() -> Any:
+    """A ``yaml.SafeLoader`` subclass that refuses duplicate mapping keys."""
+    import yaml
+
+    class UniqueKeyLoader(yaml.SafeLoader):
+        pass
+
+    def construct_mapping(loader: Any, node: Any, deep: bool = False) -> Any:
+        loader.flatten_mapping(node)
+        seen: dict[Any, int] = {}
+        for key_node, _ in node.value:
+            key = loader.construct_object(key_node, deep=True)
+            try:
+                first = seen.get(key)
+            except TypeError:  # an unhashable key: let the normal constructor report it
+                continue
+            line = key_node.start_mark.line + 1
+            if first is not None:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"duplicate key {key!r} (lines {first} and {line}): the second "
+                    "would silently replace the first; keep one", key_node.start_mark)
+            seen[key] = line
+        return yaml.SafeLoader.construct_mapping(loader, node, deep=deep)
+
+    UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG,
+                                    construct_mapping)
+    return UniqueKeyLoader
+
+
+def load_yaml(text_or_path: Any, what: str, *, where: Where = None, source: str | None = None
+              ) -> Any:
+    """Parse YAML (a path to a file, or the text itself with ``source`` naming it).
+
+    Duplicate keys are an error (with both line numbers), as are syntax errors
+    (line and column), nesting so deep it exhausts the recursion limit, and
+    files that are not UTF-8 text.
+
+    Examples
+    --------
+    >>> load_yaml("a: 1\\nb: [1, 2]", "config", source="<text>")
+    {'a': 1, 'b': [1, 2]}
+    >>> load_yaml("a: 1\\na: 2", "config", source="<text>")
+    Traceback (most recent call last):
+    ...
+    fm2uav.errors.InputError: config <text>: duplicate key 'a' (lines 1 and 2): the second would silently replace the first; keep one, at line 2, column 1
+    """
+    import yaml
+
+    if source is None:
+        text = read_text(text_or_path, what, where=where)
+        source = str(text_or_path)
+    else:
+        text = str(text_or_path)
+    try:
+        return yaml.load(text, Loader=_unique_key_loader())  # noqa: S506 (SafeLoader subclass)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        at = f", at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        if not str(problem).startswith("duplicate key"):
+            problem = f"not valid YAML: {problem}"
+        raise InputError(f"{_named(what, source)}: {problem}{at}{where_text(where)}") from None
+    except RecursionError:
+        raise InputError(f"{_named(what, source)}: nested too deeply to read (more than a few hundred "
+                         f"levels of lists/mappings); flatten it{where_text(where)}") from None
+
+
+def load_json(path: Any, what: str, *, where: Where = None) -> Any:
+    """Parse the JSON file ``path``; syntax errors name the line and column.
+
+    Raises
+    ------
+    InputError
+        Not a readable regular UTF-8 file, invalid JSON, or nested too deeply.
+    """
+    import json
+
+    text = read_text(path, what, where=where)
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise InputError(f"{_named(what, path)}: not valid JSON ({exc.msg} at line {exc.lineno}, "
+                         f"column {exc.colno}){where_text(where)}") from None
+    except RecursionError:
+        raise InputError(f"{_named(what, path)}: nested too deeply to read{where_text(where)}"
+                         ) from None

@@ -3,12 +3,19 @@
 Every command follows the same contract (issue "operator workflow"):
 
 * exit code 0 = ok, 1 = planning failed (e.g. unreachable goal), 2 = bad input
-  (including a start/goal outside the map or inside an obstacle: PointError);
-* errors are one line on stderr: what is wrong, where, how to fix it — never a
-  traceback (set ``FM2UAV_DEBUG=1`` to see one);
-* outputs go to ``--out DIR``; existing files are never overwritten without
-  ``--force``; files are written to a temporary name and renamed, so a failed
-  run leaves no half-written file;
+  (including a start/goal outside the map or inside an obstacle: PointError;
+  unreadable, non-UTF-8 or malformed files; a grid too large for memory; a
+  full disk or read-only ``--out``), 130 = interrupted (SIGINT/SIGTERM), 70 =
+  an internal error (a bug: the only case with a traceback, plus a line asking
+  to report it);
+* errors are one line on stderr: what is wrong, where, how to fix it — printed
+  verbatim (never read as rich markup) — never a traceback for bad input (set
+  ``FM2UAV_DEBUG=1`` to see one);
+* outputs go to ``--out DIR`` as one set (:class:`fm2uav.io.outdir.OutputDir`):
+  written into a temporary folder beside it and renamed into place when the
+  command succeeds; an existing folder is replaced as a whole only with
+  ``--force``; a failed or interrupted run leaves the previous set intact and
+  no temporary file; a second run into the same folder is refused (lock);
 * ``--json`` prints one JSON document on stdout, ``--quiet`` prints nothing but
   errors.
 """
@@ -19,8 +26,7 @@ import functools
 import json
 import os
 import sys
-import tempfile
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any, TypeVar
@@ -30,13 +36,18 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
+from rich.text import Text
 
-from ..errors import Fm2uavError, InputError, PlanningError, PointError, WorldError
+from ..errors import Fm2uavError, InputError, PlanningError, PointError
+from ..io.outdir import Interrupted, OutputDir, abort_all, finish_all, interrupt_signals
 
 __all__ = [
     "EXIT_OK",
     "EXIT_PLANNING",
     "EXIT_INPUT",
+    "EXIT_INTERRUPTED",
+    "EXIT_INTERNAL",
+    "describe_error",
     "console",
     "err_console",
     "handle_errors",
@@ -51,6 +62,8 @@ __all__ = [
 EXIT_OK = 0
 EXIT_PLANNING = 1
 EXIT_INPUT = 2
+EXIT_INTERNAL = 70  # EX_SOFTWARE (sysexits.h): a bug in fm2uav
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, also for SIGTERM (the output set is left as it was)
 
 console = Console()
 err_console = Console(stderr=True)
@@ -76,8 +89,86 @@ def to_jsonable(obj: Any) -> Any:
 
 
 def _fail(message: str, code: int) -> None:
-    err_console.print(f"[bold red]error:[/] {message}", highlight=False, soft_wrap=True)
+    """Print ``error: MESSAGE`` verbatim (no markup) on stderr and exit with ``code``."""
+    err_console.print(Text.assemble(("error: ", "bold red"), str(message)), highlight=False,
+                      soft_wrap=True)
     raise typer.Exit(code)
+
+
+def _os_message(exc: OSError) -> str:
+    import errno
+
+    name = exc.filename if exc.filename is not None else ""
+    where = f" {name}" if name != "" else ""
+    if isinstance(exc, FileNotFoundError):
+        return f"file not found:{where}; check the path"
+    if isinstance(exc, IsADirectoryError):
+        return f"{name or 'the path'} is a directory, not a file; give the file inside it"
+    if isinstance(exc, NotADirectoryError):
+        return f"{name or 'the path'}: a part of the path is a file, not a folder; check it"
+    if isinstance(exc, PermissionError):
+        return f"permission denied:{where}; fix its permissions or choose another path"
+    if exc.errno == errno.ENOSPC:
+        return f"the disk is full{' writing' + where if where else ''}; free space or choose " \
+               "another --out"
+    if exc.errno == errno.EROFS:
+        return f"read-only file system:{where}; choose another --out"
+    return f"cannot read or write{where}: {exc.strerror or exc}; check the path"
+
+
+def describe_error(exc: BaseException) -> tuple[str, int] | None:
+    """``(one-line message, exit code)`` for an error caused by the input or the
+    environment, or None for a genuine internal error (a bug).
+
+    Fm2uavError subclasses keep their message (PlanningError → exit 1, others
+    → 2); OS errors, undecodable text, malformed YAML/JSON/zip files, invalid
+    geometries, inputs nested too deeply and memory exhaustion are named with
+    exit 2, so no bad input ends in a traceback.
+    """
+    import json
+    import zipfile
+
+    if isinstance(exc, PointError):
+        return str(exc), EXIT_INPUT
+    if isinstance(exc, PlanningError):
+        return str(exc), EXIT_PLANNING
+    if isinstance(exc, Fm2uavError):
+        return str(exc), EXIT_INPUT
+    if isinstance(exc, OSError):
+        return _os_message(exc), EXIT_INPUT
+    if isinstance(exc, UnicodeDecodeError):
+        return (f"an input file is not UTF-8 text (byte {exc.start}: {exc.reason}); give a "
+                "text file (YAML, GeoJSON, CSV) or the right format"), EXIT_INPUT
+    if isinstance(exc, json.JSONDecodeError):
+        return (f"an input file is not valid JSON ({exc.msg} at line {exc.lineno}, column "
+                f"{exc.colno}); check the file"), EXIT_INPUT
+    if isinstance(exc, zipfile.BadZipFile):
+        return f"an input file is not a valid zip archive (KMZ/NPZ): {exc}", EXIT_INPUT
+    if isinstance(exc, RecursionError):
+        return ("an input is nested too deeply to read (YAML/JSON with hundreds of levels); "
+                "flatten it"), EXIT_INPUT
+    if isinstance(exc, MemoryError):
+        return ("out of memory: the grid or the input is too large for this machine; use a "
+                "coarser --cell-size/--spacing or a smaller area (--bbox)"), EXIT_INPUT
+    mod = type(exc).__module__ or ""
+    if mod.startswith("yaml"):
+        return f"an input file is not valid YAML: {str(exc).splitlines()[0]}", EXIT_INPUT
+    if type(exc).__name__ == "GEOSException" or mod.startswith("shapely"):
+        return (f"an input geometry is invalid ({exc}); check the polygons (closed rings, "
+                "no self-intersections, finite coordinates)"), EXIT_INPUT
+    return None
+
+
+def _internal(exc: BaseException) -> None:
+    import traceback
+
+    traceback.print_exception(exc, file=sys.stderr)
+    err_console.print(Text.assemble(
+        ("internal error: ", "bold red"),
+        f"{type(exc).__name__}: {exc} — this is a bug in fm2uav, not a problem with your input; "
+        "please report it with the command line and the traceback above"),
+        highlight=False, soft_wrap=True)
+    raise typer.Exit(EXIT_INTERNAL)
 
 
 @contextmanager
@@ -102,35 +193,49 @@ def warning_lines() -> Iterator[None]:
 
 
 def handle_errors(func: F) -> F:
-    """Map fm2uav errors to one-line messages and exit codes 1 (planning) / 2 (input).
+    """Run a command: map errors to one-line messages and exit codes, finish its output sets.
 
-    Warnings of fm2uav (:class:`fm2uav.world.dem.GeodataWarning`, ...) are shown
-    as one ``warning:`` line each on stderr.
+    Exit codes: 1 (planning failed), 2 (bad input or environment, see
+    :func:`describe_error`), 130 (SIGINT/SIGTERM), 70 (an internal error: a
+    traceback plus a line asking to report it). The command's output sets
+    (:class:`~fm2uav.io.outdir.OutputDir`) are renamed into place when it returns
+    or exits deliberately (``typer.Exit``, e.g. 1 = infeasible with its report);
+    on any error they are removed and the previous sets stay. Warnings
+    of fm2uav (:class:`fm2uav.world.dem.GeodataWarning`, ...) are shown as one
+    ``warning:`` line each on stderr.
     """
 
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
+        debug = bool(os.environ.get("FM2UAV_DEBUG"))
         try:
-            with warning_lines():
-                return func(*args, **kwargs)
+            with interrupt_signals(), warning_lines():
+                try:
+                    result = func(*args, **kwargs)
+                except typer.Exit:
+                    # a deliberate exit after the outputs (e.g. 1 = infeasible, with its
+                    # report): the set is complete, keep it
+                    finish_all()
+                    raise
+                except BaseException:
+                    abort_all()
+                    raise
+                finish_all()
+                return result
         except typer.Exit:
             raise
-        except PointError as exc:
-            if os.environ.get("FM2UAV_DEBUG"):
+        except (KeyboardInterrupt, Interrupted) as exc:
+            what = "SIGTERM" if isinstance(exc, Interrupted) else "SIGINT (Ctrl-C)"
+            _fail(f"interrupted by {what}; no partial outputs were left (an earlier output set "
+                  "is as it was)", EXIT_INTERRUPTED)
+        except Exception as exc:  # noqa: BLE001 - the one place errors become exit codes
+            if debug:
                 raise
-            _fail(str(exc), EXIT_INPUT)
-        except PlanningError as exc:
-            if os.environ.get("FM2UAV_DEBUG"):
-                raise
-            _fail(str(exc), EXIT_PLANNING)
-        except (InputError, WorldError, Fm2uavError) as exc:
-            if os.environ.get("FM2UAV_DEBUG"):
-                raise
-            _fail(str(exc), EXIT_INPUT)
-        except FileNotFoundError as exc:
-            if os.environ.get("FM2UAV_DEBUG"):
-                raise
-            _fail(f"file not found: {exc.filename}; check the path", EXIT_INPUT)
+            known = describe_error(exc)
+            if known is None:
+                _internal(exc)
+            else:
+                _fail(*known)
 
     return wrapper  # type: ignore[return-value]
 
@@ -145,80 +250,6 @@ def parse_point(text: str, ndim: int, what: str) -> np.ndarray:
     if values.size != ndim:
         raise InputError(f"--{what} needs {ndim} numbers (x,y[,z]); got {values.size} in {text!r}")
     return values
-
-
-def _umask_mode(path: str | os.PathLike[str]) -> None:
-    """Give a temporary file the permissions of a normally created file (0666 & ~umask)."""
-    mask = os.umask(0)
-    os.umask(mask)
-    os.chmod(path, 0o666 & ~mask)
-
-
-class OutputDir:
-    """An output directory that refuses to overwrite and writes atomically.
-
-    Parameters
-    ----------
-    path : path-like
-        Directory; created if missing.
-    force : bool
-        Allow overwriting existing files.
-    """
-
-    def __init__(self, path: str | os.PathLike[str], *, force: bool = False) -> None:
-        self.path = Path(path)
-        self.force = force
-        self.written: list[Path] = []
-
-    def check(self, names: Iterable[str]) -> None:
-        """Fail (InputError) before any work if a target file exists and not ``force``."""
-        if self.path.exists() and not self.path.is_dir():
-            raise InputError(f"--out {self.path} exists and is not a directory; choose another path")
-        clashes = [n for n in names if (self.path / n).exists()]
-        if clashes and not self.force:
-            raise InputError(
-                f"{self.path / clashes[0]} already exists (and {len(clashes) - 1} more); "
-                "pass --force to overwrite or choose another --out"
-            )
-
-    @contextmanager
-    def open(self, name: str, mode: str = "w") -> Iterator[Any]:
-        """Open ``name`` for writing via a temporary file renamed on success."""
-        self.path.mkdir(parents=True, exist_ok=True)
-        target = self.path / name
-        if target.exists() and not self.force:
-            raise InputError(f"{target} already exists; pass --force to overwrite")
-        fd, tmp = tempfile.mkstemp(prefix=f".{name}.", dir=self.path)
-        os.close(fd)
-        try:
-            with open(tmp, mode) as fh:
-                yield fh
-            _umask_mode(tmp)
-            os.replace(tmp, target)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-            raise
-        self.written.append(target)
-
-    def target(self, name: str) -> Path:
-        """Temporary path for libraries that write by filename; call :meth:`commit` after."""
-        self.path.mkdir(parents=True, exist_ok=True)
-        target = self.path / name
-        if target.exists() and not self.force:
-            raise InputError(f"{target} already exists; pass --force to overwrite")
-        suffix = "".join(target.suffixes)
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=suffix, dir=self.path)
-        os.close(fd)
-        return Path(tmp)
-
-    def commit(self, tmp: Path, name: str) -> Path:
-        """Move a temporary file from :meth:`target` into place."""
-        target = self.path / name
-        _umask_mode(tmp)
-        os.replace(tmp, target)
-        self.written.append(target)
-        return target
 
 
 def print_summary(
@@ -238,7 +269,7 @@ def print_summary(
             payload["files"] = [str(f) for f in files]
         sys.stdout.write(json.dumps(to_jsonable(payload), indent=2) + "\n")
         return
-    table = Table(title=title, show_header=False, title_justify="left")
+    table = Table(title=escape(title), show_header=False, title_justify="left")
     table.add_column("what", style="bold")
     table.add_column("value")
     for key, value in rows.items():
@@ -247,7 +278,7 @@ def print_summary(
     if files:
         console.print("outputs:")
         for f in files:
-            console.print(f"  {f}")
+            console.print(Text(f"  {f}"), highlight=False)
 
 
 @contextmanager

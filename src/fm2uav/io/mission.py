@@ -51,7 +51,6 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from pydantic import field_validator, model_validator
 
@@ -642,18 +641,11 @@ def load_mission(file: str | Path, *, world_overrides: dict[str, Any] | None = N
         Missing file, invalid YAML (line and column named) or an invalid
         mission (see :func:`parse_mission`).
     """
+    from .. import _validate as v
+
     file = Path(file)
-    if not file.is_file():
-        raise InputError(f"mission file {file} not found; check the path")
-    try:
-        data = yaml.safe_load(file.read_text())
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise InputError(f"{file}: not valid YAML{where}: {problem}") from None
-    except UnicodeDecodeError:
-        raise InputError(f"{file}: not a text (UTF-8) file") from None
+    # a regular UTF-8 file (no directory, no pipe), YAML without duplicate keys (issue 17)
+    data = v.load_yaml(file, "")
     if data is None:
         raise InputError(f"{file}: the mission file is empty; see examples/ for a template")
     if world_overrides and isinstance(data, dict):

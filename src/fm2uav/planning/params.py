@@ -194,6 +194,11 @@ class FlightLevel:
                 "planner.max_agl; CLI: --min-agl, --max-agl)")
 
 
+#: Smallest geodesic step [cells]: finer steps do not change the path measurably but
+#: multiply the descent's work (1e-9 took minutes).
+MIN_STEP = 0.01
+
+
 @dataclass(frozen=True, eq=False)
 class PlanOptions:
     """How :func:`fm2uav.plan` computes, beyond the shaping and the flight level.
@@ -203,7 +208,7 @@ class PlanOptions:
     order : {1, 2}
         Order of both Fast Marching runs. Default 2.
     step : float
-        Geodesic step in cells of the finest axis, in (0, 1]. Default 0.5.
+        Geodesic step in cells of the finest axis, in [0.01, 1]. Default 0.5.
     speed_map : ndarray or None
         Use this velocity map (one value per node, 0 = impassable) instead of
         computing one; the shaping and the flight level are then ignored. The
@@ -217,7 +222,9 @@ class PlanOptions:
     def __post_init__(self) -> None:
         _set(self, "order", v.integer(self.order, "order", where=_where("order")))
         v.choice(self.order, (1, 2), "order", where=_where("order"))
-        _set(self, "step", v.in_range(self.step, "step", 0.0, 1.0, low_open=True,
+        # below 0.01 cells the descent only multiplies its work (issue 17: step 1e-9 ran for
+        # minutes); see MIN_STEP
+        _set(self, "step", v.in_range(self.step, "step", MIN_STEP, 1.0,
                                       where=_where("step"), hint="the geodesic step in cells"))
         if self.speed_map is not None:
             try:

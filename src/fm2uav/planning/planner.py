@@ -19,7 +19,7 @@ from scipy import ndimage
 from .. import _validate
 from ..eikonal.fmm import fast_marching
 from ..eikonal.velocity import distance_map, distance_scale, normalise_distance, shape_velocity
-from ..errors import InputError, PointError, UnreachableError
+from ..errors import InputError, PlanningError, PointError, UnreachableError
 from ..geometry import path_length
 from ..world import World
 from ..world.clearance import clearance_profile
@@ -251,6 +251,7 @@ def plan(
     goal_m = _validate.point(goal, world.ndim, "goal")
     start_cell = _check_free(world, start_m, "start")
     goal_cell = _check_free(world, goal_m, "goal")
+    _check_work(world, start_m, goal_m, start_cell, goal_cell, options)
 
     t0 = time.perf_counter()
     if options.speed_map is None:
@@ -285,14 +286,22 @@ def plan(
     # T = inf, unless a custom speed map gave them a speed: only then pass the
     # mask (it costs a copy of T, ~1 s on a 40M-node map).
     blocked = world.occupancy if np.isfinite(T[world.occupancy]).any() else None
-    path_idx = descend(
-        T,
-        world.to_index(start_m),
-        world.to_index(goal_m),
-        spacing=world.spacing,
-        blocked=blocked,
-        step=options.step,
-    )
+    try:
+        path_idx = descend(
+            T,
+            world.to_index(start_m),
+            world.to_index(goal_m),
+            spacing=world.spacing,
+            blocked=blocked,
+            step=options.step,
+        )
+    except PlanningError as exc:  # "descent ... stuck": T reached the start, W too dark
+        raise PlanningError(
+            f"no path could be traced from the start {np.round(start_m, 3).tolist()} m to the "
+            f"goal {np.round(goal_m, 3).tolist()} m although the goal is reachable: W is too "
+            f"small along the only passage (exponent {shaping.exponent:g}); lower "
+            "planner.exponent (CLI --exponent), raise planner.saturation (--saturation) or use "
+            f"a finer grid ({exc})") from None
     path = world.to_world(path_idx)
     t3 = time.perf_counter()
     w = ndimage.map_coordinates(W, path_idx.T, order=1, mode="nearest")
@@ -318,6 +327,134 @@ def plan(
         params=plan_params(shaping, level, options),
         shaping=shaping,
         level=level if options.speed_map is None else None,
+    )
+
+
+#: Most geodesic steps a plan may take (step * min cell each, along the straight line
+#: between start and goal): beyond it the request is refused, not run for hours.
+MAX_PATH_STEPS = 5_000_000
+
+
+def _check_work(world: World, start_m: np.ndarray, goal_m: np.ndarray,
+                start_cell: tuple[int, ...], goal_cell: tuple[int, ...],
+                options: PlanOptions) -> None:
+    """Refuse start == goal and requests whose descent would take absurdly many steps."""
+    if start_cell == goal_cell:
+        raise PointError(
+            f"start {np.round(start_m, 3).tolist()} m and goal {np.round(goal_m, 3).tolist()} m "
+            f"fall on the same grid node {list(start_cell)}: there is nothing to plan; give a "
+            "goal at least one cell away (mission file start/goal; CLI --start/--goal)")
+    h = float(np.min(world.spacing))
+    steps = float(np.linalg.norm(goal_m - start_m)) / (float(options.step) * h)
+    if steps > MAX_PATH_STEPS:
+        raise InputError(
+            f"the path would take at least {steps:.3g} geodesic steps of {options.step:g} x "
+            f"{h:g} m (limit {MAX_PATH_STEPS:.0e}): the step or the smallest cell is far too "
+            "small for this distance; raise planner.step (CLI --step, default 0.5 cells) or "
+            "use a coarser, less anisotropic grid (world.dz / --dz, world.cell_size / "
+            "--cell-size)")
+
+
+def plan_velocity(world: World, shaping: Shaping, level: FlightLevel | None,
+                  options: PlanOptions) -> np.ndarray:
+    """The velocity map W that :func:`plan` marches on (shaped, flight level, or custom).
+
+    Returns
+    -------
+    ndarray
+        W in [0, 1] per node (read-only when it is the world's cached base map).
+    """
+    if options.speed_map is None:
+        # 0 on obstacles already (distance 0); the cached base map is read-only
+        # and used as is when there is nothing to shape
+        W = shaped_velocity(world, shaping)
+        if level is not None:
+            W = flight_level_speed(W, world, level)
+    else:
+        W = options.speed_map
+        if W.shape != world.shape:
+            raise InputError(
+                f"speed_map has shape {W.shape} but the world is {world.shape}; "
+                "give one speed per node"
+            )
+    return W
+
+
+def trace_plan(world: World, W: np.ndarray, T: np.ndarray, start_m: np.ndarray,
+               goal_m: np.ndarray, shaping: Shaping, level: FlightLevel | None,
+               options: PlanOptions, marks: tuple[float, float, float, float]) -> Plan:
+    """Descend ``T`` from the start, set the final heights and measure: the end of :func:`plan`.
+
+    Shared with :class:`fm2uav.planning.session.Planner`, which keeps ``W`` and ``T``
+    between re-plans. ``marks`` = perf-counter times (start, before W, after W,
+    after the march) for the timings.
+    """
+    t_all, t0, t1, t2 = marks
+    start_cell = world.to_cell(start_m, what="start")
+    if not np.isfinite(T[start_cell]):
+        raise UnreachableError(
+            f"the goal {np.round(goal_m, 3).tolist()} m cannot be reached from the start "
+            f"{np.round(start_m, 3).tolist()} m: no free connection between them; move one "
+            "of them into the other's free region or clear the separating obstacles"
+        )
+    # descend() never enters nodes with T = inf; obstacles have W = 0, hence
+    # T = inf, unless a custom speed map gave them a speed: only then pass the
+    # mask (it costs a copy of T, ~1 s on a 40M-node map).
+    blocked = world.occupancy if np.isfinite(T[world.occupancy]).any() else None
+    try:
+        path_idx = descend(
+            T,
+            world.to_index(start_m),
+            world.to_index(goal_m),
+            spacing=world.spacing,
+            blocked=blocked,
+            step=options.step,
+        )
+    except PlanningError as exc:  # "descent ... stuck": T reached the start, W too dark
+        raise PlanningError(
+            f"no path could be traced from the start {np.round(start_m, 3).tolist()} m to the "
+            f"goal {np.round(goal_m, 3).tolist()} m although the goal is reachable: W is too "
+            f"small along the only passage (exponent {shaping.exponent:g}); lower "
+            "planner.exponent (CLI --exponent), raise planner.saturation (--saturation) or use "
+            f"a finer grid ({exc})") from None
+    path = world.to_world(path_idx)
+    profile = None
+    if level is not None and options.speed_map is None and world.ndim == 3:
+        # heights from the continuous ground along the FM² route (issue 13)
+        profile = final_profile(world, path, level)
+        path = profile.path
+        path_idx = world.to_index(path)
+    if world.zones:
+        bad = zone_violations(world, path)
+        if bad:  # the zone nodes are obstacles: this is a bug, never a user error
+            raise PlanningError(
+                f"the planned path enters {bad[0].zone!r} at {np.round(bad[0].point, 1).tolist()}"
+                " m; please report this (the zones were rasterised too thinly)")
+    t3 = time.perf_counter()
+    w = ndimage.map_coordinates(W, path_idx.T, order=1, mode="nearest")
+    length = path_length(path)
+    clearance = float(surface_clearance(world, path).min())
+    t4 = time.perf_counter()
+    timings = {
+        "velocity_map": t1 - t0,
+        "fast_marching": t2 - t1,
+        "geodesic": t3 - t2,
+        "metrics": t4 - t3,
+        "total": t4 - t_all,
+    }
+    return Plan(
+        path=path,
+        w=w,
+        length=length,
+        clearance=clearance,
+        timings=timings,
+        W=W,
+        T=T,
+        world=world,
+        params=plan_params(shaping, level, options),
+        shaping=shaping,
+        level=level if options.speed_map is None else None,
+        profile=profile,
     )
 
 

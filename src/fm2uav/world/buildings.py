@@ -316,6 +316,7 @@ def from_buildings(
         ground = np.full((nx, ny), org[2])
     # ---- roofs
     roof, outside, off_grid = _roofs(polys, heights, ground, org, cs, all_touched)
+    _report_left_out(data, outside, off_grid)
     surface = np.maximum(roof, ground)
     smax = float(surface.max())
     # ---- vertical size
@@ -386,6 +387,26 @@ def from_buildings(
         filled=None if terrain is None else terrain.filled,
         georef=georef,
     )
+
+
+def _report_left_out(data: Any, outside: int, off_grid: int) -> None:
+    """Warn (GeodataWarning, one line) about footprints that did not become buildings:
+    empty / zero-area / invalid / non-polygon features, footprints outside the grid and
+    footprints smaller than a cell that cover no node (issue 17: never silently)."""
+    import warnings
+
+    from .dem import GeodataWarning
+
+    names = {"invalid": "invalid (e.g. zero-area)"}
+    parts = [f"{n} {names.get(k, k)} feature(s)" for k, n in sorted(data.skipped.items())]
+    if outside:
+        parts.append(f"{outside} footprint(s) outside the grid (enlarge shape / world.bbox)")
+    if off_grid:
+        parts.append(f"{off_grid} footprint(s) covering no grid node (smaller than a cell, or "
+                     "zero area; use a finer cell size or all_touched)")
+    if parts:
+        warnings.warn(f"buildings {data.source.path or '(given)'}: left out "
+                      + ", ".join(parts), GeodataWarning, stacklevel=3)
 
 
 def _roofs(polys: Sequence[Any], heights: Sequence[float], ground: np.ndarray, org: np.ndarray,

@@ -158,11 +158,47 @@ def _band_unit_factor(unit: str | None) -> float:
     return 1.0
 
 
+#: A pixel higher (or lower) than every one of its (at least 3 valid) neighbours by
+#: more than this [m] is an isolated spike (a glitch or undeclared nodata), refused.
+SPIKE_HEIGHT = 250.0
+
+
+def _check_spikes(z: np.ndarray, where: str) -> None:
+    """Refuse isolated one-pixel spikes/pits (issue 17: no silent wrong worlds)."""
+    if z.size > 50_000_000 or min(z.shape) < 2:
+        return
+    pad = np.pad(z.astype(float), 1, constant_values=np.nan)
+    rows, cols = z.shape
+    nb = [pad[1 + di:1 + di + rows, 1 + dj:1 + dj + cols]
+          for di in (-1, 0, 1) for dj in (-1, 0, 1) if (di, dj) != (0, 0)]
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        stack = np.stack(nb)
+        hi = np.nanmax(stack, axis=0)
+        lo = np.nanmin(stack, axis=0)
+        count = np.isfinite(stack).sum(axis=0)
+        spike = np.isfinite(z) & (count >= 3) & (
+            (z - hi > SPIKE_HEIGHT) | (lo - z > SPIKE_HEIGHT))
+    n = int(spike.sum())
+    if n == 0:
+        return
+    r, c = (int(k[0]) for k in np.nonzero(spike))
+    raise WorldError(
+        f"{where} has {n} isolated spike(s)/pit(s): pixel (row {r}, col {c}) is "
+        f"{float(z[r, c]):g} m while its neighbours lie between {float(lo[r, c]):g} and "
+        f"{float(hi[r, c]):g} m (a single pixel more than {SPIKE_HEIGHT:g} m above/below all "
+        "its neighbours is a data error, not terrain); fix or mask it in the file (gdal_calc), "
+        "or declare its value as nodata with world.nodata_value (CLI --nodata-value) and "
+        "world.nodata: fill (CLI --nodata fill)")
+
+
 def _check_values(z: np.ndarray, where: str) -> None:
-    """Refuse elevations that look like undeclared nodata or a wrong unit."""
+    """Refuse elevations that look like undeclared nodata or a wrong unit, and isolated
+    spikes (:data:`SPIKE_HEIGHT`)."""
     finite = z[np.isfinite(z)]
     bad = finite[(finite < MIN_ELEVATION) | (finite > MAX_ELEVATION)]
     if bad.size == 0:
+        _check_spikes(z, where)
         return
     vals, counts = np.unique(bad, return_counts=True)
     v = float(vals[np.argmax(counts)])
@@ -229,6 +265,9 @@ def _read_files(paths: list[Path], crs: Any, nodata: float | None,
             if not p.exists():
                 raise InputError(f"cannot read the DEM {str(p)!r}: the file does not exist; "
                                  "check world.dem / --dem")
+            from .. import _validate as v
+
+            v.input_file(p, "the DEM", where=("world.dem", "--dem"))  # no folder / pipe
             try:
                 datasets.append(rasterio.open(p))
             except RasterioIOError as exc:

@@ -177,13 +177,32 @@ def from_lonlat(world: Any, lonlatalt: Any) -> np.ndarray:
 MAX_NODES = 400_000_000
 
 
+#: Memory FM² planning takes per grid node [bytes] (occupancy, distance, W, T, the
+#: marcher's state), used to say how much a refused grid would need.
+BYTES_PER_NODE = 40
+
+
+def _memory_bytes() -> float:
+    """Physical memory of this machine [bytes] (inf if unknown)."""
+    import os
+
+    try:
+        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
+        return float("inf")
+
+
 def check_size(shape: Any, cell: Any) -> None:
-    """Refuse a grid larger than :data:`MAX_NODES` with the options that shrink it."""
-    n = int(np.prod([int(v) for v in shape], dtype=np.float64))
-    if n > MAX_NODES:
+    """Refuse, before anything is allocated, a grid larger than :data:`MAX_NODES` or
+    than this machine's memory, saying how much it would need and what shrinks it."""
+    n = float(np.prod([float(int(v)) for v in shape]))
+    need = n * BYTES_PER_NODE
+    limit = min(float(MAX_NODES), _memory_bytes() / BYTES_PER_NODE)
+    if n > limit:
         raise WorldError(
             f"the world would have {' x '.join(str(int(v)) for v in shape)} = {n:.3g} nodes "
-            f"(limit {MAX_NODES:.0e}) at cells of {' x '.join(f'{float(c):g}' for c in cell)} m; "
+            f"(about {need / 2**30:.3g} GiB to plan on; limit {limit:.2g} nodes on this "
+            f"machine) at cells of {' x '.join(f'{float(c):g}' for c in cell)} m; "
             "use a larger world.cell_size / world.dz (CLI --cell-size / --dz) or crop the "
             "area with world.bbox (CLI --bbox W,S,E,N)")
 

@@ -102,6 +102,17 @@ def _num(default: Any = None, *, unit: str = "", desc: str = "", **bounds: float
     return Field(default, description=desc, json_schema_extra={"unit": unit}, **bounds)
 
 
+def _regular_file(path: Path) -> None:
+    """A directory, named pipe or unreadable file as a ValueError (pydantic) — never a hang."""
+    from .. import _validate as v
+    from ..errors import InputError
+
+    try:
+        v.input_file(path, "file")
+    except InputError as exc:
+        raise ValueError(str(exc).removeprefix("file ")) from None
+
+
 class WorldSpec(BaseModel):
     """The real-data part of a world: DEM, buildings, crop, sea, grid (see the module docstring).
 
@@ -148,9 +159,10 @@ class WorldSpec(BaseModel):
         out = []
         for item in items:
             path = _resolve(item, info)
-            if not path.is_file():
+            if not path.exists():
                 raise ValueError(f"file not found ({path}); allowed: an existing raster file "
                                  "(GeoTIFF, VRT, .hgt, ...)")
+            _regular_file(path)
             try:
                 import rasterio
 
@@ -176,6 +188,7 @@ class WorldSpec(BaseModel):
         if not path.exists():
             raise ValueError(f"file not found ({path}); allowed: an existing vector file "
                              "(GeoJSON, GeoPackage, Shapefile, KML/KMZ)")
+        _regular_file(path)
         return str(path)
 
     @field_validator("bbox")

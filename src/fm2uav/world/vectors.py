@@ -300,6 +300,9 @@ def read_vectors(
         where = f"the {role} file {path}"
         if not path.exists():
             raise WorldError(f"{where} does not exist; check the path")
+        from .. import _validate as v
+
+        v.input_file(path, f"the {role} file")  # no directory / pipe (would block) / unreadable
         geoms, props, declared, driver, layers = _read_file(path, layer)
         kml = driver.upper() in ("LIBKML", "KML") or path.suffix.lower() in (".kml", ".kmz")
         geojson = driver.upper() in ("GEOJSON", "GEOJSONSEQ") or path.suffix.lower() in (

@@ -165,6 +165,33 @@ def _unit_normals(xy: np.ndarray) -> np.ndarray:
     return np.column_stack([-tangent[:, 1], tangent[:, 0]])
 
 
+#: Most geodesic steps (of half the corridor grid's finest cell) a coverage path may take.
+MAX_CORRIDOR_STEPS = 5_000_000
+
+
+def _check_corridor_work(total: float, n_sigma: int, n_rho: int, world: World, fine: float,
+                         spacing: float) -> None:
+    """Refuse a corridor grid too large to allocate or to descend (a tiny band spacing)."""
+    from ...errors import WorldError
+    from ...world.geo import check_size
+
+    cell = min(world.spacing[0], world.spacing[1])
+    hint = (f"use a band spacing of at least the map cell, {cell:g} m (fm2uav cover --spacing, "
+            "or a camera/altitude giving a wider footprint with --camera)")
+    steps = total / (0.5 * fine)
+    if steps > MAX_CORRIDOR_STEPS:
+        raise InputError(
+            f"the band spacing D = {spacing:g} m is far finer than the map's {cell:g} m cells: "
+            f"the coverage path ({total:.0f} m) would take {steps:.3g} steps of "
+            f"{0.5 * fine:.3g} m (limit {MAX_CORRIDOR_STEPS:.0e}); {hint}")
+    try:
+        check_size((n_sigma, n_rho, world.shape[2]), (total / max(n_sigma - 1, 1), fine,
+                                                      world.spacing[2]))
+    except WorldError as exc:  # it names the world options; name the spacing here
+        raise InputError(f"the coverage corridor grid is too large for D = {spacing:g} m "
+                         f"({exc}); {hint}") from None
+
+
 def corridor_grid(world: World, zz: Zigzag, half_width: float) -> CorridorGrid:
     """Resample ``world`` on the unrolled corridor of half-width ``half_width`` around ``zz``.
 
@@ -209,6 +236,7 @@ def corridor_grid(world: World, zz: Zigzag, half_width: float) -> CorridorGrid:
     r = max(int(math.ceil(h / cell - 1e-9)), 2)
     h_rho = h / r
     n_rho = 2 * r - 1
+    _check_corridor_work(total, n_sigma, n_rho, world, min(h_sigma, h_rho), zz.spacing)
     g0 = World(np.zeros((n_sigma, n_rho, 1), bool), spacing=(h_sigma, h_rho, 1.0),
                origin=(0.0, -(r - 1) * h_rho, 0.0))
     probe = CorridorGrid(world=g0, map=world, half_width=h, inside=np.ones((1, 1), bool),

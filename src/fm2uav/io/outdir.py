@@ -1,0 +1,466 @@
+"""Whole output sets: a command's files appear all together, or not at all.
+
+:class:`OutputDir` is the one output-directory helper every ``fm2uav`` command
+writes through:
+
+* files are written into a temporary folder beside the target
+  (``.<name>.tmp-XXXX`` in the same parent, so the final rename is atomic) and
+  the folder is renamed into place by :meth:`OutputDir.finish`;
+* an existing target is refused unless ``force``; with ``force`` the *whole* old
+  set is moved aside (``.<name>.old-XXXX``), the new one renamed into place, then
+  the old one removed — an old mission's exports never remain beside the new ones;
+* a run that fails (an exception, SIGINT/SIGTERM, a full disk, a read-only
+  folder) removes its temporary folder: the previous set stays intact, and no
+  stray temporary file is left;
+* a lock (``fcntl.flock`` on ``.<name>.lock`` beside the target, removed at the
+  end) refuses a second run into the same folder while one is writing;
+* an ``OutputDir`` inside the target of an active one (a per-case subfolder)
+  writes into the parent's temporary folder, so the subfolders belong to the
+  parent's set.
+
+If files appear in the target *while* the run writes (a library that writes
+into the folder directly, e.g. a resumable sweep's results log), the target is
+not swapped: the staged files are moved in one by one instead, so nothing that
+was written meanwhile is lost.
+
+Exit codes and messages are the CLI's business: every refusal here is an
+:class:`~fm2uav.errors.InputError` naming ``--out`` / ``--force``.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+import shutil
+import signal
+import tempfile
+import threading
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+from ..errors import InputError
+
+__all__ = ["OutputDir", "Interrupted", "active_sets", "finish_all", "abort_all",
+           "interrupt_signals"]
+
+_ACTIVE: list[OutputDir] = []
+
+
+class Interrupted(BaseException):  # noqa: N818 (it is a signal, like KeyboardInterrupt)
+    """Raised in the main thread on SIGTERM while an output set is being written."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(f"interrupted by signal {signal.Signals(signum).name}")
+        self.signum = signum
+
+
+def _raise_interrupted(signum: int, frame: Any) -> None:  # noqa: ARG001
+    raise Interrupted(signum)
+
+
+@contextmanager
+def interrupt_signals() -> Iterator[None]:
+    """Turn SIGTERM (and SIGHUP) into :class:`Interrupted` for the duration.
+
+    SIGINT already raises :class:`KeyboardInterrupt`. Outside the main thread
+    (where handlers cannot be set) this does nothing.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = {}
+    for sig in (signal.SIGTERM, signal.SIGHUP):
+        try:
+            old[sig] = signal.signal(sig, _raise_interrupted)
+        except (ValueError, OSError):  # pragma: no cover - exotic platforms
+            pass
+    try:
+        yield
+    finally:
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
+
+
+def active_sets() -> list[OutputDir]:
+    """The output sets of this process that are not finished or aborted yet."""
+    return list(_ACTIVE)
+
+
+def finish_all() -> None:
+    """Finish every active set (outermost last); on a failure abort the rest."""
+    try:
+        for od in reversed(active_sets()):
+            od.finish()
+    except BaseException:
+        abort_all()
+        raise
+
+
+def abort_all() -> None:
+    """Abort every active set: temporary folders removed, targets untouched."""
+    for od in reversed(active_sets()):
+        od.abort()
+
+
+def _umask_mode(path: Path, directory: bool = False) -> None:
+    """Give a temporary file/folder the permissions of a normally created one."""
+    mask = os.umask(0)
+    os.umask(mask)
+    os.chmod(path, (0o777 if directory else 0o666) & ~mask)
+
+
+def _is_dangerous(target: Path) -> str | None:
+    """Why replacing ``target`` as a whole would be a mistake, or None."""
+    t = target.resolve()
+    cwd = Path.cwd().resolve()
+    home = Path.home().resolve()
+    if t == Path(t.anchor):
+        return "it is the root of the file system"
+    if t == home or t in home.parents:
+        return "it is (or contains) your home folder"
+    if t == cwd or t in cwd.parents:
+        return "it is (or contains) the current folder"
+    if (t / ".git").exists():
+        return "it holds a git repository"
+    return None
+
+
+def _listing(path: Path) -> dict[str, tuple[int, int]]:
+    """Name -> (mtime_ns, size) of the entries of ``path`` (empty if missing)."""
+    try:
+        with os.scandir(path) as it:
+            out = {}
+            for e in it:
+                try:
+                    st = e.stat(follow_symlinks=False)
+                    out[e.name] = (st.st_mtime_ns, st.st_size)
+                except OSError:
+                    out[e.name] = (0, 0)
+            return out
+    except (FileNotFoundError, NotADirectoryError):
+        return {}
+
+
+class OutputDir:
+    """An output folder written as one set (see the module docstring).
+
+    Parameters
+    ----------
+    path : path-like
+        The folder the outputs end up in (CLI ``--out``).
+    force : bool
+        Replace an existing folder as a whole (CLI ``--force``).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> root = pathlib.Path(tempfile.mkdtemp())
+    >>> with OutputDir(root / "run") as out:
+    ...     with out.open("a.txt") as fh:
+    ...         _ = fh.write("one")
+    >>> sorted(p.name for p in (root / "run").iterdir())
+    ['a.txt']
+    """
+
+    def __init__(self, path: str | os.PathLike[str], *, force: bool = False) -> None:
+        self.path = Path(path)
+        self.force = force
+        self.written: list[Path] = []
+        self.parent_set: OutputDir | None = None
+        self._stage: Path | None = None
+        self._lock_fd: int | None = None
+        self._lock_path: Path | None = None
+        self._made_dirs: list[Path] = []
+        self._before: dict[str, tuple[int, int]] | None = None
+        self._checked = False
+        self._done = False
+        for od in reversed(_ACTIVE):
+            if od is not self and od._contains(self.path):
+                self.parent_set = od
+                break
+        if self.parent_set is None:
+            _ACTIVE.append(self)
+
+    # -- context manager ----------------------------------------------------------------
+    def __enter__(self) -> OutputDir:
+        return self
+
+    def __exit__(self, exc_type: Any, exc: Any, tb: Any) -> None:
+        if exc_type is None:
+            self.finish()
+        else:
+            self.abort()
+
+    # -- checks -------------------------------------------------------------------------
+    def _contains(self, other: Path) -> bool:
+        a, b = os.path.abspath(self.path), os.path.abspath(other)
+        return b != a and b.startswith(a.rstrip(os.sep) + os.sep)
+
+    def _relative(self) -> Path:
+        assert self.parent_set is not None
+        return Path(os.path.relpath(os.path.abspath(self.path),
+                                    os.path.abspath(self.parent_set.path)))
+
+    def check(self, names: Iterable[str] = ()) -> None:
+        """Refuse (InputError) before any work: a target that is a file, a folder that
+        already holds files (unless ``force``), another run writing into it.
+
+        ``names`` are the files the command will write; a clash is named first.
+        """
+        if self.parent_set is not None:
+            self.parent_set.check(())
+            return
+        if self._checked:
+            return
+        names = list(names)
+        p = self.path
+        if p.exists() and not p.is_dir():
+            raise InputError(f"--out {p} exists and is not a folder; choose another --out")
+        if p.is_dir() and not os.access(p, os.W_OK | os.X_OK):
+            raise InputError(f"--out {p} is read-only (permission denied); nothing was "
+                             "written; fix its permissions or choose another --out")
+        self._lock()
+        entries = sorted(_listing(p))
+        if entries:
+            clashes = [n for n in names if (p / n).exists()] or entries
+            first = p / clashes[0]
+            more = len(entries) - 1
+            if not self.force:
+                raise InputError(
+                    f"{first} already exists" + (f" (and {more} more in {p})" if more else "")
+                    + "; pass --force to replace the whole output folder or choose another "
+                    "--out")
+            why = _is_dangerous(p)
+            if why:
+                raise InputError(f"--force would replace the whole folder {p}, but {why}; "
+                                 "give a dedicated --out folder")
+        self._before = _listing(p)
+        self._checked = True
+
+    # -- the lock -----------------------------------------------------------------------
+    def _lock(self) -> None:
+        import fcntl
+
+        if self._lock_fd is not None:
+            return
+        parent = self._parent()
+        lock = parent / f".{self.path.name}.lock"
+        while True:
+            try:
+                fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o666)
+            except OSError as exc:
+                raise _os_error(exc, lock, "create the lock file of") from None
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                os.close(fd)
+                raise InputError(
+                    f"--out {self.path} is being written by another fm2uav run (lock {lock} "
+                    "is held); wait for it to finish or choose another --out") from None
+            try:  # the holder before us may have removed the file: lock the live one
+                same = os.fstat(fd).st_ino == os.stat(lock).st_ino
+            except FileNotFoundError:
+                same = False
+            if same:
+                break
+            os.close(fd)
+        self._lock_fd, self._lock_path = fd, lock
+        self._clean_stale()
+
+    def _unlock(self) -> None:
+        if self._lock_fd is None:
+            return
+        try:
+            if self._lock_path is not None:
+                self._lock_path.unlink(missing_ok=True)
+        except OSError:
+            pass
+        os.close(self._lock_fd)
+        self._lock_fd = None
+
+    def _clean_stale(self) -> None:
+        """Remove temporary folders of this target left by a killed run (we hold the lock)."""
+        parent = self.path.parent if str(self.path.parent) else Path(".")
+        prefixes = (f".{self.path.name}.tmp-", f".{self.path.name}.old-")
+        try:
+            with os.scandir(parent) as it:
+                stale = [Path(e.path) for e in it if e.name.startswith(prefixes)]
+        except OSError:
+            return
+        for s in stale:
+            shutil.rmtree(s, ignore_errors=True)
+
+    def _parent(self) -> Path:
+        parent = self.path.parent if str(self.path.parent) else Path(".")
+        missing = []
+        q = parent
+        while not q.exists():
+            missing.append(q)
+            if q.parent == q:
+                break
+            q = q.parent
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise _os_error(exc, parent, "create") from None
+        self._made_dirs.extend(missing)  # innermost first
+        return parent
+
+    # -- writing ------------------------------------------------------------------------
+    def _staging(self) -> Path:
+        if self.parent_set is not None:
+            d = self.parent_set._staging() / self._relative()
+            d.mkdir(parents=True, exist_ok=True)
+            return d
+        if self._done:
+            raise RuntimeError(f"output set {self.path} is already finished")
+        if not self._checked:
+            self.check(())
+        if self._stage is None:
+            parent = self._parent()
+            try:
+                self._stage = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.tmp-",
+                                                    dir=parent))
+            except OSError as exc:
+                raise _os_error(exc, parent, "write into") from None
+            _umask_mode(self._stage, directory=True)
+        return self._stage
+
+    def _final(self, name: str) -> Path:
+        return self.path / name
+
+    @contextmanager
+    def open(self, name: str, mode: str = "w", **kwargs: Any) -> Iterator[Any]:
+        """Open ``name`` (may contain ``/``) in the set for writing."""
+        tmp = self.target(name)
+        if "b" not in mode:
+            kwargs.setdefault("encoding", "utf-8")
+        try:
+            with open(tmp, mode, **kwargs) as fh:
+                yield fh
+        except OSError as exc:
+            if exc.errno in _WRITE_ERRNOS:
+                raise _os_error(exc, self._final(name), "write") from None
+            raise
+        self.commit(tmp, name)
+
+    def target(self, name: str) -> Path:
+        """A path in the temporary folder for libraries that write by filename;
+        call :meth:`commit` with it when written."""
+        tmp = self._staging() / name
+        tmp.parent.mkdir(parents=True, exist_ok=True)
+        return tmp
+
+    def commit(self, tmp: Path, name: str) -> Path:
+        """Record the file ``name`` written at ``tmp`` (from :meth:`target`) as part of
+        the set; returns its final path."""
+        dest = self._staging() / name
+        if Path(tmp) != dest:
+            os.replace(tmp, dest)
+        final = self._final(name)
+        if final not in self.written:
+            self.written.append(final)
+        if self.parent_set is not None and final not in self.parent_set.written:
+            self.parent_set.written.append(final)
+        return final
+
+    def staged(self, name: str) -> Path:
+        """Where ``name`` is until :meth:`finish` (to read back a file just written)."""
+        return self._staging() / name
+
+    # -- the end ------------------------------------------------------------------------
+    def finish(self) -> None:
+        """Rename the set into place (replacing an old set as a whole); release the lock."""
+        if self.parent_set is not None or self._done:
+            return
+        try:
+            if self._stage is not None:
+                self._swap()
+        except BaseException:
+            self.abort()
+            raise
+        self._done = True
+        self._forget()
+        self._unlock()
+
+    def _swap(self) -> None:
+        stage, target = self._stage, self.path
+        assert stage is not None
+        changed = _listing(target) != (self._before or {})
+        try:
+            if changed and target.is_dir():
+                # someone wrote into the folder meanwhile: keep their files, add ours
+                self._merge(stage, target)
+                shutil.rmtree(stage, ignore_errors=True)
+            else:
+                old = None
+                if target.is_dir():
+                    if any(target.iterdir()):
+                        old = Path(tempfile.mkdtemp(prefix=f".{target.name}.old-",
+                                                    dir=target.parent))
+                        os.rmdir(old)
+                        os.rename(target, old)
+                    else:
+                        os.rmdir(target)
+                try:
+                    os.rename(stage, target)
+                except BaseException:
+                    if old is not None and not target.exists():
+                        os.rename(old, target)  # put the previous set back
+                    raise
+                if old is not None:
+                    shutil.rmtree(old, ignore_errors=True)
+        except OSError as exc:
+            raise _os_error(exc, target, "write") from None
+        self._stage = None
+
+    def _merge(self, stage: Path, target: Path) -> None:
+        for root, _dirs, files in os.walk(stage):
+            rel = Path(root).relative_to(stage)
+            (target / rel).mkdir(parents=True, exist_ok=True)
+            for f in files:
+                os.replace(Path(root) / f, target / rel / f)
+
+    def abort(self) -> None:
+        """Remove the temporary folder (the target is left as it was); release the lock."""
+        if self.parent_set is not None or self._done:
+            return
+        self._done = True
+        if self._stage is not None:
+            shutil.rmtree(self._stage, ignore_errors=True)
+            self._stage = None
+        self.written.clear()
+        self._unlock()
+        for d in self._made_dirs:  # parents this set created, innermost first
+            try:
+                d.rmdir()
+            except OSError:
+                break
+        self._forget()
+
+    def _forget(self) -> None:
+        if self in _ACTIVE:
+            _ACTIVE.remove(self)
+
+
+_WRITE_ERRNOS = (errno.ENOSPC, errno.EROFS, errno.EDQUOT, errno.EFBIG)
+
+
+def _os_error(exc: OSError, path: Path, verb: str) -> InputError:
+    """An OSError while writing the set as a one-line InputError naming --out."""
+    code = exc.errno
+    if code == errno.ENOSPC:
+        why = "the disk is full"
+    elif code == errno.EROFS:
+        why = "the file system is read-only"
+    elif code in (errno.EACCES, errno.EPERM):
+        why = "permission denied"
+    elif code == errno.EDQUOT:
+        why = "the disk quota is exceeded"
+    else:
+        why = exc.strerror or str(exc)
+    return InputError(f"cannot {verb} {path}: {why}; nothing was written (an earlier output set "
+                      "is left as it was); free space, fix the permissions or choose another "
+                      "--out")
