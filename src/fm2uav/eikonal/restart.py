@@ -30,7 +30,7 @@ from . import _kernels
 from .fmm import SOURCE_INIT_CELLS, SOURCE_INIT_FRACTION, _as_speed, as_index_array, as_spacing
 from .fmm import fast_marching, run_march
 
-__all__ = ["remarch"]
+__all__ = ["remarch", "unaffected"]
 
 
 def remarch(
@@ -52,8 +52,10 @@ def remarch(
     sources : sequence of int tuples
         The same sources as the previous march.
     previous : ndarray, same shape
-        Arrival times [s] of a *complete* march (no ``stop_at``) from the same
-        sources over the old speed, with the same ``spacing`` and ``order``.
+        Arrival times [s] of a march from the same sources over the old speed,
+        with the same ``spacing`` and ``order``: complete, or stopped early
+        (``stop_at``; nodes not frozen are ``inf``), in which case the march is
+        continued from its frozen nodes.
     changed : ndarray of bool, same shape
         Nodes whose speed differs from the old speed.
     spacing, order, stop_at
@@ -83,19 +85,47 @@ def remarch(
             f"previous times {prev.shape} and changed mask {chg.shape} must have the "
             f"speed's shape {shape}"
         )
-    if not chg.any():
-        return prev.copy()  # nothing changed: the complete previous times stand
     h = as_spacing(spacing, v.ndim)
-    src = as_index_array(sources, shape, "sources")
-    if _near_source(chg, src, shape, h):
-        return fast_marching(v, sources, spacing=spacing, order=order, stop_at=stop_at)
-    reach = ndimage.binary_dilation(chg, structure=ndimage.generate_binary_structure(v.ndim, 1))
-    t_star = float(prev[reach].min())
-    keep = prev < t_star
+    if chg.any():
+        src = as_index_array(sources, shape, "sources")
+        if _near_source(chg, src, shape, h):
+            return fast_marching(v, sources, spacing=spacing, order=order, stop_at=stop_at)
+    keep = unaffected(prev, chg) & np.isfinite(prev)
+    if not chg.any() and stop_at is not None:
+        stops = as_index_array(stop_at, shape, "stop_at")
+        if keep[tuple(stops.T)].all():
+            return prev.copy()  # nothing changed and the stop nodes are known already
     T = np.where(keep, prev, np.inf).reshape(-1)
     state = np.where(keep.reshape(-1), _kernels.FROZEN, 0).astype(np.uint8)
     h3 = h + (1.0,) * (3 - v.ndim)
     return run_march(v.reshape(-1), T, state, shape, h3, order, stop_at)
+
+
+def unaffected(previous: np.ndarray, changed: np.ndarray) -> np.ndarray:
+    """Nodes whose arrival time a speed change on ``changed`` cannot alter.
+
+    Parameters
+    ----------
+    previous : ndarray
+        Arrival times of the complete march over the old speed [s].
+    changed : ndarray of bool
+        Nodes whose speed changed.
+
+    Returns
+    -------
+    ndarray of bool
+        ``previous < t*`` with ``t*`` the smallest old time on the changed nodes
+        and their face neighbours (all False if nothing is below it).
+    """
+    chg = np.asarray(changed, dtype=bool)
+    if not chg.any():
+        return np.ones(chg.shape, dtype=bool)
+    prev = np.asarray(previous)
+    # dilate only the bounding box of the change (+1 node): C and its face neighbours
+    idx = np.argwhere(chg)
+    box = tuple(slice(max(a - 1, 0), b + 2) for a, b in zip(idx.min(0), idx.max(0)))
+    reach = ndimage.binary_dilation(chg[box], structure=ndimage.generate_binary_structure(chg.ndim, 1))
+    return prev < float(prev[box][reach].min())
 
 
 def _near_source(chg: np.ndarray, src: np.ndarray, shape: tuple, h: tuple) -> bool:
