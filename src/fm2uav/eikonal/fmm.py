@@ -207,6 +207,30 @@ def fast_marching(
         BALL_MAX_SPEED_RATIO,
     )
 
+    return run_march(flat_speed, T, state, shape, h3, order, stop_at)
+
+
+def run_march(
+    flat_speed: np.ndarray,
+    T: np.ndarray,
+    state: np.ndarray,
+    shape: tuple[int, ...],
+    h3: tuple[float, float, float],
+    order: int,
+    stop_at: Any,
+) -> np.ndarray:
+    """March from the frozen/band nodes of ``state`` (in place on ``T``).
+
+    Shared by :func:`fast_marching` and :func:`fm2uav.eikonal.restart.remarch`:
+    nodes frozen on entry (state 2) are expanded first, band nodes (state 1)
+    carry tentative times. ``stop_at`` as in :func:`fast_marching`.
+
+    Returns
+    -------
+    ndarray
+        ``T`` reshaped to ``shape``.
+    """
+    shape3 = shape + (1,) * (3 - len(shape))
     if stop_at is not None:
         stops = as_index_array(stop_at, shape, "stop_at")
         stop_mask = np.zeros(flat_speed.size, dtype=np.uint8)
