@@ -476,3 +476,25 @@ class World:
         from .buildings import from_buildings
 
         return from_buildings(footprints, cell_size, **kwargs)
+
+    @classmethod
+    def from_image(cls, path: Any, resolution: float, **kwargs: Any) -> World:
+        """A 2D world from a picture (dark pixels = obstacles), ``resolution`` [m/pixel].
+
+        See :func:`fm2uav.world.images.world_from_image` (``threshold``, ``negate``,
+        ``origin``).
+        """
+        from .images import world_from_image
+
+        return world_from_image(path, resolution, **kwargs)
+
+    @classmethod
+    def from_ros_map(cls, yaml_path: Any, **kwargs: Any) -> World:
+        """A 2D world from a ROS ``map_server`` map (``map.yaml`` + PGM/PNG image).
+
+        See :func:`fm2uav.world.images.world_from_ros_map` (thresholds, negate,
+        unknown cells = obstacles by default).
+        """
+        from .images import world_from_ros_map
+
+        return world_from_ros_map(yaml_path, **kwargs)
