@@ -40,17 +40,22 @@ def test_run_resume_and_failures(tmp_path):
     assert res.references[(1, "dubins")]["error"].startswith("PointError")
     assert np.all(cols["frechet_dubins"][ok] > 0)
     assert seen[-1] == ("fm2", 8, 8, 4)
+    assert all(e.startswith("no dubins reference: PointError") for e in cols["error"][~ok])
     text = (tmp_path / "r.csv").read_text().splitlines()
-    assert len(text) == 9  # header + one line per case, streamed
+    assert len(text) == 9  # summary: header + one line per case
+    assert len((tmp_path / "cases.jsonl").read_text().splitlines()) == 9  # log: header + 8 cases
 
+    # a resume re-runs the failed cases (and their failed reference) by default; failures that
+    # repeat word for word are not appended to the log again
     again = run_sweep(cfg, tmp_path, workers=1)
-    assert again.cases_run == 0 and again.cases_skipped == 8
+    assert again.cases_run == 4 and again.cases_skipped == 4 and again.cases_failed == 4
     np.testing.assert_allclose(np.sort(again.columns["frechet_dubins"][again.columns["status"] == "ok"]),
                                np.sort(cols["frechet_dubins"][ok]), rtol=1e-12)
     assert len((tmp_path / "r.csv").read_text().splitlines()) == 9
+    assert len((tmp_path / "cases.jsonl").read_text().splitlines()) == 9
 
-    retry = run_sweep(cfg, tmp_path, workers=1, retry_failed=True)
-    assert retry.cases_run == 4 and retry.cases_skipped == 4
+    keep = run_sweep(cfg, tmp_path, workers=1, retry_failed=False)
+    assert keep.cases_run == 0 and keep.cases_skipped == 8 and keep.cases_failed == 4
 
     other = _config(bad=False)
     with pytest.raises(InputError, match="different configuration"):
@@ -62,14 +67,15 @@ def test_run_resume_and_failures(tmp_path):
 def test_resume_after_partial_run(tmp_path):
     cfg = _config(bad=False)
     full = run_sweep(cfg, tmp_path / "a", workers=1)
-    # simulate an interrupted run: keep the header and the first 3 cases
+    # simulate an interrupted run: the log's header and first 3 cases, no summary yet
     (tmp_path / "b").mkdir()
     for name in ("config.json", "references.npz"):
         (tmp_path / "b" / name).write_bytes((tmp_path / "a" / name).read_bytes())
-    lines = (tmp_path / "a" / "r.csv").read_text().splitlines()
-    (tmp_path / "b" / "r.csv").write_text("\n".join(lines[:4]) + "\n")
+    lines = (tmp_path / "a" / "cases.jsonl").read_text().splitlines()
+    (tmp_path / "b" / "cases.jsonl").write_text("\n".join(lines[:4]) + "\n")
     part = run_sweep(cfg, tmp_path / "b", workers=1)
     assert part.cases_skipped == 3 and part.cases_run == 5
+    assert len((tmp_path / "b" / "cases.jsonl").read_text().splitlines()) == 1 + 8
 
     def key(c):
         order = np.lexsort((c["beta"], c["alpha"], c["pair"]))
@@ -89,7 +95,10 @@ def test_dask_local_cluster_and_parquet(tmp_path):
             distributed.Client(cluster) as client:
         res = run_sweep(cfg, tmp_path / "dask", client=client)
     assert res.cases_run == 8
-    assert list((tmp_path / "dask" / "r.parquet").glob("part-*.parquet"))
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(tmp_path / "dask" / "r.parquet")  # one file, written at the end
+    assert table.num_rows == 8 and set(table.column("status").to_pylist()) == {"ok"}
 
     def key(c):
         order = np.lexsort((c["beta"], c["alpha"], c["pair"]))
@@ -133,9 +142,13 @@ def test_cli_sweep_and_resume(tmp_path):
                  "best_paths_area.png", "results.csv"):
         assert (out / name).exists()
     assert "Table 3" in (out / "tables.md").read_text()
+    kept = {n: (out / n).read_bytes() for n in ("cases.jsonl", "references.npz", "results.csv")}
     r = runner.invoke(app, ["sweep", str(cfg), "--out", str(out), "--workers", "1", "--json"])
     assert r.exit_code == 0, r.output
     assert json.loads(r.output)["cases"] == {"run": 0, "resumed": 4, "failed": 0}
+    # the report is rewritten, the sweep's own files stay (the report set is merged in)
+    assert {n: (out / n).read_bytes() for n in kept} == kept
+    assert (out / "tables.md").exists() and not [p for p in out.parent.iterdir() if ".tmp-" in p.name]
     bad = tmp_path / "bad.yaml"
     bad.write_text("xi: -1\n")
     r = runner.invoke(app, ["sweep", str(bad), "--out", str(tmp_path / "o2")])

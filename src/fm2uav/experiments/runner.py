@@ -1,31 +1,69 @@
-"""Sweep runner: the α–β sweep on local processes or a Dask cluster.
+"""Sweep runner: the α–β sweep on local processes or a Dask cluster, losing nothing.
 
 ``run_sweep(config, out_dir)`` does the sweep of :mod:`fm2uav.experiments.sweep`
 at scale:
 
 1. the reference paths (one lattice search per pair and model) are computed
-   once, in parallel, and stored in ``out_dir/references.npz``;
-2. the FM² cases are grouped in tasks of one pair × one α (all β), run on
-   local processes (default, ``workers`` of them) or on an existing Dask
-   cluster (``scheduler="tcp://host:8786"`` or a ``client``);
-3. results stream to ``out_dir/<results>`` as tasks finish: a CSV file
-   (appended row by row) or a Parquet dataset (a directory of part files,
-   flushed every few seconds);
-4. a re-run with the same configuration resumes: finished cases are read back
-   and not redone; a failed case is recorded with its error (status
-   ``"error"``) and never loses the others (``retry_failed`` runs them again);
-5. ``on_progress(done, total, failed)`` is called as tasks finish.
+   once, in parallel, and kept in ``out_dir/references.npz``;
+2. the FM² cases are grouped in jobs of one pair × one α (all β) and run on
+   supervised local worker processes (default, ``workers`` of them), in this
+   process (``workers=1``) or on an existing Dask cluster
+   (``scheduler="tcp://host:8786"`` or a ``client``);
+3. every case outcome is appended to the log ``out_dir/cases.jsonl`` as soon as
+   it is known; at the end the summary ``out_dir/<results>`` (CSV or Parquet,
+   one row per case) is written from the log, atomically;
+4. a re-run with the same configuration resumes: cases with an "ok" row in the
+   log are not run again; missing cases and (unless ``retry_failed=False``)
+   failed cases and failed references are;
+5. ``on_progress(stage, done, total, failed)`` is called as cases finish.
+
+Files of a sweep folder
+    ``config.json`` (the configuration; a resume must match it),
+    ``references.npz`` (written to a temporary file and renamed),
+    ``cases.jsonl`` (the log), ``results.csv``/``results.parquet`` (the
+    summary) and ``.sweep.lock`` (held while a sweep runs).
+
+The log
+    One line per case outcome: ``<CRC-32 of the JSON, 8 hex digits> <JSON>``;
+    the first line is a header naming the configuration (its SHA-256). Each line
+    is written with a single ``write(2)`` as soon as its case finished, so a
+    killed process loses no recorded case; the file is fsync'd at most once a
+    second and at the end. On reading, a torn last line (a write cut short) and
+    any line whose checksum does not match are dropped with a warning and their
+    cases run again; a torn tail is cut off before new lines are appended. A row
+    is never both "ok" and non-finite: a case whose metrics are NaN or missing
+    is recorded ``status="failed"`` with the reason in ``error``.
+
+Faults
+    A worker process that dies costs its case only: that case is run once more
+    on a fresh worker, then recorded as failed with the reason; the other cases
+    go on (:mod:`fm2uav.experiments._executors`). On Dask the scheduler re-runs
+    the tasks of a dead worker (``distributed.scheduler.allowed-failures``,
+    default 3); a job whose task still fails with ``KilledWorker`` is split into
+    one task per case, so again only the deadly case fails. References are
+    handled the same way; a case whose pair has no reference for a model is
+    recorded as failed ("no dubins reference: ...") and is run on a later resume
+    once the reference has been computed.
+
+Interruption
+    SIGINT and SIGTERM (in the main thread) stop the workers, flush the log and
+    the references, and raise :class:`SweepInterrupted`; run the same sweep again
+    to resume. A second sweep into a folder that is in use is refused
+    (:func:`sweep_lock`).
 """
 
 from __future__ import annotations
 
-import csv
+import contextlib
+import hashlib
 import json
 import math
 import os
 import shutil
+import signal
+import threading
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
@@ -38,9 +76,45 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 from ..errors import InputError
 from ..world import World
 from ..baselines.reference import MODELS, reference_path
+from ._executors import DaskPool, InlinePool, Job, LocalPool
+from ._store import (
+    LOG_NAME,
+    CaseKey,
+    CaseLog,
+    case_key,
+    checked_row,
+    columns_of,
+    decode_line,
+    latest_rows,
+    load_references,
+    read_config_json,
+    read_summary,
+    save_references,
+    sweep_lock,
+    write_atomic,
+    write_summary,
+)
 from .sweep import METRICS, parameter_grid, sweep_alpha_row
 
-__all__ = ["GridSpec", "SweepConfig", "SweepResult", "load_config", "run_sweep", "sweep_world"]
+__all__ = [
+    "GridSpec",
+    "SweepConfig",
+    "SweepResult",
+    "SweepInterrupted",
+    "SweepWarning",
+    "load_config",
+    "make_config",
+    "run_sweep",
+    "same_sweep",
+    "sweep_lock",
+    "sweep_world",
+    "read_log",
+    "raise_on_signals",
+    "LOG_NAME",
+]
+
+_CONFIG_NAME = "config.json"
+_REFS_NAME = "references.npz"
 
 
 class GridSpec(BaseModel):
@@ -81,7 +155,7 @@ class SweepConfig(BaseModel):
     order : int
         FM² Fast Marching order.
     results : str
-        Results file name in the output directory: ``*.csv`` or ``*.parquet``.
+        Summary file name in the output directory: ``*.csv`` or ``*.parquet``.
     """
 
     model_config = ConfigDict(extra="forbid")
@@ -109,7 +183,7 @@ class SweepConfig(BaseModel):
     @field_validator("results")
     @classmethod
     def _results(cls, v: str) -> str:
-        if not (v.endswith(".csv") or v.endswith(".parquet")) or "/" in v:
+        if not (v.endswith(".csv") or v.endswith(".parquet")) or "/" in v or v.startswith("."):
             raise ValueError(f"results must be a file name ending in .csv or .parquet, got {v!r}")
         return v
 
@@ -124,32 +198,53 @@ class SweepConfig(BaseModel):
         """Everything that defines the cases (a resume must match it)."""
         return self.model_dump()
 
+    def identity_hash(self) -> str:
+        """SHA-256 of :meth:`identity` (names the sweep in its log)."""
+        text = json.dumps(self.identity(), sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()
+
+    def metric_columns(self) -> list[str]:
+        """``frechet_<model>``, ``area_<model>`` for the configured models."""
+        return [f"{m}_{model}" for m in METRICS for model in self.models]
+
     def result_columns(self) -> list[str]:
+        """Columns of the summary (one row per case)."""
         cols = ["pair", "alpha", "beta", "status", "error", "fm2_time_s", "length_m", "clearance_m"]
-        return cols + [f"{m}_{model}" for m in METRICS for model in self.models]
+        return cols + self.metric_columns() + ["attempts"]
 
 
 def load_config(path: str | os.PathLike[str]) -> SweepConfig:
     """Read a YAML sweep configuration (unknown keys are errors)."""
     p = Path(path)
     if not p.is_file():
-        raise InputError(f"config file {p} not found; give the path of a YAML file")
+        what = "a directory" if p.is_dir() else "not found"
+        raise InputError(f"config file {p} is {what}; give the path of a YAML file")
     try:
-        data = yaml.safe_load(p.read_text()) or {}
+        data = yaml.safe_load(p.read_text(encoding="utf-8")) or {}
+    except UnicodeDecodeError:
+        raise InputError(f"{p} is not a UTF-8 text file; give a YAML sweep configuration") from None
+    except OSError as exc:
+        raise InputError(f"cannot read {p}: {exc.strerror}; check the path and permissions") from None
     except yaml.YAMLError as exc:
-        raise InputError(f"{p} is not valid YAML: {exc}") from None
+        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise InputError(f"{p} is not valid YAML ({first}); fix the file") from None
+    except RecursionError:
+        raise InputError(f"{p} is nested too deeply to be a sweep configuration; fix the file") from None
     if not isinstance(data, dict):
         raise InputError(f"{p} must hold a YAML mapping of sweep settings")
     return make_config(data, where=str(p))
 
 
 def make_config(data: dict[str, Any], where: str = "config") -> SweepConfig:
+    """A :class:`SweepConfig` from a mapping; errors name ``where`` and the key."""
     try:
         return SweepConfig(**data)
     except ValidationError as exc:
         first = exc.errors()[0]
         loc = ".".join(str(x) for x in first["loc"])
         raise InputError(f"{where}: {loc}: {first['msg']}") from None
+    except TypeError as exc:  # e.g. non-string keys
+        raise InputError(f"{where}: {exc}") from None
 
 
 @lru_cache(maxsize=4)
@@ -168,167 +263,128 @@ def sweep_world(config: SweepConfig) -> tuple[World, np.ndarray, np.ndarray]:
         starts, goals = city2d_pairs(config.pairs, config.pair_seed, world=world)
     else:
         arr = np.asarray(config.pairs, dtype=float)
-        if arr.ndim != 2 or arr.shape[1] != 4:
+        if arr.ndim != 2 or arr.shape[1] != 4 or not np.all(np.isfinite(arr)):
             raise InputError("pairs must be a number or a list of [x0, y0, x1, y1] in metres")
         starts, goals = arr[:, :2], arr[:, 2:]
     return world, starts, goals
 
 
-# ----------------------------------------------------------------- tasks (picklable)
-def _reference_task(cfg: dict[str, Any], pair: int, model: str) -> dict[str, Any]:
-    config = SweepConfig(**cfg)
-    world, starts, goals = sweep_world(config)
-    t0 = time.perf_counter()
+# ----------------------------------------------------------------- case functions (workers)
+def _reference_case(ctx: dict[str, Any], model: str) -> dict[str, Any]:
+    world = _world_cached(ctx["scenario"], ctx["cell"])
+    ref = reference_path(world, ctx["start"], ctx["goal"], model=model, xi=ctx["xi"],
+                         max_int=ctx["max_int"])
+    return {"path": np.asarray(ref.path, dtype=float), "cost": float(ref.cost),
+            "length": float(ref.length), "time_s": float(ref.timings["search"])}
+
+
+def _fm2_case(ctx: dict[str, Any], beta: float) -> dict[str, Any]:
+    world = _world_cached(ctx["scenario"], ctx["cell"])
+    row = sweep_alpha_row(world, ctx["start"], ctx["goal"], ctx["alpha"], [beta],
+                          ctx["references"], ds=ctx["ds"], order=ctx["order"])[0]
+    row["pair"] = ctx["pair"]
+    return row
+
+
+# ----------------------------------------------------------------- folder
+def same_sweep(config: SweepConfig, out_dir: str | os.PathLike[str]) -> bool:
+    """True if ``out_dir`` holds (part of) the sweep of ``config``.
+
+    Decided by ``config.json``, or by the log's header when ``config.json`` is missing.
+    Raises :class:`~fm2uav.InputError` if ``config.json`` is damaged.
+    """
+    out = Path(out_dir)
+    data = read_config_json(out / _CONFIG_NAME)
+    if data is not None:
+        return data == json.loads(json.dumps(config.identity()))
     try:
-        ref = reference_path(world, starts[pair], goals[pair], model=model, xi=config.xi,
-                             max_int=config.max_int)
-    except Exception as exc:  # recorded, never lost
-        return {"pair": pair, "model": model, "error": f"{type(exc).__name__}: {exc}",
-                "time_s": time.perf_counter() - t0}
-    return {"pair": pair, "model": model, "error": "", "path": ref.path, "cost": ref.cost,
-            "length": ref.length, "time_s": ref.timings["search"]}
+        with open(out / LOG_NAME, "rb") as fh:
+            header = decode_line(fh.readline().rstrip(b"\n"))
+    except OSError:
+        return False
+    return header is not None and header.get("identity") == config.identity_hash()
 
 
-def _fm2_task(cfg: dict[str, Any], pair: int, alpha: float, betas: list[float],
-              references: dict[str, np.ndarray]) -> list[dict[str, Any]]:
-    config = SweepConfig(**cfg)
-    world, starts, goals = sweep_world(config)
-    rows = sweep_alpha_row(world, starts[pair], goals[pair], alpha, betas, references,
-                           ds=config.ds, order=config.order)
-    for r in rows:
-        r["pair"] = pair
-    return rows
+def read_log(out_dir: str | os.PathLike[str], config: SweepConfig,
+             warn: Callable[[str], None] | None = None) -> list[dict[str, Any]]:
+    """Every case row of a sweep folder's log, in the order written (latest last)."""
+    return CaseLog(Path(out_dir) / LOG_NAME, config.identity_hash()).read(warn or _warn)
 
 
-# ----------------------------------------------------------------- executors
-class _Local:
-    """Local process pool (or inline with one worker)."""
+# ----------------------------------------------------------------- lock and signals
+class SweepInterrupted(KeyboardInterrupt):
+    """A sweep stopped by SIGINT or SIGTERM; its recorded cases are kept.
 
-    def __init__(self, workers: int) -> None:
-        self.workers = workers
-        self.pool = None
-        if workers > 1:
-            from concurrent.futures import ProcessPoolExecutor
+    Attributes
+    ----------
+    signum : int
+        The signal.
+    message : str
+        What was kept and how to resume.
+    """
 
-            self.pool = ProcessPoolExecutor(max_workers=workers)
+    def __init__(self, signum: int, message: str = "") -> None:
+        super().__init__(message or f"sweep interrupted by {signal.Signals(signum).name}")
+        self.signum = signum
+        self.message = message or str(self.args[0])
 
-    def map_unordered(self, fn: Callable, arglist: list[tuple]) -> Iterable[tuple[tuple, Any, BaseException | None]]:
-        if self.pool is None:
-            for args in arglist:
-                try:
-                    yield args, fn(*args), None
-                except Exception as exc:  # noqa: BLE001 - recorded by the caller
-                    yield args, None, exc
+    def __str__(self) -> str:
+        return self.message
+
+
+class _Signals:
+    """SIGINT/SIGTERM raise :class:`SweepInterrupted`, deferred out of log writes."""
+
+    def __init__(self) -> None:
+        self.critical = 0
+        self.pending: int | None = None
+        self.closing = False
+        self._old: dict[int, Any] = {}
+
+    def __enter__(self) -> _Signals:
+        if threading.current_thread() is threading.main_thread():
+            for s in (signal.SIGINT, signal.SIGTERM):
+                self._old[s] = signal.signal(s, self._handler)
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        for s, h in self._old.items():
+            signal.signal(s, h)
+        self._old = {}
+
+    def _handler(self, signum: int, frame: Any) -> None:
+        if self.closing or self.critical:
+            self.pending = self.pending or signum
             return
-        from concurrent.futures import as_completed
+        raise SweepInterrupted(signum)
 
-        futs = {self.pool.submit(fn, *a): a for a in arglist}
+    @contextlib.contextmanager
+    def deferred(self) -> Iterator[None]:
+        self.critical += 1
         try:
-            for f in as_completed(futs):
-                exc = f.exception()
-                yield futs[f], (None if exc else f.result()), exc
+            yield
         finally:
-            for f in futs:
-                f.cancel()
-
-    def close(self) -> None:
-        if self.pool is not None:
-            self.pool.shutdown(wait=True, cancel_futures=True)
+            self.critical -= 1
+        if not self.critical and self.pending and not self.closing:
+            raise SweepInterrupted(self.pending)
 
 
-class _Dask:
-    """An existing Dask cluster (scheduler address or Client)."""
-
-    def __init__(self, scheduler: str | None, client: Any) -> None:
-        from dask.distributed import Client
-
-        self.own = client is None
-        self.client = client if client is not None else Client(scheduler, timeout="20s")
-
-    def map_unordered(self, fn: Callable, arglist: list[tuple]):
-        from dask.distributed import as_completed
-
-        futs = {}
-        for a in arglist:
-            futs[self.client.submit(fn, *a, pure=False)] = a
-        try:
-            for f in as_completed(list(futs)):
-                a = futs[f]
-                if f.status == "error":
-                    yield a, None, f.exception()
-                else:
-                    yield a, f.result(), None
-        finally:
-            self.client.cancel([f for f in futs if not f.done()])
-
-    def close(self) -> None:
-        if self.own:
-            self.client.close()
+def raise_on_signals() -> contextlib.AbstractContextManager[Any]:
+    """Within the block (main thread), SIGINT and SIGTERM raise :class:`SweepInterrupted`."""
+    return _Signals()
 
 
-# ----------------------------------------------------------------- result store
-class _Store:
-    """Results file: CSV (appended) or Parquet dataset (part files)."""
-
-    def __init__(self, path: Path, columns: list[str]) -> None:
-        self.path = path
-        self.columns = columns
-        self.parquet = path.suffix == ".parquet"
-        self.buffer: list[dict[str, Any]] = []
-        self.last_flush = time.monotonic()
-
-    def read(self) -> list[dict[str, Any]]:
-        if not self.path.exists():
-            return []
-        if self.parquet:
-            import pyarrow.parquet as pq
-
-            parts = sorted(self.path.glob("part-*.parquet"))
-            rows: list[dict[str, Any]] = []
-            for part in parts:
-                rows.extend(pq.read_table(part).to_pylist())
-            return rows
-        with open(self.path, newline="") as fh:
-            rows = list(csv.DictReader(fh))
-        for r in rows:
-            for k, v in r.items():
-                if k in ("status", "error"):
-                    continue
-                r[k] = int(v) if k == "pair" else (float(v) if v not in ("", None) else math.nan)
-        return rows
-
-    def append(self, rows: list[dict[str, Any]], *, force: bool = False) -> None:
-        self.buffer.extend({c: r.get(c, math.nan if c not in ("status", "error") else "")
-                            for c in self.columns} for r in rows)
-        if force or not self.parquet or time.monotonic() - self.last_flush > 5.0:
-            self.flush()
-
-    def flush(self) -> None:
-        if not self.buffer:
-            return
-        if self.parquet:
-            import pyarrow as pa
-            import pyarrow.parquet as pq
-
-            self.path.mkdir(parents=True, exist_ok=True)
-            n = len(list(self.path.glob("part-*.parquet")))
-            table = pa.Table.from_pylist(self.buffer)
-            tmp = self.path / f".part-{n:05d}.tmp"
-            pq.write_table(table, tmp)
-            os.replace(tmp, self.path / f"part-{n:05d}.parquet")
-        else:
-            new = not self.path.exists()
-            with open(self.path, "a", newline="") as fh:
-                w = csv.DictWriter(fh, fieldnames=self.columns)
-                if new:
-                    w.writeheader()
-                w.writerows(self.buffer)
-                fh.flush()
-                os.fsync(fh.fileno())
-        self.buffer = []
-        self.last_flush = time.monotonic()
+class SweepWarning(UserWarning):
+    """Something in a sweep folder was repaired (e.g. a torn log line dropped)."""
 
 
+def _warn(message: str) -> None:
+    import warnings
+
+    warnings.warn(message, SweepWarning, stacklevel=3)
+
+
+# ----------------------------------------------------------------- result
 @dataclass
 class SweepResult:
     """Outcome of :func:`run_sweep`.
@@ -337,17 +393,25 @@ class SweepResult:
     ----------
     config : SweepConfig
     columns : dict of str to ndarray
-        All result rows (latest row per case), column-wise.
+        One row per case (the summary), column-wise.
     alphas, betas : ndarray
         The grid.
     starts, goals : ndarray, (n, 2)
         The pairs [m].
     references : dict
-        ``(pair, model) -> dict(path, cost, length, time_s, error)``.
+        ``(pair, model) -> dict(path, cost, length, time_s, error, attempts)``.
     cases_run, cases_skipped, cases_failed : int
-        Cases computed now, read back from a previous run, failed (now or before).
+        Cases computed now, taken from a previous run, failed (now or before).
+    cases_retried : int
+        Cases run a second time now because their worker process died.
+    worker_deaths : int
+        Worker processes that died while running a case or reference.
     wall_s : dict
         Wall time of the references and of the FM² cases [s].
+    log, summary : Path
+        The case log and the summary file.
+    warnings : list of str
+        What was repaired on reading (torn or damaged log lines).
     """
 
     config: SweepConfig
@@ -360,47 +424,24 @@ class SweepResult:
     cases_run: int = 0
     cases_skipped: int = 0
     cases_failed: int = 0
+    cases_retried: int = 0
+    worker_deaths: int = 0
     wall_s: dict[str, float] = field(default_factory=dict)
+    log: Path | None = None
+    summary: Path | None = None
+    warnings: list[str] = field(default_factory=list)
 
 
-def _columns(rows: list[dict[str, Any]], names: list[str]) -> dict[str, np.ndarray]:
-    out: dict[str, np.ndarray] = {}
-    for c in names:
-        vals = [r.get(c) for r in rows]
-        if c in ("status", "error"):
-            out[c] = np.array(["" if v is None else str(v) for v in vals], dtype=object)
-        elif c == "pair":
-            out[c] = np.array(vals, dtype=np.int64)
-        else:
-            out[c] = np.array([math.nan if v is None else float(v) for v in vals], dtype=float)
-    return out
-
-
-def _load_references(path: Path) -> dict[tuple[int, str], dict[str, Any]]:
-    refs: dict[tuple[int, str], dict[str, Any]] = {}
-    if not path.exists():
-        return refs
-    with np.load(path, allow_pickle=False) as z:
-        meta = json.loads(str(z["meta"]))
-        for m in meta:
-            key = (int(m["pair"]), str(m["model"]))
-            entry = dict(m)
-            if not m["error"]:
-                entry["path"] = z[f"path_{m['pair']}_{m['model']}"]
-            refs[key] = entry
-    return refs
-
-
-def _save_references(path: Path, refs: dict[tuple[int, str], dict[str, Any]]) -> None:
-    arrays = {}
-    meta = []
-    for (pair, model), r in sorted(refs.items()):
-        meta.append({k: v for k, v in r.items() if k != "path"})
-        if not r["error"]:
-            arrays[f"path_{pair}_{model}"] = np.asarray(r["path"])
-    tmp = path.with_suffix(".tmp.npz")
-    np.savez_compressed(tmp, meta=np.array(json.dumps(meta)), **arrays)
-    os.replace(tmp, path)
+# ----------------------------------------------------------------- run
+def _executor(workers: int | None, scheduler: str | None, client: Any) -> Any:
+    if scheduler is not None or client is not None:
+        try:
+            return DaskPool(scheduler, client)
+        except (OSError, ValueError, TypeError) as exc:
+            raise InputError(f"cannot reach the Dask scheduler {scheduler}: {exc}; check "
+                             "--scheduler") from None
+    n = max(1, int(workers or os.cpu_count() or 1))
+    return InlinePool() if n == 1 else LocalPool(n)
 
 
 def run_sweep(
@@ -410,9 +451,10 @@ def run_sweep(
     workers: int | None = None,
     scheduler: str | None = None,
     client: Any = None,
-    retry_failed: bool = False,
+    retry_failed: bool = True,
     fresh: bool = False,
     on_progress: Callable[[str, int, int, int], None] | None = None,
+    on_warning: Callable[[str], None] | None = None,
 ) -> SweepResult:
     """Run (or resume) an α–β sweep; see the module docstring.
 
@@ -420,136 +462,257 @@ def run_sweep(
     ----------
     config : SweepConfig
     out_dir : path-like
-        Holds ``config.json``, ``references.npz`` and the results file.
+        The sweep folder (created if missing; see the module docstring).
     workers : int, optional
-        Local processes (default: all cores). 1 runs in this process.
+        Local worker processes (default: all cores). 1 runs in this process
+        (no protection against a crash of the process itself).
     scheduler : str, optional
         Address of an existing Dask scheduler, e.g. ``"tcp://10.0.0.5:8786"``.
     client : dask.distributed.Client, optional
         Use this client (e.g. a ``LocalCluster`` in tests).
     retry_failed : bool
-        Run the cases that failed in a previous run again.
+        Run failed cases and failed references of a previous run again
+        (default). With False they are kept as they are.
     fresh : bool
         Discard previous results in ``out_dir`` (needed when the configuration
         changed).
     on_progress : callable, optional
         ``on_progress(stage, done, total, failed)`` with stage
-        ``"references"`` or ``"fm2"``.
+        ``"references"`` or ``"fm2"``, called after each outcome is recorded.
+    on_warning : callable, optional
+        Receives one-line warnings (damaged log lines that were dropped);
+        default: :func:`warnings.warn`.
 
     Raises
     ------
     fm2uav.InputError
-        ``out_dir`` holds results of a different configuration (pass
-        ``fresh=True``), or a bad configuration.
+        ``out_dir`` holds a sweep of a different configuration (pass
+        ``fresh=True``), is used by another sweep, holds a damaged file (the
+        message names it and the fix), or a bad configuration.
+    SweepInterrupted
+        SIGINT/SIGTERM: the workers were stopped and every finished case kept.
     """
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    cfg_path = out / "config.json"
-    results_path = out / config.results
-    refs_path = out / "references.npz"
-    identity = config.identity()
-    if cfg_path.exists() and not fresh:
-        previous = json.loads(cfg_path.read_text())
-        if previous != json.loads(json.dumps(identity)):
-            raise InputError(
-                f"{out} holds a sweep with a different configuration; pass --force (fresh=True) "
-                "to discard it or choose another output directory"
-            )
-    if fresh:
-        for p in (results_path, refs_path, cfg_path):
-            if p.is_dir():
-                shutil.rmtree(p)
-            elif p.exists():
-                p.unlink()
-    cfg_path.write_text(json.dumps(identity, indent=2))
+    warnings_seen: list[str] = []
 
+    def warn(message: str) -> None:
+        warnings_seen.append(message)
+        (on_warning or _warn)(message)
+
+    with sweep_lock(out):
+        cfg_path = out / _CONFIG_NAME
+        results_path = out / config.results
+        refs_path = out / _REFS_NAME
+        log = CaseLog(out / LOG_NAME, config.identity_hash())
+        identity = json.loads(json.dumps(config.identity()))
+        if fresh:
+            old_results = []
+            with contextlib.suppress(InputError):  # the summary of the sweep being discarded
+                name = (read_config_json(cfg_path) or {}).get("results")
+                if isinstance(name, str) and name.endswith((".csv", ".parquet")) \
+                        and "/" not in name and not name.startswith("."):
+                    old_results.append(out / name)
+            for p in (log.path, results_path, refs_path, cfg_path, *old_results):
+                if p.is_dir():
+                    shutil.rmtree(p)
+                elif p.exists():
+                    p.unlink()
+        else:
+            previous = read_config_json(cfg_path)
+            if previous is not None and previous != identity:
+                raise InputError(
+                    f"{out} holds a sweep with a different configuration; pass --force "
+                    "(fresh=True) to discard it or choose another output directory")
+        metric_cols = config.metric_columns()
+        history = [checked_row(r, metric_cols) for r in log.read(warn)]
+        imported: list[dict[str, Any]] = []
+        if not log.path.exists() and results_path.exists():
+            # a sweep folder of an older fm2uav: keep its finished cases
+            for r in read_summary(results_path, config.result_columns(), warn):
+                r = checked_row(r, metric_cols)
+                if r["status"] == "ok":
+                    imported.append(r)
+        write_atomic(cfg_path, lambda tmp: tmp.write_text(json.dumps(identity, indent=2)))
+        refs = load_references(refs_path)
+        return _run(config, out, log, history, imported, refs, refs_path, results_path,
+                    workers=workers, scheduler=scheduler, client=client,
+                    retry_failed=retry_failed, on_progress=on_progress, warnings=warnings_seen)
+
+
+def _run(config: SweepConfig, out: Path, log: CaseLog, history: list[dict[str, Any]],
+         imported: list[dict[str, Any]], refs: dict[tuple[int, str], dict[str, Any]],
+         refs_path: Path, results_path: Path, *, workers: int | None, scheduler: str | None,
+         client: Any, retry_failed: bool, on_progress: Callable[..., None] | None,
+         warnings: list[str]) -> SweepResult:
     world, starts, goals = sweep_world(config)
     alphas, betas = config.alpha.values(), config.beta.values()
-    cfg = config.model_dump()
     n_pairs = len(starts)
-
-    if scheduler is not None or client is not None:
-        executor: Any = _Dask(scheduler, client)
-    else:
-        executor = _Local(max(1, int(workers or os.cpu_count() or 1)))
+    grid = {(p, float(a), float(b)) for p in range(n_pairs) for a in alphas for b in betas}
+    metric_cols = config.metric_columns()
+    base_ctx = {"scenario": config.scenario, "cell": float(config.cell)}
     wall: dict[str, float] = {}
-    try:
-        # 1. references
-        t0 = time.perf_counter()
-        refs = _load_references(refs_path)
-        todo = [(cfg, p, m) for p in range(n_pairs) for m in config.models if (p, m) not in refs]
-        done = len(refs)
-        total = n_pairs * len(config.models)
-        failed = sum(1 for r in refs.values() if r["error"])
-        if on_progress:
-            on_progress("references", done, total, failed)
-        for args, res, exc in executor.map_unordered(_reference_task, todo):
-            if exc is not None:
-                res = {"pair": args[1], "model": args[2], "error": f"{type(exc).__name__}: {exc}",
-                       "time_s": math.nan}
-            refs[(res["pair"], res["model"])] = res
-            done += 1
-            failed += bool(res["error"])
-            if done % 8 == 0 or done == total:
-                _save_references(refs_path, refs)
-            if on_progress:
-                on_progress("references", done, total, failed)
-        if todo:
-            _save_references(refs_path, refs)
-        wall["references"] = time.perf_counter() - t0
+    stats = {"run": 0, "skipped": 0, "retried": 0, "deaths": 0}
+    signals = _Signals()
+    executor: Any = None
+    stage = "references"
+    latest: dict[CaseKey, dict[str, Any]] = {}
+    refs_total = n_pairs * len(config.models)
+    refs_dirty = False
 
-        # 2. FM² cases
-        t1 = time.perf_counter()
-        store = _Store(results_path, config.result_columns())
-        previous = store.read()
-        latest: dict[tuple[int, float, float], dict[str, Any]] = {}
-        for r in previous:
-            latest[(int(r["pair"]), round(float(r["alpha"]), 10), round(float(r["beta"]), 10))] = r
-        finished = {k for k, r in latest.items() if r["status"] == "ok" or not retry_failed}
-        tasks = []
-        skipped = 0
-        for p in range(n_pairs):
-            ref_paths = {m: refs[(p, m)]["path"] for m in config.models if not refs[(p, m)]["error"]}
-            for a in alphas:
-                todo_b = [float(b) for b in betas if (p, float(a), float(b)) not in finished]
-                skipped += len(betas) - len(todo_b)
-                if todo_b:
-                    tasks.append((cfg, p, float(a), todo_b, ref_paths))
-        total = n_pairs * len(alphas) * len(betas)
-        done = skipped
-        failed = sum(1 for k in finished if latest[k]["status"] != "ok")
-        run = 0
-        if on_progress:
-            on_progress("fm2", done, total, failed)
-        for args, rows, exc in executor.map_unordered(_fm2_task, tasks):
-            if exc is not None:
-                rows = [{"pair": args[1], "alpha": args[2], "beta": b, "status": "error",
-                         "error": f"{type(exc).__name__}: {exc}"} for b in args[3]]
-            store.append(rows)
-            for r in rows:
-                latest[(int(r["pair"]), round(float(r["alpha"]), 10), round(float(r["beta"]), 10))] = r
-            done += len(rows)
-            run += len(rows)
-            failed += sum(r["status"] != "ok" for r in rows)
-            if on_progress:
-                on_progress("fm2", done, total, failed)
-        store.flush()
-        wall["fm2"] = time.perf_counter() - t1
-    finally:
-        executor.close()
+    def progress(*args: Any) -> None:
+        if on_progress is not None:
+            on_progress(*args)
 
-    rows = list(latest.values())
-    columns = _columns(rows, config.result_columns())
+    with signals:  # installed until the cleanup is over (a second Ctrl-C waits)
+        try:
+            log.open()
+            for r in imported:
+                with signals.deferred():
+                    log.append(r)
+            latest = {k: r for k, r in latest_rows(history + imported).items() if k in grid}
+
+            # 1. references
+            t0 = time.perf_counter()
+            need = [(p, m) for p in range(n_pairs) for m in config.models
+                    if (p, m) not in refs or (retry_failed and refs[(p, m)]["error"])]
+            done = refs_total - len(need)
+            failed = sum(1 for k, r in refs.items() if r["error"] and k not in need)
+            progress("references", done, refs_total, failed)
+            executor = _executor(workers, scheduler, client)
+            jobs = [Job({**base_ctx, "start": starts[p], "goal": goals[p], "xi": float(config.xi),
+                         "max_int": int(config.max_int)}, [m], tag=p) for p, m in need]
+            for o in executor.run(_reference_case, jobs):
+                p, m = o.job.tag, o.unit
+                entry = {"pair": p, "model": m, "attempts": o.attempt}
+                if o.ok:
+                    entry.update(o.value, error="")
+                else:
+                    entry.update(error=str(o.value), time_s=math.nan)
+                refs[(p, m)] = entry
+                refs_dirty = True
+                with signals.deferred():  # each reference is kept as soon as it is known
+                    save_references(refs_path, refs)
+                refs_dirty = False
+                done += 1
+                failed += bool(entry["error"])
+                progress("references", done, refs_total, failed)
+            wall["references"] = time.perf_counter() - t0
+            retried0 = executor.retried
+
+            # 2. FM² cases
+            stage = "fm2"
+            t1 = time.perf_counter()
+            total = len(grid)
+            done = failed = 0
+
+            def record(row: dict[str, Any]) -> None:
+                nonlocal done, failed
+                k = case_key(row)
+                old = latest.get(k)
+                # a failure that repeats itself word for word is not appended again
+                if not (old is not None and old["status"] == row["status"] == "failed"
+                        and old.get("error") == row.get("error")):
+                    with signals.deferred():
+                        log.append(row)
+                latest[k] = row
+                stats["run"] += 1
+                done += 1
+                failed += row["status"] != "ok"
+
+            jobs = []
+            missing_refs: list[tuple[int, float, list[float], str]] = []
+            for p in range(n_pairs):
+                ref_paths, ref_errors = {}, []
+                for m in config.models:
+                    r = refs[(p, m)]
+                    if r["error"]:
+                        ref_errors.append(f"no {m} reference: {r['error']}")
+                    else:
+                        ref_paths[m] = r["path"]
+                for a in alphas:
+                    todo = []
+                    for b in betas:
+                        old = latest.get((p, float(a), float(b)))
+                        if old is not None and (old["status"] == "ok" or not retry_failed):
+                            stats["skipped"] += 1
+                            done += 1
+                            failed += old["status"] != "ok"
+                        else:
+                            todo.append(float(b))
+                    if not todo:
+                        continue
+                    if ref_errors:
+                        missing_refs.append((p, float(a), todo, "; ".join(ref_errors)))
+                    else:
+                        jobs.append(Job({**base_ctx, "pair": p, "start": starts[p],
+                                         "goal": goals[p], "alpha": float(a),
+                                         "references": ref_paths, "ds": float(config.ds),
+                                         "order": int(config.order)}, todo, tag=(p, float(a))))
+            progress("fm2", done, total, failed)
+            for p, a, todo, reason in missing_refs:
+                for b in todo:
+                    record({"pair": p, "alpha": a, "beta": b, "status": "failed", "error": reason})
+                progress("fm2", done, total, failed)
+            for o in executor.run(_fm2_case, jobs):
+                p, a = o.job.tag
+                if o.ok:
+                    row = dict(o.value)
+                else:
+                    row = {"pair": p, "alpha": a, "beta": o.unit, "status": "failed",
+                           "error": str(o.value)}
+                row = checked_row(row, metric_cols)
+                row.update(pair=p, alpha=a, beta=float(o.unit), attempts=o.attempt,
+                           worker=o.worker, time=time.time())
+                record(row)
+                progress("fm2", done, total, failed)
+            wall["fm2"] = time.perf_counter() - t1
+            stats["deaths"] = executor.deaths
+            stats["retried"] = executor.retried - retried0
+        except SweepInterrupted as exc:
+            signals.closing = True
+            if executor is not None:
+                executor.close(now=True)
+                executor = None
+            if refs_dirty:
+                with contextlib.suppress(OSError):
+                    save_references(refs_path, refs)
+            log.close()
+            kept = sum(1 for r in latest.values() if r["status"] == "ok")
+            if stage == "references":
+                ok_refs = sum(1 for r in refs.values() if not r["error"])
+                what = f"in the references phase ({ok_refs} of {refs_total} references kept in {refs_path})"
+            else:
+                what = f"{kept} of {len(grid)} cases recorded in {log.path}"
+            raise SweepInterrupted(exc.signum, f"sweep interrupted by {signal.Signals(exc.signum).name}: "
+                                   f"workers stopped, {what}; run the same sweep again to resume") from None
+        finally:
+            signals.closing = True
+            if executor is not None:
+                executor.close()
+            log.close()
+
+    # 3. the summary, from the log
+    rows_by_key = {k: r for k, r in latest_rows([checked_row(r, metric_cols) for r in
+                                             log.read(lambda m: None)]).items() if k in grid}
+    rows = [rows_by_key[k] for k in sorted(rows_by_key)]
+    columns = config.result_columns()
+    write_summary(results_path, rows, columns)
+    cols = columns_of(rows, columns)
     return SweepResult(
         config=config,
-        columns=columns,
+        columns=cols,
         alphas=alphas,
         betas=betas,
         starts=starts,
         goals=goals,
         references=refs,
-        cases_run=run,
-        cases_skipped=skipped,
-        cases_failed=int(np.sum(columns["status"] != "ok")) if rows else 0,
+        cases_run=stats["run"],
+        cases_skipped=stats["skipped"],
+        cases_failed=int(np.sum(cols["status"] != "ok")) if rows else 0,
+        cases_retried=stats["retried"],
+        worker_deaths=stats["deaths"],
         wall_s=wall,
+        log=log.path,
+        summary=results_path,
+        warnings=warnings,
     )
