@@ -74,6 +74,7 @@ def test_flight_level_options_reach_the_planner_and_exports(tmp_path):
     assert res.exit_code == 0, res.output
     data = json.loads(res.output)
     assert data["params"]["agl"] == 150.0 and data["params"]["p2"] == 1.3
-    assert data["mavlink_frame"] == 10  # terrain-relative for terrain-following plans
+    # terrain-following plans: PX4 (the default) gets AMSL from the DEM, ArduPilot the terrain frame
+    assert data["mavlink_frame"] == 0 and data["autopilot"]["frame"]["name"] == "amsl"
     res = runner.invoke(app, ["plan", "--agl", "900", "--out", str(tmp_path / "high")])
     assert res.exit_code == 1 and "leaves the map" in res.output

@@ -250,7 +250,7 @@ def test_plan_command_report_and_exports(tmp_path):
                               "--anchor", "2.35,48.85,35", "--thin", "10", "--json"])
     assert res.exit_code == 0, res.output
     data = json.loads(res.output)
-    assert len(data["files"]) == 8 and data["waypoints"] < 60
+    assert len(data["files"]) == 9 and data["waypoints"] < 60  # + path.kmz
     plan = read_plan(out / "mission.plan")
     assert plan["home"][:2] == pytest.approx((48.85, 2.35), abs=0.05)
     assert (out / "report.html").stat().st_size > 1_000_000

@@ -10,6 +10,21 @@ import typer
 
 from ..errors import InputError
 from ._common import OutputDir, handle_errors, print_summary, progress, to_jsonable
+from ._mission_options import (
+    AnchorText,
+    CruiseSpeed,
+    End,
+    Endurance,
+    Firmware,
+    Frame,
+    HoverSpeed,
+    MinSpeed,
+    Reserve,
+    SpeedChanges,
+    Thin,
+    Vehicle,
+    export_options,
+)
 from .options import (
     AllowFilledOpt,
     BboxOpt,
@@ -29,11 +44,15 @@ from .options import (
     world_spec,
 )
 
+#: Mission files of a coverage flight (written by fm2uav.io.export_mission).
+COVER_EXPORTS = ("csv", "plan", "wpl", "kml", "kmz", "geojson")
 COVER_FILES = ("path.csv", "zigzag.csv", "bands.png", "coverage.png", "coverage.html",
-               "summary.json", "mission.plan")
+               "summary.json", "mission.plan", "mission.waypoints", "path.kml", "path.kmz",
+               "path.geojson")
 REPORT = "report.html"
 
-def _camera_spacing(camera: str, agl: float, side_overlap: float) -> float:
+def _camera(camera: str):
+    """``--camera`` text → :class:`~fm2uav.missions.coverage.Camera`."""
     from ..missions.coverage import Camera
 
     parts = [p for p in camera.replace(",", " ").split() if p]
@@ -46,8 +65,7 @@ def _camera_spacing(camera: str, agl: float, side_overlap: float) -> float:
         sw, sh, f, iw, ih = (float(p) for p in parts)
     except ValueError:
         raise InputError(f"--camera values must be numbers, got {camera!r}") from None
-    cam = Camera(sw * 1e-3, sh * 1e-3, f * 1e-3, int(iw), int(ih))
-    return cam.spacing(agl, side_overlap)
+    return Camera(sw * 1e-3, sh * 1e-3, f * 1e-3, int(iw), int(ih))
 
 
 def _load_area(area: str, world=None, crs=None):
@@ -92,31 +110,29 @@ def _write_png(outdir: OutputDir, fig, name: str) -> None:
     outdir.commit(tmp, name)
 
 
-def _write_cover_outputs(outdir: OutputDir, cp, area: str, *, report: bool, title: str):
-    """path.csv, zigzag.csv, PNGs, coverage.html, mission.plan and report.html."""
+def _write_cover_outputs(outdir: OutputDir, cp, area: str, *, report: bool, title: str,
+                         options=None, camera=None):
+    """The mission files (path.csv, mission.plan, .waypoints, KML/KMZ, GeoJSON), zigzag.csv,
+    PNGs, coverage.html and report.html; returns the built mission."""
     from ..io import write_path_csv
     from ..viz.coverage import bands_figure, coverage_figure, coverage_html
+    from .cmd_run import write_exports
 
     world = cp.plan.world
     georef = getattr(world, "georef", None)
     comment = georef.comment() if georef is not None else None
-    with outdir.open("path.csv") as fh:
-        write_path_csv(fh, cp.path, cp.plan.w, comment=comment)
+    from ..io import export_mission
+
+    mission, files = export_mission(cp.plan, COVER_EXPORTS, options, agl=cp.level.agl,
+                                    camera=camera)
+    write_exports(outdir, files)
+    wps = mission.waypoints
     with outdir.open("zigzag.csv") as fh:
         write_path_csv(fh, cp.zigzag.path(), comment=comment)
     _write_png(outdir, bands_figure(cp.zigzag, title=f"zigzag over {area}"), "bands.png")
     _write_png(outdir, coverage_figure(cp, title=title), "coverage.png")
     with outdir.open("coverage.html") as fh:
         fh.write(coverage_html(cp, title=title))
-    try:
-        from ..io.qgc import write_plan
-        from ..io.waypoints import mission_waypoints
-    except ImportError:  # pragma: no cover - the exporter ships with fm2uav.io
-        wps = None
-    else:
-        wps = mission_waypoints(cp.path, world, frame="terrain", terrain_following=True)
-        with outdir.open("mission.plan") as fh:
-            write_plan(fh, wps)
     if report:
         e = np.abs(cp.agl_error)
         metrics = {
@@ -127,15 +143,18 @@ def _write_cover_outputs(outdir: OutputDir, cp, area: str, *, report: bool, titl
             "FM² path length [m]": round(float(cp.plan.length), 1),
             "coverage (FM² path) [%]": round(100 * cp.coverage, 2),
             "|AGL error| mean / max [m]": f"{e.mean():.1f} / {e.max():.1f}",
-            "mission.plan waypoints": "-" if wps is None else len(wps),
+            "mission": f"{mission.options.firmware} {mission.options.vehicle}, "
+                       f"{len(mission.items)} items, frame {mission.frame}, end {mission.end}",
+            "camera trigger [m]": mission.info["camera"]["trigger_distance_m"],
+            **({"GSD [cm/px]": mission.info["camera"]["gsd_cm_per_px"]}
+               if "gsd_cm_per_px" in mission.info["camera"] else {}),
             "planning time [s]": round(cp.timings.get("total", 0.0), 3),
         }
         _write_report(outdir, cp, title=title,
                       subtitle=f"zigzag bands over {area}, FM² at "
                                f"{cp.level.agl:g} m above the terrain",
-                      metrics=metrics, waypoints=None if wps is None else wps.points_m,
-                      files=list(COVER_FILES))
-    return wps
+                      metrics=metrics, waypoints=wps.points_m, files=list(COVER_FILES))
+    return mission
 
 def _write_coverage_figures(outdir: OutputDir, run) -> None:
     """bands_<area>.png, coverage_<area>.png and bands_S1_D<d>.png of a coverage run."""
@@ -162,9 +181,12 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         help=(
             "Coverage mission: zigzag bands over an area, steering angle by Differential "
             "Evolution, FM² along the bands at a height above the terrain. Writes path.csv, "
-            "zigzag.csv, mission.plan (QGroundControl, terrain-relative altitudes), bands.png, "
-            "coverage.png, coverage.html and summary.json (and with --report an interactive, "
-            "self-contained report.html).\n\n"
+            "zigzag.csv, the mission (mission.plan for QGroundControl, mission.waypoints QGC WPL "
+            "110, path.kml/.kmz, path.geojson: takeoff, the camera triggered on each band "
+            "(DO_SET_CAM_TRIGG_DIST on at its start, off at its end), the end; frame and checks "
+            "per --firmware), bands.png, coverage.png, coverage.html and summary.json (with the "
+            "camera's ground sample distance and overlaps), and with --report an interactive, "
+            "self-contained report.html.\n\n"
             "Examples:\n\n"
             "  fm2uav cover --area S1 --spacing 80 --agl 100 --out out/cover\n\n"
             "  fm2uav cover --area S3 --spacing 80 --report --out out/cover-report\n\n"
@@ -187,6 +209,23 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         camera: str | None = typer.Option(
             None, help="Compute D from a camera: sensor_w_mm,sensor_h_mm,focal_mm,img_w,img_h."),
         side_overlap: float = typer.Option(0.0, help="Side overlap share in [0, 1) with --camera."),
+        front_overlap: float = typer.Option(
+            0.0, help="Front overlap share in [0, 1) between photos with --camera (sets the "
+            "trigger distance)."),
+        trigger_distance: float | None = typer.Option(
+            None, help="Distance between photos (m); default: from --camera, else D."),
+        firmware: Firmware = None,
+        vehicle: Vehicle = None,
+        frame: Frame = None,
+        end: End = None,
+        thin: Thin = None,
+        anchor: AnchorText = None,
+        speed_changes: SpeedChanges = None,
+        min_speed: MinSpeed = None,
+        cruise_speed: CruiseSpeed = None,
+        hover_speed: HoverSpeed = None,
+        endurance: Endurance = None,
+        reserve: Reserve = None,
         angle: float | None = typer.Option(None, help="Steering angle (deg); default: searched."),
         search: str = typer.Option("de", help="Angle search: de (seeds), sweep, scipy-de."),
         full_range: bool = typer.Option(False, "--full-range",
@@ -215,11 +254,20 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         allow_filled: AllowFilledOpt = False,
     ) -> None:
         from ..missions.coverage import FULL_BOUNDS_DEG, plan_coverage
+        from .cmd_run import mission_rows
         from ..planning import FlightLevel
+
+        from ..missions.coverage.triggers import camera_plan
 
         if (spacing is None) == (camera is None):
             raise InputError("give exactly one of --spacing (metres) or --camera")
-        d = spacing if spacing is not None else _camera_spacing(camera, agl, side_overlap)
+        cam = None if camera is None else _camera(camera)
+        d = spacing if spacing is not None else cam.spacing(agl, side_overlap)
+        mission_options = export_options(
+            None, firmware=firmware, vehicle=vehicle, frame=frame, end=end, thin=thin,
+            anchor=anchor, speed_changes=speed_changes, min_speed=min_speed,
+            cruise_speed=cruise_speed, hover_speed=hover_speed, endurance=endurance,
+            reserve=reserve, name=f"coverage of {area}")
         outdir = OutputDir(out, force=force)
         outdir.check(COVER_FILES + ((REPORT,) if report else ()))
         opts = {}
@@ -239,17 +287,17 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
                                angle=None if angle is None else np.radians(angle),
                                search=search, search_options=opts, seed=seed)
             step("writing the outputs")
-            wps = _write_cover_outputs(outdir, cp, area, report=report,
-                                       title=f"coverage of {area}")
+            shots = camera_plan(cp, camera=cam, front_overlap=front_overlap,
+                                trigger_distance=trigger_distance)
+            mission = _write_cover_outputs(outdir, cp, area, report=report,
+                                           title=f"coverage of {area}", options=mission_options,
+                                           camera=shots)
         from ..world.load import world_summary
 
         summary = {"area": area, "scenario": scenario, "world": world_summary(world),
                    **({"area_source": area_source.as_dict()} if area_source else {}),
                    **cp.summary()}
-        if wps is None:
-            summary["mission_plan"] = "not written: fm2uav.io.qgc is not available"
-        else:
-            summary["mission_plan_waypoints"] = len(wps)
+        summary["autopilot"] = mission.summary()
         with outdir.open("summary.json") as fh:
             json.dump(to_jsonable(summary), fh, indent=2)
         rows = {
@@ -262,6 +310,11 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "coverage (FM² path) [%]": f"{100 * cp.coverage:.2f}",
             "|AGL error| mean/max [m]": f"{np.abs(cp.agl_error).mean():.1f} / "
                                         f"{np.abs(cp.agl_error).max():.1f}",
+            "camera": ", ".join(
+                f"{k} {v}" for k, v in mission.info["camera"].items()
+                if k in ("gsd_cm_per_px", "side_overlap", "front_overlap", "trigger_distance_m",
+                         "trigger_items")),
+            **mission_rows(mission),
             "timings [ms]": ", ".join(f"{k} {v * 1e3:.0f}" for k, v in cp.timings.items()),
             **world_rows(world),
         }

@@ -8,7 +8,6 @@ from pathlib import Path
 import numpy as np
 import typer
 
-from ..planning import plan as plan_path
 from ..planning.params import planner_objects
 from ..scenarios import SCENARIOS
 from ..errors import InputError
@@ -34,7 +33,22 @@ from .options import (
     world_rows,
     world_spec,
 )
-from .cmd_run import output_names, plan_outputs
+from ._mission_options import (
+    CruiseSpeed,
+    End,
+    Endurance,
+    Firmware,
+    Frame,
+    HoverSpeed,
+    MinSpeed,
+    Reserve,
+    Return,
+    SpeedChanges,
+    Vehicle,
+    Via,
+    export_options as mission_export_options,
+)
+from .cmd_run import mission_rows, output_names, plan_outputs
 
 PLAN_FILES = ("path.csv", "plan.png", "summary.json")
 
@@ -52,6 +66,8 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "  fm2uav plan --start 20,20,20 --goal 100,80,30 --cells --exponent 0.5 --out out/b\n\n"
             "  fm2uav plan --agl 150 --p1 0.5 --p2 1.3 --report --export all --out out/tff\n\n"
             "  fm2uav plan --report --export plan,wpl,geojson,kml --out out/c\n\n"
+            "  fm2uav plan --agl 150 --via 1400,300,480 --via 500,1100,420 --return --export "
+            "plan,wpl --firmware ardupilot --out out/route\n\n"
             "  fm2uav plan --dem dem.tif --bbox 10.05,45.54,10.2,45.66 --lonlat --start "
             "10.06,45.55 --goal 10.19,45.65 --agl 120 --out out/dem\n\n"
             "  fm2uav plan --dem coast.tif --sea-level 0 --buildings osm.geojson "
@@ -100,7 +116,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         report: bool = typer.Option(
             False, "--report", help="Also write report.html (interactive, self-contained)."),
         export: str = typer.Option(
-            "", help="Also write these exports (comma list): geojson, kml, plan "
+            "", help="Also write these exports (comma list): geojson, kml, kmz, plan "
             "(QGroundControl), wpl (MAVLink QGC WPL 110), or 'all'."),
         anchor: str | None = typer.Option(
             None, help="lon,lat[,alt] of world x=y=0 for the exports (worlds without CRS). "
@@ -119,7 +135,21 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         crs: CrsOpt = None,
         default_height: DefaultHeightOpt = None,
         allow_filled: AllowFilledOpt = False,
+        via: Via = None,
+        return_to_start: Return = None,
+        firmware: Firmware = None,
+        vehicle: Vehicle = None,
+        frame: Frame = None,
+        end: End = None,
+        speed_changes: SpeedChanges = None,
+        min_speed: MinSpeed = None,
+        cruise_speed: CruiseSpeed = None,
+        hover_speed: HoverSpeed = None,
+        endurance: Endurance = None,
+        reserve: Reserve = None,
     ) -> None:
+        from ..missions.route import plan_route
+
         spec = world_spec(dem=dem, buildings=buildings, bbox=bbox, sea_level=sea_level,
                           cell_size=cell_size, dz=dz, ceiling=ceiling, nodata=nodata,
                           nodata_value=nodata_value, crs=crs, default_height=default_height,
@@ -130,7 +160,10 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         description = sc.description if sc is not None else f"real data: {scenario}"
         outdir = OutputDir(out, force=force)
         extra = _extra_formats(export, report)
-        export_options = _export_options(anchor, thin) if extra else None
+        export_options = mission_export_options(
+            _export_options(anchor, thin), firmware=firmware, vehicle=vehicle, frame=frame,
+            end=end, speed_changes=speed_changes, min_speed=min_speed, cruise_speed=cruise_speed,
+            hover_speed=hover_speed, endurance=endurance, reserve=reserve)
         outdir.check(PLAN_FILES + tuple(output_names(extra)))
 
         def point(text: str | None, default: np.ndarray | None, what: str) -> np.ndarray:
@@ -141,18 +174,25 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         goal_m = point(goal, sc.goal if sc else None, "goal")
         from ..world.load import check_points, world_summary
 
-        check_points(world, {"start": start_m, "goal": goal_m}, allow_filled=allow_filled)
+        via_m = [point(v, None, f"via {k + 1}") for k, v in enumerate(via or [])]
+        check_points(world, {"start": start_m, "goal": goal_m,
+                             **{f"via {k + 1}": v for k, v in enumerate(via_m)}},
+                     allow_filled=allow_filled)
 
         level_keys = (dict(agl=agl, p1=p1, p2=p2, band=band, graded=graded, mode=mode)
                       if agl is not None else {})
         shaping, level, options = planner_objects(dict(
             saturation=saturation, saturation_distance=saturation_distance, exponent=exponent,
             order=order, **level_keys))
-        p = plan_path(world, start_m, goal_m, shaping=shaping, level=level, options=options)
+        route = plan_route(world, start_m, goal_m, via=via_m,
+                           return_to_start=bool(return_to_start), shaping=shaping, level=level,
+                           options=options)
+        p = route.plan
         from ..io import write_path_csv
         from ..viz import plan_figure
 
-        summary = {"scenario": scenario, "world": world_summary(world), **p.summary()}
+        summary = {"scenario": scenario, "world": world_summary(world), **p.summary(),
+                   "route": route.summary()}
         georef = getattr(world, "georef", None)
         fig = plan_figure(p, title=f"FM² plan — {scenario}")
         tmp_png = outdir.target("plan.png")
@@ -161,10 +201,11 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             write_path_csv(fh, p.path, p.w, comment=georef.comment() if georef else None)
         outdir.commit(tmp_png, "plan.png")
         if extra:
-            info, _mission = plan_outputs(outdir, p, extra, export_options,
-                                title=f"FM² plan — {scenario}", subtitle=description)
+            info, built = plan_outputs(outdir, p, extra, export_options,
+                                       title=f"FM² plan — {scenario}", subtitle=description,
+                                       via=route.junctions[1:-1])
             summary.update(waypoints=info["waypoints"], mavlink_frame=info["mavlink_frame"],
-                           home_lat_lon_alt=info["home_lat_lon_alt"])
+                           home_lat_lon_alt=info["home_lat_lon_alt"], autopilot=info["autopilot"])
         with outdir.open("summary.json") as fh:
             json.dump(to_jsonable(summary), fh, indent=2)
         rows = {
@@ -177,13 +218,16 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "timings [ms]": ", ".join(f"{k} {v * 1e3:.1f}" for k, v in p.timings.items()),
             **world_rows(world),
         }
+        if len(route.legs) > 1:
+            rows["legs"] = len(route.legs)
         if "waypoints" in summary:
             rows["waypoints"] = f"{summary['waypoints']} (MAVLink frame {summary['mavlink_frame']})"
+            rows.update(mission_rows(built))
         print_summary("FM² plan", rows if not as_json else summary, as_json=as_json,
                       quiet=quiet, files=outdir.written)
 
 
-_EXPORTS = ("geojson", "kml", "plan", "wpl")
+_EXPORTS = ("geojson", "kml", "kmz", "plan", "wpl")
 
 
 def _extra_formats(export: str, report: bool) -> list[str]:

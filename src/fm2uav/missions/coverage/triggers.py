@@ -87,9 +87,15 @@ def band_indices(zigzag: Any, path: Any) -> tuple[list[tuple[int, int]], float]:
             worst = max(worst, float(d[j]))
             idx.append(lo + j)
             lo = lo + j + 1 if lo + j + 1 < len(p) else lo + j
-        if idx[1] <= idx[0]:
-            raise InputError(f"band {k + 1}: the path does not fly it forward (start index "
-                             f"{idx[0]}, end {idx[1]}); is it this zigzag's path?")
+        if idx[1] <= idx[0]:  # a band shorter than the path's step (a sliver of the area)
+            if idx[1] - 1 > (out[-1][1] if out else -1):
+                idx[0] = idx[1] - 1
+            elif idx[0] + 1 < len(p):
+                idx[1] = idx[0] + 1
+            else:
+                raise InputError(f"band {k + 1}: the path does not fly it forward (start index "
+                                 f"{idx[0]}, end {idx[1]}); is it this zigzag's path?")
+            lo = min(idx[1] + 1, len(p) - 1)
         out.append((idx[0], idx[1]))
     return out, worst
 
