@@ -5,7 +5,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-stamp
 OUT    ?= out
 
-.PHONY: run test bench install clean
+.PHONY: run test test-fast bench install clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -29,6 +29,12 @@ run: $(STAMP)
 test: $(STAMP)
 	$(VENV)/bin/lint-imports
 	$(VENV)/bin/pytest -q
+
+## make test-fast: for development — the same suite without the tests marked `slow`
+## (long end-to-end runs: reproductions, sweeps, CLI missions); `make test` runs them too
+test-fast: $(STAMP)
+	$(VENV)/bin/lint-imports
+	$(VENV)/bin/pytest -q -m "not slow"
 
 ## make bench: speed and memory against peers (writes benchmarks/results/*.json)
 bench: $(STAMP)
