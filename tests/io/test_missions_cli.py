@@ -62,3 +62,28 @@ def test_plan_via_and_return_flags(tmp_path):
     assert set(plan["frame"][plan["command"] == 16]) == {10}
     wpl = read_wpl(out / "mission.waypoints")
     np.testing.assert_array_equal(wpl["command"], plan["command"])
+
+
+def test_formation_writes_one_time_consistent_mission_per_uav(tmp_path):
+    out = tmp_path / "f"
+    res = runner.invoke(app, ["formation", "--no-gif", "--followers", "2", "--firmware",
+                              "ardupilot", "--out", str(out), "--json"])
+    assert res.exit_code == 0, res.output
+    s = json.loads((out / "summary.json").read_text())
+    assert set(s["missions"]) == {"leader", "follower 1", "follower 2"}
+    holds = []
+    for name, prefix in (("leader", "leader"), ("follower 1", "follower1"),
+                         ("follower 2", "follower2")):
+        plan = read_plan(out / f"{prefix}_mission.plan")
+        wpl = read_wpl(out / f"{prefix}_mission.waypoints")
+        np.testing.assert_array_equal(plan["command"], wpl["command"])
+        assert plan["command"][0] == 22 and plan["command"][-1] == 21
+        assert (plan["command"] == 178).sum() >= 1  # the simulated speeds
+        m = s["missions"][name]
+        assert m["timing"]["planned_s"] == pytest.approx(s["mission_time_s"], abs=1.0)
+        holds.append(m["timing"]["start_hold_s"])
+        # honest timing: the route's time, and a warning if the vehicle's vertical speed
+        # cannot follow the simulated climbs
+        late = m["timing"]["error_s"] > 0.05 * m["timing"]["planned_s"]
+        assert late == any(w.startswith("timing:") for w in m["warnings"])
+    assert min(holds) == 0.0  # the one with the most to climb does not wait

@@ -19,6 +19,17 @@ from ._common import (
     progress,
     to_jsonable,
 )
+from ._mission_options import (
+    AnchorText,
+    End,
+    Endurance,
+    Firmware,
+    Frame,
+    Reserve,
+    Thin,
+    Vehicle,
+    export_options,
+)
 from .options import (
     AllowFilledOpt,
     BboxOpt,
@@ -42,6 +53,8 @@ from .options import (
 )
 
 FIGURES = ("paths.png", "profiles.png", "metrics.png")
+#: Mission files written per UAV (``leader_mission.plan``, ``follower1_mission.waypoints``, ...).
+MISSION_FORMATS = ("plan", "wpl")
 TABLES = ("trajectories.csv", "metrics.csv", "cycles.csv", "summary.json")
 ANIMATION = "formation.gif"
 REPORT = "report.html"
@@ -111,8 +124,11 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         "formation",
         help=(
             "Fly a leader–follower formation with FM² (thesis ch. 6) and write trajectories.csv, "
-            "metrics.csv, cycles.csv, summary.json, paths.png, profiles.png, metrics.png and "
-            "formation.gif (and with --report an interactive report.html).\n\n"
+            "metrics.csv, cycles.csv, summary.json, paths.png, profiles.png, metrics.png, "
+            "formation.gif (and with --report an interactive report.html), and one mission per "
+            "UAV (leader_mission.plan / .waypoints, follower1_mission.plan, ...): its own route "
+            "with a DO_CHANGE_SPEED per leg and holds so that it keeps the simulated timing; "
+            "started together, the vehicles leave their start points at the same moment.\n\n"
             "Examples:\n\n"
             "  fm2uav formation --scenario fissure --out out/formation\n\n"
             "  fm2uav formation --scenario fissure --level 7 --report --out out/formation-l7\n\n"
@@ -167,9 +183,19 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         crs: CrsOpt = None,
         default_height: DefaultHeightOpt = None,
         allow_filled: AllowFilledOpt = False,
+        firmware: Firmware = None,
+        vehicle: Vehicle = None,
+        frame: Frame = None,
+        end: End = None,
+        thin: Thin = None,
+        anchor: AnchorText = None,
+        endurance: Endurance = None,
+        reserve: Reserve = None,
     ) -> None:
         from ..errors import InputError
         from ..experiments.formation import fly_and_summarise, summary_rows
+        from ..io.exports import EXPORT_FILES, export_formation, file_prefix
+        from .cmd_run import write_exports
         from ..missions.formation import FormationConfig
         from ..planning import FlightLevel
 
@@ -185,7 +211,12 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         if level is not None:
             agl = float(level) * world.spacing[2]
         outdir = OutputDir(out, force=force)
-        outdir.check(_outputs(gif, report))
+        uavs = ["leader"] + [f"follower {k + 1}" for k in range(followers)]
+        mission_names = [file_prefix(n) + EXPORT_FILES[f] for n in uavs for f in MISSION_FORMATS]
+        outdir.check(_outputs(gif, report) + tuple(mission_names))
+        mission_options = export_options(
+            None, firmware=firmware, vehicle=vehicle, frame=frame, end=end, thin=thin,
+            anchor=anchor, endurance=endurance, reserve=reserve, name=f"formation {scenario}")
 
         from ..scenarios.scenario import Scenario
         from ..world.load import check_points, world_summary
@@ -208,11 +239,21 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             result, summary = fly_and_summarise(
                 sc, config=config,
                 level=None if agl is None else FlightLevel(agl=agl, p1=p1, p2=p2))
-            summary = {"scenario": scenario, "world": world_summary(world), **summary}
+            step("building one mission per UAV")
+            missions, files = export_formation(result, MISSION_FORMATS, mission_options)
+            summary = {"scenario": scenario, "world": world_summary(world), **summary,
+                       "missions": {n: m.summary() for n, m in missions.items()}}
+            write_exports(outdir, files, step)
             _write_case(outdir, result, summary, title=title, gif=gif, frames=frames,
                         report=report, subtitle=sc.description, step=step)
+        timing = {f"mission {n}": f"{m.summary()['items']} items, route "
+                                  f"{m.summary()['timing']['mission_route_s']:.0f} s (planned "
+                                  f"{m.summary()['timing']['planned_s']:.0f} s), start hold "
+                                  f"{m.summary()['timing']['start_hold_s']:.1f} s"
+                  for n, m in missions.items()}
         print_summary("FM² formation",
-                      summary if as_json else {**summary_rows(summary), **world_rows(world)},
+                      summary if as_json else {**summary_rows(summary), **timing,
+                                               **world_rows(world)},
                       as_json=as_json, quiet=quiet, files=outdir.written)
         if not result.completed:
             raise typer.Exit(EXIT_PLANNING)

@@ -29,6 +29,7 @@ from typing import IO, Any
 import numpy as np
 
 from ..errors import InputError
+from ..geometry import path_length
 from .build import CameraPlan, ExportOptions, MissionExport, build_mission
 from .geojson import write_geojson
 from .kml import write_kml, write_kmz
@@ -44,6 +45,7 @@ __all__ = [
     "parse_formats",
     "export_mission",
     "export_formation",
+    "file_prefix",
     "export_writers",
 ]
 
@@ -193,6 +195,11 @@ def export_mission(
     return mission, files
 
 
+def file_prefix(name: str) -> str:
+    """``"follower 1"`` → ``"follower1_"``: a vehicle's name as a file-name prefix."""
+    return "".join(c for c in str(name) if c.isalnum() or c in "-_") + "_"
+
+
 def export_formation(
     result: Any,
     formats: Sequence[str],
@@ -201,7 +208,8 @@ def export_formation(
     """One mission per vehicle of a formation flight, each following its own timing.
 
     Every UAV's simulated trajectory (``result.positions[:, i]`` at
-    ``result.times``) becomes a mission (files prefixed ``<name>_``): its
+    ``result.times``) becomes a mission (files prefixed with the UAV's name
+    without spaces, :func:`file_prefix`: ``leader_``, ``follower1_``, ...): its
     waypoints, a ``DO_CHANGE_SPEED`` per leg with the simulated mean speed
     (0.1 m/s steps), holds where it waited, and a hold at its start so that all
     vehicles leave their start points together: vehicles armed and started at
@@ -231,13 +239,12 @@ def export_formation(
     files: dict[str, ExportFile] = {}
     for i, name in enumerate(result.names):
         path = np.asarray(result.positions[:, i], dtype=float)
-        length = float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1)))
         track = SimpleNamespace(path=path, world=world, w=None, level=None, params={},
-                                length=length)
+                                length=path_length(path))
         agl = result.agl[i] if i < len(result.agl) else None
         m, f = export_mission(track, formats, replace(opt, name=f"{opt.name} — {name}"),
                               agl=agl, times=result.times, start_hold=t0 - float(climb_s[i]),
-                              prefix=f"{name}_")
+                              prefix=file_prefix(name))
         missions[name] = m
         files.update(f)
     return missions, files
