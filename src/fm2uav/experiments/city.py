@@ -12,6 +12,8 @@ and the FM² vs RRT comparison.
 * Safety distance = the plan's clearance (smallest distance from the planned
   path to a building or ground node); separation distance = the largest
   distance from the flown (Dubins) trajectory to the planned path.
+* ``plan_s`` / FM² ``time_s`` are warm: each plan runs once untimed first
+  (:func:`._timing.warm`, numba compilation excluded, distance cache cleared).
 """
 
 from __future__ import annotations
@@ -21,11 +23,13 @@ from typing import Any
 
 import numpy as np
 
+from ..geometry import arc_length
 from ..planning import Plan, Shaping, plan
 from ..vehicles import FeasibilityReport, check_feasibility, get_airframe
 from ..world import World
 from ..scenarios import Scenario, get_scenario
 from ..baselines.rrt import RRTResult, plan_rrt
+from ._timing import WARM_NOTE, warm
 
 __all__ = [
     "THESIS_TABLE_3_1",
@@ -125,13 +129,14 @@ def run_city_case(
     if mission == "low":
         z = float(scenario.start[2])
         w2 = horizontal_slice(w3, z)
-        p = plan(w2, scenario.start[:2], scenario.goal[:2],
-                 shaping=Shaping(exponent=exponent, walls=True))
+        p, _ = warm(lambda: plan(w2, scenario.start[:2], scenario.goal[:2],
+                                 shaping=Shaping(exponent=exponent, walls=True)), [w2])
         path3 = np.column_stack([p.path, np.full(len(p.path), z)])
         rep = check_feasibility(path3, airframe, world=w3, w=p.w, tolerance=tolerance,
                                 lookahead=lookahead)
     else:
-        p = plan(w3, scenario.start, scenario.goal, shaping=Shaping(exponent=exponent, walls=True))
+        p, _ = warm(lambda: plan(w3, scenario.start, scenario.goal,
+                                 shaping=Shaping(exponent=exponent, walls=True)), [w3])
         path3 = p.path
         rep = check_feasibility(path3, airframe, world=w3, w=p.w, tolerance=tolerance,
                                 lookahead=lookahead)
@@ -244,9 +249,7 @@ class CityRun:
     def speed_profiles(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """``label -> (arc length [m], W along the path)`` of every case (Fig. 3.4)."""
         return {f"{c.mission} W^{c.exponent:g}": (
-            np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(c.path3, axis=0),
-                                                            axis=1))]),
-            c.plan.w) for c in self.cases}
+            arc_length(c.path3), c.plan.w) for c in self.cases}
 
 
 def reproduce_city(seed: int = 0, airframe: Any = "disco", *, tolerance: float = 5.0,
@@ -294,10 +297,13 @@ def markdown_table(rows: list[dict[str, Any]], cols: tuple[str, ...] | list[str]
 def city_markdown(run: CityRun) -> str:
     """``table.md``: the safety/separation table and (when run) FM² vs RRT."""
     text = ("## Safety and separation distances (Tables 3.1/3.2)\n\n"
-            + markdown_table(run.rows, CITY_TABLE_COLUMNS))
+            + markdown_table(run.rows, CITY_TABLE_COLUMNS)
+            + f"\nplan_s = plan() wall time [s]; {WARM_NOTE}.\n")
     if run.rrt is not None:
         text += ("\n## FM² vs RRT, low altitude (thesis: FM² 1.2 s, RRT 5 s)\n\n"
-                 + markdown_table(run.rrt_rows, RRT_TABLE_COLUMNS))
+                 + markdown_table(run.rrt_rows, RRT_TABLE_COLUMNS)
+                 + "\ntime_s: FM² warm (run once untimed first); OMPL planners single runs "
+                 "(no compilation).\n")
     return text
 
 

@@ -75,7 +75,8 @@ def tables_markdown(summary: dict[str, Any], result: Any) -> str:
         "",
         "References: lattice search time (compiled Dijkstra, control set cached); FM²: sum over "
         "pairs of the median `plan()` time over the grid (both Fast Marching waves, descent, "
-        "metrics). Both are measured inside the sweep's worker processes, running side by "
+        "metrics), warm: a worker's first, compiling call is one case of the grid and the "
+        "median does not see it. Both are measured inside the sweep's worker processes, running side by "
         "side on a shared machine, so the ratios are indicative; `benchmarks/bench_reference.py` "
         "times both in one process, one after the other.",
         "",
