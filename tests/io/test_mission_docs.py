@@ -1,0 +1,34 @@
+"""The defaults docs/operator.md states for missions are the code's (no hand-copied figures)."""
+
+from pathlib import Path
+
+from fm2uav.io import ExportOptions
+from fm2uav.io.build import DEFAULT_CLIMB, DEFAULT_DESCENT
+from fm2uav.io.mission import AirframeSpec, OutputSpec
+from fm2uav.io.validate import PX4_FW_LND_ANG
+
+DOC = (Path(__file__).resolve().parents[2] / "docs" / "operator.md").read_text()
+
+
+def _g(v: float) -> str:
+    return f"{v:g}"
+
+
+def test_landing_pattern_defaults_in_the_guide():
+    o = ExportOptions()
+    assert f"`land_slope_deg` = {_g(o.land_slope_deg)}°" in DOC
+    assert f"`FW_LND_ANG`, default {_g(PX4_FW_LND_ANG)}°" in DOC
+    assert o.max_land_slope_deg == PX4_FW_LND_ANG
+    assert f"from a loiter {_g(o.land_approach_agl)} m above" in DOC
+    assert f"({_g(o.loiter_radius)} m radius" in DOC
+
+
+def test_speed_and_flight_time_defaults_in_the_guide():
+    assert (f"multirotor {_g(DEFAULT_CLIMB['multirotor'])} / {_g(DEFAULT_DESCENT['multirotor'])}, "
+            f"fixed-wing {_g(DEFAULT_CLIMB['fixed_wing'])} / {_g(DEFAULT_DESCENT['fixed_wing'])}"
+            ) in DOC
+    assert ExportOptions().speed_hysteresis == 2 and "allows two steps more" in DOC
+    assert "multirotor 1 m/s" in DOC  # the floor of build._speeds
+    assert f"| `airframe.reserve` | 0 ≤ r < 1 (share of the endurance kept) | " \
+           f"{_g(AirframeSpec().reserve)} |" in DOC
+    assert f"| `outputs.speed_step` | 0 < step ≤ 20 m/s | {_g(OutputSpec().speed_step)} |" in DOC
