@@ -71,6 +71,9 @@ def test_formation_writes_one_time_consistent_mission_per_uav(tmp_path):
     assert res.exit_code == 0, res.output
     s = json.loads((out / "summary.json").read_text())
     assert set(s["missions"]) == {"leader", "follower 1", "follower 2"}
+    for prefix in ("leader", "follower1", "follower2"):
+        for f in MISSION_FILES:
+            assert (out / f"{prefix}_{f}").stat().st_size > 0
     holds = []
     for name, prefix in (("leader", "leader"), ("follower 1", "follower1"),
                          ("follower 2", "follower2")):

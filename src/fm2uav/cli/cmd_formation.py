@@ -53,8 +53,9 @@ from .options import (
 )
 
 FIGURES = ("paths.png", "profiles.png", "metrics.png")
-#: Mission files written per UAV (``leader_mission.plan``, ``follower1_mission.waypoints``, ...).
-MISSION_FORMATS = ("plan", "wpl")
+#: Mission files written per UAV (``leader_mission.plan``, ``follower1_mission.waypoints``,
+#: ``leader_path.kml`` / ``.kmz`` / ``.geojson`` / ``.csv``, ...).
+MISSION_FORMATS = ("plan", "wpl", "kml", "kmz", "geojson", "csv")
 TABLES = ("trajectories.csv", "metrics.csv", "cycles.csv", "summary.json")
 ANIMATION = "formation.gif"
 REPORT = "report.html"
@@ -126,7 +127,8 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "Fly a leader–follower formation with FM² (thesis ch. 6) and write trajectories.csv, "
             "metrics.csv, cycles.csv, summary.json, paths.png, profiles.png, metrics.png, "
             "formation.gif (and with --report an interactive report.html), and one mission per "
-            "UAV (leader_mission.plan / .waypoints, follower1_mission.plan, ...): its own route "
+            "UAV in every format (leader_mission.plan / .waypoints, leader_path.kml / .kmz / "
+            ".geojson / .csv, follower1_..., ...): its own route "
             "with a DO_CHANGE_SPEED per leg and holds so that it keeps the simulated timing; "
             "started together, the vehicles leave their start points at the same moment.\n\n"
             "Examples:\n\n"
