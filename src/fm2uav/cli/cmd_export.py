@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -10,6 +11,7 @@ import numpy as np
 import typer
 
 from ..errors import InputError
+from ..geometry import path_length
 from ._common import OutputDir, handle_errors, print_summary, to_jsonable
 from ._mission_options import (
     AnchorText,
@@ -30,17 +32,19 @@ from .cmd_run import mission_rows, write_exports
 
 
 def _world(mission_file: Path | None, scenario: str | None, seed: int):
-    """(world, base ExportOptions or None, agl or None, description) of the path's world."""
+    """(world, base ExportOptions or None, FlightLevel or None, description) of the world."""
     if (mission_file is None) == (scenario is None):
         raise InputError("give the world the path was planned on: --mission FILE.yaml (its "
                          "world, airframe and outputs) or --scenario NAME")
     if mission_file is not None:
         from ..io.mission import load_mission
 
+        from ..planning.params import planner_objects
+
         m = load_mission(mission_file)
         rm = m.resolve()
-        agl = getattr(m.planner, "agl", None)
-        return rm.world, m.export_options(), agl, f"mission {mission_file}"
+        level = planner_objects(m.plan_kwargs())[1]
+        return rm.world, m.export_options(), level, f"mission {mission_file}"
     from ..scenarios import get_scenario
 
     return get_scenario(scenario, seed=seed).world, None, None, f"scenario {scenario}"
@@ -97,12 +101,13 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
     ) -> None:
         from ..io import EXPORT_FILES, export_mission, parse_formats, read_path_csv
-        from ..io.path_header import read_path_header, read_path_w
+        from ..io.path_header import read_path_floor, read_path_header, read_path_w
+        from ..planning import FlightLevel
 
         formats = parse_formats(",".join(fmt))
         outdir = OutputDir(out, force=force)
         outdir.check([EXPORT_FILES[f] for f in formats] + ["summary.json"])
-        world, base, mission_agl, where = _world(mission_file, scenario, seed)
+        world, base, mission_level, where = _world(mission_file, scenario, seed)
         header = read_path_header(path_file)
         crs = getattr(world, "crs", None)
         if header["crs"] and crs and header["crs"] != crs:
@@ -121,6 +126,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             raise InputError(f"{path_file}: point {k} {np.round(path[k], 1).tolist()} m lies "
                              f"outside the {where} world; is this the world it was planned on?")
         w = read_path_w(path_file)
+        floor = read_path_floor(path_file)
         options = export_options(base, firmware=firmware, vehicle=vehicle, frame=frame, end=end,
                                  thin=thin, anchor=anchor, speed_changes=speed_changes,
                                  min_speed=min_speed, cruise_speed=cruise_speed,
@@ -128,11 +134,17 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         if options.speed_changes and w is None:
             raise InputError(f"--speed-changes needs W along the path: {path_file} has no "
                              "speed column (write it with fm2uav plan / run)")
+        level = (FlightLevel(agl=agl) if agl is not None and mission_level is None else
+                 mission_level if agl is None else replace(mission_level, agl=agl))
+        # a path with a final altitude profile (its floor column): heights as they are, legs
+        # checked against the floor (see fm2uav.io.build_mission)
+        profile = None if floor is None else SimpleNamespace(
+            required=floor, level=level if level is not None else FlightLevel(agl=1.0))
         track = SimpleNamespace(
-            path=path, world=world, w=w, level=None, params={},
-            length=float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1))))
-        level_agl = agl if agl is not None else mission_agl
-        mission, files = export_mission(track, formats, options, agl=level_agl)
+            path=path, world=world, w=w, level=None, params={}, profile=profile,
+            length=path_length(path))
+        mission, files = export_mission(track, formats, options,
+                                        agl=None if level is None else level.agl)
         write_exports(outdir, files)
         summary = {"path_file": str(path_file), "world": where, "path_crs": header["crs"],
                    "points": len(path), "length_m": round(track.length, 3),

@@ -198,7 +198,9 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         tmp_png = outdir.target("plan.png")
         fig.savefig(tmp_png, dpi=110)
         with outdir.open("path.csv") as fh:
-            write_path_csv(fh, p.path, p.w, comment=georef.comment() if georef else None)
+            floor = getattr(getattr(p, "profile", None), "required", None)
+            write_path_csv(fh, p.path, p.w, comment=georef.comment() if georef else None,
+                           floor=floor if np.shape(floor) == (len(p.path),) else None)
         outdir.commit(tmp_png, "plan.png")
         if extra:
             info, built = plan_outputs(outdir, p, extra, export_options,

@@ -173,12 +173,16 @@ def export_mission(
              "home_source": s["home"]["source"], "warnings": list(mission.warnings),
              **{k: v for k, v in params.items() if isinstance(v, (int, float, str, bool))}}
     wpm = mission.waypoints.points_m
+    floor = getattr(getattr(plan, "profile", None), "required", None)
+    if floor is not None and np.shape(floor) != (len(path),):
+        floor = None
     georef = getattr(world, "georef", None)
     if georef is not None:
         props["georef"] = georef.as_dict()
     a = opt.anchor
     writers: dict[str, Callable[[IO[Any]], Any]] = {
-        "csv": lambda fh: write_path_csv(fh, path, speed, comment=georef and georef.comment()),
+        "csv": lambda fh: write_path_csv(fh, path, speed, comment=georef and georef.comment(),
+                                         floor=floor),
         "geojson": lambda fh: write_geojson(fh, path, world, anchor=a, waypoints_m=wpm,
                                             properties=props),
         "kml": lambda fh: write_kml(fh, path, world, anchor=a, waypoints_m=wpm, name=opt.name,

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["read_path_header", "read_path_w"]
+__all__ = ["read_path_header", "read_path_w", "read_path_floor", "read_path_column"]
 
 _CRS = re.compile(r"\bcrs\s*[=:]\s*([^;\s]+)", re.IGNORECASE)
 
@@ -51,12 +51,22 @@ def read_path_header(file: str | Path) -> dict[str, Any]:
 
 def read_path_w(file: str | Path) -> np.ndarray | None:
     """The ``speed`` / ``w`` column of a path CSV (W along the path), or None."""
+    return read_path_column(file, ("speed", "w"))
+
+
+def read_path_floor(file: str | Path) -> np.ndarray | None:
+    """The ``floor_agl_m`` column (the final profile's floor above the surface [m]), or None."""
+    return read_path_column(file, ("floor_agl_m",))
+
+
+def read_path_column(file: str | Path, names: tuple[str, ...]) -> np.ndarray | None:
+    """The first of the columns ``names`` in a path CSV, as floats, or None."""
     file = Path(file)
     rows = [ln.strip() for ln in _lines(file) if ln.strip() and not ln.lstrip().startswith("#")]
     if not rows:
         return None
     header = [c.strip().lower() for c in rows[0].split(",")]
-    col = next((header.index(n) for n in ("speed", "w") if n in header), None)
+    col = next((header.index(n) for n in names if n in header), None)
     if col is None:
         return None
     try:

@@ -1,4 +1,8 @@
-"""Path files as CSV: one point a row, columns ``x_m,y_m[,z_m][,speed]``.
+"""Path files as CSV: one point a row, columns ``x_m,y_m[,z_m][,speed][,floor_agl_m]``.
+
+``floor_agl_m`` (paths with a final altitude profile, ``Plan.profile.required``)
+is the lowest height above the surface each point must keep [m] (``-inf`` at
+the take-off and landing points): ``fm2uav export`` checks the legs against it.
 
 A path on a geo-referenced world starts with a comment line saying where it is,
 ``# crs=EPSG:32632; z=DEM heights, ...; sources: dem x.tif sha256=...``
@@ -20,10 +24,12 @@ _AXES = ("x_m", "y_m", "z_m")
 
 
 def write_path_csv(fh: IO[str], path: np.ndarray, speed: np.ndarray | None = None,
-                   *, comment: str | None = None) -> None:
+                   *, comment: str | None = None, floor: np.ndarray | None = None) -> None:
     """Write a path [m] (and optionally W along it) as CSV to an open text file.
 
-    ``comment`` (e.g. ``world.georef.comment()``) is written first as a ``# `` line.
+    ``comment`` (e.g. ``world.georef.comment()``) is written first as a ``# `` line;
+    ``floor`` (one value per point [m], e.g. ``Plan.profile.required``) adds the
+    ``floor_agl_m`` column.
     """
     path = np.asarray(path, dtype=float)
     if comment:
@@ -33,6 +39,13 @@ def write_path_csv(fh: IO[str], path: np.ndarray, speed: np.ndarray | None = Non
     if speed is not None:
         cols.append("speed")
         data = np.column_stack([path, speed])
+    if floor is not None:
+        f = np.asarray(floor, dtype=float)
+        if f.shape != (len(path),):
+            raise InputError(f"floor must hold one value per path point ({len(path)}), got "
+                             f"shape {f.shape}")
+        cols.append("floor_agl_m")
+        data = np.column_stack([data, f])
     fh.write(",".join(cols) + "\n")
     np.savetxt(fh, data, delimiter=",", fmt="%.6f")
 
