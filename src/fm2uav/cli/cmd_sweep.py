@@ -7,8 +7,29 @@ from pathlib import Path
 from typing import Any
 
 import typer
+from rich.markup import escape
+from rich.text import Text
 
-from ._common import OutputDir, handle_errors, print_summary, to_jsonable
+from ._common import (
+    EXIT_INTERRUPTED,
+    OutputDir,
+    err_console,
+    handle_errors,
+    print_summary,
+    to_jsonable,
+)
+
+#: Exit code of a sweep that finished but has failed cases (0 ok, 1 planning, 2 bad input,
+#: 130 interrupted, 70 internal error).
+EXIT_CASES_FAILED = 3
+
+EXIT_CODES_HELP = (
+    "Exit codes: 0 every case ok; 2 bad input, a damaged sweep file or --out in use by another "
+    "run (the message names the file and the fix); 3 the sweep finished but some cases failed "
+    "(report written; reason in the error column of the results file; the same command "
+    "retries them); 130 stopped by SIGINT or SIGTERM (workers stopped, finished cases kept; "
+    "the same command resumes); 70 an internal error."
+)
 
 REPORT_FILES = (
     "tables.md",
@@ -39,24 +60,75 @@ def _progress(quiet: bool):
     return prog, update
 
 
+def _warning(message: str) -> None:
+    err_console.print(f"[bold yellow]warning:[/] {escape(message)}", highlight=False, soft_wrap=True)
+
+
 def run_and_report(config, out: Path, *, force: bool, scheduler: str | None, workers: int | None,
                    retry_failed: bool, as_json: bool, quiet: bool, title: str) -> None:
-    """Run (or resume) a sweep, then write tables and figures into ``out``."""
+    """Run (or resume) a sweep holding its folder, then write tables and figures into ``out``.
+
+    The report files are one output set (:class:`~fm2uav.io.outdir.OutputDir`): staged
+    beside ``out`` and moved in at the end. The sweep's own files (log, references,
+    config, results) are written into ``out`` by :func:`~fm2uav.experiments.runner.run_sweep`
+    as it goes, so the set is merged into the folder, never swapped for it (``OutputDir``
+    merges when the folder changed while it was staged, and ``run_sweep`` rewrites
+    ``config.json`` on every run). Exits with :data:`EXIT_CASES_FAILED` (report written)
+    when a case failed and with :data:`EXIT_INTERRUPTED` on SIGINT/SIGTERM (the finished
+    cases are kept, the report is not written).
+    """
+    from ..errors import InputError
+    from ..experiments.runner import SweepInterrupted, raise_on_signals, same_sweep, sweep_lock
+
+    try:
+        same = same_sweep(config, out)
+    except InputError:  # a damaged config.json: --force starts over
+        if not force:
+            raise
+        same = False
+    # the report files belong to the sweep in `out`: a resume rewrites them
+    outdir = OutputDir(out, force=force or same)
+    outdir.check(REPORT_FILES)  # before the sweep writes into `out`
+    try:
+        with sweep_lock(out), raise_on_signals():
+            result = _run_and_report(config, out, outdir, fresh=force and not same,
+                                     scheduler=scheduler, workers=workers,
+                                     retry_failed=retry_failed, as_json=as_json, quiet=quiet,
+                                     title=title)
+    except SweepInterrupted as exc:
+        message = exc.message
+        if "resume" not in message:  # stopped while the report was being written
+            message += (f" while writing the report; every case is kept in {out}; run the same "
+                        "command again to write it")
+        _fail(message, EXIT_INTERRUPTED, prefix="interrupted: ")
+    if result.cases_failed:
+        outdir.finish()  # the report of the cases that did not fail is written all the same
+        first = next(str(e) for e, st in zip(result.columns["error"], result.columns["status"])
+                     if st != "ok")
+        _fail(f"{result.cases_failed} of {len(result.columns['status'])} cases failed (first: "
+              f"{first}); the reasons are in {result.summary} (column error); run the same "
+              "command again to retry them", EXIT_CASES_FAILED)
+
+
+def _fail(message: str, code: int, prefix: str = "error: ") -> None:
+    err_console.print(Text.assemble((prefix, "bold red"), str(message)), highlight=False,
+                      soft_wrap=True)
+    raise typer.Exit(code)
+
+
+def _run_and_report(config, out: Path, outdir: OutputDir, *, fresh: bool, scheduler: str | None,
+                    workers: int | None, retry_failed: bool, as_json: bool, quiet: bool,
+                    title: str) -> Any:
     from ..experiments.curvature import summarise_run, sweep_payload, tables_markdown
     from ..experiments.runner import run_sweep
 
-    cfg_file = out / "config.json"
-    same = cfg_file.exists() and json.loads(cfg_file.read_text()) == json.loads(
-        json.dumps(config.identity()))
-    # the report files belong to the sweep in `out`: a resume rewrites them
-    outdir = OutputDir(out, force=force or same)
-    outdir.check(REPORT_FILES)
     prog, update = _progress(quiet or as_json)
     if prog is not None:
         prog.start()
     try:
         result = run_sweep(config, out, workers=workers, scheduler=scheduler,
-                           retry_failed=retry_failed, fresh=force and not same, on_progress=update)
+                           retry_failed=retry_failed, fresh=fresh, on_progress=update,
+                           on_warning=_warning)
     finally:
         if prog is not None:
             prog.stop()
@@ -79,10 +151,15 @@ def run_and_report(config, out: Path, *, force: bool, scheduler: str | None, wor
     with outdir.open("tables.md") as fh:
         fh.write(tables_markdown(summary, result))
     payload = sweep_payload(summary, result, config, out)
+    payload["faults"] = {"cases_retried": result.cases_retried,
+                         "worker_deaths": result.worker_deaths, "log_warnings": result.warnings}
+    payload["log_file"] = str(result.log)
     with outdir.open("summary.json") as fh:
         json.dump(to_jsonable(payload), fh, indent=2)
     rows: dict[str, Any] = {
         "cases": f"{result.cases_run} run, {result.cases_skipped} resumed, {result.cases_failed} failed",
+        "faults": (f"{result.worker_deaths} worker processes died, {result.cases_retried} cases "
+                   "run again" if result.worker_deaths else "none"),
         "wall [s]": ", ".join(f"{k} {v:.1f}" for k, v in result.wall_s.items()),
     }
     for metric in ("frechet", "area"):
@@ -93,7 +170,8 @@ def run_and_report(config, out: Path, *, force: bool, scheduler: str | None, wor
     rows["Table 1 [s]"] = ", ".join(
         [f"{m} {t[f'{m}_s']:.3f} (×{t[f'{m}_ratio']:.0f})" for m in config.models] + [f"FM² {t['fm2_s']:.4f}"])
     print_summary(title, payload if as_json else rows, as_json=as_json, quiet=quiet,
-                  files=outdir.written + [out / config.results])
+                  files=outdir.written + [out / config.results, result.log])
+    return result
 
 
 def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
@@ -103,14 +181,21 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         "sweep",
         help=(
             "Run (or resume) an α–β sweep of FM² against the Dubins, elastica and Reeds–Shepp "
-            "references from a YAML config; results stream to --out as cases finish, then "
-            "Tables 1-4 (tables.md), heat maps and curvature profiles are written.\n\n"
+            "references from a YAML config; every case is appended to --out/cases.jsonl as it "
+            "finishes (checksummed lines), then the results file, Tables 1-4 (tables.md), heat "
+            "maps and curvature profiles are written.\n\n"
+            "Re-running the same command resumes: finished cases are kept, missing and failed "
+            "ones are run (--keep-failed keeps failed ones). A worker process that dies costs "
+            "only its case: it is run once more, then recorded as failed with the reason. "
+            "SIGINT/SIGTERM stop the workers and keep every finished case. A second sweep into "
+            "the same --out is refused while one runs.\n\n"
             "Examples:\n\n"
             "  fm2uav sweep sweep.yaml --out out/sweep\n\n"
             "  fm2uav sweep sweep.yaml --scheduler tcp://10.0.0.5:8786 --out out/sweep\n\n"
             "Config keys (all optional): scenario: city2d, cell: 2.0, pairs: 24, pair_seed: 0, "
-            "alpha: {start: 0.02, stop: 1.0, step: 0.02}, beta: {...}, models: [dubins, elastica, "
+            "alpha: {start: 0.02, stop: 1.0, step: 0.02}, beta: {...}, models: \\[dubins, elastica, "
             "rs], xi: 10.0, max_int: 4, ds: 1.0, order: 2, results: results.parquet (or .csv)."
+            "\n\n" + EXIT_CODES_HELP
         ),
     )
     @handle_errors
@@ -119,8 +204,12 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         scheduler: str | None = typer.Option(
             None, help="Address of an existing Dask scheduler, e.g. tcp://host:8786 "
             "(default: local processes)."),
-        workers: int | None = typer.Option(None, help="Local worker processes (default: all cores)."),
-        retry_failed: bool = typer.Option(False, "--retry-failed", help="Run failed cases again."),
+        workers: int | None = typer.Option(None, help="Local worker processes (default: all "
+                                           "cores; 1 runs in this process)."),
+        retry_failed: bool = typer.Option(
+            True, "--retry-failed/--keep-failed",
+            help="On a resume, run the cases (and references) that failed before again "
+            "(default), or keep them as failed."),
         out: Path = typer.Option(Path("out/sweep"), help="Output directory (resumed if it holds "
                                  "the same sweep)."),
         force: bool = typer.Option(False, "--force", help="Discard a different sweep in --out."),
@@ -145,7 +234,8 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "coarser 25 × 25 grid.\n\n"
             "Examples:\n\n"
             "  fm2uav reproduce curvature --out out/curvature\n\n"
-            "  fm2uav reproduce curvature --step 0.1 --pairs 8 --out out/curvature-quick"
+            "  fm2uav reproduce curvature --step 0.1 --pairs 8 --out out/curvature-quick\n\n"
+            "Resumes like fm2uav sweep (failed cases are run again). " + EXIT_CODES_HELP
         ),
     )
     @handle_errors
@@ -166,5 +256,5 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
 
         cfg = curvature_config(step=None if full else step, pairs=pairs, xi=xi)
         run_and_report(cfg, out, force=force, scheduler=scheduler, workers=workers,
-                       retry_failed=False, as_json=as_json, quiet=quiet,
+                       retry_failed=True, as_json=as_json, quiet=quiet,
                        title="Seed 004: FM² vs curvature-penalised references")

@@ -195,8 +195,16 @@ def _worker_main(fd: int, parent_pid: int) -> None:
             return
         if msg is None:
             return
-        job_id, fn, context, units = msg
+        job_id, n_units, payload = msg
         conn.send_bytes(pickle.dumps(("start", job_id, 0)))  # later starts: implied by results
+        try:
+            fn, context, units = pickle.loads(payload)  # may import the job's modules
+        except Exception as exc:  # noqa: BLE001 - every unit of the job fails with the reason
+            why = f"cannot load the job in the worker: {type(exc).__name__}: {exc}"
+            for i in range(n_units):
+                conn.send_bytes(pickle.dumps(("unit", job_id, i, False, why)))
+            conn.send_bytes(pickle.dumps(("done", job_id)))
+            continue
         for i, unit in enumerate(units):
             ok, value = _run_unit(fn, context, unit)
             try:
@@ -296,7 +304,7 @@ class LocalPool:
     def _send(self, w: _Worker, fn: Callable, job: Job) -> None:
         self._ids += 1
         w.job, w.job_id, w.next, w.started = job, self._ids, 0, -1
-        w.conn.send((w.job_id, fn, job.context, job.units))
+        w.conn.send((w.job_id, len(job.units), pickle.dumps((fn, job.context, job.units))))
 
     def run(self, fn: Callable[[Any, Any], Any], jobs: Iterable[Job]) -> Iterator[Outcome]:
         from multiprocessing.connection import wait
