@@ -16,6 +16,7 @@ from fm2uav import (
     plan,
 )
 from fm2uav.world import clearance_profile
+from fm2uav.world.clearance import surface_clearance
 
 
 @pytest.fixture(scope="module")
@@ -48,8 +49,9 @@ def test_path_goes_around_wall_and_ends_exactly(wall_world):
 
 def test_clearance_and_speed_are_consistent(wall_world):
     p = plan(wall_world, (5.0, 5.0), (35.0, 5.0))
-    assert p.clearance == pytest.approx(clearance_profile(wall_world, p.path).min())
-    assert p.clearance > 0
+    # clearance is to the obstacles' cells (continuous), never more than to their nodes
+    assert p.clearance == pytest.approx(surface_clearance(wall_world, p.path).min())
+    assert 0 < p.clearance <= clearance_profile(wall_world, p.path).min()
     assert p.w.shape == (len(p.path),)
     assert np.all((p.w > 0) & (p.w <= 1))
     assert set(p.timings) == {"velocity_map", "fast_marching", "geodesic", "metrics", "total"}

@@ -116,7 +116,8 @@ def test_literal_mode_climbs_to_the_ceiling(open_field):
     # the measured reason for the capped default (docs/tff.md)
     sc = open_field
     p = fm2uav.plan(sc.world, sc.start, sc.goal,
-                    level=FlightLevel(agl=150.0, p1=0.5, p2=1.3, mode="literal"))
+                    level=FlightLevel(agl=150.0, p1=0.5, p2=1.3, mode="literal",
+                                      heights="fm2"))
     r = flight_level_deviation(sc.world, p.path, 150.0)
     assert r.within < 0.2
     assert p.path[:, 2].max() >= 39 * 15.0 - 1e-6

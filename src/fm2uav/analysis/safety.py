@@ -80,8 +80,9 @@ def leg_figures(world: Any, waypoints: Any, *, requested: float | None = None,
     requested : float, optional
         Requested AGL [m] (share within ±5 m).
     step : float, optional
-        Sampling along the legs [m]; default :func:`~fm2uav.world.ground_model.sampling_step`
-        (a quarter cell, at most half a source-DEM pixel).
+        Sampling along the legs [m]; default a quarter of
+        :func:`~fm2uav.world.ground_model.sampling_step` (at most 1/16 of a
+        source-DEM pixel).
     terrain_frame : bool
         The autopilot follows the terrain between waypoints (MAVLink frame
         10): the AGL along a leg is the waypoints' AGL (``waypoint_agl``)
@@ -103,7 +104,7 @@ def leg_figures(world: Any, waypoints: Any, *, requested: float | None = None,
     if p.ndim != 2 or p.shape[1] != 3 or len(p) < 2:
         raise InputError(f"waypoints must be (n >= 2, 3) metres, got shape {p.shape}")
     if step is None:
-        step = sampling_step(world)
+        step = 0.25 * sampling_step(world)
     dense, leg = densify_legs(p, step)
     if terrain_frame:
         own = height_above_ground(world, p) if waypoint_agl is None else \

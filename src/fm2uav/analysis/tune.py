@@ -245,7 +245,9 @@ def tune(
         try:
             pl = plan(world, start, goal,
                       shaping=dataclasses.replace(shaping, saturation=sat, exponent=beta),
-                      level=dataclasses.replace(level, p1=p1, p2=p2), options=options)
+                      # tune Algorithm 2 itself: the FM² heights, not the final profile
+                      level=dataclasses.replace(level, p1=p1, p2=p2, heights="fm2"),
+                      options=options)
         except PlanningError as exc:
             if not rows:  # the first plan fails: bad start/goal/agl, not the parameters
                 raise

@@ -91,7 +91,7 @@ def _write_tune_report(outdir: OutputDir, res, sc, s, g, *, agl: float, scenario
         row = res.pareto[0]
         p = plan(sc.world, s, g, shaping=Shaping(saturation=row["saturation"],
                                                  exponent=row["exponent"]),
-                 level=FlightLevel(agl=agl, p1=row["p1"], p2=row["p2"]))
+                 level=FlightLevel(agl=agl, p1=row["p1"], p2=row["p2"], heights="fm2"))
         label = (f"closest (breaks the limits): p1={row['p1']:g}, p2={row['p2']:g}, "
                  f"α={row['saturation']:g}")
     m = tff_metrics(p, agl)

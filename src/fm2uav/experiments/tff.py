@@ -137,7 +137,8 @@ def run_tff(scenario: str = "open-field", seed: int = 0,
     rows, plans = [], []
     for case in cases:
         agl = case.level * dz
-        level = FlightLevel(agl=agl, p1=case.p1, p2=case.p2, mode=case.mode)
+        # the seeds' experiment measures the FM² path itself (heights="fm2")
+        level = FlightLevel(agl=agl, p1=case.p1, p2=case.p2, mode=case.mode, heights="fm2")
         p, seconds = warm(lambda: plan(sc.world, sc.start, sc.goal, level=level), [sc.world])
         m = tff_metrics(fm2_geodesic(p), agl)
         m.update(case=case.name, level=case.level, agl_m=agl, p1=case.p1, p2=case.p2,

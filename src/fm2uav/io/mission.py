@@ -240,6 +240,9 @@ class PlannerSpec(BaseModel):
     max_climb: float | None = _num(None, unit="deg", gt=0, le=90, desc="steepest climb (45)")
     max_descent: float | None = _num(None, unit="deg", gt=0, le=90,
                                      desc="steepest descent (45)")
+    heights: Literal["ground", "fm2"] | None = Field(
+        None, description="ground: final profile above the continuous ground; fm2: the "
+        "FM² layer's own heights")
     step: float = _num(0.5, gt=0, le=1, desc="geodesic step in cells")
 
     @model_validator(mode="after")

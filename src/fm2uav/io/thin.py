@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from ..geometry import arc_length
 
 __all__ = ["thin_path", "thin_indices", "segment_distances", "refine_legs"]
 
@@ -143,7 +144,8 @@ def refine_legs(
     """Add waypoints where a straight leg would pass too low or through a no-fly zone.
 
     Every leg between consecutive kept points is sampled every ``step`` metres
-    (default a quarter of the horizontal cell, finer than the DEM's nodes);
+    (default a quarter of :func:`~fm2uav.world.ground_model.sampling_step`, i.e. at most
+    1/16 of a source-DEM pixel);
     where the leg's height above the surface (:meth:`World.surface_height`)
     falls below the ``required`` height of the dense path it replaces, or the
     leg enters a zone's kept-out air (:func:`fm2uav.world.zones.zone_violations`),
@@ -185,13 +187,12 @@ def refine_legs(
     if p.ndim != 2 or p.shape[1] != 3 or req.shape != (len(p),):
         raise InputError(f"flown must be (N, 3) and required (N,), got {p.shape} and {req.shape}")
     if step is None:
-        step = sampling_step(world)
+        step = 0.25 * sampling_step(world)  # legs are long: read them finely
     keep = set(int(i) for i in np.asarray(indices, dtype=int))
     keep |= {0, len(p) - 1}
     ground = np.asarray(world.ground_height(p[:, 0], p[:, 1]), dtype=float)
     own_agl = p[:, 2] - ground
-    seg = np.linalg.norm(np.diff(p[:, :2], axis=0), axis=1)
-    cum = np.concatenate([[0.0], np.cumsum(seg)])
+    cum = arc_length(p[:, :2])  # horizontal distance along the path
     stack = [(a, b) for a, b in zip(sorted(keep)[:-1], sorted(keep)[1:])]
     added = zone_splits = unresolved = 0
     worst_margin = np.inf

@@ -19,6 +19,7 @@ import numpy as np
 from ..errors import InputError, PlanningError
 from ..planning import Plan, plan
 from ..planning.params import FlightLevel, PlanOptions, Shaping
+from ..planning.altitude import join_profiles
 
 __all__ = ["Route", "plan_route"]
 
@@ -140,5 +141,6 @@ def plan_route(
         params={**legs[0].params, "legs": len(legs), "via": len(pts) - 2 - int(return_to_start),
                 "return_to_start": bool(return_to_start)},
         shaping=legs[0].shaping, level=legs[0].level,
+        profile=join_profiles([lg.profile for lg in legs]),
     )
     return Route(plan=joined, legs=tuple(legs), points=np.array(pts), junctions=junctions)

@@ -7,10 +7,14 @@ continuous ground (:meth:`World.surface_height`: the DEM interpolated
 bilinearly, roofs of buildings):
 
 1. the route is resampled every ``ds`` metres of horizontal arc length (a
-   quarter of the horizontal cell by default) and the surface is read at each
-   sample and at the midpoints of the chords to its neighbours; ``S_max`` /
-   ``S_min`` are the highest / lowest of the three (what the straight leg
-   between samples passes over);
+   quarter of the horizontal cell, at most a quarter of a source-DEM pixel, by
+   default) and the surface is read at each sample and at 1/4, 1/2 and 3/4 of
+   the chords to its neighbours. The flown height is linear along a chord, so
+   what matters is how far the surface bulges above the straight line between
+   its values at the two samples (a few centimetres, up to a metre at pixel
+   kinks of a rough DEM): ``S_max`` is the surface at the sample raised by the
+   larger bulge of its two chords, ``G_min`` the ground lowered by the larger
+   dip;
 2. per sample, three bounds [m, world z]:
 
    * target ``L_t = S_max + agl`` — where the profile wants to be;
@@ -60,11 +64,13 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError, PlanningError
+from ..geometry import arc_length
 from .params import FlightLevel
 
 __all__ = [
     "AltitudeProfile",
     "final_profile",
+    "join_profiles",
     "floor_agl",
     "envelope_above",
     "envelope_below",
@@ -427,6 +433,9 @@ def final_profile(world: Any, path: Any, level: FlightLevel, *, ds: float | None
         ds = sampling_step(world)
     xy, s = resample_route(p, ds)
     mids = 0.5 * (xy[:-1] + xy[1:])
+    # the chord between two samples is flown straight: read it at 1/4, 1/2, 3/4
+    fr = np.array([0.25, 0.5, 0.75])
+    inner = (xy[:-1, None, :] + fr[None, :, None] * (xy[1:] - xy[:-1])[:, None, :]).reshape(-1, 2)
 
     def surf(q: np.ndarray) -> np.ndarray:
         return np.asarray(world.surface_height(q[:, 0], q[:, 1]), dtype=float)
@@ -434,12 +443,22 @@ def final_profile(world: Any, path: Any, level: FlightLevel, *, ds: float | None
     def grnd(q: np.ndarray) -> np.ndarray:
         return np.asarray(world.ground_height(q[:, 0], q[:, 1]), dtype=float)
 
-    s_at, s_mid = surf(xy), surf(mids)
-    smax = _window(s_at, s_mid, np.maximum)
-    gmin = _window(grnd(xy), grnd(mids), np.minimum)
+    s_at, g_at = surf(xy), grnd(xy)
+    n_ch = len(xy) - 1
+    # z is linear along a chord, so only the surface's departure from its own chord
+    # between two samples matters: bump (above the chord) for the floor, dip (below
+    # it) for the ceiling; each sample takes the larger of its two chords
+    if n_ch:
+        lin_s = s_at[:-1, None] + fr[None, :] * (s_at[1:] - s_at[:-1])[:, None]
+        lin_g = g_at[:-1, None] + fr[None, :] * (g_at[1:] - g_at[:-1])[:, None]
+        bump = np.maximum((surf(inner).reshape(n_ch, 3) - lin_s).max(axis=1), 0.0)
+        dip = np.maximum((lin_g - grnd(inner).reshape(n_ch, 3)).max(axis=1), 0.0)
+    else:
+        bump = dip = np.zeros(0)
+    smax = s_at + _window(np.zeros(len(xy)), bump, np.maximum)
+    gmin = g_at - _window(np.zeros(len(xy)), dip, np.maximum)
     # the FM² route's own height at each sample (chooses over/under a zone)
-    seg = np.linalg.norm(np.diff(p[:, :2], axis=0), axis=1)
-    cum = np.concatenate([[0.0], np.cumsum(seg)])
+    cum = arc_length(p[:, :2])  # horizontal distance along the route
     z_route = np.interp(s, cum, p[:, 2]) if cum[-1] > 0 else np.full(len(s), p[0, 2])
     lo_x, up_x = zone_bounds_along(world, xy, z_route, mids)
     top = float(world.bounds[2, 1])
@@ -474,6 +493,40 @@ def final_profile(world: Any, path: Any, level: FlightLevel, *, ds: float | None
         descent_m=float(sss[-1] - sss[de].min()) if de.any() else 0.0,
         lifted_m=float(out["lifted_m"]),
     )
+
+
+def join_profiles(profiles: Any) -> AltitudeProfile | None:
+    """One profile of consecutive legs (a route through via points), or None.
+
+    The legs' paths must join (each leg starts where the previous ended); the
+    first point of every later leg is dropped, arc lengths are continued, the
+    phases and floors kept per leg (a via point is a descent then a climb-out
+    when its height differs from the cruise). Vertical legs, climb-out and
+    descent lengths are those of the first / last leg; ``lifted_m`` the largest.
+    """
+    ps = [p for p in profiles]
+    if not ps or any(p is None for p in ps):
+        return None
+    if len(ps) == 1:
+        return ps[0]
+    path = [ps[0].path]
+    s = [ps[0].s]
+    sf, ph, rq = [ps[0].surface], [ps[0].phase], [ps[0].required]
+    off = float(ps[0].s[-1])
+    for p in ps[1:]:
+        path.append(p.path[1:])
+        s.append(p.s[1:] - p.s[0] + off)
+        sf.append(p.surface[1:])
+        ph.append(p.phase[1:])
+        rq.append(p.required[1:])
+        off += float(p.s[-1] - p.s[0])
+    first, last = ps[0], ps[-1]
+    return AltitudeProfile(
+        path=np.concatenate(path), s=np.concatenate(s), surface=np.concatenate(sf),
+        phase=np.concatenate(ph), required=np.concatenate(rq), level=first.level,
+        vertical_start_m=first.vertical_start_m, vertical_goal_m=last.vertical_goal_m,
+        climb_out_m=first.climb_out_m, descent_m=last.descent_m,
+        lifted_m=max(p.lifted_m for p in ps))
 
 
 def height_figures(agl: Any, requested: float | None = None, *, band: float = 5.0,

@@ -41,6 +41,8 @@ __all__ = [
 
 #: Accepted values of :attr:`FlightLevel.mode`.
 FLIGHT_LEVEL_MODES = ("capped", "literal")
+#: Accepted values of ``FlightLevel.heights``.
+FLIGHT_LEVEL_HEIGHTS = ("ground", "fm2")
 #: Accepted values of :attr:`Shaping.method`.
 SHAPING_METHODS = ("edt", "fmm")
 
@@ -144,6 +146,13 @@ class FlightLevel:
     max_climb, max_descent : float
         [deg] in (0, 90]: steepest flight-path angle up / down of the final
         altitude profile. Default 45.
+    heights : {"ground", "fm2"}
+        Where the path's heights come from. "ground" (default): the final
+        altitude profile, ``agl`` above the continuous ground along the FM²
+        route within the limits above (:mod:`fm2uav.planning.altitude`).
+        "fm2": the FM² geodesic's own heights on the grid's flight layer (the
+        seeds' result, for reproducing and tuning Algorithm 2; up to a cell
+        below the request and blind to the ground between nodes).
     """
 
     agl: float
@@ -157,6 +166,7 @@ class FlightLevel:
     max_agl: float | None = None
     max_climb: float = 45.0
     max_descent: float = 45.0
+    heights: Literal["ground", "fm2"] = "ground"
 
     def __post_init__(self) -> None:
         _set(self, "agl", v.positive(self.agl, "agl", unit="m", where=_where("agl")))
@@ -170,6 +180,7 @@ class FlightLevel:
         _set(self, "band", v.non_negative(self.band, "band", unit="m", where=_where("band")))
         _set(self, "graded", v.flag(self.graded, "graded", where=_where("graded")))
         v.choice(self.mode, FLIGHT_LEVEL_MODES, "mode", where=_where("mode"))
+        v.choice(self.heights, FLIGHT_LEVEL_HEIGHTS, "heights", where=_where("heights"))
         _set(self, "tolerance", v.non_negative(
             self.tolerance, "tolerance", unit="m", where=_where("tolerance")))
         _set(self, "min_agl", v.optional(

@@ -22,7 +22,9 @@ from ..eikonal.velocity import distance_map, distance_scale, normalise_distance,
 from ..errors import InputError, PlanningError, PointError, UnreachableError
 from ..geometry import path_length
 from ..world import World
-from ..world.clearance import clearance_profile
+from ..world.clearance import surface_clearance
+from ..world.zones import check_points_allowed, zone_violations
+from .altitude import AltitudeProfile, final_profile, height_figures
 from .flight_level import flight_level_speed
 from .geodesic import descend
 from .params import FlightLevel, PlanOptions, Shaping
@@ -45,8 +47,9 @@ class Plan:
     length : float
         Path length [m].
     clearance : float
-        Smallest distance from a path point to an obstacle node [m]
-        (``inf`` on a map without obstacles).
+        Smallest distance from a path point to the terrain/building surface [m]
+        (continuous: :func:`fm2uav.world.clearance.surface_clearance`; not to
+        grid nodes, not to no-fly zones; ``inf`` on a 2D map without obstacles).
     timings : dict of str to float
         Wall time of each stage [s]: ``velocity_map``, ``fast_marching``,
         ``geodesic``, ``metrics``, ``total``.
@@ -66,6 +69,10 @@ class Plan:
         The shaping of W used (ignored with a custom speed map).
     level : FlightLevel or None
         The flight level imposed, None without one.
+    profile : AltitudeProfile or None
+        With a flight level on a 3D world: the final altitude profile that set
+        the heights of ``path`` (climb-out, cruise at ``agl`` above the
+        continuous ground, descent; :mod:`fm2uav.planning.altitude`).
     """
 
     path: np.ndarray
@@ -79,6 +86,19 @@ class Plan:
     params: dict[str, Any] = field(default_factory=dict)
     shaping: Shaping = field(default_factory=Shaping)
     level: FlightLevel | None = None
+    profile: AltitudeProfile | None = field(default=None, repr=False)
+
+    @property
+    def phase(self) -> np.ndarray | None:
+        """``"climb-out"`` / ``"cruise"`` / ``"descent"`` per path point (None without a profile)."""
+        return None if self.profile is None else self.profile.phase
+
+    def height_above_ground(self) -> np.ndarray | None:
+        """``z - World.ground_height(x, y)`` [m] at every path point (None for 2D)."""
+        if self.path.shape[1] != 3:
+            return None
+        return self.path[:, 2] - np.asarray(
+            self.world.ground_height(self.path[:, 0], self.path[:, 1]), dtype=float)
 
     @property
     def start(self) -> np.ndarray:
@@ -90,15 +110,16 @@ class Plan:
         """Goal point [m]."""
         return self.path[-1]
 
-    def lonlat(self) -> np.ndarray:
+    def lonlat(self, anchor: Any = None) -> np.ndarray:
         """Path as WGS84 ``(lon [deg], lat [deg], alt [m])`` rows.
 
-        Needs a geo-referenced world (``world.crs`` set, e.g. ``World.from_dem``);
-        raises InputError otherwise. See :func:`fm2uav.world.geo.to_lonlat`.
+        A geo-referenced world (``world.crs`` set, e.g. ``World.from_dem``) uses
+        its CRS; a world without one is placed at ``anchor`` (default
+        ``DEFAULT_ANCHOR``, as the exports do). See :func:`fm2uav.world.geo.to_lonlat`.
         """
         from ..world.geo import to_lonlat
 
-        return to_lonlat(self.world, self.path)
+        return to_lonlat(self.world, self.path, anchor=anchor)
 
     def summary(self) -> dict[str, Any]:
         """Plain-Python summary (JSON-friendly) of the plan's numbers."""
@@ -111,7 +132,25 @@ class Plan:
             "min_w": round(float(self.w.min()), 6),
             "params": dict(self.params),
             "timings_s": {k: round(v, 6) for k, v in self.timings.items()},
+            **self._height_summary(),
         }
+
+    def _height_summary(self) -> dict[str, Any]:
+        h = self.height_above_ground()
+        if h is None:
+            return {}
+        req = None if self.level is None else self.level.agl
+        out: dict[str, Any] = {"height_above_ground": {"path": height_figures(h, req,
+                                                                               points=self.path)}}
+        if self.profile is not None:
+            c = self.profile.cruise
+            if c.any():
+                idx = np.flatnonzero(c)
+                out["height_above_ground"]["cruise"] = height_figures(h[c], req,
+                                                                      points=self.path[c])
+                out["cruise_points"] = [int(idx[0]), int(idx[-1])]
+            out["altitude_profile"] = self.profile.summary()
+        return out
 
 
 def base_velocity(world: World, *, method: str = "edt", walls: bool = False) -> np.ndarray:
@@ -179,7 +218,7 @@ def _check_free(world: World, point: np.ndarray, what: str) -> tuple[int, ...]:
     if world.occupancy[cell]:
         hint = ""
         if world.terrain is not None and world.ndim == 3:
-            ground = float(world.terrain[cell[0], cell[1]])
+            ground = world.ground_height(point[0], point[1])
             hint = f" (the ground there is at z = {ground:.1f} m; raise the {what} above it)"
         raise PointError(
             f"{what} {np.round(point, 3).tolist()} m is inside an obstacle (node {list(cell)})"
@@ -249,24 +288,14 @@ def plan(
     _check_objects(shaping, level, options)
     start_m = _validate.point(start, world.ndim, "start")
     goal_m = _validate.point(goal, world.ndim, "goal")
+    if world.zones:  # name the zone rather than "inside an obstacle"
+        check_points_allowed(world, {"start": start_m, "goal": goal_m})
     start_cell = _check_free(world, start_m, "start")
     goal_cell = _check_free(world, goal_m, "goal")
     _check_work(world, start_m, goal_m, start_cell, goal_cell, options)
 
     t0 = time.perf_counter()
-    if options.speed_map is None:
-        # 0 on obstacles already (distance 0); the cached base map is read-only
-        # and used as is when there is nothing to shape
-        W = shaped_velocity(world, shaping)
-        if level is not None:
-            W = flight_level_speed(W, world, level)
-    else:
-        W = options.speed_map
-        if W.shape != world.shape:
-            raise InputError(
-                f"speed_map has shape {W.shape} but the world is {world.shape}; "
-                "give one speed per node"
-            )
+    W = plan_velocity(world, shaping, level, options)
     t1 = time.perf_counter()
     if W[start_cell] <= 0 or W[goal_cell] <= 0:
         which = "start" if W[start_cell] <= 0 else "goal"
@@ -276,58 +305,8 @@ def plan(
     T = fast_marching(W, [goal_cell], spacing=world.spacing, order=options.order,
                       stop_at=[start_cell])
     t2 = time.perf_counter()
-    if not np.isfinite(T[start_cell]):
-        raise UnreachableError(
-            f"the goal {np.round(goal_m, 3).tolist()} m cannot be reached from the start "
-            f"{np.round(start_m, 3).tolist()} m: no free connection between them; move one "
-            "of them into the other's free region or clear the separating obstacles"
-        )
-    # descend() never enters nodes with T = inf; obstacles have W = 0, hence
-    # T = inf, unless a custom speed map gave them a speed: only then pass the
-    # mask (it costs a copy of T, ~1 s on a 40M-node map).
-    blocked = world.occupancy if np.isfinite(T[world.occupancy]).any() else None
-    try:
-        path_idx = descend(
-            T,
-            world.to_index(start_m),
-            world.to_index(goal_m),
-            spacing=world.spacing,
-            blocked=blocked,
-            step=options.step,
-        )
-    except PlanningError as exc:  # "descent ... stuck": T reached the start, W too dark
-        raise PlanningError(
-            f"no path could be traced from the start {np.round(start_m, 3).tolist()} m to the "
-            f"goal {np.round(goal_m, 3).tolist()} m although the goal is reachable: W is too "
-            f"small along the only passage (exponent {shaping.exponent:g}); lower "
-            "planner.exponent (CLI --exponent), raise planner.saturation (--saturation) or use "
-            f"a finer grid ({exc})") from None
-    path = world.to_world(path_idx)
-    t3 = time.perf_counter()
-    w = ndimage.map_coordinates(W, path_idx.T, order=1, mode="nearest")
-    length = path_length(path)
-    clearance = float(clearance_profile(world, path).min())
-    t4 = time.perf_counter()
-    timings = {
-        "velocity_map": t1 - t0,
-        "fast_marching": t2 - t1,
-        "geodesic": t3 - t2,
-        "metrics": t4 - t3,
-        "total": t4 - t_all,
-    }
-    return Plan(
-        path=path,
-        w=w,
-        length=length,
-        clearance=clearance,
-        timings=timings,
-        W=W,
-        T=T,
-        world=world,
-        params=plan_params(shaping, level, options),
-        shaping=shaping,
-        level=level if options.speed_map is None else None,
-    )
+    return trace_plan(world, W, T, start_m, goal_m, shaping, level, options,
+                      (t_all, t0, t1, t2))
 
 
 #: Most geodesic steps a plan may take (step * min cell each, along the straight line
@@ -419,8 +398,9 @@ def trace_plan(world: World, W: np.ndarray, T: np.ndarray, start_m: np.ndarray,
             f"a finer grid ({exc})") from None
     path = world.to_world(path_idx)
     profile = None
-    if level is not None and options.speed_map is None and world.ndim == 3:
-        # heights from the continuous ground along the FM² route (issue 13)
+    if level is not None and level.heights == "ground" and world.ndim == 3:
+        # heights from the continuous ground along the FM² route (issue 13); with a
+        # custom speed map (route legs re-use the first leg's W) the level still sets them
         profile = final_profile(world, path, level)
         path = profile.path
         path_idx = world.to_index(path)
