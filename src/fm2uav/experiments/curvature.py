@@ -4,7 +4,9 @@ The sweep (:mod:`.runner`, :mod:`.sweep`) plans FM² for every (α, β) and star
 of the 2D city map and compares each path with the Dubins, Euler–Mumford elastica and
 Reeds–Shepp forward references (:mod:`fm2uav.baselines.reference`). This module holds
 the seed's grid (:func:`curvature_config`), the summary of a finished sweep
-(:func:`summarise_run`) and its Tables 1–4 (:func:`tables_markdown`).
+(:func:`summarise_run`) and its Tables 1–4 (:func:`tables_markdown`). Tables 2/3 give
+the argmin and the set of (α, β) within 1 % of it (count, α and β ranges): the valley is
+flat, so the argmin alone moves with the grid step.
 """
 
 from __future__ import annotations
@@ -48,6 +50,16 @@ def _fmt(v: Any, digits: int = 3) -> str:
     if v is None or (isinstance(v, float) and not math.isfinite(v)):
         return "–"
     return f"{v:.{digits}g}" if isinstance(v, float) else str(v)
+
+
+def _near_count(best: dict[str, Any] | None) -> str:
+    near = (best or {}).get("near_best")
+    return "–" if not near else f"{near['count']} ({near['share']:.1%} of the grid)"
+
+
+def _near_range(best: dict[str, Any] | None, key: str) -> str:
+    near = (best or {}).get("near_best")
+    return "–" if not near else f"{near[key + '_min']:g}–{near[key + '_max']:g}"
 
 
 def tables_markdown(summary: dict[str, Any], result: Any) -> str:
@@ -94,6 +106,12 @@ def tables_markdown(summary: dict[str, Any], result: Any) -> str:
             f"| {metric} | " + " | ".join(_fmt(best.get(m, {}).get("value"), 4) for m in models) + " |",
             "| valley: Spearman(α, best β) | "
             + " | ".join(_fmt(val.get(m, {}).get("spearman"), 2) for m in models) + " |",
+            "| (α, β) within 1 % of the best | "
+            + " | ".join(_near_count(best.get(m)) for m in models) + " |",
+            "| their α range | "
+            + " | ".join(_near_range(best.get(m), "alpha") for m in models) + " |",
+            "| their β range | "
+            + " | ".join(_near_range(best.get(m), "beta") for m in models) + " |",
             "",
         ]
     clear = summary["clearance"]
@@ -122,6 +140,7 @@ def sweep_payload(summary: dict[str, Any], result: Any, config: SweepConfig,
         "best": summary["best"],
         "valley_spearman": {m: {k: v["spearman"] for k, v in d.items()}
                             for m, d in summary["valley"].items()},
+        "near_best": summary.get("near_best", {}),
         "timing_s": summary["timing"],
         "clearance_m": summary["clearance"],
         "grid": {"alpha": [float(result.alphas[0]), config.alpha.step, float(result.alphas[-1])],

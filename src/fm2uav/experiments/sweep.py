@@ -26,7 +26,7 @@ from ..errors import Fm2uavError, InputError
 from ..planning import PlanOptions, Shaping, plan
 from ..world import World
 from ..analysis.similarity import area_between_curves, frechet_distance
-from ..geometry import menger_curvature, resample_path
+from ..geometry import arc_length, menger_curvature, resample_path
 from ..world.clearance import clearance_profile
 
 __all__ = [
@@ -35,6 +35,8 @@ __all__ = [
     "sweep_alpha_row",
     "distance_matrix",
     "best_parameters",
+    "NEAR_BEST_TOLERANCE",
+    "near_best",
     "valley",
     "smooth_dct",
     "curvature_profile",
@@ -170,6 +172,44 @@ def best_parameters(matrix: np.ndarray, alphas: np.ndarray, betas: np.ndarray) -
     return {"alpha": float(alphas[i]), "beta": float(betas[j]), "value": float(m[i, j])}
 
 
+#: Relative tolerance of the near-best set: (α, β) within 1 % of the best distance.
+NEAR_BEST_TOLERANCE = 0.01
+
+
+def near_best(matrix: np.ndarray, alphas: np.ndarray, betas: np.ndarray, *,
+              tolerance: float = NEAR_BEST_TOLERANCE) -> dict[str, Any]:
+    """The (α, β) whose distance is within ``tolerance`` of the best: the flat valley.
+
+    The argmin of a flat valley moves with the grid step and the pairs; the set of
+    near-best parameters does not (much). Returns ``tolerance``, ``threshold``
+    (``best · (1 + tolerance)``), ``count``, the extent ``alpha_min``, ``alpha_max``,
+    ``beta_min``, ``beta_max``, ``share`` (count over the finite cells) and ``points``
+    (list of ``(α, β)``, ordered by distance).
+
+    >>> m = np.array([[1.0, 1.005], [1.02, np.inf]])
+    >>> r = near_best(m, np.array([0.1, 0.2]), np.array([0.5, 0.6]))
+    >>> r["count"], r["beta_max"], r["points"]
+    (2, 0.6, [(0.1, 0.5), (0.1, 0.6)])
+    """
+    if not tolerance >= 0:
+        raise InputError(f"near-best tolerance must be >= 0, got {tolerance!r}")
+    m = np.where(np.isfinite(matrix), matrix, np.inf)
+    if not np.isfinite(m).any():
+        raise InputError("the distance matrix has no finite entry (every case failed)")
+    best = float(m.min())
+    thr = best * (1.0 + tolerance) if best >= 0 else best * (1.0 - tolerance)
+    ia, ib = np.nonzero(m <= thr)
+    order = np.argsort(m[ia, ib], kind="stable")
+    ia, ib = ia[order], ib[order]
+    a = np.asarray(alphas, dtype=float)[ia]
+    b = np.asarray(betas, dtype=float)[ib]
+    return {"tolerance": float(tolerance), "threshold": thr, "count": int(len(ia)),
+            "share": float(len(ia) / np.isfinite(m).sum()),
+            "alpha_min": float(a.min()), "alpha_max": float(a.max()),
+            "beta_min": float(b.min()), "beta_max": float(b.max()),
+            "points": [(float(x), float(y)) for x, y in zip(a, b)]}
+
+
 def valley(matrix: np.ndarray, alphas: np.ndarray, betas: np.ndarray) -> dict[str, Any]:
     """The valley of a distance matrix: the best β for every α.
 
@@ -241,7 +281,7 @@ def curvature_profile(path: np.ndarray, *, ds: float = 1.0, smooth: bool = True)
     a = p[1:-1] - p[:-2]
     b = p[2:] - p[1:-1]
     k = k * np.sign(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0])
-    s = np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))[:-1]
+    s = arc_length(p)[1:-1]  # at the interior points, where the curvature is
     out = {"s": s, "kappa": k}
     if smooth:
         out["kappa_smooth"] = smooth_dct(k)
@@ -273,6 +313,9 @@ def summarise_sweep(
     * ``matrices[metric][model]``: mean-over-pairs distance matrices;
     * ``best[metric][model]``: ``{alpha, beta, value}`` (Tables 2 and 3);
     * ``valley[metric][model]``: best β per α and its Spearman correlation;
+    * ``near_best[metric][model]``: the (α, β) within 1 % of the best and their extent
+      (:func:`near_best`); ``best[metric][model]["near_best"]`` repeats the extent
+      (count, α and β ranges) without the points;
     * ``timing``: Table 1 — total reference search time over the pairs per
       model and FM²'s (sum over pairs of the median plan time over the grid),
       with their ratios;
@@ -285,9 +328,11 @@ def summarise_sweep(
       the first pair.
     """
     n_pairs = len(starts)
-    out: dict[str, Any] = {"matrices": {}, "best": {}, "valley": {}, "paths": {}, "curvature": {}}
+    out: dict[str, Any] = {"matrices": {}, "best": {}, "valley": {}, "near_best": {},
+                           "paths": {}, "curvature": {}}
     for metric in METRICS:
         out["matrices"][metric], out["best"][metric], out["valley"][metric] = {}, {}, {}
+        out["near_best"][metric] = {}
         out["paths"][metric], out["curvature"][metric] = {}, {}
         for model in models:
             col = f"{metric}_{model}"
@@ -298,7 +343,10 @@ def summarise_sweep(
             if not np.isfinite(m).any():
                 continue
             best = best_parameters(m, alphas, betas)
+            near = near_best(m, alphas, betas)
+            best["near_best"] = {k: v for k, v in near.items() if k != "points"}
             out["best"][metric][model] = best
+            out["near_best"][metric][model] = near
             out["valley"][metric][model] = valley(m, alphas, betas)
             pairs = []
             for k in range(n_pairs):
