@@ -28,6 +28,7 @@ import os
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -53,6 +54,11 @@ __all__ = [
     "handle_errors",
     "warning_lines",
     "OutputDir",
+    "Output",
+    "write_json",
+    "write_figure",
+    "write_text",
+    "plan_rows",
     "parse_point",
     "print_summary",
     "progress",
@@ -299,3 +305,74 @@ def progress(enabled: bool = True) -> Iterator[Callable[[str], None]]:
         return
     with err_console.status("starting", spinner="dots") as status:
         yield lambda message: status.update(f"[bold]{message}[/]")
+
+
+def write_json(outdir: OutputDir, name: str, payload: Any) -> None:
+    """Write ``payload`` (numpy values allowed) as indented JSON into the output set."""
+    with outdir.open(name) as fh:
+        json.dump(to_jsonable(payload), fh, indent=2)
+
+
+def write_text(outdir: OutputDir, name: str, text: str) -> None:
+    """Write a text file (Markdown, CSV, HTML) into the output set."""
+    with outdir.open(name) as fh:
+        fh.write(text)
+
+
+def write_figure(outdir: OutputDir, fig: Any, name: str, dpi: int = 110) -> None:
+    """Save a matplotlib figure as ``name`` (PNG) into the output set."""
+    tmp = outdir.target(name)
+    fig.savefig(tmp, dpi=dpi)
+    outdir.commit(tmp, name)
+
+
+def plan_rows(p: Any) -> dict[str, Any]:
+    """The printed summary rows every planning command shows of a plan."""
+    return {
+        "start [m]": np.round(p.start, 1).tolist(),
+        "goal [m]": np.round(p.goal, 1).tolist(),
+        "length [m]": f"{p.length:.1f}",
+        "clearance [m]": f"{p.clearance:.1f}",
+    }
+
+
+@dataclass
+class Output:
+    """The output flags of a command (``--out``, ``--force``, ``--json``, ``--quiet``,
+    ``--report``) and its output set.
+
+    ``dir(names)`` opens the :class:`OutputDir` (checked for ``names``);
+    ``summary(title, rows, payload)`` prints ``rows``, or ``payload`` with ``--json``.
+    """
+
+    out: Path | None = None
+    force: bool = False
+    as_json: bool = False
+    quiet: bool = False
+    report: bool = False
+    outdir: OutputDir | None = field(default=None, repr=False)
+
+    @property
+    def show_progress(self) -> bool:
+        """Whether a progress spinner may be shown (neither ``--quiet`` nor ``--json``)."""
+        return not (self.quiet or self.as_json)
+
+    def progress(self) -> Any:
+        """:func:`progress` enabled unless ``--quiet``/``--json``."""
+        return progress(enabled=self.show_progress)
+
+    def dir(self, names: Any = None, *, path: Path | None = None) -> OutputDir:
+        """The command's :class:`OutputDir` at ``path`` (default ``--out``), checked for
+        ``names`` when given."""
+        if self.outdir is None:
+            self.outdir = OutputDir(path if path is not None else self.out, force=self.force)
+        if names is not None:
+            self.outdir.check(names)
+        return self.outdir
+
+    def summary(self, title: str, rows: dict[str, Any], payload: Any = None) -> None:
+        """Print ``rows`` as a table (or ``payload``, default ``rows``, with ``--json``)
+        followed by the files written."""
+        print_summary(title, (rows if payload is None else payload) if self.as_json else rows,
+                      as_json=self.as_json, quiet=self.quiet,
+                      files=None if self.outdir is None else self.outdir.written)

@@ -15,6 +15,10 @@ mission file's ``world:`` section becomes), :func:`build_world` and
 
 from __future__ import annotations
 
+import functools
+import inspect
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -27,7 +31,8 @@ __all__ = [
     "DemOpt", "BuildingsOpt", "BboxOpt", "SeaLevelOpt", "CellSizeOpt", "DzOpt", "CeilingOpt",
     "NodataOpt", "NodataValueOpt", "CrsOpt", "DefaultHeightOpt", "AllowFilledOpt", "LonLatOpt",
     "ScenarioOpt", "WORLD_FLAGS", "world_spec", "build_world", "cli_point", "world_rows",
-    "requested_heights", "world_overrides", "point_overrides",
+    "requested_heights", "world_overrides", "point_overrides", "option_group", "WorldFlags",
+    "world_options", "MissionFlags", "mission_options", "output_options",
 ]
 
 _P = "World (real data)"
@@ -335,3 +340,150 @@ def world_rows(world: Any) -> dict[str, str]:
     rows["sources"] = ", ".join(f"{Path(s.path).name} (sha256 {s.sha256[:12]})"
                                 for s in g.sources if s.sha256)
     return rows
+
+
+# -- option groups: one decorator adds a group's flags to a command --------------------------
+
+def option_group(name: str, params: Sequence[tuple[str, Any, Any]],
+                 build: Callable[..., Any]) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """A decorator that replaces the command parameter ``name`` by a group of options.
+
+    The command declares one parameter ``name`` (e.g. ``world: WorldFlags``) where the
+    group's flags belong in ``--help``; the decorated function's signature (read by
+    typer) has the group's ``(parameter, Annotated alias, default)`` entries in its
+    place, and the command is called with ``name=build(**their values)``.
+    """
+    keys = [p for p, _, _ in params]
+
+    def decorate(func: Callable[..., Any]) -> Callable[..., Any]:
+        sig = inspect.signature(func, eval_str=True)
+        if name not in sig.parameters:
+            raise TypeError(f"{func.__name__} has no parameter {name!r} for its option group")
+        new: list[inspect.Parameter] = []
+        for p in sig.parameters.values():
+            if p.name == name:
+                new += [inspect.Parameter(k, inspect.Parameter.POSITIONAL_OR_KEYWORD,
+                                          annotation=ann, default=default)
+                        for k, ann, default in params]
+            else:
+                new.append(p)
+
+        @functools.wraps(func)
+        def wrapper(*args: Any, **kwargs: Any) -> Any:
+            kwargs[name] = build(**{k: kwargs.pop(k) for k in keys if k in kwargs})
+            return func(*args, **kwargs)
+
+        wrapper.__signature__ = sig.replace(parameters=new)  # type: ignore[attr-defined]
+        wrapper.__annotations__ = {p.name: p.annotation for p in new
+                                   if p.annotation is not inspect.Parameter.empty}
+        return wrapper
+
+    return decorate
+
+
+@dataclass(frozen=True)
+class WorldFlags:
+    """The world options as given (``--dem`` ... ``--allow-filled``)."""
+
+    dem: list[Path] | None = None
+    buildings: Path | None = None
+    bbox: str | None = None
+    sea_level: float | None = None
+    cell_size: float | None = None
+    dz: float | None = None
+    ceiling: float | None = None
+    nodata: str = "error"
+    nodata_value: float | None = None
+    crs: str | None = None
+    default_height: float | None = None
+    allow_filled: bool = False
+
+    def values(self) -> dict[str, Any]:
+        """The flags as keywords of :func:`world_spec` / :func:`world_overrides`."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    def spec(self) -> Any:
+        """:func:`world_spec` of the flags (None without ``--dem``/``--buildings``)."""
+        return world_spec(**self.values())
+
+    def overrides(self) -> dict[str, Any] | None:
+        """:func:`world_overrides` of the flags (mission-file ``world:`` keys)."""
+        return world_overrides(**self.values())
+
+
+#: ``@world_options``: the 12 world flags in place of the command's ``world`` parameter.
+world_options = option_group("world", [
+    ("dem", DemOpt, None), ("buildings", BuildingsOpt, None), ("bbox", BboxOpt, None),
+    ("sea_level", SeaLevelOpt, None), ("cell_size", CellSizeOpt, None), ("dz", DzOpt, None),
+    ("ceiling", CeilingOpt, None), ("nodata", NodataOpt, "error"),
+    ("nodata_value", NodataValueOpt, None), ("crs", CrsOpt, None),
+    ("default_height", DefaultHeightOpt, None), ("allow_filled", AllowFilledOpt, False),
+], WorldFlags)
+
+
+@dataclass(frozen=True)
+class MissionFlags:
+    """The mission options as given: route (``--via``, ``--return``) and export flags."""
+
+    via: list[str] | None = None
+    return_to_start: bool | None = None
+    export: dict[str, Any] = field(default_factory=dict)
+
+    def export_options(self, base: Any = None, **more: Any) -> Any:
+        """``base`` ExportOptions with the export flags that were given (and ``more``)."""
+        from ._mission_options import export_options
+
+        return export_options(base, **self.export, **more)
+
+
+def _mission_params() -> dict[str, Any]:
+    from . import _mission_options as m
+
+    return {"via": m.Via, "return_to_start": m.Return, "firmware": m.Firmware,
+            "vehicle": m.Vehicle, "frame": m.Frame, "end": m.End, "thin": m.Thin,
+            "anchor": m.AnchorText, "speed_changes": m.SpeedChanges, "min_speed": m.MinSpeed,
+            "cruise_speed": m.CruiseSpeed, "hover_speed": m.HoverSpeed,
+            "endurance": m.Endurance, "reserve": m.Reserve}
+
+
+#: The mission flags of ``plan``/``formation`` (in their ``--help`` order).
+MISSION_FLAGS = ("via", "return_to_start", "firmware", "vehicle", "frame", "end",
+                 "speed_changes", "min_speed", "cruise_speed", "hover_speed", "endurance",
+                 "reserve")
+
+
+def _mission_flags(via: list[str] | None = None, return_to_start: bool | None = None,
+                   **export: Any) -> MissionFlags:
+    return MissionFlags(via=via, return_to_start=return_to_start, export=export)
+
+
+def mission_options(*names: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """``@mission_options(...)``: mission flags (default :data:`MISSION_FLAGS`) in place of
+    the command's ``mission`` parameter, passed as one :class:`MissionFlags`."""
+    table = _mission_params()
+    return option_group("mission", [(n, table[n], None) for n in names or MISSION_FLAGS],
+                        _mission_flags)
+
+
+def output_options(out: str | None, *, out_help: str = "Output directory.",
+                   force_help: str = "Overwrite existing outputs.",
+                   json_help: str = "Print the summary as JSON.",
+                   report_help: str | None = None
+                   ) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """``@output_options("out/plan", ...)``: ``--out``, ``--force``, ``--json``, ``--quiet``
+    (and ``--report`` with ``report_help``) in place of the command's ``output`` parameter,
+    passed as one :class:`~fm2uav.cli._common.Output`."""
+    from ._common import Output
+
+    params = [
+        ("out", Annotated[Path | None if out is None else Path,
+                          typer.Option(help=out_help)], None if out is None else Path(out)),
+        ("force", Annotated[bool, typer.Option("--force", help=force_help)], False),
+        ("as_json", Annotated[bool, typer.Option("--json", help=json_help)], False),
+        ("quiet", Annotated[bool, typer.Option("--quiet", help="Print nothing but errors.")],
+         False),
+    ]
+    if report_help is not None:
+        params.append(("report", Annotated[bool, typer.Option("--report", help=report_help)],
+                       False))
+    return option_group("output", params, Output)
