@@ -68,6 +68,9 @@ def write_geojson(fh: IO[str], path_m: Any, world: Any, **options: Any) -> dict[
 def read_geojson_path(file: str | Path, name: str = "path") -> np.ndarray:
     """``(N, 3)`` lon, lat, alt of the LineString feature called ``name``."""
     file = Path(file)
+    from .. import _validate as _v
+
+    _v.input_file(file, "GeoJSON file")  # no folder / named pipe (would block)
     try:
         doc = json.loads(file.read_text())
     except (OSError, json.JSONDecodeError) as exc:

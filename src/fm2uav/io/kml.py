@@ -98,6 +98,9 @@ def write_kmz(fh: IO[bytes], path_m: Any, world: Any, **options: Any) -> str:
 def read_kml_path(file: str | Path, name: str = "path") -> np.ndarray:
     """``(N, 3)`` lon, lat, alt of the LineString Placemark called ``name`` (KML or KMZ)."""
     file = Path(file)
+    from .. import _validate as _v
+
+    _v.input_file(file, "KML/KMZ file")  # no folder / named pipe (would block)
     try:
         if zipfile.is_zipfile(file):
             with zipfile.ZipFile(file) as z:

@@ -23,10 +23,9 @@ _CRS = re.compile(r"\bcrs\s*[=:]\s*([^;\s]+)", re.IGNORECASE)
 
 
 def _lines(file: Path) -> list[str]:
-    try:
-        return file.read_text().splitlines()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"path file {file}: cannot read: {exc}") from None
+    from .. import _validate as v
+
+    return v.read_text(file, "path file").splitlines()  # no folder / pipe / binary
 
 
 def read_path_header(file: str | Path) -> dict[str, Any]:

@@ -63,10 +63,13 @@ def read_path_csv(file: str | Path) -> np.ndarray:
     InputError
         Missing file, fewer than 2 points, non-numeric or non-finite values.
     """
+    from .. import _validate as v
+
     file = Path(file)
     if not file.exists():
         raise InputError(f"path file {file} does not exist")
-    lines = [ln.strip() for ln in file.read_text().splitlines()
+    # a regular UTF-8 file: a folder, a named pipe (would block) or binary data is refused
+    lines = [ln.strip() for ln in v.read_text(file, "path file").splitlines()
              if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:
         raise InputError(f"path file {file} is empty")

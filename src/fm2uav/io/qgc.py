@@ -291,6 +291,9 @@ def read_plan(file: str | Path) -> dict[str, Any]:
         fm2uav cannot expand (named with its type and position).
     """
     file = Path(file)
+    from .. import _validate as _v
+
+    _v.input_file(file, ".plan file")  # no folder / named pipe (would block)
     try:
         doc = json.loads(file.read_text())
     except (OSError, json.JSONDecodeError, UnicodeDecodeError) as exc:

@@ -78,7 +78,10 @@ def read_trajectories_csv(
         In the order of their first appearance.
     """
     if isinstance(file, (str, Path)):
-        with open(file, newline="") as fh:
+        from .. import _validate as _v
+
+        _v.input_file(file, "trajectories file")  # no folder / named pipe (would block)
+        with open(file, newline="", encoding="utf-8") as fh:
             return read_trajectories_csv(fh)
     rows = list(csv.DictReader(file))
     need = {"time_s", "uav", "x_m", "y_m", "z_m"}

@@ -84,6 +84,9 @@ def read_wpl(file: str | Path) -> dict[str, Any]:
         line is named).
     """
     file = Path(file)
+    from .. import _validate as _v
+
+    _v.input_file(file, "waypoints file")  # no folder / named pipe (would block)
     try:
         lines = file.read_text().splitlines()
     except (OSError, UnicodeDecodeError) as exc:

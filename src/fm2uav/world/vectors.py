@@ -310,6 +310,10 @@ def read_vectors(
         member = _geojson_crs_member(path) if geojson else None
         if geojson and member is None:
             declared = None  # GDAL reports EPSG:4326 for RFC 7946 files: an assumption
+        elif geojson and isinstance(member, Mapping) and (
+                {"name", "code"} & set(member.get("properties") or {})):
+            # GDAL silently ignores a crs member it cannot parse (then reads lon/lat): refuse
+            declared = _member_crs(member, where)
         sha = sha256_file(path)
         shown = str(path)
     else:
