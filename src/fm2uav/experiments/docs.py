@@ -204,6 +204,9 @@ def _city_rrt() -> str:
 
 #: Where the curvature block's sweep lives (resumed, so a rerun only re-summarises).
 CURVATURE_DIR = DOCS.parent / "out" / "docs" / "curvature"
+#: Grid step of the curvature block: 0.1 (10 × 10 × 24 pairs = 2400 cases, minutes on one
+#: core); the seed's 0.02 grid (60 000 cases) is ``fm2uav reproduce curvature``.
+CURVATURE_STEP = 0.1
 _MODEL_NAMES = {"dubins": "Dubins", "elastica": "Elastica", "rs": "Reeds–Shepp forward"}
 
 
@@ -212,8 +215,8 @@ def _curvature() -> tuple[Any, Any, dict[str, Any]]:
     from .curvature import curvature_config, summarise_run
     from .runner import run_sweep
 
-    config = curvature_config()
-    result = run_sweep(config, CURVATURE_DIR, workers=1)
+    config = curvature_config(CURVATURE_STEP)
+    result = run_sweep(config, CURVATURE_DIR / f"step{CURVATURE_STEP:g}", workers=1)
     _world, summary = summarise_run(config, result)
     return config, result, summary
 
@@ -223,7 +226,7 @@ def _curvature_results() -> str:
     config, result, summary = _curvature()
     models = [m for m in config.models if m in summary["best"]["frechet"]]
     a, b = result.alphas, result.betas
-    out = [f"Seed grid α, β = {a[0]:g}:{config.alpha.step:g}:{a[-1]:g} ({len(a)} × {len(b)}), "
+    out = [f"Grid α, β = {a[0]:g}:{config.alpha.step:g}:{a[-1]:g} ({len(a)} × {len(b)}), "
            f"{len(result.starts)} pairs (seed {config.pair_seed}), ξ = {config.xi:g} m; "
            "distances are means over the pairs.", "",
            "| | " + " | ".join(_MODEL_NAMES.get(m, m) for m in models) + " |",
@@ -299,6 +302,19 @@ def _city_rrt_claims() -> str:
     return "\n".join(lines)
 
 
+@cache
+def _urban() -> Any:
+    from .urban import reproduce_urban
+
+    return reproduce_urban()
+
+
+def _urban_table() -> str:
+    from .urban import urban_markdown
+
+    return urban_markdown(_urban())
+
+
 def _formation_table() -> str:
     from .formation import thesis_markdown
 
@@ -311,6 +327,7 @@ BLOCKS: dict[str, Block] = {
     "tff-jacksboro": Block("tff.md", lambda: _tff_table("jacksboro"), slow=True),
     "tff-readings-open-field": Block("tff.md", lambda: _tff_readings("open-field")),
     "tff-readings-jacksboro": Block("tff.md", lambda: _tff_readings("jacksboro"), slow=True),
+    "urban-table": Block("tff.md", _urban_table, slow=True),
     "coverage-table-5-1": Block("coverage.md", _coverage_t51),
     "coverage-table-5-2": Block("coverage.md", _coverage_t52),
     "coverage-fm2": Block("coverage.md", _coverage_fm2),
