@@ -96,9 +96,12 @@ def leg_figures(world: Any, waypoints: Any, *, requested: float | None = None,
     Returns
     -------
     dict
-        ``legs``, ``step_m``, figures over every leg sample except the take-off
-        and landing points themselves (``min_m`` ..., ``lowest_leg``,
-        ``lowest_point_m``), ``cruise`` figures, zone entries of the legs.
+        ``legs``, ``step_m``, figures over every leg sample, the take-off and
+        landing points included (``min_m`` ..., ``lowest_leg``,
+        ``lowest_point_m``), ``min_off_takeoff_landing_m`` (the lowest sample
+        outside the take-off and landing columns: what ``min_agl`` is checked
+        on), ``cruise`` figures (legs between two cruise waypoints), zone
+        entries of the legs.
     """
     p = np.asarray(waypoints, dtype=float)
     if p.ndim != 2 or p.shape[1] != 3 or len(p) < 2:
@@ -121,16 +124,16 @@ def leg_figures(world: Any, waypoints: Any, *, requested: float | None = None,
         dense[:, 2] = np.asarray(world.ground_height(dense[:, 0], dense[:, 1])) + h
     else:
         h = height_above_ground(world, dense)
-    inner = np.ones(len(dense), dtype=bool)
-    inner[0] = inner[-1] = False  # the take-off and landing points themselves
-    if not inner.any():
-        inner[:] = True
-    fig = height_figures(h[inner], requested, points=dense[inner])
-    k_low = int(np.flatnonzero(inner)[int(np.argmin(h[inner]))])
+    fig = height_figures(h, requested, points=dense)
+    # off the take-off and landing columns (their vertical legs are exempt from min_agl)
+    off = (np.hypot(*(dense[:, :2] - p[0, :2]).T) > 1e-6) & \
+        (np.hypot(*(dense[:, :2] - p[-1, :2]).T) > 1e-6)
+    inner = off if off.any() else np.ones(len(dense), dtype=bool)
     out: dict[str, Any] = {
         "legs": int(len(p) - 1), "step_m": round(float(step), 3),
         "frame": "terrain (AGL interpolated between waypoints)" if terrain_frame
-        else "straight legs in altitude", **fig, "lowest_leg": int(leg[k_low])}
+        else "straight legs in altitude", **fig, "lowest_leg": int(leg[int(np.argmin(h))]),
+        "min_off_takeoff_landing_m": round(float(h[inner].min()), 3)}
     if cruise is not None:
         c = np.asarray(cruise, dtype=bool)
         cl = c[:-1] & c[1:]
@@ -258,8 +261,9 @@ def _checks(agl: np.ndarray, cruise: np.ndarray | None, level: Any,
         checks["cruise_legs_floor"] = {"limit_m": round(float(floor), 3), "lowest_m": low,
                                        "ok": bool(low >= floor - 1e-6)}
     if legs is not None and getattr(level, "min_agl", None) is not None:
-        checks["legs_min_agl"] = {"limit_m": level.min_agl, "lowest_m": legs["min_m"],
-                                  "ok": bool(legs["min_m"] >= level.min_agl - 1e-6)}
+        low = legs["min_off_takeoff_landing_m"]
+        checks["legs_min_agl"] = {"limit_m": level.min_agl, "lowest_m": low,
+                                  "ok": bool(low >= level.min_agl - 1e-6)}
     zones = figs.get("zones")
     if zones is not None:
         checks["zones"] = {"ok": not zones["path_entries"] and not (legs or {}).get(

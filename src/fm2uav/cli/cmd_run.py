@@ -92,6 +92,77 @@ def mission_rows(mission: Any) -> dict[str, str]:
     return rows
 
 
+def safety_rows(safety: dict[str, Any]) -> dict[str, str]:
+    """Printed / report rows of :func:`fm2uav.analysis.safety.safety_summary`."""
+    rows: dict[str, str] = {}
+    hag = safety.get("height_above_ground", {})
+
+    def fig(f: dict[str, Any]) -> str:
+        band = f.get("within_band")
+        share = "" if band is None else f", {100 * band:.0f} % within ±{f['band_m']:g} m"
+        return (f"min {f['min_m']:.1f}, p5 {f['p5_m']:.1f}, median {f['median_m']:.1f}, "
+                f"max {f['max_m']:.1f}{share}")
+    if "cruise" in hag:
+        rows["height above ground, cruise [m]"] = fig(hag["cruise"])
+    if "path" in hag:
+        low = hag["path"]
+        rows["height above ground, whole path [m]"] = (
+            fig(low) + f"; lowest at ({', '.join(f'{v:.0f}' for v in low['lowest_point_m'])}) m")
+    legs = safety.get("legs")
+    if legs:
+        lc = legs.get("cruise", legs)
+        rows["lowest AGL along the legs [m]"] = (f"{legs['min_m']:.1f} (cruise legs "
+                                                 f"{lc['min_m']:.1f})")
+    if "clearance_m" in safety:
+        rows["clearance to the surface [m]"] = f"{safety['clearance_m']:.1f}"
+    z = safety.get("zones")
+    if z:
+        near = min(z["distance_m"].values()) if z["distance_m"] else float("inf")
+        rows["no-fly zones"] = (f"{z['count']}, nearest {near:.0f} m away, "
+                                f"{len(z['path_entries'])} entries")
+    bad = [k for k, c in safety.get("checks", {}).items() if not c.get("ok", True)]
+    if bad:
+        rows["limits NOT met"] = ", ".join(bad)
+    return rows
+
+
+def zone_overlays(zones: Any) -> dict[str, Any]:
+    """Report overlays (outlines draped on the terrain) of no-fly zones and the operating area."""
+    out: dict[str, Any] = {}
+    for k, z in enumerate(zones or ()):
+        geoms = getattr(z.geometry, "geoms", [z.geometry])
+        rings = []
+        for g in geoms:
+            rings.append(np.asarray(g.exterior.coords)[:, :2])
+            rings.append(np.full((1, 2), np.nan))
+        pts = np.concatenate(rings)[:-1]
+        name = f"{z.kind}: {z.name or k + 1}"
+        out[name] = {"points": pts, "color": "#2ca02c" if z.inclusion else "#d62728",
+                     "width": 4}
+        if z.buffer > 0:
+            grown = z.keep_out()
+            parts = getattr(grown, "geoms", [grown])
+            ring = np.concatenate([np.vstack([np.asarray(g.exterior.coords)[:, :2],
+                                              np.full((1, 2), np.nan)]) for g in parts
+                                   if not g.is_empty])[:-1]
+            out[f"{name} (buffer {z.buffer:g} m)"] = {"points": ring, "dash": "dash",
+                                                      "color": out[name]["color"], "width": 2}
+    return out
+
+
+def _with_cli_zones(rm: Any, files: Sequence[Path]) -> Any:
+    """The resolved mission with the ``--no-fly`` files' zones added to its world."""
+    import dataclasses
+
+    from ..io.zone_spec import zones_from_cli
+    from ..world.zones import check_points_allowed, with_zones
+
+    world = with_zones(rm.world, zones_from_cli([str(f) for f in files], rm.world))
+    check_points_allowed(world, {"start": rm.start, "goal": rm.goal,
+                                 **{f"via[{k}]": v for k, v in enumerate(rm.via)}})
+    return dataclasses.replace(rm, world=world)
+
+
 def output_names(formats: Sequence[str]) -> list[str]:
     """File names of the given output formats (for ``OutputDir.check``)."""
     return [OUTPUT_FILES[f] for f in formats]
@@ -133,12 +204,29 @@ def plan_outputs(
     mission : fm2uav.io.MissionExport
         The built mission.
     """
+    from ..analysis.safety import safety_summary
     from ..io import EXPORT_FILES, export_mission
+    from ..io.fence import zone_fences
 
     exports = [f for f in formats if f in EXPORT_FILES]
+    zones = tuple(getattr(plan.world, "zones", ()))
+    fence_warnings: list[str] = []
+    if zones and "fences" not in mission_inputs:  # no-fly zones -> the .plan geoFence
+        mission_inputs["fences"], fence_warnings = zone_fences(
+            zones, plan.world, getattr(options, "anchor", None))
     step("building the mission (altitudes, waypoints, takeoff, end, firmware checks)")
     mission, files = export_mission(plan, exports, options, **mission_inputs)
     wps = mission.waypoints
+    step("measuring the flight against the ground, the zones and the limits")
+    level = getattr(plan, "level", None)
+    safety = safety_summary(
+        plan.world, plan.path, requested=None if level is None else level.agl,
+        phase=getattr(plan, "phase", None), waypoints=wps.points_m,
+        waypoint_indices=wps.indices, terrain_frame=wps.frame == 10, waypoint_agl=wps.agl,
+        level=level)
+    if zones:
+        safety["geofence"] = {"fences": len(mission_inputs.get("fences") or ()),
+                              "warnings": fence_warnings}
     info = {
         **(summary or {}),
         **plan.summary(),
@@ -147,10 +235,11 @@ def plan_outputs(
         "mavlink_frame": wps.frame,
         "home_lat_lon_alt": [round(v, 9) for v in wps.home],
         "thin_tolerance_m": options.tolerance,
+        "safety": safety,
     }
     write_exports(outdir, files, step)
     if "html" in formats:
-        from ..viz.report import plan_report
+        from ..viz.report import report_html
 
         step("writing report.html")
         ms = info["autopilot"]
@@ -171,11 +260,14 @@ def plan_outputs(
             "home (lat, lon, alt AMSL)": [round(v, 7) for v in wps.home],
             "flight time [min]": round(ms["flight"]["flight_time_s"] / 60, 2),
             "planning time [s]": round(float(plan.timings.get("total", 0.0)), 3),
-            **{f"warning {k + 1}": w for k, w in enumerate(ms["warnings"])},
+            **safety_rows(safety),
+            **{f"warning {k + 1}": w for k, w in enumerate(ms["warnings"] + fence_warnings)},
         }
-        html = plan_report(plan, title=title, subtitle=subtitle,
-                           waypoints={"FM² path": wps.points_m}, params=params,
-                           metrics=metrics, files=output_names(formats))
+        html = report_html(
+            plan.world, {"FM² path": plan.path}, title=title, subtitle=subtitle,
+            speeds={"FM² path": plan.w}, waypoints={"FM² path": wps.points_m}, params=params,
+            metrics=metrics, files=output_names(formats),
+            agl=None if level is None else level.agl, overlays=zone_overlays(zones))
         with outdir.open("report.html", mode="w") as fh:
             fh.write(html)
     if "png" in formats:
@@ -254,6 +346,20 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         speed_changes: SpeedChanges = None,
         endurance: Endurance = None,
         reserve: Reserve = None,
+        no_fly: list[Path] | None = typer.Option(
+            None, "--no-fly", help="No-fly zones file (GeoJSON lon/lat, KML/KMZ, GPKG, SHP; "
+            "points need a 'radius' in metres), added to the mission's no_fly_zones. "
+            "Repeatable.", show_default=False),
+        min_agl: float | None = typer.Option(
+            None, "--min-agl", help="Override planner.min_agl: hard floor (m) above the ground "
+            "for the whole flight except the take-off/landing points."),
+        max_agl: float | None = typer.Option(
+            None, "--max-agl", help="Override planner.max_agl: hard ceiling (m) above the "
+            "ground, e.g. 120."),
+        saturation_distance: float | None = typer.Option(
+            None, "--saturation-distance", help="Override planner.saturation_distance: the "
+            "distance (m) from obstacles beyond which W = 1 (a margin that means the same on "
+            "any map)."),
     ) -> None:
         from ..io.mission import load_mission
         from ..missions.route import plan_route
@@ -279,9 +385,14 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
         with progress(enabled=not (quiet or as_json)) as step:
             step("building the world")
             rm = mission.resolve()
+            if no_fly:
+                rm = _with_cli_zones(rm, no_fly)
             step("planning (FM²)" + (f", {len(rm.via) + 1 + rm.return_to_start} legs"
                                      if rm.via or rm.return_to_start else ""))
-            shaping, level, popts = planner_objects(mission.plan_kwargs())
+            planner = {**mission.plan_kwargs(), **{k: v for k, v in (
+                ("min_agl", min_agl), ("max_agl", max_agl),
+                ("saturation_distance", saturation_distance)) if v is not None}}
+            shaping, level, popts = planner_objects(planner)
             route = plan_route(rm.world, rm.start, rm.goal, via=rm.via,
                                return_to_start=rm.return_to_start, shaping=shaping,
                                level=level, options=popts)
@@ -306,6 +417,7 @@ def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
             "length [m]": f"{p.length:.1f}",
             "clearance [m]": f"{p.clearance:.1f}",
             "legs": len(route.legs),
+            **safety_rows(info["safety"]),
             **mission_rows(built),
             "time [s]": f"{p.timings['total']:.2f}",
             **world_rows(rm.world),

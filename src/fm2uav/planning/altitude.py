@@ -63,7 +63,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError, PlanningError
+from ..errors import InputError, PlanningError, PointError
 from ..geometry import arc_length
 from .params import FlightLevel
 
@@ -431,6 +431,15 @@ def final_profile(world: Any, path: Any, level: FlightLevel, *, ds: float | None
         raise InputError(f"a final altitude profile needs a 3D path (N, 3), got {p.shape}")
     if ds is None:
         ds = sampling_step(world)
+    if level.max_agl is not None:  # the take-off / landing points must be legal too
+        for what, q in (("start", p[0]), ("goal", p[-1])):
+            above = float(q[2] - world.ground_height(q[0], q[1]))
+            if above > level.max_agl + 1e-6:
+                raise PointError(
+                    f"the {what} is {above:.1f} m above the ground, above planner.max_agl = "
+                    f"{level.max_agl:g} m (CLI --max-agl); give the {what} at most "
+                    f"{level.max_agl:g} m above the ground (e.g. {what}: {{..., agl: "
+                    f"{min(level.agl, level.max_agl):g}}}) or raise --max-agl")
     xy, s = resample_route(p, ds)
     mids = 0.5 * (xy[:-1] + xy[1:])
     # the chord between two samples is flown straight: read it at 1/4, 1/2, 3/4
