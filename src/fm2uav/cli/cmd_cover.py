@@ -2,46 +2,29 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 import typer
 
 from ..errors import InputError
-from ._common import OutputDir, handle_errors, print_summary, progress, to_jsonable
-from ._mission_options import (
-    AnchorText,
-    CruiseSpeed,
-    End,
-    Endurance,
-    Firmware,
-    Frame,
-    HoverSpeed,
-    MinSpeed,
-    Reserve,
-    SpeedChanges,
-    Thin,
-    Vehicle,
-    export_options,
+from ._common import (
+    Output,
+    OutputDir,
+    handle_errors,
+    write_figure,
+    write_json,
+    write_text,
 )
 from .options import (
-    AllowFilledOpt,
-    BboxOpt,
-    BuildingsOpt,
-    CeilingOpt,
-    CellSizeOpt,
-    CrsOpt,
-    DefaultHeightOpt,
-    DemOpt,
-    DzOpt,
-    NodataOpt,
-    NodataValueOpt,
+    MissionFlags,
     ScenarioOpt,
-    SeaLevelOpt,
+    WorldFlags,
     build_world,
+    mission_options,
+    output_options,
+    world_options,
     world_rows,
-    world_spec,
 )
 
 #: Mission files of a coverage flight (written by fm2uav.io.export_mission).
@@ -104,12 +87,6 @@ def _write_report(outdir: OutputDir, cp, *, title: str, subtitle: str, metrics: 
         fh.write(html)
 
 
-def _write_png(outdir: OutputDir, fig, name: str) -> None:
-    tmp = outdir.target(name)
-    fig.savefig(tmp, dpi=110)
-    outdir.commit(tmp, name)
-
-
 def _write_cover_outputs(outdir: OutputDir, cp, area: str, *, report: bool, title: str,
                          options=None, camera=None):
     """The mission files (path.csv, mission.plan, .waypoints, KML/KMZ, GeoJSON), zigzag.csv,
@@ -129,8 +106,8 @@ def _write_cover_outputs(outdir: OutputDir, cp, area: str, *, report: bool, titl
     wps = mission.waypoints
     with outdir.open("zigzag.csv") as fh:
         write_path_csv(fh, cp.zigzag.path(), comment=comment)
-    _write_png(outdir, bands_figure(cp.zigzag, title=f"zigzag over {area}"), "bands.png")
-    _write_png(outdir, coverage_figure(cp, title=title), "coverage.png")
+    write_figure(outdir, bands_figure(cp.zigzag, title=f"zigzag over {area}"), "bands.png")
+    write_figure(outdir, coverage_figure(cp, title=title), "coverage.png")
     with outdir.open("coverage.html") as fh:
         fh.write(coverage_html(cp, title=title))
     if report:
@@ -163,227 +140,188 @@ def _write_coverage_figures(outdir: OutputDir, run) -> None:
     from ..viz.coverage import bands_figure, coverage_figure
 
     for n, cp in run.plans.items():
-        _write_png(outdir, bands_figure(cp.zigzag, title=f"{n}, D = 80 m"), f"bands_{n}.png")
-        _write_png(outdir, coverage_figure(cp, title=f"{n} at {COVERAGE_AGL:g} m AGL"),
+        write_figure(outdir, bands_figure(cp.zigzag, title=f"{n}, D = 80 m"), f"bands_{n}.png")
+        write_figure(outdir, coverage_figure(cp, title=f"{n} at {COVERAGE_AGL:g} m AGL"),
                    f"coverage_{n}.png")
     s1 = coverage_area("S1")
     for d, angle in run.s1_angles.items():
         if d != 80:
-            _write_png(outdir, bands_figure(zigzag(s1, d, angle), title=f"S1, D = {d} m"),
+            write_figure(outdir, bands_figure(zigzag(s1, d, angle), title=f"S1, D = {d} m"),
                        f"bands_S1_D{d}.png")
+
+
+COVER_HELP = (
+    "Coverage mission: zigzag bands over an area, steering angle by Differential "
+    "Evolution, FM² along the bands at a height above the terrain. Writes path.csv, "
+    "zigzag.csv, the mission (mission.plan for QGroundControl, mission.waypoints QGC WPL "
+    "110, path.kml/.kmz, path.geojson: takeoff, the camera triggered on each band "
+    "(DO_SET_CAM_TRIGG_DIST on at its start, off at its end), the end; frame and checks "
+    "per --firmware), bands.png, coverage.png, coverage.html and summary.json (with the "
+    "camera's ground sample distance and overlaps), and with --report an interactive, "
+    "self-contained report.html.\n\n"
+    "Examples:\n\n"
+    "  fm2uav cover --area S1 --spacing 80 --agl 100 --out out/cover\n\n"
+    "  fm2uav cover --area S3 --spacing 80 --report --out out/cover-report\n\n"
+    "  fm2uav cover --area area.geojson --spacing 80 --agl 100 --out out/cover\n\n"
+    "  fm2uav cover --area S2 --camera 13.2,8.8,8.8,5472,3648 --side-overlap 0.7 "
+    "--agl 100 --out out/cam\n\n"
+    "  fm2uav cover --dem dem.tif --area field.kml --spacing 60 --agl 90 "
+    "--out out/field   (KML/KMZ, GeoPackage, Shapefile, GeoJSON in lon/lat)\n\n"
+    "--area is a polygon file — on --dem/--buildings worlds in any CRS (GeoJSON: "
+    "lon/lat), on the built-in maps a GeoJSON in the map's metres — or S1..S4 (the "
+    "seeds' areas on the built-in coverage map)."
+)
+
+REPRODUCE_HELP = (
+    "Reproduce the coverage experiments (paper 003 / thesis ch. 5): Table 5.1 (areas "
+    "S1-S4, D = 80 m) and Table 5.2 (S1 with D = 40/60/80/100 m) from the seeds' DE, "
+    "checked against a 0.1° sweep and scipy's DE, plus figures (bands, 3D path, path "
+    "vs ideal profile) of the FM² path at 100 m AGL; with --report an interactive "
+    "report.html of the four FM² paths and both tables.\n\n"
+    "Examples:\n\n"
+    "  fm2uav reproduce coverage --out out/coverage\n\n"
+    "  fm2uav reproduce coverage --report --out out/coverage-report"
+)
+
+_REPORT_HELP = "Also write report.html (interactive, self-contained)."
+
+
+@handle_errors
+@output_options("out/cover", report_help=_REPORT_HELP)
+@world_options
+@mission_options("firmware", "vehicle", "frame", "end", "thin", "anchor", "speed_changes",
+                 "min_speed", "cruise_speed", "hover_speed", "endurance", "reserve")
+def cover_cmd(
+    area: str = typer.Option(..., help="Polygon file (GeoJSON lon/lat, GPKG, SHP, "
+                             "KML/KMZ) or S1..S4 (built-in map)."),
+    spacing: float | None = typer.Option(None, help="Band spacing D (m)."),
+    agl: float = typer.Option(100.0, help="Flight level above the ground (m)."),
+    camera: str | None = typer.Option(
+        None, help="Compute D from a camera: sensor_w_mm,sensor_h_mm,focal_mm,img_w,img_h."),
+    side_overlap: float = typer.Option(0.0, help="Side overlap share in [0, 1) with --camera."),
+    front_overlap: float = typer.Option(
+        0.0, help="Front overlap share in [0, 1) between photos with --camera (sets the "
+        "trigger distance)."),
+    trigger_distance: float | None = typer.Option(
+        None, help="Distance between photos (m); default: from --camera, else D."),
+    mission: MissionFlags = None,
+    angle: float | None = typer.Option(None, help="Steering angle (deg); default: searched."),
+    search: str = typer.Option("de", help="Angle search: de (seeds), sweep, scipy-de."),
+    full_range: bool = typer.Option(False, "--full-range",
+                                    help="Search α in [0°, 180°) instead of [1°, 89°]."),
+    p1: float = typer.Option(0.5, help="Exponent on the flight level (seeds 0.5)."),
+    p2: float = typer.Option(1.3, help="Exponent elsewhere (seeds 1.3)."),
+    scenario: ScenarioOpt = None,
+    seed: int = typer.Option(0, help="Seed of the terrain and of the DE."),
+    output: Output = None,
+    world: WorldFlags = None,
+) -> None:
+    """``fm2uav cover``: parse, :func:`~fm2uav.missions.coverage.plan_coverage`, write, print."""
+    from ..missions.coverage import FULL_BOUNDS_DEG, plan_coverage
+    from ..missions.coverage.triggers import camera_plan
+    from ..planning import FlightLevel
+    from ..world.load import world_summary
+
+    if (spacing is None) == (camera is None):
+        raise InputError("give exactly one of --spacing (metres) or --camera")
+    cam = None if camera is None else _camera(camera)
+    d = spacing if spacing is not None else cam.spacing(agl, side_overlap)
+    mission_options = mission.export_options(name=f"coverage of {area}")
+    outdir = output.dir(COVER_FILES + ((REPORT,) if output.report else ()))
+    opts = {"bounds_deg": FULL_BOUNDS_DEG} if full_range else {}
+    with output.progress() as step:
+        step("building the map")
+        w, _, scenario = build_world(world.spec(), scenario=scenario, seed=seed, agl=agl,
+                                     default="coverage")
+        poly, area_source = _load_area(area, w, world.crs)
+        step("searching the steering angle and planning FM² along the bands")
+        cp = plan_coverage(w, poly, d, level=FlightLevel(agl=agl, p1=p1, p2=p2),
+                           angle=None if angle is None else np.radians(angle),
+                           search=search, search_options=opts, seed=seed)
+        step("writing the outputs")
+        shots = camera_plan(cp, camera=cam, front_overlap=front_overlap,
+                            trigger_distance=trigger_distance)
+        built = _write_cover_outputs(outdir, cp, area, report=output.report,
+                                     title=f"coverage of {area}", options=mission_options,
+                                     camera=shots)
+    summary = {"area": area, "scenario": scenario, "world": world_summary(w),
+               **({"area_source": area_source.as_dict()} if area_source else {}),
+               **cp.summary()}
+    summary["autopilot"] = built.summary()
+    write_json(outdir, "summary.json", summary)
+    output.summary("coverage plan", _cover_rows(area, d, cp, built, w), summary)
+
+
+def _cover_rows(area: str, d: float, cp, mission, world) -> dict:
+    """The printed summary of ``fm2uav cover``."""
+    from .cmd_run import mission_rows
+
+    return {
+        "area": area,
+        "band spacing D [m]": f"{d:.1f}",
+        "steering angle [deg]": f"{cp.zigzag.angle_deg:.3f}",
+        "bands": cp.zigzag.n_bands,
+        "zigzag cost [m]": f"{cp.zigzag.cost:.1f}",
+        "FM² path length [m]": f"{cp.plan.length:.1f}",
+        "coverage (FM² path) [%]": f"{100 * cp.coverage:.2f}",
+        "|AGL error| mean/max [m]": f"{np.abs(cp.agl_error).mean():.1f} / "
+                                    f"{np.abs(cp.agl_error).max():.1f}",
+        "camera": ", ".join(
+            f"{k} {v}" for k, v in mission.info["camera"].items()
+            if k in ("gsd_cm_per_px", "side_overlap", "front_overlap", "trigger_distance_m",
+                     "trigger_items")),
+        **mission_rows(mission),
+        "timings [ms]": ", ".join(f"{k} {v * 1e3:.0f}" for k, v in cp.timings.items()),
+        **world_rows(world),
+    }
+
+
+@handle_errors
+@output_options("out/coverage", json_help="Print the tables as JSON.", report_help=_REPORT_HELP)
+def reproduce_coverage_cmd(
+    seed: int = typer.Option(0, help="Seed of the terrain and of the DE."),
+    output: Output = None,
+) -> None:
+    """``fm2uav reproduce coverage``: :func:`~fm2uav.experiments.coverage.reproduce_coverage`."""
+    from ..experiments.coverage import (
+        SEEDS_T51,
+        SEEDS_T52,
+        coverage_payload,
+        reproduce_coverage,
+        table_csv,
+        tables_markdown,
+    )
+    from ..scenarios.coverage import COVERAGE_AREAS
+
+    names = list(COVERAGE_AREAS)
+    files = ["table_5_1.csv", "table_5_2.csv", "tables.md", "summary.json"]
+    files += [f"bands_{n}.png" for n in names] + [f"coverage_{n}.png" for n in names]
+    files += [f"bands_S1_D{d}.png" for d in (40, 60, 100)]
+    outdir = output.dir(files + ([REPORT] if output.report else []))
+    with output.progress() as step:
+        run = reproduce_coverage(seed, on_step=step)
+        step("drawing the figures")
+        _write_coverage_figures(outdir, run)
+    write_text(outdir, "table_5_1.csv", table_csv(run.table_5_1, "surface", SEEDS_T51))
+    write_text(outdir, "table_5_2.csv", table_csv(run.table_5_2, "D_m", SEEDS_T52))
+    write_text(outdir, "tables.md", tables_markdown(run))
+    payload = coverage_payload(run)
+    write_json(outdir, "summary.json", payload)
+    if output.report:
+        from ..viz.coverage import coverage_tables_report
+
+        write_text(outdir, REPORT, coverage_tables_report(run, files))
+    rows = {f"{n} (D=80)": f"best {r['min_cost']:.1f} m at {r['min_alpha']:.3f}° "
+            f"(sweep {r['sweep_cost']:.1f}; seeds {SEEDS_T51[n][0]:.1f} at "
+            f"{SEEDS_T51[n][1]:.3f}°), coverage {r['coverage_pct']:.2f} %"
+            for n, r in run.table_5_1.items()}
+    rows.update({f"S1 D={d}": f"best {r['min_cost']:.1f} m at {r['min_alpha']:.3f}° "
+                 f"(seeds {SEEDS_T52[d][0]:.1f} at {SEEDS_T52[d][1]:.3f}°)"
+                 for d, r in run.table_5_2.items()})
+    output.summary("coverage (Tables 5.1 / 5.2)", rows, payload)
 
 
 def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
     """Add ``cover`` and ``reproduce coverage``."""
-
-    @app.command(
-        "cover",
-        help=(
-            "Coverage mission: zigzag bands over an area, steering angle by Differential "
-            "Evolution, FM² along the bands at a height above the terrain. Writes path.csv, "
-            "zigzag.csv, the mission (mission.plan for QGroundControl, mission.waypoints QGC WPL "
-            "110, path.kml/.kmz, path.geojson: takeoff, the camera triggered on each band "
-            "(DO_SET_CAM_TRIGG_DIST on at its start, off at its end), the end; frame and checks "
-            "per --firmware), bands.png, coverage.png, coverage.html and summary.json (with the "
-            "camera's ground sample distance and overlaps), and with --report an interactive, "
-            "self-contained report.html.\n\n"
-            "Examples:\n\n"
-            "  fm2uav cover --area S1 --spacing 80 --agl 100 --out out/cover\n\n"
-            "  fm2uav cover --area S3 --spacing 80 --report --out out/cover-report\n\n"
-            "  fm2uav cover --area area.geojson --spacing 80 --agl 100 --out out/cover\n\n"
-            "  fm2uav cover --area S2 --camera 13.2,8.8,8.8,5472,3648 --side-overlap 0.7 "
-            "--agl 100 --out out/cam\n\n"
-            "  fm2uav cover --dem dem.tif --area field.kml --spacing 60 --agl 90 "
-            "--out out/field   (KML/KMZ, GeoPackage, Shapefile, GeoJSON in lon/lat)\n\n"
-            "--area is a polygon file — on --dem/--buildings worlds in any CRS (GeoJSON: "
-            "lon/lat), on the built-in maps a GeoJSON in the map's metres — or S1..S4 (the "
-            "seeds' areas on the built-in coverage map)."
-        ),
-    )
-    @handle_errors
-    def cover_cmd(
-        area: str = typer.Option(..., help="Polygon file (GeoJSON lon/lat, GPKG, SHP, "
-                                 "KML/KMZ) or S1..S4 (built-in map)."),
-        spacing: float | None = typer.Option(None, help="Band spacing D (m)."),
-        agl: float = typer.Option(100.0, help="Flight level above the ground (m)."),
-        camera: str | None = typer.Option(
-            None, help="Compute D from a camera: sensor_w_mm,sensor_h_mm,focal_mm,img_w,img_h."),
-        side_overlap: float = typer.Option(0.0, help="Side overlap share in [0, 1) with --camera."),
-        front_overlap: float = typer.Option(
-            0.0, help="Front overlap share in [0, 1) between photos with --camera (sets the "
-            "trigger distance)."),
-        trigger_distance: float | None = typer.Option(
-            None, help="Distance between photos (m); default: from --camera, else D."),
-        firmware: Firmware = None,
-        vehicle: Vehicle = None,
-        frame: Frame = None,
-        end: End = None,
-        thin: Thin = None,
-        anchor: AnchorText = None,
-        speed_changes: SpeedChanges = None,
-        min_speed: MinSpeed = None,
-        cruise_speed: CruiseSpeed = None,
-        hover_speed: HoverSpeed = None,
-        endurance: Endurance = None,
-        reserve: Reserve = None,
-        angle: float | None = typer.Option(None, help="Steering angle (deg); default: searched."),
-        search: str = typer.Option("de", help="Angle search: de (seeds), sweep, scipy-de."),
-        full_range: bool = typer.Option(False, "--full-range",
-                                        help="Search α in [0°, 180°) instead of [1°, 89°]."),
-        p1: float = typer.Option(0.5, help="Exponent on the flight level (seeds 0.5)."),
-        p2: float = typer.Option(1.3, help="Exponent elsewhere (seeds 1.3)."),
-        scenario: ScenarioOpt = None,
-        seed: int = typer.Option(0, help="Seed of the terrain and of the DE."),
-        out: Path = typer.Option(Path("out/cover"), help="Output directory."),
-        force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
-        as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
-        quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
-        report: bool = typer.Option(
-            False, "--report", help="Also write report.html (interactive, self-contained)."),
-        dem: DemOpt = None,
-        buildings: BuildingsOpt = None,
-        bbox: BboxOpt = None,
-        sea_level: SeaLevelOpt = None,
-        cell_size: CellSizeOpt = None,
-        dz: DzOpt = None,
-        ceiling: CeilingOpt = None,
-        nodata: NodataOpt = "error",
-        nodata_value: NodataValueOpt = None,
-        crs: CrsOpt = None,
-        default_height: DefaultHeightOpt = None,
-        allow_filled: AllowFilledOpt = False,
-    ) -> None:
-        from ..missions.coverage import FULL_BOUNDS_DEG, plan_coverage
-        from .cmd_run import mission_rows
-        from ..planning import FlightLevel
-
-        from ..missions.coverage.triggers import camera_plan
-
-        if (spacing is None) == (camera is None):
-            raise InputError("give exactly one of --spacing (metres) or --camera")
-        cam = None if camera is None else _camera(camera)
-        d = spacing if spacing is not None else cam.spacing(agl, side_overlap)
-        mission_options = export_options(
-            None, firmware=firmware, vehicle=vehicle, frame=frame, end=end, thin=thin,
-            anchor=anchor, speed_changes=speed_changes, min_speed=min_speed,
-            cruise_speed=cruise_speed, hover_speed=hover_speed, endurance=endurance,
-            reserve=reserve, name=f"coverage of {area}")
-        outdir = OutputDir(out, force=force)
-        outdir.check(COVER_FILES + ((REPORT,) if report else ()))
-        opts = {}
-        if full_range:
-            opts["bounds_deg"] = FULL_BOUNDS_DEG
-        with progress(enabled=not (quiet or as_json)) as step:
-            step("building the map")
-            spec = world_spec(dem=dem, buildings=buildings, bbox=bbox, sea_level=sea_level,
-                              cell_size=cell_size, dz=dz, ceiling=ceiling, nodata=nodata,
-                              nodata_value=nodata_value, crs=crs,
-                              default_height=default_height, allow_filled=allow_filled)
-            world, _, scenario = build_world(spec, scenario=scenario, seed=seed, agl=agl,
-                                             default="coverage")
-            poly, area_source = _load_area(area, world, crs)
-            step("searching the steering angle and planning FM² along the bands")
-            cp = plan_coverage(world, poly, d, level=FlightLevel(agl=agl, p1=p1, p2=p2),
-                               angle=None if angle is None else np.radians(angle),
-                               search=search, search_options=opts, seed=seed)
-            step("writing the outputs")
-            shots = camera_plan(cp, camera=cam, front_overlap=front_overlap,
-                                trigger_distance=trigger_distance)
-            mission = _write_cover_outputs(outdir, cp, area, report=report,
-                                           title=f"coverage of {area}", options=mission_options,
-                                           camera=shots)
-        from ..world.load import world_summary
-
-        summary = {"area": area, "scenario": scenario, "world": world_summary(world),
-                   **({"area_source": area_source.as_dict()} if area_source else {}),
-                   **cp.summary()}
-        summary["autopilot"] = mission.summary()
-        with outdir.open("summary.json") as fh:
-            json.dump(to_jsonable(summary), fh, indent=2)
-        rows = {
-            "area": area,
-            "band spacing D [m]": f"{d:.1f}",
-            "steering angle [deg]": f"{cp.zigzag.angle_deg:.3f}",
-            "bands": cp.zigzag.n_bands,
-            "zigzag cost [m]": f"{cp.zigzag.cost:.1f}",
-            "FM² path length [m]": f"{cp.plan.length:.1f}",
-            "coverage (FM² path) [%]": f"{100 * cp.coverage:.2f}",
-            "|AGL error| mean/max [m]": f"{np.abs(cp.agl_error).mean():.1f} / "
-                                        f"{np.abs(cp.agl_error).max():.1f}",
-            "camera": ", ".join(
-                f"{k} {v}" for k, v in mission.info["camera"].items()
-                if k in ("gsd_cm_per_px", "side_overlap", "front_overlap", "trigger_distance_m",
-                         "trigger_items")),
-            **mission_rows(mission),
-            "timings [ms]": ", ".join(f"{k} {v * 1e3:.0f}" for k, v in cp.timings.items()),
-            **world_rows(world),
-        }
-        print_summary("coverage plan", summary if as_json else rows, as_json=as_json,
-                      quiet=quiet, files=outdir.written)
-
-    @reproduce_app.command(
-        "coverage",
-        help=(
-            "Reproduce the coverage experiments (paper 003 / thesis ch. 5): Table 5.1 (areas "
-            "S1-S4, D = 80 m) and Table 5.2 (S1 with D = 40/60/80/100 m) from the seeds' DE, "
-            "checked against a 0.1° sweep and scipy's DE, plus figures (bands, 3D path, path "
-            "vs ideal profile) of the FM² path at 100 m AGL; with --report an interactive "
-            "report.html of the four FM² paths and both tables.\n\n"
-            "Examples:\n\n"
-            "  fm2uav reproduce coverage --out out/coverage\n\n"
-            "  fm2uav reproduce coverage --report --out out/coverage-report"
-        ),
-    )
-    @handle_errors
-    def reproduce_coverage(
-        seed: int = typer.Option(0, help="Seed of the terrain and of the DE."),
-        out: Path = typer.Option(Path("out/coverage"), help="Output directory."),
-        force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
-        as_json: bool = typer.Option(False, "--json", help="Print the tables as JSON."),
-        quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
-        report: bool = typer.Option(
-            False, "--report", help="Also write report.html (interactive, self-contained)."),
-    ) -> None:
-        from ..experiments.coverage import (
-            SEEDS_T51,
-            SEEDS_T52,
-            coverage_payload,
-            reproduce_coverage,
-            table_csv,
-            tables_markdown,
-        )
-        from ..scenarios.coverage import COVERAGE_AREAS
-
-        names = list(COVERAGE_AREAS)
-        files = ["table_5_1.csv", "table_5_2.csv", "tables.md", "summary.json"]
-        files += [f"bands_{n}.png" for n in names] + [f"coverage_{n}.png" for n in names]
-        files += [f"bands_S1_D{d}.png" for d in (40, 60, 100)]
-        outdir = OutputDir(out, force=force)
-        outdir.check(files + ([REPORT] if report else []))
-        with progress(enabled=not (quiet or as_json)) as step:
-            run = reproduce_coverage(seed, on_step=step)
-            step("drawing the figures")
-            _write_coverage_figures(outdir, run)
-        with outdir.open("table_5_1.csv") as fh:
-            fh.write(table_csv(run.table_5_1, "surface", SEEDS_T51))
-        with outdir.open("table_5_2.csv") as fh:
-            fh.write(table_csv(run.table_5_2, "D_m", SEEDS_T52))
-        with outdir.open("tables.md") as fh:
-            fh.write(tables_markdown(run))
-        payload = coverage_payload(run)
-        with outdir.open("summary.json") as fh:
-            json.dump(to_jsonable(payload), fh, indent=2)
-        if report:
-            from ..viz.coverage import coverage_tables_report
-
-            with outdir.open(REPORT) as fh:
-                fh.write(coverage_tables_report(run, files))
-        rows = {f"{n} (D=80)": f"best {r['min_cost']:.1f} m at {r['min_alpha']:.3f}° "
-                f"(sweep {r['sweep_cost']:.1f}; seeds {SEEDS_T51[n][0]:.1f} at "
-                f"{SEEDS_T51[n][1]:.3f}°), coverage {r['coverage_pct']:.2f} %"
-                for n, r in run.table_5_1.items()}
-        rows.update({f"S1 D={d}": f"best {r['min_cost']:.1f} m at {r['min_alpha']:.3f}° "
-                     f"(seeds {SEEDS_T52[d][0]:.1f} at {SEEDS_T52[d][1]:.3f}°)"
-                     for d, r in run.table_5_2.items()})
-        print_summary("coverage (Tables 5.1 / 5.2)", payload if as_json else rows,
-                      as_json=as_json, quiet=quiet, files=outdir.written)
+    app.command("cover", help=COVER_HELP)(cover_cmd)
+    reproduce_app.command("coverage", help=REPRODUCE_HELP)(reproduce_coverage_cmd)
