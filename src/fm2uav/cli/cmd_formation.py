@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -13,43 +11,25 @@ import typer
 from ..scenarios import SCENARIOS, get_scenario
 from ._common import (
     EXIT_PLANNING,
+    Output,
     OutputDir,
     handle_errors,
     print_summary,
-    progress,
-    to_jsonable,
-)
-from ._mission_options import (
-    AnchorText,
-    End,
-    Endurance,
-    Firmware,
-    Frame,
-    Reserve,
-    Thin,
-    Vehicle,
-    export_options,
+    write_json,
+    write_text,
 )
 from .options import (
-    AllowFilledOpt,
-    BboxOpt,
-    BuildingsOpt,
-    CeilingOpt,
-    CellSizeOpt,
-    CrsOpt,
-    DefaultHeightOpt,
-    DemOpt,
-    DzOpt,
     LonLatOpt,
-    NodataOpt,
-    NodataValueOpt,
+    MissionFlags,
     ScenarioOpt,
-    SeaLevelOpt,
+    WorldFlags,
     build_world,
     cli_point,
+    mission_options,
+    output_options,
     requested_heights,
+    world_options,
     world_rows,
-    world_spec,
 )
 
 FIGURES = ("paths.png", "profiles.png", "metrics.png")
@@ -103,8 +83,7 @@ def _write_case(outdir: OutputDir, result, summary: dict[str, Any], *, title: st
         fig.savefig(tmp, dpi=100)
         outdir.commit(tmp, name)
     _write_tables(outdir, result)
-    with outdir.open("summary.json") as fh:
-        json.dump(to_jsonable(summary), fh, indent=2)
+    write_json(outdir, "summary.json", summary)
     if gif:
         step(f"{title}: writing {ANIMATION}")
         tmp = outdir.target(ANIMATION)
@@ -112,211 +91,182 @@ def _write_case(outdir: OutputDir, result, summary: dict[str, Any], *, title: st
         outdir.commit(tmp, ANIMATION)
     if report:
         step(f"{title}: writing {REPORT}")
-        html = formation_report_html(result, summary, title=title, subtitle=subtitle,
-                                     files=list(_outputs(gif, False)))
-        with outdir.open(REPORT) as fh:
-            fh.write(html)
+        write_text(outdir, REPORT, formation_report_html(
+            result, summary, title=title, subtitle=subtitle, files=list(_outputs(gif, False))))
+
+
+FORMATION_HELP = (
+    "Fly a leader–follower formation with FM² (thesis ch. 6) and write trajectories.csv, "
+    "metrics.csv, cycles.csv, summary.json, paths.png, profiles.png, metrics.png, "
+    "formation.gif (and with --report an interactive report.html), and one mission per "
+    "UAV in every format (leader_mission.plan / .waypoints, leader_path.kml / .kmz / "
+    ".geojson / .csv, follower1_..., ...): its own route "
+    "with a DO_CHANGE_SPEED per leg and holds so that it keeps the simulated timing; "
+    "started together, the vehicles leave their start points at the same moment.\n\n"
+    "Examples:\n\n"
+    "  fm2uav formation --scenario fissure --out out/formation\n\n"
+    "  fm2uav formation --scenario fissure --level 7 --report --out out/formation-l7\n\n"
+    "  fm2uav formation --shape v --followers 4 --dist 45 --no-gif --out out/v4\n\n"
+    "  fm2uav formation --dem dem.tif --bbox 10.05,45.54,10.2,45.66 --lonlat --start "
+    "10.06,45.55 --goal 10.19,45.65 --agl 120 --no-gif --out out/formation-dem\n\n"
+    f"Scenarios: {', '.join(SCENARIOS)}."
+)
+
+REPRODUCE_HELP = (
+    "Thesis ch. 6: the triangle formation across the fissure without (case 1) and with "
+    "(case 2) the flight level 7 cells; case 2 is run with the thesis' p1 = 1, p2 = 0.5 "
+    "and with the planner's p1 = 0.5, p2 = 1.5. Writes one folder per case and "
+    "table.md comparing our times with the thesis' 130.6 s / 135.6 s (Matlab); with "
+    "--report also report.html per case and one comparing the cases.\n\n"
+    "Examples:\n\n"
+    "  fm2uav reproduce formation --out out/formation-thesis\n\n"
+    "  fm2uav reproduce formation --no-gif --report --out out/formation-report"
+)
+
+
+@handle_errors
+@output_options("out/formation",
+                report_help="Also write report.html (interactive, self-contained).")
+@world_options
+@mission_options("firmware", "vehicle", "frame", "end", "thin", "anchor", "endurance",
+                 "reserve")
+def formation_cmd(
+    scenario: ScenarioOpt = None,
+    start: str | None = typer.Option(None, help="Leader start x,y,z (m) (cells with --cells; "
+                                     "LON,LAT[,AGL] with --lonlat)."),
+    goal: str | None = typer.Option(None, help="Leader goal x,y,z (m) (cells with --cells; "
+                                    "LON,LAT[,AGL] with --lonlat)."),
+    cells: bool = typer.Option(False, "--cells", help="Read --start/--goal as grid cells."),
+    lonlat: LonLatOpt = False,
+    shape: str = typer.Option("triangle", help="Formation: triangle, v or line."),
+    followers: int = typer.Option(2, help="Number of followers."),
+    dist: float = typer.Option(
+        60.0, help="Safety distance dist (m); UAVs never closer than dist/2."),
+    speed: float = typer.Option(10.0, help="Leader speed (m/s)."),
+    follower_speed: float | None = typer.Option(
+        None, help="Followers' top speed (m/s) (default 1.5 × leader)."),
+    cycle: float = typer.Option(1.0, help="Re-planning period (s)."),
+    agl: float | None = typer.Option(None, help="Flight level (m above ground) for all UAVs."),
+    level: float | None = typer.Option(
+        None, help="Flight level in vertical cells (thesis: 7)."),
+    p1: float = typer.Option(0.5, help="Flight-level exponent on the level (thesis ch. 6: 1)."),
+    p2: float = typer.Option(1.5, help="Flight-level exponent elsewhere (thesis ch. 6: 0.5)."),
+    grey: str = typer.Option(
+        "goal", help="Grey level at the partial 'goal' or the 'follower'."),
+    seed: int = typer.Option(0, help="Seed of the scenario's random relief."),
+    gif: bool = typer.Option(True, "--gif/--no-gif", help="Write the animation."),
+    frames: int = typer.Option(60, help="Animation frames (at most)."),
+    output: Output = None,
+    world: WorldFlags = None,
+    mission: MissionFlags = None,
+) -> None:
+    """``fm2uav formation``: parse, :func:`~fm2uav.experiments.formation.fly_and_summarise`,
+    one mission per UAV, write, print."""
+    from ..errors import InputError
+    from ..experiments.formation import fly_and_summarise, summary_rows
+    from ..io.exports import EXPORT_FILES, export_formation, file_prefix
+    from ..missions.formation import FormationConfig
+    from ..planning import FlightLevel
+    from ..scenarios.scenario import Scenario
+    from ..world.load import check_points, world_summary
+    from .cmd_run import write_exports
+
+    need_agl, need_top = requested_heights(start, goal, lonlat=lonlat, agl=agl)
+    w, sc, scenario = build_world(world.spec(), scenario=scenario, seed=seed, agl=need_agl,
+                                  top=need_top, default="fissure")
+    if agl is not None and level is not None:
+        raise InputError("give either --agl (metres) or --level (cells), not both")
+    if level is not None:
+        agl = float(level) * w.spacing[2]
+    uavs = ["leader"] + [f"follower {k + 1}" for k in range(followers)]
+    mission_names = [file_prefix(n) + EXPORT_FILES[f] for n in uavs for f in MISSION_FORMATS]
+    outdir = output.dir(_outputs(gif, output.report) + tuple(mission_names))
+    mission_options = mission.export_options(name=f"formation {scenario}")
+
+    def point(text: str | None, default: np.ndarray | None, what: str) -> np.ndarray:
+        return cli_point(text, what, w, lonlat=lonlat, cells=cells, agl=agl, default=default)
+
+    s = point(start, sc.start if sc else None, "start")
+    g = point(goal, sc.goal if sc else None, "goal")
+    check_points(w, {"start": s, "goal": g}, allow_filled=world.allow_filled)
+    sc = Scenario(world=w, start=s, goal=g,
+                  description=sc.description if sc else f"real data: {scenario}")
+    title = f"formation — {scenario}" + (f", flight level {agl:g} m" if agl else "")
+    with output.progress() as step:
+        step(f"{title}: flying the formation (FM² re-planning every cycle)")
+        config = FormationConfig(n_followers=followers, shape=shape, dist=dist,
+                                 leader_speed=speed, follower_speed=follower_speed,
+                                 cycle=cycle, grey=grey)
+        result, summary = fly_and_summarise(
+            sc, config=config, level=None if agl is None else FlightLevel(agl=agl, p1=p1, p2=p2))
+        step("building one mission per UAV")
+        missions, files = export_formation(result, MISSION_FORMATS, mission_options)
+        summary = {"scenario": scenario, "world": world_summary(w), **summary,
+                   "missions": {n: m.summary() for n, m in missions.items()}}
+        write_exports(outdir, files, step)
+        _write_case(outdir, result, summary, title=title, gif=gif, frames=frames,
+                    report=output.report, subtitle=sc.description, step=step)
+    output.summary("FM² formation",
+                   {**summary_rows(summary), **_timing_rows(missions), **world_rows(w)}, summary)
+    if not result.completed:
+        raise typer.Exit(EXIT_PLANNING)
+
+
+def _timing_rows(missions: dict[str, Any]) -> dict[str, str]:
+    """One printed row per UAV mission: items, route time vs planned, start hold."""
+    rows = {}
+    for n, m in missions.items():
+        t = m.summary()["timing"]
+        rows[f"mission {n}"] = (f"{m.summary()['items']} items, route "
+                                f"{t['mission_route_s']:.0f} s (planned {t['planned_s']:.0f} s), "
+                                f"start hold {t['start_hold_s']:.1f} s")
+    return rows
+
+
+@handle_errors
+@output_options("out/formation-thesis", json_help="Print the results as JSON.",
+                report_help="Also write report.html (per case and comparing them).")
+def reproduce_formation_cmd(
+    seed: int = typer.Option(0, help="Seed of the fissure terrain."),
+    gif: bool = typer.Option(True, "--gif/--no-gif", help="Write the animations."),
+    output: Output = None,
+) -> None:
+    """``fm2uav reproduce formation``: :func:`~fm2uav.experiments.formation.reproduce_formation`,
+    one folder per case, table.md."""
+    from ..experiments.formation import THESIS_CASES, reproduce_formation, thesis_markdown
+
+    out, report = output.out, output.report
+    root = output.dir(["table.md", "summary.json"] + ([REPORT] if report else []))
+    for case in THESIS_CASES:
+        OutputDir(out / case.folder, force=output.force).check(_outputs(gif, report))
+    subtitle = get_scenario("fissure", seed=seed).description
+    with output.progress() as step:
+        def write(case, result, summary) -> None:  # each case's folder as soon as it flew
+            _write_case(OutputDir(out / case.folder, force=output.force), result, summary,
+                        title=case.title, gif=gif, frames=60, report=report,
+                        subtitle=subtitle, step=step)
+
+        run = reproduce_formation(seed, on_case=write, on_step=step)
+    lines = thesis_markdown(run)
+    write_text(root, "table.md", lines)
+    write_json(root, "summary.json", run.summaries)
+    if report:
+        from ..viz.formation import thesis_report_html
+
+        write_text(root, REPORT, thesis_report_html(
+            run, ["table.md", "summary.json"] + [f"{c.folder}/" for c in run.cases]))
+    if output.as_json:
+        print_summary("", run.summaries, as_json=True, quiet=output.quiet)
+    elif not output.quiet:
+        from ._common import console
+
+        console.print(lines.rstrip("\n"))
+        console.print(f"outputs in {out}/")
+    if not run.completed:
+        raise typer.Exit(EXIT_PLANNING)
 
 
 def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
     """Add ``formation`` and ``reproduce formation``."""
-
-    @app.command(
-        "formation",
-        help=(
-            "Fly a leader–follower formation with FM² (thesis ch. 6) and write trajectories.csv, "
-            "metrics.csv, cycles.csv, summary.json, paths.png, profiles.png, metrics.png, "
-            "formation.gif (and with --report an interactive report.html), and one mission per "
-            "UAV in every format (leader_mission.plan / .waypoints, leader_path.kml / .kmz / "
-            ".geojson / .csv, follower1_..., ...): its own route "
-            "with a DO_CHANGE_SPEED per leg and holds so that it keeps the simulated timing; "
-            "started together, the vehicles leave their start points at the same moment.\n\n"
-            "Examples:\n\n"
-            "  fm2uav formation --scenario fissure --out out/formation\n\n"
-            "  fm2uav formation --scenario fissure --level 7 --report --out out/formation-l7\n\n"
-            "  fm2uav formation --shape v --followers 4 --dist 45 --no-gif --out out/v4\n\n"
-            "  fm2uav formation --dem dem.tif --bbox 10.05,45.54,10.2,45.66 --lonlat --start "
-            "10.06,45.55 --goal 10.19,45.65 --agl 120 --no-gif --out out/formation-dem\n\n"
-            f"Scenarios: {', '.join(SCENARIOS)}."
-        ),
-    )
-    @handle_errors
-    def formation_cmd(
-        scenario: ScenarioOpt = None,
-        start: str | None = typer.Option(None, help="Leader start x,y,z (m) (cells with --cells; "
-                                         "LON,LAT[,AGL] with --lonlat)."),
-        goal: str | None = typer.Option(None, help="Leader goal x,y,z (m) (cells with --cells; "
-                                        "LON,LAT[,AGL] with --lonlat)."),
-        cells: bool = typer.Option(False, "--cells", help="Read --start/--goal as grid cells."),
-        lonlat: LonLatOpt = False,
-        shape: str = typer.Option("triangle", help="Formation: triangle, v or line."),
-        followers: int = typer.Option(2, help="Number of followers."),
-        dist: float = typer.Option(
-            60.0, help="Safety distance dist (m); UAVs never closer than dist/2."),
-        speed: float = typer.Option(10.0, help="Leader speed (m/s)."),
-        follower_speed: float | None = typer.Option(
-            None, help="Followers' top speed (m/s) (default 1.5 × leader)."),
-        cycle: float = typer.Option(1.0, help="Re-planning period (s)."),
-        agl: float | None = typer.Option(None, help="Flight level (m above ground) for all UAVs."),
-        level: float | None = typer.Option(
-            None, help="Flight level in vertical cells (thesis: 7)."),
-        p1: float = typer.Option(0.5, help="Flight-level exponent on the level (thesis ch. 6: 1)."),
-        p2: float = typer.Option(1.5, help="Flight-level exponent elsewhere (thesis ch. 6: 0.5)."),
-        grey: str = typer.Option(
-            "goal", help="Grey level at the partial 'goal' or the 'follower'."),
-        seed: int = typer.Option(0, help="Seed of the scenario's random relief."),
-        gif: bool = typer.Option(True, "--gif/--no-gif", help="Write the animation."),
-        frames: int = typer.Option(60, help="Animation frames (at most)."),
-        out: Path = typer.Option(Path("out/formation"), help="Output directory."),
-        force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
-        as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
-        quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
-        report: bool = typer.Option(
-            False, "--report", help="Also write report.html (interactive, self-contained)."),
-        dem: DemOpt = None,
-        buildings: BuildingsOpt = None,
-        bbox: BboxOpt = None,
-        sea_level: SeaLevelOpt = None,
-        cell_size: CellSizeOpt = None,
-        dz: DzOpt = None,
-        ceiling: CeilingOpt = None,
-        nodata: NodataOpt = "error",
-        nodata_value: NodataValueOpt = None,
-        crs: CrsOpt = None,
-        default_height: DefaultHeightOpt = None,
-        allow_filled: AllowFilledOpt = False,
-        firmware: Firmware = None,
-        vehicle: Vehicle = None,
-        frame: Frame = None,
-        end: End = None,
-        thin: Thin = None,
-        anchor: AnchorText = None,
-        endurance: Endurance = None,
-        reserve: Reserve = None,
-    ) -> None:
-        from ..errors import InputError
-        from ..experiments.formation import fly_and_summarise, summary_rows
-        from ..io.exports import EXPORT_FILES, export_formation, file_prefix
-        from .cmd_run import write_exports
-        from ..missions.formation import FormationConfig
-        from ..planning import FlightLevel
-
-        spec = world_spec(dem=dem, buildings=buildings, bbox=bbox, sea_level=sea_level,
-                          cell_size=cell_size, dz=dz, ceiling=ceiling, nodata=nodata,
-                          nodata_value=nodata_value, crs=crs, default_height=default_height,
-                          allow_filled=allow_filled)
-        need_agl, need_top = requested_heights(start, goal, lonlat=lonlat, agl=agl)
-        world, sc, scenario = build_world(spec, scenario=scenario, seed=seed, agl=need_agl,
-                                          top=need_top, default="fissure")
-        if agl is not None and level is not None:
-            raise InputError("give either --agl (metres) or --level (cells), not both")
-        if level is not None:
-            agl = float(level) * world.spacing[2]
-        outdir = OutputDir(out, force=force)
-        uavs = ["leader"] + [f"follower {k + 1}" for k in range(followers)]
-        mission_names = [file_prefix(n) + EXPORT_FILES[f] for n in uavs for f in MISSION_FORMATS]
-        outdir.check(_outputs(gif, report) + tuple(mission_names))
-        mission_options = export_options(
-            None, firmware=firmware, vehicle=vehicle, frame=frame, end=end, thin=thin,
-            anchor=anchor, endurance=endurance, reserve=reserve, name=f"formation {scenario}")
-
-        from ..scenarios.scenario import Scenario
-        from ..world.load import check_points, world_summary
-
-        def point(text: str | None, default: np.ndarray | None, what: str) -> np.ndarray:
-            return cli_point(text, what, world, lonlat=lonlat, cells=cells, agl=agl,
-                             default=default)
-
-        s = point(start, sc.start if sc else None, "start")
-        g = point(goal, sc.goal if sc else None, "goal")
-        check_points(world, {"start": s, "goal": g}, allow_filled=allow_filled)
-        sc = Scenario(world=world, start=s, goal=g,
-                      description=sc.description if sc else f"real data: {scenario}")
-        title = f"formation — {scenario}" + (f", flight level {agl:g} m" if agl else "")
-        with progress(enabled=not (quiet or as_json)) as step:
-            step(f"{title}: flying the formation (FM² re-planning every cycle)")
-            config = FormationConfig(n_followers=followers, shape=shape, dist=dist,
-                                     leader_speed=speed, follower_speed=follower_speed,
-                                     cycle=cycle, grey=grey)
-            result, summary = fly_and_summarise(
-                sc, config=config,
-                level=None if agl is None else FlightLevel(agl=agl, p1=p1, p2=p2))
-            step("building one mission per UAV")
-            missions, files = export_formation(result, MISSION_FORMATS, mission_options)
-            summary = {"scenario": scenario, "world": world_summary(world), **summary,
-                       "missions": {n: m.summary() for n, m in missions.items()}}
-            write_exports(outdir, files, step)
-            _write_case(outdir, result, summary, title=title, gif=gif, frames=frames,
-                        report=report, subtitle=sc.description, step=step)
-        timing = {f"mission {n}": f"{m.summary()['items']} items, route "
-                                  f"{m.summary()['timing']['mission_route_s']:.0f} s (planned "
-                                  f"{m.summary()['timing']['planned_s']:.0f} s), start hold "
-                                  f"{m.summary()['timing']['start_hold_s']:.1f} s"
-                  for n, m in missions.items()}
-        print_summary("FM² formation",
-                      summary if as_json else {**summary_rows(summary), **timing,
-                                               **world_rows(world)},
-                      as_json=as_json, quiet=quiet, files=outdir.written)
-        if not result.completed:
-            raise typer.Exit(EXIT_PLANNING)
-
-    @reproduce_app.command(
-        "formation",
-        help=(
-            "Thesis ch. 6: the triangle formation across the fissure without (case 1) and with "
-            "(case 2) the flight level 7 cells; case 2 is run with the thesis' p1 = 1, p2 = 0.5 "
-            "and with the planner's p1 = 0.5, p2 = 1.5. Writes one folder per case and "
-            "table.md comparing our times with the thesis' 130.6 s / 135.6 s (Matlab); with "
-            "--report also report.html per case and one comparing the cases.\n\n"
-            "Examples:\n\n"
-            "  fm2uav reproduce formation --out out/formation-thesis\n\n"
-            "  fm2uav reproduce formation --no-gif --report --out out/formation-report"
-        ),
-    )
-    @handle_errors
-    def reproduce_formation(
-        seed: int = typer.Option(0, help="Seed of the fissure terrain."),
-        gif: bool = typer.Option(True, "--gif/--no-gif", help="Write the animations."),
-        out: Path = typer.Option(Path("out/formation-thesis"), help="Output directory."),
-        force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
-        as_json: bool = typer.Option(False, "--json", help="Print the results as JSON."),
-        quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
-        report: bool = typer.Option(
-            False, "--report", help="Also write report.html (per case and comparing them)."),
-    ) -> None:
-        from ..experiments.formation import THESIS_CASES, reproduce_formation, thesis_markdown
-
-        root = OutputDir(out, force=force)
-        root.check(["table.md", "summary.json"] + ([REPORT] if report else []))
-        for case in THESIS_CASES:
-            OutputDir(out / case.folder, force=force).check(_outputs(gif, report))
-        subtitle = get_scenario("fissure", seed=seed).description
-        with progress(enabled=not (quiet or as_json)) as step:
-            def write(case, result, summary) -> None:  # each case's folder as soon as it flew
-                _write_case(OutputDir(out / case.folder, force=force), result, summary,
-                            title=case.title, gif=gif, frames=60, report=report,
-                            subtitle=subtitle, step=step)
-
-            run = reproduce_formation(seed, on_case=write, on_step=step)
-        results = run.summaries
-        lines = thesis_markdown(run)
-        with root.open("table.md") as fh:
-            fh.write(lines)
-        with root.open("summary.json") as fh:
-            json.dump(to_jsonable(results), fh, indent=2)
-        if report:
-            from ..viz.formation import thesis_report_html
-
-            html = thesis_report_html(
-                run, ["table.md", "summary.json"] + [f"{c.folder}/" for c in run.cases])
-            with root.open(REPORT) as fh:
-                fh.write(html)
-        if as_json:
-            print_summary("", results, as_json=True, quiet=quiet)
-        elif not quiet:
-            from ._common import console
-
-            console.print(lines.rstrip("\n"))
-            console.print(f"outputs in {out}/")
-        if not run.completed:
-            raise typer.Exit(EXIT_PLANNING)
+    app.command("formation", help=FORMATION_HELP)(formation_cmd)
+    reproduce_app.command("formation", help=REPRODUCE_HELP)(reproduce_formation_cmd)
