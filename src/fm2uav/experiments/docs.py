@@ -303,6 +303,20 @@ def _city_rrt_claims() -> str:
 
 
 @cache
+def _tracking() -> Any:
+    from .tracking import reproduce_tracking
+
+    return reproduce_tracking(DOCS.parent / "out" / "docs" / "tracking" / f"step{CURVATURE_STEP:g}",
+                              step=CURVATURE_STEP)
+
+
+def _tracking_table() -> str:
+    from .tracking import tracking_markdown
+
+    return tracking_markdown(_tracking())
+
+
+@cache
 def _urban() -> Any:
     from .urban import reproduce_urban
 
@@ -337,6 +351,7 @@ BLOCKS: dict[str, Block] = {
     "city-rrt-claims": Block("feasibility.md", _city_rrt_claims, slow=True, exact=False),
     "formation-table": Block("formation.md", _formation_table, slow=True),
     "curvature-results": Block("curvature.md", _curvature_results, slow=True),
+    "tracking": Block("curvature.md", _tracking_table, slow=True),
 }
 
 
