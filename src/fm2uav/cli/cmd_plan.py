@@ -22,7 +22,7 @@ from .options import (
     world_options,
     world_rows,
 )
-from .cmd_run import mission_rows, output_names, plan_outputs
+from .cmd_run import mission_rows, output_names, plan_outputs, safety_rows
 
 PLAN_FILES = ("path.csv", "plan.png", "summary.json")
 
@@ -79,6 +79,15 @@ def plan_cmd(
         False, "--graded", help="Blend the exponent from p1 to p2 across --band."),
     mode: str = typer.Option(
         "capped", help="Flight-level reading: 'capped' or 'literal' (W**p as is)."),
+    min_agl: float | None = typer.Option(
+        None, "--min-agl", help="Hard floor (m) above the ground for the whole flight except "
+        "the take-off/landing points (with --agl)."),
+    max_agl: float | None = typer.Option(
+        None, "--max-agl", help="Hard ceiling (m) above the ground, e.g. 120 (with --agl)."),
+    no_fly: list[str] | None = typer.Option(
+        None, "--no-fly", help="No-fly zones file (GeoJSON lon/lat, KML/KMZ, GPKG, SHP; points "
+        "need a 'radius' in metres); the plan keeps out of them and the .plan carries them "
+        "as geofences. Repeatable.", show_default=False),
 
     seed: int = typer.Option(0, help="Seed of the scenario's random relief."),
     output: Output = None,
@@ -115,8 +124,20 @@ def plan_cmd(
     check_points(w, {"start": start_m, "goal": goal_m,
                      **{f"via {k + 1}": v for k, v in enumerate(via_m)}},
                  allow_filled=world.allow_filled)
-    level_keys = (dict(agl=agl, p1=p1, p2=p2, band=band, graded=graded, mode=mode)
+    if no_fly:  # no-fly zones become obstacles of the world
+        from ..io.zone_spec import zones_from_cli
+        from ..world.zones import check_points_allowed, with_zones
+
+        w = with_zones(w, zones_from_cli(no_fly, w, crs=world.crs))
+        check_points_allowed(w, {"start": start_m, "goal": goal_m,
+                                 **{f"via {k + 1}": v for k, v in enumerate(via_m)}})
+    level_keys = (dict(agl=agl, p1=p1, p2=p2, band=band, graded=graded, mode=mode,
+                       **{k: v for k, v in (("min_agl", min_agl), ("max_agl", max_agl))
+                          if v is not None})
                   if agl is not None else {})
+    if agl is None and (min_agl is not None or max_agl is not None):
+        raise InputError("--min-agl / --max-agl limit a terrain-following flight; give --agl "
+                         "too (the requested height above ground)")
     shaping, level, options = planner_objects(dict(
         saturation=saturation, saturation_distance=saturation_distance, exponent=exponent,
         order=order, **level_keys))
@@ -126,6 +147,11 @@ def plan_cmd(
     p = route.plan
     summary = {"scenario": scenario, "world": world_summary(w), **p.summary(),
                "route": route.summary()}
+    if p.path.shape[1] == 3:  # measured on the continuous ground (legs: with the exports)
+        from ..analysis.safety import safety_summary
+
+        summary["safety"] = safety_summary(w, p.path, requested=agl, phase=p.phase,
+                                           level=p.level)
     _write_plan(outdir, p, w, title=f"FM² plan — {scenario}")
     built = None
     if extra:
@@ -133,7 +159,8 @@ def plan_cmd(
                                    title=f"FM² plan — {scenario}", subtitle=description,
                                    via=route.junctions[1:-1])
         summary.update(waypoints=info["waypoints"], mavlink_frame=info["mavlink_frame"],
-                       home_lat_lon_alt=info["home_lat_lon_alt"], autopilot=info["autopilot"])
+                       home_lat_lon_alt=info["home_lat_lon_alt"], autopilot=info["autopilot"],
+                       safety=info["safety"])
     write_json(outdir, "summary.json", summary)
     output.summary("FM² plan", _rows(scenario, route, w, summary, built), summary)
 
@@ -166,6 +193,8 @@ def _rows(scenario: str, route, world, summary: dict, built) -> dict:
     }
     if len(route.legs) > 1:
         rows["legs"] = len(route.legs)
+    if "safety" in summary:
+        rows.update(safety_rows(summary["safety"]))
     if "waypoints" in summary:
         rows["waypoints"] = f"{summary['waypoints']} (MAVLink frame {summary['mavlink_frame']})"
         rows.update(mission_rows(built))
