@@ -214,7 +214,13 @@ class OutputDir:
             return
         if self._checked:
             return
-        names = list(names)
+        try:
+            self._check(list(names))
+        except BaseException:
+            self.abort()  # a refused set holds no lock and is not active any more
+            raise
+
+    def _check(self, names: list[str]) -> None:
         p = self.path
         if p.exists() and not p.is_dir():
             raise InputError(f"--out {p} exists and is not a folder; choose another --out")

@@ -313,6 +313,8 @@ def from_buildings(
             raise WorldError(f"origin must be three finite numbers (x0, y0, z0) in metres, got "
                              f"{origin!r}")
         check_size((nx, ny), cs[:2])
+        # refuse a 3D grid beyond memory before the (nx, ny) roof pass (seconds on 1e8 columns)
+        check_size((nx, ny, _nz_estimate(heights, shape, height_cells, agl, top, cs[2])), cs)
         ground = np.full((nx, ny), org[2])
     # ---- roofs
     roof, outside, off_grid = _roofs(polys, heights, ground, org, cs, all_touched)
@@ -387,6 +389,20 @@ def from_buildings(
         filled=None if terrain is None else terrain.filled,
         georef=georef,
     )
+
+
+def _nz_estimate(heights: Sequence[float], shape: Any, height_cells: Any, agl: Any, top: Any,
+                 dz: float) -> int:
+    """Vertical node count the flat-ground grid will get (as below, ground z0 = 0)."""
+    if shape is not None:
+        return int(shape[2])
+    if height_cells is not None:
+        return int(height_cells)
+    hs = [float(h) for h in heights if np.isfinite(h)]
+    rel = max(hs) if hs else 0.0
+    nz = (int(np.ceil(rel / dz)) + 3 if agl is None
+          else int(np.ceil((rel + float(agl)) / dz)) + 10)
+    return max(nz, int(np.ceil(float(top) / dz)) + 5) if top is not None else nz
 
 
 def _report_left_out(data: Any, outside: int, off_grid: int) -> None:
