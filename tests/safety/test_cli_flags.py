@@ -24,7 +24,7 @@ def test_plan_keeps_out_of_two_no_fly_files_and_below_max_agl(tmp_path):
     out = tmp_path / "out"
     res = CliRunner().invoke(app, [
         "plan", "--agl", "120", "--min-agl", "30", "--max-agl", "250", "--no-fly", str(a),
-        "--no-fly", str(b), "--export", "plan", "--out", str(out), "--json"])
+        "--no-fly", str(b), "--export", "plan", "--report", "--out", str(out), "--json"])
     assert res.exit_code == 0, res.output
     s = json.loads((out / "summary.json").read_text())
     assert s["safety"]["zones"]["count"] == 2 and s["safety"]["zones"]["path_entries"] == []
@@ -36,6 +36,8 @@ def test_plan_keeps_out_of_two_no_fly_files_and_below_max_agl(tmp_path):
         assert not shapely.intersects(shapely.LineString(xy), shapely.Polygon(ring).buffer(30))
     fence = json.loads((out / "mission.plan").read_text())["geoFence"]
     assert len(fence["polygons"]) == 2
+    html = (out / "report.html").read_text()
+    assert "no-fly zone: wall" in html and "no-fly zone: box (buffer 30 m)" in html
 
 
 def test_agl_above_max_agl_is_one_line_naming_the_flag(tmp_path):
