@@ -361,5 +361,5 @@ def test_mission_start_equal_goal_refused_before_writing(tmp_path):
     out = tmp_path / "out"
     res = CliRunner().invoke(app, ["run", str(f), "--out", str(out)])
     assert res.exit_code == 2, res.output
-    assert "same place" in res.output
+    assert "start and goal are the same place" in res.output
     assert not out.exists() and not list(tmp_path.glob(".out*"))

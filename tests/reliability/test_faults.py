@@ -310,3 +310,15 @@ def test_real_plan_sigterm_never_leaves_a_mix(tmp_path):
         assert proc.returncode == 130
         assert names == before
     assert _leftovers(tmp_path, "out") == []
+
+
+def test_merge_mode_never_swaps(tmp_path):
+    out = tmp_path / "sweep"
+    out.mkdir()
+    (out / "cases.jsonl").write_text("1\n")
+    with OutputDir(out, force=True, merge=True) as s:
+        with s.open("tables.md") as fh:
+            fh.write("t")
+        assert not (out / "tables.md").exists()  # staged until the end
+    assert sorted(p.name for p in out.iterdir()) == ["cases.jsonl", "tables.md"]
+    assert _leftovers(tmp_path, "sweep") == []

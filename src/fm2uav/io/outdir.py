@@ -152,6 +152,10 @@ class OutputDir:
         The folder the outputs end up in (CLI ``--out``).
     force : bool
         Replace an existing folder as a whole (CLI ``--force``).
+    merge : bool
+        Never swap the folder: move the staged files into it one by one at the end
+        (for folders a library also writes into directly, e.g. a resumable sweep).
+        The staged files still appear only when the run succeeds.
 
     Examples
     --------
@@ -164,9 +168,11 @@ class OutputDir:
     ['a.txt']
     """
 
-    def __init__(self, path: str | os.PathLike[str], *, force: bool = False) -> None:
+    def __init__(self, path: str | os.PathLike[str], *, force: bool = False,
+                 merge: bool = False) -> None:
         self.path = Path(path)
         self.force = force
+        self.merge = merge
         self.written: list[Path] = []
         self.parent_set: OutputDir | None = None
         self._stage: Path | None = None
@@ -396,7 +402,7 @@ class OutputDir:
         assert stage is not None
         changed = _listing(target) != (self._before or {})
         try:
-            if changed and target.is_dir():
+            if (changed or self.merge) and target.is_dir():
                 # someone wrote into the folder meanwhile: keep their files, add ours
                 self._merge(stage, target)
                 shutil.rmtree(stage, ignore_errors=True)

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError, PlanningError
+from ..errors import InputError, PlanningError, PointError
 from ..planning import Plan, plan
 from ..planning.params import FlightLevel, PlanOptions, Shaping
 from ..planning.altitude import join_profiles
@@ -114,6 +114,10 @@ def plan_route(
             raise InputError(f"{what} must be {ndim} finite numbers [m], got {p.tolist()}")
     for k in range(len(pts) - 1):
         if np.linalg.norm(pts[k + 1] - pts[k]) < 1e-9:
+            if len(pts) == 2:
+                raise PointError(f"start and goal are the same place {pts[k].tolist()} m: there "
+                                 "is nothing to plan; give a goal elsewhere (mission file "
+                                 "start/goal; CLI --start/--goal)")
             raise InputError(f"points {k} and {k + 1} of the route are the same place "
                              f"{pts[k].tolist()} m; remove the repeated via point")
     legs: list[Plan] = []
