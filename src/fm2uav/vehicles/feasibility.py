@@ -109,6 +109,31 @@ class FeasibilityReport:
             "collision": self.collision,
         }
 
+    def summary_rows(self, airframe: Airframe | None = None) -> dict[str, str]:
+        """The verdict as printable ``{label: text}`` rows (what ``fm2uav check`` prints).
+
+        ``airframe`` is the airframe as asked (default :attr:`airframe`); a
+        fixed-wing adds its minimum turn radius at the simulated cruise speed.
+        """
+        af = self.airframe if airframe is None else airframe
+        tr, geo = self.tracking, self.geometric
+        sat = ", ".join(f"{k} {v:.1f} s" for k, v in tr.saturation_time().items()) or "none"
+        rows = {
+            "verdict": "FEASIBLE" if self.feasible else "INFEASIBLE",
+            "reason": self.reason,
+            "airframe": f"{af.name} ({af.kind})",
+            "separation max / mean [m]": f"{tr.max_separation:.2f} / {tr.mean_separation:.2f}",
+            "limits saturated": sat,
+            "geometric check": ("ok" if geo.feasible else "violated") + f": {geo.reason}",
+            "min radius of curvature [m]": (f"{geo.min_radius:.1f}"
+                                            if math.isfinite(geo.min_radius) else "inf"),
+            "max climb / descent [deg]": (f"{np.degrees(geo.climb_angle.max()):.1f} / "
+                                          f"{np.degrees(-geo.climb_angle.min()):.1f}"),
+        }
+        if getattr(af, "kind", "") == "fixed-wing":
+            rows["R_min [m]"] = f"{af.turn_radius(self.airframe.cruise_speed):.1f}"
+        return rows
+
 
 def check_feasibility(
     path: Any,
