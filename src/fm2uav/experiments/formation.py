@@ -1,7 +1,13 @@
 """The leader–follower formation experiments of thesis ch. 6.
 
 The triangle formation crosses the fissure without (case 1) and with (case 2)
-the flight level of 7 cells; case 2 is flown with the thesis' p1 = 1, p2 = 0.5
+the flight level of 7 cells. Case 1 is read as the thesis describes it (docs/formation.md):
+the UAVs fly at "30 cells, approximately" and deform between the fissure's mountains, so
+the map's border and ceiling are obstacles (``walls``, which keeps the FM² path half-way
+between the ground and the ceiling instead of at the ceiling) and the stand-in relief is
+scaled so that its mountains rise above that flight (:data:`CASE1_RELIEF_TOP`), with the
+thesis' 8-cell (120 m) spacing; the stand-in relief as built (whose ridges stay below the
+start altitude) is flown too (``case1-over-ridges``); case 2 is flown with the thesis' p1 = 1, p2 = 0.5
 and with the planner's p1 = 0.5, p2 = 1.5 (:data:`THESIS_CASES`). Our times are
 compared with the thesis' Matlab times (:data:`THESIS_TIMES`); ours are warm: every
 case is flown once untimed first (:func:`._timing.warm`, numba compilation excluded).
@@ -11,12 +17,14 @@ case is flown once untimed first (:func:`._timing.warm`, numba compilation exclu
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import lru_cache
 from typing import Any
 
 from ..analysis.flight_level import flight_level_deviation
-from ..missions.formation import FormationResult, fly_formation, inside_terrain
-from ..planning import FlightLevel
+from ..errors import WorldError
+from ..missions.formation import FormationConfig, FormationResult, fly_formation, inside_terrain
+from ..planning import FlightLevel, Shaping
 from ..scenarios import Scenario, get_scenario
 from ._timing import warm
 
@@ -48,16 +56,66 @@ class FormationCase:
     level: float | None = None
     p1: float | None = None
     p2: float | None = None
+    #: map border and ceiling as obstacles (``Shaping(walls=True)``)
+    walls: bool = False
+    #: relief scaled so that its highest point is this many vertical cells (None: as built)
+    relief_top: float | None = None
+    #: distance between the UAVs [m] (None: the FormationConfig default)
+    dist: float | None = None
 
     def options(self, dz: float) -> dict[str, Any]:
         """The ``fly_formation`` keyword arguments of this case on vertical cells of ``dz`` m."""
-        if self.level is None:
-            return {}
-        return {"level": FlightLevel(agl=self.level * dz, p1=self.p1, p2=self.p2)}
+        out: dict[str, Any] = {}
+        if self.level is not None:
+            out["level"] = FlightLevel(agl=self.level * dz, p1=self.p1, p2=self.p2)
+        if self.walls:
+            out["shaping"] = Shaping(walls=True)
+        if self.dist is not None:
+            out["config"] = FormationConfig(dist=self.dist)
+        return out
+
+
+#: Case 1's relief top [vertical cells]: the lateral mountains rise above the ~30-cell flight.
+CASE1_RELIEF_TOP = 36.0
+
+
+def case_scenario(seed: int, case: FormationCase) -> Scenario:
+    """The fissure of ``seed``; with ``case.relief_top`` its relief scaled to that top [cells]
+    (same start/goal cells, same horizontal layout)."""
+    sc = get_scenario("fissure", seed=seed)
+    if case.relief_top is None:
+        return sc
+    return _deep_fissure(seed, float(case.relief_top))
+
+
+@lru_cache(maxsize=2)
+def _deep_fissure(seed: int, top: float) -> Scenario:
+    import numpy as np
+
+    from ..scenarios.open_field import OPEN_FIELD_CELL, OPEN_FIELD_HEIGHT_CELLS
+    from ..world import World
+    from ..world.terrain import OPEN_FIELD_SHAPE, open_field_heights
+
+    base = get_scenario("fissure", seed=seed)
+    h = open_field_heights(seed, OPEN_FIELD_SHAPE)
+    world = World.from_heightmap(h * (top / float(h.max())) * OPEN_FIELD_CELL, OPEN_FIELD_CELL,
+                                 OPEN_FIELD_HEIGHT_CELLS, name=f"fissure, relief to {top:g} cells")
+    start = world.to_world(world.to_index(base.start))
+    goal = world.to_world(world.to_index(base.goal))
+    for what, p in (("start", start), ("goal", goal)):
+        if world.occupancy[world.to_cell(p)]:
+            raise WorldError(f"the fissure {what} is inside the relief scaled to {top:g} cells; "
+                             "lower the relief top")
+    return Scenario(world=world, start=start, goal=goal,
+                    description=f"{base.description}; relief scaled to a top of {top:g} cells "
+                                f"({top * OPEN_FIELD_CELL:g} m)")
 
 
 THESIS_CASES = (
-    FormationCase("case1", "case 1: no flight level", "case1"),
+    FormationCase("case1", "case 1: no flight level, walls, relief to 36 cells, dist 120 m",
+                  "case1", walls=True, relief_top=CASE1_RELIEF_TOP, dist=120.0),
+    FormationCase("case1-over-ridges", "case 1 on the stand-in relief (flies over the ridges)",
+                  "case1"),
     FormationCase("case2-thesis-p", "case 2: level 7, p1 = 1, p2 = 0.5 (thesis)", "case2",
                   level=7, p1=1.0, p2=0.5),
     FormationCase("case2", "case 2: level 7, p1 = 0.5, p2 = 1.5", "case2",
@@ -117,6 +175,8 @@ class ThesisRun:
     cases: tuple[FormationCase, ...]
     flights: dict[str, FormationResult]
     summaries: dict[str, dict[str, Any]]
+    #: each case's own scenario (case 1's relief differs), by case folder
+    scenarios: dict[str, Scenario] = field(default_factory=dict)
 
     @property
     def completed(self) -> bool:
@@ -140,8 +200,10 @@ def reproduce_formation(
     run = ThesisRun(seed=seed, scenario=sc, cases=cases, flights={}, summaries={})
     for case in cases:
         on_step(f"{case.title}: flying the formation (FM² re-planning every cycle)")
-        (result, summary), _ = warm(lambda: fly_and_summarise(sc, **case.options(dz)),
-                                    [sc.world])
+        csc = case_scenario(seed, case)
+        run.scenarios[case.folder] = csc
+        (result, summary), _ = warm(lambda: fly_and_summarise(csc, **case.options(dz)),
+                                    [csc.world])
         run.flights[case.folder], run.summaries[case.folder] = result, summary
         on_case(case, result, summary)
     return run
