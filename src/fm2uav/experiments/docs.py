@@ -204,9 +204,10 @@ def _city_rrt() -> str:
 
 #: Where the curvature block's sweep lives (resumed, so a rerun only re-summarises).
 CURVATURE_DIR = DOCS.parent / "out" / "docs" / "curvature"
-#: Grid step of the curvature block: 0.1 (10 × 10 × 24 pairs = 2400 cases, minutes on one
-#: core); the seed's 0.02 grid (60 000 cases) is ``fm2uav reproduce curvature``.
-CURVATURE_STEP = 0.1
+#: Grid step of the curvature and tracking blocks: 0.05 (20 × 20 × 24 pairs = 9600 cases,
+#: ~15 min on one loaded core, resumed afterwards); the seed's 0.02 grid (60 000 cases) is
+#: ``fm2uav reproduce curvature``.
+CURVATURE_STEP = 0.05
 _MODEL_NAMES = {"dubins": "Dubins", "elastica": "Elastica", "rs": "Reeds–Shepp forward"}
 
 
@@ -306,8 +307,9 @@ def _city_rrt_claims() -> str:
 def _tracking() -> Any:
     from .tracking import reproduce_tracking
 
-    return reproduce_tracking(DOCS.parent / "out" / "docs" / "tracking" / f"step{CURVATURE_STEP:g}",
-                              step=CURVATURE_STEP)
+    config, _result, summary = _curvature()  # the curvature block's sweep includes Dubins
+    return reproduce_tracking(CURVATURE_DIR, step=CURVATURE_STEP, pairs=len(_result.starts),
+                              xi=config.xi, summary=summary)
 
 
 def _tracking_table() -> str:

@@ -69,13 +69,18 @@ class TrackingRun:
 
 def reproduce_tracking(out_dir: str | Path, *, step: float = 0.1, pairs: int = 24,
                        xi: float = 10.0, workers: int = 1,
+                       summary: dict[str, Any] | None = None,
                        on_step: Callable[[str], None] = lambda message: None) -> TrackingRun:
     """The tracking experiment on the best area match to Dubins (see the module docstring).
 
-    ``out_dir`` holds the Dubins sweep (resumed when it exists).
+    ``out_dir`` holds the Dubins sweep (resumed when it exists); ``summary``: use the
+    :func:`~fm2uav.experiments.curvature.summarise_run` of a finished sweep that includes
+    the Dubins model (on the grid ``step``) instead.
     """
-    on_step(f"sweeping α, β (step {step:g}) against the Dubins reference ({pairs} pairs)")
-    config, summary = best_dubins_match(out_dir, step=step, pairs=pairs, xi=xi, workers=workers)
+    if summary is None:
+        on_step(f"sweeping α, β (step {step:g}) against the Dubins reference ({pairs} pairs)")
+        _config, summary = best_dubins_match(out_dir, step=step, pairs=pairs, xi=xi,
+                                             workers=workers)
     best = summary["best"]["area"]["dubins"]
     run = TrackingRun(alpha=best["alpha"], beta=best["beta"], xi=xi, step=step)
     bound = 1.0 / xi
