@@ -322,7 +322,11 @@ def write_text(outdir: OutputDir, name: str, text: str) -> None:
 def write_figure(outdir: OutputDir, fig: Any, name: str, dpi: int = 110) -> None:
     """Save a matplotlib figure as ``name`` (PNG) into the output set."""
     tmp = outdir.target(name)
-    fig.savefig(tmp, dpi=dpi)
+    try:
+        fig.savefig(tmp, dpi=dpi)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
     outdir.commit(tmp, name)
 
 

@@ -6,7 +6,6 @@ Also holds :func:`plan_outputs`, the writer of a plan's output files shared by
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -14,36 +13,24 @@ from typing import Any
 import numpy as np
 import typer
 
-from ._common import OutputDir, handle_errors, print_summary, progress, to_jsonable
-from ._mission_options import (
-    End,
-    Endurance,
-    Firmware,
-    Frame,
-    Reserve,
-    Return,
-    SpeedChanges,
-    Vehicle,
-    Via,
-    export_options,
-    via_points,
+from ._common import (
+    Output,
+    OutputDir,
+    handle_errors,
+    plan_rows,
+    write_figure,
+    write_json,
+    write_text,
 )
+from ._mission_options import via_points
 from .options import (
-    AllowFilledOpt,
-    BboxOpt,
-    BuildingsOpt,
-    CeilingOpt,
-    CellSizeOpt,
-    CrsOpt,
-    DefaultHeightOpt,
-    DemOpt,
-    DzOpt,
     LonLatOpt,
-    NodataOpt,
-    NodataValueOpt,
-    SeaLevelOpt,
+    MissionFlags,
+    WorldFlags,
+    mission_options,
+    output_options,
     point_overrides,
-    world_overrides,
+    world_options,
     world_rows,
 )
 
@@ -239,188 +226,160 @@ def plan_outputs(
     }
     write_exports(outdir, files, step)
     if "html" in formats:
-        from ..viz.report import report_html
-
         step("writing report.html")
-        ms = info["autopilot"]
-        params = {**plan.params, "waypoint tolerance [m]": options.tolerance,
-                  "firmware / airframe": f"{ms['firmware']} / {ms['vehicle']}",
-                  "MAVLink frame": {0: "0 (AMSL: DEM ground + AGL)", 3: "3 (relative to home)",
-                                    10: "10 (above terrain)"}.get(wps.frame, wps.frame),
-                  "mission end": ms["end"]}
-        w_path = plan.w
-        metrics = {
-            "length [m]": round(float(plan.length), 1),
-            "clearance [m]": (round(float(plan.clearance), 2) if np.isfinite(plan.clearance)
-                              else "inf"),
-            "min W on path": round(float(np.min(w_path)), 4),
-            "path points": len(plan.path),
-            "waypoints": len(wps),
-            "mission items": ms["items"],
-            "home (lat, lon, alt AMSL)": [round(v, 7) for v in wps.home],
-            "flight time [min]": round(ms["flight"]["flight_time_s"] / 60, 2),
-            "planning time [s]": round(float(plan.timings.get("total", 0.0)), 3),
-            **safety_rows(safety),
-            **{f"warning {k + 1}": w for k, w in enumerate(ms["warnings"] + fence_warnings)},
-        }
-        html = report_html(
-            plan.world, {"FM² path": plan.path}, title=title, subtitle=subtitle,
-            speeds={"FM² path": plan.w}, waypoints={"FM² path": wps.points_m}, params=params,
-            metrics=metrics, files=output_names(formats),
-            agl=None if level is None else level.agl, overlays=zone_overlays(zones))
-        with outdir.open("report.html", mode="w") as fh:
-            fh.write(html)
+        write_text(outdir, "report.html", _plan_report(
+            plan, info, wps, options, formats, title=title, subtitle=subtitle, zones=zones,
+            fence_warnings=fence_warnings))
     if "png" in formats:
         from ..viz import plan_figure
 
         step("writing plan.png")
-        fig = plan_figure(plan, title=title)
-        tmp = outdir.target("plan.png")
-        try:
-            fig.savefig(tmp, dpi=110)
-        except BaseException:
-            tmp.unlink(missing_ok=True)
-            raise
-        outdir.commit(tmp, "plan.png")
+        write_figure(outdir, plan_figure(plan, title=title), "plan.png")
     if "json" in formats:
-        with outdir.open("summary.json") as fh:
-            json.dump(to_jsonable({**info, "files": [str(p.name) for p in outdir.written]
-                                   + ["summary.json"]}), fh, indent=2)
+        write_json(outdir, "summary.json", {**info, "files": [str(p.name) for p in outdir.written]
+                                            + ["summary.json"]})
     return info, mission
+
+
+def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
+                 formats: Sequence[str], *, title: str, subtitle: str, zones: Any,
+                 fence_warnings: list[str]) -> str:
+    """report.html of a plan and its autopilot mission's waypoints ``wps`` (see
+    :func:`plan_outputs`)."""
+    from ..viz.report import report_html
+
+    ms, level = info["autopilot"], getattr(plan, "level", None)
+    params = {**plan.params, "waypoint tolerance [m]": options.tolerance,
+              "firmware / airframe": f"{ms['firmware']} / {ms['vehicle']}",
+              "MAVLink frame": {0: "0 (AMSL: DEM ground + AGL)", 3: "3 (relative to home)",
+                                10: "10 (above terrain)"}.get(wps.frame, wps.frame),
+              "mission end": ms["end"]}
+    metrics = {
+        "length [m]": round(float(plan.length), 1),
+        "clearance [m]": (round(float(plan.clearance), 2) if np.isfinite(plan.clearance)
+                          else "inf"),
+        "min W on path": round(float(np.min(plan.w)), 4),
+        "path points": len(plan.path),
+        "waypoints": len(wps),
+        "mission items": ms["items"],
+        "home (lat, lon, alt AMSL)": [round(v, 7) for v in wps.home],
+        "flight time [min]": round(ms["flight"]["flight_time_s"] / 60, 2),
+        "planning time [s]": round(float(plan.timings.get("total", 0.0)), 3),
+        **safety_rows(info["safety"]),
+        **{f"warning {k + 1}": w for k, w in enumerate(ms["warnings"] + fence_warnings)},
+    }
+    return report_html(
+        plan.world, {"FM² path": plan.path}, title=title, subtitle=subtitle,
+        speeds={"FM² path": plan.w}, waypoints={"FM² path": wps.points_m},
+        params=params, metrics=metrics, files=output_names(formats),
+        agl=None if level is None else level.agl, overlays=zone_overlays(zones))
+
+
+RUN_HELP = (
+    "Plan the mission described by a YAML file (start, via points, goal, optional "
+    "return leg) and write its outputs: path.csv, path.geojson, path.kml, path.kmz, "
+    "mission.plan (QGroundControl), mission.waypoints (MAVLink QGC WPL 110), "
+    "report.html (interactive), plan.png and summary.json — as listed under "
+    "outputs.formats. The mission starts with a takeoff and ends as outputs.end says, "
+    "in the altitude frame of outputs.frame (auto: ArduPilot terrain, PX4 AMSL), and "
+    "is checked against the firmware's rules before anything is written.\n\n"
+    "Examples:\n\n"
+    "  fm2uav run examples/open_field_tff.yaml\n\n"
+    "  fm2uav run examples/jacksboro_tff.yaml --out out/jacksboro --force\n\n"
+    "  fm2uav run examples/open_field_tff.yaml --firmware ardupilot --end rtl "
+    "--via 1400,300,300 --return --out out/open_field_ardu\n\n"
+    "See docs/operator.md for the mission file format."
+)
+
+
+@handle_errors
+@output_options(None, out_help="Output directory. Default: the mission's outputs.dir, else "
+                "out/<mission file name>.")
+@world_options
+@mission_options("via", "return_to_start", "firmware", "vehicle", "frame", "end",
+                 "speed_changes", "endurance", "reserve")
+def run_cmd(
+    mission_file: Path = typer.Argument(..., help="Mission YAML file.", show_default=False),
+    output: Output = None,
+    start: str | None = typer.Option(
+        None, help="Override the mission's start: LON,LAT,AGL with --lonlat (degrees, "
+        "degrees, metres above ground), else x,y,z metres."),
+    goal: str | None = typer.Option(
+        None, help="Override the mission's goal (as --start)."),
+    lonlat: LonLatOpt = False,
+    world: WorldFlags = None,
+    mission: MissionFlags = None,
+    no_fly: list[Path] | None = typer.Option(
+        None, "--no-fly", help="No-fly zones file (GeoJSON lon/lat, KML/KMZ, GPKG, SHP; "
+        "points need a 'radius' in metres), added to the mission's no_fly_zones. "
+        "Repeatable.", show_default=False),
+    min_agl: float | None = typer.Option(
+        None, "--min-agl", help="Override planner.min_agl: hard floor (m) above the ground "
+        "for the whole flight except the take-off/landing points."),
+    max_agl: float | None = typer.Option(
+        None, "--max-agl", help="Override planner.max_agl: hard ceiling (m) above the "
+        "ground, e.g. 120."),
+    saturation_distance: float | None = typer.Option(
+        None, "--saturation-distance", help="Override planner.saturation_distance: the "
+        "distance (m) from obstacles beyond which W = 1 (a margin that means the same on "
+        "any map)."),
+) -> None:
+    """``fm2uav run``: load the mission file (with the flags' overrides),
+    :func:`~fm2uav.missions.route.plan_route`, :func:`plan_outputs`, print."""
+    from ..io.mission import load_mission
+    from ..missions.route import plan_route
+    from ..planning.params import planner_objects
+    from ..world.load import world_summary
+
+    points = point_overrides(start=start, goal=goal, lonlat=lonlat) or {}
+    if mission.via:
+        points["via"] = via_points(mission.via, lonlat=lonlat)
+    if mission.return_to_start is not None:
+        points["return"] = mission.return_to_start
+    m = load_mission(mission_file, world_overrides=world.overrides(),
+                     point_overrides=points or None)
+    options = mission.export_options(m.export_options())
+    target = output.out or Path(m.outputs.dir or Path("out") / mission_file.stem)
+    formats = list(dict.fromkeys(m.outputs.formats))
+    outdir = output.dir(output_names(formats), path=target)
+    with output.progress() as step:
+        step("building the world")
+        rm = m.resolve()
+        if no_fly:
+            rm = _with_cli_zones(rm, no_fly)
+        step("planning (FM²)" + (f", {len(rm.via) + 1 + rm.return_to_start} legs"
+                                 if rm.via or rm.return_to_start else ""))
+        planner = {**m.plan_kwargs(), **{k: v for k, v in (
+            ("min_agl", min_agl), ("max_agl", max_agl),
+            ("saturation_distance", saturation_distance)) if v is not None}}
+        shaping, level, popts = planner_objects(planner)
+        route = plan_route(rm.world, rm.start, rm.goal, via=rm.via,
+                           return_to_start=rm.return_to_start, shaping=shaping,
+                           level=level, options=popts)
+        p = route.plan
+        world_desc = m.world.scenario or m.world.describe()
+        info, built = plan_outputs(
+            outdir, p, formats, options,
+            title=f"{m.name}", subtitle=f"{world_desc} — {m.description}"
+            if m.description else world_desc,
+            summary={"mission": m.name, "mission_file": str(mission_file),
+                     "world": {**world_summary(rm.world), "name": world_desc},
+                     "route": route.summary()},
+            step=step, via=route.junctions[1:-1],
+        )
+    rows = {
+        "mission": m.name,
+        "world": world_desc,
+        **plan_rows(p),
+        "legs": len(route.legs),
+        **safety_rows(info["safety"]),
+        **mission_rows(built),
+        "time [s]": f"{p.timings['total']:.2f}",
+        **world_rows(rm.world),
+    }
+    output.summary("fm2uav run", rows, {**info, "out": str(target)})
 
 
 def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
     """Add the ``run`` command."""
-
-    @app.command(
-        "run",
-        help=(
-            "Plan the mission described by a YAML file (start, via points, goal, optional "
-            "return leg) and write its outputs: path.csv, path.geojson, path.kml, path.kmz, "
-            "mission.plan (QGroundControl), mission.waypoints (MAVLink QGC WPL 110), "
-            "report.html (interactive), plan.png and summary.json — as listed under "
-            "outputs.formats. The mission starts with a takeoff and ends as outputs.end says, "
-            "in the altitude frame of outputs.frame (auto: ArduPilot terrain, PX4 AMSL), and "
-            "is checked against the firmware's rules before anything is written.\n\n"
-            "Examples:\n\n"
-            "  fm2uav run examples/open_field_tff.yaml\n\n"
-            "  fm2uav run examples/jacksboro_tff.yaml --out out/jacksboro --force\n\n"
-            "  fm2uav run examples/open_field_tff.yaml --firmware ardupilot --end rtl "
-            "--via 1400,300,300 --return --out out/open_field_ardu\n\n"
-            "See docs/operator.md for the mission file format."
-        ),
-    )
-    @handle_errors
-    def run_cmd(
-        mission_file: Path = typer.Argument(..., help="Mission YAML file.", show_default=False),
-        out: Path | None = typer.Option(
-            None, help="Output directory. Default: the mission's outputs.dir, else "
-            "out/<mission file name>."),
-        force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
-        as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
-        quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
-        start: str | None = typer.Option(
-            None, help="Override the mission's start: LON,LAT,AGL with --lonlat (degrees, "
-            "degrees, metres above ground), else x,y,z metres."),
-        goal: str | None = typer.Option(
-            None, help="Override the mission's goal (as --start)."),
-        lonlat: LonLatOpt = False,
-        dem: DemOpt = None,
-        buildings: BuildingsOpt = None,
-        bbox: BboxOpt = None,
-        sea_level: SeaLevelOpt = None,
-        cell_size: CellSizeOpt = None,
-        dz: DzOpt = None,
-        ceiling: CeilingOpt = None,
-        nodata: NodataOpt = "error",
-        nodata_value: NodataValueOpt = None,
-        crs: CrsOpt = None,
-        default_height: DefaultHeightOpt = None,
-        allow_filled: AllowFilledOpt = False,
-        via: Via = None,
-        return_to_start: Return = None,
-        firmware: Firmware = None,
-        vehicle: Vehicle = None,
-        frame: Frame = None,
-        end: End = None,
-        speed_changes: SpeedChanges = None,
-        endurance: Endurance = None,
-        reserve: Reserve = None,
-        no_fly: list[Path] | None = typer.Option(
-            None, "--no-fly", help="No-fly zones file (GeoJSON lon/lat, KML/KMZ, GPKG, SHP; "
-            "points need a 'radius' in metres), added to the mission's no_fly_zones. "
-            "Repeatable.", show_default=False),
-        min_agl: float | None = typer.Option(
-            None, "--min-agl", help="Override planner.min_agl: hard floor (m) above the ground "
-            "for the whole flight except the take-off/landing points."),
-        max_agl: float | None = typer.Option(
-            None, "--max-agl", help="Override planner.max_agl: hard ceiling (m) above the "
-            "ground, e.g. 120."),
-        saturation_distance: float | None = typer.Option(
-            None, "--saturation-distance", help="Override planner.saturation_distance: the "
-            "distance (m) from obstacles beyond which W = 1 (a margin that means the same on "
-            "any map)."),
-    ) -> None:
-        from ..io.mission import load_mission
-        from ..missions.route import plan_route
-        from ..planning.params import planner_objects
-
-        over = world_overrides(dem=dem, buildings=buildings, bbox=bbox, sea_level=sea_level,
-                               cell_size=cell_size, dz=dz, ceiling=ceiling, nodata=nodata,
-                               nodata_value=nodata_value, crs=crs,
-                               default_height=default_height, allow_filled=allow_filled)
-        points = point_overrides(start=start, goal=goal, lonlat=lonlat) or {}
-        if via:
-            points["via"] = via_points(via, lonlat=lonlat)
-        if return_to_start is not None:
-            points["return"] = return_to_start
-        mission = load_mission(mission_file, world_overrides=over, point_overrides=points or None)
-        options = export_options(mission.export_options(), firmware=firmware, vehicle=vehicle,
-                                 frame=frame, end=end, speed_changes=speed_changes,
-                                 endurance=endurance, reserve=reserve)
-        target = out or Path(mission.outputs.dir or Path("out") / mission_file.stem)
-        outdir = OutputDir(target, force=force)
-        formats = list(dict.fromkeys(mission.outputs.formats))
-        outdir.check(output_names(formats))
-        with progress(enabled=not (quiet or as_json)) as step:
-            step("building the world")
-            rm = mission.resolve()
-            if no_fly:
-                rm = _with_cli_zones(rm, no_fly)
-            step("planning (FM²)" + (f", {len(rm.via) + 1 + rm.return_to_start} legs"
-                                     if rm.via or rm.return_to_start else ""))
-            planner = {**mission.plan_kwargs(), **{k: v for k, v in (
-                ("min_agl", min_agl), ("max_agl", max_agl),
-                ("saturation_distance", saturation_distance)) if v is not None}}
-            shaping, level, popts = planner_objects(planner)
-            route = plan_route(rm.world, rm.start, rm.goal, via=rm.via,
-                               return_to_start=rm.return_to_start, shaping=shaping,
-                               level=level, options=popts)
-            p = route.plan
-            world_desc = mission.world.scenario or mission.world.describe()
-            from ..world.load import world_summary
-
-            world_info = {**world_summary(rm.world), "name": world_desc}
-            info, built = plan_outputs(
-                outdir, p, formats, options,
-                title=f"{mission.name}", subtitle=f"{world_desc} — {mission.description}"
-                if mission.description else world_desc,
-                summary={"mission": mission.name, "mission_file": str(mission_file),
-                         "world": world_info, "route": route.summary()},
-                step=step, via=route.junctions[1:-1],
-            )
-        rows = {
-            "mission": mission.name,
-            "world": world_desc,
-            "start [m]": np.round(p.start, 1).tolist(),
-            "goal [m]": np.round(p.goal, 1).tolist(),
-            "length [m]": f"{p.length:.1f}",
-            "clearance [m]": f"{p.clearance:.1f}",
-            "legs": len(route.legs),
-            **safety_rows(info["safety"]),
-            **mission_rows(built),
-            "time [s]": f"{p.timings['total']:.2f}",
-            **world_rows(rm.world),
-        }
-        print_summary("fm2uav run", rows if not as_json else {**info, "out": str(target)},
-                      as_json=as_json, quiet=quiet, files=outdir.written)
+    app.command("run", help=RUN_HELP)(run_cmd)
