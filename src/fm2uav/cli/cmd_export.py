@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
@@ -12,22 +11,8 @@ import typer
 
 from ..errors import InputError
 from ..geometry import path_length
-from ._common import OutputDir, handle_errors, print_summary, to_jsonable
-from ._mission_options import (
-    AnchorText,
-    CruiseSpeed,
-    End,
-    Endurance,
-    Firmware,
-    Frame,
-    HoverSpeed,
-    MinSpeed,
-    Reserve,
-    SpeedChanges,
-    Thin,
-    Vehicle,
-    export_options,
-)
+from ._common import Output, handle_errors, write_json
+from .options import MissionFlags, mission_options, output_options
 from .cmd_run import mission_rows, write_exports
 
 
@@ -50,109 +35,101 @@ def _world(mission_file: Path | None, scenario: str | None, seed: int):
     return get_scenario(scenario, seed=seed).world, None, None, f"scenario {scenario}"
 
 
+EXPORT_HELP = (
+    "Turn an existing path (path.csv, x_m,y_m,z_m[,speed]) into mission files: "
+    "mission.plan (QGroundControl), mission.waypoints (QGC WPL 110), path.kml, "
+    "path.kmz, path.geojson — with takeoff, end, altitude frame and firmware checks as "
+    "every command writes them. The world comes from the mission file the path was "
+    "planned with (--mission) or a built-in scenario; a path whose '# crs=' header "
+    "names another CRS than the world's is refused.\n\n"
+    "Examples:\n\n"
+    "  fm2uav export out/open_field_tff/path.csv --mission examples/open_field_tff.yaml "
+    "--format plan,waypoints --firmware ardupilot --out out/ardu\n\n"
+    "  fm2uav export out/plan/path.csv --scenario open-field --agl 150 --format kmz "
+    "--out out/kmz"
+)
+
+
+@handle_errors
+@mission_options("firmware", "vehicle", "frame", "end", "thin", "anchor", "speed_changes",
+                 "min_speed", "cruise_speed", "hover_speed", "endurance", "reserve")
+@output_options("out/export")
+def export_cmd(
+    path_file: Path = typer.Argument(..., help="Path CSV (as written by fm2uav)."),
+    fmt: list[str] = typer.Option(
+        ["plan,waypoints"], "--format", help="Formats (repeat or comma list): plan, "
+        "waypoints (= wpl), kml, kmz, geojson, csv, or all."),
+    mission_file: Path | None = typer.Option(
+        None, "--mission", help="Mission YAML the path was planned with (world, airframe, "
+        "outputs); the flags below override its values."),
+    scenario: str | None = typer.Option(None, help="Built-in scenario the path is in."),
+    seed: int = typer.Option(0, help="Seed of the scenario's relief."),
+    agl: float | None = typer.Option(
+        None, help="Requested height above ground (m) the path was planned at (default: "
+        "the mission's planner.agl): waypoints on the level get exactly this AGL."),
+    mission: MissionFlags = None,
+    output: Output = None,
+) -> None:
+    """``fm2uav export``: read the path, :func:`~fm2uav.io.export_mission`, write, print."""
+    from ..io import EXPORT_FILES, export_mission, parse_formats
+    from ..io.path_header import read_path_header
+    from ..planning import FlightLevel
+
+    formats = parse_formats(",".join(fmt))
+    outdir = output.dir([EXPORT_FILES[f] for f in formats] + ["summary.json"])
+    world, base, mission_level, where = _world(mission_file, scenario, seed)
+    header = read_path_header(path_file)
+    path, w, floor = _read_path(path_file, header, world, where)
+    options = mission.export_options(base)
+    if options.speed_changes and w is None:
+        raise InputError(f"--speed-changes needs W along the path: {path_file} has no "
+                         "speed column (write it with fm2uav plan / run)")
+    level = (FlightLevel(agl=agl) if agl is not None and mission_level is None else
+             mission_level if agl is None else replace(mission_level, agl=agl))
+    # a path with a final altitude profile (its floor column): heights as they are, legs
+    # checked against the floor (see fm2uav.io.build_mission)
+    profile = None if floor is None else SimpleNamespace(
+        required=floor, level=level if level is not None else FlightLevel(agl=1.0))
+    track = SimpleNamespace(
+        path=path, world=world, w=w, level=None, params={}, profile=profile,
+        length=path_length(path))
+    built, files = export_mission(track, formats, options,
+                                  agl=None if level is None else level.agl)
+    write_exports(outdir, files)
+    summary = {"path_file": str(path_file), "world": where, "path_crs": header["crs"],
+               "points": len(path), "length_m": round(track.length, 3),
+               "autopilot": built.summary()}
+    write_json(outdir, "summary.json", {**summary, "files": [p.name for p in outdir.written]
+                                        + ["summary.json"]})
+    rows = {"path": f"{path_file} ({len(path)} points, {track.length:.1f} m)",
+            "world": where, **mission_rows(built)}
+    output.summary("fm2uav export", rows, summary)
+
+
+def _read_path(path_file: Path, header: dict, world, where: str):
+    """``(path, W or None, floor or None)`` of a path CSV, checked against the world."""
+    from ..io import read_path_csv
+    from ..io.path_header import read_path_floor, read_path_w
+
+    crs = getattr(world, "crs", None)
+    if header["crs"] and crs and header["crs"] != crs:
+        raise InputError(f"{path_file} says crs={header['crs']} but the {where} world is in "
+                         f"{crs}: give the mission or scenario the path was planned on")
+    if header["crs"] and not crs:
+        raise InputError(f"{path_file} says crs={header['crs']} but the {where} world has "
+                         "no CRS: give the mission file of that DEM (--mission)")
+    path = read_path_csv(path_file)
+    if path.shape[1] != world.ndim:
+        raise InputError(f"{path_file} has {path.shape[1]} coordinates a point but the "
+                         f"{where} world is {world.ndim}D")
+    inside = world.contains(path)
+    if not np.all(inside):
+        k = int(np.argmin(inside))
+        raise InputError(f"{path_file}: point {k} {np.round(path[k], 1).tolist()} m lies "
+                         f"outside the {where} world; is this the world it was planned on?")
+    return path, read_path_w(path_file), read_path_floor(path_file)
+
+
 def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
     """Add the ``export`` command."""
-
-    @app.command(
-        "export",
-        help=(
-            "Turn an existing path (path.csv, x_m,y_m,z_m[,speed]) into mission files: "
-            "mission.plan (QGroundControl), mission.waypoints (QGC WPL 110), path.kml, "
-            "path.kmz, path.geojson — with takeoff, end, altitude frame and firmware checks as "
-            "every command writes them. The world comes from the mission file the path was "
-            "planned with (--mission) or a built-in scenario; a path whose '# crs=' header "
-            "names another CRS than the world's is refused.\n\n"
-            "Examples:\n\n"
-            "  fm2uav export out/open_field_tff/path.csv --mission examples/open_field_tff.yaml "
-            "--format plan,waypoints --firmware ardupilot --out out/ardu\n\n"
-            "  fm2uav export out/plan/path.csv --scenario open-field --agl 150 --format kmz "
-            "--out out/kmz"
-        ),
-    )
-    @handle_errors
-    def export_cmd(
-        path_file: Path = typer.Argument(..., help="Path CSV (as written by fm2uav)."),
-        fmt: list[str] = typer.Option(
-            ["plan,waypoints"], "--format", help="Formats (repeat or comma list): plan, "
-            "waypoints (= wpl), kml, kmz, geojson, csv, or all."),
-        mission_file: Path | None = typer.Option(
-            None, "--mission", help="Mission YAML the path was planned with (world, airframe, "
-            "outputs); the flags below override its values."),
-        scenario: str | None = typer.Option(None, help="Built-in scenario the path is in."),
-        seed: int = typer.Option(0, help="Seed of the scenario's relief."),
-        agl: float | None = typer.Option(
-            None, help="Requested height above ground (m) the path was planned at (default: "
-            "the mission's planner.agl): waypoints on the level get exactly this AGL."),
-        firmware: Firmware = None,
-        vehicle: Vehicle = None,
-        frame: Frame = None,
-        end: End = None,
-        thin: Thin = None,
-        anchor: AnchorText = None,
-        speed_changes: SpeedChanges = None,
-        min_speed: MinSpeed = None,
-        cruise_speed: CruiseSpeed = None,
-        hover_speed: HoverSpeed = None,
-        endurance: Endurance = None,
-        reserve: Reserve = None,
-        out: Path = typer.Option(Path("out/export"), help="Output directory."),
-        force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
-        as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
-        quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
-    ) -> None:
-        from ..io import EXPORT_FILES, export_mission, parse_formats, read_path_csv
-        from ..io.path_header import read_path_floor, read_path_header, read_path_w
-        from ..planning import FlightLevel
-
-        formats = parse_formats(",".join(fmt))
-        outdir = OutputDir(out, force=force)
-        outdir.check([EXPORT_FILES[f] for f in formats] + ["summary.json"])
-        world, base, mission_level, where = _world(mission_file, scenario, seed)
-        header = read_path_header(path_file)
-        crs = getattr(world, "crs", None)
-        if header["crs"] and crs and header["crs"] != crs:
-            raise InputError(f"{path_file} says crs={header['crs']} but the {where} world is in "
-                             f"{crs}: give the mission or scenario the path was planned on")
-        if header["crs"] and not crs:
-            raise InputError(f"{path_file} says crs={header['crs']} but the {where} world has "
-                             "no CRS: give the mission file of that DEM (--mission)")
-        path = read_path_csv(path_file)
-        if path.shape[1] != world.ndim:
-            raise InputError(f"{path_file} has {path.shape[1]} coordinates a point but the "
-                             f"{where} world is {world.ndim}D")
-        inside = world.contains(path)
-        if not np.all(inside):
-            k = int(np.argmin(inside))
-            raise InputError(f"{path_file}: point {k} {np.round(path[k], 1).tolist()} m lies "
-                             f"outside the {where} world; is this the world it was planned on?")
-        w = read_path_w(path_file)
-        floor = read_path_floor(path_file)
-        options = export_options(base, firmware=firmware, vehicle=vehicle, frame=frame, end=end,
-                                 thin=thin, anchor=anchor, speed_changes=speed_changes,
-                                 min_speed=min_speed, cruise_speed=cruise_speed,
-                                 hover_speed=hover_speed, endurance=endurance, reserve=reserve)
-        if options.speed_changes and w is None:
-            raise InputError(f"--speed-changes needs W along the path: {path_file} has no "
-                             "speed column (write it with fm2uav plan / run)")
-        level = (FlightLevel(agl=agl) if agl is not None and mission_level is None else
-                 mission_level if agl is None else replace(mission_level, agl=agl))
-        # a path with a final altitude profile (its floor column): heights as they are, legs
-        # checked against the floor (see fm2uav.io.build_mission)
-        profile = None if floor is None else SimpleNamespace(
-            required=floor, level=level if level is not None else FlightLevel(agl=1.0))
-        track = SimpleNamespace(
-            path=path, world=world, w=w, level=None, params={}, profile=profile,
-            length=path_length(path))
-        mission, files = export_mission(track, formats, options,
-                                        agl=None if level is None else level.agl)
-        write_exports(outdir, files)
-        summary = {"path_file": str(path_file), "world": where, "path_crs": header["crs"],
-                   "points": len(path), "length_m": round(track.length, 3),
-                   "autopilot": mission.summary()}
-        with outdir.open("summary.json") as fh:
-            json.dump(to_jsonable({**summary, "files": [p.name for p in outdir.written]
-                                   + ["summary.json"]}), fh, indent=2)
-        rows = {"path": f"{path_file} ({len(path)} points, {track.length:.1f} m)",
-                "world": where, **mission_rows(mission)}
-        print_summary("fm2uav export", summary if as_json else rows, as_json=as_json,
-                      quiet=quiet, files=outdir.written)
+    app.command("export", help=EXPORT_HELP)(export_cmd)
