@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
@@ -138,25 +137,8 @@ def _write_track(outdir, rep, world, name: str) -> None:
 
 
 def _rows(rep, af, world) -> dict:
-    """The printed summary of ``fm2uav check``."""
-    tr, geo = rep.tracking, rep.geometric
-    sat = ", ".join(f"{k} {v:.1f} s" for k, v in tr.saturation_time().items()) or "none"
-    rows = {
-        "verdict": "FEASIBLE" if rep.feasible else "INFEASIBLE",
-        "reason": rep.reason,
-        "airframe": f"{af.name} ({af.kind})",
-        "separation max / mean [m]": f"{tr.max_separation:.2f} / {tr.mean_separation:.2f}",
-        "limits saturated": sat,
-        "geometric check": ("ok" if geo.feasible else "violated") + f": {geo.reason}",
-        "min radius of curvature [m]": (f"{geo.min_radius:.1f}"
-                                        if math.isfinite(geo.min_radius) else "inf"),
-        "max climb / descent [deg]": (f"{np.degrees(geo.climb_angle.max()):.1f} / "
-                                      f"{np.degrees(-geo.climb_angle.min()):.1f}"),
-    }
-    rows.update(world_rows(world) if world is not None else {})
-    if getattr(af, "kind", "") == "fixed-wing":
-        rows["R_min [m]"] = f"{af.turn_radius(rep.airframe.cruise_speed):.1f}"
-    return rows
+    """The printed summary of ``fm2uav check``: the verdict rows and the world's."""
+    return {**rep.summary_rows(af), **(world_rows(world) if world is not None else {})}
 
 
 def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
