@@ -260,8 +260,8 @@ def reproduce_formation_cmd(
     elif not output.quiet:
         from ._common import console
 
-        console.print(lines.rstrip("\n"))
-        console.print(f"outputs in {out}/")
+        console.print(lines.rstrip("\n"), markup=False, highlight=False)  # verbatim
+        console.print(f"outputs in {out}/", markup=False, highlight=False)
     if not run.completed:
         raise typer.Exit(EXIT_PLANNING)
 
