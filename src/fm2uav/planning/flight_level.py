@@ -105,6 +105,13 @@ def flight_layer(world: World, agl: float) -> np.ndarray:
 
     lf = level_cells(world, agl)
     dz = world.spacing[2]
+    nz = world.shape[2]
+    if lf >= nz:  # above the whole grid wherever the ground is (and no int64 overflow)
+        raise PlanningError(
+            f"the flight level agl = {float(agl):g} m leaves the map everywhere: it is higher "
+            f"than the whole map ({nz} layers of {dz:g} m, {(nz - 1) * dz:g} m from bottom to "
+            "top); lower agl or build a taller world (mission file planner.agl / "
+            "world.ceiling; CLI --agl / --ceiling)")
     surface = terrain_surface_index(world)  # no-fly zone nodes are not ground
     layer = surface.astype(np.int64) + lf
     nz = world.shape[2]
