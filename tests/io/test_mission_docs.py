@@ -3,7 +3,7 @@
 from pathlib import Path
 
 from fm2uav.io import ExportOptions
-from fm2uav.io.build import DEFAULT_CLIMB, DEFAULT_DESCENT
+from fm2uav.io.build import DEFAULT_CLIMB, DEFAULT_DESCENT, DEFAULT_MIN_SPEED
 from fm2uav.io.mission import AirframeSpec, OutputSpec
 from fm2uav.io.validate import PX4_FW_LND_ANG
 
@@ -28,7 +28,7 @@ def test_speed_and_flight_time_defaults_in_the_guide():
             f"fixed-wing {_g(DEFAULT_CLIMB['fixed_wing'])} / {_g(DEFAULT_DESCENT['fixed_wing'])}"
             ) in DOC
     assert ExportOptions().speed_hysteresis == 2 and "allows two steps more" in DOC
-    assert "multirotor 1 m/s" in DOC  # the floor of build._speeds
+    assert f"multirotor {_g(DEFAULT_MIN_SPEED)} m/s" in DOC
     assert f"| `airframe.reserve` | 0 ≤ r < 1 (share of the endurance kept) | " \
            f"{_g(AirframeSpec().reserve)} |" in DOC
     assert f"| `outputs.speed_step` | 0 < step ≤ 20 m/s | {_g(OutputSpec().speed_step)} |" in DOC

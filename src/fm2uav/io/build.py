@@ -79,6 +79,9 @@ ENDS = ("auto", "rtl", "land", "loiter")
 #: and VTOL = TECS_CLMB_MAX / TECS_SINK_MAX (ArduPlane) and FW_T_CLMB_MAX /
 #: FW_T_SINK_MAX (PX4), both 5 m/s by default.
 DEFAULT_CLIMB = {"multirotor": 2.5, "fixed_wing": 5.0, "vtol": 2.5}
+#: Lowest commanded speed of multirotors and VTOL without ``min_speed`` [m/s] (never 0:
+#: a 0 m/s DO_CHANGE_SPEED would stop the vehicle on its leg).
+DEFAULT_MIN_SPEED = 1.0
 DEFAULT_DESCENT = {"multirotor": 1.5, "fixed_wing": 5.0, "vtol": 1.5}
 
 
@@ -469,7 +472,7 @@ def _speeds(opt: ExportOptions, wps: Waypoints, w: Any, times: Any,
     idx = wps.indices
     vmax = opt.forward_speed
     floor = opt.min_speed if opt.min_speed is not None else (
-        1.0 if opt.vehicle != "fixed_wing" else None)
+        DEFAULT_MIN_SPEED if opt.vehicle != "fixed_wing" else None)
     holds = np.zeros(len(idx))
     changes: list[tuple[int, float]] = []
     timing = None
@@ -592,13 +595,16 @@ def _end(geo: _Geo, wps: Waypoints, opt: ExportOptions
         inside = _inside_xy(geo.world, line)
         rise = (float((geo.ground(line[inside]) - geo.ground(start_xy)[0]).max())
                 if inside.any() else float("nan"))
-        landing["rtl_straight_line_m"] = round(float(np.hypot(*(end_xy - start_xy))), 1)
+        back = float(np.hypot(*(end_xy - start_xy)))
+        landing["rtl_straight_line_m"] = round(back, 1)
         landing["rtl_max_ground_above_home_m"] = None if not np.isfinite(rise) else round(rise, 1)
-        warnings.append("RTL flies a straight line home at the firmware's return altitude (PX4 "
-                        "RTL_RETURN_ALT, ArduPilot RTL_ALT / ALT_HOLD_RTL); fm2uav neither plans "
-                        "nor checks it" + (f" — the ground under it rises {rise:.0f} m above home"
-                                           if np.isfinite(rise) and rise > 0 else "")
-                        + "; use return: true (--return) for a planned way back")
+        if back > max(10.0, opt.tolerance):  # the route did not come back home itself
+            rises = (f" — the ground under it rises {rise:.0f} m above home"
+                     if np.isfinite(rise) and rise > 0 else "")
+            warnings.append("RTL flies a straight line home at the firmware's return altitude "
+                            "(PX4 RTL_RETURN_ALT, ArduPilot RTL_ALT / ALT_HOLD_RTL); fm2uav "
+                            f"neither plans nor checks it{rises}; use return: true (--return) "
+                            "for a planned way back")
     elif end == "land" and opt.vehicle == "fixed_wing":
         heading = _unit_xy(wps.points_m, from_end=True)
         items, landing, warnings = _landing_pattern(geo, end_xy, heading, f_route, opt, "landing")
@@ -637,7 +643,25 @@ def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: _Speeds, start_hol
         route_t = float(ft.leg_time.sum() + sp.holds[0] - float(start_hold))
         info["timing"] = {**sp.timing, "mission_route_s": round(route_t, 2),
                           "error_s": round(route_t - sp.timing["planned_s"], 2)}
+        late = route_t - sp.timing["planned_s"]
+        if late > 0.05 * sp.timing["planned_s"]:
+            info["timing"]["warning"] = (
+                f"timing: the mission's route takes {route_t:.0f} s, {late:.0f} s more than the "
+                f"planned {sp.timing['planned_s']:.0f} s: the trajectory climbs or descends "
+                f"faster than {climb:g} / {descent:g} m/s (airframe climb_rate / descent_rate)")
     return info, rep.warning
+
+
+def _snap(profile: Any, frame: str) -> bool | float:
+    """How waypoints get the requested AGL: without a final profile, within a vertical
+    cell (FM²'s grid bias); with one, the path's own heights — except in the terrain
+    frame, where the autopilot follows the ground itself and cruise points within the
+    profile's tolerance carry the request."""
+    if profile is None:
+        return True
+    if frame == "terrain":
+        return float(getattr(getattr(profile, "level", None), "tolerance", 2.0))
+    return False
 
 
 def build_mission(
@@ -681,7 +705,8 @@ def build_mission(
         leave the start at the same moment as other vehicles).
     profile : AltitudeProfile, optional
         The plan's final altitude profile (``Plan.profile``): the path's heights
-        are then used as they are, and its ``required`` floor checks the legs.
+        are then used as they are (terrain frame: the request where the profile
+        is within its tolerance of it), and its ``required`` floor checks the legs.
 
     Raises
     ------
@@ -712,7 +737,7 @@ def build_mission(
     wps = mission_waypoints(p, world, frame=frame, agl=agl, tolerance=opt.tolerance,
                             anchor=opt.anchor, flight_alt=opt.flight_alt,
                             max_points=opt.max_points, keep=sorted(keep),
-                            snap=profile is None, required=required)
+                            snap=_snap(profile, frame), required=required)
     geo = _Geo(world, opt.anchor, wps)
     sp = _speeds(opt, wps, w, times, start_hold)
     end, end_items, landing, end_warnings = _end(geo, wps, opt)
@@ -724,6 +749,8 @@ def build_mission(
     info, endurance_warning = _flight(wps, opt, end, sp, start_hold)
     if endurance_warning:
         warnings.append(endurance_warning)
+    if "warning" in info.get("timing", {}):
+        warnings.append(info["timing"]["warning"])
     info["speed_changes"] = {"items": len(sp.changes),
                              "speeds_mps": sorted({round(v, 3) for _, v in sp.changes}),
                              "step_mps": opt.speed_step,

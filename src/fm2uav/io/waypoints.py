@@ -153,12 +153,15 @@ class Waypoints:
 
 
 def altitude_profile(path_m: Any, world: Any, *, agl: float | None = None,
-                     flight_alt: float = 30.0, snap: bool = True
+                     flight_alt: float = 30.0, snap: bool | float = True
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The flown profile of a dense path (see the module docstring).
 
-    ``snap=False`` keeps the path's own heights (a plan whose altitudes are
-    already the final profile over the continuous ground, ``Plan.profile``).
+    ``snap``: points whose own height above the ground is within this many
+    metres of ``agl`` get exactly ``agl`` (True: one vertical cell, the grid
+    bias of FM²'s flight level; False: keep the path's own heights, for a plan
+    whose altitudes already are the final profile over the continuous ground,
+    ``Plan.profile``).
 
     Returns
     -------
@@ -179,9 +182,10 @@ def altitude_profile(path_m: Any, world: Any, *, agl: float | None = None,
     else:
         own = p[:, 2] - ground
     height = own
-    if agl is not None and snap and p.shape[1] == 3:
+    if agl is not None and snap is not False and p.shape[1] == 3:
         dz = float(world.spacing[2]) if getattr(world, "ndim", 3) == 3 else 0.0
-        on_level = np.abs(own - float(agl)) <= dz + 1e-9
+        tol = dz if snap is True else float(snap)
+        on_level = np.abs(own - float(agl)) <= tol + 1e-9
         height = np.where(on_level, float(agl), own)
     return np.column_stack([p[:, :2], ground + height]), height, ground
 
@@ -237,7 +241,7 @@ def mission_waypoints(
     flight_alt: float = 30.0,
     max_points: int | None = None,
     keep: Any = (),
-    snap: bool = True,
+    snap: bool | float = True,
     required: Any = None,
 ) -> Waypoints:
     """Thin a dense path and express it as MAVLink waypoints.
@@ -262,9 +266,10 @@ def mission_waypoints(
         Cap on the number of waypoints.
     keep : sequence of int, optional
         Dense-path indices that must be waypoints (via points, band ends).
-    snap : bool, optional
-        Give flight-level points the requested ``agl`` (default); False keeps
-        the path's own heights (plans with a final altitude profile).
+    snap : bool or float, optional
+        Give flight-level points the requested ``agl``: True (default) within
+        one vertical cell, a number within that many metres, False never (the
+        path's own heights: plans with a final altitude profile).
     required : array_like, shape (N,), optional
         Lowest admissible height above the surface at each dense point [m]
         (``Plan.profile.required``); legs that would dip below it, or enter a
