@@ -139,7 +139,8 @@ def _run_and_report(config, out: Path, outdir: OutputDir, *, fresh: bool, schedu
         figs = {
             f"heatmap_{metric}.png": heatmap_figure(
                 summary["matrices"][metric], result.alphas, result.betas, metric=metric,
-                best=summary["best"][metric], valleys=summary["valley"][metric]),
+                best=summary["best"][metric], valleys=summary["valley"][metric],
+                near=summary.get("near_best", {}).get(metric)),
             f"best_paths_{metric}.png": best_paths_figure(
                 world, summary["paths"][metric], summary["best"][metric], metric=metric),
             f"curvature_{metric}.png": curvature_figure(summary["curvature"][metric], metric=metric),
@@ -166,6 +167,11 @@ def _run_and_report(config, out: Path, outdir: OutputDir, *, fresh: bool, schedu
         for m, b in summary["best"][metric].items():
             rows[f"best {metric} {m}"] = (f"α={b['alpha']:.2f} β={b['beta']:.2f} → {b['value']:.4g}"
                                           f" (valley ρ={summary['valley'][metric][m]['spearman']:.2f})")
+            n = b.get("near_best")
+            if n:
+                rows[f"within 1 % of best {metric} {m}"] = (
+                    f"{n['count']} (α {n['alpha_min']:g}–{n['alpha_max']:g}, "
+                    f"β {n['beta_min']:g}–{n['beta_max']:g})")
     t = summary["timing"]
     rows["Table 1 [s]"] = ", ".join(
         [f"{m} {t[f'{m}_s']:.3f} (×{t[f'{m}_ratio']:.0f})" for m in config.models] + [f"FM² {t['fm2_s']:.4f}"])

@@ -26,11 +26,13 @@ def heatmap_figure(
     metric: str,
     best: Mapping[str, Mapping[str, float]] | None = None,
     valleys: Mapping[str, Mapping[str, Any]] | None = None,
+    near: Mapping[str, Mapping[str, Any]] | None = None,
 ) -> Figure:
     """Distance matrices over (α, β), one panel per model (Figs 8 and 12).
 
     Colours are logarithmic; the white line is the valley (best β for each
-    α), the star the best (α, β).
+    α), the star the best (α, β), the open circles the (α, β) within 1 % of
+    the best (``near``: :func:`fm2uav.experiments.sweep.near_best` per model).
     """
     models = list(matrices)
     fig = Figure(figsize=(5.0 * len(models), 4.4), layout="constrained")
@@ -48,6 +50,10 @@ def heatmap_figure(
         if valleys and model in valleys:
             v = valleys[model]
             ax.plot(v["beta_best"], v["alpha"], "w-", lw=1.2, label="best β for each α")
+        if near and model in near and near[model].get("points"):
+            pts = np.asarray(near[model]["points"], dtype=float)
+            ax.plot(pts[:, 1], pts[:, 0], "o", mfc="none", mec="white", ms=6,
+                    label=f"within 1 % of the best ({len(pts)})")
         if best and model in best:
             b = best[model]
             ax.plot(b["beta"], b["alpha"], marker="*", color="red", ms=14, mec="white",
