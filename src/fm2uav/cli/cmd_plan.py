@@ -8,7 +8,7 @@ import typer
 from ..planning.params import planner_objects
 from ..scenarios import SCENARIOS
 from ..errors import InputError
-from ._common import Output, handle_errors, plan_rows, write_figure, write_json
+from ._common import Output, handle_errors, plan_rows, write_json
 from .options import (
     LonLatOpt,
     MissionFlags,
@@ -22,6 +22,7 @@ from .options import (
     world_options,
     world_rows,
 )
+from ._mission_options import parse_anchor
 from .cmd_run import mission_rows, output_names, plan_outputs, safety_rows
 
 PLAN_FILES = ("path.csv", "plan.png", "summary.json")
@@ -222,19 +223,8 @@ def _extra_formats(export: str, report: bool) -> list[str]:
 
 
 def _export_options(anchor: str | None, thin: float):
-    from ..io import Anchor, ExportOptions
+    from ..io import ExportOptions
 
     if not np.isfinite(thin) or thin < 0:
         raise InputError(f"--thin must be a tolerance >= 0 m, got {thin}")
-    a = None
-    if anchor is not None:
-        parts = anchor.replace(",", " ").split()
-        try:
-            v = [float(x) for x in parts]
-        except ValueError:
-            v = []
-        if len(v) not in (2, 3):
-            raise InputError(f"--anchor must be lon,lat or lon,lat,alt (degrees, degrees, "
-                             f"metres), got {anchor!r}")
-        a = Anchor(lon=v[0], lat=v[1], alt=v[2] if len(v) == 3 else 0.0)
-    return ExportOptions(tolerance=thin, anchor=a)
+    return ExportOptions(tolerance=thin, anchor=parse_anchor(anchor))

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 import typer
 
+from ..io.exports import EXPORT_FILES
 from ._common import (
     Output,
     OutputDir,
@@ -35,17 +36,7 @@ from .options import (
 )
 
 #: Output format → file name, for every format a command can write.
-OUTPUT_FILES = {
-    "csv": "path.csv",
-    "geojson": "path.geojson",
-    "kml": "path.kml",
-    "kmz": "path.kmz",
-    "plan": "mission.plan",
-    "wpl": "mission.waypoints",
-    "html": "report.html",
-    "png": "plan.png",
-    "json": "summary.json",
-}
+OUTPUT_FILES = {**EXPORT_FILES, "html": "report.html", "png": "plan.png", "json": "summary.json"}
 
 
 def write_exports(outdir: OutputDir, files: dict[str, Any],
@@ -192,7 +183,7 @@ def plan_outputs(
         The built mission.
     """
     from ..analysis.safety import safety_summary
-    from ..io import EXPORT_FILES, export_mission
+    from ..io import export_mission
     from ..io.fence import zone_fences
 
     exports = [f for f in formats if f in EXPORT_FILES]
