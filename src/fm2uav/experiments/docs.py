@@ -331,6 +331,29 @@ def _urban_table() -> str:
     return urban_markdown(_urban())
 
 
+def _airframe_presets() -> str:
+    """The preset tables of docs/feasibility.md, from ``fm2uav.vehicles.AIRFRAMES``."""
+    import math
+
+    from ..vehicles.airframes import AIRFRAMES, FixedWing
+
+    fw = [a for a in AIRFRAMES.values() if isinstance(a, FixedWing)]
+    mr = [a for a in AIRFRAMES.values() if not isinstance(a, FixedWing)]
+    out = ["| preset | kind | V cruise / min / max [m/s] | φ_max | γ climb / descent | "
+           "R_min at cruise | source |", "|---|---|---|---|---|---|---|"]
+    for a in fw:
+        out.append(f"| `{a.name}` | {a.kind} | {a.cruise_speed:g} / {a.min_speed:g} / "
+                   f"{a.max_speed:g} | {math.degrees(a.max_bank):.0f}° | "
+                   f"{math.degrees(a.max_climb):.0f}° / {math.degrees(a.max_descent):.0f}° | "
+                   f"{a.turn_radius():.1f} m | {a.source} |")
+    out += ["", "| preset | kind | v_max | a_max | climb / descent rate | source |",
+            "|---|---|---|---|---|---|"]
+    for a in mr:
+        out.append(f"| `{a.name}` | {a.kind} | {a.max_speed:g} m/s | {a.max_accel:g} m/s² | "
+                   f"{a.max_climb_rate:g} / {a.max_descent_rate:g} m/s | {a.source} |")
+    return "\n".join(out)
+
+
 def _formation_table() -> str:
     from .formation import thesis_markdown
 
@@ -347,6 +370,7 @@ BLOCKS: dict[str, Block] = {
     "coverage-table-5-1": Block("coverage.md", _coverage_t51),
     "coverage-table-5-2": Block("coverage.md", _coverage_t52),
     "coverage-fm2": Block("coverage.md", _coverage_fm2),
+    "airframe-presets": Block("feasibility.md", _airframe_presets),
     "city-table": Block("feasibility.md", _city_table, slow=True),
     "city-rrt": Block("feasibility.md", _city_rrt, slow=True, exact_rows=("FM2 W^1",)),
     "city-claims": Block("feasibility.md", _city_claims, slow=True),
