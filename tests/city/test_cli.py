@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 from typer.testing import CliRunner
 
 from fm2uav.cli import app
@@ -65,10 +66,12 @@ def test_check_bad_input_exit_2(tmp_path):
         assert "Traceback" not in res.output
 
 
-def test_reproduce_city(tmp_path):
-    out = tmp_path / "city"
-    res = runner.invoke(app, ["reproduce", "city", "--out", str(out), "--rrt-time", "2",
-                              "--rrtstar-time", "0.2", "--json"])
+@pytest.mark.slow
+def test_reproduce_city(tmp_path, cli_once):
+    # the same run as tests/cli_reports (one run per session, tests/conftest.py)
+    run = cli_once(["reproduce", "city", "--rrt-time", "0.5", "--rrtstar-time", "0.3",
+                    "--report", "--json"])
+    res, out = run.result, run.out
     assert res.exit_code == 0, res.output
     summary = json.loads(res.stdout)
     assert len(summary["table"]) == 6

@@ -76,18 +76,31 @@ CASES = {
 }
 
 
+#: the reproductions take tens of seconds each: their cases are marked slow
+SLOW = {name for name in CASES if name.startswith("reproduce-")}
+
+
+def _cases():
+    return [pytest.param(name, marks=pytest.mark.slow) if name in SLOW else name
+            for name in CASES]
+
+
 @pytest.fixture(scope="module")
-def runs(tmp_path_factory):
-    """Run every command once with --report --json; keep (result, out dir, args)."""
+def runs(tmp_path_factory, cli_once):
+    """Every command run once, when a test first asks for it, with --report --json:
+    name -> (result, out dir, args). The reproductions go through the session's
+    ``cli_once`` (tests/conftest.py), shared with the tests of tests/city, tff, formation."""
     tmp = tmp_path_factory.mktemp("cli_reports")
     bent = str(_bent_path(tmp))
-    done = {}
-    for name, (args, *_rest) in CASES.items():
-        args = [bent if a == "{bent}" else a for a in args]
-        out = tmp / name
-        full = args + ["--report", "--json", "--out", str(out)]
-        done[name] = (runner.invoke(app, full), out, args)
-    return done
+
+    class Runs(dict):
+        def __missing__(self, name):
+            args = [bent if a == "{bent}" else a for a in CASES[name][0]]
+            r = cli_once(args + ["--report", "--json"])
+            self[name] = (r.result, r.out, args)
+            return self[name]
+
+    return Runs()
 
 
 def _figure(html: str, div_id: str) -> list[dict]:
@@ -104,7 +117,7 @@ def _snapshot(out):
             for p in sorted(out.rglob("*")) if p.is_file()}
 
 
-@pytest.mark.parametrize("name", list(CASES))
+@pytest.mark.parametrize("name", _cases())
 def test_report_written_self_contained_with_expected_traces(runs, name):
     res, out, _ = runs[name]
     assert res.exit_code == 0, res.output
@@ -127,7 +140,7 @@ def test_report_written_self_contained_with_expected_traces(runs, name):
         assert f"<h2>{title}</h2>" in html, title
 
 
-@pytest.mark.parametrize("name", list(CASES))
+@pytest.mark.parametrize("name", _cases())
 def test_json_summary_parses_and_lists_report(runs, name):
     res, out, _ = runs[name]
     payload = json.loads(res.stdout)  # --json: stdout is one JSON document, nothing else
@@ -136,7 +149,7 @@ def test_json_summary_parses_and_lists_report(runs, name):
         assert str(out / "report.html") in payload["files"]
 
 
-@pytest.mark.parametrize("name", list(CASES))
+@pytest.mark.parametrize("name", _cases())
 def test_second_run_without_force_exits_2_and_keeps_files(runs, name):
     _, out, args = runs[name]
     before = _snapshot(out)

@@ -5,9 +5,12 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[2]
 
 
+@pytest.mark.slow
 def test_every_benchmark_runs_quick(tmp_path):
     out = tmp_path / "bench.json"
     res = subprocess.run(

@@ -131,6 +131,7 @@ def _explode(ctx, unit):
     return unit.upper()
 
 
+@pytest.mark.slow
 def test_pool_retries_a_deadly_case_once_then_records_it():
     pool = LocalPool(2)
     try:
@@ -169,6 +170,7 @@ def test_pool_job_that_cannot_load_fails_its_units(tmp_path, monkeypatch):
     assert pool.deaths == 0
 
 
+@pytest.mark.slow
 def test_killed_worker_costs_its_case_only(tmp_path, baseline):
     cfg = make_config(SMALL)
     out = _seed(tmp_path / "s", baseline, SMALL)
@@ -267,6 +269,7 @@ def test_main_process_killed_in_references_phase(tmp_path):
         assert r["time_s"] == res.references[k]["time_s"]
 
 
+@pytest.mark.slow
 def test_sigint_stops_workers_and_keeps_the_cases(tmp_path, baseline):
     from fm2uav.experiments.runner import SweepInterrupted
 

@@ -4,6 +4,7 @@ import csv
 import json
 
 import numpy as np
+import pytest
 from typer.testing import CliRunner
 
 from fm2uav.cli import app
@@ -63,9 +64,11 @@ def test_figures_and_gif(corridor, tmp_path):
     assert data[:6] in (b"GIF87a", b"GIF89a")
 
 
-def test_reproduce_formation_table(tmp_path):
-    res = runner.invoke(app, ["reproduce", "formation", "--no-gif", "--json",
-                              "--out", str(tmp_path)])
+@pytest.mark.slow
+def test_reproduce_formation_table(cli_once):
+    # the same run as tests/cli_reports (one run per session, tests/conftest.py)
+    run = cli_once(["reproduce", "formation", "--no-gif", "--report", "--json"])
+    res, out = run.result, run.out
     assert res.exit_code == 0, res.output
     results = json.loads(res.output)
     assert set(results) == {"case1", "case1-over-ridges", "case2-thesis-p", "case2"}
@@ -79,5 +82,5 @@ def test_reproduce_formation_table(tmp_path):
     # with the planner's exponents the leader keeps level 7; the formation narrows
     assert results["case2"]["level_keeping"]["leader"]["within_1_cell"] > 0.9
     assert results["case2"]["min_grey"] < 0.6
-    table = (tmp_path / "table.md").read_text()
+    table = (out / "table.md").read_text()
     assert "130.6" in table and "135.6" in table

@@ -78,6 +78,7 @@ def test_dubins_free_space_within_2_percent(free_world, start, goal):
     assert k.max() <= 1.0 / XI * 1.1
 
 
+@pytest.mark.slow
 def test_free_headings_give_straight_line(free_world):
     for model in ("dubins", "elastica", "rs"):
         ref = reference_path(free_world, (10, 10), (70, 40), model=model, xi=XI)

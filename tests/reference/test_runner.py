@@ -121,6 +121,7 @@ def test_config_errors(tmp_path):
         load_config(tmp_path / "missing.yaml")
 
 
+@pytest.mark.slow
 def test_cli_sweep_and_resume(tmp_path):
     from fm2uav.cli import app
 

@@ -128,6 +128,7 @@ def test_osm_buildings_in_lonlat_with_most_heights_missing(data, tmp_path):
         assert np.all(path[inside, 2] > h), (h, path[inside, 2].min())
 
 
+@pytest.mark.slow
 def test_buildings_on_the_dem(data, tmp_path):
     f, polys = _osm(tmp_path)
     out, _ = _ok(["plan", "--dem", str(data["4326"]), "--bbox", BBOX, "--buildings", str(f),
@@ -167,6 +168,7 @@ def test_mission_file_world_section_and_run_overrides(data, tmp_path):
     assert read_path_csv(out / "path.csv")[:, 2].min() >= 0.0
 
 
+@pytest.mark.slow
 def test_tune_formation_cover_and_check_take_the_world_options(data, tmp_path):
     dem = ["--dem", str(data["4326"]), "--bbox", BBOX]
     out, res = _ok(["tune", *dem, *PTS, "--agl", "120", *FAST, "--p1", "0.5", "--p2", "1.3"],

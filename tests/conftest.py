@@ -1,0 +1,52 @@
+"""Session-wide fixtures: expensive runs made once and shared by every test that reads them.
+
+``cli_once(args)`` runs ``fm2uav <args> --out <dir>`` once per distinct argument list for the
+whole session (the reproductions, the default mission) and hands every caller the same
+result and output folder. Tests that read such a run must not write into its folder (a
+second run without ``--force`` is fine: it is refused and leaves the folder as it was).
+
+Long end-to-end tests are marked ``@pytest.mark.slow``: ``make test`` runs them,
+``make test-fast`` (``-m "not slow"``) leaves them out.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner, Result
+
+
+@dataclass(frozen=True)
+class CliRun:
+    """One shared CLI run: its result, its output folder and its arguments (without --out)."""
+
+    result: Result
+    out: Path
+    args: tuple[str, ...]
+
+
+@pytest.fixture(scope="session")
+def cli_once(tmp_path_factory):
+    """``cli_once(args) -> CliRun``: ``fm2uav <args> --out <dir>``, run once per session.
+
+    Identical argument lists share one run (the cache key is the argument tuple), so give
+    the same arguments wherever the same run is wanted.
+    """
+    from fm2uav.cli import app
+
+    runner = CliRunner()
+    done: dict[tuple[str, ...], CliRun] = {}
+    root = tmp_path_factory.mktemp("cli_once")
+
+    def run(args) -> CliRun:
+        key = tuple(str(a) for a in args)
+        if key not in done:
+            slug = re.sub(r"[^A-Za-z0-9]+", "-", "-".join(Path(a).name for a in key[:2]))
+            out = root / f"{len(done):02d}-{slug.strip('-')}"
+            done[key] = CliRun(runner.invoke(app, [*key, "--out", str(out)]), out, key)
+        return done[key]
+
+    return run
