@@ -26,6 +26,8 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 __all__ = ["DOCS", "Block", "BLOCKS", "blocks_in", "fill", "generate", "normalise", "check",
            "write", "main"]
 
@@ -172,6 +174,27 @@ def _coverage_fm2() -> str:
     for n, r in run.table_5_1.items():
         out.append(f"| {n} | {r['coverage_pct']:.3f} | {r['fm2_length']:.0f} | "
                    f"{r['agl_err_mean']:.2f} | {r['plan_s']:.3f} |")
+    return "\n".join(out)
+
+
+def _coverage_grids() -> str:
+    """Coverage of the flown FM² path on the map's grid (the seeds' W0) and on the corridor
+    grid, S1–S4 at D = 80 m, 100 m AGL, seed 0."""
+    from ..missions.coverage import plan_coverage
+    from ..planning import FlightLevel
+    from ..scenarios.coverage import (COVERAGE_AGL, COVERAGE_AREAS, COVERAGE_SPACING,
+                                      coverage_area, coverage_world)
+
+    world = coverage_world(0)
+    res = {(n, g): plan_coverage(world, coverage_area(n), COVERAGE_SPACING,
+                                 level=FlightLevel(agl=COVERAGE_AGL), grid=g)
+           for n in COVERAGE_AREAS for g in ("map", "corridor")}
+    out = ["| | " + " | ".join(COVERAGE_AREAS) + " |", "|---|" + "---|" * len(COVERAGE_AREAS)]
+    for g, label in (("map", 'map grid (`grid="map"`)'), ("corridor", 'corridor grid (`grid="corridor"`, default)')):
+        out.append(f"| {label}, coverage | " + " | ".join(
+            f"{100 * res[n, g].coverage:.3f} %" for n in COVERAGE_AREAS) + " |")
+        out.append(f"| {label}, mean \\|AGL error\\| | " + " | ".join(
+            f"{float(np.abs(res[n, g].agl_error).mean()):.2f} m" for n in COVERAGE_AREAS) + " |")
     return "\n".join(out)
 
 
@@ -370,6 +393,7 @@ BLOCKS: dict[str, Block] = {
     "coverage-table-5-1": Block("coverage.md", _coverage_t51),
     "coverage-table-5-2": Block("coverage.md", _coverage_t52),
     "coverage-fm2": Block("coverage.md", _coverage_fm2),
+    "coverage-grids": Block("coverage.md", _coverage_grids),
     "airframe-presets": Block("feasibility.md", _airframe_presets),
     "city-table": Block("feasibility.md", _city_table, slow=True),
     "city-rrt": Block("feasibility.md", _city_rrt, slow=True, exact_rows=("FM2 W^1",)),
