@@ -105,7 +105,7 @@ def plan_cmd(
 ) -> None:
     """``fm2uav plan``: parse, :func:`~fm2uav.missions.route.plan_route`, write, print."""
     from ..missions.route import plan_route
-    from ..world.load import check_points, world_summary
+    from ..world.load import world_summary
 
     need_agl, need_top = requested_heights(start, goal, lonlat=lonlat, agl=agl)
     w, sc, scenario = build_world(world.spec(), scenario=scenario, seed=seed, agl=need_agl,
@@ -115,33 +115,14 @@ def plan_cmd(
     export_options = mission.export_options(_export_options(anchor, thin))
     outdir = output.dir(PLAN_FILES + tuple(output_names(extra)))
 
-    def point(text: str | None, default: np.ndarray | None, what: str) -> np.ndarray:
-        return cli_point(text, what, w, lonlat=lonlat, cells=cells, agl=agl,
-                         default=default, anchor=getattr(export_options, "anchor", None))
-
-    start_m = point(start, sc.start if sc else None, "start")
-    goal_m = point(goal, sc.goal if sc else None, "goal")
-    via_m = [point(v, None, f"via {k + 1}") for k, v in enumerate(mission.via or [])]
-    check_points(w, {"start": start_m, "goal": goal_m,
-                     **{f"via {k + 1}": v for k, v in enumerate(via_m)}},
-                 allow_filled=world.allow_filled)
-    if no_fly:  # no-fly zones become obstacles of the world
-        from ..io.zone_spec import zones_from_cli
-        from ..world.zones import check_points_allowed, with_zones
-
-        w = with_zones(w, zones_from_cli(no_fly, w, crs=world.crs))
-        check_points_allowed(w, {"start": start_m, "goal": goal_m,
-                                 **{f"via {k + 1}": v for k, v in enumerate(via_m)}})
-    level_keys = (dict(agl=agl, p1=p1, p2=p2, band=band, graded=graded, mode=mode,
-                       **{k: v for k, v in (("min_agl", min_agl), ("max_agl", max_agl))
-                          if v is not None})
-                  if agl is not None else {})
-    if agl is None and (min_agl is not None or max_agl is not None):
-        raise InputError("--min-agl / --max-agl limit a terrain-following flight; give --agl "
-                         "too (the requested height above ground)")
-    shaping, level, options = planner_objects(dict(
-        saturation=saturation, saturation_distance=saturation_distance, exponent=exponent,
-        order=order, **level_keys))
+    w, start_m, goal_m, via_m = _points(
+        w, sc, start, goal, mission.via, world=world, no_fly=no_fly, lonlat=lonlat,
+        cells=cells, agl=agl, anchor=getattr(export_options, "anchor", None))
+    shaping, level, options = _planner(
+        dict(saturation=saturation, saturation_distance=saturation_distance, exponent=exponent,
+             order=order),
+        dict(agl=agl, p1=p1, p2=p2, band=band, graded=graded, mode=mode, min_agl=min_agl,
+             max_agl=max_agl))
     route = plan_route(w, start_m, goal_m, via=via_m,
                        return_to_start=bool(mission.return_to_start), shaping=shaping,
                        level=level, options=options)
@@ -164,6 +145,41 @@ def plan_cmd(
                        safety=info["safety"])
     write_json(outdir, "summary.json", summary)
     output.summary("FM² plan", _rows(scenario, route, w, summary, built), summary)
+
+
+def _planner(shaping: dict, level: dict) -> tuple:
+    """``(Shaping, FlightLevel or None, PlanOptions)`` of the planner flags (the flight-level
+    ones only with ``--agl``; unset ``--min-agl``/``--max-agl`` left out)."""
+    if level["agl"] is None:
+        if level["min_agl"] is not None or level["max_agl"] is not None:
+            raise InputError("--min-agl / --max-agl limit a terrain-following flight; give "
+                             "--agl too (the requested height above ground)")
+        level = {}
+    level = {k: v for k, v in level.items() if v is not None or k not in ("min_agl", "max_agl")}
+    return planner_objects({**shaping, **level})
+
+
+def _points(w, sc, start: str | None, goal: str | None, via: list[str] | None, *,
+            world: WorldFlags, no_fly: list[str] | None, **how) -> tuple:
+    """``(world, start, goal, via points)`` in metres, checked (free, not over filled
+    nodata, outside the ``--no-fly`` zones, which become obstacles of the world)."""
+    from ..world.load import check_points
+
+    def point(text: str | None, default: np.ndarray | None, what: str) -> np.ndarray:
+        return cli_point(text, what, w, default=default, **how)
+
+    start_m = point(start, sc.start if sc else None, "start")
+    goal_m = point(goal, sc.goal if sc else None, "goal")
+    via_m = [point(v, None, f"via {k + 1}") for k, v in enumerate(via or [])]
+    named = {"start": start_m, "goal": goal_m, **{f"via {k + 1}": v for k, v in enumerate(via_m)}}
+    check_points(w, named, allow_filled=world.allow_filled)
+    if no_fly:  # no-fly zones become obstacles of the world
+        from ..io.zone_spec import zones_from_cli
+        from ..world.zones import check_points_allowed, with_zones
+
+        w = with_zones(w, zones_from_cli(no_fly, w, crs=world.crs))
+        check_points_allowed(w, named)
+    return w, start_m, goal_m, via_m
 
 
 def _write_plan(outdir, p, world, *, title: str) -> None:
