@@ -377,6 +377,24 @@ def _airframe_presets() -> str:
     return "\n".join(out)
 
 
+def _curvature_timing() -> str:
+    """Table 1 of seed 004 from the curvature block's sweep (one worker process)."""
+    config, result, summary = _curvature()
+    t = summary["timing"]
+    models = [m for m in config.models if f"{m}_s" in t]
+    out = ["| | " + " | ".join(_MODEL_NAMES.get(m, m) for m in models) + " | FM² |",
+           "|---|" + "---|" * (len(models) + 1),
+           "| time, all pairs [s] | " + " | ".join(f"{t[f'{m}_s']:.3g}" for m in models)
+           + f" | {t['fm2_s']:.3g} |",
+           "| FM² faster by (time ratio) | " + " | ".join(f"{t[f'{m}_ratio']:.0f}×" for m in models)
+           + " | – |",
+           "",
+           f"{t['pairs']} pairs, measured inside the sweep's single worker process on a shared "
+           "2-core machine (references: lattice search; FM²: sum over the pairs of the median "
+           "`plan()` time over the grid, so compilation is excluded)."]
+    return "\n".join(out)
+
+
 def _formation_table() -> str:
     from .formation import thesis_markdown
 
@@ -401,6 +419,7 @@ BLOCKS: dict[str, Block] = {
     "city-rrt-claims": Block("feasibility.md", _city_rrt_claims, slow=True, exact=False),
     "formation-table": Block("formation.md", _formation_table, slow=True),
     "curvature-results": Block("curvature.md", _curvature_results, slow=True),
+    "curvature-timing": Block("curvature.md", _curvature_timing, slow=True, exact=False),
     "tracking": Block("curvature.md", _tracking_table, slow=True),
 }
 
