@@ -19,25 +19,20 @@ the route the vehicle gets before it eats into the reserve.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from .._validate import positive
 from ..errors import InputError
 
 __all__ = ["FlightTime", "EnduranceReport", "flight_time", "check_endurance"]
 
 
 def _positive(name: str, value: Any) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"{name} must be a number, got {value!r}") from None
-    if not (math.isfinite(v) and v > 0):
-        raise InputError(f"{name} must be > 0, got {value!r}")
-    return v
+    """``value`` as a finite float > 0 (:func:`fm2uav._validate.positive`)."""
+    return positive(value, f"{name}")
 
 
 @dataclass(frozen=True)

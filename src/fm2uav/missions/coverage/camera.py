@@ -12,22 +12,18 @@ looking straight down over flat ground):
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
+from typing import Any
 
+from ..._validate import positive
 from ...errors import InputError
 
 __all__ = ["Camera", "band_spacing"]
 
 
-def _positive(name: str, value: float) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"camera {name} must be a number, got {value!r}") from None
-    if not (math.isfinite(v) and v > 0):
-        raise InputError(f"camera {name} must be > 0, got {value!r}")
-    return v
+def _positive(name: str, value: Any) -> float:
+    """``value`` as a finite float > 0 (:func:`fm2uav._validate.positive`)."""
+    return positive(value, f"camera {name}")
 
 
 @dataclass(frozen=True)
