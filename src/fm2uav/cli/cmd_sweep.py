@@ -12,12 +12,14 @@ from rich.text import Text
 
 from ._common import (
     EXIT_INTERRUPTED,
+    Output,
     OutputDir,
     err_console,
     handle_errors,
     print_summary,
     to_jsonable,
 )
+from .options import output_options
 
 #: Exit code of a sweep that finished but has failed cases (0 ok, 1 planning, 2 bad input,
 #: 130 interrupted, 70 internal error).
@@ -180,87 +182,87 @@ def _run_and_report(config, out: Path, outdir: OutputDir, *, fresh: bool, schedu
     return result
 
 
+SWEEP_HELP = (
+    "Run (or resume) an α–β sweep of FM² against the Dubins, elastica and Reeds–Shepp "
+    "references from a YAML config; every case is appended to --out/cases.jsonl as it "
+    "finishes (checksummed lines), then the results file, Tables 1-4 (tables.md), heat "
+    "maps and curvature profiles are written.\n\n"
+    "Re-running the same command resumes: finished cases are kept, missing and failed "
+    "ones are run (--keep-failed keeps failed ones). A worker process that dies costs "
+    "only its case: it is run once more, then recorded as failed with the reason. "
+    "SIGINT/SIGTERM stop the workers and keep every finished case. A second sweep into "
+    "the same --out is refused while one runs.\n\n"
+    "Examples:\n\n"
+    "  fm2uav sweep sweep.yaml --out out/sweep\n\n"
+    "  fm2uav sweep sweep.yaml --scheduler tcp://10.0.0.5:8786 --out out/sweep\n\n"
+    "Config keys (all optional): scenario: city2d, cell: 2.0, pairs: 24, pair_seed: 0, "
+    "alpha: {start: 0.02, stop: 1.0, step: 0.02}, beta: {...}, models: \\[dubins, elastica, "
+    "rs], xi: 10.0, max_int: 4, ds: 1.0, order: 2, results: results.parquet (or .csv)."
+    "\n\n" + EXIT_CODES_HELP
+)
+
+CURVATURE_HELP = (
+    "Seed 004 (Sensors 2022): FM² α–β sweep against Dubins, Euler–Mumford elastica and "
+    "Reeds–Shepp forward references on the 2D city map, 24 pairs → Tables 1-4, heat maps "
+    "(Figs 8/12), best matches (Figs 9/13), curvature profiles (Figs 10/14).\n\n"
+    "The default is the seed's full grid α, β = 0.02:0.02:1 (2500 × 24 = 60000 FM² runs; "
+    "~5 min on 2 cores, about half of it for the 72 reference paths); --step 0.04 gives a "
+    "coarser 25 × 25 grid.\n\n"
+    "Examples:\n\n"
+    "  fm2uav reproduce curvature --out out/curvature\n\n"
+    "  fm2uav reproduce curvature --step 0.1 --pairs 8 --out out/curvature-quick\n\n"
+    "Resumes like fm2uav sweep (failed cases are run again). " + EXIT_CODES_HELP
+)
+
+_FORCE_HELP = "Discard a different sweep in --out."
+
+
+@handle_errors
+@output_options("out/sweep", out_help="Output directory (resumed if it holds the same sweep).",
+                force_help=_FORCE_HELP)
+def sweep_cmd(
+    config: Path = typer.Argument(..., help="YAML sweep configuration."),
+    scheduler: str | None = typer.Option(
+        None, help="Address of an existing Dask scheduler, e.g. tcp://host:8786 "
+        "(default: local processes)."),
+    workers: int | None = typer.Option(None, help="Local worker processes (default: all "
+                                       "cores; 1 runs in this process)."),
+    retry_failed: bool = typer.Option(
+        True, "--retry-failed/--keep-failed",
+        help="On a resume, run the cases (and references) that failed before again "
+        "(default), or keep them as failed."),
+    output: Output = None,
+) -> None:
+    """``fm2uav sweep``: :func:`~fm2uav.experiments.runner.load_config`, :func:`run_and_report`."""
+    from ..experiments.runner import load_config
+
+    run_and_report(load_config(config), output.out, force=output.force, scheduler=scheduler,
+                   workers=workers, retry_failed=retry_failed, as_json=output.as_json,
+                   quiet=output.quiet, title="α–β sweep")
+
+
+@handle_errors
+@output_options("out/curvature", force_help=_FORCE_HELP)
+def curvature_cmd(
+    full: bool = typer.Option(False, "--full", help="Force the seed's grid 0.02:0.02:1 "
+                              "(the default; overrides --step)."),
+    step: float = typer.Option(0.02, help="Grid step of α and β: the grid is step:step:1."),
+    pairs: int = typer.Option(24, help="Number of start/goal pairs."),
+    xi: float = typer.Option(10.0, help="ξ of the references, in metres."),
+    scheduler: str | None = typer.Option(None, help="Dask scheduler address (tcp://...)."),
+    workers: int | None = typer.Option(None, help="Local worker processes (default: all cores)."),
+    output: Output = None,
+) -> None:
+    """``fm2uav reproduce curvature``: the seed's sweep config, :func:`run_and_report`."""
+    from ..experiments.curvature import curvature_config
+
+    cfg = curvature_config(step=None if full else step, pairs=pairs, xi=xi)
+    run_and_report(cfg, output.out, force=output.force, scheduler=scheduler, workers=workers,
+                   retry_failed=True, as_json=output.as_json, quiet=output.quiet,
+                   title="Seed 004: FM² vs curvature-penalised references")
+
+
 def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
     """Add ``sweep`` and ``reproduce curvature``."""
-
-    @app.command(
-        "sweep",
-        help=(
-            "Run (or resume) an α–β sweep of FM² against the Dubins, elastica and Reeds–Shepp "
-            "references from a YAML config; every case is appended to --out/cases.jsonl as it "
-            "finishes (checksummed lines), then the results file, Tables 1-4 (tables.md), heat "
-            "maps and curvature profiles are written.\n\n"
-            "Re-running the same command resumes: finished cases are kept, missing and failed "
-            "ones are run (--keep-failed keeps failed ones). A worker process that dies costs "
-            "only its case: it is run once more, then recorded as failed with the reason. "
-            "SIGINT/SIGTERM stop the workers and keep every finished case. A second sweep into "
-            "the same --out is refused while one runs.\n\n"
-            "Examples:\n\n"
-            "  fm2uav sweep sweep.yaml --out out/sweep\n\n"
-            "  fm2uav sweep sweep.yaml --scheduler tcp://10.0.0.5:8786 --out out/sweep\n\n"
-            "Config keys (all optional): scenario: city2d, cell: 2.0, pairs: 24, pair_seed: 0, "
-            "alpha: {start: 0.02, stop: 1.0, step: 0.02}, beta: {...}, models: \\[dubins, elastica, "
-            "rs], xi: 10.0, max_int: 4, ds: 1.0, order: 2, results: results.parquet (or .csv)."
-            "\n\n" + EXIT_CODES_HELP
-        ),
-    )
-    @handle_errors
-    def sweep_cmd(
-        config: Path = typer.Argument(..., help="YAML sweep configuration."),
-        scheduler: str | None = typer.Option(
-            None, help="Address of an existing Dask scheduler, e.g. tcp://host:8786 "
-            "(default: local processes)."),
-        workers: int | None = typer.Option(None, help="Local worker processes (default: all "
-                                           "cores; 1 runs in this process)."),
-        retry_failed: bool = typer.Option(
-            True, "--retry-failed/--keep-failed",
-            help="On a resume, run the cases (and references) that failed before again "
-            "(default), or keep them as failed."),
-        out: Path = typer.Option(Path("out/sweep"), help="Output directory (resumed if it holds "
-                                 "the same sweep)."),
-        force: bool = typer.Option(False, "--force", help="Discard a different sweep in --out."),
-        as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
-        quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
-    ) -> None:
-        from ..experiments.runner import load_config
-
-        cfg = load_config(config)
-        run_and_report(cfg, out, force=force, scheduler=scheduler, workers=workers,
-                       retry_failed=retry_failed, as_json=as_json, quiet=quiet,
-                       title="α–β sweep")
-
-    @reproduce_app.command(
-        "curvature",
-        help=(
-            "Seed 004 (Sensors 2022): FM² α–β sweep against Dubins, Euler–Mumford elastica and "
-            "Reeds–Shepp forward references on the 2D city map, 24 pairs → Tables 1-4, heat maps "
-            "(Figs 8/12), best matches (Figs 9/13), curvature profiles (Figs 10/14).\n\n"
-            "The default is the seed's full grid α, β = 0.02:0.02:1 (2500 × 24 = 60000 FM² runs; "
-            "~5 min on 2 cores, about half of it for the 72 reference paths); --step 0.04 gives a "
-            "coarser 25 × 25 grid.\n\n"
-            "Examples:\n\n"
-            "  fm2uav reproduce curvature --out out/curvature\n\n"
-            "  fm2uav reproduce curvature --step 0.1 --pairs 8 --out out/curvature-quick\n\n"
-            "Resumes like fm2uav sweep (failed cases are run again). " + EXIT_CODES_HELP
-        ),
-    )
-    @handle_errors
-    def curvature_cmd(
-        full: bool = typer.Option(False, "--full", help="Force the seed's grid 0.02:0.02:1 "
-                                  "(the default; overrides --step)."),
-        step: float = typer.Option(0.02, help="Grid step of α and β: the grid is step:step:1."),
-        pairs: int = typer.Option(24, help="Number of start/goal pairs."),
-        xi: float = typer.Option(10.0, help="ξ of the references, in metres."),
-        scheduler: str | None = typer.Option(None, help="Dask scheduler address (tcp://...)."),
-        workers: int | None = typer.Option(None, help="Local worker processes (default: all cores)."),
-        out: Path = typer.Option(Path("out/curvature"), help="Output directory."),
-        force: bool = typer.Option(False, "--force", help="Discard a different sweep in --out."),
-        as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
-        quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
-    ) -> None:
-        from ..experiments.curvature import curvature_config
-
-        cfg = curvature_config(step=None if full else step, pairs=pairs, xi=xi)
-        run_and_report(cfg, out, force=force, scheduler=scheduler, workers=workers,
-                       retry_failed=True, as_json=as_json, quiet=quiet,
-                       title="Seed 004: FM² vs curvature-penalised references")
+    app.command("sweep", help=SWEEP_HELP)(sweep_cmd)
+    reproduce_app.command("curvature", help=CURVATURE_HELP)(curvature_cmd)
