@@ -18,11 +18,13 @@ from ._common import (
 )
 from .options import (
     MissionFlags,
+    SafetyFlags,
     ScenarioOpt,
     WorldFlags,
     build_world,
     mission_options,
     output_options,
+    safety_options,
     world_options,
     world_rows,
 )
@@ -75,14 +77,19 @@ def _load_area(area: str, world=None, crs=None):
 def _write_report(outdir: OutputDir, cp, *, title: str, subtitle: str, metrics: dict,
                   waypoints=None, files=()) -> None:
     from ..viz.coverage import coverage_overlays
+    from ..viz.overlays import filled_overlay
     from ..viz.report import report_html
+    from .cmd_run import zone_overlays
 
     name = "FM² path"
+    world = cp.plan.world
+    overlays = {**filled_overlay(world), **coverage_overlays(cp),
+                **zone_overlays(getattr(world, "zones", ()))}
     html = report_html(
-        cp.plan.world, {name: cp.path}, title=title, subtitle=subtitle,
+        world, {name: cp.path}, title=title, subtitle=subtitle,
         speeds={name: cp.plan.w}, ideal_agl={name: cp.level.agl},
         waypoints=None if waypoints is None else {name: waypoints},
-        overlays=coverage_overlays(cp), params=cp.params, metrics=metrics, files=files)
+        overlays=overlays, params=cp.params, metrics=metrics, files=files)
     with outdir.open(REPORT) as fh:
         fh.write(html)
 
@@ -90,7 +97,8 @@ def _write_report(outdir: OutputDir, cp, *, title: str, subtitle: str, metrics: 
 def _write_cover_outputs(outdir: OutputDir, cp, area: str, *, report: bool, title: str,
                          options=None, camera=None):
     """The mission files (path.csv, mission.plan, .waypoints, KML/KMZ, GeoJSON), zigzag.csv,
-    PNGs, coverage.html and report.html; returns the built mission."""
+    PNGs, coverage.html and report.html; returns ``(built mission, safety figures)`` (the
+    no-fly zones of the world go into the .plan geoFence)."""
     from ..io import write_path_csv
     from ..viz.coverage import bands_figure, coverage_figure, coverage_html
     from .cmd_run import write_exports
@@ -98,12 +106,23 @@ def _write_cover_outputs(outdir: OutputDir, cp, area: str, *, report: bool, titl
     world = cp.plan.world
     georef = getattr(world, "georef", None)
     comment = georef.comment() if georef is not None else None
+    from ..analysis.safety import safety_summary
     from ..io import export_mission
+    from ..io.fence import zone_fences
 
+    zones = tuple(getattr(world, "zones", ()))
+    fences, fence_warnings = (zone_fences(zones, world, getattr(options, "anchor", None))
+                              if zones else ([], []))
     mission, files = export_mission(cp.plan, COVER_EXPORTS, options, agl=cp.level.agl,
-                                    camera=camera)
-    write_exports(outdir, files)
+                                    camera=camera, fences=fences)
     wps = mission.waypoints
+    safety = safety_summary(
+        world, cp.path, requested=cp.level.agl, phase=getattr(cp.plan, "phase", None),
+        waypoints=wps.points_m, waypoint_indices=wps.indices, terrain_frame=wps.frame == 10,
+        waypoint_agl=wps.agl, level=cp.level)
+    if zones:
+        safety["geofence"] = {"fences": len(fences), "warnings": fence_warnings}
+    write_exports(outdir, files)
     with outdir.open("zigzag.csv") as fh:
         write_path_csv(fh, cp.zigzag.path(), comment=comment)
     write_figure(outdir, bands_figure(cp.zigzag, title=f"zigzag over {area}"), "bands.png")
@@ -126,12 +145,19 @@ def _write_cover_outputs(outdir: OutputDir, cp, area: str, *, report: bool, titl
             **({"GSD [cm/px]": mission.info["camera"]["gsd_cm_per_px"]}
                if "gsd_cm_per_px" in mission.info["camera"] else {}),
             "planning time [s]": round(cp.timings.get("total", 0.0), 3),
+            **_safety_rows(safety),
         }
         _write_report(outdir, cp, title=title,
                       subtitle=f"zigzag bands over {area}, FM² at "
                                f"{cp.level.agl:g} m above the terrain",
                       metrics=metrics, waypoints=wps.points_m, files=list(COVER_FILES))
-    return mission
+    return mission, safety
+
+
+def _safety_rows(safety: dict) -> dict:
+    from .cmd_run import safety_rows
+
+    return safety_rows(safety)
 
 def _write_coverage_figures(outdir: OutputDir, run) -> None:
     """bands_<area>.png, coverage_<area>.png and bands_S1_D<d>.png of a coverage run."""
@@ -189,6 +215,7 @@ _REPORT_HELP = "Also write report.html (interactive, self-contained)."
 @handle_errors
 @output_options("out/cover", report_help=_REPORT_HELP)
 @world_options
+@safety_options
 @mission_options("firmware", "vehicle", "frame", "end", "thin", "anchor", "speed_changes",
                  "min_speed", "cruise_speed", "hover_speed", "endurance", "reserve")
 def cover_cmd(
@@ -215,13 +242,14 @@ def cover_cmd(
     seed: int = typer.Option(0, help="Seed of the terrain and of the DE."),
     output: Output = None,
     world: WorldFlags = None,
+    safety: SafetyFlags = None,
 ) -> None:
     """``fm2uav cover``: parse, :func:`~fm2uav.missions.coverage.plan_coverage`, write, print."""
     from ..missions.coverage import FULL_BOUNDS_DEG, plan_coverage
     from ..missions.coverage.triggers import camera_plan
-    from ..planning import FlightLevel
     from ..world.load import world_summary
 
+    level = safety.level(agl, p1=p1, p2=p2)  # refuses agl outside --min-agl/--max-agl
     if (spacing is None) == (camera is None):
         raise InputError("give exactly one of --spacing (metres) or --camera")
     cam = None if camera is None else _camera(camera)
@@ -234,22 +262,26 @@ def cover_cmd(
         w, _, scenario = build_world(world.spec(), scenario=scenario, seed=seed, agl=agl,
                                      default="coverage")
         poly, area_source = _load_area(area, w, world.crs)
+        w = safety.apply(w, crs=world.crs)  # --no-fly zones become obstacles
         step("searching the steering angle and planning FM² along the bands")
-        cp = plan_coverage(w, poly, d, level=FlightLevel(agl=agl, p1=p1, p2=p2),
+        cp = plan_coverage(w, poly, d, level=level,
                            angle=None if angle is None else np.radians(angle),
-                           search=search, search_options=opts, seed=seed)
+                           search=search, search_options=opts, seed=seed,
+                           shaping=safety.shaping())
         step("writing the outputs")
         shots = camera_plan(cp, camera=cam, front_overlap=front_overlap,
                             trigger_distance=trigger_distance)
-        built = _write_cover_outputs(outdir, cp, area, report=output.report,
+        built, safety_figures = _write_cover_outputs(outdir, cp, area, report=output.report,
                                      title=f"coverage of {area}", options=mission_options,
                                      camera=shots)
     summary = {"area": area, "scenario": scenario, "world": world_summary(w),
                **({"area_source": area_source.as_dict()} if area_source else {}),
                **cp.summary()}
     summary["autopilot"] = built.summary()
+    summary["safety"] = safety_figures
     write_json(outdir, "summary.json", summary)
-    output.summary("coverage plan", _cover_rows(area, d, cp, built, w), summary)
+    output.summary("coverage plan", {**_cover_rows(area, d, cp, built, w),
+                                     **_safety_rows(safety_figures)}, summary)
 
 
 def _cover_rows(area: str, d: float, cp, mission, world) -> dict:

@@ -21,6 +21,7 @@ from ._common import (
 from .options import (
     LonLatOpt,
     MissionFlags,
+    SafetyFlags,
     ScenarioOpt,
     WorldFlags,
     build_world,
@@ -28,6 +29,7 @@ from .options import (
     mission_options,
     output_options,
     requested_heights,
+    safety_options,
     world_options,
     world_rows,
 )
@@ -128,6 +130,7 @@ REPRODUCE_HELP = (
 @output_options("out/formation",
                 report_help="Also write report.html (interactive, self-contained).")
 @world_options
+@safety_options
 @mission_options("firmware", "vehicle", "frame", "end", "thin", "anchor", "endurance",
                  "reserve")
 def formation_cmd(
@@ -159,6 +162,7 @@ def formation_cmd(
     output: Output = None,
     world: WorldFlags = None,
     mission: MissionFlags = None,
+    safety: SafetyFlags = None,
 ) -> None:
     """``fm2uav formation``: parse, :func:`~fm2uav.experiments.formation.fly_and_summarise`,
     one mission per UAV, write, print."""
@@ -166,7 +170,7 @@ def formation_cmd(
     from ..experiments.formation import fly_and_summarise, summary_rows
     from ..io.exports import EXPORT_FILES, export_formation, file_prefix
     from ..missions.formation import FormationConfig
-    from ..planning import FlightLevel
+    from ..io.fence import zone_fences
     from ..scenarios.scenario import Scenario
     from ..world.load import check_points, world_summary
     from .cmd_run import write_exports
@@ -178,6 +182,7 @@ def formation_cmd(
         raise InputError("give either --agl (metres) or --level (cells), not both")
     if level is not None:
         agl = float(level) * w.spacing[2]
+    flight_level = safety.level(agl, p1=p1, p2=p2)  # refuses agl outside --min/--max-agl
     uavs = ["leader"] + [f"follower {k + 1}" for k in range(followers)]
     mission_names = [file_prefix(n) + EXPORT_FILES[f] for n in uavs for f in MISSION_FORMATS]
     outdir = output.dir(_outputs(gif, output.report) + tuple(mission_names))
@@ -189,6 +194,11 @@ def formation_cmd(
     s = point(start, sc.start if sc else None, "start")
     g = point(goal, sc.goal if sc else None, "goal")
     check_points(w, {"start": s, "goal": g}, allow_filled=world.allow_filled)
+    w = safety.apply(w, {"start": s, "goal": g}, crs=world.crs)  # --no-fly: obstacles
+    zones = tuple(getattr(w, "zones", ()))
+    fences, fence_warnings = (zone_fences(zones, w, getattr(mission_options, "anchor", None))
+                              if zones else ([], []))
+    shaping = safety.shaping()
     sc = Scenario(world=w, start=s, goal=g,
                   description=sc.description if sc else f"real data: {scenario}")
     title = f"formation — {scenario}" + (f", flight level {agl:g} m" if agl else "")
@@ -198,18 +208,59 @@ def formation_cmd(
                                  leader_speed=speed, follower_speed=follower_speed,
                                  cycle=cycle, grey=grey)
         result, summary = fly_and_summarise(
-            sc, config=config, level=None if agl is None else FlightLevel(agl=agl, p1=p1, p2=p2))
+            sc, config=config, level=flight_level,
+            **({} if shaping is None else {"shaping": shaping}))
         step("building one mission per UAV")
-        missions, files = export_formation(result, MISSION_FORMATS, mission_options)
+        missions, files = export_formation(result, MISSION_FORMATS, mission_options,
+                                           fences=fences)
         summary = {"scenario": scenario, "world": world_summary(w), **summary,
-                   "missions": {n: m.summary() for n, m in missions.items()}}
+                   "missions": {n: m.summary() for n, m in missions.items()},
+                   "safety": _safety(result, missions, flight_level, fences, fence_warnings)}
         write_exports(outdir, files, step)
         _write_case(outdir, result, summary, title=title, gif=gif, frames=frames,
                     report=output.report, subtitle=sc.description, step=step)
     output.summary("FM² formation",
-                   {**summary_rows(summary), **_timing_rows(missions), **world_rows(w)}, summary)
+                   {**summary_rows(summary), **_timing_rows(missions),
+                    **_safety_rows(summary["safety"]), **world_rows(w)}, summary)
     if not result.completed:
         raise typer.Exit(EXIT_PLANNING)
+
+
+def _safety(result, missions: dict[str, Any], level, fences, fence_warnings) -> dict[str, Any]:
+    """summary.json 'safety': :func:`~fm2uav.analysis.safety.safety_summary` of every UAV's
+    flown trajectory and its mission's legs (and the geofence count with zones)."""
+    from ..analysis.safety import safety_summary
+
+    out: dict[str, Any] = {}
+    for i, name in enumerate(result.names):
+        wps = missions[name].waypoints
+        out[name] = safety_summary(
+            result.world, np.asarray(result.positions[:, i], dtype=float),
+            requested=None if level is None else level.agl, waypoints=wps.points_m,
+            waypoint_indices=wps.indices, terrain_frame=wps.frame == 10,
+            waypoint_agl=wps.agl, level=level)
+    if getattr(result.world, "zones", ()):
+        out["geofence"] = {"fences": len(fences), "warnings": list(fence_warnings)}
+    return out
+
+
+def _safety_rows(safety: dict[str, Any]) -> dict[str, str]:
+    """One printed row per UAV: lowest AGL along its legs, no-fly zone entries."""
+    rows = {}
+    for name, s in safety.items():
+        if name == "geofence":
+            continue
+        parts = []
+        if s.get("legs"):
+            parts.append(f"lowest AGL along the legs {s['legs']['min_m']:.1f} m")
+        if s.get("zones"):
+            parts.append(f"{len(s['zones']['path_entries'])} no-fly zone entries")
+        bad = [k for k, c in s.get("checks", {}).items() if not c.get("ok", True)]
+        if bad:
+            parts.append("limits NOT met: " + ", ".join(bad))
+        if parts:
+            rows[f"safety {name}"] = "; ".join(parts)
+    return rows
 
 
 def _timing_rows(missions: dict[str, Any]) -> dict[str, str]:

@@ -32,7 +32,8 @@ __all__ = [
     "NodataOpt", "NodataValueOpt", "CrsOpt", "DefaultHeightOpt", "AllowFilledOpt", "LonLatOpt",
     "ScenarioOpt", "WORLD_FLAGS", "world_spec", "build_world", "cli_point", "world_rows",
     "requested_heights", "world_overrides", "point_overrides", "option_group", "WorldFlags",
-    "world_options", "MissionFlags", "mission_options", "output_options",
+    "world_options", "MissionFlags", "mission_options", "output_options", "NoFlyOpt",
+    "MinAglOpt", "MaxAglOpt", "SaturationDistanceOpt", "SafetyFlags", "safety_options",
 ]
 
 _P = "World (real data)"
@@ -487,3 +488,106 @@ def output_options(out: str | None, *, out_help: str = "Output directory.",
         params.append(("report", Annotated[bool, typer.Option("--report", help=report_help)],
                        False))
     return option_group("output", params, Output)
+
+
+# -- flight safety (issue 13): no-fly zones, AGL limits, saturation in metres ------------------
+
+_S = "Flight safety"
+
+NoFlyOpt = Annotated[list[Path] | None, typer.Option(
+    "--no-fly", show_default=False, rich_help_panel=_S, metavar="FILE",
+    help="No-fly zones file (GeoJSON lon/lat, KML/KMZ, GPKG, SHP; points need a 'radius' in "
+         "metres): the zones become obstacles, the flight keeps out of them and the .plan "
+         "carries them as geofences. Repeatable.")]
+MinAglOpt = Annotated[float | None, typer.Option(
+    "--min-agl", show_default=False, rich_help_panel=_S,
+    help="Hard floor (m) above the ground for the whole flight except the take-off/landing "
+         "points (with --agl).")]
+MaxAglOpt = Annotated[float | None, typer.Option(
+    "--max-agl", show_default=False, rich_help_panel=_S,
+    help="Hard ceiling (m) above the ground, e.g. 120 (with --agl).")]
+SaturationDistanceOpt = Annotated[float | None, typer.Option(
+    "--saturation-distance", show_default=False, rich_help_panel=_S,
+    help="Distance (m) from the obstacles beyond which W = 1 (a margin that means the same "
+         "on any map).")]
+
+
+@dataclass(frozen=True)
+class SafetyFlags:
+    """The flight-safety options as given (``--no-fly``, ``--min-agl``, ``--max-agl``,
+    ``--saturation-distance``)."""
+
+    no_fly: list[Path] | None = None
+    min_agl: float | None = None
+    max_agl: float | None = None
+    saturation_distance: float | None = None
+
+    def limits(self, agl: float | None) -> dict[str, float]:
+        """``min_agl`` / ``max_agl`` keywords of a :class:`~fm2uav.FlightLevel` (the given ones).
+
+        Raises
+        ------
+        InputError
+            A limit without a requested height above ground ``agl`` (names the flag).
+        """
+        out = {k: float(v) for k, v in (("min_agl", self.min_agl), ("max_agl", self.max_agl))
+               if v is not None}
+        if out and agl is None:
+            flag = "--min-agl" if "min_agl" in out else "--max-agl"
+            raise InputError(f"{flag} limits a terrain-following flight; give --agl too (the "
+                             "requested height above ground)")
+        return out
+
+    def level(self, agl: float | None, **keys: Any) -> Any:
+        """The :class:`~fm2uav.FlightLevel` at ``agl`` with the limits (None without ``agl``).
+
+        Raises
+        ------
+        InputError
+            One line naming ``--max-agl`` / ``--min-agl`` when ``agl`` is outside the limits.
+        """
+        limits = self.limits(agl)
+        if agl is None:
+            return None
+        from ..planning import FlightLevel
+
+        return FlightLevel(agl=agl, **keys, **limits)
+
+    def shaping(self, **keys: Any) -> Any:
+        """The :class:`~fm2uav.Shaping` with ``--saturation-distance`` (None when not given
+        and no ``keys``)."""
+        if self.saturation_distance is None and not keys:
+            return None
+        from ..planning.params import planner_objects
+
+        extra = ({} if self.saturation_distance is None
+                 else {"saturation_distance": float(self.saturation_distance)})
+        return planner_objects({**keys, **extra})[0]
+
+    def apply(self, world: Any, points: dict[str, Any] | None = None, *, crs: str | None = None
+              ) -> Any:
+        """``world`` with the ``--no-fly`` zones as obstacles (``world`` itself without them);
+        ``points`` (name → metres) are checked to lie outside the zones.
+
+        Raises
+        ------
+        InputError
+            A file not found or not readable, a point inside a zone (names it).
+        """
+        if not self.no_fly:
+            return world
+        from ..io.zone_spec import zones_from_cli
+        from ..world.zones import check_points_allowed, with_zones
+
+        out = with_zones(world, zones_from_cli([str(f) for f in self.no_fly], world, crs=crs))
+        if points:
+            check_points_allowed(out, points)
+        return out
+
+
+#: ``@safety_options``: ``--no-fly`` (repeatable), ``--min-agl``, ``--max-agl``,
+#: ``--saturation-distance`` in place of the command's ``safety`` parameter.
+safety_options = option_group("safety", [
+    ("no_fly", NoFlyOpt, None), ("min_agl", MinAglOpt, None), ("max_agl", MaxAglOpt, None),
+    ("saturation_distance", SaturationDistanceOpt, None),
+], SafetyFlags)

@@ -208,6 +208,8 @@ def export_formation(
     result: Any,
     formats: Sequence[str],
     options: ExportOptions | None = None,
+    *,
+    fences: Any = (),
 ) -> tuple[dict[str, MissionExport], dict[str, ExportFile]]:
     """One mission per vehicle of a formation flight, each following its own timing.
 
@@ -228,6 +230,10 @@ def export_formation(
     formats : sequence of str
     options : ExportOptions, optional
         Shared by all vehicles (firmware, airframe, frame, end, ...).
+    fences : optional
+        Geofences written into every vehicle's ``.plan`` and checked against its
+        waypoints (as :func:`export_mission` ``fences``), e.g. the no-fly zones of
+        :func:`fm2uav.io.fence.zone_fences`.
     """
     opt = options or ExportOptions()
     opt = replace(opt, speed_step=min(opt.speed_step, 0.1))
@@ -248,7 +254,7 @@ def export_formation(
         agl = result.agl[i] if i < len(result.agl) else None
         m, f = export_mission(track, formats, replace(opt, name=f"{opt.name} — {name}"),
                               agl=agl, times=result.times, start_hold=t0 - float(climb_s[i]),
-                              prefix=file_prefix(name))
+                              prefix=file_prefix(name), fences=fences)
         missions[name] = m
         files.update(f)
     return missions, files

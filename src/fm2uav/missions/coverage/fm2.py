@@ -43,7 +43,7 @@ from scipy.spatial import cKDTree
 
 from ...errors import InputError, PlanningError
 from ...geometry import path_length
-from ...planning import FlightLevel, Plan, PlanOptions, base_velocity
+from ...planning import FlightLevel, Plan, PlanOptions, Shaping, base_velocity, shaped_velocity
 from ...planning import plan as fm2_plan
 from ...planning.flight_level import flight_layer, flight_level_speed
 from ...world import World
@@ -98,6 +98,7 @@ def coverage_speed_map(
     corridor: float = 0.25,
     level_contrast: float = 0.5,
     level_base: str = "world",
+    shaping: Shaping | None = None,
 ) -> np.ndarray:
     """Velocity map W of the coverage FM² (corridor × flight level), shape of the world.
 
@@ -122,13 +123,16 @@ def coverage_speed_map(
         exactly as ``plan(level=...)`` does (capped Algorithm 2); ``"uniform"``
         a constant ``level_contrast`` on the free nodes, which gives the level
         the same contrast everywhere however far the obstacles are.
+    shaping : Shaping, optional
+        Shaping of the world's map with ``level_base="world"`` (e.g.
+        ``saturation_distance`` in metres); default the unshaped distance map.
     """
     if world.ndim != 3:
         raise InputError("coverage FM² needs a 3D world with terrain")
     h = _corridor_half_width(world, zz, corridor, level_contrast, level_base)
     cell = min(world.spacing[0], world.spacing[1])
     if level_base == "world":
-        base = base_velocity(world)  # the planner's FM² map: distance to obstacles
+        base = _base(world, shaping)  # the planner's FM² map: distance to obstacles
     else:
         base = np.where(world.occupancy, 0.0, float(level_contrast))
     c = corridor_speed(world, zz.path(step=cell / 2.0), h)
@@ -157,6 +161,7 @@ def corridor_grid_speed(
     *,
     level_contrast: float = 0.5,
     level_base: str = "world",
+    shaping: Shaping | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Velocity map W of the coverage FM² on a corridor grid, and the flight layer.
 
@@ -176,7 +181,7 @@ def corridor_grid_speed(
     c = grid.centre
     occ = gw.occupancy
     if level_base == "world":
-        base = grid.sample(base_velocity(grid.map))[:, c:c + 1, :]
+        base = grid.sample(_base(grid.map, shaping))[:, c:c + 1, :]
         base[occ[:, c:c + 1, :]] = 0.0
     else:
         base = np.where(occ[:, c:c + 1, :], 0.0, float(level_contrast))
@@ -188,6 +193,11 @@ def corridor_grid_speed(
     W[occ] = 0.0
     W[~grid.inside] = 0.0
     return W, flight_layer(curtain, level.agl)[:, 0]
+
+
+def _base(world: World, shaping: Shaping | None) -> np.ndarray:
+    """The world's FM² map: unshaped distance map, or shaped by ``shaping``."""
+    return base_velocity(world) if shaping is None else shaped_velocity(world, shaping)
 
 
 def _check_level_options(level_contrast: float, level_base: str) -> None:
@@ -318,6 +328,7 @@ def plan_coverage(
     level_base: str = "world",
     options: PlanOptions = PlanOptions(),
     grid: str = "corridor",
+    shaping: Shaping | None = None,
 ) -> CoveragePlan:
     """Coverage path: best zigzag over ``area``, then FM² along it at a flight level.
 
@@ -352,6 +363,12 @@ def plan_coverage(
         track is the zigzag unless an obstacle intrudes, :mod:`.grid`);
         ``"map"`` the map's own grid, as the seeds (the path drifts 1–2 m off
         the bands and leaves slivers uncovered between them).
+        With no-fly zones (``world.zones``) whose footprint the corridor meets,
+        the coverage is flown as an FM² route around them instead
+        (:mod:`.zones`; ``params["grid"] == "route"``).
+    shaping : Shaping, optional
+        Shaping of the world's FM² map (e.g. ``saturation_distance`` [m]);
+        default the unshaped distance map (the seeds').
 
     Returns
     -------
@@ -399,11 +416,17 @@ def plan_coverage(
             "use a smaller D"
         )
     t2 = time.perf_counter()
-    opts = dict(level_contrast=level_contrast, level_base=level_base)
+    opts = dict(level_contrast=level_contrast, level_base=level_base, shaping=shaping)
     if not (0 < corridor < 0.5):
         raise InputError(f"corridor must be a share of D in (0, 0.5), got {corridor!r}")
     cg = grid_plan = None
-    if grid == "corridor":
+    from .zones import meets_zones, plan_zone_route
+
+    if meets_zones(world, ideal, corridor * d):  # no-fly zones cut the corridor: a route
+        grid = "route"
+        t3 = time.perf_counter()
+        fm = plan_zone_route(world, ideal, d, level, shaping=shaping, options=options).plan
+    elif grid == "corridor":
         cg = corridor_grid(world, zz, corridor * d)
         W, layer = corridor_grid_speed(cg, level, **opts)
         gw = cg.world

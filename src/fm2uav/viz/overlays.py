@@ -1,0 +1,60 @@
+"""Report overlays drawn from the world itself: filled DEM nodata (issue 12 item 4).
+
+:func:`filled_overlay` turns ``World.filled`` (an (nx, ny) bool mask, True where
+the DEM had no data and the nearest valid elevation was used) into a hatch of
+horizontal lines across the filled columns, for
+:func:`fm2uav.viz.report.report_html` ``overlays=`` (drawn draped on the ground
+in 3D, flat in 2D).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+__all__ = ["FILLED_NAME", "filled_overlay"]
+
+#: Legend name of the hatch.
+FILLED_NAME = "filled DEM nodata (invented ground)"
+
+
+def filled_overlay(world: Any, *, lines: int = 60) -> dict[str, Any]:
+    """``{FILLED_NAME: overlay}`` hatching the filled nodata columns of ``world``.
+
+    Parameters
+    ----------
+    world : World
+        ``world.filled`` (nx, ny) bool, or None / no True value: nothing to draw.
+    lines : int
+        At most this many hatch rows across the map (every k-th grid row).
+
+    Returns
+    -------
+    dict
+        Empty when nothing was filled; else one overlay ``{"points": (k, 2) [m]
+        with NaN rows between segments, "color", "width"}``: a segment per run of
+        filled columns along x, extended half a cell either side.
+    """
+    mask = getattr(world, "filled", None)
+    if mask is None:
+        return {}
+    mask = np.asarray(mask, dtype=bool)
+    if mask.ndim != 2 or not mask.any():
+        return {}
+    nx, ny = mask.shape
+    dx, dy = float(world.spacing[0]), float(world.spacing[1])
+    x0, y0 = float(world.origin[0]), float(world.origin[1])
+    step = max(1, int(np.ceil(ny / max(int(lines), 1))))
+    rows = [j for j in range(ny) if mask[:, j].any()]
+    picked = [j for j in rows if j % step == 0] or rows[:1]
+    segs: list[np.ndarray] = []
+    gap = np.full((1, 2), np.nan)
+    for j in picked:
+        col = np.r_[False, mask[:, j], False].astype(np.int8)
+        edges = np.flatnonzero(np.diff(col))
+        y = y0 + j * dy
+        for a, b in zip(edges[::2], edges[1::2]):  # filled columns a .. b-1
+            segs += [np.array([[x0 + (a - 0.5) * dx, y], [x0 + (b - 0.5) * dx, y]]), gap]
+    pts = np.concatenate(segs[:-1])
+    return {FILLED_NAME: {"points": pts, "color": "#7f7f7f", "width": 2}}
