@@ -27,6 +27,7 @@ def _files(tmp):
     (tmp / "dup.yaml").write_text("version: 1\nname: a\nname: b\n")
     (tmp / "deep.yaml").write_text("[" * 4000)
     (tmp / "path.csv").write_text("x,y,z\n1,2,3\n")
+    (tmp / "good.csv").write_text("x,y,z\n0,0,100\n100,0,100\n200,50,110\n300,100,120\n")
     (tmp / "bad.csv").write_text("x,y\nfoo,bar\n")
     (tmp / "binary.csv").write_bytes(b"\x89PNG\r\n\x1a\n\x00\x00")
     (tmp / "area.geojson").write_text("{broken")
@@ -109,6 +110,20 @@ CASES = [
     (["check", "{tmp}/bad.csv"], "bad.csv"),
     (["check", "{tmp}/binary.csv"], "binary.csv is not a UTF-8 text file"),
     (["check", "{tmp}/path.csv", "--airframe", "concorde"], "concorde"),
+    (["check", "{tmp}/good.csv", "--dt", "1e308"], "--dt"),
+    (["check", "{tmp}/good.csv", "--dt", "1e-300"], "steps of dt"),
+    (["check", "{tmp}/good.csv", "--dt", "0"], "--dt"),
+    (["check", "{tmp}/good.csv", "--tolerance", "-1"], "tolerance"),
+    (["check", "{tmp}/good.csv", "--lookahead", "-5"], "lookahead"),
+    (["check", "{tmp}/good.csv", "--lookahead-points", "0"], "lookahead_points"),
+    # formation: bounded speeds and cycles (1e-300 m/s never arrived)
+    (["formation", "--speed", "1e308", "--no-gif"], "--speed"),
+    (["formation", "--speed", "1e-300", "--no-gif"], "[0.1, 300] m/s"),
+    (["formation", "--follower-speed", "1e308", "--no-gif"], "--follower-speed"),
+    (["formation", "--cycle", "1e308", "--no-gif"], "--cycle"),
+    (["formation", "--cycle", "0", "--no-gif"], "--cycle"),
+    (["formation", "--followers", "0", "--no-gif"], "--followers"),
+    (["formation", "--start", "[/b]", "--no-gif"], "[/b]"),
     (["export", "{tmp}/pipe.geojson", "--format", "plan", "--scenario", "open-field"],
      "named pipe"),
     (["export", "{tmp}/bad.csv", "--format", "plan"], "--mission"),
@@ -129,7 +144,8 @@ def bad_files(tmp_path_factory):
 @pytest.mark.parametrize("args, fragment", CASES, ids=[" ".join(a)[:60] for a, _ in CASES])
 def test_cli_bad_input(bad_files, tmp_path, args, fragment):
     argv = [a.replace("{tmp}", str(bad_files)) for a in args]
-    if "--out" not in argv and argv[0] in ("plan", "run", "cover", "export", "check"):
+    if "--out" not in argv and argv[0] in ("plan", "run", "cover", "export", "check",
+                                           "formation"):
         argv += ["--out", str(tmp_path / "out")]
     res = runner.invoke(app, argv)
     out = res.output

@@ -30,7 +30,8 @@ import numpy as np
 from ..errors import InputError
 from ..geometry import arc_length, as_path3
 from .airframes import Airframe, FixedWing, get_airframe
-from .tracking import Carrot, Tracking, check_dt, check_lookahead, check_max_time, finish_tracking
+from .tracking import (Carrot, Tracking, check_dt, check_lookahead, check_max_time,
+                       check_steps, finish_tracking)
 
 __all__ = ["track_dubins"]
 
@@ -100,7 +101,7 @@ def track_dubins(
     pos = planned[0].copy()
     c0 = carrot.pts[min(carrot.n_ahead, carrot.last)] - pos
     psi = math.atan2(c0[1], c0[0])
-    n_max = int(math.ceil(t_max / dt)) + 1
+    n_max = check_steps(t_max, dt)  # bounded: refused beyond MAX_STEPS
     traj = np.empty((n_max, 3))
     prog = np.empty(n_max)
     heading = np.empty(n_max)

@@ -21,7 +21,8 @@ from ..errors import InputError
 from ..geometry import arc_length, as_path3
 from .airframes import Multirotor, get_airframe
 from .speed_profile import speed_profile
-from .tracking import Carrot, Tracking, check_dt, check_lookahead, check_max_time, finish_tracking
+from .tracking import (Carrot, Tracking, check_dt, check_lookahead, check_max_time,
+                       check_steps, finish_tracking)
 
 __all__ = ["track_multirotor"]
 
@@ -85,7 +86,7 @@ def track_multirotor(
 
     pos = planned[0].copy()
     vel = np.zeros(3)
-    n_max = int(math.ceil(t_max / dt)) + 1
+    n_max = check_steps(t_max, dt)  # bounded: refused beyond MAX_STEPS
     traj = np.empty((n_max, 3))
     prog = np.empty(n_max)
     spd = np.empty(n_max)

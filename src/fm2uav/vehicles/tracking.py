@@ -153,15 +153,38 @@ def check_lookahead(
     v = float(lookahead)
     if not (math.isfinite(v) and v > 0):
         raise InputError(f"lookahead must be a positive distance in metres, got {lookahead!r}")
-    return v
+    # beyond the path's length the carrot sits on the goal anyway: same result, bounded work
+    total = float(np.sum(np.linalg.norm(np.diff(as_path3(path), axis=0), axis=1)))
+    return min(v, max(total, 1.0))
+
+
+#: Largest integration step [s] (a longer step skips whole manoeuvres).
+MAX_DT = 10.0
+#: Most integration steps a simulation may take (beyond: refused, not allocated).
+MAX_STEPS = 5_000_000
 
 
 def check_dt(dt: float) -> float:
-    """Validate the integration step [s]."""
-    v = float(dt)
-    if not (math.isfinite(v) and v > 0):
-        raise InputError(f"dt must be a positive time step in seconds, got {dt!r}")
+    """Validate the integration step [s]: in (0, :data:`MAX_DT`]."""
+    try:
+        v = float(dt)
+    except (TypeError, ValueError):
+        raise InputError(f"dt must be a time step in seconds, got {dt!r} (CLI --dt)") from None
+    if not (math.isfinite(v) and 0 < v <= MAX_DT):
+        raise InputError(f"dt must be a time step in (0, {MAX_DT:g}] seconds, got {dt!r} "
+                         "(CLI --dt)")
     return v
+
+
+def check_steps(t_max: float, dt: float) -> int:
+    """Number of integration steps for ``t_max`` [s] at ``dt`` [s] (refused beyond
+    :data:`MAX_STEPS` with the step that would fit)."""
+    n = t_max / dt
+    if not n <= MAX_STEPS:
+        raise InputError(
+            f"the simulation would take {n:.3g} steps of dt = {dt:g} s for {t_max:.3g} s of "
+            f"flight (limit {MAX_STEPS:.0e}); use dt >= {t_max / MAX_STEPS:.3g} s (CLI --dt)")
+    return int(math.ceil(n)) + 1
 
 
 def check_max_time(max_time: float | None, length: float, speed: float) -> float:

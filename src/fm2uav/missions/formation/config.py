@@ -98,12 +98,16 @@ class FormationConfig:
         _set(self, "shape", v.choice(str(self.shape).strip().lower(), tuple(SHAPES), "shape",
                                      where=_where("shape")))
         _set(self, "dist", v.positive(self.dist, "dist", unit="m", where=_where("dist")))
-        _set(self, "leader_speed", v.positive(self.leader_speed, "leader_speed", unit="m/s",
+        # bounded: a UAV between 0.1 and 300 m/s, a re-planning cycle up to 10 min (issue 17:
+        # 1e-300 m/s never arrived, 1e308 m/s overflowed)
+        _set(self, "leader_speed", v.in_range(self.leader_speed, "leader_speed", 0.1, 300.0,
+                                              unit="m/s",
                                               where=_where("leader_speed", "--speed")))
-        _set(self, "follower_speed", v.optional(v.positive, self.follower_speed,
-                                                "follower_speed", unit="m/s",
+        _set(self, "follower_speed", v.optional(v.in_range, self.follower_speed,
+                                                "follower_speed", 0.1, 300.0, unit="m/s",
                                                 where=_where("follower_speed")))
-        _set(self, "cycle", v.positive(self.cycle, "cycle", unit="s", where=_where("cycle")))
+        _set(self, "cycle", v.in_range(self.cycle, "cycle", 0.0, 600.0, low_open=True,
+                                       unit="s", where=_where("cycle")))
         _set(self, "clearance", v.optional(v.positive, self.clearance, "clearance", unit="m"))
         v.choice(self.grey, GREY_MODES, "grey", where=_where("grey"))
         _set(self, "grey_reference", v.optional(v.positive, self.grey_reference,

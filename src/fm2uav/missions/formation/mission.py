@@ -331,6 +331,11 @@ def _resolve(world: World, config: Any, level: Any, follower_levels: Any, shapin
     return cfg, levels
 
 
+#: Most re-planning cycles (incl. settling) and sub-steps per cycle of a formation flight.
+MAX_CYCLES = 100_000
+MAX_SUBSTEPS = 100_000
+
+
 def _cycle_settings(world: World, cfg: FormationConfig, options: PlanOptions, maps: StaticMaps,
                     length: float) -> CycleSettings:
     """The cycles' fixed numbers: safety radius, samples per cycle, cycle limits."""
@@ -342,10 +347,18 @@ def _cycle_settings(world: World, cfg: FormationConfig, options: PlanOptions, ma
                   else cfg.max_cycles)
     settle = (int(np.ceil(4 * cfg.dist / (v_fol * cycle))) + 10 if cfg.settle_cycles is None
               else cfg.settle_cycles)
+    n_sub = max(2, int(np.ceil(v_max * cycle / (0.25 * float(h.min())))))
+    if max_cycles + settle > MAX_CYCLES or n_sub > MAX_SUBSTEPS:
+        raise InputError(
+            f"the formation flight would take {max_cycles + settle} re-planning cycles of "
+            f"{n_sub} sub-steps (limits {MAX_CYCLES}, {MAX_SUBSTEPS}) for a {length:.0f} m "
+            f"route at {v_lead:g} m/s with cycles of {cycle:g} s on {float(h.min()):g} m cells; "
+            "use a faster --speed, a longer --cycle (or a shorter one for fast vehicles), "
+            "or a coarser grid")
     return CycleSettings(
         cycle=cycle, speeds=np.array([v_lead] + [v_fol] * cfg.n_followers),
         radius=bound + v_max * cycle + maps.half_diagonal + 1e-6,
-        n_sub=max(2, int(np.ceil(v_max * cycle / (0.25 * float(h.min()))))),
+        n_sub=n_sub,
         bound=bound, window=cfg.window, order=options.order, step=options.step,
         max_cycles=max_cycles, settle_cycles=settle, tol=0.05 * cfg.dist,
     )
