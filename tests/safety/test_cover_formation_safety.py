@@ -34,6 +34,18 @@ def _xy(csv_text):
     return np.array([[float(v) for v in ln.split(",")[:2]] for ln in rows])
 
 
+def _plan_legs_outside_fences(plan):
+    """Every straight leg between the .plan's position items (lat, lon) stays outside each
+    exclusion fence polygon (read from the same file); returns the fence count."""
+    items = [i for i in plan["mission"]["items"] if i.get("command") in (16, 22)]
+    latlon = np.array([i["params"][4:6] for i in items], dtype=float)
+    fences = plan["geoFence"]["polygons"]
+    for f in fences:
+        assert f["inclusion"] is False
+        assert not shapely.intersects(shapely.LineString(latlon), shapely.Polygon(f["polygon"]))
+    return len(fences)
+
+
 def _legs_outside(points, keep_out):
     """True if no straight leg between successive points touches ``keep_out``."""
     return not shapely.intersects(shapely.LineString(np.asarray(points)[:, :2]), keep_out)
@@ -80,12 +92,9 @@ def test_cover_cli_no_fly_strip_path_legs_geofence_report(tmp_path):
     assert s["safety"]["zones"]["count"] == 1 and s["safety"]["zones"]["path_entries"] == []
     assert all(c["ok"] for c in s["safety"]["checks"].values())
     assert s["safety"]["legs"]["min_m"] >= 60.0 - 1e-6
-    # the waypoints (every leg of the mission) stay outside too, checked from the .plan
-    plan = json.loads((out / "mission.plan").read_text())
-    fence = plan["geoFence"]["polygons"]
-    assert len(fence) == 1 and fence[0]["inclusion"] is False
-    wps = json.loads((out / "path.geojson").read_text())
-    assert wps["type"] == "FeatureCollection"
+    assert s["safety"]["legs"]["zone_entries"] == []
+    # the .plan carries the zone in geoFence, and every leg of its waypoints stays outside it
+    assert _plan_legs_outside_fences(json.loads((out / "mission.plan").read_text())) == 1
     html = (out / "report.html").read_text()
     assert "no-fly zone: strip" in html and "(buffer 20 m)" in html
 
@@ -133,9 +142,10 @@ def test_formation_cli_no_fly_box_every_uav_and_leg_outside(tmp_path):
         track = _xy((out / f"{n}_path.csv").read_text())
         assert _legs_outside(track, keep_out), n
         plan = json.loads((out / f"{n}_mission.plan").read_text())
-        assert len(plan["geoFence"]["polygons"]) == 1
+        assert _plan_legs_outside_fences(plan) == 1, n
     for n in ("leader", "follower 1", "follower 2"):
         assert s["safety"][n]["zones"]["path_entries"] == []
+        assert s["safety"][n]["legs"]["zone_entries"] == []
     # the trajectories themselves (every simulated sample) stay outside the zone
     rows = [r.split(",") for r in (out / "trajectories.csv").read_text().splitlines()[1:]]
     for n in ("leader", "follower 1", "follower 2"):
