@@ -171,3 +171,21 @@ def test_filled_nodata_hatch_in_report():
     path = np.array([[5.0, 5.0, 30.0], [100.0, 80.0, 30.0]])
     html = report_html(wf, {"p": path}, title="t", overlays=filled_overlay(wf))
     assert FILLED_NAME in html
+
+
+def test_plan_report_hatches_filled_nodata(tmp_path):
+    """`fm2uav plan --dem ... --nodata fill --report`: the filled DEM gaps are in report.html."""
+    from fm2uav.viz.overlays import FILLED_NAME
+
+    from ..world import geodata_data as gd
+
+    dem = gd.dem_4326(tmp_path / "country_4326.tif")
+    out = tmp_path / "p"
+    res = CliRunner().invoke(app, [
+        "plan", "--dem", str(dem), "--nodata", "fill", "--lonlat", "--start",
+        f"{gd.START[0]},{gd.START[1]}", "--goal", f"{gd.GOAL[0]},{gd.GOAL[1]}", "--agl", "120",
+        "--cell-size", "200", "--report", "--out", str(out), "--quiet"])
+    assert res.exit_code == 0, res.output
+    s = json.loads((out / "summary.json").read_text())
+    assert s["world"]["filled_nodes"] > 0
+    assert FILLED_NAME in (out / "report.html").read_text()

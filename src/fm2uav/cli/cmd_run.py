@@ -237,6 +237,7 @@ def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
                  fence_warnings: list[str]) -> str:
     """report.html of a plan and its autopilot mission's waypoints ``wps`` (see
     :func:`plan_outputs`)."""
+    from ..viz.overlays import filled_overlay
     from ..viz.report import report_html
 
     ms, level = info["autopilot"], getattr(plan, "level", None)
@@ -263,7 +264,8 @@ def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
         plan.world, {"FM² path": plan.path}, title=title, subtitle=subtitle,
         speeds={"FM² path": plan.w}, waypoints={"FM² path": wps.points_m},
         params=params, metrics=metrics, files=output_names(formats),
-        agl=None if level is None else level.agl, overlays=zone_overlays(zones))
+        agl=None if level is None else level.agl,
+        overlays={**filled_overlay(plan.world), **zone_overlays(zones)})
 
 
 RUN_HELP = (
