@@ -26,6 +26,13 @@ def test_ground_height_is_the_source_dem_bilinear(rough_tif):
     assert np.max(np.abs(grid - theirs)) > 5.0
 
 
-def test_no_ground_model_when_the_dem_is_coarser(rough_tif):
+def test_ground_model_kept_when_the_dem_is_coarser(rough_tif):
+    # the bilinear surface of a finer reprojected grid is not the DEM's own:
+    # the model is kept at any cell size (acceptance, tests/acceptance)
     w = World.from_dem(str(rough_tif), (40.0, 40.0, 20.0))
-    assert w.ground is None
+    assert w.ground is not None and w.ground.pixel_m > 40.0
+    rng = np.random.default_rng(2)
+    b = w.bounds
+    x = rng.uniform(b[0, 0], b[0, 1], 2000)
+    y = rng.uniform(b[1, 0], b[1, 1], 2000)
+    assert np.max(np.abs(w.ground_height(x, y) - source_ground(rough_tif, w, x, y))) < 0.01

@@ -324,16 +324,27 @@ def _read_files(paths: list[Path], crs: Any, nodata: float | None,
                 if win is None or win.width < 2 or win.height < 2:
                     b = first.bounds
                     raise InputError(_no_overlap(bbox, h_crs, (b.left, b.bottom, b.right, b.top)))
-            band = first.read(1, masked=True, window=win, out_dtype="float64")
-            t = first.window_transform(win) if win is not None else first.transform
-            z = np.ma.filled(band, np.nan)
-            z = _apply_alpha(first, z, win)
+            try:  # a truncated or corrupt file opens (header) but fails here
+                band = first.read(1, masked=True, window=win, out_dtype="float64")
+                t = first.window_transform(win) if win is not None else first.transform
+                z = np.ma.filled(band, np.nan)
+                z = _apply_alpha(first, z, win)
+            except RasterioIOError as exc:
+                raise InputError(
+                    f"cannot read the pixels of the DEM {str(paths[0])!r} (truncated or corrupt "
+                    f"file: {exc}); check world.dem / --dem, re-download or repair it "
+                    "(gdalinfo -checksum FILE shows the broken blocks)") from None
         else:
             kw = {"bounds": window_bounds} if window_bounds is not None else {}
             try:
                 arr, t = merge(datasets, masked=True, dtype="float64", **kw)
             except ValueError as exc:
                 raise InputError(f"cannot merge the DEM tiles: {exc}") from None
+            except RasterioIOError as exc:
+                raise InputError(
+                    f"cannot read the pixels of a DEM tile (truncated or corrupt file: {exc}); "
+                    "check world.dem / --dem, re-download or repair it (gdalinfo -checksum "
+                    "FILE shows the broken blocks)") from None
             z = np.ma.filled(arr[0], np.nan)
             if window_bounds is not None and not np.isfinite(z).any():
                 lefts = [ds.bounds for ds in datasets]
