@@ -180,3 +180,38 @@ def test_duplicate_keys_always_refused(tmp_path_factory, doc, dup):
         assert "duplicate key" in str(exc)
     else:
         raise AssertionError("duplicate key accepted")
+
+
+@st.composite
+def terrain_worlds(draw):
+    nx, ny = draw(st.integers(8, 20)), draw(st.integers(8, 20))
+    nz = draw(st.integers(10, 20))
+    rng = np.random.default_rng(draw(st.integers(0, 2**31)))
+    ground = np.cumsum(rng.normal(0.0, draw(st.floats(0.0, 2.0)), (nx, ny)), axis=0)
+    ground = np.clip(ground - ground.min(), 0.0, nz / 2)
+    z = np.arange(nz, dtype=float)
+    occ = z[None, None, :] <= ground[:, :, None]
+    return World(occ, spacing=(10.0, 10.0, 5.0), terrain=ground * 5.0)
+
+
+@given(world=terrain_worlds(), data=st.data(), agl=st.floats(5.0, 60.0),
+       p2=st.floats(0.5, 3.0))
+def test_terrain_following_plans_stay_out_of_the_ground(world, data, agl, p2):
+    """Terrain-following plans on random relief: an Fm2uavError or a path whose points all
+    lie in free nodes (the final altitude profile included)."""
+    hi = (np.asarray(world.shape) - 1) * np.asarray(world.spacing)
+    pts = []
+    for _ in range(2):
+        x = data.draw(st.floats(0.0, float(hi[0])))
+        y = data.draw(st.floats(0.0, float(hi[1])))
+        pts.append([x, y, float(world.ground_height(x, y)) + agl])
+    try:
+        p = plan(world, pts[0], pts[1], level=FlightLevel(agl=agl, p2=p2))
+    except Fm2uavError:
+        return
+    # the heights follow the continuous ground (bilinear), so the obstacle here is the
+    # continuous surface, not the nearest grid node
+    surface = np.asarray(world.surface_height(p.path[:, 0], p.path[:, 1]), dtype=float)
+    below = p.path[:, 2] < surface - 1e-6
+    assert not below.any(), (f"{int(below.sum())} path point(s) below the ground, worst "
+                             f"{float((surface - p.path[:, 2]).max()):.3f} m")
