@@ -77,9 +77,8 @@ def _load_area(area: str, world=None, crs=None):
 def _write_report(outdir: OutputDir, cp, *, title: str, subtitle: str, metrics: dict,
                   waypoints=None, files=()) -> None:
     from ..viz.coverage import coverage_overlays
-    from ..viz.overlays import filled_overlay
+    from ..viz.overlays import filled_overlay, zone_overlays
     from ..viz.report import report_html
-    from .cmd_run import zone_overlays
 
     name = "FM² path"
     world = cp.plan.world

@@ -14,6 +14,7 @@ import numpy as np
 import typer
 
 from ..io.exports import EXPORT_FILES
+from ..viz.overlays import zone_overlays  # noqa: F401  (re-exported: was defined here)
 from ._common import (
     Output,
     OutputDir,
@@ -102,30 +103,6 @@ def safety_rows(safety: dict[str, Any]) -> dict[str, str]:
     if bad:
         rows["limits NOT met"] = ", ".join(bad)
     return rows
-
-
-def zone_overlays(zones: Any) -> dict[str, Any]:
-    """Report overlays (outlines draped on the terrain) of no-fly zones and the operating area."""
-    out: dict[str, Any] = {}
-    for k, z in enumerate(zones or ()):
-        geoms = getattr(z.geometry, "geoms", [z.geometry])
-        rings = []
-        for g in geoms:
-            rings.append(np.asarray(g.exterior.coords)[:, :2])
-            rings.append(np.full((1, 2), np.nan))
-        pts = np.concatenate(rings)[:-1]
-        name = f"{z.kind}: {z.name or k + 1}"
-        out[name] = {"points": pts, "color": "#2ca02c" if z.inclusion else "#d62728",
-                     "width": 4}
-        if z.buffer > 0:
-            grown = z.keep_out()
-            parts = getattr(grown, "geoms", [grown])
-            ring = np.concatenate([np.vstack([np.asarray(g.exterior.coords)[:, :2],
-                                              np.full((1, 2), np.nan)]) for g in parts
-                                   if not g.is_empty])[:-1]
-            out[f"{name} (buffer {z.buffer:g} m)"] = {"points": ring, "dash": "dash",
-                                                      "color": out[name]["color"], "width": 2}
-    return out
 
 
 def _with_cli_zones(rm: Any, files: Sequence[Path]) -> Any:

@@ -1,4 +1,5 @@
-"""Report overlays drawn from the world itself: filled DEM nodata (issue 12 item 4).
+"""Report overlays drawn from the world itself: filled DEM nodata (issue 12 item 4) and the
+no-fly zones / operating area (issue 13).
 
 :func:`filled_overlay` turns ``World.filled`` (an (nx, ny) bool mask, True where
 the DEM had no data and the nearest valid elevation was used) into a hatch of
@@ -13,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["FILLED_NAME", "filled_overlay"]
+__all__ = ["FILLED_NAME", "filled_overlay", "zone_overlays"]
 
 #: Legend name of the hatch.
 FILLED_NAME = "filled DEM nodata (invented ground)"
@@ -58,3 +59,27 @@ def filled_overlay(world: Any, *, lines: int = 60) -> dict[str, Any]:
             segs += [np.array([[x0 + (a - 0.5) * dx, y], [x0 + (b - 0.5) * dx, y]]), gap]
     pts = np.concatenate(segs[:-1])
     return {FILLED_NAME: {"points": pts, "color": "#7f7f7f", "width": 2}}
+
+
+def zone_overlays(zones: Any) -> dict[str, Any]:
+    """Report overlays (outlines draped on the terrain) of no-fly zones and the operating area."""
+    out: dict[str, Any] = {}
+    for k, z in enumerate(zones or ()):
+        geoms = getattr(z.geometry, "geoms", [z.geometry])
+        rings = []
+        for g in geoms:
+            rings.append(np.asarray(g.exterior.coords)[:, :2])
+            rings.append(np.full((1, 2), np.nan))
+        pts = np.concatenate(rings)[:-1]
+        name = f"{z.kind}: {z.name or k + 1}"
+        out[name] = {"points": pts, "color": "#2ca02c" if z.inclusion else "#d62728",
+                     "width": 4}
+        if z.buffer > 0:
+            grown = z.keep_out()
+            parts = getattr(grown, "geoms", [grown])
+            ring = np.concatenate([np.vstack([np.asarray(g.exterior.coords)[:, :2],
+                                              np.full((1, 2), np.nan)]) for g in parts
+                                   if not g.is_empty])[:-1]
+            out[f"{name} (buffer {z.buffer:g} m)"] = {"points": ring, "dash": "dash",
+                                                      "color": out[name]["color"], "width": 2}
+    return out
