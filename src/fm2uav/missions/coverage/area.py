@@ -228,7 +228,8 @@ def check_inside_world(area: Polygon, world: Any, *, margin: float = 0.0) -> Non
         raise InputError(
             f"the area (x in [{x0:.1f}, {x1:.1f}], y in [{y0:.1f}, {y1:.1f}] m) lies outside the "
             f"map (x in [{b[0, 0]:g}, {b[0, 1]:g}], y in [{b[1, 0]:g}, {b[1, 1]:g}] m); "
-            "give the area in the map's metres"
+            "check the area's coordinates and CRS (--area / world.crs, --crs) or widen the map "
+            "to cover it (world.bbox, CLI --bbox W,S,E,N)"
         )
     grown = area.buffer(margin) if margin > 0 else area
     outside = grown.difference(box)
