@@ -15,7 +15,7 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 from .analysis import flight_level_deviation, path_profiles
-from .analysis.tune import AirframeLimits, tune
+from .analysis.tune import tune
 from .eikonal import distance_map, fast_marching, velocity_map
 from .errors import (
     Fm2uavError,
@@ -35,7 +35,13 @@ from .missions import (
 )
 from .planning import FlightLevel, Plan, PlanOptions, Shaping, plan
 from .scenarios import Scenario
-from .vehicles import AIRFRAMES, FeasibilityReport, check_feasibility, get_airframe
+from .vehicles import (
+    AIRFRAMES,
+    AirframeLimits,
+    FeasibilityReport,
+    check_feasibility,
+    get_airframe,
+)
 from .world import World
 
 if TYPE_CHECKING:  # loaded on first attribute access (PEP 562), see __getattr__

@@ -21,6 +21,8 @@ __all__ = [
     "path_length",
     "resample_path",
     "resample_uniform",
+    "densify",
+    "at_arc_length",
     "circumcurvature",
     "menger_curvature",
     "segment_angles",
@@ -103,8 +105,45 @@ def resample_uniform(path: np.ndarray, ds: float) -> tuple[np.ndarray, np.ndarra
     s = arc_length(path)
     n = max(int(np.ceil(s[-1] / ds)), 1)
     s_new = np.linspace(0.0, s[-1], n + 1)
-    pts = np.column_stack([np.interp(s_new, s, path[:, k]) for k in range(path.shape[1])])
-    return pts, s_new
+    return at_arc_length(path, s, s_new), s_new
+
+
+def at_arc_length(path: np.ndarray, s_arr: np.ndarray, s: Any) -> np.ndarray:
+    """Points of a polyline ``(N, d)`` at arc length(s) ``s`` [m], linear, shape ``s.shape + (d,)``.
+
+    ``s_arr`` is the polyline's :func:`arc_length`; ``s`` outside ``[0, L]`` gives
+    the end points.
+    """
+    return np.stack([np.interp(s, s_arr, path[:, a]) for a in range(path.shape[1])], axis=-1)
+
+
+def densify(points: np.ndarray, step: float, *, horizontal: bool = False
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """Points every <= ``step`` [m] along a polyline, its vertices kept exactly.
+
+    Each segment ``k`` is cut into ``n_k = max(ceil(length_k / step), 1)``
+    equal pieces (``horizontal=True``: ``length_k`` is the x-y length).
+
+    Returns
+    -------
+    points : ndarray, shape (M, d)
+        ``p[k] + (i / n_k) (p[k+1] - p[k])`` for ``i < n_k``, then the last vertex.
+    segment : ndarray of int, shape (M,)
+        The segment each point lies on (the last vertex: the last segment).
+    """
+    p = np.asarray(points, dtype=float)
+    if len(p) < 2:
+        return p.copy(), np.zeros(len(p), dtype=np.int64)
+    seg = np.linalg.norm(np.diff(p[:, :2] if horizontal else p, axis=0), axis=1)
+    n = np.maximum(np.ceil(seg / step).astype(np.int64), 1)
+    out, which = [], []
+    for k in range(len(p) - 1):
+        t = np.arange(n[k]) / n[k]
+        out.append(p[k] + t[:, None] * (p[k + 1] - p[k]))
+        which.append(np.full(n[k], k))
+    out.append(p[-1:])
+    which.append(np.array([len(p) - 2]))
+    return np.concatenate(out), np.concatenate(which)
 
 
 def resample_path(path: np.ndarray, ds: float) -> np.ndarray:
@@ -124,7 +163,7 @@ def resample_path(path: np.ndarray, ds: float) -> np.ndarray:
     n = max(int(np.ceil(s[-1] / ds - 1e-9)), 1)
     t = np.minimum(np.arange(n + 1) * ds, s[-1])
     t[-1] = s[-1]
-    return np.stack([np.interp(t, s, p[:, k]) for k in range(p.shape[1])], axis=1)
+    return at_arc_length(p, s, t)
 
 
 def circumcurvature(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:

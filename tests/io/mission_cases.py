@@ -51,7 +51,7 @@ def hill_free():
 def bilinear_ground(world: World, lonlat: np.ndarray, anchor: Anchor | None = ANCHOR) -> np.ndarray:
     """Ground under lon/lat points, interpolated bilinearly on the terrain map (independent of
     fm2uav.io: back to world metres, then scipy's linear interpolation)."""
-    xy = from_lonlat(np.asarray(lonlat)[:, :2], world, anchor=anchor)
+    xy = from_lonlat(world, np.asarray(lonlat)[:, :2], anchor=anchor)
     idx = (xy - np.asarray(world.origin[:2])) / np.asarray(world.spacing[:2])
     g = ndimage.map_coordinates(world.terrain, idx.T, order=1, mode="nearest")
     offset = 0.0 if world.crs else (anchor.alt if anchor is not None else 0.0)

@@ -107,8 +107,8 @@ def test_wpl_loads_in_pymavlink_and_round_trips(tmp_path):
     np.testing.assert_allclose([w.z for w in route], wps.alt[1:], atol=1e-3)
     ours = read_wpl(tmp_path / "mission.waypoints")
     route_ours = ours["command"] == 16
-    back = from_lonlat(np.column_stack([ours["lon"][route_ours], ours["lat"][route_ours]]),
-                       hill_tff().world, anchor=ANCHOR)
+    back = from_lonlat(hill_tff().world,
+                       np.column_stack([ours["lon"][route_ours], ours["lat"][route_ours]]), anchor=ANCHOR)
     np.testing.assert_allclose(back, wps.points_m[1:, :2], atol=1e-3)
 
 
@@ -182,14 +182,14 @@ def test_plan_checker_names_the_problem(mutate, problem):
 def test_geojson_and_kml_round_trip_coordinates(tmp_path):
     p = hill_tff()
     m = _write_all(p, tmp_path)
-    geo = to_lonlat(p.path, p.world, anchor=ANCHOR)
+    geo = to_lonlat(p.world, p.path, anchor=ANCHOR)
     for reader, file in ((read_geojson_path, "path.geojson"), (read_kml_path, "path.kml"),
                          (read_kml_path, "path.kmz")):
         got = reader(tmp_path / file)
         assert got.shape == geo.shape
         np.testing.assert_allclose(got[:, :2], geo[:, :2], atol=1e-7, rtol=0)
         np.testing.assert_allclose(got[:, 2], geo[:, 2], atol=1e-3)
-        np.testing.assert_allclose(from_lonlat(got, p.world, anchor=ANCHOR), p.path, atol=0.02)
+        np.testing.assert_allclose(from_lonlat(p.world, got, anchor=ANCHOR), p.path, atol=0.02)
         wp = reader(tmp_path / file, name="waypoints")
         np.testing.assert_allclose(wp[:, 1], m.waypoints.lat, atol=1e-7, rtol=0)
         np.testing.assert_allclose(wp[:, 2], m.waypoints.alt_amsl, atol=1e-3)

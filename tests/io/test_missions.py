@@ -113,7 +113,7 @@ def test_terrain_frame_altitude_is_the_requested_agl():
 def test_home_is_the_dem_ground_under_the_start_with_its_source():
     p = hill_tff(UTM)
     m, _ = export_mission(p, ["plan"], ExportOptions(firmware="px4"))
-    lonlat = to_lonlat(p.path[:1], p.world)[:, :2]
+    lonlat = to_lonlat(p.world, p.path[:1])[:, :2]
     assert m.home[2] == pytest.approx(float(bilinear_ground(p.world, lonlat, None)[0]), abs=1e-6)
     s = m.summary()
     assert "DEM ground" in s["home"]["source"] and s["crs"] == UTM
@@ -282,7 +282,7 @@ def test_camera_triggers_switch_on_at_each_band_start_and_off_at_its_end(firmwar
     m = build_mission(path, hill(), _opts(firmware=firmware), agl=60.0, camera=cam)
     trig = [(k, it) for k, it in enumerate(m.items) if it.command == 206]
     assert [it.params[0] for _, it in trig] == [23.5, 0.0, 23.5, 0.0]
-    geo = to_lonlat(path, hill(), anchor=ANCHOR)
+    geo = to_lonlat(hill(), path, anchor=ANCHOR)
     ends = [b1[0], b1[1], b2[0], b2[1]]
     for (k, it), i in zip(trig, ends):
         prev = next(m.items[j] for j in range(k - 1, -1, -1) if m.items[j].has_position)
@@ -313,7 +313,7 @@ def test_a_two_via_mission_reaches_each_via_in_order():
     for k, v in enumerate(via):
         np.testing.assert_array_equal(route.plan.path[route.junctions[k + 1]], v)
     m, _ = export_mission(route.plan, ["plan"], _opts(), via=route.junctions[1:-1])
-    geo = to_lonlat(np.array(via), world, anchor=ANCHOR)
+    geo = to_lonlat(world, np.array(via), anchor=ANCHOR)
     labelled = [(k, it) for k, it in enumerate(m.items) if it.label.startswith("via")]
     assert [it.label for _, it in labelled] == ["via 1", "via 2"]
     assert labelled[0][0] < labelled[1][0]
@@ -575,7 +575,7 @@ def test_a_coverage_export_triggers_the_camera_at_the_band_ends(firmware):
         it = m.items[k]
         assert it.params[0] == (plan_cam.trigger_distance if n % 2 == 0 else 0.0)
         prev = next(m.items[j] for j in range(k - 1, -1, -1) if m.items[j].has_position)
-        xy = from_lonlat([[prev.lon, prev.lat]], world, anchor=ANCHOR)[0]
+        xy = from_lonlat(world, [[prev.lon, prev.lat]], anchor=ANCHOR)[0]
         assert np.hypot(*(xy - ends[n])) < 5.0  # at the band's start / end (m)
     s = m.summary()["camera"]
     # GSD = sensor width x AGL / (focal x image width): 13.2 mm x 100 m / (8.8 mm x 5472 px)

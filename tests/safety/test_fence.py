@@ -7,7 +7,7 @@ import pytest
 
 from fm2uav.io.fence import zone_fences
 from fm2uav.io.geofence import FenceCircle, FencePolygon, geofence_document
-from fm2uav.io.georef import from_lonlat
+from fm2uav.world.geo import from_lonlat
 from fm2uav.scenarios import get_scenario
 from fm2uav.world.zones import zone_from_mapping
 
@@ -27,7 +27,7 @@ def test_zone_fences_kinds_and_positions():
     assert len(warnings) == 1 and "low" in warnings[0] and "2D" in warnings[0]
     # the polygon's vertices go back to the zone's metres (no buffer in the fence)
     lat, lon = np.array(fences[0].points).T
-    back = from_lonlat(np.column_stack([lon, lat]), w)
+    back = from_lonlat(w, np.column_stack([lon, lat]))
     got = np.array(sorted(map(tuple, np.round(back[:, :2], 3))))
     np.testing.assert_allclose(got, [(700, 300), (900, 300), (900, 1000)], atol=0.01)
     c = fences[1]

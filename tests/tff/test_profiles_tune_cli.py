@@ -12,7 +12,8 @@ import fm2uav
 from fm2uav.analysis import flight_level_deviation, path_profiles
 from fm2uav.geometry import menger_curvature, resample_path
 from fm2uav.errors import InputError
-from fm2uav.analysis.tune import AirframeLimits, as_limits, tune
+from fm2uav.analysis.tune import as_limits, tune
+from fm2uav.vehicles import AirframeLimits, FixedWing
 from fm2uav import FlightLevel
 
 
@@ -81,24 +82,29 @@ def test_flight_level_deviation_exact():
 
 
 def test_limits_parsing():
-    assert as_limits({"max_climb_deg": 20, "min_turn_radius_m": 50}) == AirframeLimits(20, 50)
-    assert as_limits((20, 50)) == AirframeLimits(20.0, 50.0)
+    lim = AirframeLimits.from_degrees(20, 50)
+    assert lim.max_climb == pytest.approx(np.radians(20)) and lim.min_turn_radius == 50.0
+    assert as_limits({"max_climb": np.radians(20), "min_turn_radius": 50}) == lim
+    assert as_limits(lim) is lim
     with pytest.raises(InputError):
         AirframeLimits(0, 50)
+    with pytest.raises(InputError, match="90 degrees"):
+        AirframeLimits(2.0, 50)  # radians, not degrees: 115 degrees
     with pytest.raises(InputError):
-        AirframeLimits(20, -1)
+        AirframeLimits.from_degrees(95, 50)
+    with pytest.raises(InputError):
+        AirframeLimits(0.3, -1)
     with pytest.raises(InputError, match="missing"):
-        as_limits({"max_climb_deg": 20})
-
-    class Wing:  # duck-typed airframe: radians and a turn radius
-        max_climb = np.radians(15)
-        max_descent = np.radians(12)
-
-        def turn_radius(self):
-            return 80.0
-
-    lim = as_limits(Wing())
-    assert lim.max_climb_deg == pytest.approx(12.0) and lim.min_turn_radius_m == 80.0
+        as_limits({"max_climb": 0.3})
+    with pytest.raises(InputError, match="AirframeLimits"):
+        as_limits((20, 50))
+    # an airframe: the smaller of climb and descent, its turn radius at cruise
+    wing = FixedWing("w", 14.0, 12.0, 17.0, np.radians(55), np.radians(15), np.radians(12))
+    lim = as_limits(wing)
+    assert lim.max_climb_deg == pytest.approx(12.0)
+    assert lim.min_turn_radius == pytest.approx(wing.turn_radius())
+    assert as_limits("disco") == fm2uav.get_airframe("disco").limits()
+    assert as_limits("arducopter").max_climb == pytest.approx(np.pi / 2)
 
 
 @pytest.fixture(scope="module")
@@ -109,8 +115,10 @@ def open_field():
 def test_tune_trade_off(open_field):
     sc = open_field
     grid = {"p1": [0.5], "p2": [0.6, 0.8, 1.3, 2.5]}
-    loose = tune(sc.world, sc.start, sc.goal, (89.9, 0.0), FlightLevel(agl=150.0), grid=grid)
-    strict = tune(sc.world, sc.start, sc.goal, (25.0, 200.0), FlightLevel(agl=150.0), grid=grid)
+    lv = FlightLevel(agl=150.0)
+    loose = tune(sc.world, sc.start, sc.goal, AirframeLimits.from_degrees(89.9, 0.0), lv, grid=grid)
+    strict = tune(sc.world, sc.start, sc.goal, AirframeLimits.from_degrees(25.0, 200.0), lv,
+                  grid=grid)
     assert len(loose.rows) == 4 and all(r["error"] is None for r in loose.rows)
     # with no limits the best is the closest follower; with tight limits a smoother one
     assert loose.best["deviation_m"] == min(r["deviation_m"] for r in loose.rows)
@@ -127,10 +135,11 @@ def test_tune_trade_off(open_field):
                         and b["min_turn_radius_m"] > a["min_turn_radius_m"])
     assert "| p1 | p2 |" in strict.table()
     with pytest.raises(InputError, match="p2 > p1"):
-        tune(sc.world, sc.start, sc.goal, (30, 10), FlightLevel(agl=150.0),
+        tune(sc.world, sc.start, sc.goal, AirframeLimits.from_degrees(30, 10), lv,
              grid={"p1": [1.0], "p2": [0.5]})
     with pytest.raises(InputError, match="grid 'p1'"):
-        tune(sc.world, sc.start, sc.goal, (30, 10), FlightLevel(agl=150.0), grid={"p1": [-1.0]})
+        tune(sc.world, sc.start, sc.goal, AirframeLimits.from_degrees(30, 10), lv,
+             grid={"p1": [-1.0]})
 
 
 def _cli(args):
@@ -139,9 +148,11 @@ def _cli(args):
     return CliRunner().invoke(app, args)
 
 
-def test_reproduce_tff_cli(tmp_path):
-    out = tmp_path / "tff"
-    r = _cli(["reproduce", "tff", "--out", str(out), "--quiet"])
+@pytest.mark.slow
+def test_reproduce_tff_cli(cli_once):
+    # the same run as tests/cli_reports (one run per session, tests/conftest.py)
+    run = cli_once(["reproduce", "tff", "--report", "--json"])
+    r, out = run.result, run.out
     assert r.exit_code == 0, r.output
     table = (out / "tff_table.md").read_text()
     assert table.count("\n| ") >= 7

@@ -1,11 +1,12 @@
 """Flight-level deviation of a path against the ideal terrain-following path.
 
-The ideal path flies ``agl`` metres over the ground: its altitude at a path
-point's horizontal position is ``terrain(x, y) + agl`` (terrain interpolated
-bilinearly between nodes; ``reference="terrain"``), or the flight-level node
-``z0 + (Surface + round(agl/dz)) dz`` of the nearest column, i.e. exactly the
-layer Algorithm 2 clarifies (``reference="layer"``). Worlds without a terrain
-map use the top obstacle node of the column as the ground.
+The ideal path flies ``agl`` metres over the surface Algorithm 2 follows (the
+ground, or a roof): its altitude at a path point's horizontal position is
+``World.surface_height(x, y) + agl`` (``reference="terrain"``: the ground
+interpolated bilinearly, roofs from the nearest column; see
+:mod:`fm2uav.world.ground`), or the flight-level node ``z0 + (Surface +
+round(agl/dz)) dz`` of the nearest column, i.e. exactly the layer Algorithm 2
+clarifies (``reference="layer"``).
 
 As in the seeds, the start and goal *transition stretches* (the initial descent
 or climb to the level and the final one to the goal) are reported apart: the
@@ -20,16 +21,15 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy import ndimage
 
 from ..errors import InputError
+from ..geometry import arc_length
 from ..planning.flight_level import level_cells
 from ..world import World
 
 __all__ = [
     "FlightLevelReport",
     "flight_level_deviation",
-    "ground_altitude",
     "ideal_altitude",
     "transition_bounds",
     "tff_metrics",
@@ -45,26 +45,6 @@ def _xy_index(world: World, points: np.ndarray) -> np.ndarray:
     return np.clip(idx, 0, hi)
 
 
-def ground_altitude(world: World, points: Any) -> np.ndarray:
-    """Ground height under each point [m]: bilinear terrain, or top obstacle node.
-
-    Parameters
-    ----------
-    world : World
-        3D world.
-    points : array_like, (N, 3)
-        Points [m]; only x, y are used.
-    """
-    if world.ndim != 3:
-        raise InputError("ground altitude needs a 3D world")
-    idx = _xy_index(world, np.asarray(points, dtype=float))
-    if world.terrain is not None:
-        return ndimage.map_coordinates(world.terrain, idx.T, order=1, mode="nearest")
-    near = np.floor(idx + 0.5).astype(int)
-    surf = world.surface_index()[near[:, 0], near[:, 1]]
-    return world.origin[2] + surf * world.spacing[2]
-
-
 def ideal_altitude(
     world: World, points: Any, agl: float, *, reference: str = "terrain"
 ) -> np.ndarray:
@@ -73,13 +53,15 @@ def ideal_altitude(
     Parameters
     ----------
     reference : {"terrain", "layer"}
-        ``"terrain"``: ground height (bilinear) + ``agl``. ``"layer"``: the
-        flight-level node of the nearest column (Algorithm 2's layer).
+        ``"terrain"``: :meth:`World.surface_height` (ground bilinear, roofs) +
+        ``agl``. ``"layer"``: the flight-level node of the nearest column
+        (Algorithm 2's layer).
     """
     pts = np.asarray(points, dtype=float)
     if reference == "terrain":
         level_cells(world, agl)  # validates agl
-        return ground_altitude(world, pts) + float(agl)
+        _xy_index(world, pts)  # validates the points
+        return world.surface_height(pts[:, 0], pts[:, 1]) + float(agl)
     if reference == "layer":
         lf = level_cells(world, agl)
         near = np.floor(_xy_index(world, pts) + 0.5).astype(int)
@@ -193,8 +175,7 @@ def flight_level_deviation(
     dev = p[:, 2] - ideal
     ok = np.abs(dev) <= tol + 1e-9
     a, b = transition_bounds(ok)
-    seg = np.linalg.norm(np.diff(p, axis=0), axis=1)
-    s = np.concatenate([[0.0], np.cumsum(seg)])
+    s = arc_length(p)
     if b >= a:
         mid = np.abs(dev[a : b + 1])
         within, mean_d, max_d = float(ok[a : b + 1].mean()), float(mid.mean()), float(mid.max())
@@ -202,7 +183,7 @@ def flight_level_deviation(
     else:
         within, mean_d, max_d = 0.0, float("nan"), float("nan")
         start_m, end_m, n_mid = float(s[-1]), 0.0, 0
-    ground = ground_altitude(world, p)
+    ground = world.surface_height(p[:, 0], p[:, 1])
     cells = np.floor(world.to_index(p) + 0.5).astype(int)
     cells = np.clip(cells, 0, np.asarray(world.shape) - 1)
     in_obstacle = world.occupancy[cells[:, 0], cells[:, 1], cells[:, 2]]

@@ -24,7 +24,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..geometry import as_path, menger_curvature, resample_path, segment_angles, turn_angles
+from ..geometry import (
+    arc_length,
+    as_path,
+    menger_curvature,
+    resample_path,
+    segment_angles,
+    turn_angles,
+)
 
 __all__ = ["Profiles", "path_profiles"]
 
@@ -106,10 +113,9 @@ def path_profiles(path: np.ndarray, ds: float | None = None) -> Profiles:
     q = resample_path(p, float(ds))
     if q.shape[1] == 2:
         q = np.concatenate([q, np.zeros((len(q), 1))], axis=1)
-    d = np.diff(q, axis=0)
     heading, climb, horiz = segment_angles(q)
     turn = turn_angles(heading, horiz)
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(d, axis=1))])
+    s = arc_length(q)
     return Profiles(
         points=q,
         s=s,

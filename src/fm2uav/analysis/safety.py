@@ -29,12 +29,13 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from ..geometry import densify
 from ..planning.altitude import height_figures
 from ..world.clearance import surface_clearance
 from ..world.ground_model import sampling_step
 from ..world.zones import zone_distances, zone_violations
 
-__all__ = ["height_above_ground", "leg_figures", "safety_summary", "densify_legs"]
+__all__ = ["height_above_ground", "leg_figures", "safety_summary"]
 
 
 def height_above_ground(world: Any, points: Any, *, surface: bool = False) -> np.ndarray:
@@ -44,27 +45,6 @@ def height_above_ground(world: Any, points: Any, *, surface: bool = False) -> np
         raise InputError(f"points must be (N, 3) metres, got shape {p.shape}")
     fn = world.surface_height if surface else world.ground_height
     return p[:, 2] - np.asarray(fn(p[:, 0], p[:, 1]), dtype=float)
-
-
-def densify_legs(points: Any, step: float) -> tuple[np.ndarray, np.ndarray]:
-    """Points every <= ``step`` m (horizontally) along the legs of a polyline.
-
-    Returns the points ``(M, d)`` (each waypoint included) and the leg index of
-    each point (the last waypoint belongs to the last leg).
-    """
-    p = np.asarray(points, dtype=float)
-    if len(p) < 2:
-        return p.copy(), np.zeros(len(p), dtype=np.int64)
-    seg = np.linalg.norm(np.diff(p[:, :2], axis=0), axis=1)
-    n = np.maximum(np.ceil(seg / step).astype(np.int64), 1)
-    out, leg = [], []
-    for k in range(len(p) - 1):
-        t = np.arange(n[k]) / n[k]
-        out.append(p[k] + t[:, None] * (p[k + 1] - p[k]))
-        leg.append(np.full(n[k], k))
-    out.append(p[-1:])
-    leg.append(np.array([len(p) - 2]))
-    return np.concatenate(out), np.concatenate(leg)
 
 
 def leg_figures(world: Any, waypoints: Any, *, requested: float | None = None,
@@ -108,7 +88,7 @@ def leg_figures(world: Any, waypoints: Any, *, requested: float | None = None,
         raise InputError(f"waypoints must be (n >= 2, 3) metres, got shape {p.shape}")
     if step is None:
         step = 0.25 * sampling_step(world)
-    dense, leg = densify_legs(p, step)
+    dense, leg = densify(p, step, horizontal=True)  # every point's leg
     if terrain_frame:
         own = height_above_ground(world, p) if waypoint_agl is None else \
             np.asarray(waypoint_agl, dtype=float)

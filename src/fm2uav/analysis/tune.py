@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
-import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -34,8 +33,9 @@ from .profiles import path_profiles
 from ..errors import InputError, PlanningError
 from ..world import World
 from ..planning import FlightLevel, Plan, PlanOptions, Shaping, plan
+from ..vehicles.airframes import AirframeLimits, FixedWing, Multirotor, get_airframe
 
-__all__ = ["AirframeLimits", "TuneResult", "tune", "as_limits", "DEFAULT_GRID"]
+__all__ = ["TuneResult", "tune", "as_limits", "DEFAULT_GRID"]
 
 #: Default search grid.
 DEFAULT_GRID: dict[str, tuple[float, ...]] = {
@@ -46,53 +46,31 @@ DEFAULT_GRID: dict[str, tuple[float, ...]] = {
 }
 
 
-@dataclass(frozen=True)
-class AirframeLimits:
-    """What the airframe can fly.
-
-    Attributes
-    ----------
-    max_climb_deg : float
-        Largest climb or descent (flight-path) angle [deg], in (0, 90].
-    min_turn_radius_m : float
-        Smallest horizontal turn radius [m], >= 0.
-    """
-
-    max_climb_deg: float
-    min_turn_radius_m: float
-
-    def __post_init__(self) -> None:
-        c, r = float(self.max_climb_deg), float(self.min_turn_radius_m)
-        if not (np.isfinite(c) and 0 < c <= 90):
-            raise InputError(f"max_climb_deg must be in (0, 90] degrees, got {self.max_climb_deg!r}")
-        if not (np.isfinite(r) and r >= 0):
-            raise InputError(f"min_turn_radius_m must be >= 0 metres, got {self.min_turn_radius_m!r}")
-        object.__setattr__(self, "max_climb_deg", c)
-        object.__setattr__(self, "min_turn_radius_m", r)
-
-
 def as_limits(limits: Any) -> AirframeLimits:
-    """Accept :class:`AirframeLimits`, a mapping with ``max_climb_deg`` and
-    ``min_turn_radius_m``, a ``(max_climb_deg, min_turn_radius_m)`` pair, or an
-    airframe object with ``max_climb`` [rad] (and ``max_descent``) and
-    ``turn_radius()`` [m] (e.g. :class:`fm2uav.vehicles.airframes.FixedWing`)."""
+    """The :class:`~fm2uav.vehicles.airframes.AirframeLimits` (SI) of ``limits``: the
+    limits themselves, an airframe or a preset name (its ``limits()``), or a mapping
+    ``{"max_climb": rad, "min_turn_radius": m}``.
+
+    Raises
+    ------
+    InputError
+        Anything else, or bad values.
+    """
     if isinstance(limits, AirframeLimits):
         return limits
+    if isinstance(limits, (str, FixedWing, Multirotor)):
+        return get_airframe(limits).limits()
     if isinstance(limits, dict):
         try:
-            return AirframeLimits(limits["max_climb_deg"], limits["min_turn_radius_m"])
+            return AirframeLimits(limits["max_climb"], limits["min_turn_radius"])
         except KeyError as exc:
             raise InputError(
-                f"airframe limits need 'max_climb_deg' and 'min_turn_radius_m', missing {exc}"
+                f"airframe limits need 'max_climb' [rad] and 'min_turn_radius' [m], missing {exc}"
             ) from None
-    if isinstance(limits, (tuple, list)) and len(limits) == 2:
-        return AirframeLimits(*limits)
-    if hasattr(limits, "max_climb") and hasattr(limits, "turn_radius"):
-        climb = min(float(limits.max_climb), float(getattr(limits, "max_descent", limits.max_climb)))
-        return AirframeLimits(math.degrees(climb), float(limits.turn_radius()))
     raise InputError(
-        "airframe_limits must be AirframeLimits(max_climb_deg, min_turn_radius_m), a dict with "
-        f"those keys, a (climb_deg, radius_m) pair or an airframe object, got {limits!r}"
+        "airframe_limits must be AirframeLimits(max_climb [rad], min_turn_radius [m]) (e.g. "
+        "AirframeLimits.from_degrees(30, 60)), an airframe or preset name, or a mapping with "
+        f"those keys, got {limits!r}"
     )
 
 
@@ -179,8 +157,8 @@ def tune(
         3D world.
     start, goal : sequence of float
         World points [m].
-    airframe_limits : AirframeLimits, dict, pair or airframe
-        Max climb angle [deg] and min turn radius [m] (see :func:`as_limits`).
+    airframe_limits : AirframeLimits, airframe, preset name or dict
+        Max climb angle [rad] and min turn radius [m] (see :func:`as_limits`).
     level : FlightLevel
         The flight level; its ``p1`` and ``p2`` are replaced by the grid's
         values, the rest (``agl``, ``band``, ``mode``, ...) is kept.
@@ -211,7 +189,8 @@ def tune(
     --------
     >>> import fm2uav
     >>> sc = fm2uav.scenarios.open_field()
-    >>> res = tune(sc.world, sc.start, sc.goal, (30.0, 60.0), fm2uav.FlightLevel(agl=150.0),
+    >>> lim = fm2uav.AirframeLimits.from_degrees(30.0, 60.0)
+    >>> res = tune(sc.world, sc.start, sc.goal, lim, fm2uav.FlightLevel(agl=150.0),
     ...            grid={"p1": [0.5], "p2": [0.8, 1.3]})
     >>> len(res.rows)
     2
@@ -269,7 +248,7 @@ def tune(
         )
         row["feasible"] = bool(
             row["climb_max_deg"] <= limits.max_climb_deg + 1e-9
-            and row["min_turn_radius_m"] >= limits.min_turn_radius_m - 1e-9
+            and row["min_turn_radius_m"] >= limits.min_turn_radius - 1e-9
             and fl.inside_terrain == 0
         )
         rows.append(row)

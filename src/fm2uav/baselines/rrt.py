@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError, PointError, UnreachableError
+from ..geometry import densify, path_length
 from ..world import World
 from ..world.clearance import clearance_profile
 
@@ -91,19 +92,6 @@ class RRTResult:
             "timings_s": {k: round(v, 6) for k, v in self.timings.items()},
             "seeded": self.seeded,
         }
-
-
-def _densify(vertices: np.ndarray, step: float) -> np.ndarray:
-    out = [vertices[:1]]
-    for a, b in zip(vertices[:-1], vertices[1:]):
-        n = max(int(math.ceil(np.linalg.norm(b - a) / step)), 1)
-        t = np.arange(1, n + 1)[:, None] / n
-        out.append(a + t * (b - a))
-    return np.vstack(out)
-
-
-def _length(p: np.ndarray) -> float:
-    return float(np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1)))
 
 
 def plan_rrt(
@@ -251,14 +239,14 @@ def plan_rrt(
             c = data.getVertex(int(j)).getState()
             edges.append([[a[k] for k in range(nd)], [c[k] for k in range(nd)]])
     tree = np.asarray(edges, dtype=float).reshape(-1, 2, nd)
-    dense = _densify(verts, 0.5 * float(sp.min()))
+    dense, _ = densify(verts, 0.5 * float(sp.min()))
     clearance = float(clearance_profile(world, dense).min())
     # drop OMPL objects (and the Python callback they hold) before returning
     ss.clear()
     del ss, pl, si, work, sol, data
     return RRTResult(
-        path=dense, vertices=verts, raw=raw, tree=tree, length=_length(verts),
-        raw_length=_length(raw), clearance=clearance,
+        path=dense, vertices=verts, raw=raw, tree=tree, length=path_length(verts),
+        raw_length=path_length(raw), clearance=clearance,
         timings={"solve": t1 - t0, "simplify": t2 - t1, "total": t2 - t0},
         planner=RRT_PLANNERS[key], seeded=seeded,
     )

@@ -1,6 +1,6 @@
 """Reading and writing: path files, geo-referencing, mission exports, mission files.
 
-Exports (all in WGS84 lon/lat; see :mod:`fm2uav.io.georef` for how worlds
+Exports (all in WGS84 lon/lat; see :func:`fm2uav.world.geo.to_lonlat` for how worlds
 without a CRS are placed on the Earth): CSV, GeoJSON, KML/KMZ, QGroundControl
 ``.plan`` and MAVLink ``QGC WPL 110``, all written by :func:`export_mission`
 from one list of MAVLink items (:mod:`fm2uav.io.build`: takeoff, waypoints
@@ -19,11 +19,11 @@ from .exports import (
     export_writers,
     parse_formats,
 )
+from ..world.geo import DEFAULT_ANCHOR, Anchor, from_lonlat, to_lonlat  # the one conversion
 from .geofence import FenceCircle, FencePolygon, fences_from_world, geofence_document
 from .items import MissionItem
 from .validate import Problem, check_mission, validate_mission
 from .geojson import geojson_document, read_geojson_path, write_geojson
-from .georef import DEFAULT_ANCHOR, Anchor, from_lonlat, ground_height, to_lonlat
 from .kml import kml_document, read_kml_path, write_kml, write_kmz
 from .paths import read_path_csv, write_path_csv
 from .qgc import plan_document, read_plan, validate_plan, write_plan
@@ -44,7 +44,6 @@ __all__ = [
     "DEFAULT_ANCHOR",
     "to_lonlat",
     "from_lonlat",
-    "ground_height",
     "thin_path",
     "thin_indices",
     "Waypoints",

@@ -41,7 +41,7 @@ from ..errors import InputError, MissionError
 from ..geometry import runs
 from ..missions.coverage.triggers import CameraPlan
 from .geofence import as_fences
-from .georef import DEFAULT_ANCHOR, Anchor, to_lonlat
+from ..world.geo import DEFAULT_ANCHOR, Anchor, to_lonlat
 from .items import (
     CMD_DO_CHANGE_SPEED,
     CMD_DO_LAND_START,
@@ -99,7 +99,7 @@ class ExportOptions:
         Altitude frame (:func:`fm2uav.io.waypoints.resolve_frame`).
     anchor : Anchor or None
         Placement of a world without CRS (default
-        :data:`~fm2uav.io.georef.DEFAULT_ANCHOR`).
+        :data:`~fm2uav.world.geo.DEFAULT_ANCHOR`).
     takeoff : bool
         Must be True: every mission starts with a takeoff (kept so that mission
         files written with ``outputs.takeoff: true`` still load).
@@ -362,7 +362,7 @@ class _Geo:
     def item(self, command: int, frame: int, xy: np.ndarray, z_world: float, *,
              label: str, **params: float) -> MissionItem:
         """A position item at world ``xy`` and flown altitude ``z_world`` [m]."""
-        lo, la, amsl = to_lonlat([[xy[0], xy[1], z_world]], self.world, anchor=self.anchor)[0]
+        lo, la, amsl = to_lonlat(self.world, [[xy[0], xy[1], z_world]], anchor=self.anchor)[0]
         g = float(self.ground(xy)[0])
         agl = z_world - g
         alt = {FRAME_GLOBAL: amsl, FRAME_RELATIVE: amsl - self.home_amsl,

@@ -18,7 +18,7 @@ from __future__ import annotations
 from typing import Any
 
 from .geofence import fences_from_world
-from .georef import Anchor
+from ..world.geo import Anchor
 
 __all__ = ["zone_fences"]
 

@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from .georef import Anchor, to_lonlat
+from ..world.geo import Anchor, to_lonlat
 
 __all__ = [
     "FencePolygon",
@@ -110,7 +110,7 @@ Fence = FencePolygon | FenceCircle
 
 def _ring_latlon(coords: Any, world: Any, anchor: Anchor | None) -> tuple[tuple[float, float], ...]:
     xy = np.asarray(coords, dtype=float)[:, :2]
-    geo = to_lonlat(xy, world, anchor=anchor)
+    geo = to_lonlat(world, xy, anchor=anchor)
     return tuple((float(la), float(lo)) for lo, la in geo[:, :2])
 
 
@@ -136,7 +136,7 @@ def fences_from_world(geometry: Any, world: Any, *, anchor: Anchor | None = None
     warnings: list[str] = []
     if isinstance(geometry, tuple) and len(geometry) == 3 and geometry[0] == "circle":
         cx, cy = (float(v) for v in geometry[1])
-        lo, la = to_lonlat([[cx, cy]], world, anchor=anchor)[0, :2]
+        lo, la = to_lonlat(world, [[cx, cy]], anchor=anchor)[0, :2]
         return [FenceCircle((float(la), float(lo)), float(geometry[2]), inclusion, name)], warnings
     geoms = getattr(geometry, "geoms", None)
     polys = list(geoms) if geoms is not None else [geometry]

@@ -19,7 +19,7 @@ from typing import IO, Any
 import numpy as np
 
 from ..errors import InputError
-from .georef import Anchor, to_lonlat
+from ..world.geo import Anchor, to_lonlat
 
 __all__ = ["geojson_document", "write_geojson", "read_geojson_path"]
 
@@ -40,14 +40,14 @@ def geojson_document(
     p = np.asarray(path_m, dtype=float)
     if p.ndim != 2 or len(p) < 2:
         raise InputError(f"path must be an (N, 2|3) array with N >= 2, got shape {p.shape}")
-    geo = to_lonlat(p, world, anchor=anchor)
+    geo = to_lonlat(world, p, anchor=anchor)
     props = {"name": "path", "points": int(len(p)), **(properties or {})}
     feats: list[dict[str, Any]] = [
         {"type": "Feature", "properties": props,
          "geometry": {"type": "LineString", "coordinates": _coords(geo)}},
     ]
     if waypoints_m is not None:
-        wgeo = to_lonlat(np.asarray(waypoints_m, dtype=float), world, anchor=anchor)
+        wgeo = to_lonlat(world, np.asarray(waypoints_m, dtype=float), anchor=anchor)
         feats.append({"type": "Feature",
                       "properties": {"name": "waypoints", "points": int(len(wgeo))},
                       "geometry": {"type": "LineString", "coordinates": _coords(wgeo)}})

@@ -19,7 +19,7 @@ from xml.sax.saxutils import escape
 import numpy as np
 
 from ..errors import InputError
-from .georef import Anchor, to_lonlat
+from ..world.geo import Anchor, to_lonlat
 
 __all__ = ["kml_document", "write_kml", "write_kmz", "read_kml_path"]
 
@@ -60,7 +60,7 @@ def kml_document(
     p = np.asarray(path_m, dtype=float)
     if p.ndim != 2 or len(p) < 2:
         raise InputError(f"path must be an (N, 2|3) array with N >= 2, got shape {p.shape}")
-    geo = to_lonlat(p, world, anchor=anchor)
+    geo = to_lonlat(world, p, anchor=anchor)
     parts = [
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<kml xmlns="{_NS}"><Document><name>{escape(name)}</name>'
@@ -72,7 +72,7 @@ def kml_document(
         _line("path", "path", geo, extrude=True),
     ]
     if waypoints_m is not None:
-        wgeo = to_lonlat(np.asarray(waypoints_m, dtype=float), world, anchor=anchor)
+        wgeo = to_lonlat(world, np.asarray(waypoints_m, dtype=float), anchor=anchor)
         parts.append(_line("waypoints", "waypoints", wgeo, extrude=False))
     parts += [_point("start", geo[0]), _point("goal", geo[-1]), "</Document></kml>"]
     return "\n".join(parts) + "\n"

@@ -58,7 +58,7 @@ from ..errors import InputError
 from ..world.load import WorldSpec as DataWorldSpec
 from ..world.load import check_points, load_world
 from .exports import EXPORT_FILES, ExportOptions
-from .georef import DEFAULT_ANCHOR, Anchor, from_lonlat, ground_height, to_lonlat
+from ..world.geo import DEFAULT_ANCHOR, Anchor, from_lonlat, to_lonlat
 from .zone_spec import ZoneSpec, resolve_zones
 
 __all__ = [
@@ -445,14 +445,14 @@ def _resolve_point(p: PointSpec, world: Any, anchor: Anchor, what: str) -> np.nd
             raise InputError(f"{what}.cell needs a 3D world")
         return world.to_world(np.asarray(p.cell, dtype=float))
     if p.lon is not None:
-        xy = from_lonlat([[p.lon, p.lat]], world, anchor=anchor)[0]
+        xy = from_lonlat(world, [[p.lon, p.lat]], anchor=anchor)[0]
         if p.alt is not None:
-            z = float(from_lonlat([[p.lon, p.lat, p.alt]], world, anchor=anchor)[0, 2])
+            z = float(from_lonlat(world, [[p.lon, p.lat, p.alt]], anchor=anchor)[0, 2])
         else:
-            z = float(ground_height(world, xy[None])[0]) + float(p.agl)
+            z = float(world.ground_height(xy[0], xy[1])) + float(p.agl)
     else:
         xy = np.array([p.x, p.y], dtype=float)
-        z = p.z if p.z is not None else float(ground_height(world, xy[None])[0]) + float(p.agl)
+        z = p.z if p.z is not None else float(world.ground_height(xy[0], xy[1])) + float(p.agl)
     if world.ndim == 2:
         return xy
     point = np.array([xy[0], xy[1], z], dtype=float)
@@ -463,7 +463,7 @@ def _resolve_point(p: PointSpec, world: Any, anchor: Anchor, what: str) -> np.nd
             from ..world.geo import bounds_lonlat
 
             w_, s_, e_, n_ = bounds_lonlat((b[0, 0], b[1, 0], b[0, 1], b[1, 1]), world.crs)
-            ll = to_lonlat(point[None], world)[0]
+            ll = to_lonlat(world, point[None])[0]
             where = (f" (lon {ll[0]:.5f}, lat {ll[1]:.5f}; the map covers about lon "
                      f"{w_:.5f}..{e_:.5f}, lat {s_:.5f}..{n_:.5f})")
         raise InputError(
@@ -479,7 +479,7 @@ def resolve_point(p: PointSpec, world: Any, anchor: Anchor | None = None,
 
     Used by the mission file and the CLI (``--start LON,LAT,AGL --lonlat``).
     Lon/lat go through the world's CRS, or through ``anchor`` (default
-    :data:`~fm2uav.io.georef.DEFAULT_ANCHOR`) for a world without one; ``agl``
+    :data:`~fm2uav.world.geo.DEFAULT_ANCHOR`) for a world without one; ``agl``
     is added to the ground height there (bilinear).
 
     Raises

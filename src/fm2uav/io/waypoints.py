@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from .georef import Anchor, ground_height, to_lonlat
+from ..world.geo import Anchor, to_lonlat
 from .items import FRAME_GLOBAL, FRAME_RELATIVE, FRAME_TERRAIN, CMD_NAV_TAKEOFF, CMD_NAV_WAYPOINT
 from .thin import thin_indices
 
@@ -90,10 +90,8 @@ def ground_at(world: Any, xy: Any) -> np.ndarray:
     """Ground height (world z [m]) under points ``(n, 2|3)``: ``World.ground_height``
     (the DEM, bilinear; the grid floor without terrain)."""
     p = np.atleast_2d(np.asarray(xy, dtype=float))
-    gh = getattr(world, "ground_height", None)
-    if callable(gh):
-        return np.broadcast_to(np.asarray(gh(p[:, 0], p[:, 1]), dtype=float), (len(p),)).copy()
-    return np.asarray(ground_height(world, p), dtype=float)
+    return np.broadcast_to(np.asarray(world.ground_height(p[:, 0], p[:, 1]), dtype=float),
+                           (len(p),)).copy()
 
 
 @dataclass(frozen=True)
@@ -259,7 +257,7 @@ def mission_waypoints(
     tolerance : float, optional
         Douglas–Peucker tolerance [m]. Default 5 m.
     anchor : Anchor, optional
-        Placement of a world without CRS (see :mod:`fm2uav.io.georef`).
+        Placement of a world without CRS (see :func:`fm2uav.world.geo.to_lonlat`).
     flight_alt : float, optional
         Altitude above home [m] of 2D paths. Default 30 m.
     max_points : int, optional
@@ -295,10 +293,10 @@ def mission_waypoints(
                              f"shape {req.shape}")
         idx, legs = refine_legs(idx, flown, world, required=req, terrain_frame=frame == "terrain")
     kept = flown[idx]
-    geo = to_lonlat(kept, world, anchor=anchor)
-    gnd = to_lonlat(np.column_stack([kept[:, :2], ground[idx]]), world, anchor=anchor)[:, 2]
+    geo = to_lonlat(world, kept, anchor=anchor)
+    gnd = to_lonlat(world, np.column_stack([kept[:, :2], ground[idx]]), anchor=anchor)[:, 2]
     home_world = float(ground[0])
-    home_geo = to_lonlat(np.array([[p[0, 0], p[0, 1], home_world]]), world, anchor=anchor)[0]
+    home_geo = to_lonlat(world, np.array([[p[0, 0], p[0, 1], home_world]]), anchor=anchor)[0]
     if frame == "terrain":
         alt = height[idx]
     elif frame == "amsl":

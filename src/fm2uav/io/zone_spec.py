@@ -116,12 +116,12 @@ class ZoneSpec(BaseModel):
 def _to_metres(pts: np.ndarray, spec: ZoneSpec, world: Any, anchor: Any) -> np.ndarray:
     if not spec.lonlat:
         return pts
-    from .georef import from_lonlat
+    from ..world.geo import from_lonlat
 
     if np.any(np.abs(pts[:, 0]) > 180) or np.any(np.abs(pts[:, 1]) > 90):
         raise InputError("a lonlat zone has coordinates outside lon [-180, 180], lat [-90, 90]; "
                          "give degrees as [lon, lat] or drop lonlat: true for metres")
-    return np.asarray(from_lonlat(pts, world, anchor=anchor), dtype=float)[:, :2]
+    return np.asarray(from_lonlat(world, pts, anchor=anchor), dtype=float)[:, :2]
 
 
 def _one(spec: ZoneSpec, world: Any, anchor: Any, *, inclusion: bool, where: str) -> list[Any]:

@@ -7,7 +7,7 @@ Typical use::
     report.feasible, report.reason, report.tracking.max_separation
 """
 
-from .airframes import AIRFRAMES, Airframe, FixedWing, Multirotor, get_airframe
+from .airframes import AIRFRAMES, Airframe, AirframeLimits, FixedWing, Multirotor, get_airframe
 from .dubins_airplane import track_dubins
 from .feasibility import DEFAULT_TOLERANCE, FeasibilityReport, check_feasibility, collision_check
 from .geometric import GeometricCheck, climb_angle_profile, curvature_profile, geometric_check
@@ -18,6 +18,7 @@ from .tracking import Tracking
 __all__ = [
     "AIRFRAMES",
     "Airframe",
+    "AirframeLimits",
     "FixedWing",
     "Multirotor",
     "get_airframe",

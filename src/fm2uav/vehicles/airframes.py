@@ -41,6 +41,7 @@ from ..errors import InputError
 
 __all__ = [
     "G",
+    "AirframeLimits",
     "FixedWing",
     "Multirotor",
     "Airframe",
@@ -62,6 +63,55 @@ def _positive(name: str, value: Any, *, allow_zero: bool = False) -> float:
             f"airframe {name} must be finite and {'>=' if allow_zero else '>'} 0, got {value!r}"
         )
     return v
+
+
+@dataclass(frozen=True)
+class AirframeLimits:
+    """The geometric limits a path must keep for an airframe to fly it, in SI.
+
+    Attributes
+    ----------
+    max_climb : float
+        Steepest climb or descent (flight-path) angle [rad], in (0, π/2].
+    min_turn_radius : float
+        Tightest horizontal turn radius [m], >= 0.
+
+    Examples
+    --------
+    >>> lim = AirframeLimits.from_degrees(30.0, 60.0)
+    >>> round(lim.max_climb, 6), lim.min_turn_radius, round(lim.max_climb_deg, 6)
+    (0.523599, 60.0, 30.0)
+    >>> get_airframe("disco").limits().min_turn_radius > 0
+    True
+    """
+
+    max_climb: float
+    min_turn_radius: float
+
+    def __post_init__(self) -> None:
+        c = _positive("max_climb [rad]", self.max_climb)
+        if c > math.pi / 2 + 1e-12:
+            raise InputError(f"airframe max_climb must be at most 90 degrees (π/2 rad), got "
+                             f"{c:.6g} rad = {math.degrees(c):.6g} degrees")
+        object.__setattr__(self, "max_climb", c)
+        object.__setattr__(self, "min_turn_radius", _positive(
+            "min_turn_radius [m]", self.min_turn_radius, allow_zero=True))
+
+    @classmethod
+    def from_degrees(cls, max_climb_deg: float, min_turn_radius: float) -> AirframeLimits:
+        """The limits from a climb angle in degrees (CLI, mission files) and a radius [m]."""
+        try:
+            deg = float(max_climb_deg)
+        except (TypeError, ValueError):
+            raise InputError(f"max climb must be an angle in degrees, got {max_climb_deg!r}") from None
+        if not (math.isfinite(deg) and 0 < deg <= 90):
+            raise InputError(f"max climb must be in (0, 90] degrees, got {max_climb_deg!r}")
+        return cls(math.radians(deg), min_turn_radius)
+
+    @property
+    def max_climb_deg(self) -> float:
+        """:attr:`max_climb` in degrees (for display)."""
+        return math.degrees(self.max_climb)
 
 
 @dataclass(frozen=True)
@@ -124,6 +174,10 @@ class FixedWing:
         """Maximum turn rate ``g tan φ_max / V`` [rad/s] at ``speed`` (default cruise)."""
         v = self.cruise_speed if speed is None else _positive("speed [m/s]", speed)
         return G * math.tan(self.max_bank) / v
+
+    def limits(self) -> AirframeLimits:
+        """Path limits: the smaller of the climb and descent angles, the turn radius at cruise."""
+        return AirframeLimits(min(self.max_climb, self.max_descent), self.turn_radius())
 
     def with_speed(self, cruise_speed: float) -> FixedWing:
         """The same airframe flown at another cruise speed [m/s] (validated)."""
@@ -193,6 +247,10 @@ class Multirotor:
         """Tightest turn radius ``v² / a_max`` [m] at ``speed`` (default max speed)."""
         v = self.max_speed if speed is None else _positive("speed [m/s]", speed, allow_zero=True)
         return v * v / self.max_accel
+
+    def limits(self) -> AirframeLimits:
+        """Path limits: any climb angle (it can climb vertically), the turn radius at max speed."""
+        return AirframeLimits(math.pi / 2, self.turn_radius())
 
     def summary(self) -> dict[str, Any]:
         """JSON-friendly numbers."""

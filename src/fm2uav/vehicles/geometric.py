@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from ..geometry import arc_length, as_path3, circumcurvature, runs
+from ..geometry import arc_length, as_path3, at_arc_length, circumcurvature, runs
 from .airframes import Airframe, FixedWing, Multirotor, get_airframe
 
 __all__ = [
@@ -52,8 +52,7 @@ def default_window(path: Any, airframe: Airframe | str | None = None) -> float:
 
 
 def _at(path: np.ndarray, s: np.ndarray, q: np.ndarray) -> np.ndarray:
-    q = np.clip(q, 0.0, s[-1])
-    return np.column_stack([np.interp(q, s, path[:, k]) for k in range(3)])
+    return at_arc_length(path, s, np.clip(q, 0.0, s[-1]))
 
 
 def curvature_profile(

@@ -15,8 +15,7 @@ import numpy as np
 from matplotlib.colors import LightSource
 from matplotlib.figure import Figure
 
-from ..world.ground import terrain_along
-from .figures import _arc_length
+from ..geometry import arc_length
 
 if TYPE_CHECKING:
     from ..experiments.coverage import CoverageRun
@@ -106,10 +105,10 @@ def coverage_figure(cp: CoveragePlan, *, title: str | None = None) -> Figure:
     ax3.set_title("3D view", fontsize=10)
 
     ax2 = fig.add_subplot(1, 3, 3)
-    s = _arc_length(path)
-    ground = terrain_along(world, path)
+    s = arc_length(path)
     agl = cp.level.agl
-    if ground is not None:
+    if world.terrain is not None:
+        ground = world.ground_height(path[:, 0], path[:, 1])
         ax2.fill_between(s, b[2, 0], ground, color="saddlebrown", alpha=0.45, label="terrain")
         ax2.plot(s, ground + agl, color="k", lw=1.0, ls="--", label=f"ideal ({agl:g} m AGL)")
     ax2.plot(s, path[:, 2], color="crimson", lw=1.5, label="FM² path")
@@ -140,7 +139,7 @@ def coverage_html(cp: CoveragePlan, *, title: str = "coverage plan") -> str:
         data.append(go.Surface(x=gx, y=gy, z=world.terrain.T, colorscale="Earth",
                                opacity=0.85, showscale=False, name="terrain"))
         ring = np.asarray(cp.zigzag.area.exterior.coords)
-        rz = terrain_along(world, np.column_stack([ring, np.zeros(len(ring))])) + 2.0
+        rz = world.ground_height(ring[:, 0], ring[:, 1]) + 2.0
         data.append(go.Scatter3d(x=ring[:, 0], y=ring[:, 1], z=rz, mode="lines",
                                  line=dict(color="white", width=4), name="area"))
     data.append(go.Scatter3d(x=path[:, 0], y=path[:, 1], z=path[:, 2], mode="lines",

@@ -11,6 +11,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from matplotlib.figure import Figure
 
+from ..geometry import arc_length
+
 if TYPE_CHECKING:
     from ..baselines.rrt import RRTResult
     from ..experiments.city import CityRun
@@ -29,10 +31,6 @@ def _footprint(ax: Any, world: World | None) -> None:
     top = occ[:, :, 1:].any(axis=2) if occ.ndim == 3 else occ  # skip the ground layer
     ax.imshow(top.T, origin="lower", extent=(b[0, 0], b[0, 1], b[1, 0], b[1, 1]),
               cmap="Greys", vmin=0, vmax=1.4, alpha=0.6, aspect="equal")
-
-
-def _arc(p: np.ndarray) -> np.ndarray:
-    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
 
 
 def tracking_figure(report: FeasibilityReport, world: World | None = None, *,
@@ -56,7 +54,7 @@ def tracking_figure(report: FeasibilityReport, world: World | None = None, *,
     ax.set_title("top view")
     ax.legend(fontsize=8, loc="upper left")
     ax = axes[1]
-    ax.plot(_arc(planned), planned[:, 2], color="tab:blue", lw=2, label="planned")
+    ax.plot(arc_length(planned), planned[:, 2], color="tab:blue", lw=2, label="planned")
     ax.plot(tr.progress, flown[:, 2], color="crimson", lw=1.2, ls="--", label="flown")
     ax.set_xlabel("distance along the plan [m]")
     ax.set_ylabel("altitude z [m]")
@@ -114,7 +112,7 @@ def city_cases_figure(cases: Sequence[Any], world: World, *, title: str = "") ->
         ax.set_ylabel("y [m]")
         ax.legend(fontsize=7, loc="upper left")
         ax = axes[1, j]
-        ax.plot(_arc(c.path3), c.path3[:, 2], color="tab:blue", lw=2, label="planned")
+        ax.plot(arc_length(c.path3), c.path3[:, 2], color="tab:blue", lw=2, label="planned")
         ax.plot(tr.progress, tr.trajectory[:, 2], color="crimson", ls="--", lw=1.2, label="flown")
         ax.set_xlabel("distance along the plan [m]")
         ax.set_ylabel("z [m]")

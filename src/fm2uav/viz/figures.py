@@ -9,16 +9,12 @@ import numpy as np
 from matplotlib.colors import LightSource
 from matplotlib.figure import Figure
 
-from ..world.ground import terrain_along
+from ..geometry import arc_length
 
 if TYPE_CHECKING:
     from ..planning import Plan
 
 __all__ = ["plan_figure"]
-
-
-def _arc_length(path: np.ndarray) -> np.ndarray:
-    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])
 
 
 def plan_figure(plan: Plan, *, title: str | None = None) -> Figure:
@@ -66,9 +62,9 @@ def plan_figure(plan: Plan, *, title: str | None = None) -> Figure:
     ax.legend(loc="upper left", fontsize=8)
     if three_d:
         ax2 = axes[0, 1]
-        s = _arc_length(path)
-        ground = terrain_along(world, path)
-        if ground is not None:
+        s = arc_length(path)
+        if world.terrain is not None:
+            ground = world.ground_height(path[:, 0], path[:, 1])
             ax2.fill_between(s, b[2, 0], ground, color="saddlebrown", alpha=0.5, label="terrain")
         ax2.plot(s, path[:, 2], color="crimson", lw=2, label="path altitude")
         ax2.set_xlabel("distance along path [m]")

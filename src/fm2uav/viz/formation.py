@@ -26,7 +26,7 @@ from matplotlib import animation
 from matplotlib.colors import LightSource
 from matplotlib.figure import Figure
 
-from ..analysis.flight_level import ground_altitude
+from ..geometry import arc_length
 
 if TYPE_CHECKING:
     from ..experiments.formation import ThesisRun
@@ -163,8 +163,8 @@ def formation_profiles_figure(result: FormationResult, *, title: str | None = No
     for i in range(n):
         ax = axes[i, 0]
         p = pos[:, i, :]
-        s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
-        ground = ground_altitude(world, p)
+        s = arc_length(p)
+        ground = world.surface_height(p[:, 0], p[:, 1])
         ax.fill_between(s, b[2, 0], ground, color="saddlebrown", alpha=0.5, label="terrain")
         agl = result.agl[i]
         if agl is not None:
@@ -172,7 +172,7 @@ def formation_profiles_figure(result: FormationResult, *, title: str | None = No
         elif i == 0:
             ideal, label = None, None
             lp = result.leader_plan.path
-            sl = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(lp, axis=0), axis=1))])
+            sl = arc_length(lp)
             ax.plot(sl, lp[:, 2], "--", color="k", lw=1, label="ideal (FM² plan)")
         else:
             ideal, label = pos[:, 0, 2], "ideal (leader's height)"

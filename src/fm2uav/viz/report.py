@@ -30,6 +30,8 @@ from typing import Any
 
 import numpy as np
 
+from ..geometry import arc_length
+
 __all__ = ["report_html", "plan_report", "write_report", "join_polylines"]
 
 _COLOURS = ["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#e377c2",
@@ -37,16 +39,11 @@ _COLOURS = ["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#
 _CONFIG = {"displaylogo": False, "responsive": True}
 
 
-def _arc(path: np.ndarray) -> np.ndarray:
-    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])
-
-
 def _ground(world: Any, path: np.ndarray) -> np.ndarray | None:
+    """Ground under a 3D path for the profile (None: no terrain to draw)."""
     if world is None or getattr(world, "terrain", None) is None or path.shape[1] != 3:
         return None
-    from ..world.ground import terrain_along
-
-    return np.asarray(terrain_along(world, path), dtype=float)
+    return np.asarray(world.ground_height(path[:, 0], path[:, 1]), dtype=float)
 
 
 def _stride(n: int, limit: int) -> int:
@@ -283,7 +280,7 @@ def _profile_figure(world: Any, paths: Mapping[str, np.ndarray],
         st = {k: v for k, v in styles.get(name, {}).items() if k in ("color", "dash")}
         c = st.get("color", _COLOURS[i % len(_COLOURS)])
         line = {"color": c, **st}
-        s = _arc(p)
+        s = arc_length(p)
         r = 1
         if three_d:
             fig.add_trace(go.Scatter(x=s, y=p[:, 2], name=f"{name} altitude", legendgroup=name,

@@ -14,8 +14,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from ..analysis.flight_level import ground_altitude, ideal_altitude
+from ..analysis.flight_level import ideal_altitude
 from ..analysis.profiles import path_profiles
+from ..geometry import arc_length
 
 if TYPE_CHECKING:
     from ..experiments.tff import TffRun
@@ -24,10 +25,6 @@ if TYPE_CHECKING:
 
 __all__ = ["tff_3d_figure", "tff_profile_figure", "tff_kinematics_figure", "tff_figures",
            "tff_report_html"]
-
-
-def _arc(path: np.ndarray) -> np.ndarray:
-    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])
 
 
 def tff_3d_figure(plans: Sequence[Plan], labels: Sequence[str], *, title: str = "") -> Figure:
@@ -64,8 +61,8 @@ def tff_profile_figure(
     axes = fig.subplots(n, 1, squeeze=False)
     for ax, p, agl, lab in zip(axes[:, 0], plans, agls, labels):
         q = p.path
-        s = _arc(q)
-        ground = ground_altitude(p.world, q)
+        s = arc_length(q)
+        ground = p.world.surface_height(q[:, 0], q[:, 1])
         ideal = ideal_altitude(p.world, q, agl)
         ax.fill_between(s, p.world.origin[2], ground, color="0.8", label="terrain")
         ax.plot(s, ideal, "g--", lw=1.2, label=f"ideal (terrain + {agl:g} m)")

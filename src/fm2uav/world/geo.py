@@ -4,7 +4,9 @@ A world built from a DEM keeps its x/y in a *metric* projected CRS (the DEM's
 own if it is projected in metres, else the UTM zone of the DEM's centre) and
 stores it as :attr:`World.crs`; z is the DEM's elevation datum (normally
 metres above mean sea level). These helpers pick that CRS and convert world
-points to WGS84 longitude/latitude/altitude and back.
+points to WGS84 longitude/latitude/altitude and back (:func:`to_lonlat`,
+:func:`from_lonlat`, world first); a world without a CRS is placed at an
+:class:`Anchor` on the Earth (the one conversion every export uses).
 
 Choosing the world's CRS (:func:`local_metric_crs`): lengths in the world must
 be true to :data:`MAX_SCALE_ERROR` (0.5 %). A projected CRS in metres is kept
@@ -50,6 +52,8 @@ __all__ = [
     "utm_crs",
     "metric_crs",
     "transformer",
+    "Anchor",
+    "DEFAULT_ANCHOR",
     "to_lonlat",
     "from_lonlat",
 ]
@@ -123,52 +127,128 @@ def transformer(src: Any, dst: Any) -> Any:
     return _transformer(parse_crs(src).to_string(), parse_crs(dst).to_string())
 
 
-def _points(points: Any, what: str) -> np.ndarray:
+@dataclass(frozen=True)
+class Anchor:
+    """Where a world without a CRS is placed on the Earth.
+
+    Attributes
+    ----------
+    lon, lat : float
+        WGS84 longitude and latitude of world ``(x, y) = (0, 0)`` [deg].
+    alt : float
+        Altitude of world ``z = 0`` above mean sea level [m].
+    """
+
+    lon: float
+    lat: float
+    alt: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name, lo, hi in (("lon", -180.0, 180.0), ("lat", -89.0, 89.0)):
+            v = getattr(self, name)
+            if not isinstance(v, (int, float, np.number)) or not np.isfinite(v) or not lo <= v <= hi:
+                raise InputError(f"anchor {name} must be a number in [{lo:g}, {hi:g}] deg, got {v!r}")
+        if not np.isfinite(self.alt):
+            raise InputError(f"anchor alt must be a finite height in metres, got {self.alt!r}")
+
+
+#: Default anchor of synthetic worlds: UC3M, Leganés (Madrid), 0 m.
+DEFAULT_ANCHOR = Anchor(lon=-3.7649, lat=40.3326, alt=0.0)
+
+
+@lru_cache(maxsize=32)
+def _anchor_transformers(proj: str) -> tuple[Any, Any]:
+    from pyproj import Transformer
+
+    return (Transformer.from_crs(proj, "EPSG:4326", always_xy=True),
+            Transformer.from_crs("EPSG:4326", proj, always_xy=True))
+
+
+def _anchor_crs(anchor: Anchor) -> str:
+    return (
+        f"+proj=aeqd +lat_0={anchor.lat!r} +lon_0={anchor.lon!r} +x_0=0 +y_0=0 "
+        "+datum=WGS84 +units=m +no_defs"
+    )
+
+
+def _frame(world: Any, anchor: Anchor | None) -> tuple[Any, Any, float]:
+    """(world → WGS84, WGS84 → world, altitude offset [m]) of a world."""
+    crs = getattr(world, "crs", None)
+    if crs:
+        c = parse_crs(str(crs))
+        if c.is_geographic:
+            raise WorldError(
+                f"world CRS {crs!r} is geographic (degrees), but world x/y are metres; "
+                "build the world in a projected CRS (e.g. the UTM zone of the area)"
+            )
+        return transformer(c, WGS84), transformer(WGS84, c), 0.0
+    a = DEFAULT_ANCHOR if anchor is None else anchor
+    if not isinstance(a, Anchor):
+        raise InputError(f"anchor must be a fm2uav.io.Anchor(lon, lat, alt), got {a!r}")
+    fwd, inv = _anchor_transformers(_anchor_crs(a))
+    return fwd, inv, float(a.alt)
+
+
+def _points(points: Any, what: str) -> tuple[np.ndarray, bool]:
+    """``(N, 2|3)`` finite float points, and whether one point ``(2|3,)`` was given."""
     try:
         p = np.asarray(points, dtype=float)
     except (TypeError, ValueError):
-        raise InputError(f"{what} must be numeric (N, 3), got {points!r}") from None
+        raise InputError(f"{what} must be numeric, got {points!r}") from None
     one = p.ndim == 1
-    p = np.atleast_2d(p)
-    if p.ndim != 2 or p.shape[1] != 3 or not np.all(np.isfinite(p)):
-        raise InputError(f"{what} must be finite points of shape (N, 3), got shape {p.shape}")
-    return p[0] if one else p
+    q = p[None, :] if one else p
+    if q.ndim != 2 or q.shape[1] not in (2, 3):
+        raise InputError(f"{what} must have shape (N, 2) or (N, 3), got {p.shape}")
+    if not np.all(np.isfinite(q)):
+        raise InputError(f"{what} has non-finite values")
+    return q, one
 
 
-def to_lonlat(world: Any, points_m: Any) -> np.ndarray:
-    """World points [m] → WGS84 ``(lon [deg], lat [deg], alt [m])``, shape kept.
+def to_lonlat(world: Any, points_m: Any, *, anchor: Anchor | None = None) -> np.ndarray:
+    """World points [m] → WGS84 ``(lon [deg], lat [deg], alt [m])``.
 
-    ``alt`` is world z (the DEM's elevation datum).
+    Parameters
+    ----------
+    world : World or None
+        With ``world.crs`` (a DEM or footprints in a projected CRS): world x, y
+        are coordinates of that CRS and ``alt`` is world z (the data's
+        vertical datum, normally metres above mean sea level). Without a CRS
+        (synthetic scenarios, or None) the world sits on the local tangent
+        plane of ``anchor`` (azimuthal equidistant, +x east, +y north) and
+        ``alt = z + anchor.alt``.
+    points_m : array_like, shape (N, 2|3) or (2|3,)
+        World coordinates [m]; 2D points get ``z = 0``.
+    anchor : Anchor, optional
+        Placement of a world without CRS; default :data:`DEFAULT_ANCHOR`
+        (the UC3M Leganés campus, where the source thesis was written).
+        Ignored when the world has a CRS.
 
-    Raises
-    ------
-    InputError
-        The world has no CRS (synthetic scenario).
+    Returns
+    -------
+    ndarray, shape (N, 3) (or (3,) for one point)
     """
-    if getattr(world, "crs", None) is None:
-        raise InputError(
-            f"world {getattr(world, 'name', '')!r} has no CRS, so its points have no "
-            "longitude/latitude; build it from a DEM (World.from_dem) or place it with "
-            "fm2uav.io.georef and an anchor"
-        )
-    p = _points(points_m, "points")
-    q = np.atleast_2d(p)
-    lon, lat = transformer(world.crs, WGS84).transform(q[:, 0], q[:, 1])
-    out = np.stack([np.asarray(lon), np.asarray(lat), q[:, 2]], axis=1)
-    return out[0] if p.ndim == 1 else out
+    q, one = _points(points_m, "points_m")
+    fwd, _, dz = _frame(world, anchor)
+    lon, lat = fwd.transform(q[:, 0], q[:, 1])
+    z = q[:, 2] if q.shape[1] == 3 else np.zeros(len(q))
+    out = np.column_stack([np.asarray(lon), np.asarray(lat), z + dz])
+    return out[0] if one else out
 
 
-def from_lonlat(world: Any, lonlatalt: Any) -> np.ndarray:
-    """WGS84 ``(lon, lat, alt)`` → world points [m]; the inverse of :func:`to_lonlat`."""
-    if getattr(world, "crs", None) is None:
-        raise InputError("the world has no CRS; longitude/latitude cannot be placed in it")
-    p = _points(lonlatalt, "lonlatalt")
-    q = np.atleast_2d(p)
+def from_lonlat(world: Any, lonlatalt: Any, *, anchor: Anchor | None = None) -> np.ndarray:
+    """WGS84 ``(lon [deg], lat [deg][, alt [m]])`` → world [m]; the inverse of :func:`to_lonlat`.
+
+    ``(N, 2)`` lon/lat give ``(N, 2)`` world x, y; ``(N, 3)`` give x, y, z.
+    """
+    q, one = _points(lonlatalt, "lonlatalt")
     if np.any(np.abs(q[:, 1]) > 90) or np.any(np.abs(q[:, 0]) > 180):
         raise InputError("longitude must be in [-180, 180] and latitude in [-90, 90] degrees")
-    x, y = transformer(WGS84, world.crs).transform(q[:, 0], q[:, 1])
-    out = np.stack([np.asarray(x), np.asarray(y), q[:, 2]], axis=1)
-    return out[0] if p.ndim == 1 else out
+    _, inv, dz = _frame(world, anchor)
+    x, y = inv.transform(q[:, 0], q[:, 1])
+    out = np.column_stack([np.asarray(x), np.asarray(y)])
+    if q.shape[1] == 3:
+        out = np.column_stack([out, q[:, 2] - dz])
+    return out[0] if one else out
 
 
 # ---------------------------------------------------------------------- CRS choice

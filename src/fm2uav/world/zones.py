@@ -42,6 +42,7 @@ from shapely.geometry import Point, Polygon
 from shapely.geometry.base import BaseGeometry
 
 from ..errors import InputError, PlanningError, WorldError
+from ..geometry import densify
 
 if TYPE_CHECKING:
     from .world import World
@@ -488,23 +489,6 @@ def zone_bounds_along(world: World, xy: np.ndarray, z_route: np.ndarray,
     return lower, upper
 
 
-def _densify(points: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
-    """Points every <= ``step`` m along a polyline, and the segment of each."""
-    p = np.asarray(points, dtype=float)
-    if len(p) == 1:
-        return p.copy(), np.zeros(1, dtype=np.int64)
-    seg = np.linalg.norm(np.diff(p[:, :2], axis=0), axis=1)
-    n = np.maximum(np.ceil(seg / step).astype(np.int64), 1)
-    out, which = [], []
-    for k in range(len(p) - 1):
-        t = np.arange(n[k]) / n[k]
-        out.append(p[k] + t[:, None] * (p[k + 1] - p[k]))
-        which.append(np.full(n[k], k))
-    out.append(p[-1:])
-    which.append(np.array([len(p) - 2]))
-    return np.concatenate(out), np.concatenate(which)
-
-
 @dataclass(frozen=True)
 class ZoneViolation:
     """A point of a path/leg inside a zone's kept-out air."""
@@ -544,7 +528,7 @@ def zone_violations(world: World, points: Any, *, step: float | None = None,
         from .ground_model import sampling_step
 
         step = sampling_step(world)
-    dense, seg = _densify(p, step)
+    dense, seg = densify(p, step, horizontal=True)
     ground = (np.asarray(world.ground_height(dense[:, 0], dense[:, 1]), dtype=float)
               if dense.shape[1] == 3 else None)
     out: list[ZoneViolation] = []

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from ...errors import InputError, PointError, UnreachableError
+from ...geometry import path_length
 from ...world import World
 from . import _kernels as _k
 from .primitives import MODELS, Primitives, build_primitives
@@ -219,7 +220,7 @@ def reference_path(
         )
     path_cells, heading, cost = _trace(prims, parent, goal_state, ny, K)
     path = world.to_world(path_cells)
-    length = float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1)))
+    length = path_length(path)
     t3 = time.perf_counter()
     return ReferencePath(
         model=model,

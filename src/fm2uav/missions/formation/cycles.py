@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import InputError, PlanningError, PointError
-from ...geometry import arc_length
+from ...geometry import arc_length, at_arc_length
 from ...world import World
 from .checks import segment_min_distance
 from .guide import LeaderGuide
@@ -134,7 +134,7 @@ def resample_cycle(path: np.ndarray, speed: float, cycle: float, n_sub: int) -> 
     s = np.minimum(np.linspace(0.0, speed * cycle, n_sub + 1), s_arr[-1])
     if s_arr[-1] <= 0.0:
         return np.repeat(path[:1], n_sub + 1, axis=0)
-    return np.stack([np.interp(s, s_arr, path[:, a]) for a in range(3)], axis=-1)
+    return at_arc_length(path, s_arr, s)
 
 
 def resolve_conflicts(motions: np.ndarray, bound: float) -> np.ndarray:

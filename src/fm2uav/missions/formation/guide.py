@@ -14,7 +14,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ...geometry import arc_length
+from ...geometry import arc_length, at_arc_length
 from ...planning import FlightLevel
 from .local import StaticMaps
 from .metrics import path_heading
@@ -123,7 +123,7 @@ class LeaderGuide:
 
     def point(self, s: float) -> np.ndarray:
         """The leader's path point at arc length ``s`` [m] (linear)."""
-        return np.array([np.interp(s, self.s, self.path[:, a]) for a in range(self.path.shape[1])])
+        return at_arc_length(self.path, self.s, s)
 
     def heading(self, s: float, previous: np.ndarray) -> np.ndarray:
         """Unit horizontal direction of the path at ``s``; ``previous`` where it has none."""

@@ -4,19 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...geometry import arc_length, at_arc_length
 from .shapes import FormationShape, slot_positions
 
-__all__ = ["arc_length", "path_heading", "formation_error"]
-
-
-def arc_length(path: np.ndarray) -> np.ndarray:
-    """Cumulative arc length [m] of a polyline ``(N, ndim)``, starting at 0."""
-    seg = np.linalg.norm(np.diff(np.asarray(path, dtype=float), axis=0), axis=1)
-    return np.concatenate([[0.0], np.cumsum(seg)])
-
-
-def _interp(path: np.ndarray, s_arr: np.ndarray, s: np.ndarray) -> np.ndarray:
-    return np.stack([np.interp(s, s_arr, path[:, a]) for a in range(path.shape[1])], axis=-1)
+__all__ = ["path_heading", "formation_error"]
 
 
 def path_heading(
@@ -34,8 +25,8 @@ def path_heading(
     """
     s = np.asarray(s, dtype=float)
     L = float(s_arr[-1])
-    a = _interp(path, s_arr, np.clip(s - half_window, 0.0, L))
-    b = _interp(path, s_arr, np.clip(s + half_window, 0.0, L))
+    a = at_arc_length(path, s_arr, np.clip(s - half_window, 0.0, L))
+    b = at_arc_length(path, s_arr, np.clip(s + half_window, 0.0, L))
     d = (b - a)[..., :2]
     n = np.linalg.norm(d, axis=-1, keepdims=True)
     with np.errstate(invalid="ignore", divide="ignore"):
