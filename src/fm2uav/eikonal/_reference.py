@@ -342,6 +342,9 @@ def fast_marching_reference(
 ) -> np.ndarray:
     """Arrival times by a slow pure-Python Fast Marching Method (tests only).
 
+    Long by design (reference): one readable loop written out step by step to be
+    checked against the compiled march; helpers would hide the algorithm.
+
     Same discretisation as :func:`fm2uav.eikonal.fast_marching` (see the
     module docstring). Inputs are assumed valid: no checks beyond what is
     needed to read them.

@@ -301,6 +301,8 @@ def _box_range(speed, si, sj, sk, ri, rj, rk, nx, ny, nz):
 def init_sources(speed, T, state, nx, ny, nz, hx, hy, hz, src, radius, min_radius, max_ratio):
     """Initialise point sources in place: ``T = 0`` (frozen) and the source balls.
 
+    Long by design (kernel): one compiled loop; splitting adds call overhead in the hot path.
+
     See the module docstring for the rule. Same interface as the march expects:
     on return ``T``/``state`` hold the sources (0, frozen) and the ball nodes
     (frozen when every source is clean, else in the band, ``state = 1``).

@@ -542,6 +542,8 @@ def _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step):
 def descend_kernel(T, start, goal, hx, hy, hz, step, max_steps):
     """Descend ``T`` from ``start`` to ``goal``; see the module docstring.
 
+    Long by design (kernel): one compiled loop; splitting adds call overhead in the hot path.
+
     Parameters
     ----------
     T : float64 array (nx, ny, nz)

@@ -61,6 +61,8 @@ def lattice_search(
 ):
     """Cheapest lattice path from any source state to the goal node.
 
+    Long by design (kernel): one compiled loop; splitting adds call overhead in the hot path.
+
     Parameters
     ----------
     free : bool[nx, ny]
