@@ -3,35 +3,23 @@
 
 from __future__ import annotations
 
-import json
 import time
-from pathlib import Path
 
 import numpy as np
 import typer
 
 from ..errors import InputError
-from ._common import OutputDir, handle_errors, print_summary, progress, to_jsonable
+from ._common import Output, OutputDir, handle_errors, write_figure, write_json, write_text
 from .options import (
-    AllowFilledOpt,
-    BboxOpt,
-    BuildingsOpt,
-    CeilingOpt,
-    CellSizeOpt,
-    CrsOpt,
-    DefaultHeightOpt,
-    DemOpt,
-    DzOpt,
     LonLatOpt,
-    NodataOpt,
-    NodataValueOpt,
     ScenarioOpt,
-    SeaLevelOpt,
+    WorldFlags,
     build_world,
     cli_point,
+    output_options,
     requested_heights,
+    world_options,
     world_rows,
-    world_spec,
 )
 
 TFF_FILES = (
@@ -46,6 +34,7 @@ TFF_FILES = (
 TUNE_FILES = ("tune_table.md", "tune.json", "tune_best_path.csv", "tune_best.png")
 REPORT = "report.html"
 
+
 def _write_tff_outputs(outdir: OutputDir, run, *, report: bool) -> None:
     """The figures, tff_table.md, tff_summary.json (and report.html) of a TFF run."""
     from ..experiments.tff import tff_markdown
@@ -58,11 +47,9 @@ def _write_tff_outputs(outdir: OutputDir, run, *, report: bool) -> None:
         tmps[name] = tmp
     for name, tmp in tmps.items():
         outdir.commit(tmp, name)
-    with outdir.open("tff_table.md") as fh:
-        fh.write(tff_markdown(run))
-    with outdir.open("tff_summary.json") as fh:
-        json.dump(to_jsonable({"scenario": run.scenario_name, "seed": run.seed,
-                               "mode": run.mode, "cases": run.rows}), fh, indent=2)
+    write_text(outdir, "tff_table.md", tff_markdown(run))
+    write_json(outdir, "tff_summary.json", {"scenario": run.scenario_name, "seed": run.seed,
+                                            "mode": run.mode, "cases": run.rows})
     if report:
         sc = run.scenario
         html = tff_report_html(run.plans, run.rows, run.labels, sc,
@@ -73,8 +60,7 @@ def _write_tff_outputs(outdir: OutputDir, run, *, report: bool) -> None:
                                        "goal [m]": np.round(sc.goal, 1),
                                        "vertical cell [m]": sc.world.spacing[2]},
                                files=list(TFF_FILES))
-        with outdir.open(REPORT) as fh:
-            fh.write(html)
+        write_text(outdir, REPORT, html)
 
 
 def _write_tune_report(outdir: OutputDir, res, sc, s, g, *, agl: float, scenario: str,
@@ -112,192 +98,180 @@ def _write_tune_report(outdir: OutputDir, res, sc, s, g, *, agl: float, scenario
                 **{f"grid {k}": v for k, v in grid.items()}},
         files=list(TUNE_FILES), table_title="The tuned path",
         extra_tables={"Pareto front (deviation ↓, max climb ↓, min turn radius ↑)": pareto})
-    with outdir.open(REPORT) as fh:
-        fh.write(html)
+    write_text(outdir, REPORT, html)
+
+
+TFF_HELP = (
+    "Reproduce the terrain-following experiments (TFF paper §5 / thesis §4.3): flight "
+    "levels 2, 5, 10 cells with (p1,p2) = (0.5,2.5), (0.5,1.5), (0.5,1.3) and the "
+    "smoothness cases p2 = 1.0, 0.8 at level 10; writes the 3D views, path-vs-ideal "
+    "profiles, turn/climb/curvature profiles and tff_table.md (and with --report an "
+    "interactive report.html: every path vs its ideal level).\n\n"
+    "Examples:\n\n"
+    "  fm2uav reproduce tff --out out/tff\n\n"
+    "  fm2uav reproduce tff --report --out out/tff-report\n\n"
+    "  fm2uav reproduce tff --scenario jacksboro --out out/tff-jacksboro"
+)
+
+TUNE_HELP = (
+    "Search p1/p2 (and α/β) for the terrain-following path that keeps an airframe's max "
+    "climb angle and min turn radius with the least flight-level deviation; writes the "
+    "Pareto table (tune_table.md), tune.json, the best path and its figure (and with "
+    "--report an interactive report.html of the best path vs its ideal level).\n\n"
+    "Examples:\n\n"
+    "  fm2uav tune --agl 150 --max-climb 45 --min-turn-radius 60 --out out/tune\n\n"
+    "  fm2uav tune --p1 0.5 --p2 1.3,1.5 --report --out out/tune-report\n\n"
+    "  fm2uav tune --dem dem.tif --bbox 10.05,45.54,10.2,45.66 --lonlat --start "
+    "10.06,45.55 --goal 10.19,45.65 --agl 120 --out out/tune-dem\n\n"
+    "  fm2uav tune --scenario jacksboro --agl 300 --max-climb 20 --min-turn-radius 300 "
+    "--saturation 1,0.5 --out out/tune-jb"
+)
+
+_REPORT_HELP = "Also write report.html (interactive, self-contained)."
+
+
+@handle_errors
+@output_options("out/tff", report_help=_REPORT_HELP)
+def reproduce_tff_cmd(
+    scenario: str = typer.Option("open-field", help="Built-in 3D scenario with terrain."),
+    seed: int = typer.Option(0, help="Seed of the scenario's random relief."),
+    mode: str = typer.Option(
+        "capped", help="Flight-level reading: 'capped' (default) or 'literal' (W**p as is)."
+    ),
+    output: Output = None,
+) -> None:
+    """``fm2uav reproduce tff``: :func:`~fm2uav.experiments.tff.run_tff`, write, print."""
+    from ..experiments.tff import run_tff, tff_cases
+
+    tff_cases(mode)  # bad --mode fails before anything is written
+    outdir = output.dir(TFF_FILES + ((REPORT,) if output.report else ()))
+    t0 = time.perf_counter()
+    with output.progress() as step:
+        step(f"planning the terrain-following cases on {scenario}")
+        run = run_tff(scenario, seed, mode)
+        step("drawing the figures")
+        _write_tff_outputs(outdir, run, report=output.report)
+    summary = {
+        r["case"]: f"within {r['within']:.0%}, mean|dev| {r['mean_dev_all_m']:.1f} m, "
+        f"max turn {r['turn_max_deg']:.0f}°, max climb {r['climb_max_deg']:.0f}°"
+        for r in run.rows
+    }
+    summary["total [s]"] = f"{time.perf_counter() - t0:.1f}"
+    output.summary("Terrain-following experiments", summary, {"cases": run.rows})
+
+
+def _grid(**texts: str) -> dict[str, list[float]]:
+    """``--p1``/``--p2``/``--saturation``/``--exponent`` comma lists → the tune grid."""
+    def values(text: str, what: str) -> list[float]:
+        try:
+            return [float(v) for v in text.split(",") if v.strip()]
+        except ValueError:
+            raise InputError(f"--{what} must be a comma list of numbers, got {text!r}") from None
+
+    return {k: values(v, k) for k, v in texts.items()}
+
+
+@handle_errors
+@output_options("out/tune", report_help=_REPORT_HELP)
+@world_options
+def tune_cmd(
+    scenario: ScenarioOpt = None,
+    agl: float = typer.Option(150.0, help="Flight level over the ground (m)."),
+    max_climb: float = typer.Option(45.0, help="Airframe max climb/descent angle (deg)."),
+    min_turn_radius: float = typer.Option(60.0, help="Airframe min turn radius (m)."),
+    p1: str = typer.Option("0.3,0.5,0.8", help="Values of p1 to try (comma list)."),
+    p2: str = typer.Option("0.6,0.8,1.0,1.3,1.5,2.0,2.5", help="Values of p2 to try."),
+    saturation: str = typer.Option("1.0", help="Values of α to try."),
+    exponent: str = typer.Option("1.0", help="Values of β to try."),
+    start: str | None = typer.Option(None, help="Start x,y,z (m), LON,LAT[,AGL] with "
+                                     "--lonlat. Default: the scenario's."),
+    goal: str | None = typer.Option(None, help="Goal x,y,z (m), LON,LAT[,AGL] with "
+                                    "--lonlat. Default: the scenario's."),
+    lonlat: LonLatOpt = False,
+    seed: int = typer.Option(0, help="Seed of the scenario's random relief."),
+    output: Output = None,
+    world: WorldFlags = None,
+) -> None:
+    """``fm2uav tune``: parse, :func:`~fm2uav.analysis.tune.tune`, write, print."""
+    from ..analysis.tune import tune
+    from ..vehicles import AirframeLimits
+    from ..planning import FlightLevel
+    from ..world.load import world_summary
+
+    grid = _grid(p1=p1, p2=p2, saturation=saturation, exponent=exponent)
+    limits = AirframeLimits.from_degrees(max_climb, min_turn_radius)
+    need_agl, need_top = requested_heights(start, goal, lonlat=lonlat, agl=agl)
+    w, sc, scenario = build_world(world.spec(), scenario=scenario, seed=seed, agl=need_agl,
+                                  top=need_top)
+    s = cli_point(start, "start", w, lonlat=lonlat, agl=agl, default=sc.start if sc else None)
+    g = cli_point(goal, "goal", w, lonlat=lonlat, agl=agl, default=sc.goal if sc else None)
+    if sc is None:
+        from ..scenarios.scenario import Scenario
+        from ..world.load import check_points
+
+        check_points(w, {"start": s, "goal": g}, allow_filled=world.allow_filled)
+        sc = Scenario(world=w, start=s, goal=g, description=f"real data: {scenario}")
+    outdir = output.dir(TUNE_FILES + ((REPORT,) if output.report else ()))
+    with output.progress() as step:
+        n = sum(1 for a in grid["p1"] for b in grid["p2"] if b > a)
+        step(f"planning {n * len(grid['saturation']) * len(grid['exponent'])} candidates")
+        res = tune(sc.world, s, g, limits, FlightLevel(agl=agl), grid=grid)
+    _write_tune_best(outdir, res, w, agl)
+    write_text(outdir, "tune_table.md", _tune_markdown(
+        res, f"Auto-tuning — {scenario}, agl {agl:g} m, max climb {max_climb:g}°, "
+        f"min turn radius {min_turn_radius:g} m"))
+    payload = {"scenario": scenario, "world": world_summary(w), "agl_m": agl,
+               "limits": {"max_climb_deg": round(limits.max_climb_deg, 9),
+                          "min_turn_radius_m": limits.min_turn_radius}, "best": res.best, "pareto": res.pareto,
+               "rows": res.rows}
+    write_json(outdir, "tune.json", payload)
+    if output.report:
+        _write_tune_report(outdir, res, sc, s, g, agl=agl, scenario=scenario, limits=limits,
+                           grid=grid)
+    output.summary("Auto-tuning", {**_tune_rows(res), **world_rows(w)}, payload)
+
+
+def _tune_markdown(res, title: str) -> str:
+    """tune_table.md: the Pareto front and all candidates."""
+    md = [f"# {title}", "",
+          "## Pareto front (deviation ↓, max climb ↓, min turn radius ↑)", "",
+          res.table(), "", "## All candidates", "", res.table(res.rows), ""]
+    if res.best is None:
+        md.insert(2, "**No candidate keeps the limits**; the Pareto front shows the closest.\n")
+    return "\n".join(md)
+
+
+def _tune_rows(res) -> dict:
+    """The printed summary of ``fm2uav tune`` (without the world rows)."""
+    b = res.best
+    return {
+        "candidates": len(res.rows),
+        "feasible": sum(r["feasible"] for r in res.rows),
+        "best": ("none keeps the limits" if b is None else
+                 f"p1={b['p1']:g} p2={b['p2']:g} α={b['saturation']:g} β={b['exponent']:g}: "
+                 f"mean|dev| {b['deviation_m']:.1f} m, max climb {b['climb_max_deg']:.1f}°, "
+                 f"min turn radius {b['min_turn_radius_m']:.0f} m"),
+        "pareto front": len(res.pareto),
+    }
+
+
+def _write_tune_best(outdir: OutputDir, res, world, agl: float) -> None:
+    """tune_best_path.csv and tune_best.png of the tuned path (nothing without one)."""
+    if res.best_plan is None:
+        return
+    from ..io import write_path_csv
+    from ..viz.tff import tff_profile_figure
+
+    b = res.best
+    lab = f"best: p1={b['p1']:g}, p2={b['p2']:g}, α={b['saturation']:g}"
+    with outdir.open("tune_best_path.csv") as fh:
+        write_path_csv(fh, res.best_plan.path, res.best_plan.w,
+                       comment=world.georef.comment() if world.georef else None)
+    write_figure(outdir, tff_profile_figure([res.best_plan], [agl], [lab], title="Tuned path"),
+                 "tune_best.png", dpi=100)
 
 
 def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
     """Add ``reproduce tff`` and ``tune``."""
-
-    @reproduce_app.command(
-        "tff",
-        help=(
-            "Reproduce the terrain-following experiments (TFF paper §5 / thesis §4.3): flight "
-            "levels 2, 5, 10 cells with (p1,p2) = (0.5,2.5), (0.5,1.5), (0.5,1.3) and the "
-            "smoothness cases p2 = 1.0, 0.8 at level 10; writes the 3D views, path-vs-ideal "
-            "profiles, turn/climb/curvature profiles and tff_table.md (and with --report an "
-            "interactive report.html: every path vs its ideal level).\n\n"
-            "Examples:\n\n"
-            "  fm2uav reproduce tff --out out/tff\n\n"
-            "  fm2uav reproduce tff --report --out out/tff-report\n\n"
-            "  fm2uav reproduce tff --scenario jacksboro --out out/tff-jacksboro"
-        ),
-    )
-    @handle_errors
-    def reproduce_tff(
-        scenario: str = typer.Option("open-field", help="Built-in 3D scenario with terrain."),
-        seed: int = typer.Option(0, help="Seed of the scenario's random relief."),
-        mode: str = typer.Option(
-            "capped", help="Flight-level reading: 'capped' (default) or 'literal' (W**p as is)."
-        ),
-        out: Path = typer.Option(Path("out/tff"), help="Output directory."),
-        force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
-        as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
-        quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
-        report: bool = typer.Option(
-            False, "--report", help="Also write report.html (interactive, self-contained)."),
-    ) -> None:
-        from ..experiments.tff import run_tff, tff_cases
-
-        tff_cases(mode)  # bad --mode fails before anything is written
-        outdir = OutputDir(out, force=force)
-        outdir.check(TFF_FILES + ((REPORT,) if report else ()))
-        t0 = time.perf_counter()
-        with progress(enabled=not (quiet or as_json)) as step:
-            step(f"planning the terrain-following cases on {scenario}")
-            run = run_tff(scenario, seed, mode)
-            step("drawing the figures")
-            _write_tff_outputs(outdir, run, report=report)
-        rows = run.rows
-        summary = {
-            r["case"]: f"within {r['within']:.0%}, mean|dev| {r['mean_dev_all_m']:.1f} m, "
-            f"max turn {r['turn_max_deg']:.0f}°, max climb {r['climb_max_deg']:.0f}°"
-            for r in rows
-        }
-        summary["total [s]"] = f"{time.perf_counter() - t0:.1f}"
-        print_summary("Terrain-following experiments", summary if not as_json else
-                      {"cases": rows}, as_json=as_json, quiet=quiet, files=outdir.written)
-
-    @app.command(
-        "tune",
-        help=(
-            "Search p1/p2 (and α/β) for the terrain-following path that keeps an airframe's max "
-            "climb angle and min turn radius with the least flight-level deviation; writes the "
-            "Pareto table (tune_table.md), tune.json, the best path and its figure (and with "
-            "--report an interactive report.html of the best path vs its ideal level).\n\n"
-            "Examples:\n\n"
-            "  fm2uav tune --agl 150 --max-climb 45 --min-turn-radius 60 --out out/tune\n\n"
-            "  fm2uav tune --p1 0.5 --p2 1.3,1.5 --report --out out/tune-report\n\n"
-            "  fm2uav tune --dem dem.tif --bbox 10.05,45.54,10.2,45.66 --lonlat --start "
-            "10.06,45.55 --goal 10.19,45.65 --agl 120 --out out/tune-dem\n\n"
-            "  fm2uav tune --scenario jacksboro --agl 300 --max-climb 20 --min-turn-radius 300 "
-            "--saturation 1,0.5 --out out/tune-jb"
-        ),
-    )
-    @handle_errors
-    def tune_cmd(
-        scenario: ScenarioOpt = None,
-        agl: float = typer.Option(150.0, help="Flight level over the ground (m)."),
-        max_climb: float = typer.Option(45.0, help="Airframe max climb/descent angle (deg)."),
-        min_turn_radius: float = typer.Option(60.0, help="Airframe min turn radius (m)."),
-        p1: str = typer.Option("0.3,0.5,0.8", help="Values of p1 to try (comma list)."),
-        p2: str = typer.Option("0.6,0.8,1.0,1.3,1.5,2.0,2.5", help="Values of p2 to try."),
-        saturation: str = typer.Option("1.0", help="Values of α to try."),
-        exponent: str = typer.Option("1.0", help="Values of β to try."),
-        start: str | None = typer.Option(None, help="Start x,y,z (m), LON,LAT[,AGL] with "
-                                         "--lonlat. Default: the scenario's."),
-        goal: str | None = typer.Option(None, help="Goal x,y,z (m), LON,LAT[,AGL] with "
-                                        "--lonlat. Default: the scenario's."),
-        lonlat: LonLatOpt = False,
-        seed: int = typer.Option(0, help="Seed of the scenario's random relief."),
-        out: Path = typer.Option(Path("out/tune"), help="Output directory."),
-        force: bool = typer.Option(False, "--force", help="Overwrite existing outputs."),
-        as_json: bool = typer.Option(False, "--json", help="Print the summary as JSON."),
-        quiet: bool = typer.Option(False, "--quiet", help="Print nothing but errors."),
-        report: bool = typer.Option(
-            False, "--report", help="Also write report.html (interactive, self-contained)."),
-        dem: DemOpt = None,
-        buildings: BuildingsOpt = None,
-        bbox: BboxOpt = None,
-        sea_level: SeaLevelOpt = None,
-        cell_size: CellSizeOpt = None,
-        dz: DzOpt = None,
-        ceiling: CeilingOpt = None,
-        nodata: NodataOpt = "error",
-        nodata_value: NodataValueOpt = None,
-        crs: CrsOpt = None,
-        default_height: DefaultHeightOpt = None,
-        allow_filled: AllowFilledOpt = False,
-    ) -> None:
-        from ..analysis.tune import tune
-        from ..vehicles import AirframeLimits
-        from ..planning import FlightLevel
-
-        def values(text: str, what: str) -> list[float]:
-            try:
-                return [float(v) for v in text.split(",") if v.strip()]
-            except ValueError:
-                raise InputError(f"--{what} must be a comma list of numbers, got {text!r}") from None
-
-        grid = {"p1": values(p1, "p1"), "p2": values(p2, "p2"),
-                "saturation": values(saturation, "saturation"),
-                "exponent": values(exponent, "exponent")}
-        limits = AirframeLimits.from_degrees(max_climb, min_turn_radius)
-        spec = world_spec(dem=dem, buildings=buildings, bbox=bbox, sea_level=sea_level,
-                          cell_size=cell_size, dz=dz, ceiling=ceiling, nodata=nodata,
-                          nodata_value=nodata_value, crs=crs, default_height=default_height,
-                          allow_filled=allow_filled)
-        need_agl, need_top = requested_heights(start, goal, lonlat=lonlat, agl=agl)
-        world, sc, scenario = build_world(spec, scenario=scenario, seed=seed, agl=need_agl,
-                                          top=need_top)
-        s = cli_point(start, "start", world, lonlat=lonlat, agl=agl,
-                      default=sc.start if sc else None)
-        g = cli_point(goal, "goal", world, lonlat=lonlat, agl=agl,
-                      default=sc.goal if sc else None)
-        if sc is None:
-            from ..scenarios.scenario import Scenario
-            from ..world.load import check_points
-
-            check_points(world, {"start": s, "goal": g}, allow_filled=allow_filled)
-            sc = Scenario(world=world, start=s, goal=g, description=f"real data: {scenario}")
-        outdir = OutputDir(out, force=force)
-        outdir.check(TUNE_FILES + ((REPORT,) if report else ()))
-        with progress(enabled=not (quiet or as_json)) as step:
-            n = sum(1 for a in grid["p1"] for b in grid["p2"] if b > a)
-            step(f"planning {n * len(grid['saturation']) * len(grid['exponent'])} candidates")
-            res = tune(sc.world, s, g, limits, FlightLevel(agl=agl), grid=grid)
-        from ..io import write_path_csv
-
-        md = [f"# Auto-tuning — {scenario}, agl {agl:g} m, max climb {max_climb:g}°, "
-              f"min turn radius {min_turn_radius:g} m", "",
-              "## Pareto front (deviation ↓, max climb ↓, min turn radius ↑)", "",
-              res.table(), "", "## All candidates", "", res.table(res.rows), ""]
-        if res.best is None:
-            md.insert(2, "**No candidate keeps the limits**; the Pareto front shows the closest.\n")
-        if res.best_plan is not None:
-            from ..viz.tff import tff_profile_figure
-
-            lab = f"best: p1={res.best['p1']:g}, p2={res.best['p2']:g}, α={res.best['saturation']:g}"
-            fig = tff_profile_figure([res.best_plan], [agl], [lab], title="Tuned path")
-            tmp = outdir.target("tune_best.png")
-            fig.savefig(tmp, dpi=100)
-            with outdir.open("tune_best_path.csv") as fh:
-                write_path_csv(fh, res.best_plan.path, res.best_plan.w,
-                               comment=world.georef.comment() if world.georef else None)
-            outdir.commit(tmp, "tune_best.png")
-        with outdir.open("tune_table.md") as fh:
-            fh.write("\n".join(md))
-        from ..world.load import world_summary
-
-        payload = {"scenario": scenario, "world": world_summary(world), "agl_m": agl,
-                   "limits": {"max_climb_deg": round(limits.max_climb_deg, 9),
-                              "min_turn_radius_m": limits.min_turn_radius},
-                   "best": res.best, "pareto": res.pareto, "rows": res.rows}
-        with outdir.open("tune.json") as fh:
-            json.dump(to_jsonable(payload), fh, indent=2)
-        if report:
-            _write_tune_report(outdir, res, sc, s, g, agl=agl, scenario=scenario, limits=limits,
-                               grid=grid)
-        b = res.best
-        rows = {
-            "candidates": len(res.rows),
-            "feasible": sum(r["feasible"] for r in res.rows),
-            "best": ("none keeps the limits" if b is None else
-                     f"p1={b['p1']:g} p2={b['p2']:g} α={b['saturation']:g} β={b['exponent']:g}: "
-                     f"mean|dev| {b['deviation_m']:.1f} m, max climb {b['climb_max_deg']:.1f}°, "
-                     f"min turn radius {b['min_turn_radius_m']:.0f} m"),
-            "pareto front": len(res.pareto),
-            **world_rows(world),
-        }
-        print_summary("Auto-tuning", rows if not as_json else payload, as_json=as_json,
-                      quiet=quiet, files=outdir.written)
+    reproduce_app.command("tff", help=TFF_HELP)(reproduce_tff_cmd)
+    app.command("tune", help=TUNE_HELP)(tune_cmd)
