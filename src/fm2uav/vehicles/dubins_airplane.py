@@ -124,35 +124,57 @@ def track_dubins(
         prog[k] = carrot.s[idx]
         d = c - pos
         lxy = math.hypot(d[0], d[1])
-        # flight-path angle towards the carrot, clipped
-        g_cmd = math.atan2(d[2], lxy)
-        if g_cmd > g_up:
-            sat_c[k] = True
-            g_cmd = g_up
-        elif g_cmd < -g_dn:
-            sat_d[k] = True
-            g_cmd = -g_dn
-        # pure-pursuit turn rate, clipped
-        if lxy > 1e-9:
-            eta = (math.atan2(d[1], d[0]) - psi + math.pi) % (2 * math.pi) - math.pi
-            if abs(eta) > math.pi / 2:
-                cmd = math.copysign(math.inf, eta)
-            else:
-                cmd = 2.0 * V * math.cos(g_cmd) * math.sin(eta) / lxy
-        else:
-            cmd = 0.0
-        if abs(cmd) > rate_max * (1 + 1e-9):
-            sat_t[k] = True
-            cmd = math.copysign(rate_max, cmd)
+        g_cmd, sat_c[k], sat_d[k] = _flight_path_command(d[2], lxy, g_up, g_dn)
+        cmd, sat_t[k] = _turn_rate_command(d, lxy, psi, V, g_cmd, rate_max)
         heading[k], fpa[k], rate[k] = psi, g_cmd, cmd
-        # integrate (midpoint heading, constant γ over the step)
-        pm = psi + 0.5 * cmd * dt
-        cg = math.cos(g_cmd)
-        pos = pos + V * dt * np.array([math.cos(pm) * cg, math.sin(pm) * cg, math.sin(g_cmd)])
-        psi = psi + cmd * dt
+        pos, psi = _integrate_step(pos, psi, cmd, g_cmd, V, dt)
     return finish_tracking(
         af, planned, traj, prog, k + 1, dt,
         saturated={"turn": sat_t, "climb": sat_c, "descent": sat_d},
         states={"heading": heading, "flight_path_angle": fpa, "turn_rate": rate, "speed": np.full(len(traj), V)},
         reached=reached, lookahead=L,
     )
+
+
+def _flight_path_command(dz: float, lxy: float, g_up: float, g_dn: float) -> tuple[float, bool, bool]:
+    """Flight-path angle [rad] towards the carrot, clipped to ``[-g_dn, g_up]``.
+
+    Returns the angle and whether the climb / the descent limit clipped it.
+    """
+    g_cmd = math.atan2(dz, lxy)
+    if g_cmd > g_up:
+        return g_up, True, False
+    if g_cmd < -g_dn:
+        return -g_dn, False, True
+    return g_cmd, False, False
+
+
+def _turn_rate_command(
+    d: np.ndarray, lxy: float, psi: float, V: float, g_cmd: float, rate_max: float,
+) -> tuple[float, bool]:
+    """Pure-pursuit turn rate [rad/s] towards the carrot offset ``d`` [m], clipped to ``rate_max``.
+
+    A carrot behind the aircraft commands the maximum rate. Returns the rate and
+    whether it was clipped.
+    """
+    if lxy > 1e-9:
+        eta = (math.atan2(d[1], d[0]) - psi + math.pi) % (2 * math.pi) - math.pi
+        if abs(eta) > math.pi / 2:
+            cmd = math.copysign(math.inf, eta)
+        else:
+            cmd = 2.0 * V * math.cos(g_cmd) * math.sin(eta) / lxy
+    else:
+        cmd = 0.0
+    if abs(cmd) > rate_max * (1 + 1e-9):
+        return math.copysign(rate_max, cmd), True
+    return cmd, False
+
+
+def _integrate_step(
+    pos: np.ndarray, psi: float, cmd: float, g_cmd: float, V: float, dt: float,
+) -> tuple[np.ndarray, float]:
+    """One step of ``dt`` [s]: midpoint heading, constant flight-path angle; new position and heading."""
+    pm = psi + 0.5 * cmd * dt
+    cg = math.cos(g_cmd)
+    pos = pos + V * dt * np.array([math.cos(pm) * cg, math.sin(pm) * cg, math.sin(g_cmd)])
+    return pos, psi + cmd * dt

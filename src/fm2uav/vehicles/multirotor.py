@@ -109,21 +109,8 @@ def track_multirotor(
         dn = float(np.linalg.norm(d))
         v_ref = min(float(v_at[idx]), math.sqrt(2.0 * a_max * goal_d))
         vref[k] = v_ref
-        v_des = d / dn * v_ref if dn > 1e-12 else np.zeros(3)
-        if v_des[2] > af.max_climb_rate:
-            sat_c[k] = True
-            v_des[2] = af.max_climb_rate
-        elif v_des[2] < -af.max_descent_rate:
-            sat_d[k] = True
-            v_des[2] = -af.max_descent_rate
-        h = math.hypot(v_des[0], v_des[1])
-        if h > af.max_speed:
-            v_des[:2] *= af.max_speed / h
-        acc = (v_des - vel) / _TAU
-        an = float(np.linalg.norm(acc))
-        if an > a_max * (1 + 1e-9):
-            sat_a[k] = True
-            acc *= a_max / an
+        v_des, sat_c[k], sat_d[k] = _desired_velocity(d, dn, v_ref, af)
+        acc, sat_a[k] = _acceleration(v_des, vel, a_max)
         new_vel = vel + acc * dt
         pos = pos + 0.5 * (vel + new_vel) * dt
         vel = new_vel
@@ -133,3 +120,33 @@ def track_multirotor(
         states={"speed": spd, "v_ref": vref},
         reached=reached, lookahead=L,
     )
+
+
+def _desired_velocity(d: np.ndarray, dn: float, v_ref: float, af: Multirotor) -> tuple[np.ndarray, bool, bool]:
+    """Velocity [m/s] towards the carrot offset ``d`` (length ``dn`` [m]) at ``v_ref``.
+
+    Its vertical part is clipped to ``[-max_descent_rate, max_climb_rate]``, its
+    horizontal part to ``max_speed``. Returns it and whether the climb / the
+    descent limit clipped it.
+    """
+    v_des = d / dn * v_ref if dn > 1e-12 else np.zeros(3)
+    sat_c = sat_d = False
+    if v_des[2] > af.max_climb_rate:
+        sat_c = True
+        v_des[2] = af.max_climb_rate
+    elif v_des[2] < -af.max_descent_rate:
+        sat_d = True
+        v_des[2] = -af.max_descent_rate
+    h = math.hypot(v_des[0], v_des[1])
+    if h > af.max_speed:
+        v_des[:2] *= af.max_speed / h
+    return v_des, sat_c, sat_d
+
+
+def _acceleration(v_des: np.ndarray, vel: np.ndarray, a_max: float) -> tuple[np.ndarray, bool]:
+    """First-order response ``(v_des - vel) / τ`` [m/s²] clipped to ``a_max``; and whether it was clipped."""
+    acc = (v_des - vel) / _TAU
+    an = float(np.linalg.norm(acc))
+    if an > a_max * (1 + 1e-9):
+        return acc * (a_max / an), True
+    return acc, False
