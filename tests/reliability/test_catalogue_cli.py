@@ -23,6 +23,9 @@ def _files(tmp):
     os.mkfifo(tmp / "pipe.geojson")
     os.mkfifo(tmp / "pipe.yaml")
     (tmp / "junk.tif").write_bytes(b"junk")
+    from .conftest import relief, write_dem
+
+    write_dem(tmp / "dem.tif", relief(60))
     (tmp / "bin.yaml").write_bytes(b"name: \xff\xfe\n")
     (tmp / "dup.yaml").write_text("version: 1\nname: a\nname: b\n")
     (tmp / "deep.yaml").write_text("[" * 4000)
@@ -83,6 +86,8 @@ CASES = [
     (["plan", "--buildings", "{tmp}/dir.tif"], "is a directory"),
     (["plan", "--buildings", "{tmp}/area.geojson"], "area.geojson"),
     (["plan", "--scenario", "open-field", "--buildings", "{tmp}/area.geojson"], "not both"),
+    (["plan", "--dem", "{tmp}/dem.tif", "--dz", "0.001", "--start", "500100,4498300,150",
+      "--goal", "501600,4498500,150"], "limit 1000"),
     # plan: output folder
     (["plan", "--out", "{tmp}/path.csv"], "is not a folder"),
     # run: mission files

@@ -102,6 +102,10 @@ def _num(default: Any = None, *, unit: str = "", desc: str = "", **bounds: float
     return Field(default, description=desc, json_schema_extra={"unit": unit}, **bounds)
 
 
+#: Largest ratio between the horizontal cell and the vertical cell of a data world.
+MAX_ASPECT = 1000.0
+
+
 def _regular_file(path: Path) -> None:
     """A directory, named pipe or unreadable file as a ValueError (pydantic) — never a hang."""
     from .. import _validate as v
@@ -419,6 +423,13 @@ def load_world(spec: WorldSpec, *, agl: float | None = None, top: float | None =
         raise InputError(
             f"world.dz (--dz) = {dz:g} m is more than twice the requested height above ground "
             f"{agl:g} m: the flight level would round to the ground; use world.dz <= {agl / 6:g}")
+    if max(dx, dz) / min(dx, dz) > MAX_ASPECT:
+        # e.g. dz 1 mm under 30 m cells: 9e4 layers, a 3e8-node march running for hours
+        raise InputError(
+            f"world.cell_size (--cell-size) = {dx:g} m and world.dz (--dz) = {dz:g} m differ by "
+            f"a factor {max(dx, dz) / min(dx, dz):.3g} (limit {MAX_ASPECT:g}): the grid would "
+            "need absurdly many nodes for its accuracy; give a dz between "
+            f"{dx / MAX_ASPECT:g} and {dx * MAX_ASPECT:g} m")
     stem = name
     if not stem:
         first = spec.dem if isinstance(spec.dem, str) else (spec.dem or [spec.buildings])[0]
