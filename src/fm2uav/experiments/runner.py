@@ -559,9 +559,7 @@ def _run(config: SweepConfig, out: Path, log: CaseLog, history: list[dict[str, A
     refs_total = n_pairs * len(config.models)
     refs_dirty = False
 
-    def progress(*args: Any) -> None:
-        if on_progress is not None:
-            on_progress(*args)
+    progress = on_progress if on_progress is not None else _no_progress
 
     with signals:  # installed until the cleanup is over (a second Ctrl-C waits)
         try:
@@ -573,22 +571,12 @@ def _run(config: SweepConfig, out: Path, log: CaseLog, history: list[dict[str, A
 
             # 1. references
             t0 = time.perf_counter()
-            need = [(p, m) for p in range(n_pairs) for m in config.models
-                    if (p, m) not in refs or (retry_failed and refs[(p, m)]["error"])]
-            done = refs_total - len(need)
-            failed = sum(1 for k, r in refs.items() if r["error"] and k not in need)
+            need, done, failed = _references_to_run(config, refs, n_pairs, retry_failed)
             progress("references", done, refs_total, failed)
             executor = _executor(workers, scheduler, client)
-            jobs = [Job({**base_ctx, "start": starts[p], "goal": goals[p], "xi": float(config.xi),
-                         "max_int": int(config.max_int)}, [m], tag=p) for p, m in need]
-            for o in executor.run(_reference_case, jobs):
-                p, m = o.job.tag, o.unit
-                entry = {"pair": p, "model": m, "attempts": o.attempt}
-                if o.ok:
-                    entry.update(o.value, error="")
-                else:
-                    entry.update(error=str(o.value), time_s=math.nan)
-                refs[(p, m)] = entry
+            for o in executor.run(_reference_case, _reference_jobs(config, base_ctx, starts, goals, need)):
+                entry = _reference_entry(o)
+                refs[(o.job.tag, o.unit)] = entry
                 refs_dirty = True
                 with signals.deferred():  # each reference is kept as soon as it is known
                     save_references(refs_path, refs)
@@ -607,63 +595,23 @@ def _run(config: SweepConfig, out: Path, log: CaseLog, history: list[dict[str, A
 
             def record(row: dict[str, Any]) -> None:
                 nonlocal done, failed
-                k = case_key(row)
-                old = latest.get(k)
-                # a failure that repeats itself word for word is not appended again
-                if not (old is not None and old["status"] == row["status"] == "failed"
-                        and old.get("error") == row.get("error")):
-                    with signals.deferred():
-                        log.append(row)
-                latest[k] = row
+                _log_case(log, signals, latest, row)
                 stats["run"] += 1
                 done += 1
                 failed += row["status"] != "ok"
 
-            jobs = []
-            missing_refs: list[tuple[int, float, list[float], str]] = []
-            for p in range(n_pairs):
-                ref_paths, ref_errors = {}, []
-                for m in config.models:
-                    r = refs[(p, m)]
-                    if r["error"]:
-                        ref_errors.append(f"no {m} reference: {r['error']}")
-                    else:
-                        ref_paths[m] = r["path"]
-                for a in alphas:
-                    todo = []
-                    for b in betas:
-                        old = latest.get((p, float(a), float(b)))
-                        if old is not None and (old["status"] == "ok" or not retry_failed):
-                            stats["skipped"] += 1
-                            done += 1
-                            failed += old["status"] != "ok"
-                        else:
-                            todo.append(float(b))
-                    if not todo:
-                        continue
-                    if ref_errors:
-                        missing_refs.append((p, float(a), todo, "; ".join(ref_errors)))
-                    else:
-                        jobs.append(Job({**base_ctx, "pair": p, "start": starts[p],
-                                         "goal": goals[p], "alpha": float(a),
-                                         "references": ref_paths, "ds": float(config.ds),
-                                         "order": int(config.order)}, todo, tag=(p, float(a))))
+            jobs, missing_refs, skipped, skipped_failed = _fm2_jobs(
+                config, refs, latest, base_ctx, starts, goals, alphas, betas, retry_failed)
+            stats["skipped"] += skipped
+            done += skipped
+            failed += skipped_failed
             progress("fm2", done, total, failed)
             for p, a, todo, reason in missing_refs:
                 for b in todo:
                     record({"pair": p, "alpha": a, "beta": b, "status": "failed", "error": reason})
                 progress("fm2", done, total, failed)
             for o in executor.run(_fm2_case, jobs):
-                p, a = o.job.tag
-                if o.ok:
-                    row = dict(o.value)
-                else:
-                    row = {"pair": p, "alpha": a, "beta": o.unit, "status": "failed",
-                           "error": str(o.value)}
-                row = checked_row(row, metric_cols)
-                row.update(pair=p, alpha=a, beta=float(o.unit), attempts=o.attempt,
-                           worker=o.worker, time=time.time())
-                record(row)
+                record(_fm2_row(o, metric_cols))
                 progress("fm2", done, total, failed)
             wall["fm2"] = time.perf_counter() - t1
             stats["deaths"] = executor.deaths
@@ -677,14 +625,8 @@ def _run(config: SweepConfig, out: Path, log: CaseLog, history: list[dict[str, A
                 with contextlib.suppress(OSError):
                     save_references(refs_path, refs)
             log.close()
-            kept = sum(1 for r in latest.values() if r["status"] == "ok")
-            if stage == "references":
-                ok_refs = sum(1 for r in refs.values() if not r["error"])
-                what = f"in the references phase ({ok_refs} of {refs_total} references kept in {refs_path})"
-            else:
-                what = f"{kept} of {len(grid)} cases recorded in {log.path}"
-            raise SweepInterrupted(exc.signum, f"sweep interrupted by {signal.Signals(exc.signum).name}: "
-                                   f"workers stopped, {what}; run the same sweep again to resume") from None
+            raise _interrupted(exc.signum, stage, refs, refs_total, refs_path, latest,
+                               len(grid), log.path) from None
         finally:
             signals.closing = True
             if executor is not None:
@@ -692,27 +634,160 @@ def _run(config: SweepConfig, out: Path, log: CaseLog, history: list[dict[str, A
             log.close()
 
     # 3. the summary, from the log
-    rows_by_key = {k: r for k, r in latest_rows([checked_row(r, metric_cols) for r in
-                                             log.read(lambda m: None)]).items() if k in grid}
-    rows = [rows_by_key[k] for k in sorted(rows_by_key)]
-    columns = config.result_columns()
-    write_summary(results_path, rows, columns)
-    cols = columns_of(rows, columns)
+    rows, cols = _write_results(config, log, grid, metric_cols, results_path)
+    return _sweep_result(config, cols, bool(rows), starts, goals, refs, stats, wall,
+                         log.path, results_path, warnings)
+
+
+def _sweep_result(config: SweepConfig, cols: dict[str, Any], any_rows: bool, starts: Any,
+                  goals: Any, refs: dict[tuple[int, str], dict[str, Any]], stats: dict[str, int],
+                  wall: dict[str, float], log_path: Path, results_path: Path,
+                  warnings: list[str]) -> SweepResult:
+    """The :class:`SweepResult` of a finished sweep (``cols``: the summary's columns)."""
     return SweepResult(
         config=config,
         columns=cols,
-        alphas=alphas,
-        betas=betas,
+        alphas=config.alpha.values(),
+        betas=config.beta.values(),
         starts=starts,
         goals=goals,
         references=refs,
         cases_run=stats["run"],
         cases_skipped=stats["skipped"],
-        cases_failed=int(np.sum(cols["status"] != "ok")) if rows else 0,
+        cases_failed=int(np.sum(cols["status"] != "ok")) if any_rows else 0,
         cases_retried=stats["retried"],
         worker_deaths=stats["deaths"],
         wall_s=wall,
-        log=log.path,
+        log=log_path,
         summary=results_path,
         warnings=warnings,
     )
+
+
+def _references_to_run(config: SweepConfig, refs: dict[tuple[int, str], dict[str, Any]],
+                       n_pairs: int, retry_failed: bool) -> tuple[list[tuple[int, str]], int, int]:
+    """The (pair, model) references still to compute; and how many are done / failed already."""
+    need = [(p, m) for p in range(n_pairs) for m in config.models
+            if (p, m) not in refs or (retry_failed and refs[(p, m)]["error"])]
+    done = n_pairs * len(config.models) - len(need)
+    failed = sum(1 for k, r in refs.items() if r["error"] and k not in need)
+    return need, done, failed
+
+
+def _no_progress(*args: Any) -> None:
+    """The progress callback of a sweep run without one."""
+
+
+def _reference_jobs(config: SweepConfig, base_ctx: dict[str, Any], starts: Any, goals: Any,
+                    need: list[tuple[int, str]]) -> list[Job]:
+    """One job per (pair, model) reference in ``need``."""
+    return [Job({**base_ctx, "start": starts[p], "goal": goals[p], "xi": float(config.xi),
+                 "max_int": int(config.max_int)}, [m], tag=p) for p, m in need]
+
+
+def _log_case(log: CaseLog, signals: _Signals, latest: dict[CaseKey, dict[str, Any]],
+              row: dict[str, Any]) -> None:
+    """Append ``row`` to the log (unless it repeats a failure word for word) and make it the latest."""
+    k = case_key(row)
+    if not _repeats_failure(latest.get(k), row):
+        with signals.deferred():
+            log.append(row)
+    latest[k] = row
+
+
+def _repeats_failure(old: dict[str, Any] | None, row: dict[str, Any]) -> bool:
+    """True when ``row`` is a failure that repeats ``old`` word for word (not appended again)."""
+    return (old is not None and old["status"] == row["status"] == "failed"
+            and old.get("error") == row.get("error"))
+
+
+def _reference_entry(o: Any) -> dict[str, Any]:
+    """The references-file entry of one finished reference job ``o`` (its value or its error)."""
+    entry = {"pair": o.job.tag, "model": o.unit, "attempts": o.attempt}
+    if o.ok:
+        entry.update(o.value, error="")
+    else:
+        entry.update(error=str(o.value), time_s=math.nan)
+    return entry
+
+
+def _fm2_jobs(config: SweepConfig, refs: dict[tuple[int, str], dict[str, Any]],
+              latest: dict[CaseKey, dict[str, Any]], base_ctx: dict[str, Any],
+              starts: Any, goals: Any, alphas: Any, betas: Any, retry_failed: bool,
+              ) -> tuple[list[Job], list[tuple[int, float, list[float], str]], int, int]:
+    """The FM² cases still to run, one job per (pair, alpha) with its betas.
+
+    A case already in ``latest`` is skipped when it succeeded (or failed and
+    ``retry_failed`` is off). Returns the jobs, the cases that cannot run because a
+    reference failed ``(pair, alpha, betas, reason)``, and the numbers of skipped
+    cases and of skipped failed cases.
+    """
+    jobs: list[Job] = []
+    missing_refs: list[tuple[int, float, list[float], str]] = []
+    skipped = skipped_failed = 0
+    for p in range(len(starts)):
+        ref_paths, ref_errors = {}, []
+        for m in config.models:
+            r = refs[(p, m)]
+            if r["error"]:
+                ref_errors.append(f"no {m} reference: {r['error']}")
+            else:
+                ref_paths[m] = r["path"]
+        for a in alphas:
+            todo = []
+            for b in betas:
+                old = latest.get((p, float(a), float(b)))
+                if old is not None and (old["status"] == "ok" or not retry_failed):
+                    skipped += 1
+                    skipped_failed += old["status"] != "ok"
+                else:
+                    todo.append(float(b))
+            if not todo:
+                continue
+            if ref_errors:
+                missing_refs.append((p, float(a), todo, "; ".join(ref_errors)))
+            else:
+                jobs.append(Job({**base_ctx, "pair": p, "start": starts[p],
+                                 "goal": goals[p], "alpha": float(a),
+                                 "references": ref_paths, "ds": float(config.ds),
+                                 "order": int(config.order)}, todo, tag=(p, float(a))))
+    return jobs, missing_refs, skipped, skipped_failed
+
+
+def _fm2_row(o: Any, metric_cols: Any) -> dict[str, Any]:
+    """The log row of one finished FM² case ``o`` (its metrics or its error), stamped."""
+    p, a = o.job.tag
+    if o.ok:
+        row = dict(o.value)
+    else:
+        row = {"pair": p, "alpha": a, "beta": o.unit, "status": "failed",
+               "error": str(o.value)}
+    row = checked_row(row, metric_cols)
+    row.update(pair=p, alpha=a, beta=float(o.unit), attempts=o.attempt,
+               worker=o.worker, time=time.time())
+    return row
+
+
+def _interrupted(signum: int, stage: str, refs: dict[tuple[int, str], dict[str, Any]],
+                 refs_total: int, refs_path: Path, latest: dict[CaseKey, dict[str, Any]],
+                 n_cases: int, log_path: Path) -> SweepInterrupted:
+    """The one-line :class:`SweepInterrupted` of a sweep stopped by ``signum``: what it kept."""
+    if stage == "references":
+        ok_refs = sum(1 for r in refs.values() if not r["error"])
+        what = f"in the references phase ({ok_refs} of {refs_total} references kept in {refs_path})"
+    else:
+        kept = sum(1 for r in latest.values() if r["status"] == "ok")
+        what = f"{kept} of {n_cases} cases recorded in {log_path}"
+    return SweepInterrupted(signum, f"sweep interrupted by {signal.Signals(signum).name}: "
+                            f"workers stopped, {what}; run the same sweep again to resume")
+
+
+def _write_results(config: SweepConfig, log: CaseLog, grid: set[CaseKey], metric_cols: Any,
+                   results_path: Path) -> tuple[list[dict[str, Any]], dict[str, Any]]:
+    """Write the summary table from the log (latest row per case of ``grid``, sorted); rows and columns."""
+    rows_by_key = {k: r for k, r in latest_rows([checked_row(r, metric_cols) for r in
+                                             log.read(lambda m: None)]).items() if k in grid}
+    rows = [rows_by_key[k] for k in sorted(rows_by_key)]
+    columns = config.result_columns()
+    write_summary(results_path, rows, columns)
+    return rows, columns_of(rows, columns)
