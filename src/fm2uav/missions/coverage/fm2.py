@@ -405,45 +405,15 @@ def plan_coverage(
     t1 = time.perf_counter()
     zz = zigzag(poly, d, angle)
     ideal = zz.path()
-    b = world.bounds
-    out = ((ideal[:, 0] < b[0, 0]) | (ideal[:, 0] > b[0, 1]) | (ideal[:, 1] < b[1, 0])
-           | (ideal[:, 1] > b[1, 1]))
-    if out.any():
-        p = ideal[np.argmax(out)]
-        raise InputError(
-            f"the zigzag (turns reach D/2 = {d / 2:g} m beyond the bands) leaves the map at "
-            f"({p[0]:.1f}, {p[1]:.1f}) m; keep the area at least D/2 from the map's edge or "
-            "use a smaller D"
-        )
+    _check_zigzag_in_map(world, ideal, d)
     t2 = time.perf_counter()
-    opts = dict(level_contrast=level_contrast, level_base=level_base, shaping=shaping)
     if not (0 < corridor < 0.5):
         raise InputError(f"corridor must be a share of D in (0, 0.5), got {corridor!r}")
-    cg = grid_plan = None
-    from .zones import meets_zones, plan_zone_route
-
-    if meets_zones(world, ideal, corridor * d):  # no-fly zones cut the corridor: a route
-        grid = "route"
-        t3 = time.perf_counter()
-        fm = plan_zone_route(world, ideal, d, level, shaping=shaping, options=options).plan
-    elif grid == "corridor":
-        cg = corridor_grid(world, zz, corridor * d)
-        W, layer = corridor_grid_speed(cg, level, **opts)
-        gw = cg.world
-        z = gw.origin[2] + layer[[0, -1]] * gw.spacing[2]
-        start = np.array([0.0, 0.0, z[0]])
-        goal = np.array([gw.origin[0] + (gw.shape[0] - 1) * gw.spacing[0], 0.0, z[1]])
-        t3 = time.perf_counter()
-        grid_plan = fm2_plan(gw, start, goal, options=dataclasses.replace(options, speed_map=W))
-        fm = _on_map(cg, grid_plan)
-    else:
-        W = coverage_speed_map(world, zz, level, corridor=corridor, **opts)
-        layer = flight_layer(world, level.agl)
-        start = _on_level(world, zz.start, layer, "start")
-        goal = _on_level(world, zz.goal, layer, "end")
-        t3 = time.perf_counter()
-        fm = fm2_plan(world, start, goal, options=dataclasses.replace(options, speed_map=W))
+    fm, grid, cg, grid_plan, t3 = _fly_zigzag(
+        world, zz, ideal, d, level, grid, corridor, options,
+        dict(level_contrast=level_contrast, level_base=level_base, shaping=shaping))
     _check_free(world, fm.path)
+    fm = with_flown_heights(world, fm, level)
     t4 = time.perf_counter()
     cov = coverage_share(poly, fm.path, d / 2.0)
     zcov = coverage_share(poly, ideal, d / 2.0)
@@ -459,6 +429,79 @@ def plan_coverage(
                 "order": int(options.order), "step": float(options.step), "grid": grid},
         level=level, grid=cg, grid_plan=grid_plan,
     )
+
+
+def with_flown_heights(world: World, fm: Plan, level: FlightLevel) -> Plan:
+    """The coverage plan with its heights set from the continuous ground (issue 13).
+
+    The coverage FM² runs on its own speed map, so :func:`fm2uav.plan` sets no
+    final altitude profile; the route found is kept horizontally and its heights
+    become ground (source DEM, bilinear) + ``level.agl`` within the airframe's
+    climb/descent limits (:func:`fm2uav.planning.altitude.final_profile`), as for
+    every other plan. ``level.heights == "fm2"`` keeps the flight layer's own
+    heights (the seeds' measurement); a plan that has a profile is returned as is.
+    """
+    if level.heights != "ground" or fm.profile is not None:
+        return fm
+    from scipy import ndimage
+
+    from ...planning.altitude import final_profile
+    from ...world.clearance import surface_clearance
+
+    profile = final_profile(world, fm.path, level)
+    path = profile.path
+    w = ndimage.map_coordinates(fm.W, world.to_index(path).T, order=1, mode="nearest")
+    return dataclasses.replace(fm, path=path, w=w, length=path_length(path),
+                               clearance=float(surface_clearance(world, path).min()),
+                               level=level, profile=profile)
+
+
+def _check_zigzag_in_map(world: World, ideal: np.ndarray, d: float) -> None:
+    """InputError if the zigzag (its turns reach D/2 beyond the bands) leaves the map."""
+    b = world.bounds
+    out = ((ideal[:, 0] < b[0, 0]) | (ideal[:, 0] > b[0, 1]) | (ideal[:, 1] < b[1, 0])
+           | (ideal[:, 1] > b[1, 1]))
+    if out.any():
+        p = ideal[np.argmax(out)]
+        raise InputError(
+            f"the zigzag (turns reach D/2 = {d / 2:g} m beyond the bands) leaves the map at "
+            f"({p[0]:.1f}, {p[1]:.1f}) m; keep the area at least D/2 from the map's edge or "
+            "use a smaller D"
+        )
+
+
+def _fly_zigzag(world: World, zz: Zigzag, ideal: np.ndarray, d: float, level: FlightLevel,
+                grid: str, corridor: float, options: PlanOptions, opts: dict[str, Any]
+                ) -> tuple[Plan, str, CorridorGrid | None, Plan | None, float]:
+    """FM² along the zigzag on the chosen grid (or a route around no-fly zones).
+
+    Returns the plan on the map, the grid actually used (``"route"`` when zones
+    cut the corridor), the corridor grid and its own plan (corridor grid only)
+    and the time the speed map was ready (:func:`time.perf_counter`).
+    """
+    from .zones import meets_zones, plan_zone_route
+
+    if meets_zones(world, ideal, corridor * d):  # no-fly zones cut the corridor: a route
+        t3 = time.perf_counter()
+        route = plan_zone_route(world, ideal, d, level, shaping=opts["shaping"], options=options)
+        return route.plan, "route", None, None, t3
+    if grid == "corridor":
+        cg = corridor_grid(world, zz, corridor * d)
+        W, layer = corridor_grid_speed(cg, level, **opts)
+        gw = cg.world
+        z = gw.origin[2] + layer[[0, -1]] * gw.spacing[2]
+        start = np.array([0.0, 0.0, z[0]])
+        goal = np.array([gw.origin[0] + (gw.shape[0] - 1) * gw.spacing[0], 0.0, z[1]])
+        t3 = time.perf_counter()
+        grid_plan = fm2_plan(gw, start, goal, options=dataclasses.replace(options, speed_map=W))
+        return _on_map(cg, grid_plan), grid, cg, grid_plan, t3
+    W = coverage_speed_map(world, zz, level, corridor=corridor, **opts)
+    layer = flight_layer(world, level.agl)
+    start = _on_level(world, zz.start, layer, "start")
+    goal = _on_level(world, zz.goal, layer, "end")
+    t3 = time.perf_counter()
+    fm = fm2_plan(world, start, goal, options=dataclasses.replace(options, speed_map=W))
+    return fm, grid, None, None, t3
 
 
 def _on_map(cg: CorridorGrid, fm: Plan) -> Plan:
