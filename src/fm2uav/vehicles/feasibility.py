@@ -192,17 +192,34 @@ def check_feasibility(
         raise InputError(
             f"the path has {raw.shape[1]} coordinates per point but the world is {world.ndim}D"
         )
+    af, tr = _fly(raw, af, w=w, speed=speed, lookahead=lookahead,
+                  lookahead_points=lookahead_points, dt=dt)
+    geo = geometric_check(raw, af, window=window)
+    prof = speed_profile(raw, af, w, window=window)
+    ok, reasons, col = _verdict(tr, tol, world)
+    return FeasibilityReport(
+        airframe=af, tracking=tr, geometric=geo, speed=prof, tolerance=tol, collision=col,
+        feasible=ok, reasons=reasons,
+    )
+
+
+def _fly(raw: np.ndarray, af: Airframe, *, w: Any, speed: float | None, lookahead: float | None,
+         lookahead_points: int | None, dt: float) -> tuple[Airframe, Tracking]:
+    """Fly ``raw`` with the tracker of ``af``'s kind; the airframe flown (at ``speed``) and its tracking."""
     if isinstance(af, FixedWing):
         if speed is not None:
             af = af.with_speed(speed)
-        tr = track_dubins(raw, af, lookahead=lookahead, lookahead_points=lookahead_points, dt=dt)
-    else:
-        if speed is not None:
-            raise InputError("speed= applies to fixed-wings; a multirotor flies the W profile")
-        tr = track_multirotor(raw, af, w=w, lookahead=lookahead,
-                              lookahead_points=lookahead_points, dt=dt)
-    geo = geometric_check(raw, af, window=window)
-    prof = speed_profile(raw, af, w, window=window)
+        return af, track_dubins(raw, af, lookahead=lookahead, lookahead_points=lookahead_points,
+                                dt=dt)
+    if speed is not None:
+        raise InputError("speed= applies to fixed-wings; a multirotor flies the W profile")
+    return af, track_multirotor(raw, af, w=w, lookahead=lookahead,
+                                lookahead_points=lookahead_points, dt=dt)
+
+
+def _verdict(tr: Tracking, tol: float, world: World | None,
+             ) -> tuple[bool, list[str], dict[str, Any] | None]:
+    """Feasible or not, the reasons (one sentence each) and the collision check of the trajectory."""
     reasons: list[str] = []
     ok = True
     if not tr.reached:
@@ -235,7 +252,4 @@ def check_feasibility(
     busy = {k: v for k, v in sat.items() if v > 0}
     if busy:
         reasons.append("limits saturated " + ", ".join(f"{k} {v:.1f} s" for k, v in busy.items()))
-    return FeasibilityReport(
-        airframe=af, tracking=tr, geometric=geo, speed=prof, tolerance=tol, collision=col,
-        feasible=ok, reasons=reasons,
-    )
+    return ok, reasons, col
