@@ -403,14 +403,7 @@ def report_html(
                               div_id="fm2uav-scene")
     div_prof = prof.to_html(full_html=False, include_plotlyjs=False, config=_CONFIG,
                             div_id="fm2uav-profiles")
-    world_rows = {"world": "none given (paths only)"} if world is None else {
-        "name": getattr(world, "name", "") or "-",
-        "grid (nodes)": " x ".join(str(n) for n in world.shape),
-        "spacing [m]": world.spacing,
-        "origin [m]": world.origin,
-        "terrain": "yes" if world.terrain is not None else "no",
-        "CRS": world.crs or "none (local anchor)",
-    }
+    world_rows = _world_rows(world)
     tables_html = "".join(_results_table(t, rows) for t, rows in (tables or {}).items())
     data = json.dumps({"paths": {k: int(len(v)) for k, v in P.items()}})
     files_html = "".join(f"<li>{html.escape(f)}</li>" for f in files)
@@ -431,6 +424,20 @@ def report_html(
 <script type="application/json" id="fm2uav-data">{data}</script></footer>
 </body></html>
 """
+
+
+def _world_rows(world: Any) -> dict[str, Any]:
+    """Rows of the report's World table (name, grid, spacing [m], origin [m], terrain, CRS)."""
+    if world is None:
+        return {"world": "none given (paths only)"}
+    return {
+        "name": getattr(world, "name", "") or "-",
+        "grid (nodes)": " x ".join(str(n) for n in world.shape),
+        "spacing [m]": world.spacing,
+        "origin [m]": world.origin,
+        "terrain": "yes" if world.terrain is not None else "no",
+        "CRS": world.crs or "none (local anchor)",
+    }
 
 
 def plan_report(
