@@ -9,13 +9,14 @@ itself when it is made (through :mod:`fm2uav._validate`) and raises
 
 Examples
 --------
->>> from fm2uav import FlightLevel, Shaping
+>>> from fm2uav import FlightLevel, InputError, Shaping
 >>> Shaping(exponent=2.0).exponent
 2.0
->>> FlightLevel(agl=-5)
-Traceback (most recent call last):
-...
-fm2uav.errors.InputError: agl must be a finite number > 0 m, got -5 (mission file: planner.agl; CLI: --agl)
+>>> try:
+...     FlightLevel(agl=-5)
+... except InputError as exc:
+...     print(exc)
+agl must be a finite number > 0 m, got -5 (mission file: planner.agl; CLI: --agl)
 """
 
 from __future__ import annotations
