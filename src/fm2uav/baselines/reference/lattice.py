@@ -128,6 +128,23 @@ def _heading_mask(headings: np.ndarray, value: float | None, what: str) -> np.nd
     return mask
 
 
+def _check_reference_args(world: Any, model: str, xi: float) -> float:
+    """Check the world (2D, square cells), the model and ξ of :func:`reference_path`; the spacing [m]."""
+    if not isinstance(world, World) or world.ndim != 2:
+        raise InputError("reference_path needs a 2D fm2uav.World")
+    h = float(world.spacing[0])
+    if abs(world.spacing[1] - h) > 1e-9 * h:
+        raise InputError(
+            f"reference_path needs the same spacing on x and y, got {world.spacing}; "
+            "resample the map"
+        )
+    if model not in MODELS:
+        raise InputError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
+    if not (np.isfinite(xi) and xi > 0):
+        raise InputError(f"xi must be > 0 metres, got {xi!r}")
+    return h
+
+
 def reference_path(
     world: World,
     start: Any,
@@ -180,18 +197,7 @@ def reference_path(
         Bad model, ξ, headings, or a 3D / anisotropic world.
     """
     t_all = time.perf_counter()
-    if not isinstance(world, World) or world.ndim != 2:
-        raise InputError("reference_path needs a 2D fm2uav.World")
-    h = float(world.spacing[0])
-    if abs(world.spacing[1] - h) > 1e-9 * h:
-        raise InputError(
-            f"reference_path needs the same spacing on x and y, got {world.spacing}; "
-            "resample the map"
-        )
-    if model not in MODELS:
-        raise InputError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
-    if not (np.isfinite(xi) and xi > 0):
-        raise InputError(f"xi must be > 0 metres, got {xi!r}")
+    h = _check_reference_args(world, model, xi)
     sx, sy = _node(world, start, "start")
     gx, gy = _node(world, goal, "goal")
 
