@@ -664,6 +664,21 @@ def _snap(profile: Any, frame: str) -> bool | float:
     return False
 
 
+def _world_warnings(world: Any, opt: ExportOptions, frame: str, has_terrain: bool) -> list[str]:
+    """Warnings about the world the mission is built on (no CRS: made-up relief; no terrain map)."""
+    warnings: list[str] = []
+    if not getattr(world, "crs", None):
+        a = opt.anchor or DEFAULT_ANCHOR
+        warnings.append("synthetic world without CRS: its relief is made up and placed at the "
+                        f"anchor lon {a.lon:g}, lat {a.lat:g}, alt {a.alt:g} m (world.anchor / "
+                        "--anchor): it is not the real terrain there, so the altitudes do not "
+                        "clear the real ground — do not fly this mission as it is")
+    if frame == "terrain" and not has_terrain:
+        warnings.append("frame terrain on a world without a terrain map: altitudes are above "
+                        "the world's flat ground")
+    return warnings
+
+
 def build_mission(
     path_m: Any,
     world: Any,
@@ -720,16 +735,7 @@ def build_mission(
     has_terrain = getattr(world, "terrain", None) is not None
     frame = resolve_frame(opt.frame, opt.firmware, terrain_following=agl is not None,
                           has_terrain=has_terrain)
-    warnings: list[str] = []
-    if not getattr(world, "crs", None):
-        a = opt.anchor or DEFAULT_ANCHOR
-        warnings.append("synthetic world without CRS: its relief is made up and placed at the "
-                        f"anchor lon {a.lon:g}, lat {a.lat:g}, alt {a.alt:g} m (world.anchor / "
-                        "--anchor): it is not the real terrain there, so the altitudes do not "
-                        "clear the real ground — do not fly this mission as it is")
-    if frame == "terrain" and not has_terrain:
-        warnings.append("frame terrain on a world without a terrain map: altitudes are above "
-                        "the world's flat ground")
+    warnings = _world_warnings(world, opt, frame, has_terrain)
     keep, via_idx = _events(p, via, camera, times)
     required = getattr(profile, "required", None)
     if required is not None and np.shape(required) != (len(p),):
