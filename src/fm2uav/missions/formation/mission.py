@@ -267,16 +267,11 @@ def fly_formation(
     check_point(world, maps, goal_m, "goal")
     W_stat = [maps.speed(lv) for lv in levels]
     t1 = time.perf_counter()
-    leader_plan = plan(world, start_m, goal_m,
-                       options=dataclasses.replace(options, speed_map=W_stat[0]))
-    fshape = formation_shape(cfg.shape, cfg.n_followers)
-    guide = LeaderGuide(leader_plan.path, maps, fshape, cfg.dist, cfg.grey_reference, cfg.grey,
-                        levels[1:])
+    leader_plan, fshape, guide = _leader(world, start_m, goal_m, options, W_stat[0], maps, cfg,
+                                         levels)
     t2 = time.perf_counter()
 
-    heading0 = guide.heading(0.0, np.array([1.0, 0.0]))
-    if not np.all(np.isfinite(heading0)):
-        heading0 = np.array([1.0, 0.0])
+    heading0 = _start_heading(guide)
     pos = place_starts(guide, start_m, heading0, follower_starts, cfg.dist)
     names = ("leader",) + tuple(f"follower {j + 1}" for j in range(fshape.n_followers))
     check_separation(pos, names, cfg.dist)
@@ -290,6 +285,26 @@ def fly_formation(
     return _result(world, log, names, guide, leader_plan, fshape, cfg, levels, shaping, options,
                    cs, timings={"static_maps": t1 - t0, "leader_plan": t2 - t1,
                                 "cycles": t3 - t_loop, "total": t_all})
+
+
+def _leader(world: World, start_m: np.ndarray, goal_m: np.ndarray, options: PlanOptions,
+            W_leader: np.ndarray, maps: StaticMaps, cfg: FormationConfig,
+            levels: Sequence[FlightLevel | None]) -> tuple[Any, Any, LeaderGuide]:
+    """The leader's FM² plan on its static map ``W_leader``, the formation shape and the guide."""
+    leader_plan = plan(world, start_m, goal_m,
+                       options=dataclasses.replace(options, speed_map=W_leader))
+    fshape = formation_shape(cfg.shape, cfg.n_followers)
+    guide = LeaderGuide(leader_plan.path, maps, fshape, cfg.dist, cfg.grey_reference, cfg.grey,
+                        levels[1:])
+    return leader_plan, fshape, guide
+
+
+def _start_heading(guide: LeaderGuide) -> np.ndarray:
+    """The leader's horizontal unit heading at the start (+x where the path gives none)."""
+    heading0 = guide.heading(0.0, np.array([1.0, 0.0]))
+    if not np.all(np.isfinite(heading0)):
+        heading0 = np.array([1.0, 0.0])
+    return heading0
 
 
 def _check_world_and_points(world: Any, start: Any, goal: Any) -> tuple[np.ndarray, np.ndarray]:
