@@ -114,6 +114,37 @@ class TuneResult:
             )
         return "\n".join(out)
 
+    def markdown(self, title: str) -> str:
+        """The tuning report (``tune_table.md``): the Pareto front and every candidate.
+
+        ``title`` is the heading's text, e.g. ``"Auto-tuning — open-field, agl 150 m"``.
+        """
+        md = [f"# {title}", "",
+              "## Pareto front (deviation ↓, max climb ↓, min turn radius ↑)", "",
+              self.table(), "", "## All candidates", "", self.table(self.rows), ""]
+        if self.best is None:
+            md.insert(2, "**No candidate keeps the limits**; the Pareto front shows the closest.\n")
+        return "\n".join(md)
+
+    def payload(self) -> dict[str, Any]:
+        """JSON-ready result (``tune.json``): limits [deg, m], best row, Pareto front, rows."""
+        return {"limits": {"max_climb_deg": round(self.limits.max_climb_deg, 9),
+                           "min_turn_radius_m": self.limits.min_turn_radius},
+                "best": self.best, "pareto": self.pareto, "rows": self.rows}
+
+    def summary_rows(self) -> dict[str, Any]:
+        """Printable ``{label: value}`` rows of the result (what ``fm2uav tune`` prints)."""
+        b = self.best
+        return {
+            "candidates": len(self.rows),
+            "feasible": sum(r["feasible"] for r in self.rows),
+            "best": ("none keeps the limits" if b is None else
+                     f"p1={b['p1']:g} p2={b['p2']:g} α={b['saturation']:g} β={b['exponent']:g}: "
+                     f"mean|dev| {b['deviation_m']:.1f} m, max climb {b['climb_max_deg']:.1f}°, "
+                     f"min turn radius {b['min_turn_radius_m']:.0f} m"),
+            "pareto front": len(self.pareto),
+        }
+
 
 def _pareto(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     ok = [r for r in rows if r["error"] is None]

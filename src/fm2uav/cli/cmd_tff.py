@@ -194,8 +194,8 @@ def tune_cmd(
 ) -> None:
     """``fm2uav tune``: parse, :func:`~fm2uav.analysis.tune.tune`, write, print."""
     from ..analysis.tune import tune
-    from ..vehicles import AirframeLimits
     from ..planning import FlightLevel
+    from ..vehicles import AirframeLimits
     from ..world.load import world_summary
 
     grid = _grid(p1=p1, p2=p2, saturation=saturation, exponent=exponent)
@@ -217,42 +217,15 @@ def tune_cmd(
         step(f"planning {n * len(grid['saturation']) * len(grid['exponent'])} candidates")
         res = tune(sc.world, s, g, limits, FlightLevel(agl=agl), grid=grid)
     _write_tune_best(outdir, res, w, agl)
-    write_text(outdir, "tune_table.md", _tune_markdown(
-        res, f"Auto-tuning — {scenario}, agl {agl:g} m, max climb {max_climb:g}°, "
+    write_text(outdir, "tune_table.md", res.markdown(
+        f"Auto-tuning — {scenario}, agl {agl:g} m, max climb {max_climb:g}°, "
         f"min turn radius {min_turn_radius:g} m"))
-    payload = {"scenario": scenario, "world": world_summary(w), "agl_m": agl,
-               "limits": {"max_climb_deg": round(limits.max_climb_deg, 9),
-                          "min_turn_radius_m": limits.min_turn_radius}, "best": res.best, "pareto": res.pareto,
-               "rows": res.rows}
+    payload = {"scenario": scenario, "world": world_summary(w), "agl_m": agl, **res.payload()}
     write_json(outdir, "tune.json", payload)
     if output.report:
         _write_tune_report(outdir, res, sc, s, g, agl=agl, scenario=scenario, limits=limits,
                            grid=grid)
-    output.summary("Auto-tuning", {**_tune_rows(res), **world_rows(w)}, payload)
-
-
-def _tune_markdown(res, title: str) -> str:
-    """tune_table.md: the Pareto front and all candidates."""
-    md = [f"# {title}", "",
-          "## Pareto front (deviation ↓, max climb ↓, min turn radius ↑)", "",
-          res.table(), "", "## All candidates", "", res.table(res.rows), ""]
-    if res.best is None:
-        md.insert(2, "**No candidate keeps the limits**; the Pareto front shows the closest.\n")
-    return "\n".join(md)
-
-
-def _tune_rows(res) -> dict:
-    """The printed summary of ``fm2uav tune`` (without the world rows)."""
-    b = res.best
-    return {
-        "candidates": len(res.rows),
-        "feasible": sum(r["feasible"] for r in res.rows),
-        "best": ("none keeps the limits" if b is None else
-                 f"p1={b['p1']:g} p2={b['p2']:g} α={b['saturation']:g} β={b['exponent']:g}: "
-                 f"mean|dev| {b['deviation_m']:.1f} m, max climb {b['climb_max_deg']:.1f}°, "
-                 f"min turn radius {b['min_turn_radius_m']:.0f} m"),
-        "pareto front": len(res.pareto),
-    }
+    output.summary("Auto-tuning", {**res.summary_rows(), **world_rows(w)}, payload)
 
 
 def _write_tune_best(outdir: OutputDir, res, world, agl: float) -> None:
