@@ -268,6 +268,45 @@ def _where(s: float, xy: np.ndarray | None, i: int) -> str:
     return f"at {s:.0f} m along the route (x = {xy[i, 0]:.1f}, y = {xy[i, 1]:.1f} m)"
 
 
+def _cone_interval(z_end: float, ground_end: float, dist: np.ndarray, up: float, down: float,
+                   where: str, lim: FlightLevel, smax: np.ndarray, lo_x: np.ndarray,
+                   ceil: np.ndarray) -> tuple[float, float, float]:
+    """Heights [m] at an end point from which its cone keeps the profile within floor and ceiling.
+
+    The cone is ``z_end + up*dist`` (above) / ``z_end - down*dist`` (below), ``dist``
+    the horizontal distance [m] of each sample from the end. Returns the lowest and
+    highest admissible height and the height above the surface kept near it.
+    """
+    own = max(z_end - ground_end, 0.0)
+    keep = lim.min_agl if lim.min_agl is not None else min(lim.agl - lim.tolerance, own)
+    low = np.maximum(smax + keep, lo_x)
+    need_lo = float(np.max(low - up * dist))
+    need_hi = float(np.min(ceil + down * dist))
+    if need_lo > need_hi + 1e-6:
+        raise PlanningError(
+            f"the {where} cannot be joined to the route within the altitude limits "
+            f"(needs {need_lo:.1f} m, ceiling allows {need_hi:.1f} m); move the {where} or "
+            "raise planner.max_agl (--max-agl)")
+    return need_lo, need_hi, keep
+
+
+def _phases(z: np.ndarray, cruise_z: np.ndarray, rel: np.ndarray, total: float) -> np.ndarray:
+    """Phase of each sample: ``climb-out`` before the profile first meets the cruise, ``descent``
+    after it last leaves it, ``cruise`` between (split at half way when it never meets it)."""
+    m = len(z)
+    on = np.abs(z - cruise_z) <= 1e-6
+    phase = np.full(m, "cruise", dtype=object)
+    if on.any():
+        i0, i1 = int(np.argmax(on)), int(m - 1 - np.argmax(on[::-1]))
+        phase[:i0] = "climb-out"
+        phase[i1 + 1:] = "descent"
+    else:  # the cones never let the profile reach the cruise: all transition
+        half = int(np.searchsorted(rel, total / 2.0))
+        phase[:half] = "climb-out"
+        phase[half:] = "descent"
+    return phase.astype(str)
+
+
 def solve_profile(
     s: Any,
     surf_max: Any,
@@ -330,8 +369,7 @@ def solve_profile(
     up_x = np.full(m, np.inf) if extra_upper is None else np.asarray(extra_upper, dtype=float)
     target = np.maximum(smax + lim.agl, lo_x)
     floor = np.maximum(smax + floor_agl(lim), lo_x)
-    ceil = np.minimum(gmin + (np.inf if lim.max_agl is None else float(lim.max_agl)), up_x)
-    ceil = np.minimum(ceil, top)
+    ceil = np.minimum(np.minimum(gmin + (np.inf if lim.max_agl is None else float(lim.max_agl)), up_x), top)
     a = envelope_above(s, floor, tc, td)
     c = envelope_below(s, ceil, tc, td)
     bad = np.flatnonzero(a > c + 1e-6)
@@ -348,27 +386,11 @@ def solve_profile(
 
     total = float(s[-1] - s[0])
     rel = s - s[0]
-
-    def cone_interval(z_end: float, ground_end: float, dist: np.ndarray, up: float,
-                      down: float, where: str) -> tuple[float, float]:
-        # heights at the end point from which the cone z_end + up*dist (above) /
-        # z_end - down*dist (below) keeps the profile within its floor and ceiling
-        own = max(z_end - ground_end, 0.0)
-        keep = lim.min_agl if lim.min_agl is not None else min(lim.agl - lim.tolerance, own)
-        low = np.maximum(smax + keep, lo_x)
-        need_lo = float(np.max(low - up * dist))
-        need_hi = float(np.min(ceil + down * dist))
-        if need_lo > need_hi + 1e-6:
-            raise PlanningError(
-                f"the {where} cannot be joined to the route within the altitude limits "
-                f"(needs {need_lo:.1f} m, ceiling allows {need_hi:.1f} m); move the {where} or "
-                "raise planner.max_agl (--max-agl)")
-        return need_lo, need_hi, keep
-
+    bounds = (lim, smax, lo_x, ceil)
     # start cone: going forward z rises at most tc and drops at most td per metre
-    lo_s, hi_s, keep_s = cone_interval(z_start, ground_start, rel, tc, td, "start")
+    lo_s, hi_s, keep_s = _cone_interval(z_start, ground_start, rel, tc, td, "start", *bounds)
     zs = min(max(z_start, lo_s), hi_s)
-    lo_g, hi_g, keep_g = cone_interval(z_goal, ground_goal, total - rel, td, tc, "goal")
+    lo_g, hi_g, keep_g = _cone_interval(z_goal, ground_goal, total - rel, td, tc, "goal", *bounds)
     # the goal's effective height must also be reachable from the start's
     lo_g, hi_g = max(lo_g, zs - td * total), min(hi_g, zs + tc * total)
     if lo_g > hi_g + 1e-6:
@@ -380,21 +402,56 @@ def solve_profile(
     lo = np.maximum(zs - td * rel, zg - tc * (total - rel))
     hi = np.minimum(zs + tc * rel, zg + td * (total - rel))
     z = np.minimum(np.maximum(cruise_z, lo), hi)
-    on = np.abs(z - cruise_z) <= 1e-6
-    phase = np.full(m, "cruise", dtype=object)
-    if on.any():
-        i0, i1 = int(np.argmax(on)), int(m - 1 - np.argmax(on[::-1]))
-        phase[:i0] = "climb-out"
-        phase[i1 + 1:] = "descent"
-    else:  # the cones never let the profile reach the cruise: all transition
-        half = int(np.searchsorted(rel, total / 2.0))
-        phase[:half] = "climb-out"
-        phase[half:] = "descent"
-    phase = phase.astype(str)
+    phase = _phases(z, cruise_z, rel, total)
     required = np.where(phase == "cruise", floor_agl(lim),
                         np.where(phase == "climb-out", keep_s, keep_g)).astype(float)
     return {"z": z, "cruise_z": cruise_z, "z_start_eff": zs, "z_goal_eff": zg,
             "phase": phase, "required": required, "lifted_m": lifted}
+
+
+def _check_ends_below_ceiling(world: Any, p: np.ndarray, level: FlightLevel) -> None:
+    """Refuse a start / goal of path ``p`` higher above the ground than ``level.max_agl`` [m]."""
+    for what, q in (("start", p[0]), ("goal", p[-1])):
+        above = float(q[2] - world.ground_height(q[0], q[1]))
+        if above > level.max_agl + 1e-6:
+            raise PointError(
+                f"the {what} is {above:.1f} m above the ground, above planner.max_agl = "
+                f"{level.max_agl:g} m (CLI --max-agl); give the {what} at most "
+                f"{level.max_agl:g} m above the ground (e.g. {what}: {{..., agl: "
+                f"{min(level.agl, level.max_agl):g}}}) or raise --max-agl")
+
+
+def _surface_envelope(world: Any, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Surface at the route samples ``xy`` [m]; its upper and the ground's lower envelope.
+
+    The chord between two samples is flown straight: it is read at 1/4, 1/2, 3/4.
+    Returns the surface height at the samples, the highest surface and the lowest
+    ground over each sample's two chords [m].
+    """
+    fr = np.array([0.25, 0.5, 0.75])
+    inner = (xy[:-1, None, :] + fr[None, :, None] * (xy[1:] - xy[:-1])[:, None, :]).reshape(-1, 2)
+
+    def surf(q: np.ndarray) -> np.ndarray:
+        return np.asarray(world.surface_height(q[:, 0], q[:, 1]), dtype=float)
+
+    def grnd(q: np.ndarray) -> np.ndarray:
+        return np.asarray(world.ground_height(q[:, 0], q[:, 1]), dtype=float)
+
+    s_at, g_at = surf(xy), grnd(xy)
+    n_ch = len(xy) - 1
+    # z is linear along a chord, so only the surface's departure from its own chord
+    # between two samples matters: bump (above the chord) for the floor, dip (below
+    # it) for the ceiling; each sample takes the larger of its two chords
+    if n_ch:
+        lin_s = s_at[:-1, None] + fr[None, :] * (s_at[1:] - s_at[:-1])[:, None]
+        lin_g = g_at[:-1, None] + fr[None, :] * (g_at[1:] - g_at[:-1])[:, None]
+        bump = np.maximum((surf(inner).reshape(n_ch, 3) - lin_s).max(axis=1), 0.0)
+        dip = np.maximum((lin_g - grnd(inner).reshape(n_ch, 3)).max(axis=1), 0.0)
+    else:
+        bump = dip = np.zeros(0)
+    smax = s_at + _window(np.zeros(len(xy)), bump, np.maximum)
+    gmin = g_at - _window(np.zeros(len(xy)), dip, np.maximum)
+    return s_at, smax, gmin
 
 
 def final_profile(world: Any, path: Any, level: FlightLevel, *, ds: float | None = None
@@ -432,40 +489,10 @@ def final_profile(world: Any, path: Any, level: FlightLevel, *, ds: float | None
     if ds is None:
         ds = sampling_step(world)
     if level.max_agl is not None:  # the take-off / landing points must be legal too
-        for what, q in (("start", p[0]), ("goal", p[-1])):
-            above = float(q[2] - world.ground_height(q[0], q[1]))
-            if above > level.max_agl + 1e-6:
-                raise PointError(
-                    f"the {what} is {above:.1f} m above the ground, above planner.max_agl = "
-                    f"{level.max_agl:g} m (CLI --max-agl); give the {what} at most "
-                    f"{level.max_agl:g} m above the ground (e.g. {what}: {{..., agl: "
-                    f"{min(level.agl, level.max_agl):g}}}) or raise --max-agl")
+        _check_ends_below_ceiling(world, p, level)
     xy, s = resample_route(p, ds)
     mids = 0.5 * (xy[:-1] + xy[1:])
-    # the chord between two samples is flown straight: read it at 1/4, 1/2, 3/4
-    fr = np.array([0.25, 0.5, 0.75])
-    inner = (xy[:-1, None, :] + fr[None, :, None] * (xy[1:] - xy[:-1])[:, None, :]).reshape(-1, 2)
-
-    def surf(q: np.ndarray) -> np.ndarray:
-        return np.asarray(world.surface_height(q[:, 0], q[:, 1]), dtype=float)
-
-    def grnd(q: np.ndarray) -> np.ndarray:
-        return np.asarray(world.ground_height(q[:, 0], q[:, 1]), dtype=float)
-
-    s_at, g_at = surf(xy), grnd(xy)
-    n_ch = len(xy) - 1
-    # z is linear along a chord, so only the surface's departure from its own chord
-    # between two samples matters: bump (above the chord) for the floor, dip (below
-    # it) for the ceiling; each sample takes the larger of its two chords
-    if n_ch:
-        lin_s = s_at[:-1, None] + fr[None, :] * (s_at[1:] - s_at[:-1])[:, None]
-        lin_g = g_at[:-1, None] + fr[None, :] * (g_at[1:] - g_at[:-1])[:, None]
-        bump = np.maximum((surf(inner).reshape(n_ch, 3) - lin_s).max(axis=1), 0.0)
-        dip = np.maximum((lin_g - grnd(inner).reshape(n_ch, 3)).max(axis=1), 0.0)
-    else:
-        bump = dip = np.zeros(0)
-    smax = s_at + _window(np.zeros(len(xy)), bump, np.maximum)
-    gmin = g_at - _window(np.zeros(len(xy)), dip, np.maximum)
+    s_at, smax, gmin = _surface_envelope(world, xy)
     # the FM² route's own height at each sample (chooses over/under a zone)
     cum = arc_length(p[:, :2])  # horizontal distance along the route
     z_route = np.interp(s, cum, p[:, 2]) if cum[-1] > 0 else np.full(len(s), p[0, 2])
