@@ -293,6 +293,47 @@ def min_clearance(world: World, path: np.ndarray) -> float:
     return float(clearance_profile(world, path).min())
 
 
+def _best_paths(world: World, starts: np.ndarray, goals: np.ndarray,
+                references: Mapping[tuple[int, str], Mapping[str, Any]], model: str,
+                best: Mapping[str, Any], order: int) -> list[tuple[np.ndarray, np.ndarray] | None]:
+    """Per pair, ``(fm2_path, ref_path)`` [m] at the best (α, β); None without a reference or plan."""
+    pairs: list[tuple[np.ndarray, np.ndarray] | None] = []
+    for k in range(len(starts)):
+        ref = references.get((k, model), {})
+        if ref.get("error", "x") or "path" not in ref:
+            pairs.append(None)
+            continue
+        try:
+            p = plan(world, starts[k], goals[k],
+                     shaping=Shaping(saturation=best["alpha"], exponent=best["beta"]),
+                     options=PlanOptions(order=order))
+        except Fm2uavError:
+            pairs.append(None)
+            continue
+        pairs.append((p.path, np.asarray(ref["path"])))
+    return pairs
+
+
+def _timing_table(columns: Mapping[str, np.ndarray], models: Sequence[str],
+                  references: Mapping[tuple[int, str], Mapping[str, Any]],
+                  n_pairs: int) -> dict[str, Any]:
+    """Table 1: total reference search time [s] per model, FM²'s (sum of per-pair medians), ratios."""
+    fm2_t = 0.0
+    ok = np.asarray(columns["status"]) == "ok"
+    for k in range(n_pairs):
+        sel = ok & (np.asarray(columns["pair"]) == k)
+        if sel.any():
+            fm2_t += float(np.median(np.asarray(columns["fm2_time_s"])[sel]))
+    timing: dict[str, Any] = {"fm2_s": fm2_t, "pairs": n_pairs}
+    for model in models:
+        ts = [references[(k, model)].get("time_s", np.nan) for k in range(n_pairs)
+              if (k, model) in references]
+        t = float(np.nansum(ts)) if ts else float("nan")
+        timing[f"{model}_s"] = t
+        timing[f"{model}_ratio"] = t / fm2_t if fm2_t > 0 else float("nan")
+    return timing
+
+
 def summarise_sweep(
     world: World,
     starts: np.ndarray,
@@ -348,20 +389,7 @@ def summarise_sweep(
             out["best"][metric][model] = best
             out["near_best"][metric][model] = near
             out["valley"][metric][model] = valley(m, alphas, betas)
-            pairs = []
-            for k in range(n_pairs):
-                ref = references.get((k, model), {})
-                if ref.get("error", "x") or "path" not in ref:
-                    pairs.append(None)
-                    continue
-                try:
-                    p = plan(world, starts[k], goals[k],
-                             shaping=Shaping(saturation=best["alpha"], exponent=best["beta"]),
-                             options=PlanOptions(order=order))
-                except Fm2uavError:
-                    pairs.append(None)
-                    continue
-                pairs.append((p.path, np.asarray(ref["path"])))
+            pairs = _best_paths(world, starts, goals, references, model, best, order)
             out["paths"][metric][model] = pairs
             first = next((pp for pp in pairs if pp is not None), None)
             if first is not None:
@@ -370,21 +398,7 @@ def summarise_sweep(
                     "fm2": curvature_profile(first[0], ds=ds),
                 }
 
-    # Table 1: timings
-    fm2_t = 0.0
-    ok = np.asarray(columns["status"]) == "ok"
-    for k in range(n_pairs):
-        sel = ok & (np.asarray(columns["pair"]) == k)
-        if sel.any():
-            fm2_t += float(np.median(np.asarray(columns["fm2_time_s"])[sel]))
-    timing: dict[str, Any] = {"fm2_s": fm2_t, "pairs": n_pairs}
-    for model in models:
-        ts = [references[(k, model)].get("time_s", np.nan) for k in range(n_pairs)
-              if (k, model) in references]
-        t = float(np.nansum(ts)) if ts else float("nan")
-        timing[f"{model}_s"] = t
-        timing[f"{model}_ratio"] = t / fm2_t if fm2_t > 0 else float("nan")
-    out["timing"] = timing
+    out["timing"] = _timing_table(columns, models, references, n_pairs)
 
     # Table 4: clearance at the best area match
     clear: dict[str, Any] = {}
