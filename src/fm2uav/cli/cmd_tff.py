@@ -81,9 +81,15 @@ def _write_tune_report(outdir: OutputDir, res, sc, s, g, *, agl: float, scenario
         label = (f"closest (breaks the limits): p1={row['p1']:g}, p2={row['p2']:g}, "
                  f"α={row['saturation']:g}")
     m = tff_metrics(p, agl)
+    from ..analysis.flight_level import flight_level_deviation
+
+    # the report's table has the reproduce-tff columns, incl. the flown path's share on the
+    # level (missing: `tune --report` ended in KeyError 'flown_within_all', exit 70)
     m.update(case=label, level=round(agl / sc.world.spacing[2], 2), agl_m=agl,
              p1=row["p1"], p2=row["p2"], diff=row["p2"] - row["p1"],
-             transitions=f"{m['start_transition_m']:.0f}/{m['end_transition_m']:.0f}")
+             transitions=f"{m['start_transition_m']:.0f}/{m['end_transition_m']:.0f}",
+             flown_within_all=flight_level_deviation(sc.world, p.path, agl).within_all,
+             plan_s=float(p.timings.get("total", float("nan"))))
     keys = ("p1", "p2", "saturation", "exponent", "deviation_m", "within", "climb_max_deg",
             "min_turn_radius_m", "length_m", "feasible")
     pareto = [{k: (round(r[k], 3) if isinstance(r[k], float) else r[k]) for k in keys}
