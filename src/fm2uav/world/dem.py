@@ -396,6 +396,57 @@ def _no_overlap(bbox: Any, crs: Any, bounds: tuple[float, float, float, float]) 
             "world.bbox (CLI --bbox W,S,E,N, lon/lat)")
 
 
+def _read_array(source: Any, crs: Any, transform: Any, bounds: Any, nodata: float | None,
+                ) -> tuple[np.ndarray, Any, Any, str | None, str]:
+    """Elevations [m] of an in-memory DEM, its pixel transform, horizontal CRS, vertical CRS, note."""
+    try:
+        z = np.array(source, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(
+            f"DEM must be a raster file path (or a list of tiles) or a 2D array of "
+            f"elevations, got {type(source).__name__}") from None
+    if z.ndim != 2:
+        raise InputError(f"DEM array must be 2D (rows, cols), got shape {z.shape}")
+    if transform is not None:
+        t = _affine(transform)
+    elif bounds is not None:
+        w, s, e, n = (float(v) for v in bounds)
+        if not (e > w and n > s):
+            raise InputError(f"bounds must be (west, south, east, north) with east > west "
+                             f"and north > south, got {bounds!r}")
+        t = ((e - w) / z.shape[1], 0.0, w, 0.0, -(n - s) / z.shape[0], n)
+    else:
+        raise InputError("a DEM array needs transform= or bounds= to place it")
+    if crs is None:
+        raise WorldError(
+            "the DEM has no coordinate reference system; pass crs= (e.g. crs='EPSG:4326' "
+            "for longitude/latitude degrees or the EPSG code of its projection)")
+    h_crs, vname, vfactor = _split_crs(crs)
+    z = z.copy()
+    if nodata is not None and np.isfinite(nodata):
+        z[z == nodata] = np.nan
+    z = z * vfactor
+    return z, t, h_crs, vname, _vertical_note("")
+
+
+def _corners(t: tuple[float, ...], shape: tuple[int, int], h_crs: Any,
+             ) -> tuple[tuple[float, ...], np.ndarray, np.ndarray]:
+    """The raster's corner x and y in its CRS; a lon/lat raster east of 180° shifted to -180..180.
+
+    Returns the (possibly shifted) transform and the corners' x and y.
+    """
+    a, b, c, d, e, f = t
+    rows, cols = shape
+    xs = np.array([c, c + a * cols + b * rows, c + a * cols, c + b * rows])
+    ys = np.array([f, f + d * cols + e * rows, f + d * cols, f + e * rows])
+    if h_crs.is_geographic and xs.min() >= 180.0:
+        # a raster in longitudes 0..360 lying east of the antimeridian: -180..180
+        c -= 360.0
+        xs -= 360.0
+        t = (a, b, c, d, e, f)
+    return t, xs, ys
+
+
 def read_dem(
     source: Any,
     *,
@@ -454,34 +505,7 @@ def read_dem(
             t = _affine(transform)
         where = f"the DEM {paths[0]}" + (f" (+{len(paths) - 1} tiles)" if len(paths) > 1 else "")
     else:
-        try:
-            z = np.array(source, dtype=float)
-        except (TypeError, ValueError):
-            raise InputError(
-                f"DEM must be a raster file path (or a list of tiles) or a 2D array of "
-                f"elevations, got {type(source).__name__}") from None
-        if z.ndim != 2:
-            raise InputError(f"DEM array must be 2D (rows, cols), got shape {z.shape}")
-        if transform is not None:
-            t = _affine(transform)
-        elif bounds is not None:
-            w, s, e, n = (float(v) for v in bounds)
-            if not (e > w and n > s):
-                raise InputError(f"bounds must be (west, south, east, north) with east > west "
-                                 f"and north > south, got {bounds!r}")
-            t = ((e - w) / z.shape[1], 0.0, w, 0.0, -(n - s) / z.shape[0], n)
-        else:
-            raise InputError("a DEM array needs transform= or bounds= to place it")
-        if crs is None:
-            raise WorldError(
-                "the DEM has no coordinate reference system; pass crs= (e.g. crs='EPSG:4326' "
-                "for longitude/latitude degrees or the EPSG code of its projection)")
-        h_crs, vname, vfactor = _split_crs(crs)
-        z = z.copy()
-        if nodata is not None and np.isfinite(nodata):
-            z[z == nodata] = np.nan
-        z = z * vfactor
-        note = _vertical_note("")
+        z, t, h_crs, vname, note = _read_array(source, crs, transform, bounds, nodata)
         where = "the DEM array"
     if z.size < 4 or min(z.shape) < 2:
         raise InputError(f"DEM must have at least 2 x 2 pixels, got {z.shape}")
@@ -490,15 +514,7 @@ def read_dem(
     if not np.isfinite(z).any():
         raise WorldError(f"{where} has no valid elevation (every pixel is nodata) in the area read; "
                          "check the file, world.nodata_value and world.bbox")
-    a, b, c, d, e, f = t
-    rows, cols = z.shape
-    xs = np.array([c, c + a * cols + b * rows, c + a * cols, c + b * rows])
-    ys = np.array([f, f + d * cols + e * rows, f + d * cols, f + e * rows])
-    if h_crs.is_geographic and xs.min() >= 180.0:
-        # a raster in longitudes 0..360 lying east of the antimeridian: -180..180
-        c -= 360.0
-        xs -= 360.0
-        t = (a, b, c, d, e, f)
+    t, xs, ys = _corners(t, z.shape, h_crs)
     if h_crs.is_geographic and xs.min() < 180.0 < xs.max():
         raise WorldError(
             f"{where} crosses the antimeridian (longitudes {xs.min():g}..{xs.max():g}); crop it "
