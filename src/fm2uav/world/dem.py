@@ -256,8 +256,6 @@ def _read_files(paths: list[Path], crs: Any, nodata: float | None,
                 ) -> tuple[np.ndarray, tuple[float, ...], Any, str | None, str, list[SourceFile]]:
     import rasterio
     from rasterio.errors import RasterioIOError
-    from rasterio.merge import merge
-    from rasterio.windows import Window, from_bounds
 
     datasets = []
     try:
@@ -272,24 +270,7 @@ def _read_files(paths: list[Path], crs: Any, nodata: float | None,
                 datasets.append(rasterio.open(p))
             except RasterioIOError as exc:
                 raise InputError(f"cannot read the DEM {str(p)!r}: {exc}") from None
-        crss = []
-        for p, ds in zip(paths, datasets):
-            if ds.crs is None and crs is None:
-                raise WorldError(
-                    f"the DEM {p} has no coordinate reference system; give it with {_CRS_HINT} "
-                    "(e.g. EPSG:4326 for lon/lat degrees) or assign one "
-                    "(gdal_edit.py -a_srs EPSG:32630 FILE)")
-            if ds.crs is not None and crs is not None and not parse_crs(
-                    ds.crs.to_wkt()).equals(parse_crs(crs), ignore_axis_order=True):
-                raise WorldError(
-                    f"the DEM {p} declares its CRS {crs_label(ds.crs.to_wkt())}, but {_CRS_HINT} "
-                    f"says {crs_label(crs)}; remove world.crs / --crs (it is only for files "
-                    "that declare none) or fix the file")
-            crss.append(parse_crs(ds.crs.to_wkt()) if ds.crs is not None else parse_crs(crs))
-        if any(not c.equals(crss[0], ignore_axis_order=True) for c in crss[1:]):
-            raise WorldError(
-                f"the DEM tiles are in different CRSs ({', '.join(sorted({crs_label(c) for c in crss}))}); "
-                "reproject them to one CRS first (gdalwarp -t_srs EPSG:4326 ...) or build a VRT")
+        crss = _tile_crss(paths, datasets, crs)
         scales = {(float(ds.scales[0] or 1.0), float(ds.offsets[0] or 0.0)) for ds in datasets}
         if len(scales) > 1:
             raise WorldError(
@@ -312,45 +293,9 @@ def _read_files(paths: list[Path], crs: Any, nodata: float | None,
             res = max(abs(first.transform.a), abs(first.transform.e))
             window_bounds = (bx[0] - 2 * res, bx[1] - 2 * res, bx[2] + 2 * res, bx[3] + 2 * res)
         if len(datasets) == 1:
-            win = None
-            if window_bounds is not None:
-                full = Window(0, 0, first.width, first.height)
-                w = from_bounds(*window_bounds, transform=first.transform)
-                w = w.round_offsets(op="floor").round_lengths(op="ceil")
-                try:
-                    win = w.intersection(full)
-                except Exception:  # rasterio.errors.WindowError: no overlap
-                    win = None
-                if win is None or win.width < 2 or win.height < 2:
-                    b = first.bounds
-                    raise InputError(_no_overlap(bbox, h_crs, (b.left, b.bottom, b.right, b.top)))
-            try:  # a truncated or corrupt file opens (header) but fails here
-                band = first.read(1, masked=True, window=win, out_dtype="float64")
-                t = first.window_transform(win) if win is not None else first.transform
-                z = np.ma.filled(band, np.nan)
-                z = _apply_alpha(first, z, win)
-            except RasterioIOError as exc:
-                raise InputError(
-                    f"cannot read the pixels of the DEM {str(paths[0])!r} (truncated or corrupt "
-                    f"file: {exc}); check world.dem / --dem, re-download or repair it "
-                    "(gdalinfo -checksum FILE shows the broken blocks)") from None
+            z, t = _read_one(first, paths[0], window_bounds, bbox, h_crs)
         else:
-            kw = {"bounds": window_bounds} if window_bounds is not None else {}
-            try:
-                arr, t = merge(datasets, masked=True, dtype="float64", **kw)
-            except ValueError as exc:
-                raise InputError(f"cannot merge the DEM tiles: {exc}") from None
-            except RasterioIOError as exc:
-                raise InputError(
-                    f"cannot read the pixels of a DEM tile (truncated or corrupt file: {exc}); "
-                    "check world.dem / --dem, re-download or repair it (gdalinfo -checksum "
-                    "FILE shows the broken blocks)") from None
-            z = np.ma.filled(arr[0], np.nan)
-            if window_bounds is not None and not np.isfinite(z).any():
-                lefts = [ds.bounds for ds in datasets]
-                raise InputError(_no_overlap(bbox, h_crs, (
-                    min(b.left for b in lefts), min(b.bottom for b in lefts),
-                    max(b.right for b in lefts), max(b.top for b in lefts))))
+            z, t = _merge_tiles(datasets, window_bounds, bbox, h_crs)
         if nodata is not None and np.isfinite(nodata):
             # an undeclared nodata value, given by the user, compared on the stored numbers
             raw = z
@@ -374,6 +319,85 @@ def _read_files(paths: list[Path], crs: Any, nodata: float | None,
     finally:
         for ds in datasets:
             ds.close()
+
+
+def _tile_crss(paths: list[Path], datasets: list[Any], crs: Any) -> list[Any]:
+    """The horizontal CRS of each DEM tile (its own, else ``crs``); all must agree."""
+    crss = []
+    for p, ds in zip(paths, datasets):
+        if ds.crs is None and crs is None:
+            raise WorldError(
+                f"the DEM {p} has no coordinate reference system; give it with {_CRS_HINT} "
+                "(e.g. EPSG:4326 for lon/lat degrees) or assign one "
+                "(gdal_edit.py -a_srs EPSG:32630 FILE)")
+        if ds.crs is not None and crs is not None and not parse_crs(
+                ds.crs.to_wkt()).equals(parse_crs(crs), ignore_axis_order=True):
+            raise WorldError(
+                f"the DEM {p} declares its CRS {crs_label(ds.crs.to_wkt())}, but {_CRS_HINT} "
+                f"says {crs_label(crs)}; remove world.crs / --crs (it is only for files "
+                "that declare none) or fix the file")
+        crss.append(parse_crs(ds.crs.to_wkt()) if ds.crs is not None else parse_crs(crs))
+    if any(not c.equals(crss[0], ignore_axis_order=True) for c in crss[1:]):
+        raise WorldError(
+            f"the DEM tiles are in different CRSs ({', '.join(sorted({crs_label(c) for c in crss}))}); "
+            "reproject them to one CRS first (gdalwarp -t_srs EPSG:4326 ...) or build a VRT")
+    return crss
+
+
+def _read_one(first: Any, path: Path, window_bounds: tuple[float, ...] | None, bbox: Any,
+              h_crs: Any) -> tuple[np.ndarray, Any]:
+    """Pixels (masked → NaN) and transform of one open DEM, in ``window_bounds`` if given."""
+    from rasterio.errors import RasterioIOError
+    from rasterio.windows import Window, from_bounds
+
+    win = None
+    if window_bounds is not None:
+        full = Window(0, 0, first.width, first.height)
+        w = from_bounds(*window_bounds, transform=first.transform)
+        w = w.round_offsets(op="floor").round_lengths(op="ceil")
+        try:
+            win = w.intersection(full)
+        except Exception:  # rasterio.errors.WindowError: no overlap
+            win = None
+        if win is None or win.width < 2 or win.height < 2:
+            b = first.bounds
+            raise InputError(_no_overlap(bbox, h_crs, (b.left, b.bottom, b.right, b.top)))
+    try:  # a truncated or corrupt file opens (header) but fails here
+        band = first.read(1, masked=True, window=win, out_dtype="float64")
+        t = first.window_transform(win) if win is not None else first.transform
+        z = np.ma.filled(band, np.nan)
+        z = _apply_alpha(first, z, win)
+    except RasterioIOError as exc:
+        raise InputError(
+            f"cannot read the pixels of the DEM {str(path)!r} (truncated or corrupt "
+            f"file: {exc}); check world.dem / --dem, re-download or repair it "
+            "(gdalinfo -checksum FILE shows the broken blocks)") from None
+    return z, t
+
+
+def _merge_tiles(datasets: list[Any], window_bounds: tuple[float, ...] | None, bbox: Any,
+                 h_crs: Any) -> tuple[np.ndarray, Any]:
+    """Pixels (masked → NaN) and transform of several open DEM tiles merged, in ``window_bounds``."""
+    from rasterio.errors import RasterioIOError
+    from rasterio.merge import merge
+
+    kw = {"bounds": window_bounds} if window_bounds is not None else {}
+    try:
+        arr, t = merge(datasets, masked=True, dtype="float64", **kw)
+    except ValueError as exc:
+        raise InputError(f"cannot merge the DEM tiles: {exc}") from None
+    except RasterioIOError as exc:
+        raise InputError(
+            f"cannot read the pixels of a DEM tile (truncated or corrupt file: {exc}); "
+            "check world.dem / --dem, re-download or repair it (gdalinfo -checksum "
+            "FILE shows the broken blocks)") from None
+    z = np.ma.filled(arr[0], np.nan)
+    if window_bounds is not None and not np.isfinite(z).any():
+        lefts = [ds.bounds for ds in datasets]
+        raise InputError(_no_overlap(bbox, h_crs, (
+            min(b.left for b in lefts), min(b.bottom for b in lefts),
+            max(b.right for b in lefts), max(b.top for b in lefts))))
+    return z, t
 
 
 def _apply_alpha(ds: Any, z: np.ndarray, win: Any) -> np.ndarray:
