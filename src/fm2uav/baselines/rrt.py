@@ -28,7 +28,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -94,6 +94,99 @@ class RRTResult:
         }
 
 
+def _check_rrt_args(world: Any, planner: str, smoothing: str, time_limit: float) -> str:
+    """Check the world, planner, smoothing and time budget of :func:`plan_rrt`; the planner key."""
+    if not isinstance(world, World):
+        raise InputError(f"world must be a fm2uav.World, got {type(world).__name__}")
+    key = str(planner).lower().replace("-", "").replace("_", "").replace("*", "star")
+    if key not in RRT_PLANNERS:
+        raise InputError(f"unknown planner {planner!r}; valid: {', '.join(RRT_PLANNERS)}")
+    if smoothing not in ("shortcut", "bspline", "none"):
+        raise InputError(f"smoothing must be 'shortcut', 'bspline' or 'none', got {smoothing!r}")
+    if not (math.isfinite(float(time_limit)) and time_limit > 0):
+        raise InputError(f"time_limit must be > 0 seconds, got {time_limit!r}")
+    return key
+
+
+def _rrt_points(world: World, start: Any, goal: Any) -> dict[str, np.ndarray]:
+    """Start and goal [m] as arrays, checked inside the map and in free space."""
+    nd = world.ndim
+    pts = {}
+    for what, p in (("start", start), ("goal", goal)):
+        arr = np.asarray(p, dtype=float).reshape(-1)
+        if arr.size != nd or not np.all(np.isfinite(arr)):
+            raise InputError(f"{what} must be {nd} finite coordinates in metres, got {p!r}")
+        cell = world.to_cell(arr, what=what)  # PointError outside the map
+        if world.occupancy[cell]:
+            raise PointError(f"{what} {arr.tolist()} m is inside an obstacle (node {list(cell)}); "
+                             f"move the {what} to free space")
+        pts[what] = arr
+    return pts
+
+
+def _validity_checker(world: World) -> Callable[[Any], bool]:
+    """OMPL state validity: inside the map and its nearest node free."""
+    nd = world.ndim
+    occ = world.occupancy
+    org = np.asarray(world.origin)
+    sp = np.asarray(world.spacing)
+    hi_idx = np.asarray(world.shape) - 1
+
+    def valid(state: Any) -> bool:
+        idx = []
+        for k in range(nd):
+            v = (state[k] - org[k]) / sp[k]
+            if v < -1e-9 or v > hi_idx[k] + 1e-9:
+                return False
+            idx.append(int(v + 0.5))
+        return not occ[tuple(idx)]
+
+    return valid
+
+
+def _simple_setup(ob: Any, og: Any, world: World, pts: dict[str, np.ndarray]
+                  ) -> tuple[Any, Any, Callable[[Any], bool]]:
+    """OMPL SimpleSetup on the world's box with its validity checker, start and goal; its space
+    information (collision checks every half cell) and the checker."""
+    nd = world.ndim
+    sp = np.asarray(world.spacing)
+    space = ob.RealVectorStateSpace(nd)
+    bounds = ob.RealVectorBounds(nd)
+    b = world.bounds
+    for k in range(nd):
+        bounds.setLow(k, float(b[k, 0]))
+        bounds.setHigh(k, float(b[k, 1]))
+    space.setBounds(bounds)
+    ss = og.SimpleSetup(space)
+    valid = _validity_checker(world)
+    ss.setStateValidityChecker(valid)
+    si = ss.getSpaceInformation()
+    si.setStateValidityCheckingResolution(0.5 * float(sp.min()) / space.getMaximumExtent())
+    s_state, g_state = space.allocState(), space.allocState()
+    for k in range(nd):
+        s_state[k] = float(pts["start"][k])
+        g_state[k] = float(pts["goal"][k])
+    ss.setStartAndGoalStates(s_state, g_state, 1e-6)
+    return ss, si, valid
+
+
+def _states(path: Any, nd: int) -> np.ndarray:
+    """The states of an OMPL path as an (n, nd) array [m]."""
+    return np.array([[path.getState(i)[k] for k in range(nd)]
+                     for i in range(path.getStateCount())])
+
+
+def _tree_edges(data: Any, nd: int) -> np.ndarray:
+    """The edges of OMPL planner data as an (n, 2, nd) array [m]."""
+    edges = []
+    for i in range(data.numVertices()):
+        a = data.getVertex(i).getState()
+        for j in data.getEdges(i):
+            c = data.getVertex(int(j)).getState()
+            edges.append([[a[k] for k in range(nd)], [c[k] for k in range(nd)]])
+    return np.asarray(edges, dtype=float).reshape(-1, 2, nd)
+
+
 def plan_rrt(
     world: World,
     start: Any,
@@ -141,26 +234,9 @@ def plan_rrt(
     from ompl import geometric as og
     from ompl import util as ou
 
-    if not isinstance(world, World):
-        raise InputError(f"world must be a fm2uav.World, got {type(world).__name__}")
-    key = str(planner).lower().replace("-", "").replace("_", "").replace("*", "star")
-    if key not in RRT_PLANNERS:
-        raise InputError(f"unknown planner {planner!r}; valid: {', '.join(RRT_PLANNERS)}")
-    if smoothing not in ("shortcut", "bspline", "none"):
-        raise InputError(f"smoothing must be 'shortcut', 'bspline' or 'none', got {smoothing!r}")
-    if not (math.isfinite(float(time_limit)) and time_limit > 0):
-        raise InputError(f"time_limit must be > 0 seconds, got {time_limit!r}")
+    key = _check_rrt_args(world, planner, smoothing, time_limit)
     nd = world.ndim
-    pts = {}
-    for what, p in (("start", start), ("goal", goal)):
-        arr = np.asarray(p, dtype=float).reshape(-1)
-        if arr.size != nd or not np.all(np.isfinite(arr)):
-            raise InputError(f"{what} must be {nd} finite coordinates in metres, got {p!r}")
-        cell = world.to_cell(arr, what=what)  # PointError outside the map
-        if world.occupancy[cell]:
-            raise PointError(f"{what} {arr.tolist()} m is inside an obstacle (node {list(cell)}); "
-                             f"move the {what} to free space")
-        pts[what] = arr
+    pts = _rrt_points(world, start, goal)
 
     ou.setLogLevel(ou.LOG_ERROR)
     seeded = False
@@ -169,46 +245,14 @@ def plan_rrt(
         _SEEDED["done"] = True
         seeded = True
 
-    occ = world.occupancy
-    org = np.asarray(world.origin)
     sp = np.asarray(world.spacing)
-    hi_idx = np.asarray(world.shape) - 1
-
-    def valid(state: Any) -> bool:
-        idx = []
-        for k in range(nd):
-            v = (state[k] - org[k]) / sp[k]
-            if v < -1e-9 or v > hi_idx[k] + 1e-9:
-                return False
-            idx.append(int(v + 0.5))
-        return not occ[tuple(idx)]
-
-    space = ob.RealVectorStateSpace(nd)
-    bounds = ob.RealVectorBounds(nd)
-    b = world.bounds
-    for k in range(nd):
-        bounds.setLow(k, float(b[k, 0]))
-        bounds.setHigh(k, float(b[k, 1]))
-    space.setBounds(bounds)
-    ss = og.SimpleSetup(space)
-    ss.setStateValidityChecker(valid)
-    si = ss.getSpaceInformation()
-    si.setStateValidityCheckingResolution(0.5 * float(sp.min()) / space.getMaximumExtent())
-    s_state, g_state = space.allocState(), space.allocState()
-    for k in range(nd):
-        s_state[k] = float(pts["start"][k])
-        g_state[k] = float(pts["goal"][k])
-    ss.setStartAndGoalStates(s_state, g_state, 1e-6)
+    ss, si, valid = _simple_setup(ob, og, world, pts)  # keep the Python callback alive
     pl = getattr(og, RRT_PLANNERS[key])(si)
     if range_m is not None:
         pl.setRange(float(range_m))
     if key != "rrtconnect":
         pl.setGoalBias(float(goal_bias))
     ss.setPlanner(pl)
-
-    def to_array(path: Any) -> np.ndarray:
-        return np.array([[path.getState(i)[k] for k in range(nd)]
-                         for i in range(path.getStateCount())])
 
     t0 = time.perf_counter()
     ss.solve(float(time_limit))
@@ -220,7 +264,7 @@ def plan_rrt(
             "the goal is reachable"
         )
     sol = ss.getSolutionPath()
-    raw = to_array(sol)
+    raw = _states(sol, nd)
     work = og.PathGeometric(sol)
     if smoothing != "none":
         ps = og.PathSimplifier(si)
@@ -228,17 +272,11 @@ def plan_rrt(
         if smoothing == "bspline":
             ps.smoothBSpline(work)
     t2 = time.perf_counter()
-    verts = to_array(work)
+    verts = _states(work, nd)
     verts[0], verts[-1] = pts["start"], pts["goal"]
     data = ob.PlannerData(si)
     pl.getPlannerData(data)
-    edges = []
-    for i in range(data.numVertices()):
-        a = data.getVertex(i).getState()
-        for j in data.getEdges(i):
-            c = data.getVertex(int(j)).getState()
-            edges.append([[a[k] for k in range(nd)], [c[k] for k in range(nd)]])
-    tree = np.asarray(edges, dtype=float).reshape(-1, 2, nd)
+    tree = _tree_edges(data, nd)
     dense, _ = densify(verts, 0.5 * float(sp.min()))
     clearance = float(clearance_profile(world, dense).min())
     # drop OMPL objects (and the Python callback they hold) before returning
