@@ -95,6 +95,7 @@ def test_signal_mid_run_without_previous_set_leaves_nothing(tmp_path):
     assert not out.exists() and not (tmp_path / "sub").exists()
 
 
+@pytest.mark.slow  # subprocesses of a few seconds each
 def test_killed_run_leftovers_are_cleaned_by_the_next_run(tmp_path):
     """SIGKILL cannot be caught: the next run into the folder removes the stale temp set."""
     out = tmp_path / "out"
@@ -110,6 +111,7 @@ def test_killed_run_leftovers_are_cleaned_by_the_next_run(tmp_path):
     assert _leftovers(tmp_path, "out") == []
 
 
+@pytest.mark.slow  # subprocesses of a few seconds each
 def test_two_concurrent_runs_one_is_refused(tmp_path):
     out = tmp_path / "out"
     script = _slow(tmp_path)
@@ -283,6 +285,7 @@ def test_files_written_meanwhile_by_a_library_are_kept(tmp_path):
     assert (out / "cases.jsonl").read_text() == "1\n2\n" and (out / "tables.md").exists()
 
 
+@pytest.mark.slow  # subprocesses of a few seconds each
 def test_real_plan_sigterm_never_leaves_a_mix(tmp_path):
     """The real command, SIGTERM as soon as its set is being written: the old set or the
     complete new one, never a mix, and no temporary folder."""
