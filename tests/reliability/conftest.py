@@ -13,8 +13,10 @@ import pytest
 from hypothesis import HealthCheck, settings
 
 settings.register_profile("reliability", derandomize=True, max_examples=25, deadline=None,
+                          database=None,
                           suppress_health_check=[HealthCheck.too_slow])
 settings.register_profile("slow", derandomize=True, max_examples=400, deadline=None,
+                          database=None,
                           suppress_health_check=[HealthCheck.too_slow])
 settings.load_profile("slow" if os.environ.get("FM2UAV_FUZZ") == "slow" else "reliability")
 
