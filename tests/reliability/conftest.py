@@ -1,7 +1,7 @@
 """Shared pieces of the reliability catalogue (issue 17).
 
-Hypothesis runs derandomized (fixed seed) with few examples by default; set
-``FM2UAV_FUZZ=slow`` for the ``slow`` profile (many more examples).
+Hypothesis runs derandomized (fixed seed) with 25 examples per property by default; set
+``FM2UAV_FUZZ=slow`` for the slow profile (400 examples each).
 """
 
 from __future__ import annotations
@@ -12,13 +12,10 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, settings
 
-settings.register_profile("reliability", derandomize=True, max_examples=25, deadline=None,
-                          database=None,
-                          suppress_health_check=[HealthCheck.too_slow])
-settings.register_profile("slow", derandomize=True, max_examples=400, deadline=None,
-                          database=None,
-                          suppress_health_check=[HealthCheck.too_slow])
-settings.load_profile("slow" if os.environ.get("FM2UAV_FUZZ") == "slow" else "reliability")
+# Applied per test (``@FUZZ``), not loaded as the session's profile: other suites keep theirs.
+FUZZ = settings(derandomize=True, database=None, deadline=None,
+                max_examples=400 if os.environ.get("FM2UAV_FUZZ") == "slow" else 25,
+                suppress_health_check=[HealthCheck.too_slow])
 
 
 def write_dem(path, z, *, x0=500000.0, y0=4500000.0, px=30.0, crs="EPSG:32630", nodata=None,

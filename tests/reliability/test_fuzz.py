@@ -12,6 +12,8 @@ from hypothesis import strategies as st
 from fm2uav import FlightLevel, PlanOptions, Shaping, World, plan
 from fm2uav.errors import Fm2uavError
 
+from .conftest import FUZZ
+
 finite = st.floats(allow_nan=False, allow_infinity=False, width=32)
 anything_number = st.one_of(finite, st.just(float("nan")), st.just(float("inf")),
                             st.just(-float("inf")), st.integers(-10**6, 10**6),
@@ -49,6 +51,7 @@ def _assert_path_free(world, p):
     assert not world.occupancy[tuple(cells.T)].any(), "a path point lies in an obstacle"
 
 
+@FUZZ
 @given(world=worlds2d(), data=st.data(),
        exponent=st.floats(0.05, 10.0), saturation=st.floats(0.01, 1.0),
        order=st.sampled_from([1, 2]), step=st.floats(0.01, 1.0))
@@ -64,6 +67,7 @@ def test_plan_2d_only_fm2uav_errors_and_free_paths(world, data, exponent, satura
     assert np.all(np.isfinite(p.path)) and p.length >= 0
 
 
+@FUZZ
 @given(world=worlds3d(), data=st.data(), exponent=st.floats(0.1, 10.0))
 def test_plan_3d_only_fm2uav_errors_and_free_paths(world, data, exponent):
     start, goal = _point(world, data), _point(world, data)
@@ -74,6 +78,7 @@ def test_plan_3d_only_fm2uav_errors_and_free_paths(world, data, exponent):
     _assert_path_free(world, p)
 
 
+@FUZZ
 @given(start=st.lists(anything_number, min_size=0, max_size=4),
        goal=st.lists(anything_number, min_size=0, max_size=4))
 def test_plan_points_of_any_shape(start, goal):
@@ -84,6 +89,7 @@ def test_plan_points_of_any_shape(start, goal):
         pass
 
 
+@FUZZ
 @given(kw=st.fixed_dictionaries({}, optional={
     "saturation": anything_number, "exponent": anything_number,
     "saturation_distance": anything_number, "method": st.text(max_size=4),
@@ -95,6 +101,7 @@ def test_shaping_any_values(kw):
         pass
 
 
+@FUZZ
 @given(kw=st.fixed_dictionaries({"agl": anything_number}, optional={
     "p1": anything_number, "p2": anything_number, "band": anything_number,
     "graded": anything_number, "mode": st.text(max_size=8), "tolerance": anything_number,
@@ -113,6 +120,7 @@ def polygons(draw):
     return pts
 
 
+@FUZZ
 @given(pts=polygons(), spacing=st.floats(0.01, 5000.0), angle=st.floats(-360.0, 360.0))
 def test_coverage_area_and_spacing(pts, spacing, angle):
     """Any polygon (self-intersecting, degenerate, outside the map) and any band spacing:
@@ -140,6 +148,7 @@ _value = st.recursive(_scalar, lambda c: st.one_of(st.lists(c, max_size=3),
                       max_leaves=8)
 
 
+@FUZZ
 @given(doc=st.dictionaries(_key, _value, max_size=6))
 def test_mission_documents(doc):
     from fm2uav.io.mission import parse_mission
@@ -151,6 +160,7 @@ def test_mission_documents(doc):
         pass
 
 
+@FUZZ
 @given(text=st.text(max_size=80))
 def test_mission_text(tmp_path_factory, text):
     from fm2uav.io.mission import load_mission
@@ -163,6 +173,7 @@ def test_mission_text(tmp_path_factory, text):
         pass
 
 
+@FUZZ
 @given(doc=st.dictionaries(_key, _value, min_size=1, max_size=4), dup=_key)
 def test_duplicate_keys_always_refused(tmp_path_factory, doc, dup):
     """A duplicated top-level key is refused whatever the document holds."""
@@ -194,6 +205,7 @@ def terrain_worlds(draw):
     return World(occ, spacing=(10.0, 10.0, 5.0), terrain=ground * 5.0)
 
 
+@FUZZ
 @given(world=terrain_worlds(), data=st.data(), agl=st.floats(5.0, 60.0),
        p2=st.floats(0.5, 3.0))
 def test_terrain_following_plans_stay_out_of_the_ground(world, data, agl, p2):
