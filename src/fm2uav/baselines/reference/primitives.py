@@ -30,6 +30,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 
@@ -212,6 +213,86 @@ def _sample(theta0, phi1, L1, k1, phi2, L2, k2, dx, dy):
     return xs, ys, th
 
 
+def _candidates(model: str, xi: float, th: np.ndarray, radius: float, r: int, max_turn: float,
+                cone: float) -> dict[str, np.ndarray]:
+    """Cheapest biarc primitive of every admissible (heading i, displacement, heading j).
+
+    Displacements up to ``radius`` [cells]; a candidate turns at most ``max_turn`` and
+    its displacement lies within ``cone`` of both headings [rad]. Returns the arrays
+    ``i``, ``dx``, ``dy``, ``j``, ``cost`` and ``geom`` (phi1, L1, k1, phi2, L2, k2).
+    """
+    K = len(th)
+    disp = np.array(
+        [(a, b) for a in range(-r, r + 1) for b in range(-r, r + 1)
+         if (a or b) and math.hypot(a, b) <= radius + 1e-9],
+        dtype=float,
+    )
+    dang = np.arctan2(disp[:, 1], disp[:, 0])
+    # candidate (i, d, j)
+    I, D, J = np.meshgrid(np.arange(K), np.arange(len(disp)), np.arange(K), indexing="ij")
+    I, D, J = I.ravel(), D.ravel(), J.ravel()
+    keep = (
+        (np.abs(_wrap(th[J] - th[I])) <= max_turn + 1e-9)
+        & (np.abs(_wrap(dang[D] - th[I])) <= cone)
+        & (np.abs(_wrap(dang[D] - th[J])) <= cone)
+    )
+    I, D, J = I[keep], D[keep], J[keep]
+    t0, t1 = th[I][:, None], th[J][:, None]
+    dx, dy = disp[D, 0][:, None], disp[D, 1][:, None]
+    phi1, L1, k1, phi2, L2, k2, ok = biarc(t0, dx, dy, t1, _RATIOS[None, :])
+    cost = np.where(ok, _model_cost(model, L1, k1, L2, k2, xi), np.inf)
+    best = np.argmin(cost, axis=1)
+    rows = np.arange(len(I))
+    c = cost[rows, best]
+    good = np.isfinite(c)
+    sel = rows[good]
+    bsel = best[good]
+    return {
+        "i": I[good], "dx": disp[D[good], 0].astype(np.int64), "dy": disp[D[good], 1].astype(np.int64),
+        "j": J[good], "cost": c[good],
+        "geom": np.stack([phi1[sel, bsel], L1[sel, bsel], k1[sel, bsel],
+                          phi2[sel, bsel], L2[sel, bsel], k2[sel, bsel]], axis=1),
+    }
+
+
+def _with_rotations(prim: dict[str, np.ndarray], th: np.ndarray, xi: float) -> dict[str, np.ndarray]:
+    """``prim`` plus the Reeds–Shepp rotations in place to both neighbouring headings (cost ξ|Δθ|)."""
+    K = len(th)
+    ii = np.concatenate([np.arange(K), np.arange(K)])
+    jj = np.concatenate([(np.arange(K) + 1) % K, (np.arange(K) - 1) % K])
+    dth = _wrap(th[jj] - th[ii])
+    geom = np.zeros((2 * K, 6))
+    geom[:, 0] = dth
+    return {
+        "i": np.concatenate([prim["i"], ii]),
+        "dx": np.concatenate([prim["dx"], np.zeros(2 * K, np.int64)]),
+        "dy": np.concatenate([prim["dy"], np.zeros(2 * K, np.int64)]),
+        "j": np.concatenate([prim["j"], jj]),
+        "cost": np.concatenate([prim["cost"], xi * np.abs(dth)]),
+        "geom": np.concatenate([prim["geom"], geom]),
+    }
+
+
+def _sweeps(prim: dict[str, np.ndarray], th: np.ndarray) -> tuple[list[Any], ...]:
+    """Per primitive: its swept cells (nearest nodes of its samples, start node included) and its
+    sampled points; CSR pointers and parts ``cell_ptr, cell_x, cell_y, pt_ptr, pt_x, pt_y, pt_th``."""
+    cell_ptr, cell_x, cell_y = [0], [], []
+    pt_ptr, pt_x, pt_y, pt_th = [0], [], [], []
+    for n in range(len(prim["i"])):
+        g = prim["geom"][n]
+        xs, ys, ths = _sample(th[prim["i"][n]], *g, float(prim["dx"][n]), float(prim["dy"][n]))
+        pt_x.append(xs)
+        pt_y.append(ys)
+        pt_th.append(ths)
+        pt_ptr.append(pt_ptr[-1] + len(xs))
+        cells = np.unique(np.floor(np.stack([np.append(xs, 0.0), np.append(ys, 0.0)], 1) + 0.5)
+                          .astype(np.int64), axis=0)
+        cell_x.append(cells[:, 0])
+        cell_y.append(cells[:, 1])
+        cell_ptr.append(cell_ptr[-1] + len(cells))
+    return cell_ptr, cell_x, cell_y, pt_ptr, pt_x, pt_y, pt_th
+
+
 @lru_cache(maxsize=16)
 def build_primitives(
     model: str,
@@ -252,72 +333,16 @@ def build_primitives(
     th = lattice_headings(max_int)
     K = len(th)
     r = int(math.floor(radius))
-    disp = np.array(
-        [(a, b) for a in range(-r, r + 1) for b in range(-r, r + 1)
-         if (a or b) and math.hypot(a, b) <= radius + 1e-9],
-        dtype=float,
-    )
-    dang = np.arctan2(disp[:, 1], disp[:, 0])
-    # candidate (i, d, j)
-    I, D, J = np.meshgrid(np.arange(K), np.arange(len(disp)), np.arange(K), indexing="ij")
-    I, D, J = I.ravel(), D.ravel(), J.ravel()
-    keep = (
-        (np.abs(_wrap(th[J] - th[I])) <= max_turn + 1e-9)
-        & (np.abs(_wrap(dang[D] - th[I])) <= cone)
-        & (np.abs(_wrap(dang[D] - th[J])) <= cone)
-    )
-    I, D, J = I[keep], D[keep], J[keep]
-    t0, t1 = th[I][:, None], th[J][:, None]
-    dx, dy = disp[D, 0][:, None], disp[D, 1][:, None]
-    phi1, L1, k1, phi2, L2, k2, ok = biarc(t0, dx, dy, t1, _RATIOS[None, :])
-    cost = np.where(ok, _model_cost(model, L1, k1, L2, k2, xi), np.inf)
-    best = np.argmin(cost, axis=1)
-    rows = np.arange(len(I))
-    c = cost[rows, best]
-    good = np.isfinite(c)
-    sel = rows[good]
-    bsel = best[good]
-    prim = {
-        "i": I[good], "dx": disp[D[good], 0].astype(np.int64), "dy": disp[D[good], 1].astype(np.int64),
-        "j": J[good], "cost": c[good],
-        "geom": np.stack([phi1[sel, bsel], L1[sel, bsel], k1[sel, bsel],
-                          phi2[sel, bsel], L2[sel, bsel], k2[sel, bsel]], axis=1),
-    }
+    prim = _candidates(model, xi, th, radius, r, max_turn, cone)
     if model == "rs":  # rotations in place to the neighbouring headings
-        ii = np.concatenate([np.arange(K), np.arange(K)])
-        jj = np.concatenate([(np.arange(K) + 1) % K, (np.arange(K) - 1) % K])
-        dth = _wrap(th[jj] - th[ii])
-        geom = np.zeros((2 * K, 6))
-        geom[:, 0] = dth
-        prim = {
-            "i": np.concatenate([prim["i"], ii]),
-            "dx": np.concatenate([prim["dx"], np.zeros(2 * K, np.int64)]),
-            "dy": np.concatenate([prim["dy"], np.zeros(2 * K, np.int64)]),
-            "j": np.concatenate([prim["j"], jj]),
-            "cost": np.concatenate([prim["cost"], xi * np.abs(dth)]),
-            "geom": np.concatenate([prim["geom"], geom]),
-        }
+        prim = _with_rotations(prim, th, xi)
     keep = _reduce(prim, K, r)
     prim = {k: v[keep] for k, v in prim.items()}
     order = np.lexsort((prim["j"], prim["dy"], prim["dx"], prim["i"]))
     prim = {k: v[order] for k, v in prim.items()}
     ptr = np.searchsorted(prim["i"], np.arange(K + 1)).astype(np.int64)
 
-    cell_ptr, cell_x, cell_y = [0], [], []
-    pt_ptr, pt_x, pt_y, pt_th = [0], [], [], []
-    for n in range(len(prim["i"])):
-        g = prim["geom"][n]
-        xs, ys, ths = _sample(th[prim["i"][n]], *g, float(prim["dx"][n]), float(prim["dy"][n]))
-        pt_x.append(xs)
-        pt_y.append(ys)
-        pt_th.append(ths)
-        pt_ptr.append(pt_ptr[-1] + len(xs))
-        # swept cells: nearest nodes of the samples, start node included
-        cells = np.unique(np.floor(np.stack([np.append(xs, 0.0), np.append(ys, 0.0)], 1) + 0.5)
-                          .astype(np.int64), axis=0)
-        cell_x.append(cells[:, 0])
-        cell_y.append(cells[:, 1])
-        cell_ptr.append(cell_ptr[-1] + len(cells))
+    cell_ptr, cell_x, cell_y, pt_ptr, pt_x, pt_y, pt_th = _sweeps(prim, th)
     length = prim["geom"][:, 1] + prim["geom"][:, 4]
     cat = lambda parts, dt: np.concatenate(parts).astype(dt) if parts else np.zeros(0, dt)  # noqa: E731
     return Primitives(
