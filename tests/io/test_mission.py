@@ -102,7 +102,7 @@ def test_geotiff_mission_runs_with_lonlat_points(tmp_path):
     rm = m.resolve()
     assert rm.world.crs == "EPSG:32630"
     # the resolved start is at that lon/lat (and 100 m above the DEM there)
-    lon, lat, _ = to_lonlat(rm.start[None], rm.world)[0]
+    lon, lat, _ = to_lonlat(rm.world, rm.start[None])[0]
     assert (lon, lat) == pytest.approx((-3.7033, 40.3847), abs=1e-9)
     res = runner.invoke(app, ["run", str(tmp_path / "m.yaml"), "--out", str(tmp_path / "o"),
                               "--quiet"])
@@ -117,7 +117,7 @@ def test_geotiff_mission_runs_with_lonlat_points(tmp_path):
 def test_lonlat_start_matches_metres_through_the_anchor():
     base = {"world": {"scenario": "open-field", "anchor": {"lon": 2.0, "lat": 45.0}}}
     m = parse_mission({**base, "start": [300, 300, 300]})
-    lon, lat, alt = to_lonlat([[300.0, 300.0, 300.0]], None, anchor=m.anchor())[0]
+    lon, lat, alt = to_lonlat(None, [[300.0, 300.0, 300.0]], anchor=m.anchor())[0]
     m2 = parse_mission({**base, "start": {"lon": lon, "lat": lat, "alt": alt}})
     np.testing.assert_allclose(m2.resolve().start, [300, 300, 300], atol=1e-6)
 
@@ -280,7 +280,7 @@ def test_a_mission_file_with_two_via_points_and_a_return_leg(tmp_path):
     m = load_mission(f)
     rm = m.resolve()
     plan = read_plan(out / "mission.plan")
-    geo = to_lonlat(np.array([*rm.via, rm.goal]), rm.world, anchor=m.anchor())
+    geo = to_lonlat(rm.world, np.array([*rm.via, rm.goal]), anchor=m.anchor())
     found = []
     for lon, lat, _ in geo:  # each via (and the goal, passed on the way back) is a waypoint
         hit = np.flatnonzero((np.abs(plan["lat"] - lat) < 1e-9) & (np.abs(plan["lon"] - lon) < 1e-9)
