@@ -11,6 +11,57 @@ gradient is unusable, so it always terminates.
 Every call goes prepare (validate, pad 2D to 3D, mark blocked nodes as ``inf``)
 → kernel (compiled, :mod:`fm2uav.planning._geodesic_kernels`) → finalise
 (trim to ``ndim`` columns, translate the kernel's status into errors).
+
+The rules of :func:`descend`:
+
+**Direction.** At every node a unit descent direction is taken from the
+same stencil the Fast Marching Method solves: per axis, where ``T`` is
+monotone through the node, the central difference; where it is not (the
+node is a kink of ``T`` along that axis, or next to a blocked node or the
+grid's edge), the FMM's upwind choice: the one-sided difference towards the
+smaller neighbour, or 0 if no neighbour is smaller. So on a one-cell bright
+layer (a terrain-following flight level) a layer node points along the
+layer, not across it. These unit vectors are blended with cubic B-spline
+weights over the 4 x 4 x 4 nodes around the point (free nodes only; on
+axes coarser than the finest, partly linear weights so the smoothing is
+isotropic in metres). The blend is a C2 field averaging over about two
+cells, so the path rounds the staircase of a level over sloping ground
+instead of tracing it.
+
+**Step rule.** Each step has physical length ``step * min(spacing)`` [m]
+(so at most ``step`` cells on every axis), integrated with the midpoint rule
+(RK2). It is accepted if the *potential* at the new point is below the
+largest potential of the last 8 accepted points by at least a tenth of the
+step's nominal decrease (length times the local slowness ``|grad T|``), the
+new point's nearest node is free (not blocked, finite ``T``) and the
+straight segment to it enters no blocked node's cell. The potential is
+``min(trilinear T, min_c T_c + s_c |p - c|)`` over the corners ``c`` of the
+interpolation cell (``s_c`` the upwind slowness at ``c``): the second term
+is the one-step eikonal (Hopf-Lax) estimate, which, unlike trilinear ``T``,
+does not jump by the dark nodes' times when the point leaves the centre of a
+thin bright channel. If a step enters a blocked cell it may slide along
+that cell's face (one axis component dropped); otherwise the step is
+halved (up to 3 tries), and the tries are repeated with the linear blend
+of the node directions, which follows corners tightly. The 8-step window
+(non-monotone acceptance, Grippo et al. 1986) with sufficient decrease
+lets the path cross the small bumps of the potential in thin channels,
+while its maximum strictly decreases every 8 steps, so the path cannot
+cycle.
+
+**Fallback and termination.** If no step is accepted (zero gradient,
+plateau, noise, obstacle ahead), the path makes discrete steepest-descent
+moves: to the free 8-neighbour (2D) / 26-neighbour (3D) of the current
+nearest node with the smallest ``T``, strictly below the current node's,
+without cutting between obstacles that touch at an edge or corner. It keeps
+moving until the node's ``T`` is below the current potential (so the
+descent potential keeps decreasing across fallbacks), then resumes
+continuous steps. After ``max_steps`` continuous iterations only discrete
+moves are made; each strictly lowers the node's ``T``, so the descent ends.
+On a fast-marching field a lower axis neighbour exists at every reached node
+but the source; where none exists away from the goal, PlanningError is
+raised. As soon as the point is within one
+cell of the goal on every axis and the straight segment to the goal is free,
+the goal is appended exactly and the descent stops.
 """
 
 from __future__ import annotations
@@ -99,6 +150,80 @@ def _as_point(p: Any, shape: tuple[int, ...], what: str) -> np.ndarray:
     return np.clip(arr, 0.0, upper)
 
 
+def _check_step(step: float, max_steps: int | None, shape: tuple[int, ...], h: Any
+                ) -> tuple[float, int]:
+    """``step`` [cells] in (0, 1] and ``max_steps`` (default :func:`default_max_steps`) checked."""
+    step = float(step)
+    if not (np.isfinite(step) and 0.0 < step <= 1.0):
+        raise InputError(f"step must be in (0, 1] cells, got {step!r}")
+    if max_steps is None:
+        max_steps = default_max_steps(shape, h, step)
+    elif (
+        isinstance(max_steps, bool)
+        or not isinstance(max_steps, (int, np.integer))
+        or max_steps < 0
+    ):
+        raise InputError(f"max_steps must be a non-negative integer or None, got {max_steps!r}")
+    return step, max_steps
+
+
+def _with_blocked(field: np.ndarray, blocked: Any) -> tuple[np.ndarray, np.ndarray | None]:
+    """``field`` with ``inf`` on the blocked nodes (a copy if any), and the checked bool mask."""
+    if blocked is None:
+        return field, None
+    shape = field.shape
+    mask = np.asarray(blocked)
+    if mask.dtype != bool and mask.dtype.kind not in "iu":
+        raise InputError(f"blocked must be a boolean array, got dtype {mask.dtype}")
+    if mask.shape != shape:
+        raise InputError(
+            f"blocked has shape {mask.shape} but T has shape {shape}; they must match"
+        )
+    mask = mask.astype(bool, copy=False)
+    if mask.any():
+        field = field.copy()
+        field[mask] = np.inf
+    return field, mask
+
+
+def _check_endpoints(field: np.ndarray, mask: np.ndarray | None, s: np.ndarray, g: np.ndarray
+                     ) -> tuple[int, ...]:
+    """Refuse a goal that is blocked or not the source of ``field``, or a blocked / unreached
+    start; the goal's nearest node."""
+    shape = field.shape
+    sn = tuple(nearest_node(s).tolist())
+    gn = tuple(nearest_node(g).tolist())
+    if mask is not None and mask[gn]:
+        raise PlanningError(
+            f"goal {g.tolist()} lies in blocked node {list(gn)}; move the goal to free space"
+        )
+    if not np.isfinite(field[gn]):
+        raise PlanningError(
+            f"goal {g.tolist()}: its nearest node {list(gn)} has T = inf, so T was not computed "
+            "from this goal; compute T with the goal's nearest node as the source"
+        )
+    t_min = float(field.min())
+    if field[gn] > t_min:
+        where = np.unravel_index(int(np.argmin(field)), shape)
+        raise PlanningError(
+            f"goal {g.tolist()}: T at its nearest node {list(gn)} is {field[gn]:g}, but T is "
+            f"lower ({t_min:g}) at node {[int(i) for i in where]}, so T was not computed from "
+            "this goal; compute T with the goal's nearest node as the source"
+        )
+    if mask is not None and mask[sn]:
+        raise PlanningError(
+            f"start {s.tolist()} lies in blocked node {list(sn)}; move the start to free space"
+        )
+    if not np.isfinite(field[sn]):
+        raise UnreachableError(
+            f"start {s.tolist()} cannot reach the goal {g.tolist()}: its nearest node {list(sn)} "
+            "was never reached by the wave from the goal (T = inf), so no free connection "
+            "joins them; move the start or the goal into the same free region, or clear "
+            "(lower the obstacles / raise the speed of) the cells that separate them"
+        )
+    return gn
+
+
 def descend(
     T: Any,
     start: Any,
@@ -114,54 +239,8 @@ def descend(
     The path follows ``-grad T`` (the physical gradient, ``dT/dx_k = dT/di_k / h_k``)
     with sub-cell steps, and ends exactly at ``goal``.
 
-    **Direction.** At every node a unit descent direction is taken from the
-    same stencil the Fast Marching Method solves: per axis, where ``T`` is
-    monotone through the node, the central difference; where it is not (the
-    node is a kink of ``T`` along that axis, or next to a blocked node or the
-    grid's edge), the FMM's upwind choice: the one-sided difference towards the
-    smaller neighbour, or 0 if no neighbour is smaller. So on a one-cell bright
-    layer (a terrain-following flight level) a layer node points along the
-    layer, not across it. These unit vectors are blended with cubic B-spline
-    weights over the 4 x 4 x 4 nodes around the point (free nodes only; on
-    axes coarser than the finest, partly linear weights so the smoothing is
-    isotropic in metres). The blend is a C2 field averaging over about two
-    cells, so the path rounds the staircase of a level over sloping ground
-    instead of tracing it.
-
-    **Step rule.** Each step has physical length ``step * min(spacing)`` [m]
-    (so at most ``step`` cells on every axis), integrated with the midpoint rule
-    (RK2). It is accepted if the *potential* at the new point is below the
-    largest potential of the last 8 accepted points by at least a tenth of the
-    step's nominal decrease (length times the local slowness ``|grad T|``), the
-    new point's nearest node is free (not blocked, finite ``T``) and the
-    straight segment to it enters no blocked node's cell. The potential is
-    ``min(trilinear T, min_c T_c + s_c |p - c|)`` over the corners ``c`` of the
-    interpolation cell (``s_c`` the upwind slowness at ``c``): the second term
-    is the one-step eikonal (Hopf-Lax) estimate, which, unlike trilinear ``T``,
-    does not jump by the dark nodes' times when the point leaves the centre of a
-    thin bright channel. If a step enters a blocked cell it may slide along
-    that cell's face (one axis component dropped); otherwise the step is
-    halved (up to 3 tries), and the tries are repeated with the linear blend
-    of the node directions, which follows corners tightly. The 8-step window
-    (non-monotone acceptance, Grippo et al. 1986) with sufficient decrease
-    lets the path cross the small bumps of the potential in thin channels,
-    while its maximum strictly decreases every 8 steps, so the path cannot
-    cycle.
-
-    **Fallback and termination.** If no step is accepted (zero gradient,
-    plateau, noise, obstacle ahead), the path makes discrete steepest-descent
-    moves: to the free 8-neighbour (2D) / 26-neighbour (3D) of the current
-    nearest node with the smallest ``T``, strictly below the current node's,
-    without cutting between obstacles that touch at an edge or corner. It keeps
-    moving until the node's ``T`` is below the current potential (so the
-    descent potential keeps decreasing across fallbacks), then resumes
-    continuous steps. After ``max_steps`` continuous iterations only discrete
-    moves are made; each strictly lowers the node's ``T``, so the descent ends.
-    On a fast-marching field a lower axis neighbour exists at every reached node
-    but the source; where none exists away from the goal, PlanningError is
-    raised. As soon as the point is within one
-    cell of the goal on every axis and the straight segment to the goal is free,
-    the goal is appended exactly and the descent stops.
+    The direction, step and fallback rules are in the module docstring
+    (sections *Direction*, *Step rule*, *Fallback and termination*).
 
     Parameters
     ----------
@@ -220,66 +299,11 @@ def descend(
     shape = field.shape
     ndim = field.ndim
     h = as_spacing(spacing, ndim)
-    step = float(step)
-    if not (np.isfinite(step) and 0.0 < step <= 1.0):
-        raise InputError(f"step must be in (0, 1] cells, got {step!r}")
-    if max_steps is None:
-        max_steps = default_max_steps(shape, h, step)
-    elif (
-        isinstance(max_steps, bool)
-        or not isinstance(max_steps, (int, np.integer))
-        or max_steps < 0
-    ):
-        raise InputError(f"max_steps must be a non-negative integer or None, got {max_steps!r}")
-
+    step, max_steps = _check_step(step, max_steps, shape, h)
     s = _as_point(start, shape, "start")
     g = _as_point(goal, shape, "goal")
-
-    if blocked is not None:
-        mask = np.asarray(blocked)
-        if mask.dtype != bool and mask.dtype.kind not in "iu":
-            raise InputError(f"blocked must be a boolean array, got dtype {mask.dtype}")
-        if mask.shape != shape:
-            raise InputError(
-                f"blocked has shape {mask.shape} but T has shape {shape}; they must match"
-            )
-        mask = mask.astype(bool, copy=False)
-        if mask.any():
-            field = field.copy()
-            field[mask] = np.inf
-    else:
-        mask = None
-
-    sn = tuple(nearest_node(s).tolist())
-    gn = tuple(nearest_node(g).tolist())
-    if mask is not None and mask[gn]:
-        raise PlanningError(
-            f"goal {g.tolist()} lies in blocked node {list(gn)}; move the goal to free space"
-        )
-    if not np.isfinite(field[gn]):
-        raise PlanningError(
-            f"goal {g.tolist()}: its nearest node {list(gn)} has T = inf, so T was not computed "
-            "from this goal; compute T with the goal's nearest node as the source"
-        )
-    t_min = float(field.min())
-    if field[gn] > t_min:
-        where = np.unravel_index(int(np.argmin(field)), shape)
-        raise PlanningError(
-            f"goal {g.tolist()}: T at its nearest node {list(gn)} is {field[gn]:g}, but T is "
-            f"lower ({t_min:g}) at node {[int(i) for i in where]}, so T was not computed from "
-            "this goal; compute T with the goal's nearest node as the source"
-        )
-    if mask is not None and mask[sn]:
-        raise PlanningError(
-            f"start {s.tolist()} lies in blocked node {list(sn)}; move the start to free space"
-        )
-    if not np.isfinite(field[sn]):
-        raise UnreachableError(
-            f"start {s.tolist()} cannot reach the goal {g.tolist()}: its nearest node {list(sn)} "
-            "was never reached by the wave from the goal (T = inf), so no free connection "
-            "joins them; move the start or the goal into the same free region, or clear "
-            "(lower the obstacles / raise the speed of) the cells that separate them"
-        )
+    field, mask = _with_blocked(field, blocked)
+    gn = _check_endpoints(field, mask, s, g)
 
     pad = 3 - ndim
     field3 = np.ascontiguousarray(field.reshape(shape + (1,) * pad))
