@@ -266,11 +266,57 @@ def from_buildings(
         Bad geometry, missing heights, a building taller than the grid, bad sizes.
     """
     cs = _cell_size(cell_size) if terrain is None else np.asarray(terrain.spacing, dtype=float)
+    _check_level_and_terrain(metres_per_level, terrain)
+    box = None if bbox is None else check_lonlat_bbox(bbox, "world.bbox (--bbox)")
+    data, polys = _read_footprints(footprints, terrain, crs, layer)
+    ids = [_feature_id(p) for p in data.properties]
+    heights, counts = _heights(data.properties, metres_per_level, default_height, ids)
+    world_crs = data.crs
+    org, nx, ny, ground = _horizontal_grid(terrain, polys, heights, box, world_crs, cs, shape,
+                                           origin, height_cells, margin, agl, top)
+    roof, outside, off_grid = _roofs(polys, heights, ground, org, cs, all_touched)
+    _report_left_out(data, outside, off_grid)
+    surface = np.maximum(roof, ground)
+    smax = float(surface.max())
+    nz = _vertical_nodes(terrain, shape, height_cells, org, cs, smax, agl, top)
+    check_size((nx, ny, nz), cs)
+    zs = org[2] + np.arange(nz) * cs[2]
+    _check_headroom(smax, zs, heights, ids, org, cs, nz, agl,
+                    height_cells is not None and terrain is None and shape is None)
+    occ = zs[None, None, :] <= surface[:, :, None]
+    georef = _buildings_georef(data, polys, counts, metres_per_level, default_height, outside,
+                               off_grid, all_touched, terrain, world_crs, org)
+    return World(
+        occupancy=occ, spacing=tuple(float(c) for c in cs), origin=tuple(float(v) for v in org),
+        terrain=ground, crs=world_crs, name=name or (terrain.name if terrain is not None else ""),
+        filled=None if terrain is None else terrain.filled, georef=georef,
+    )
+
+
+def _check_level_and_terrain(metres_per_level: float, terrain: World | None) -> None:
+    """Refuse a non-positive storey height [m] or a terrain that is not a 3D DEM world."""
     if not (np.isfinite(metres_per_level) and metres_per_level > 0):
         raise WorldError(f"metres_per_level must be > 0, got {metres_per_level!r}")
     if terrain is not None and (terrain.ndim != 3 or terrain.terrain is None):
         raise WorldError("terrain= must be a 3D world with a terrain height map (a DEM world)")
-    box = None if bbox is None else check_lonlat_bbox(bbox, "world.bbox (--bbox)")
+
+
+def _horizontal_grid(terrain: World | None, polys: list[Any], heights: Sequence[float], box: Any,
+                     world_crs: Any, cs: np.ndarray, shape: Any, origin: Any, height_cells: Any,
+                     margin: float, agl: Any, top: Any) -> tuple[np.ndarray, int, int, np.ndarray]:
+    """Origin [m], horizontal node counts and ground heights [m]: the terrain's, or flat at z0."""
+    if terrain is not None:
+        org = np.asarray(terrain.origin, dtype=float)
+        nx, ny = terrain.shape[:2]
+        return org, nx, ny, np.asarray(terrain.terrain, dtype=float)
+    org, nx, ny = _flat_grid(polys, heights, box, world_crs, cs, shape, origin, height_cells,
+                             margin, agl, top)
+    return org, nx, ny, np.full((nx, ny), org[2])
+
+
+def _read_footprints(footprints: Any, terrain: World | None, crs: Any, layer: str | None
+                     ) -> tuple[Any, list[Any]]:
+    """The footprint features (in the terrain's CRS, or an automatic metric one) and polygons."""
     target = terrain.crs if terrain is not None else "auto"
     data = read_vectors(footprints, target_crs=target, crs=crs, role="buildings", layer=layer)
     polys = list(data.geometries)
@@ -278,50 +324,52 @@ def from_buildings(
         raise WorldError(
             f"{data.source.path}: building footprints must be Polygon or MultiPolygon features, "
             "got only " + ", ".join(f"{n} {k}" for k, n in sorted(data.skipped.items())))
-    ids = [_feature_id(p) for p in data.properties]
-    heights, counts = _heights(data.properties, metres_per_level, default_height, ids)
-    world_crs = data.crs
-    # ---- the grid
-    if terrain is not None:
-        org = np.asarray(terrain.origin, dtype=float)
-        nx, ny = terrain.shape[:2]
-        ground = np.asarray(terrain.terrain, dtype=float)
-    else:
-        if shape is None:
-            if box is not None and world_crs is not None:
-                from .dem import _bbox_in
+    return data, polys
 
-                minx, miny, maxx, maxy = _bbox_in(world_crs, box)
-                mg = 0.0
-            elif polys:
-                minx, miny, maxx, maxy = shapely.total_bounds(np.array(polys, dtype=object))
-                mg = float(margin)
-            else:
-                raise WorldError("no buildings given and no shape=; give the grid size "
-                                 "(nx, ny, nz)")
-            if origin is None:
-                origin = (minx - mg, miny - mg, 0.0)
-            nx = int(np.ceil((maxx + mg - origin[0]) / cs[0] - 1e-9)) + 1
-            ny = int(np.ceil((maxy + mg - origin[1]) / cs[1] - 1e-9)) + 1
+
+def _flat_grid(polys: list[Any], heights: Sequence[float], box: Any, world_crs: Any,
+               cs: np.ndarray, shape: Any, origin: Any, height_cells: Any, margin: float,
+               agl: Any, top: Any) -> tuple[np.ndarray, int, int]:
+    """Origin [m] and horizontal node counts of a world on flat ground (no terrain).
+
+    Default extent: ``box`` (lon/lat) or the footprints' bounds plus ``margin`` [m]; the
+    3D size is checked against memory before the roofs are rasterised.
+    """
+    if shape is None:
+        if box is not None and world_crs is not None:
+            from .dem import _bbox_in
+
+            minx, miny, maxx, maxy = _bbox_in(world_crs, box)
+            mg = 0.0
+        elif polys:
+            minx, miny, maxx, maxy = shapely.total_bounds(np.array(polys, dtype=object))
+            mg = float(margin)
         else:
-            if len(shape) != 3 or any(int(n) < 1 for n in shape):
-                raise WorldError(f"shape must be three positive node counts (nx, ny, nz), "
-                                 f"got {shape!r}")
-            nx, ny = int(shape[0]), int(shape[1])
-        org = np.zeros(3) if origin is None else np.asarray(origin, dtype=float)
-        if org.shape != (3,) or not np.all(np.isfinite(org)):
-            raise WorldError(f"origin must be three finite numbers (x0, y0, z0) in metres, got "
-                             f"{origin!r}")
-        check_size((nx, ny), cs[:2])
-        # refuse a 3D grid beyond memory before the (nx, ny) roof pass (seconds on 1e8 columns)
-        check_size((nx, ny, _nz_estimate(heights, shape, height_cells, agl, top, cs[2])), cs)
-        ground = np.full((nx, ny), org[2])
-    # ---- roofs
-    roof, outside, off_grid = _roofs(polys, heights, ground, org, cs, all_touched)
-    _report_left_out(data, outside, off_grid)
-    surface = np.maximum(roof, ground)
-    smax = float(surface.max())
-    # ---- vertical size
+            raise WorldError("no buildings given and no shape=; give the grid size "
+                             "(nx, ny, nz)")
+        if origin is None:
+            origin = (minx - mg, miny - mg, 0.0)
+        nx = int(np.ceil((maxx + mg - origin[0]) / cs[0] - 1e-9)) + 1
+        ny = int(np.ceil((maxy + mg - origin[1]) / cs[1] - 1e-9)) + 1
+    else:
+        if len(shape) != 3 or any(int(n) < 1 for n in shape):
+            raise WorldError(f"shape must be three positive node counts (nx, ny, nz), "
+                             f"got {shape!r}")
+        nx, ny = int(shape[0]), int(shape[1])
+    org = np.zeros(3) if origin is None else np.asarray(origin, dtype=float)
+    if org.shape != (3,) or not np.all(np.isfinite(org)):
+        raise WorldError(f"origin must be three finite numbers (x0, y0, z0) in metres, got "
+                         f"{origin!r}")
+    check_size((nx, ny), cs[:2])
+    # refuse a 3D grid beyond memory before the (nx, ny) roof pass (seconds on 1e8 columns)
+    check_size((nx, ny, _nz_estimate(heights, shape, height_cells, agl, top, cs[2])), cs)
+    return org, nx, ny
+
+
+def _vertical_nodes(terrain: World | None, shape: Any, height_cells: Any, org: np.ndarray,
+                    cs: np.ndarray, smax: float, agl: Any, top: Any) -> int:
+    """Number of vertical nodes: the terrain's (raised to leave room above the roofs), the
+    given ``shape`` / ``height_cells``, or enough for the tallest roof ``smax`` [m] + ``agl``."""
     if terrain is not None:
         nz0 = terrain.shape[2]
         z_top = org[2] + (nz0 - 1) * cs[2]
@@ -341,8 +389,14 @@ def from_buildings(
             nz = int(np.ceil((rel + float(agl)) / cs[2])) + 10
         if top is not None:
             nz = max(nz, int(np.ceil((float(top) - org[2]) / cs[2])) + 5)
-    check_size((nx, ny, nz), cs)
-    zs = org[2] + np.arange(nz) * cs[2]
+    return nz
+
+
+def _check_headroom(smax: float, zs: np.ndarray, heights: Sequence[float], ids: list[str],
+                    org: np.ndarray, cs: np.ndarray, nz: int, agl: Any,
+                    given_height_cells: bool) -> None:
+    """Refuse a grid whose top node ``zs[-1]`` [m] is not above the tallest roof (or, with the
+    user's ``height_cells``, leaves no room for ``agl`` above it)."""
     if smax >= zs[-1]:
         i = int(np.nanargmax(np.where(np.isfinite(heights), heights, -1))) if heights else 0
         need_n = int(np.ceil((smax - org[2]) / cs[2])) + 2
@@ -350,14 +404,20 @@ def from_buildings(
             f"the tallest roof reaches {smax:.6g} m (building {i}{ids[i] if ids else ''}, "
             f"{heights[i]:.6g} m tall), at or above the top node z = {zs[-1]:.6g} m of the grid; "
             f"use at least {need_n} vertical nodes (world.height_cells / shape)")
-    if agl is not None and height_cells is not None and terrain is None and shape is None:
+    if agl is not None and given_height_cells:
         if smax + float(agl) >= zs[-1]:
             need_n = int(np.ceil((smax + float(agl) - org[2]) / cs[2])) + 2
             raise WorldError(
                 f"world.height_cells = {nz} leaves no room to fly {float(agl):g} m above the "
                 f"tallest roof ({smax:.1f} m); use world.height_cells >= {need_n} or leave it out "
                 "(the default follows the requested height above ground)")
-    occ = zs[None, None, :] <= surface[:, :, None]
+
+
+def _buildings_georef(data: Any, polys: list[Any], counts: Any, metres_per_level: float,
+                      default_height: float | None, outside: Any, off_grid: Any,
+                      all_touched: bool, terrain: World | None, world_crs: Any,
+                      org: np.ndarray) -> Any:
+    """The georeference of a buildings world, its source file noting the height rules used."""
     details = {
         "buildings": len(polys),
         "height_rule": counts,
@@ -379,16 +439,7 @@ def from_buildings(
             "model: altitudes are relative to the ground, not to sea level)",
             vertical_assumed=True, reprojection=data.source.details.get("reprojection", ""),
             sources=(src,))
-    return World(
-        occupancy=occ,
-        spacing=tuple(float(c) for c in cs),
-        origin=tuple(float(v) for v in org),
-        terrain=ground,
-        crs=world_crs,
-        name=name or (terrain.name if terrain is not None else ""),
-        filled=None if terrain is None else terrain.filled,
-        georef=georef,
-    )
+    return georef
 
 
 def _nz_estimate(heights: Sequence[float], shape: Any, height_cells: Any, agl: Any, top: Any,
