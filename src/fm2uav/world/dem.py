@@ -651,6 +651,79 @@ def from_dem(
     """
     from .world import World
 
+    dx, dy, dz = _check_dem_args(cell_size, nodata, sea_level)
+    box = None if bbox is None else check_lonlat_bbox(bbox, "world.bbox (--bbox)")
+    pre = None
+    if box is not None:
+        # the area of interest is the bbox: choose the world's CRS from it first, so that
+        # the window read covers the bbox's rectangle in that CRS
+        src0 = _source_crs(source, crs)
+        if src0 is not None:
+            pre = local_metric_crs(src0, box)
+    dem = read_dem(source, crs=crs, transform=transform, bounds=bounds, nodata=nodata_value,
+                   bbox=box, window_crs=None if pre is None else pre[0])
+    src = parse_crs(dem.crs)
+
+    area_ll = _footprint_lonlat(dem)
+    if box is not None:
+        area_ll = _overlap_with_bbox(area_ll, box)
+    dst, err, reason = pre if pre is not None else local_metric_crs(src, area_ll)
+    if err > MAX_SCALE_ERROR:
+        warnings.warn(f"{reason}; crop the DEM with world.bbox (CLI --bbox) for true lengths",
+                      GeodataWarning, stacklevel=2)
+    fwd = transformer(src, dst)
+    west, south, east, north = _inner_box(dem, fwd, dst, box)
+    nx, ny = _node_counts(west, south, east, north, dx, dy)
+    gx = west + np.arange(nx) * dx
+    gy = south + np.arange(ny) * dy
+    heights, valid = _resample(dem, src, dst, west, gy[-1], dx, dy, nx, ny)
+    heights, filled = _fill_nodata(heights, valid, nodata, gx, gy, dst)
+    vertical = (f"DEM heights, {dem.vertical_crs} (from the raster's vertical CRS)"
+                if dem.vertical_crs else f"DEM heights, {dem.vertical_note}")
+    heights, vertical, n_sea = _sea_level(heights, sea_level, vertical, gx, gy, dst)
+    z0, nz = _vertical_nodes(heights, dz, ceiling, agl, top)
+    check_size((nx, ny, nz), (dx, dy, dz))
+    w = World.from_heightmap(heights, (dx, dy, dz), nz, origin=(west, south, z0), name=name)
+    details = {"world_nodes": [nx, ny, nz], "filled_nodes": int(filled.sum()),
+               **({"sea_nodes": n_sea} if sea_level is not None else {}),
+               **({"bbox": list(box)} if box is not None else {})}
+    georef = _dem_georef(dem, details, src, dst, vertical, err, reason)
+    # the DEM at its own resolution for every height-above-ground question (issue 13)
+    from .ground_model import ground_model_from_dem
+
+    ground = ground_model_from_dem(dem, src, dst, min(dx, dy), sea_level=sea_level)
+    return dataclasses.replace(w, crs=crs_label(dst) if parse_crs(dst).to_epsg() else dst,
+                               name=name or "dem", filled=filled, georef=georef, ground=ground)
+
+
+def _node_counts(west: float, south: float, east: float, north: float, dx: float, dy: float
+                 ) -> tuple[int, int]:
+    """Horizontal node counts of the box [m] at spacing ``dx``, ``dy`` (at least 2 x 2, checked)."""
+    nx = int(np.floor((east - west) / dx + 1e-9)) + 1
+    ny = int(np.floor((north - south) / dy + 1e-9)) + 1
+    if nx < 2 or ny < 2:
+        raise InputError(
+            f"world.cell_size (--cell-size) {dx:g} x {dy:g} m leaves fewer than 2 x 2 nodes on a "
+            f"DEM area of {east - west:.0f} x {north - south:.0f} m; use a smaller cell size")
+    check_size((nx, ny), (dx, dy))
+    return nx, ny
+
+
+def _dem_georef(dem: DemRaster, details: dict[str, Any], src: Any, dst: Any, vertical: str,
+                err: float, reason: str) -> Any:
+    """The georeference of a DEM world: its source files (or the array) with ``details``."""
+    sources = tuple(dataclasses.replace(s, details={**s.details, **details})
+                    for s in dem.sources) or (SourceFile(path="<array>", role="dem",
+                                                         crs=crs_label(src), crs_rule="given",
+                                                         details=details),)
+    return make_georef(dst, vertical=vertical, vertical_crs=dem.vertical_crs,
+                       vertical_assumed=dem.vertical_crs is None, reprojection=reason,
+                       scale_error=err, sources=sources)
+
+
+def _check_dem_args(cell_size: Any, nodata: str, sea_level: float | None
+                    ) -> tuple[float, float, float]:
+    """Check the cell size [m], the nodata rule and the sea level of :func:`from_dem`; dx, dy, dz."""
     cs = np.atleast_1d(np.asarray(cell_size, dtype=float))
     if cs.size not in (1, 3) or not np.all(np.isfinite(cs)) or np.any(cs <= 0):
         raise InputError(f"world.cell_size (--cell-size) must be > 0 metres (one number or "
@@ -662,34 +735,26 @@ def from_dem(
                                       <= MAX_ELEVATION):
         raise InputError(f"world.sea_level (--sea-level) must be an altitude in metres, e.g. 0, "
                          f"got {sea_level!r}")
-    box = None if bbox is None else check_lonlat_bbox(bbox, "world.bbox (--bbox)")
-    pre = None
-    if box is not None:
-        # the area of interest is the bbox: choose the world's CRS from it first, so that
-        # the window read covers the bbox's rectangle in that CRS
-        src0 = _source_crs(source, crs)
-        if src0 is not None:
-            pre = local_metric_crs(src0, box)
-    dem = read_dem(source, crs=crs, transform=transform, bounds=bounds, nodata=nodata_value,
-                   bbox=box, window_crs=None if pre is None else pre[0])
+    return dx, dy, dz
+
+
+def _overlap_with_bbox(area_ll: tuple[float, float, float, float], box: Any
+                       ) -> tuple[float, float, float, float]:
+    """The DEM's lon/lat footprint ``area_ll`` cut to ``box``; refused when they do not overlap."""
+    full_ll = area_ll
+    area_ll = _intersect(area_ll, box)
+    if not (area_ll[2] > area_ll[0] and area_ll[3] > area_ll[1]):
+        raise InputError(
+            f"bbox {','.join(f'{v:g}' for v in box)} does not overlap the DEM, which covers "
+            f"lon {full_ll[0]:.4f}..{full_ll[2]:.4f}, lat {full_ll[1]:.4f}..{full_ll[3]:.4f}; "
+            "fix world.bbox (CLI --bbox W,S,E,N, lon/lat)")
+    return area_ll
+
+
+def _inner_box(dem: DemRaster, fwd: Any, dst: Any, box: Any) -> tuple[float, float, float, float]:
+    """Largest axis-aligned box [m] (in ``dst``) inside the DEM's pixel-centre footprint and ``box``."""
     rows, cols = dem.z.shape
     a, b, c, d, e, f = dem.transform
-    src = parse_crs(dem.crs)
-
-    area_ll = _footprint_lonlat(dem)
-    if box is not None:
-        full_ll = area_ll
-        area_ll = _intersect(area_ll, box)
-        if not (area_ll[2] > area_ll[0] and area_ll[3] > area_ll[1]):
-            raise InputError(
-                f"bbox {','.join(f'{v:g}' for v in box)} does not overlap the DEM, which covers "
-                f"lon {full_ll[0]:.4f}..{full_ll[2]:.4f}, lat {full_ll[1]:.4f}..{full_ll[3]:.4f}; "
-                "fix world.bbox (CLI --bbox W,S,E,N, lon/lat)")
-    dst, err, reason = pre if pre is not None else local_metric_crs(src, area_ll)
-    if err > MAX_SCALE_ERROR:
-        warnings.warn(f"{reason}; crop the DEM with world.bbox (CLI --bbox) for true lengths",
-                      GeodataWarning, stacklevel=2)
-    fwd = transformer(src, dst)
     # footprint of the pixel centres in the metric CRS, then an inner box
     edge = np.linspace(0, 1, 64)
     r_idx = np.concatenate([np.zeros(64), edge * (rows - 1), np.full(64, rows - 1), edge * (rows - 1)])
@@ -711,19 +776,16 @@ def from_dem(
     if not (east > west and north > south):
         raise WorldError(f"the DEM footprint in {crs_label(dst)} is degenerate (or outside "
                          "world.bbox); is the transform/CRS right?")
-    nx = int(np.floor((east - west) / dx + 1e-9)) + 1
-    ny = int(np.floor((north - south) / dy + 1e-9)) + 1
-    if nx < 2 or ny < 2:
-        raise InputError(
-            f"world.cell_size (--cell-size) {dx:g} x {dy:g} m leaves fewer than 2 x 2 nodes on a "
-            f"DEM area of {east - west:.0f} x {north - south:.0f} m; use a smaller cell size")
-    check_size((nx, ny), (dx, dy))
-    gx = west + np.arange(nx) * dx
-    gy = south + np.arange(ny) * dy
-    heights, valid = _resample(dem, src, dst, west, gy[-1], dx, dy, nx, ny)
+    return west, south, east, north
+
+
+def _fill_nodata(heights: np.ndarray, valid: np.ndarray, nodata: str, gx: np.ndarray,
+                 gy: np.ndarray, dst: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Heights with nodata nodes refused (``nodata="error"``) or filled from the nearest valid
+    node (at most half of them); and the mask of filled nodes."""
     missing = ~valid
     n_miss = int(missing.sum())
-    filled = np.zeros((nx, ny), dtype=bool)
+    filled = np.zeros(valid.shape, dtype=bool)
     if n_miss:
         i, j = np.argwhere(missing)[0]
         lon, lat = transformer(dst, WGS84).transform(float(gx[i]), float(gy[j]))
@@ -743,8 +805,13 @@ def from_dem(
             _, (ii, jj) = ndimage.distance_transform_edt(none, return_indices=True)
             heights = heights[ii, jj]
         filled = missing
-    vertical = (f"DEM heights, {dem.vertical_crs} (from the raster's vertical CRS)"
-                if dem.vertical_crs else f"DEM heights, {dem.vertical_note}")
+    return heights, filled
+
+
+def _sea_level(heights: np.ndarray, sea_level: float | None, vertical: str, gx: np.ndarray,
+               gy: np.ndarray, dst: Any) -> tuple[np.ndarray, str, int]:
+    """Ground raised to ``sea_level`` [m] (or a warning about ground below 0 m); the heights, the
+    vertical description and the number of nodes below the sea level."""
     below = heights < (0.0 if sea_level is None else float(sea_level))
     n_sea = int(below.sum())
     if sea_level is not None:
@@ -757,7 +824,13 @@ def from_dem(
             f"the DEM has ground below 0 m under {n_sea} of {heights.size} nodes (lowest "
             f"{heights[i, j]:.1f} m at lon {lon:.5f}, lat {lat:.5f}); if that is sea or lake "
             "floor, set world.sea_level: 0 (CLI --sea-level 0) to fly over the water surface — "
-            "it is kept as terrain otherwise", GeodataWarning, stacklevel=2)
+            "it is kept as terrain otherwise", GeodataWarning, stacklevel=3)
+    return heights, vertical, n_sea
+
+
+def _vertical_nodes(heights: np.ndarray, dz: float, ceiling: float | None, agl: float | None,
+                    top: float | None) -> tuple[float, int]:
+    """Bottom node height z0 [m] (a cell under the lowest ground) and number of vertical nodes."""
     hmin, hmax = float(heights.min()), float(heights.max())
     z0 = (np.floor(hmin / dz) - 1.0) * dz
     top_alt = _ceiling(ceiling, hmax, dz, agl, top)
@@ -766,24 +839,7 @@ def from_dem(
         nz = int(np.ceil((top_alt - z0) / dz - 1e-9)) + 1
     else:  # a given ceiling (or the plain default) is a maximum: the top node stays under it
         nz = int(np.floor((top_alt - z0) / dz + 1e-9)) + 1
-    check_size((nx, ny, nz), (dx, dy, dz))
-    w = World.from_heightmap(heights, (dx, dy, dz), nz, origin=(west, south, z0), name=name)
-    details = {"world_nodes": [nx, ny, nz], "filled_nodes": int(filled.sum()),
-               **({"sea_nodes": n_sea} if sea_level is not None else {}),
-               **({"bbox": list(box)} if box is not None else {})}
-    sources = tuple(dataclasses.replace(s, details={**s.details, **details})
-                    for s in dem.sources) or (SourceFile(path="<array>", role="dem",
-                                                         crs=crs_label(src), crs_rule="given",
-                                                         details=details),)
-    georef = make_georef(dst, vertical=vertical, vertical_crs=dem.vertical_crs,
-                         vertical_assumed=dem.vertical_crs is None, reprojection=reason,
-                         scale_error=err, sources=sources)
-    # the DEM at its own resolution for every height-above-ground question (issue 13)
-    from .ground_model import ground_model_from_dem
-
-    ground = ground_model_from_dem(dem, src, dst, min(dx, dy), sea_level=sea_level)
-    return dataclasses.replace(w, crs=crs_label(dst) if parse_crs(dst).to_epsg() else dst,
-                               name=name or "dem", filled=filled, georef=georef, ground=ground)
+    return z0, nz
 
 
 def _ceiling(ceiling: float | None, hmax: float, dz: float, agl: float | None,
