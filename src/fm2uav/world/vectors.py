@@ -295,93 +295,19 @@ def read_vectors(
         fit the CRS, data with a CRS on a world without one.
     """
     is_file = isinstance(source, (str, PathLike))
-    if is_file:
-        path = Path(source).expanduser()
-        where = f"the {role} file {path}"
-        if not path.exists():
-            raise WorldError(f"{where} does not exist; check the path")
-        from .. import _validate as v
-
-        v.input_file(path, f"the {role} file")  # no directory / pipe (would block) / unreadable
-        geoms, props, declared, driver, layers = _read_file(path, layer)
-        kml = driver.upper() in ("LIBKML", "KML") or path.suffix.lower() in (".kml", ".kmz")
-        geojson = driver.upper() in ("GEOJSON", "GEOJSONSEQ") or path.suffix.lower() in (
-            ".geojson", ".json")
-        member = _geojson_crs_member(path) if geojson else None
-        if geojson and member is None:
-            declared = None  # GDAL reports EPSG:4326 for RFC 7946 files: an assumption
-        elif geojson and isinstance(member, Mapping) and (
-                {"name", "code"} & set(member.get("properties") or {})):
-            # GDAL silently ignores a crs member it cannot parse (then reads lon/lat): refuse
-            declared = _member_crs(member, where)
-        sha = sha256_file(path)
-        shown = str(path)
-    else:
-        where = f"the {role} GeoJSON"
-        geoms, props, member = _read_mapping(source)
-        declared = _member_crs(member, where) if member is not None else None
-        kml = geojson = False
-        layers, driver, sha, shown = [], "GeoJSON (in memory)", None, "<in memory>"
-    given = parse_crs(crs) if crs is not None else None
-    if declared is not None:
-        if given is not None and not _same_crs(declared, given):
-            raise WorldError(
-                f"{where} declares its CRS {crs_label(declared)}, but {_CRS_HINT} says "
-                f"{crs_label(given)}; remove world.crs / --crs (it is only for files that "
-                "declare none) or fix the file")
-        src_crs, rule = parse_crs(declared), _RULE_DECLARED
-    elif kml:
-        src_crs, rule = parse_crs(_LONLAT), _RULE_KML
-    elif given is not None:
-        src_crs, rule = given, _RULE_GIVEN
-    elif is_file and geojson:
-        src_crs, rule = parse_crs(_LONLAT), _RULE_RFC
-    elif not is_file:
-        src_crs, rule = None, _RULE_MAP
-    else:
-        raise WorldError(
-            f"{where} declares no CRS (e.g. a Shapefile without its .prj); give it with "
-            f"{_CRS_HINT}, e.g. EPSG:4326 for lon/lat or EPSG:32630")
-    # keep the wanted kinds, count the others
-    kept_g, kept_p, skipped = [], [], {}
-    for g, p in zip(geoms, props):
-        if g is None or g.is_empty:
-            skipped["empty"] = skipped.get("empty", 0) + 1
-            continue
-        if kinds is not None and g.geom_type not in kinds:
-            skipped[g.geom_type] = skipped.get(g.geom_type, 0) + 1
-            continue
-        g = shapely.force_2d(g)
-        if repair and not g.is_valid:
-            g = shapely.make_valid(g)
-            if kinds is not None and g.geom_type not in kinds:
-                polys = [p_ for p_ in getattr(g, "geoms", [g]) if p_.geom_type in kinds]
-                if not polys:
-                    skipped["invalid"] = skipped.get("invalid", 0) + 1
-                    continue
-                g = shapely.union_all(polys)
-        kept_g.append(g)
-        kept_p.append(p)
+    where, geoms, props, declared, kml, geojson, layers, driver, sha, shown = _read_source(
+        source, role, layer)
+    src_crs, rule = _source_crs_rule(declared, crs, kml, geojson, is_file, where)
+    kept_g, kept_p, skipped = _keep_kinds(geoms, props, kinds, repair)
     bounds = (shapely.total_bounds(np.asarray(kept_g, dtype=object)) if kept_g
               else np.zeros(4))
 
     def looks_lonlat() -> bool:
-        minx, miny, maxx, maxy = bounds
-        return bool(kept_g) and (-180 <= minx and maxx <= 180 and -90 <= miny and maxy <= 90
-                                 and max(maxx - minx, maxy - miny) < 2.0)
+        return _looks_lonlat(kept_g, bounds)
 
     reason = ""
     if target_crs == "auto":
-        if src_crs is None or not kept_g:
-            target_crs = None if src_crs is None else (
-                src_crs.to_string() if src_crs.is_projected else None)
-            if target_crs is None and src_crs is not None:
-                wanted = " or ".join(kinds) if kinds else "usable"
-                raise WorldError(f"{where} has no {wanted} features to build a world from "
-                                 f"({_skipped_text(skipped)})")
-        else:
-            check_fit(bounds, src_crs, rule, where, _CRS_HINT)
-            target_crs, _, reason = local_metric_crs(src_crs, bounds_lonlat(bounds, src_crs))
+        target_crs, reason = _auto_target(src_crs, kept_g, bounds, kinds, skipped, rule, where)
     if target_crs is None and rule in (_RULE_RFC, _RULE_MAP):
         # a map without CRS (synthetic scenario): data without a declared CRS are its metres
         if looks_lonlat() and not is_file:
@@ -420,13 +346,135 @@ def read_vectors(
         out_crs = target_crs
         if kept_g and not _same_crs(src_crs, target_crs):
             kept_g = _reproject(kept_g, src_crs, target_crs)
-    src = SourceFile(
+    src = _source_file(shown, role, sha, src_crs, rule, len(kept_g), skipped, reason, layers,
+                       driver)
+    return VectorData(geometries=tuple(kept_g), properties=tuple(kept_p), crs=out_crs,
+                      source=src, skipped=skipped)
+
+
+def _read_source(source: Any, role: str, layer: str | None) -> tuple[Any, ...]:
+    """Features of a vector file or an in-memory GeoJSON, and what is known of their CRS.
+
+    Returns ``where`` (for messages), geometries, properties, the declared CRS (or None),
+    whether it is KML / a GeoJSON file, the file's layers, driver, sha256 and shown name.
+    """
+    if isinstance(source, (str, PathLike)):
+        path = Path(source).expanduser()
+        where = f"the {role} file {path}"
+        if not path.exists():
+            raise WorldError(f"{where} does not exist; check the path")
+        from .. import _validate as v
+
+        v.input_file(path, f"the {role} file")  # no directory / pipe (would block) / unreadable
+        geoms, props, declared, driver, layers = _read_file(path, layer)
+        kml = driver.upper() in ("LIBKML", "KML") or path.suffix.lower() in (".kml", ".kmz")
+        geojson = driver.upper() in ("GEOJSON", "GEOJSONSEQ") or path.suffix.lower() in (
+            ".geojson", ".json")
+        member = _geojson_crs_member(path) if geojson else None
+        if geojson and member is None:
+            declared = None  # GDAL reports EPSG:4326 for RFC 7946 files: an assumption
+        elif geojson and isinstance(member, Mapping) and (
+                {"name", "code"} & set(member.get("properties") or {})):
+            # GDAL silently ignores a crs member it cannot parse (then reads lon/lat): refuse
+            declared = _member_crs(member, where)
+        sha = sha256_file(path)
+        shown = str(path)
+    else:
+        where = f"the {role} GeoJSON"
+        geoms, props, member = _read_mapping(source)
+        declared = _member_crs(member, where) if member is not None else None
+        kml = geojson = False
+        layers, driver, sha, shown = [], "GeoJSON (in memory)", None, "<in memory>"
+    return where, geoms, props, declared, kml, geojson, layers, driver, sha, shown
+
+
+def _source_crs_rule(declared: Any, crs: Any, kml: bool, geojson: bool, is_file: bool,
+                     where: str) -> tuple[Any, str]:
+    """The CRS of the features and the rule that gave it (declared, KML, given, RFC 7946, map)."""
+    given = parse_crs(crs) if crs is not None else None
+    if declared is not None:
+        if given is not None and not _same_crs(declared, given):
+            raise WorldError(
+                f"{where} declares its CRS {crs_label(declared)}, but {_CRS_HINT} says "
+                f"{crs_label(given)}; remove world.crs / --crs (it is only for files that "
+                "declare none) or fix the file")
+        src_crs, rule = parse_crs(declared), _RULE_DECLARED
+    elif kml:
+        src_crs, rule = parse_crs(_LONLAT), _RULE_KML
+    elif given is not None:
+        src_crs, rule = given, _RULE_GIVEN
+    elif is_file and geojson:
+        src_crs, rule = parse_crs(_LONLAT), _RULE_RFC
+    elif not is_file:
+        src_crs, rule = None, _RULE_MAP
+    else:
+        raise WorldError(
+            f"{where} declares no CRS (e.g. a Shapefile without its .prj); give it with "
+            f"{_CRS_HINT}, e.g. EPSG:4326 for lon/lat or EPSG:32630")
+    return src_crs, rule
+
+
+def _keep_kinds(geoms: Any, props: Any, kinds: Any, repair: bool
+                ) -> tuple[list[Any], list[Any], dict[str, int]]:
+    """The 2D geometries of the wanted ``kinds`` (invalid ones repaired if ``repair``) and their
+    properties; the others counted per reason (empty, geometry type, invalid)."""
+    # keep the wanted kinds, count the others
+    kept_g, kept_p, skipped = [], [], {}
+    for g, p in zip(geoms, props):
+        if g is None or g.is_empty:
+            skipped["empty"] = skipped.get("empty", 0) + 1
+            continue
+        if kinds is not None and g.geom_type not in kinds:
+            skipped[g.geom_type] = skipped.get(g.geom_type, 0) + 1
+            continue
+        g = shapely.force_2d(g)
+        if repair and not g.is_valid:
+            g = shapely.make_valid(g)
+            if kinds is not None and g.geom_type not in kinds:
+                polys = [p_ for p_ in getattr(g, "geoms", [g]) if p_.geom_type in kinds]
+                if not polys:
+                    skipped["invalid"] = skipped.get("invalid", 0) + 1
+                    continue
+                g = shapely.union_all(polys)
+        kept_g.append(g)
+        kept_p.append(p)
+    return kept_g, kept_p, skipped
+
+
+def _looks_lonlat(kept_g: list[Any], bounds: Any) -> bool:
+    """True when the features' bounds look like lon/lat degrees of a small area (< 2 deg)."""
+    minx, miny, maxx, maxy = bounds
+    return bool(kept_g) and (-180 <= minx and maxx <= 180 and -90 <= miny and maxy <= 90
+                             and max(maxx - minx, maxy - miny) < 2.0)
+
+
+def _auto_target(src_crs: Any, kept_g: list[Any], bounds: Any, kinds: Any,
+                 skipped: dict[str, int], rule: str, where: str) -> tuple[Any, str]:
+    """``target_crs="auto"``: the features' projected CRS, or a local metric CRS around them
+    (and its reprojection note); None for features without a CRS."""
+    reason = ""
+    target_crs: Any = None
+    if src_crs is None or not kept_g:
+        target_crs = None if src_crs is None else (
+            src_crs.to_string() if src_crs.is_projected else None)
+        if target_crs is None and src_crs is not None:
+            wanted = " or ".join(kinds) if kinds else "usable"
+            raise WorldError(f"{where} has no {wanted} features to build a world from "
+                             f"({_skipped_text(skipped)})")
+    else:
+        check_fit(bounds, src_crs, rule, where, _CRS_HINT)
+        target_crs, _, reason = local_metric_crs(src_crs, bounds_lonlat(bounds, src_crs))
+    return target_crs, reason
+
+
+def _source_file(shown: str, role: str, sha: str | None, src_crs: Any, rule: str, n: int,
+                 skipped: dict[str, int], reason: str, layers: Any, driver: str) -> SourceFile:
+    """The provenance record of ``n`` features read (skipped counts, reprojection, layers, driver)."""
+    return SourceFile(
         path=shown, role=role, sha256=sha,
         crs=None if src_crs is None else crs_label(src_crs), crs_rule=rule,
-        details={"features": len(kept_g), **({"skipped": dict(skipped)} if skipped else {}),
+        details={"features": n, **({"skipped": dict(skipped)} if skipped else {}),
                  **({"reprojection": reason} if reason else {}),
                  **({"layers": list(layers)} if len(layers) > 1 else {}),
                  **({"driver": driver} if driver else {})},
     )
-    return VectorData(geometries=tuple(kept_g), properties=tuple(kept_p), crs=out_crs,
-                      source=src, skipped=skipped)
