@@ -218,16 +218,24 @@ def _check_values(z: np.ndarray, where: str) -> None:
 
 def _bbox_in(crs: Any, bbox: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
     """Outer bounds of a lon/lat box in ``crs`` (edges densified)."""
-    w, s, e, n = bbox
-    t = np.linspace(0.0, 1.0, 65)
-    lon = np.concatenate([w + (e - w) * t, np.full(65, e), e - (e - w) * t, np.full(65, w)])
-    lat = np.concatenate([np.full(65, s), s + (n - s) * t, np.full(65, n), n - (n - s) * t])
-    x, y = transformer(WGS84, crs).transform(lon, lat)
-    x, y = np.asarray(x), np.asarray(y)
-    ok = np.isfinite(x) & np.isfinite(y)
-    if not ok.any():
+    x, y = _projected_edges(bbox, WGS84, crs)
+    if not x.size:
         raise WorldError(f"bbox {bbox} cannot be projected to {crs_label(crs)}")
-    return float(x[ok].min()), float(y[ok].min()), float(x[ok].max()), float(y[ok].max())
+    return float(x.min()), float(y.min()), float(x.max()), float(y.max())
+
+
+def _projected_edges(rect: tuple[float, float, float, float], rect_crs: Any, crs: Any
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """The edges of a rectangle given in ``rect_crs``, 65 points each, projected to ``crs``
+    (the finite points only)."""
+    x0, y0, x1, y1 = rect
+    t = np.linspace(0.0, 1.0, 65)
+    x = np.concatenate([x0 + (x1 - x0) * t, np.full(65, x1), x1 - (x1 - x0) * t, np.full(65, x0)])
+    y = np.concatenate([np.full(65, y0), y0 + (y1 - y0) * t, np.full(65, y1), y1 - (y1 - y0) * t])
+    u, v = transformer(rect_crs, crs).transform(x, y)
+    u, v = np.asarray(u), np.asarray(v)
+    ok = np.isfinite(u) & np.isfinite(v)
+    return u[ok], v[ok]
 
 
 def _vertical_note(driver: str) -> str:
@@ -241,14 +249,8 @@ def _vertical_note(driver: str) -> str:
 def _rect_in(rect: tuple[float, float, float, float], rect_crs: Any, crs: Any
              ) -> tuple[float, float, float, float]:
     """Outer bounds in ``crs`` of a rectangle given in ``rect_crs`` (edges densified)."""
-    x0, y0, x1, y1 = rect
-    t = np.linspace(0.0, 1.0, 65)
-    x = np.concatenate([x0 + (x1 - x0) * t, np.full(65, x1), x1 - (x1 - x0) * t, np.full(65, x0)])
-    y = np.concatenate([np.full(65, y0), y0 + (y1 - y0) * t, np.full(65, y1), y1 - (y1 - y0) * t])
-    u, v = transformer(rect_crs, crs).transform(x, y)
-    u, v = np.asarray(u), np.asarray(v)
-    ok = np.isfinite(u) & np.isfinite(v)
-    return float(u[ok].min()), float(v[ok].min()), float(u[ok].max()), float(v[ok].max())
+    u, v = _projected_edges(rect, rect_crs, crs)
+    return float(u.min()), float(v.min()), float(u.max()), float(v.max())
 
 
 def _read_files(paths: list[Path], crs: Any, nodata: float | None,
