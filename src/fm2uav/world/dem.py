@@ -655,13 +655,7 @@ def from_dem(
 
     dx, dy, dz = _check_dem_args(cell_size, nodata, sea_level)
     box = None if bbox is None else check_lonlat_bbox(bbox, "world.bbox (--bbox)")
-    pre = None
-    if box is not None:
-        # the area of interest is the bbox: choose the world's CRS from it first, so that
-        # the window read covers the bbox's rectangle in that CRS
-        src0 = _source_crs(source, crs)
-        if src0 is not None:
-            pre = local_metric_crs(src0, box)
+    pre = _bbox_metric_crs(source, crs, box)
     dem = read_dem(source, crs=crs, transform=transform, bounds=bounds, nodata=nodata_value,
                    bbox=box, window_crs=None if pre is None else pre[0])
     src = parse_crs(dem.crs)
@@ -721,6 +715,15 @@ def _dem_georef(dem: DemRaster, details: dict[str, Any], src: Any, dst: Any, ver
     return make_georef(dst, vertical=vertical, vertical_crs=dem.vertical_crs,
                        vertical_assumed=dem.vertical_crs is None, reprojection=reason,
                        scale_error=err, sources=sources)
+
+
+def _bbox_metric_crs(source: Any, crs: Any, box: Any) -> Any:
+    """With a bbox, the world's metric CRS chosen from it first (so that the window read covers
+    the bbox's rectangle in that CRS): :func:`local_metric_crs`'s answer; else None."""
+    if box is None:
+        return None
+    src0 = _source_crs(source, crs)
+    return None if src0 is None else local_metric_crs(src0, box)
 
 
 def _check_dem_args(cell_size: Any, nodata: str, sea_level: float | None
