@@ -302,22 +302,19 @@ def read_vectors(
     bounds = (shapely.total_bounds(np.asarray(kept_g, dtype=object)) if kept_g
               else np.zeros(4))
 
-    def looks_lonlat() -> bool:
-        return _looks_lonlat(kept_g, bounds)
-
     reason = ""
     if target_crs == "auto":
         target_crs, reason = _auto_target(src_crs, kept_g, bounds, kinds, skipped, rule, where)
     if target_crs is None and rule in (_RULE_RFC, _RULE_MAP):
         # a map without CRS (synthetic scenario): data without a declared CRS are its metres
-        if looks_lonlat() and not is_file:
+        if _looks_lonlat(kept_g, bounds) and not is_file:
             minx, miny, maxx, maxy = bounds
             raise WorldError(
                 f"{where} has no CRS and is read in the map's metres, but its coordinates "
                 f"(x {minx:.6g}..{maxx:.6g}, y {miny:.6g}..{maxy:.6g}) look like lon/lat "
                 f"degrees; say so with {_CRS_HINT} = EPSG:4326 (or a 'crs' member), or give "
                 "a file path (RFC 7946 GeoJSON files are lon/lat)")
-        if looks_lonlat():
+        if _looks_lonlat(kept_g, bounds):
             minx, miny, maxx, maxy = bounds
             raise WorldError(
                 f"{where} looks like lon/lat degrees (x {minx:.6g}..{maxx:.6g}, y "
@@ -332,7 +329,7 @@ def read_vectors(
             "(CLI --dem), or give the features in the map's metres without a CRS")
     elif src_crs is None:
         # in-memory GeoJSON without a CRS on a geo-referenced world: the world's own x/y
-        if looks_lonlat():
+        if _looks_lonlat(kept_g, bounds):
             minx, miny, maxx, maxy = bounds
             raise WorldError(
                 f"{where} has no CRS and is read in the map's metres ({crs_label(target_crs)}), "
