@@ -168,6 +168,42 @@ def _grid_values(name: str, values: Any, lo: float, hi: float | None) -> tuple[f
     return vals
 
 
+def _tune_grid(grid: dict[str, Any] | None) -> tuple[tuple[float, ...], ...]:
+    """The p1, p2, saturation and exponent values of the search (``grid`` over the defaults)."""
+    g = dict(DEFAULT_GRID)
+    for k, v in (grid or {}).items():
+        if k not in DEFAULT_GRID:
+            raise InputError(f"unknown grid key {k!r}; use {sorted(DEFAULT_GRID)}")
+        g[k] = v
+    p1s = _grid_values("p1", g["p1"], 0.0, None)
+    p2s = _grid_values("p2", g["p2"], 0.0, None)
+    sats = _grid_values("saturation", g["saturation"], 0.0, 1.0)
+    exps = _grid_values("exponent", g["exponent"], 0.0, None)
+    return p1s, p2s, sats, exps
+
+
+def _measure(row: dict[str, Any], world: World, pl: Plan, agl: float, step: float,
+             limits: Any) -> None:
+    """Fill ``row`` with the plan's flight-level deviation [m], climb [deg], turn radius [m],
+    length [m] and whether it is feasible for ``limits``."""
+    fl = flight_level_deviation(world, pl.path, agl)
+    pr = path_profiles(pl.path, ds=step).summary()
+    row.update(
+        error=None,
+        deviation_m=fl.mean_dev_all_m,
+        within=fl.within_all,
+        climb_max_deg=pr["climb_max_deg"],
+        min_turn_radius_m=pr["min_turn_radius_m"],
+        length_m=float(pl.length),
+        inside_terrain=fl.inside_terrain,
+    )
+    row["feasible"] = bool(
+        row["climb_max_deg"] <= limits.max_climb_deg + 1e-9
+        and row["min_turn_radius_m"] >= limits.min_turn_radius - 1e-9
+        and fl.inside_terrain == 0
+    )
+
+
 def tune(
     world: World,
     start: Any,
@@ -233,15 +269,7 @@ def tune(
         raise InputError(f"shaping must be a fm2uav.Shaping, got {type(shaping).__name__}")
     agl = level.agl
     limits = as_limits(airframe_limits)
-    g = dict(DEFAULT_GRID)
-    for k, v in (grid or {}).items():
-        if k not in DEFAULT_GRID:
-            raise InputError(f"unknown grid key {k!r}; use {sorted(DEFAULT_GRID)}")
-        g[k] = v
-    p1s = _grid_values("p1", g["p1"], 0.0, None)
-    p2s = _grid_values("p2", g["p2"], 0.0, None)
-    sats = _grid_values("saturation", g["saturation"], 0.0, 1.0)
-    exps = _grid_values("exponent", g["exponent"], 0.0, None)
+    p1s, p2s, sats, exps = _tune_grid(grid)
     step = float(ds) if ds is not None else 2.0 * max(world.spacing[:2])
     if not (np.isfinite(step) and step > 0):
         raise InputError(f"ds must be > 0 metres, got {ds!r}")
@@ -266,22 +294,7 @@ def tune(
             rows.append(row)
             plans.append(None)
             continue
-        fl = flight_level_deviation(world, pl.path, agl)
-        pr = path_profiles(pl.path, ds=step).summary()
-        row.update(
-            error=None,
-            deviation_m=fl.mean_dev_all_m,
-            within=fl.within_all,
-            climb_max_deg=pr["climb_max_deg"],
-            min_turn_radius_m=pr["min_turn_radius_m"],
-            length_m=float(pl.length),
-            inside_terrain=fl.inside_terrain,
-        )
-        row["feasible"] = bool(
-            row["climb_max_deg"] <= limits.max_climb_deg + 1e-9
-            and row["min_turn_radius_m"] >= limits.min_turn_radius - 1e-9
-            and fl.inside_terrain == 0
-        )
+        _measure(row, world, pl, agl, step, limits)
         rows.append(row)
         plans.append(pl)
     if not rows:
