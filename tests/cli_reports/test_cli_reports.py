@@ -69,7 +69,9 @@ CASES = {
     "reproduce-formation": (["reproduce", "formation", "--no-gif"],
                             ["report.html", "case1/report.html", "case2/report.html",
                              "case2-thesis-p/report.html"],
-                            ["case 1: no flight level — leader",
+                            ["case 1: no flight level, walls, relief to 36 cells, dist 120 m"
+                             " — leader",
+                             "case 1 on the stand-in relief (flies over the ridges) — leader",
                              "case 2: level 7, p1 = 0.5, p2 = 1.5 — leader",
                              "case 2: level 7, p1 = 0.5, p2 = 1.5 — leader ideal (105 m AGL)"],
                             ["Results (thesis ch. 6)"]),

@@ -45,12 +45,12 @@ class FormationConfig:
         the nominal triangle puts the followers ``2·dist`` behind and ``2·dist``
         to each side of the leader. Default 60 m (4 cells of the thesis' map).
     leader_speed : float
-        Leader's speed [m/s] > 0. Default 10.
+        Leader's speed [m/s] in [0.1, 300]. Default 10.
     follower_speed : float or None
-        Followers' top speed [m/s] > 0; None: ``1.5 · leader_speed`` (so that
+        Followers' top speed [m/s] in [0.1, 300]; None: ``1.5 · leader_speed`` (so that
         they can catch up after a deformation).
     cycle : float
-        Re-planning period [s] > 0. Default 1.
+        Re-planning period [s] in (0, 600]. Default 1.
     clearance : float or None
         Nodes closer than this to the terrain are impassable for every UAV
         [m] > 0; None: ``2 · max(spacing)``, which keeps every path point above
@@ -76,7 +76,7 @@ class FormationConfig:
     >>> FormationConfig(cycle=0)
     Traceback (most recent call last):
     ...
-    fm2uav.errors.InputError: cycle must be a finite number > 0 s, got 0 (CLI: --cycle)
+    fm2uav.errors.InputError: cycle must be in (0, 600] s, got 0 (CLI: --cycle)
     """
 
     n_followers: int = 2
