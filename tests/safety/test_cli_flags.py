@@ -46,3 +46,18 @@ def test_agl_above_max_agl_is_one_line_naming_the_flag(tmp_path):
     assert res.exit_code == 2
     msg = res.output.strip()
     assert "--max-agl" in msg and "planner.max_agl" in msg and len(msg.splitlines()) == 1
+
+
+def test_no_fly_folder_or_missing_file_is_one_line_naming_the_flag(tmp_path):
+    # acceptance B: a folder given as --no-fly said "file not found"
+    folder = tmp_path / "zones.geojson"
+    folder.mkdir()
+    for arg, says in ((folder, "is a directory, not a file"),
+                      (tmp_path / "none.geojson", "not found")):
+        out = tmp_path / "x"
+        res = CliRunner().invoke(app, ["plan", "--agl", "150", "--no-fly", str(arg),
+                                       "--out", str(out), "--quiet"])
+        msg = res.output.strip()
+        assert res.exit_code == 2, msg
+        assert says in msg and "--no-fly" in msg and str(arg) in msg
+        assert len(msg.splitlines()) == 1 and not out.exists()

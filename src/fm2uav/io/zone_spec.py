@@ -37,6 +37,7 @@ import numpy as np
 import shapely
 from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
+from .. import _validate
 from ..errors import InputError
 
 __all__ = ["ZoneSpec", "CircleSpec", "resolve_zones", "zones_from_cli"]
@@ -186,8 +187,8 @@ def zones_from_cli(files: Any, world: Any, *, crs: Any = None) -> list[Any]:
 
     out: list[Any] = []
     for f in files or ():
-        p = Path(f)
-        if not p.is_file():
-            raise InputError(f"--no-fly {f}: file not found; give a GeoJSON/KML/GPKG/SHP file")
+        # a missing file, a folder, a FIFO: one line each, naming the flag (no hang on a pipe)
+        p = _validate.input_file(f, "the no-fly file (GeoJSON/KML/GPKG/SHP)",
+                                 where=(None, "--no-fly"))
         out.extend(read_zones(str(p), world, crs=crs))
     return out
