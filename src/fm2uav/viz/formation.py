@@ -337,11 +337,17 @@ def thesis_report_html(run: ThesisRun, files: list[str]) -> str:
 
     sc = run.scenario
     names = {c.folder: c.title for c in run.cases}
+    # a case flown on another relief (case 1: scaled to a 36-cell top) is drawn over this
+    # one's terrain: say so, its own report.html shows it over the terrain it flew
+    other = [names[f] for f, c_sc in run.scenarios.items()
+             if f in names and c_sc.description != sc.description]
+    note = (f"; drawn over the as-built relief, which {', '.join(other)} did not fly over "
+            "(see its folder)" if other else "")
     return report_html(
         sc.world,
         {f"{names[f]} — leader": r.positions[:, 0] for f, r in run.flights.items()},
-        title="Thesis ch. 6 formations: the leaders of the three cases",
-        subtitle=f"{sc.description} — each case's own report.html is in its folder",
+        title=f"Thesis ch. 6 formations: the leaders of the {len(run.cases)} cases",
+        subtitle=f"{sc.description} — each case's own report.html is in its folder{note}",
         ideal_agl={f"{names[f]} — leader": r.agl[0] for f, r in run.flights.items()
                    if r.agl[0] is not None},
         params={"seed": run.seed, "cases": ", ".join(names)},
