@@ -239,3 +239,15 @@ def test_survey_area_files_in_lonlat(tmp_path, driver, name):
     assert src.role == "area" and len(src.sha256) == 64
     b = w.bounds
     assert b[0, 0] < area.bounds[0] < area.bounds[2] < b[0, 1]
+
+
+def test_an_empty_buildings_file_on_a_dem_warns(tmp_path):
+    # acceptance note C: an empty FeatureCollection with --buildings ran without a word
+    from fm2uav.world.dem import GeodataWarning
+
+    f = tmp_path / "none.geojson"
+    f.write_text(json.dumps({"type": "FeatureCollection", "features": []}))
+    dem = _lonlat_world()
+    with pytest.warns(GeodataWarning, match="no features, so no building is drawn"):
+        w = World.from_buildings(f, None, terrain=dem)
+    assert w.occupancy.sum() == dem.occupancy.sum()

@@ -464,6 +464,12 @@ def _report_left_out(data: Any, outside: int, off_grid: int) -> None:
 
     from .dem import GeodataWarning
 
+    if not len(data.geometries) and not data.skipped:  # an empty file on a DEM (no error)
+        warnings.warn(f"buildings {data.source.path or '(given)'}: the file has no features, "
+                      "so no building is drawn (the world is the terrain alone); check the "
+                      "file given as world.buildings / --buildings", GeodataWarning,
+                      stacklevel=3)
+        return
     names = {"invalid": "invalid (e.g. zero-area)"}
     parts = [f"{n} {names.get(k, k)} feature(s)" for k, n in sorted(data.skipped.items())]
     if outside:
