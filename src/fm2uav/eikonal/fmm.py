@@ -243,11 +243,5 @@ def run_march(
         stop_mask = np.zeros(1, dtype=np.uint8)
         n_stop = 0
 
-    itype = np.int32 if flat_speed.size < 2**31 - 1 else np.int64
-    heap = np.empty(flat_speed.size, dtype=itype)
-    hkey = np.empty(flat_speed.size, dtype=np.float64)
-    hpos = np.empty(flat_speed.size, dtype=itype)
-    _kernels.march(
-        flat_speed, T, state, *shape3, *h3, order, stop_mask, n_stop, heap, hkey, hpos
-    )
+    _kernels.march(flat_speed, T, state, shape3, h3, order, stop_mask, n_stop)
     return T.reshape(shape)

@@ -1,0 +1,106 @@
+"""The march's monotone radix queue at its limits: exact ties, a band larger
+than the initial entry pool (pool growth and resume), huge key spreads.
+
+Expected values are exact (derived in the comments); ``rtol = 1e-12``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from fmm_checks import assert_same_field
+
+from fm2uav.eikonal import _kernels, fast_marching
+from fm2uav.eikonal._reference import fast_marching_reference
+
+RTOL = 1e-12
+
+
+@pytest.fixture
+def grow_calls(monkeypatch):
+    """Count the pool doublings of the march."""
+    calls = []
+    original = _kernels._grow
+
+    def spy(pool, nxt, st):
+        calls.append(nxt.size)
+        return original(pool, nxt, st)
+
+    monkeypatch.setattr(_kernels, "_grow", spy)
+    return calls
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_checkerboard_sources_overflow_the_initial_pool(grow_calls, order):
+    # Sources on every node with i + j even (more than 64: plain T = 0 nodes),
+    # speed 2, h = 1. Every other node has a source on both sides along both
+    # axes, so its update is the two-axis one from T1 = T2 = 0:
+    # 2 T^2 = (h/v)^2 -> T = 1 / (2 sqrt 2); order 2 cannot apply (the nodes two
+    # steps away are not frozen before it). The band holds half the grid,
+    # far more than the initial pool (1/16 of the nodes): the march must grow
+    # the pool and resume.
+    n = 600
+    i, j = np.indices((n, n))
+    src = np.argwhere((i + j) % 2 == 0)
+    T = fast_marching(np.full((n, n), 2.0), src, order=order)
+    expected = np.where((i + j) % 2 == 0, 0.0, 1.0 / (2.0 * math.sqrt(2.0)))
+    assert_same_field(T, expected, RTOL)
+    assert len(grow_calls) >= 2
+
+
+def test_band_given_on_entry_larger_than_the_pool(grow_calls):
+    # Every node starts in the band with a time far above its arrival time
+    # (1e6 + anything); each is lowered by the march long before that key could
+    # be popped, so the result is the plain march from the source. Seeding the
+    # band overflows the initial pool (phase 0 resumes after growing).
+    n = 500
+    speed = np.random.default_rng(7).uniform(0.5, 2.0, (n, n))
+    plain = fast_marching(speed, [(n // 2, n // 3)], order=1, source_ball=False)
+    T = np.full(n * n, 1e6) + np.arange(n * n)
+    state = np.full(n * n, _kernels.BAND, dtype=np.uint8)
+    c = (n // 2) * n + n // 3
+    T[c] = 0.0
+    state[c] = _kernels.FROZEN
+    _kernels.march(speed.reshape(-1), T, state, (n, n, 1), (1.0, 1.0, 1.0), 1,
+                   np.zeros(1, np.uint8), 0)
+    assert grow_calls
+    assert_same_field(T.reshape(n, n), plain, RTOL)
+
+
+@pytest.mark.parametrize("order", [1, 2])
+@pytest.mark.parametrize("shape", [(300, 200), (20, 30, 40)])
+def test_plane_wave_has_many_exact_ties(shape, order):
+    # Sources on the whole face x = 0, speed 1, h = 1: a plane wave, T = i
+    # exactly (a linear T is exact for both stencils). All nodes of a plane
+    # share one key, hundreds of exact ties in one bucket (several blocks).
+    src = np.argwhere(np.indices(shape)[0] == 0)
+    T = fast_marching(np.ones(shape), src, order=order)
+    expected = np.broadcast_to(
+        np.arange(shape[0], dtype=float).reshape((-1,) + (1,) * (len(shape) - 1)), shape
+    )
+    assert_same_field(T, expected, RTOL)
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_keys_spanning_many_binary_orders_match_the_reference(order):
+    # Speeds from 1e-6 to 1e3 (seeded): keys differ by up to ~12 orders of
+    # magnitude, so entries live on many radix levels at once.
+    rng = np.random.default_rng(3)
+    speed = 10.0 ** rng.uniform(-6, 3, (14, 13))
+    T = fast_marching(speed, [(0, 0), (13, 12)], order=order)
+    R = fast_marching_reference(speed, [(0, 0), (13, 12)], order=order)
+    assert_same_field(T, R, 1e-9)
+
+
+def test_stop_at_after_pool_growth(grow_calls):
+    # Checkerboard sources as above plus stop_at: the march stops once the stop
+    # node is frozen, after at least one resume; the stop node has its value.
+    n = 600
+    i, j = np.indices((n, n))
+    src = np.argwhere((i + j) % 2 == 0)
+    stop = (n - 1, n - 2)  # i + j odd: not a source
+    T = fast_marching(np.full((n, n), 2.0), src, order=1, stop_at=[stop])
+    assert math.isclose(T[stop], 1.0 / (2.0 * math.sqrt(2.0)), rel_tol=RTOL)
+    assert grow_calls
