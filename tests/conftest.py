@@ -5,6 +5,10 @@ whole session (the reproductions, the default mission) and hands every caller th
 result and output folder. Tests that read such a run must not write into its folder (a
 second run without ``--force`` is fine: it is refused and leaves the folder as it was).
 
+``rough_tif`` (a seeded rough GeoTIFF DEM) and ``corridor`` (the formation corridor world) are
+shared by test folders that mirror different packages, so they live here too; fixtures used by
+one folder only stay in that folder's conftest.py.
+
 Long end-to-end tests are marked ``@pytest.mark.slow``: ``make test`` runs them,
 ``make test-fast`` (``-m "not slow"``) leaves them out.
 """
@@ -50,3 +54,34 @@ def cli_once(tmp_path_factory):
         return done[key]
 
     return run
+
+
+@pytest.fixture(scope="session")
+def rough_tif(tmp_path_factory):
+    """A seeded rough GeoTIFF DEM in lon/lat (tests/world/rough_terrain.py), written once;
+    read by the world, io and planning flight-safety tests."""
+    from tests.world.rough_terrain import rough_dem, write_geotiff
+
+    path = tmp_path_factory.mktemp("dem") / "rough.tif"
+    return write_geotiff(path, rough_dem(5))
+
+
+def corridor_world(width_cells: int = 8, length: tuple[int, int] = (20, 40)):
+    """60 x 40 x 14 nodes of 10 m: flat ground, two walls up to 125 m (just below the
+    130 m ceiling, so the clearance band closes them) leaving a corridor along y = 20."""
+    import numpy as np
+
+    from fm2uav import World
+
+    h = np.zeros((60, 40))
+    lo = 20 - width_cells // 2
+    hi = 20 + width_cells // 2
+    h[length[0]:length[1], :lo] = 125.0
+    h[length[0]:length[1], hi + 1:] = 125.0
+    return World.from_heightmap(h, 10.0, 14, name="corridor")
+
+
+@pytest.fixture(scope="session")
+def corridor():
+    """The corridor world (``corridor_world()``), shared by the formation and viz tests."""
+    return corridor_world()

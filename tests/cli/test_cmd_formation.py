@@ -1,4 +1,4 @@
-"""`fm2uav formation`: outputs, exit codes; the figures and the GIF of a flight."""
+"""`fm2uav formation` and `fm2uav reproduce formation` (cli/cmd_formation.py): outputs, exit codes."""
 
 import csv
 import json
@@ -8,14 +8,6 @@ import pytest
 from typer.testing import CliRunner
 
 from fm2uav.cli import app
-from fm2uav import FormationConfig
-from fm2uav.missions.formation import fly_formation
-from fm2uav.viz.formation import (
-    formation_animation,
-    formation_metrics_figure,
-    formation_paths_figure,
-    formation_profiles_figure,
-)
 
 runner = CliRunner()
 
@@ -53,20 +45,9 @@ def test_formation_cli_bad_input_exit_codes(tmp_path):
     assert res.exit_code == 2
 
 
-def test_figures_and_gif(corridor, tmp_path):
-    r = fly_formation(corridor, (50.0, 200.0, 60.0), (550.0, 200.0, 60.0),
-                      config=FormationConfig(dist=20.0, leader_speed=8.0, clearance=20.0))
-    for make in (formation_paths_figure, formation_profiles_figure, formation_metrics_figure):
-        fig = make(r)
-        assert len(fig.axes) >= 2
-    gif = formation_animation(r, tmp_path / "a.gif", max_frames=4, dpi=40)
-    data = gif.read_bytes()
-    assert data[:6] in (b"GIF87a", b"GIF89a")
-
-
 @pytest.mark.slow
 def test_reproduce_formation_table(cli_once):
-    # the same run as tests/cli_reports (one run per session, tests/conftest.py)
+    # the same run as tests/e2e/test_reports.py (one run per session, tests/conftest.py)
     run = cli_once(["reproduce", "formation", "--no-gif", "--report", "--json"])
     res, out = run.result, run.out
     assert res.exit_code == 0, res.output

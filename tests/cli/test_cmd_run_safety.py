@@ -14,7 +14,7 @@ from typer.testing import CliRunner
 
 from fm2uav.cli import app
 
-from .conftest import rough_dem, source_ground, write_geotiff
+from tests.world.rough_terrain import rough_dem, source_ground, write_geotiff
 
 WEST, NORTH = -3.80, 40.36
 PIX = 1.0 / 1200.0

@@ -17,7 +17,7 @@ from typer.testing import CliRunner
 from fm2uav.cli import app
 from fm2uav.io import read_path_csv
 
-from . import geodata_data as gd
+from tests.world import geodata_data as gd
 
 runner = CliRunner()
 BBOX = "10.05,45.54,10.20,45.66"

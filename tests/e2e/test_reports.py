@@ -91,7 +91,7 @@ def _cases():
 def runs(tmp_path_factory, cli_once):
     """Every command run once, when a test first asks for it, with --report --json:
     name -> (result, out dir, args). The reproductions go through the session's
-    ``cli_once`` (tests/conftest.py), shared with the tests of tests/city, tff, formation."""
+    ``cli_once`` (tests/conftest.py), shared with tests/cli/test_cmd_city.py, test_cmd_tff.py, test_cmd_formation.py."""
     tmp = tmp_path_factory.mktemp("cli_reports")
     bent = str(_bent_path(tmp))
 
@@ -225,7 +225,7 @@ def test_bad_input_is_checked_before_any_work(tmp_path):
 def test_formation_report_renders_in_headless_chromium(runs):
     """Open the formation report in Chromium: no JS error, file-only requests, a WebGL
     scene with every UAV's track, and a non-blank screenshot showing the coloured tracks."""
-    from tests.report.cdp import Browser, find_chromium
+    from tests.viz.cdp import Browser, find_chromium
 
     chromium = find_chromium()
     if chromium is None:

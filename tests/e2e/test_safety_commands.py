@@ -177,7 +177,7 @@ def test_plan_report_hatches_filled_nodata(tmp_path):
     """`fm2uav plan --dem ... --nodata fill --report`: the filled DEM gaps are in report.html."""
     from fm2uav.viz.overlays import FILLED_NAME
 
-    from ..world import geodata_data as gd
+    from tests.world import geodata_data as gd
 
     dem = gd.dem_4326(tmp_path / "country_4326.tif")
     out = tmp_path / "p"

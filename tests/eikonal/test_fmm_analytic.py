@@ -35,7 +35,7 @@ import math
 import numpy as np
 import pytest
 import skfmm
-from fmm_checks import distance_from, error_norms, loglog_slope, node_coords
+from .fmm_checks import distance_from, error_norms, loglog_slope, node_coords
 
 from fm2uav.eikonal import fast_marching
 from fm2uav.eikonal.fmm import SOURCE_INIT_CELLS, SOURCE_INIT_FRACTION

@@ -34,7 +34,7 @@ from fractions import Fraction
 
 import numpy as np
 import pytest
-from fmm_checks import SOLVERS, assert_same_field, distance_from
+from .fmm_checks import SOLVERS, assert_same_field, distance_from
 
 from fm2uav.errors import Fm2uavError, InputError
 from fm2uav.eikonal import fast_marching

@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 import pytest
-from fmm_checks import assert_same_field
+from .fmm_checks import assert_same_field
 
 from fm2uav.eikonal import _kernels, fast_marching
 from fm2uav.eikonal._reference import fast_marching_reference

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from fmm_checks import assert_same_field, distance_from
+from .fmm_checks import assert_same_field, distance_from
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import ndimage

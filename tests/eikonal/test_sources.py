@@ -12,8 +12,8 @@ import math
 
 import numpy as np
 import pytest
-from fmm_checks import distance_from
-from point_source_cases import (
+from .fmm_checks import distance_from
+from .point_source_cases import (
     CASES,
     DOC,
     TABLE_HEADER,

@@ -22,7 +22,7 @@ from fm2uav.eikonal.fmm import fast_marching
 from fm2uav.planning import _geodesic_kernels as _k
 from fm2uav.planning.geodesic import descend
 
-from test_geodesic import check_path  # same folder (rootdir-less test module)
+from .test_geodesic import check_path
 
 
 # --------------------------------------------------------------------------- helpers

@@ -24,7 +24,7 @@ from fm2uav.scenarios import get_scenario
 from fm2uav.world import World
 from fm2uav.world.zones import with_zones, zone_from_mapping
 
-from .conftest import rough_dem
+from tests.world.rough_terrain import rough_dem
 
 PIXEL = 1.0 / 1200.0  # 3 arc-seconds
 

@@ -1,6 +1,6 @@
 """The measured table of docs/safety.md is what the code gives today.
 
-Regenerate with ``.venv/bin/python -m tests.safety.test_docs_table`` (prints the table).
+Regenerate with ``.venv/bin/python -m tests.repo.test_safety_doc`` (prints the table).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Small worlds and plans shared by the io tests (fast: tens of thousands of nodes).."""
+"""Small worlds and plans shared by the world tests (fast: tens of thousands of nodes)."""
 
 import numpy as np
 import pytest

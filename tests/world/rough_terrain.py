@@ -1,9 +1,12 @@
-"""Real-ish terrain for the safety tests: GeoTIFFs written here, the Jacksboro DEM."""
+"""Real-ish terrain for the flight-safety tests (world, planning, io, cli): seeded rough relief,
+GeoTIFFs written from it, and an independent bilinear sampler of such a file.
+
+The session fixture ``rough_tif`` (tests/conftest.py) is ``write_geotiff(..., rough_dem(5))``.
+"""
 
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 
 def rough_dem(seed: int, rows: int = 160, cols: int = 200, relief: float = 400.0) -> np.ndarray:
@@ -47,9 +50,3 @@ def source_ground(tif, world, x, y):
     col, row = inv * (np.asarray(lon), np.asarray(lat))
     return ndimage.map_coordinates(z, [np.asarray(row) - 0.5, np.asarray(col) - 0.5], order=1,
                                    mode="nearest")
-
-
-@pytest.fixture(scope="session")
-def rough_tif(tmp_path_factory):
-    path = tmp_path_factory.mktemp("dem") / "rough.tif"
-    return write_geotiff(path, rough_dem(5))

@@ -1,4 +1,4 @@
-"""World.from_buildings (GeoJSON footprints) and the thesis' city scenario."""
+"""World.from_buildings (GeoJSON footprints) and building heights (world/buildings.py)."""
 
 from __future__ import annotations
 
@@ -7,8 +7,6 @@ import pytest
 
 from fm2uav import World
 from fm2uav.errors import WorldError
-from fm2uav.scenarios import get_scenario
-from fm2uav.scenarios.city import city_buildings
 from fm2uav.world.buildings import METRES_PER_LEVEL, building_height
 
 
@@ -50,7 +48,7 @@ def test_levels_building_and_auto_extent():
              [[[20, 10], [22, 10], [22, 12], [20, 12], [20, 10]]]]}},
     ]}
     # in-memory GeoJSON without a crs member: the world's own metres (a *file* without
-    # one is lon/lat per RFC 7946, see tests/world/test_geodata_vectors.py)
+    # one is lon/lat per RFC 7946, see tests/world/test_vectors.py)
     w = World.from_buildings(fc, 1.0, margin=2.0)
     assert w.origin == (8.0, 8.0, 0.0)
     i, j = w.to_cell(np.array([12.0, 12.0, 0.0]))[:2]
@@ -73,39 +71,3 @@ def test_bad_buildings_raise_world_error():
         World.from_buildings([_sq(0, 0, 2, {"height": 5})], -1.0)
     with pytest.raises(WorldError, match="does not exist"):
         World.from_buildings("/no/such/file.geojson", 1.0)
-
-
-@pytest.mark.parametrize("seed", [0, 1, 2, 3])
-def test_city_matches_thesis_description(seed):
-    fc = city_buildings(seed)
-    feats = fc["features"]
-    assert len(feats) == 15
-    widths = [f["properties"]["width"] for f in feats]
-    heights = [f["properties"]["height"] for f in feats]
-    assert min(widths) >= 20 and max(widths) <= 60
-    assert min(heights) >= 220 and max(heights) <= 390
-    sc = get_scenario("city", seed=seed)
-    w = sc.world
-    assert w.spacing == (5.0, 5.0, 5.0) and w.name == "city"
-    # each building column is occupied up to its height
-    for f in feats:
-        ring = np.array(f["geometry"]["coordinates"][0])
-        c = ring[:4].mean(axis=0)
-        i, j = w.to_cell(np.array([c[0], c[1], 0.0]))[:2]
-        top_z = w.surface_index()[i, j] * 5.0
-        assert top_z == pytest.approx(f["properties"]["height"], abs=5.0)
-    for p in (sc.start, sc.goal):
-        assert not w.occupancy[w.to_cell(p)]
-    high = get_scenario("city-high", seed=seed)
-    assert high.world is w  # cached, shared
-    assert high.start[2] > 390.0 > sc.start[2]
-
-
-def test_city_is_seeded():
-    a = get_scenario("city", seed=5).world.occupancy
-    b = get_scenario("city", seed=5).world.occupancy
-    c = get_scenario("city", seed=6).world.occupancy
-    np.testing.assert_array_equal(a, b)
-    assert (a != c).any()
-    g = np.random.default_rng(5)
-    assert city_buildings(g) == city_buildings(np.random.default_rng(5))

@@ -6,7 +6,7 @@ import numpy as np
 
 from fm2uav.world import World
 
-from .conftest import source_ground
+from .rough_terrain import source_ground
 
 
 def test_ground_height_is_the_source_dem_bilinear(rough_tif):
@@ -28,7 +28,7 @@ def test_ground_height_is_the_source_dem_bilinear(rough_tif):
 
 def test_ground_model_kept_when_the_dem_is_coarser(rough_tif):
     # the bilinear surface of a finer reprojected grid is not the DEM's own:
-    # the model is kept at any cell size (acceptance, tests/acceptance)
+    # the model is kept at any cell size (acceptance, tests/e2e/test_acc_ground_coarse_dem.py)
     w = World.from_dem(str(rough_tif), (40.0, 40.0, 20.0))
     assert w.ground is not None and w.ground.pixel_m > 40.0
     rng = np.random.default_rng(2)
