@@ -11,7 +11,7 @@ from a fresh run of the reproduction. ``python -m fm2uav.experiments.docs`` prin
 block, ``--write`` replaces them in the pages, ``--check`` compares the pages with a fresh
 run and exits 1 on a difference; names select blocks, ``--fast`` only the blocks that
 take seconds. Wall-time cells (columns named with "time", "[s]", "(s)" or "warm") are
-not compared: they change run to run. ``tests/experiments/test_docs_generated.py`` runs
+not compared: they change run to run. ``tests/experiments/test_docs.py`` runs
 the check (the slow blocks under ``-m slow``).
 """
 

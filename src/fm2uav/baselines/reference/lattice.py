@@ -8,7 +8,7 @@ in an (x, y, θ) state lattice whose edges are biarcs between lattice poses
 Every edge is a real curve, so the result is a feasible path of the model
 (for Dubins: curvature ``<= 1/ξ`` everywhere) whose cost converges to the
 continuous optimum as the lattice is refined; in free space the Dubins
-length is within 2 % of the exact one (tests/reference).
+length is within 2 % of the exact one (tests/baselines/reference).
 
 A primitive is collision-free when the grid nodes nearest to its samples
 (every 0.2 cell) are all free.
