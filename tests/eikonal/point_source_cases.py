@@ -1,6 +1,6 @@
 """Point sources in varying media: analytic cases, our errors and scikit-fmm's, rates.
 
-Shared by ``test_point_sources.py`` (which asserts on these numbers) and
+Shared by ``test_sources.py`` (which asserts on these numbers) and
 ``docs/eikonal.md`` (whose accuracy table is this module's output)::
 
     .venv/bin/python tests/eikonal/point_source_cases.py           # print the tables

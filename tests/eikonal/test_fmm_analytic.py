@@ -6,7 +6,7 @@ margin added. Measured numbers (this discretisation, point source at a node,
 frozen ball of radius ``R = max(2 h, 0.05 * extent)``, i.e. ``R = 0.05 m`` on
 the unit domain once ``2 h <= 0.05``, n >= 41; exact straight-ray times at
 constant speed, the factored equation where the speed varies, see
-``test_point_sources.py`` for varying media):
+``test_sources.py`` for varying media):
 
 * First order converges at rate ~1 on [0, 1]^2 with n = 41..321 (least-squares
   slope 0.98 max / 1.01 L1, every refinement 0.97..1.02). In 3D (n = 41..161)

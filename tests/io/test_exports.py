@@ -1,5 +1,5 @@
 """Mission exports: waypoint thinning, QGC .plan structure and checker, WPL 110 (loaded by
-pymavlink), GeoJSON/KML round trips (the mission content itself: test_missions.py)."""
+pymavlink), GeoJSON/KML round trips (the mission content itself: test_build.py)."""
 
 import io
 import json
