@@ -25,7 +25,7 @@ import numpy as np
 
 from ..geometry import arc_length
 from ..planning import Plan, Shaping, plan
-from ..vehicles import FeasibilityReport, check_feasibility, get_airframe
+from ..vehicles import FeasibilityReport, TrackingOptions, check_feasibility, get_airframe
 from ..world import World
 from ..scenarios import Scenario, get_scenario
 from ..baselines.rrt import RRTResult, plan_rrt
@@ -133,13 +133,13 @@ def run_city_case(
                                  shaping=Shaping(exponent=exponent, walls=True)), [w2])
         path3 = np.column_stack([p.path, np.full(len(p.path), z)])
         rep = check_feasibility(path3, airframe, world=w3, w=p.w, tolerance=tolerance,
-                                lookahead=lookahead)
+                                tracking=TrackingOptions(lookahead=lookahead))
     else:
         p, _ = warm(lambda: plan(w3, scenario.start, scenario.goal,
                                  shaping=Shaping(exponent=exponent, walls=True)), [w3])
         path3 = p.path
         rep = check_feasibility(path3, airframe, world=w3, w=p.w, tolerance=tolerance,
-                                lookahead=lookahead)
+                                tracking=TrackingOptions(lookahead=lookahead))
     return CityCase(mission=mission, exponent=float(exponent), plan=p, path3=path3, report=rep,
                     world3=w3)
 
