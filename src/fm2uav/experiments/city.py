@@ -28,7 +28,7 @@ from ..planning import Plan, Shaping, plan
 from ..vehicles import FeasibilityReport, TrackingOptions, check_feasibility, get_airframe
 from ..world import World
 from ..scenarios import Scenario, get_scenario
-from ..baselines.rrt import RRTResult, plan_rrt
+from ..baselines.rrt import RRTOptions, RRTResult, plan_rrt
 from ._timing import WARM_NOTE, warm
 
 __all__ = [
@@ -197,8 +197,8 @@ def rrt_comparison(
     else:
         wp, s, g = w3, scenario.start, scenario.goal
     for name in planners:
-        r = plan_rrt(wp, s, g, planner=name,
-                     time_limit=rrtstar_time if name == "rrtstar" else time_limit, seed=seed)
+        budget = rrtstar_time if name == "rrtstar" else time_limit
+        r = plan_rrt(wp, s, g, planner=name, options=RRTOptions(time_limit=budget, seed=seed))
         path3 = r.path if wp.ndim == 3 else np.column_stack([r.path, np.full(len(r.path), z)])
         rep = check_feasibility(path3, af, world=w3, tolerance=tolerance)
         results[name] = r
