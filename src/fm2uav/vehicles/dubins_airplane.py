@@ -7,9 +7,9 @@ Model (Beard & McLain's Dubins airplane, thesis eq. 3.2), constant speed V::
 
 Guidance (where the thesis' eqs 3.3–3.10 are ambiguous, see docs/feasibility.md):
 a pure-pursuit carrot follower. The aircraft's position is projected on the
-planned path (monotone progress); the carrot is the path point ``lookahead``
-metres further along (the thesis' "p_{i+a}", eqs 3.5–3.6: ``lookahead_points=a``
-gives ``a`` path steps). Heading: the pure-pursuit turn rate
+planned path (monotone progress); the carrot is the path point
+``TrackingOptions.lookahead`` metres further along (the thesis' "p_{i+a}", eqs
+3.5–3.6: ``TrackingOptions(lookahead_points=a)`` gives ``a`` path steps). Heading: the pure-pursuit turn rate
 ``ψ̇ = 2 V cosγ sin η / L_xy`` (η = bearing of the carrot minus ψ, L_xy its
 horizontal distance; a carrot behind the aircraft commands the maximum rate),
 the thesis' proportional law ρ = K_ψ e(ψ) with gain 2V/L. Flight-path angle:
