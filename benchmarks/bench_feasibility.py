@@ -20,7 +20,7 @@ import numpy as np
 def run(quick: bool = False) -> list[dict]:
     from fm2uav import Shaping, World, plan
     from fm2uav.experiments.city import city_missions, horizontal_slice
-    from fm2uav.baselines.rrt import plan_rrt
+    from fm2uav.baselines.rrt import RRTOptions, plan_rrt
     from fm2uav.vehicles import check_feasibility
 
     repeats = 1 if quick else 5
@@ -47,8 +47,10 @@ def run(quick: bool = False) -> list[dict]:
         fm_s, p = median_time(lambda: plan(fresh(), s, g, shaping=shaping), repeats)
         for name in planners:
             budget = 1.0 if name == "rrtstar" else 10.0
-            plan_rrt(base, s, g, planner=name, time_limit=budget)  # warm-up
-            rr_s, r = median_time(lambda: plan_rrt(base, s, g, planner=name, time_limit=budget), repeats)
+            plan_rrt(base, s, g, planner=name, options=RRTOptions(time_limit=budget))  # warm-up
+            rr_s, r = median_time(
+                lambda: plan_rrt(base, s, g, planner=name, options=RRTOptions(time_limit=budget)),
+                repeats)
             rows.append({
                 "benchmark": "feasibility/fm2-vs-rrt",
                 "case": f"{label}: FM² W^1 vs {r.planner}+shortcut",

@@ -17,14 +17,8 @@ from typing import TYPE_CHECKING, Any
 from .analysis import flight_level_deviation, path_profiles
 from .analysis.tune import tune
 from .eikonal import distance_map, fast_marching, velocity_map
-from .errors import (
-    Fm2uavError,
-    InputError,
-    PlanningError,
-    PointError,
-    UnreachableError,
-    WorldError,
-)
+from . import errors
+from .errors import *  # noqa: F403 -- the error hierarchy, listed once in errors.__all__
 from .missions import (
     CoveragePlan,
     FormationConfig,
@@ -105,12 +99,7 @@ __all__ = [
     "scenarios",
     "vehicles",
     "viz",
-    # errors
-    "Fm2uavError",
-    "InputError",
-    "WorldError",
-    "PlanningError",
-    "PointError",
-    "UnreachableError",
+    # errors (Fm2uavError, InputError, WorldError, ...)
+    *errors.__all__,
     "__version__",
 ]

@@ -38,6 +38,7 @@ __all__ = [
     "choice",
     "flag",
     "point",
+    "grid",
     "input_file",
     "read_text",
     "load_yaml",
@@ -196,6 +197,37 @@ def point(value: Any, ndim: int, what: str, *, where: Where = None) -> np.ndarra
     if not np.all(np.isfinite(arr)):
         raise InputError(f"{what} must be finite, got {arr.tolist()}{where_text(where)}")
     return arr
+
+
+def grid(value: Any, what: str, *, holding: str = "") -> np.ndarray:
+    """``value`` as a non-empty 2D or 3D float64 array of numbers (not bools).
+
+    ``holding`` completes "must be a numeric array" in the message (e.g. ``" of
+    arrival times"``).
+
+    Raises
+    ------
+    InputError
+        Not numeric, not 2D/3D, or empty.
+
+    Examples
+    --------
+    >>> grid([[1, 2], [3, 4]], "speed").dtype
+    dtype('float64')
+    >>> grid([1, 2], "speed")
+    Traceback (most recent call last):
+    ...
+    fm2uav.errors.InputError: speed must be a 2D or 3D array, got 1D with shape (2,)
+    """
+    arr = np.asarray(value)
+    if arr.dtype == bool or arr.dtype.kind not in "iuf":
+        raise InputError(f"{what} must be a numeric array{holding}, got dtype {arr.dtype}")
+    if arr.ndim not in (2, 3):
+        raise InputError(f"{what} must be a 2D or 3D array, got {arr.ndim}D with shape "
+                         f"{arr.shape}")
+    if min(arr.shape) < 1:
+        raise InputError(f"{what} must not be empty, got shape {arr.shape}")
+    return np.asarray(arr, dtype=np.float64)
 
 
 # ---------------------------------------------------------------------------------------

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from fm2uav import World
-from fm2uav.baselines.rrt import plan_rrt
+from fm2uav.baselines.rrt import RRTOptions, plan_rrt
 from fm2uav.errors import InputError, PointError, UnreachableError
 
 
@@ -19,7 +19,8 @@ def _wall_world():
 @pytest.mark.parametrize("planner", ["rrt", "rrtconnect", "rrtstar"])
 def test_rrt_paths_are_valid(planner):
     w = _wall_world()
-    r = plan_rrt(w, (5.0, 5.0), (55.0, 5.0), planner=planner, time_limit=0.3 if planner == "rrtstar" else 5.0)
+    r = plan_rrt(w, (5.0, 5.0), (55.0, 5.0), planner=planner,
+                 options=RRTOptions(time_limit=0.3 if planner == "rrtstar" else 5.0))
     np.testing.assert_allclose(r.path[0], [5, 5])
     np.testing.assert_allclose(r.path[-1], [55, 5])
     cells = w.to_cell(r.path)
@@ -45,4 +46,5 @@ def test_rrt_3d_and_errors():
     sealed = occ.copy()
     sealed[8:12, :, :] = True
     with pytest.raises(UnreachableError):
-        plan_rrt(World(sealed, spacing=2.0), (4.0, 20.0, 4.0), (34.0, 20.0, 4.0), time_limit=0.2)
+        plan_rrt(World(sealed, spacing=2.0), (4.0, 20.0, 4.0), (34.0, 20.0, 4.0),
+                 options=RRTOptions(time_limit=0.2))

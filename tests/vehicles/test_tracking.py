@@ -11,6 +11,7 @@ from fm2uav import World
 from fm2uav.errors import InputError
 from fm2uav.vehicles import (
     FixedWing,
+    TrackingOptions,
     check_feasibility,
     get_airframe,
     track_dubins,
@@ -45,7 +46,7 @@ def test_straight_path_has_zero_separation(airframe):
 
 
 def test_dubins_flies_at_constant_speed_with_exact_kinematics():
-    tr = track_dubins(_circle(3 * R), DISCO, dt=0.02)
+    tr = track_dubins(_circle(3 * R), DISCO, tracking=TrackingOptions(dt=0.02))
     step = np.linalg.norm(np.diff(tr.trajectory, axis=0), axis=1)
     # each step is a chord of an arc of length V dt
     assert np.all(step <= DISCO.cruise_speed * tr.dt + 1e-9)
@@ -88,10 +89,10 @@ def test_steep_climb_saturates_climb_limit():
 
 def test_lookahead_points_is_a_times_the_step():
     p = _line(length=400, n=81)  # 5 m steps
-    tr = track_dubins(p, DISCO, lookahead_points=4)
+    tr = track_dubins(p, DISCO, tracking=TrackingOptions(lookahead_points=4))
     assert tr.lookahead == pytest.approx(20.0)
     with pytest.raises(InputError):
-        track_dubins(p, DISCO, lookahead=10.0, lookahead_points=2)
+        track_dubins(p, DISCO, tracking=TrackingOptions(lookahead=10.0, lookahead_points=2))
 
 
 def test_multirotor_follows_a_tight_circle():
@@ -141,7 +142,7 @@ def test_bad_options_raise_input_error():
     with pytest.raises(InputError):
         check_feasibility(p, DISCO, tolerance=0.0)
     with pytest.raises(InputError):
-        track_dubins(p, DISCO, dt=-0.1)
+        track_dubins(p, DISCO, tracking=TrackingOptions(dt=-0.1))
     with pytest.raises(InputError):
         track_dubins(p, "arducopter")
     with pytest.raises(InputError):

@@ -60,6 +60,12 @@ def _as_curve(c: Any, what: str) -> np.ndarray:
     return np.ascontiguousarray(arr)
 
 
+
+def _as_curves(P: Any, Q: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The two curves ``P``, ``Q`` of a comparison as (N, d) float arrays (:func:`_as_curve`)."""
+    return _as_curve(P, "P"), _as_curve(Q, "Q")
+
+
 def frechet_distance(P: Any, Q: Any) -> float:
     """Discrete Fréchet distance between two polylines (compiled, O(N·M)).
 
@@ -82,8 +88,7 @@ def frechet_distance(P: Any, Q: Any) -> float:
     >>> frechet_distance([[0, 0], [1, 0], [2, 0]], [[0, 1], [2, 1]])
     1.4142135623730951
     """
-    p = _as_curve(P, "P")
-    q = _as_curve(Q, "Q")
+    p, q = _as_curves(P, Q)
     if p.shape[1] != q.shape[1]:
         raise InputError(f"P and Q must have the same dimension, got {p.shape[1]} and {q.shape[1]}")
     return float(_frechet_kernel(p, q))
@@ -129,8 +134,7 @@ def area_between_curves(P: Any, Q: Any) -> float:
     >>> area_between_curves([[0, 0], [1, 1], [2, 0]], [[0, 0], [2, 0]])
     1.0
     """
-    p = _as_curve(P, "P")
-    q = _as_curve(Q, "Q")
+    p, q = _as_curves(P, Q)
     if p.shape[1] != 2 or q.shape[1] != 2:
         raise InputError("area_between_curves needs 2D curves (N, 2)")
     ring = np.concatenate([p, q[::-1], p[:1]])

@@ -267,38 +267,52 @@ def tune(
                          "e.g. FlightLevel(agl=150.0)")
     if not isinstance(shaping, Shaping):
         raise InputError(f"shaping must be a fm2uav.Shaping, got {type(shaping).__name__}")
-    agl = level.agl
     limits = as_limits(airframe_limits)
     p1s, p2s, sats, exps = _tune_grid(grid)
     step = float(ds) if ds is not None else 2.0 * max(world.spacing[:2])
     if not (np.isfinite(step) and step > 0):
         raise InputError(f"ds must be > 0 metres, got {ds!r}")
-
-    rows: list[dict[str, Any]] = []
-    plans: list[Plan | None] = []
+    rows, plans = [], []
     for sat, beta, p1, p2 in itertools.product(sats, exps, p1s, p2s):
         if p2 <= p1:
             continue
         row: dict[str, Any] = {"p1": p1, "p2": p2, "saturation": sat, "exponent": beta}
-        try:
-            pl = plan(world, start, goal,
-                      shaping=dataclasses.replace(shaping, saturation=sat, exponent=beta),
-                      # tune Algorithm 2 itself: the FM² heights, not the final profile
-                      level=dataclasses.replace(level, p1=p1, p2=p2, heights="fm2"),
-                      options=options)
-        except PlanningError as exc:
-            if not rows:  # the first plan fails: bad start/goal/agl, not the parameters
-                raise
-            row.update(error=str(exc), feasible=False, deviation_m=np.inf, within=0.0,
-                       climb_max_deg=90.0, min_turn_radius_m=0.0, length_m=np.nan)
-            rows.append(row)
-            plans.append(None)
-            continue
-        _measure(row, world, pl, agl, step, limits)
+        pl = _plan_row(row, world, start, goal,
+                       dataclasses.replace(shaping, saturation=sat, exponent=beta),
+                       dataclasses.replace(level, p1=p1, p2=p2, heights="fm2"), options,
+                       first=not rows)
+        if pl is not None:
+            _measure(row, world, pl, level.agl, step, limits)
         rows.append(row)
         plans.append(pl)
     if not rows:
         raise InputError("the grid has no pair with p2 > p1; widen it")
+    return _tune_result(rows, plans, limits)
+
+
+def _plan_row(row: dict[str, Any], world: World, start: Any, goal: Any, shaping: Shaping,
+              level: FlightLevel, options: PlanOptions, *, first: bool) -> Plan | None:
+    """The plan of one grid point (Algorithm 2 itself is tuned: the FM² heights, not the
+    final profile), or None with ``row`` marked as failed.
+
+    Raises
+    ------
+    PlanningError
+        From the ``first`` plan: bad start/goal/agl, not the parameters.
+    """
+    try:
+        return plan(world, start, goal, shaping=shaping, level=level, options=options)
+    except PlanningError as exc:
+        if first:
+            raise
+        row.update(error=str(exc), feasible=False, deviation_m=np.inf, within=0.0,
+                   climb_max_deg=90.0, min_turn_radius_m=0.0, length_m=np.nan)
+        return None
+
+
+def _tune_result(rows: list[dict[str, Any]], plans: list[Plan | None], limits: Any
+                 ) -> TuneResult:
+    """The :class:`TuneResult` of the grid: the feasible row of least deviation, the front."""
     feas = [i for i, r in enumerate(rows) if r["feasible"]]
     best_i = min(feas, key=lambda i: rows[i]["deviation_m"]) if feas else None
     return TuneResult(

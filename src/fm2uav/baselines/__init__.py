@@ -5,6 +5,6 @@ A new baseline planner goes in its own module here; nothing below this layer imp
 """
 
 from .reference import MODELS, ReferencePath, dubins_length, reference_path
-from .rrt import RRTResult, plan_rrt
+from .rrt import RRTOptions, RRTResult, plan_rrt
 
-__all__ = ["RRTResult", "plan_rrt", "MODELS", "ReferencePath", "reference_path", "dubins_length"]
+__all__ = ["RRTOptions", "RRTResult", "plan_rrt", "MODELS", "ReferencePath", "reference_path", "dubins_length"]

@@ -37,11 +37,39 @@ from ..geometry import densify, path_length
 from ..world import World
 from ..world.clearance import clearance_profile
 
-__all__ = ["RRT_PLANNERS", "RRTResult", "plan_rrt"]
+__all__ = ["RRT_PLANNERS", "RRTOptions", "RRTResult", "plan_rrt"]
 
 #: Planner name → OMPL class name.
 RRT_PLANNERS = {"rrt": "RRT", "rrtstar": "RRTstar", "rrtconnect": "RRTConnect"}
 _SEEDED = {"done": False}
+
+
+@dataclass(frozen=True)
+class RRTOptions:
+    """How :func:`plan_rrt` runs its OMPL planner.
+
+    Attributes
+    ----------
+    time_limit : float
+        Planning time budget [s] (RRT*: always used in full). Default 5.
+    range_m : float, optional
+        Maximum tree edge length [m]; default OMPL's (20 % of the map diagonal).
+    goal_bias : float
+        Probability of sampling the goal (RRT, RRT*). Default 0.05.
+    smoothing : {"shortcut", "bspline", "none"}
+        Smoothing of the tree path (see the module docstring). Default "shortcut".
+    simplify_time : float
+        Time cap of the shortcut smoothing [s]. Default 1.
+    seed : int
+        OMPL seed (see the module note on determinism). Default 0.
+    """
+
+    time_limit: float = 5.0
+    range_m: float | None = None
+    goal_bias: float = 0.05
+    smoothing: str = "shortcut"
+    simplify_time: float = 1.0
+    seed: int = 0
 
 
 @dataclass(frozen=True, eq=False)
@@ -187,18 +215,46 @@ def _tree_edges(data: Any, nd: int) -> np.ndarray:
     return np.asarray(edges, dtype=float).reshape(-1, 2, nd)
 
 
+def _seed_once(ou: Any, seed: int) -> bool:
+    """Seed OMPL's global RNG on the first plan of the process (see the module note);
+    whether this call seeded it."""
+    if _SEEDED["done"]:
+        return False
+    ou.RNG.setSeed(int(seed))
+    _SEEDED["done"] = True
+    return True
+
+
+def _planner(og: Any, si: Any, key: str, range_m: float | None, goal_bias: float) -> Any:
+    """The OMPL planner ``key`` on the space information ``si``, with its range [m] and
+    goal bias (RRT, RRT*)."""
+    pl = getattr(og, RRT_PLANNERS[key])(si)
+    if range_m is not None:
+        pl.setRange(float(range_m))
+    if key != "rrtconnect":
+        pl.setGoalBias(float(goal_bias))
+    return pl
+
+
+def _smoothed(og: Any, si: Any, sol: Any, smoothing: str, simplify_time: float) -> Any:
+    """A copy of the solution path ``sol``, shortcut (``simplify_time`` [s] cap) and
+    B-spline smoothed as ``smoothing`` asks."""
+    work = og.PathGeometric(sol)
+    if smoothing != "none":
+        ps = og.PathSimplifier(si)
+        ps.simplify(work, float(simplify_time))
+        if smoothing == "bspline":
+            ps.smoothBSpline(work)
+    return work
+
+
 def plan_rrt(
     world: World,
     start: Any,
     goal: Any,
     *,
     planner: str = "rrt",
-    time_limit: float = 5.0,
-    range_m: float | None = None,
-    goal_bias: float = 0.05,
-    smoothing: str = "shortcut",
-    simplify_time: float = 1.0,
-    seed: int = 0,
+    options: RRTOptions = RRTOptions(),
 ) -> RRTResult:
     """Plan with an OMPL sampling-based planner on a :class:`World`.
 
@@ -209,24 +265,15 @@ def plan_rrt(
     start, goal : sequence of float
         World coordinates [m].
     planner : {"rrt", "rrtstar", "rrtconnect"}
-    time_limit : float
-        Planning time budget [s] (RRT*: always used in full).
-    range_m : float, optional
-        Maximum tree edge length [m]; default OMPL's (20 % of the map diagonal).
-    goal_bias : float
-        Probability of sampling the goal (RRT, RRT*).
-    smoothing : {"shortcut", "bspline", "none"}
-    simplify_time : float
-        Time cap of the shortcut smoothing [s].
-    seed : int
-        OMPL seed (see the module note on determinism).
+    options : RRTOptions
+        Time budget, tree range, goal bias, smoothing and seed.
 
     Raises
     ------
     PointError
         Start/goal outside the map or in an obstacle.
     UnreachableError
-        No exact solution within ``time_limit``.
+        No exact solution within ``options.time_limit``.
     InputError
         Unknown planner/smoothing, bad numbers.
     """
@@ -234,43 +281,30 @@ def plan_rrt(
     from ompl import geometric as og
     from ompl import util as ou
 
-    key = _check_rrt_args(world, planner, smoothing, time_limit)
+    o = options
+    key = _check_rrt_args(world, planner, o.smoothing, o.time_limit)
     nd = world.ndim
     pts = _rrt_points(world, start, goal)
 
     ou.setLogLevel(ou.LOG_ERROR)
-    seeded = False
-    if not _SEEDED["done"]:
-        ou.RNG.setSeed(int(seed))
-        _SEEDED["done"] = True
-        seeded = True
-
+    seeded = _seed_once(ou, o.seed)
     sp = np.asarray(world.spacing)
     ss, si, valid = _simple_setup(ob, og, world, pts)  # keep the Python callback alive
-    pl = getattr(og, RRT_PLANNERS[key])(si)
-    if range_m is not None:
-        pl.setRange(float(range_m))
-    if key != "rrtconnect":
-        pl.setGoalBias(float(goal_bias))
+    pl = _planner(og, si, key, o.range_m, o.goal_bias)
     ss.setPlanner(pl)
 
     t0 = time.perf_counter()
-    ss.solve(float(time_limit))
+    ss.solve(float(o.time_limit))
     t1 = time.perf_counter()
     if not ss.haveExactSolutionPath():
         raise UnreachableError(
             f"{RRT_PLANNERS[key]} found no path from {pts['start'].tolist()} m to "
-            f"{pts['goal'].tolist()} m within {time_limit:g} s; raise time_limit or check that "
+            f"{pts['goal'].tolist()} m within {o.time_limit:g} s; raise time_limit or check that "
             "the goal is reachable"
         )
     sol = ss.getSolutionPath()
     raw = _states(sol, nd)
-    work = og.PathGeometric(sol)
-    if smoothing != "none":
-        ps = og.PathSimplifier(si)
-        ps.simplify(work, float(simplify_time))
-        if smoothing == "bspline":
-            ps.smoothBSpline(work)
+    work = _smoothed(og, si, sol, o.smoothing, o.simplify_time)
     t2 = time.perf_counter()
     verts = _states(work, nd)
     verts[0], verts[-1] = pts["start"], pts["goal"]

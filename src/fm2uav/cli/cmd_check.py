@@ -73,7 +73,7 @@ def check_cmd(
 ) -> None:
     """``fm2uav check``: parse, :func:`~fm2uav.vehicles.check_feasibility`, write, print."""
     from ..io import read_path_csv
-    from ..vehicles import check_feasibility, get_airframe
+    from ..vehicles import TrackingOptions, check_feasibility, get_airframe
 
     af = get_airframe(airframe)
     path = read_path_csv(path_file)
@@ -81,9 +81,10 @@ def check_cmd(
     outdir = output.dir(CHECK_FILES + ((REPORT,) if output.report else ()))
     with output.progress() as step:
         step(f"simulating the {af.name} along the path")
-        rep = check_feasibility(path, af, world=w, tolerance=tolerance,
-                                lookahead=lookahead, lookahead_points=lookahead_points,
-                                speed=speed, dt=dt)
+        rep = check_feasibility(path, af, world=w, tolerance=tolerance, speed=speed,
+                                tracking=TrackingOptions(lookahead=lookahead,
+                                                         lookahead_points=lookahead_points,
+                                                         dt=dt))
     summary = {"path_file": str(path_file), "scenario": scenario, **rep.summary()}
     if w is not None and getattr(w, "georef", None) is not None:
         from ..world.load import world_summary

@@ -24,11 +24,9 @@ from .options import (
     SafetyFlags,
     ScenarioOpt,
     WorldFlags,
-    build_world,
     cli_point,
     mission_options,
     output_options,
-    requested_heights,
     safety_options,
     world_options,
     world_rows,
@@ -175,9 +173,8 @@ def formation_cmd(
     from ..world.load import check_points, world_summary
     from .cmd_run import write_exports
 
-    need_agl, need_top = requested_heights(start, goal, lonlat=lonlat, agl=agl)
-    w, sc, scenario = build_world(world.spec(), scenario=scenario, seed=seed, agl=need_agl,
-                                  top=need_top, default="fissure")
+    w, sc, scenario = world.build(scenario, start, goal, seed=seed, lonlat=lonlat, agl=agl,
+                                  default="fissure")
     if agl is not None and level is not None:
         raise InputError("give either --agl (metres) or --level (cells), not both")
     if level is not None:

@@ -14,11 +14,9 @@ from .options import (
     MissionFlags,
     ScenarioOpt,
     WorldFlags,
-    build_world,
     cli_point,
     mission_options,
     output_options,
-    requested_heights,
     world_options,
     world_rows,
 )
@@ -107,9 +105,7 @@ def plan_cmd(
     from ..missions.route import plan_route
     from ..world.load import world_summary
 
-    need_agl, need_top = requested_heights(start, goal, lonlat=lonlat, agl=agl)
-    w, sc, scenario = build_world(world.spec(), scenario=scenario, seed=seed, agl=need_agl,
-                                  top=need_top)
+    w, sc, scenario = world.build(scenario, start, goal, seed=seed, lonlat=lonlat, agl=agl)
     description = sc.description if sc is not None else f"real data: {scenario}"
     extra = _extra_formats(export, output.report)
     export_options = mission.export_options(_export_options(anchor, thin))

@@ -14,10 +14,8 @@ from .options import (
     LonLatOpt,
     ScenarioOpt,
     WorldFlags,
-    build_world,
     cli_point,
     output_options,
-    requested_heights,
     world_options,
     world_rows,
 )
@@ -206,9 +204,7 @@ def tune_cmd(
 
     grid = _grid(p1=p1, p2=p2, saturation=saturation, exponent=exponent)
     limits = AirframeLimits.from_degrees(max_climb, min_turn_radius)
-    need_agl, need_top = requested_heights(start, goal, lonlat=lonlat, agl=agl)
-    w, sc, scenario = build_world(world.spec(), scenario=scenario, seed=seed, agl=need_agl,
-                                  top=need_top)
+    w, sc, scenario = world.build(scenario, start, goal, seed=seed, lonlat=lonlat, agl=agl)
     s = cli_point(start, "start", w, lonlat=lonlat, agl=agl, default=sc.start if sc else None)
     g = cli_point(goal, "goal", w, lonlat=lonlat, agl=agl, default=sc.goal if sc else None)
     if sc is None:

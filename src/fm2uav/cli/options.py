@@ -38,48 +38,53 @@ __all__ = [
 
 _P = "World (real data)"
 
-DemOpt = Annotated[list[Path] | None, typer.Option(
-    "--dem", show_default=False, rich_help_panel=_P, metavar="FILE",
+
+def _option(kind: Any, flag: str, help: str, *, panel: str, metavar: str | None = None,
+            show_default: bool = False) -> Any:
+    """``Annotated[kind, typer.Option(flag, ...)]`` of a flag in the ``--help`` panel ``panel``."""
+    return Annotated[kind, typer.Option(flag, show_default=show_default, rich_help_panel=panel,
+                                        metavar=metavar, help=help)]
+
+
+DemOpt = _option(
+    list[Path] | None, "--dem", panel=_P, metavar="FILE",
     help="DEM raster, any GDAL format (GeoTIFF, VRT, SRTM .hgt); repeat for tiles. "
-         "Geographic/Web Mercator DEMs are reprojected to the local UTM zone.")]
-BuildingsOpt = Annotated[Path | None, typer.Option(
-    "--buildings", show_default=False, rich_help_panel=_P, metavar="FILE",
+         "Geographic/Web Mercator DEMs are reprojected to the local UTM zone.")
+BuildingsOpt = _option(
+    Path | None, "--buildings", panel=_P, metavar="FILE",
     help="Building footprints: GeoJSON (lon/lat, RFC 7946), GeoPackage, Shapefile, KML/KMZ; "
-         "heights from height, else building:levels x 3 m, else --default-height.")]
-BboxOpt = Annotated[str | None, typer.Option(
-    "--bbox", show_default=False, rich_help_panel=_P, metavar="W,S,E,N",
-    help="Crop the world to W,S,E,N (lon/lat degrees).")]
-SeaLevelOpt = Annotated[float | None, typer.Option(
-    "--sea-level", show_default=False, rich_help_panel=_P,
-    help="Water surface (m): ground = max(DEM, sea level), e.g. 0 for a topo-bathymetric DEM.")]
-CellSizeOpt = Annotated[float | None, typer.Option(
-    "--cell-size", show_default=False, rich_help_panel=_P,
+         "heights from height, else building:levels x 3 m, else --default-height.")
+BboxOpt = _option(str | None, "--bbox", "Crop the world to W,S,E,N (lon/lat degrees).",
+                  panel=_P, metavar="W,S,E,N")
+SeaLevelOpt = _option(
+    float | None, "--sea-level", panel=_P,
+    help="Water surface (m): ground = max(DEM, sea level), e.g. 0 for a topo-bathymetric DEM.")
+CellSizeOpt = _option(
+    float | None, "--cell-size", panel=_P,
     help="Horizontal grid cell (m) of a --dem/--buildings world. Default: the DEM pixel "
-         "(at most 250k columns), 2 m for buildings.")]
-DzOpt = Annotated[float | None, typer.Option(
-    "--dz", show_default=False, rich_help_panel=_P,
-    help="Vertical cell (m). Default: the cell size, at most agl / 6.")]
-CeilingOpt = Annotated[float | None, typer.Option(
-    "--ceiling", show_default=False, rich_help_panel=_P,
-    help="Altitude (m) of the top of the grid. Default: highest ground + agl + margin.")]
-NodataOpt = Annotated[str, typer.Option(
-    "--nodata", rich_help_panel=_P,
+         "(at most 250k columns), 2 m for buildings.")
+DzOpt = _option(float | None, "--dz", panel=_P,
+                help="Vertical cell (m). Default: the cell size, at most agl / 6.")
+CeilingOpt = _option(
+    float | None, "--ceiling", panel=_P,
+    help="Altitude (m) of the top of the grid. Default: highest ground + agl + margin.")
+NodataOpt = _option(
+    str, "--nodata", panel=_P, show_default=True,
     help="DEM gaps under the map: 'error' or 'fill' (nearest valid elevation, marked as "
-         "filled).")]
-NodataValueOpt = Annotated[float | None, typer.Option(
-    "--nodata-value", show_default=False, rich_help_panel=_P,
+         "filled).")
+NodataValueOpt = _option(
+    float | None, "--nodata-value", panel=_P,
     help="An elevation value meaning 'no data' that the DEM file does not declare "
-         "(e.g. -9999).")]
-CrsOpt = Annotated[str | None, typer.Option(
-    "--crs", show_default=False, rich_help_panel=_P,
+         "(e.g. -9999).")
+CrsOpt = _option(
+    str | None, "--crs", panel=_P,
     help="CRS of input files that declare none (e.g. EPSG:32630 for an old GeoJSON in UTM "
-         "metres).")]
-DefaultHeightOpt = Annotated[float | None, typer.Option(
-    "--default-height", show_default=False, rich_help_panel=_P,
-    help="Height (m) of buildings without height or building:levels.")]
-AllowFilledOpt = Annotated[bool, typer.Option(
-    "--allow-filled", rich_help_panel=_P,
-    help="Only warn when the start/goal lies over filled DEM nodata.")]
+         "metres).")
+DefaultHeightOpt = _option(float | None, "--default-height",
+                           "Height (m) of buildings without height or building:levels.",
+                           panel=_P)
+AllowFilledOpt = _option(bool, "--allow-filled", panel=_P, show_default=True,
+                         help="Only warn when the start/goal lies over filled DEM nodata.")
 LonLatOpt = Annotated[bool, typer.Option(
     "--lonlat", help="Read --start/--goal as LON,LAT[,AGL] (degrees, degrees, metres above "
                      "the ground; default AGL: --agl).")]
@@ -411,6 +416,14 @@ class WorldFlags:
         """:func:`world_overrides` of the flags (mission-file ``world:`` keys)."""
         return world_overrides(**self.values())
 
+    def build(self, scenario: str | None, *points: str | None, seed: int, lonlat: bool,
+              agl: float | None, default: str = "open-field") -> tuple[Any, Any, str]:
+        """:func:`build_world` of the flags, a data world sized for ``agl`` and the heights
+        of the ``--start``/``--goal`` texts ``points`` (:func:`requested_heights`)."""
+        need_agl, need_top = requested_heights(*points, lonlat=lonlat, agl=agl)
+        return build_world(self.spec(), scenario=scenario, seed=seed, agl=need_agl,
+                           top=need_top, default=default)
+
 
 #: ``@world_options``: the 12 world flags in place of the command's ``world`` parameter.
 world_options = option_group("world", [
@@ -494,22 +507,21 @@ def output_options(out: str | None, *, out_help: str = "Output directory.",
 
 _S = "Flight safety"
 
-NoFlyOpt = Annotated[list[Path] | None, typer.Option(
-    "--no-fly", show_default=False, rich_help_panel=_S, metavar="FILE",
+NoFlyOpt = _option(
+    list[Path] | None, "--no-fly", panel=_S, metavar="FILE",
     help="No-fly zones file (GeoJSON lon/lat, KML/KMZ, GPKG, SHP; points need a 'radius' in "
          "metres): the zones become obstacles, the flight keeps out of them and the .plan "
-         "carries them as geofences. Repeatable.")]
-MinAglOpt = Annotated[float | None, typer.Option(
-    "--min-agl", show_default=False, rich_help_panel=_S,
+         "carries them as geofences. Repeatable.")
+MinAglOpt = _option(
+    float | None, "--min-agl", panel=_S,
     help="Hard floor (m) above the ground for the whole flight except the take-off/landing "
-         "points (with --agl).")]
-MaxAglOpt = Annotated[float | None, typer.Option(
-    "--max-agl", show_default=False, rich_help_panel=_S,
-    help="Hard ceiling (m) above the ground, e.g. 120 (with --agl).")]
-SaturationDistanceOpt = Annotated[float | None, typer.Option(
-    "--saturation-distance", show_default=False, rich_help_panel=_S,
+         "points (with --agl).")
+MaxAglOpt = _option(float | None, "--max-agl",
+                    "Hard ceiling (m) above the ground, e.g. 120 (with --agl).", panel=_S)
+SaturationDistanceOpt = _option(
+    float | None, "--saturation-distance", panel=_S,
     help="Distance (m) from the obstacles beyond which W = 1 (a margin that means the same "
-         "on any map).")]
+         "on any map).")
 
 
 @dataclass(frozen=True)

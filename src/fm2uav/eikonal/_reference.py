@@ -331,6 +331,84 @@ def _as_nodes(points: Any, ndim: int) -> list[Index]:
     return [tuple(int(c) for c in row) for row in arr.reshape(-1, ndim)]
 
 
+def _source_ball(
+    speed: np.ndarray, source_nodes: list[Index], is_source: set[Index], h: tuple[float, ...]
+) -> tuple[dict[Index, float], bool]:
+    """The ball times around every clean source (node -> smallest over the sources) [s],
+    and whether every source is clean (then the ball nodes are final)."""
+    shape, ndim = speed.shape, speed.ndim
+    ball: dict[Index, float] = {}
+    extent = max((n - 1) * hx for n, hx in zip(shape, h))  # [m]
+    radius = max(SOURCE_RADIUS_CELLS * max(h), SOURCE_RADIUS_FRACTION * extent)  # [m]
+    smallest = SOURCE_RADIUS_CELLS * max(h)  # [m] the last radius tried
+    radii, boxes, box_ranges, clean, constant = [], [], [], [], []
+    for s in source_nodes:
+        r = radius
+        while True:  # radius, radius / 2, ... down to 2 cells: the first clean box
+            reach = [int(math.floor(r / hx)) for hx in h]  # nodes per axis
+            ranges = [
+                range(max(s[ax] - reach[ax], 0), min(s[ax] + reach[ax], shape[ax] - 1) + 1)
+                for ax in range(ndim)
+            ]
+            box = list(itertools.product(*ranges))
+            speeds = [float(speed[node]) for node in box]
+            ok = min(speeds) > 0.0 and max(speeds) <= BALL_MAX_SPEED_RATIO * min(speeds)
+            if ok or r <= smallest:
+                break
+            r = max(0.5 * r, smallest)
+        radii.append(r)
+        box_ranges.append(ranges)
+        boxes.append(box)
+        clean.append(ok)
+        constant.append(min(speeds) == max(speeds))
+    for s, r, box, ranges, ok, flat in zip(
+        source_nodes, radii, boxes, box_ranges, clean, constant
+    ):
+        if not ok:
+            continue
+        v_source = float(speed[s])
+        factored = None if flat else _factored_box_times(speed, s, ranges, h)
+        for node in box:
+            d2 = 0.0
+            for ax in range(ndim):
+                dx = (node[ax] - s[ax]) * h[ax]
+                d2 += dx * dx
+            if d2 > r * r or node in is_source:
+                continue
+            if factored is None:  # constant speed: the exact straight ray
+                t = math.sqrt(d2) * 0.5 * (1.0 / v_source + 1.0 / float(speed[node]))
+            else:
+                t = factored[node]
+            if t < ball.get(node, math.inf):
+                ball[node] = t
+    return ball, all(clean)
+
+
+def _start(speed: np.ndarray, source_nodes: list[Index], h: tuple[float, ...],
+           source_ball: bool) -> tuple[np.ndarray, np.ndarray, list[tuple[float, Index]],
+                                       list[Index]]:
+    """``(T, frozen, band, seeds)`` before the march: the sources at ``T = 0`` (frozen), the
+    ball nodes (frozen when every source is clean, else in the band heap of ``(time,
+    node)``); ``seeds`` are the frozen nodes whose neighbours join the band."""
+    shape = speed.shape
+    T = np.full(shape, math.inf)
+    frozen = np.zeros(shape, dtype=bool)
+    band: list[tuple[float, Index]] = []  # heap of (time, node); stale entries skipped
+    for s in source_nodes:
+        T[s] = 0.0
+        frozen[s] = True
+    ball: dict[Index, float] = {}  # node -> smallest ball time [s]
+    if source_ball and len(source_nodes) <= MAX_BALL_SOURCES:  # counted with repeats
+        ball, freeze_ball = _source_ball(speed, source_nodes, set(source_nodes), h)
+        for node, t in ball.items():
+            T[node] = t
+            if freeze_ball:
+                frozen[node] = True  # final: never lowered
+            else:
+                heapq.heappush(band, (t, node))  # may still be lowered
+    return T, frozen, band, source_nodes + [node for node in ball if frozen[node]]
+
+
 def fast_marching_reference(
     speed: Any,
     sources: Any,
@@ -342,8 +420,8 @@ def fast_marching_reference(
 ) -> np.ndarray:
     """Arrival times by a slow pure-Python Fast Marching Method (tests only).
 
-    Long by design (reference): one readable loop written out step by step to be
-    checked against the compiled march; helpers would hide the algorithm.
+    The march is one readable loop written out step by step to be checked against
+    the compiled march; the start (sources and ball) is :func:`_start`.
 
     Same discretisation as :func:`fm2uav.eikonal.fast_marching` (see the
     module docstring). Inputs are assumed valid: no checks beyond what is
@@ -378,70 +456,8 @@ def fast_marching_reference(
     ndim = speed.ndim
     h = tuple(float(x) for x in np.broadcast_to(np.asarray(spacing, dtype=float), (ndim,)))
 
-    T = np.full(shape, math.inf)
-    frozen = np.zeros(shape, dtype=bool)
-    band: list[tuple[float, Index]] = []  # heap of (time, node); stale entries skipped
-
-    # ---- sources: T = 0, frozen
-    source_nodes = _as_nodes(sources, ndim)
-    for s in source_nodes:
-        T[s] = 0.0
-        frozen[s] = True
-    is_source = set(source_nodes)
-
-    # ---- ball around every clean source
-    ball: dict[Index, float] = {}  # node -> smallest ball time [s]
-    if source_ball and len(source_nodes) <= MAX_BALL_SOURCES:  # counted with repeats
-        extent = max((n - 1) * hx for n, hx in zip(shape, h))  # [m]
-        radius = max(SOURCE_RADIUS_CELLS * max(h), SOURCE_RADIUS_FRACTION * extent)  # [m]
-        smallest = SOURCE_RADIUS_CELLS * max(h)  # [m] the last radius tried
-        radii, boxes, box_ranges, clean, constant = [], [], [], [], []
-        for s in source_nodes:
-            r = radius
-            while True:  # radius, radius / 2, ... down to 2 cells: the first clean box
-                reach = [int(math.floor(r / hx)) for hx in h]  # nodes per axis
-                ranges = [
-                    range(max(s[ax] - reach[ax], 0), min(s[ax] + reach[ax], shape[ax] - 1) + 1)
-                    for ax in range(ndim)
-                ]
-                box = list(itertools.product(*ranges))
-                speeds = [float(speed[node]) for node in box]
-                ok = min(speeds) > 0.0 and max(speeds) <= BALL_MAX_SPEED_RATIO * min(speeds)
-                if ok or r <= smallest:
-                    break
-                r = max(0.5 * r, smallest)
-            radii.append(r)
-            box_ranges.append(ranges)
-            boxes.append(box)
-            clean.append(ok)
-            constant.append(min(speeds) == max(speeds))
-        for s, r, box, ranges, ok, flat in zip(
-            source_nodes, radii, boxes, box_ranges, clean, constant
-        ):
-            if not ok:
-                continue
-            v_source = float(speed[s])
-            factored = None if flat else _factored_box_times(speed, s, ranges, h)
-            for node in box:
-                d2 = 0.0
-                for ax in range(ndim):
-                    dx = (node[ax] - s[ax]) * h[ax]
-                    d2 += dx * dx
-                if d2 > r * r or node in is_source:
-                    continue
-                if factored is None:  # constant speed: the exact straight ray
-                    t = math.sqrt(d2) * 0.5 * (1.0 / v_source + 1.0 / float(speed[node]))
-                else:
-                    t = factored[node]
-                if t < ball.get(node, math.inf):
-                    ball[node] = t
-        freeze_ball = all(clean)
-        for node, t in ball.items():
-            T[node] = t
-            if freeze_ball:
-                frozen[node] = True  # final: never lowered
-            else:
-                heapq.heappush(band, (t, node))  # may still be lowered
+    # ---- sources (T = 0, frozen) and the ball around every clean source
+    T, frozen, band, seeds = _start(speed, _as_nodes(sources, ndim), h, source_ball)
 
     def relax(node: Index) -> None:
         """Recompute a non-frozen node and push it if its time decreased."""
@@ -451,7 +467,7 @@ def fast_marching_reference(
             heapq.heappush(band, (t, node))
 
     # ---- every free neighbour of a node frozen so far joins the band
-    for node in source_nodes + [node for node in ball if frozen[node]]:
+    for node in seeds:
         for nb in _neighbours(node, shape):
             if not frozen[nb] and speed[nb] > 0.0:
                 relax(nb)

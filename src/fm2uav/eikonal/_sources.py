@@ -69,6 +69,8 @@ import math
 import numpy as np
 from numba import njit
 
+from ._heap import sift_down, sift_up
+
 _INF = np.inf
 
 
@@ -79,21 +81,8 @@ def _heap_push(heap, key, pos, size, c, t):
     p = pos[c]
     if p < 0:
         p = size
-        heap[p] = c
-        pos[c] = p
         size += 1
-    key[p] = t
-    while p > 0:
-        q = (p - 1) >> 1
-        if key[q] <= t:
-            break
-        heap[p] = heap[q]
-        key[p] = key[q]
-        pos[heap[p]] = p
-        p = q
-    heap[p] = c
-    key[p] = t
-    pos[c] = p
+    sift_up(key, heap, pos, p, t, c)
     return size
 
 
@@ -103,26 +92,8 @@ def _heap_pop(heap, key, pos, size):
     top = heap[0]
     pos[top] = -1
     size -= 1
-    if size == 0:
-        return top, size
-    c = heap[size]
-    t = key[size]
-    p = 0
-    while True:
-        child = 2 * p + 1
-        if child >= size:
-            break
-        if child + 1 < size and key[child + 1] < key[child]:
-            child += 1
-        if key[child] >= t:
-            break
-        heap[p] = heap[child]
-        key[p] = key[child]
-        pos[heap[p]] = p
-        p = child
-    heap[p] = c
-    key[p] = t
-    pos[c] = p
+    if size > 0:
+        sift_down(key, heap, pos, size, key[size], heap[size])
     return top, size
 
 
@@ -297,6 +268,7 @@ def _box_range(speed, si, sj, sk, ri, rj, rk, nx, ny, nz):
     return vmin, vmax
 
 
+# long on purpose: one compiled loop (numba kernel); helpers would add calls in the hot path
 @njit(cache=True, error_model="numpy")
 def init_sources(speed, T, state, nx, ny, nz, hx, hy, hz, src, radius, min_radius, max_ratio):
     """Initialise point sources in place: ``T = 0`` (frozen) and the source balls.

@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from .._validate import grid
 from ..errors import InputError
 from . import _kernels, _sources
 
@@ -93,14 +94,7 @@ def as_index_array(points: Any, shape: tuple[int, ...], what: str) -> np.ndarray
 
 
 def _as_speed(speed: Any) -> np.ndarray:
-    arr = np.asarray(speed)
-    if arr.dtype == bool or arr.dtype.kind not in "iuf":
-        raise InputError(f"speed must be a numeric array, got dtype {arr.dtype}")
-    if arr.ndim not in (2, 3):
-        raise InputError(f"speed must be a 2D or 3D array, got {arr.ndim}D with shape {arr.shape}")
-    if min(arr.shape) < 1:
-        raise InputError(f"speed must not be empty, got shape {arr.shape}")
-    arr = np.ascontiguousarray(arr, dtype=np.float64)
+    arr = np.ascontiguousarray(grid(speed, "speed"))
     # one compiled pass instead of three numpy passes (matters on 40 M-node maps)
     bad, n_tiny = _kernels.scan_speed(arr.reshape(-1), MIN_SPEED)
     if bad >= 0:

@@ -25,10 +25,10 @@ import numpy as np
 
 from ..geometry import arc_length
 from ..planning import Plan, Shaping, plan
-from ..vehicles import FeasibilityReport, check_feasibility, get_airframe
+from ..vehicles import FeasibilityReport, TrackingOptions, check_feasibility, get_airframe
 from ..world import World
 from ..scenarios import Scenario, get_scenario
-from ..baselines.rrt import RRTResult, plan_rrt
+from ..baselines.rrt import RRTOptions, RRTResult, plan_rrt
 from ._timing import WARM_NOTE, warm
 
 __all__ = [
@@ -133,13 +133,13 @@ def run_city_case(
                                  shaping=Shaping(exponent=exponent, walls=True)), [w2])
         path3 = np.column_stack([p.path, np.full(len(p.path), z)])
         rep = check_feasibility(path3, airframe, world=w3, w=p.w, tolerance=tolerance,
-                                lookahead=lookahead)
+                                tracking=TrackingOptions(lookahead=lookahead))
     else:
         p, _ = warm(lambda: plan(w3, scenario.start, scenario.goal,
                                  shaping=Shaping(exponent=exponent, walls=True)), [w3])
         path3 = p.path
         rep = check_feasibility(path3, airframe, world=w3, w=p.w, tolerance=tolerance,
-                                lookahead=lookahead)
+                                tracking=TrackingOptions(lookahead=lookahead))
     return CityCase(mission=mission, exponent=float(exponent), plan=p, path3=path3, report=rep,
                     world3=w3)
 
@@ -197,8 +197,8 @@ def rrt_comparison(
     else:
         wp, s, g = w3, scenario.start, scenario.goal
     for name in planners:
-        r = plan_rrt(wp, s, g, planner=name,
-                     time_limit=rrtstar_time if name == "rrtstar" else time_limit, seed=seed)
+        budget = rrtstar_time if name == "rrtstar" else time_limit
+        r = plan_rrt(wp, s, g, planner=name, options=RRTOptions(time_limit=budget, seed=seed))
         path3 = r.path if wp.ndim == 3 else np.column_stack([r.path, np.full(len(r.path), z)])
         rep = check_feasibility(path3, af, world=w3, tolerance=tolerance)
         results[name] = r

@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from ..vehicles import get_airframe, track_dubins, track_multirotor
+from ..vehicles import TrackingOptions, get_airframe, track_dubins, track_multirotor
 from .curvature import curvature_config, summarise_run
 from .runner import make_config, run_sweep
 from .sweep import curvature_profile
@@ -101,7 +101,7 @@ def reproduce_tracking(out_dir: str | Path, *, step: float = 0.1, pairs: int = 2
         for label, preset, fly in VEHICLES:
             af = get_airframe(preset)
             for la in LOOKAHEADS:
-                tr = fly(fm2, af, lookahead=la)
+                tr = fly(fm2, af, tracking=TrackingOptions(lookahead=la))
                 run.rows.append({"pair": k, "vehicle": label, "airframe": preset,
                                  "lookahead_m": float(tr.lookahead),
                                  "seed_lookahead": la is not None,

@@ -538,6 +538,7 @@ def _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step):
 
 
 # --------------------------------------------------------------------------- kernel
+# long on purpose: one compiled loop (numba kernel); helpers would add calls in the hot path
 @njit(cache=True)
 def descend_kernel(T, start, goal, hx, hy, hz, step, max_steps):
     """Descend ``T`` from ``start`` to ``goal``; see the module docstring.

@@ -99,6 +99,18 @@ def _steps(s: np.ndarray) -> np.ndarray:
     return np.diff(s)
 
 
+def _sweeps(s: Any, bound: Any, pick: Any, forward: float, backward: float) -> np.ndarray:
+    """``bound`` swept forward then backward: ``z_i = pick(z_i, z_(i-1) + forward * ds)``,
+    then ``z_i = pick(z_i, z_(i+1) + backward * ds)`` (``ds`` the steps of ``s`` [m])."""
+    d = _steps(s)
+    z = np.array(bound, dtype=float)
+    for i in range(1, len(z)):
+        z[i] = pick(z[i], z[i - 1] + forward * d[i - 1])
+    for i in range(len(z) - 2, -1, -1):
+        z[i] = pick(z[i], z[i + 1] + backward * d[i])
+    return z
+
+
 def envelope_above(s: Any, lower: Any, tan_climb: float, tan_descent: float) -> np.ndarray:
     """Lowest profile ``z >= lower`` with ``-tan_descent <= dz/ds <= tan_climb``.
 
@@ -122,13 +134,7 @@ def envelope_above(s: Any, lower: Any, tan_climb: float, tan_descent: float) -> 
     >>> envelope_above([0, 1, 2, 3, 4], [0, 0, 10, 0, 0], 5.0, 2.0).tolist()
     [0.0, 5.0, 10.0, 8.0, 6.0]
     """
-    d = _steps(s)
-    z = np.array(lower, dtype=float)
-    for i in range(1, len(z)):
-        z[i] = max(z[i], z[i - 1] - tan_descent * d[i - 1])
-    for i in range(len(z) - 2, -1, -1):
-        z[i] = max(z[i], z[i + 1] - tan_climb * d[i])
-    return z
+    return _sweeps(s, lower, max, -tan_descent, -tan_climb)
 
 
 def envelope_below(s: Any, upper: Any, tan_climb: float, tan_descent: float) -> np.ndarray:
@@ -141,13 +147,7 @@ def envelope_below(s: Any, upper: Any, tan_climb: float, tan_descent: float) -> 
     >>> envelope_below([0, 1, 2, 3, 4], [9, 9, 0, 9, 9], 2.0, 5.0).tolist()
     [9.0, 5.0, 0.0, 2.0, 4.0]
     """
-    d = _steps(s)
-    z = np.array(upper, dtype=float)
-    for i in range(1, len(z)):
-        z[i] = min(z[i], z[i - 1] + tan_climb * d[i - 1])
-    for i in range(len(z) - 2, -1, -1):
-        z[i] = min(z[i], z[i + 1] + tan_descent * d[i])
-    return z
+    return _sweeps(s, upper, min, tan_climb, tan_descent)
 
 
 # ---------------------------------------------------------------------- route

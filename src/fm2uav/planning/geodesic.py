@@ -71,6 +71,7 @@ from typing import Any
 
 import numpy as np
 
+from .._validate import grid
 from ..eikonal.fmm import as_spacing
 from ..errors import InputError, PlanningError, UnreachableError
 from . import _geodesic_kernels as _k
@@ -110,14 +111,7 @@ def default_max_steps(shape: Sequence[int], spacing: Sequence[float], step: floa
 
 
 def _as_field(T: Any) -> np.ndarray:
-    arr = np.asarray(T)
-    if arr.dtype == bool or arr.dtype.kind not in "iuf":
-        raise InputError(f"T must be a numeric array of arrival times, got dtype {arr.dtype}")
-    if arr.ndim not in (2, 3):
-        raise InputError(f"T must be a 2D or 3D array, got {arr.ndim}D with shape {arr.shape}")
-    if min(arr.shape) < 1:
-        raise InputError(f"T must not be empty, got shape {arr.shape}")
-    arr = np.asarray(arr, dtype=np.float64)
+    arr = grid(T, "T", holding=" of arrival times")
     bad = np.isnan(arr) | (arr == -np.inf)
     if bad.any():
         where = np.argwhere(bad)[0].tolist()
@@ -186,6 +180,15 @@ def _with_blocked(field: np.ndarray, blocked: Any) -> tuple[np.ndarray, np.ndarr
     return field, mask
 
 
+def _refuse_blocked(mask: np.ndarray | None, node: tuple[int, ...], p: np.ndarray, what: str
+                    ) -> None:
+    """PlanningError when the ``what`` point ``p`` [m] has its nearest ``node`` blocked."""
+    if mask is not None and mask[node]:
+        raise PlanningError(
+            f"{what} {p.tolist()} lies in blocked node {list(node)}; move the {what} to free space"
+        )
+
+
 def _check_endpoints(field: np.ndarray, mask: np.ndarray | None, s: np.ndarray, g: np.ndarray
                      ) -> tuple[int, ...]:
     """Refuse a goal that is blocked or not the source of ``field``, or a blocked / unreached
@@ -193,10 +196,7 @@ def _check_endpoints(field: np.ndarray, mask: np.ndarray | None, s: np.ndarray, 
     shape = field.shape
     sn = tuple(nearest_node(s).tolist())
     gn = tuple(nearest_node(g).tolist())
-    if mask is not None and mask[gn]:
-        raise PlanningError(
-            f"goal {g.tolist()} lies in blocked node {list(gn)}; move the goal to free space"
-        )
+    _refuse_blocked(mask, gn, g, "goal")
     if not np.isfinite(field[gn]):
         raise PlanningError(
             f"goal {g.tolist()}: its nearest node {list(gn)} has T = inf, so T was not computed "
@@ -210,10 +210,7 @@ def _check_endpoints(field: np.ndarray, mask: np.ndarray | None, s: np.ndarray, 
             f"lower ({t_min:g}) at node {[int(i) for i in where]}, so T was not computed from "
             "this goal; compute T with the goal's nearest node as the source"
         )
-    if mask is not None and mask[sn]:
-        raise PlanningError(
-            f"start {s.tolist()} lies in blocked node {list(sn)}; move the start to free space"
-        )
+    _refuse_blocked(mask, sn, s, "start")
     if not np.isfinite(field[sn]):
         raise UnreachableError(
             f"start {s.tolist()} cannot reach the goal {g.tolist()}: its nearest node {list(sn)} "

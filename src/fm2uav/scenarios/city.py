@@ -115,7 +115,15 @@ def _city_world_cached(seed: int) -> World:
     return city_world(seed)
 
 
-def _city_scenario(seed: int | np.random.Generator, mission: str, description: str) -> Scenario:
+#: The scenario description of each mission of :data:`CITY_MISSIONS`.
+_CITY_DESCRIPTIONS = {
+    "low": "low-altitude mission at 100 m between the buildings, corner to corner "
+           "[thesis ch. 3, §3.3.1]",
+    "high": "high-altitude mission at 350 m, over the lower roofs [thesis ch. 3, §3.3.2]",
+}
+
+
+def _city_scenario(seed: int | np.random.Generator, mission: str) -> Scenario:
     if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
         world = _city_world_cached(int(seed))  # immutable: share it (and its _cache)
     else:
@@ -126,6 +134,8 @@ def _city_scenario(seed: int | np.random.Generator, mission: str, description: s
     for what, p in (("start", start), ("goal", goal)):
         if world.occupancy[world.to_cell(p)]:
             raise WorldError(f"city {mission} {what} {p.tolist()} m is inside a building; try another seed")
+    description = ("City of 15 square buildings 20-60 m wide, 220-390 m tall on 5 m cells; "
+                   + _CITY_DESCRIPTIONS[mission])
     return Scenario(world=world, start=start, goal=goal, description=description)
 
 
@@ -136,12 +146,7 @@ def city(seed: int | np.random.Generator = 0) -> Scenario:
     220–390 m tall (seeded); start (8, 8, 20) cells = (40, 40, 100) m,
     goal (91, 91, 20) cells = (455, 455, 100) m.
     """
-    return _city_scenario(
-        seed,
-        "low",
-        "City of 15 square buildings 20-60 m wide, 220-390 m tall on 5 m cells; low-altitude "
-        "mission at 100 m between the buildings, corner to corner [thesis ch. 3, §3.3.1]",
-    )
+    return _city_scenario(seed, "low")
 
 
 def city_high(seed: int | np.random.Generator = 0) -> Scenario:
@@ -150,9 +155,4 @@ def city_high(seed: int | np.random.Generator = 0) -> Scenario:
     Same world as :func:`city`; start (8, 8, 70) cells = (40, 40, 350) m,
     goal (91, 91, 70) cells = (455, 455, 350) m.
     """
-    return _city_scenario(
-        seed,
-        "high",
-        "City of 15 square buildings 20-60 m wide, 220-390 m tall on 5 m cells; high-altitude "
-        "mission at 350 m, over the lower roofs [thesis ch. 3, §3.3.2]",
-    )
+    return _city_scenario(seed, "high")

@@ -13,7 +13,7 @@ from .feasibility import DEFAULT_TOLERANCE, FeasibilityReport, check_feasibility
 from .geometric import GeometricCheck, climb_angle_profile, curvature_profile, geometric_check
 from .multirotor import track_multirotor
 from .speed_profile import SpeedProfile, admissible_speed_from_w, speed_profile, turn_speed_limit
-from .tracking import Tracking
+from .tracking import Tracking, TrackingOptions
 
 __all__ = [
     "AIRFRAMES",
@@ -25,6 +25,7 @@ __all__ = [
     "track_dubins",
     "track_multirotor",
     "Tracking",
+    "TrackingOptions",
     "check_feasibility",
     "FeasibilityReport",
     "DEFAULT_TOLERANCE",

@@ -7,9 +7,9 @@ Model (Beard & McLain's Dubins airplane, thesis eq. 3.2), constant speed V::
 
 Guidance (where the thesis' eqs 3.3–3.10 are ambiguous, see docs/feasibility.md):
 a pure-pursuit carrot follower. The aircraft's position is projected on the
-planned path (monotone progress); the carrot is the path point ``lookahead``
-metres further along (the thesis' "p_{i+a}", eqs 3.5–3.6: ``lookahead_points=a``
-gives ``a`` path steps). Heading: the pure-pursuit turn rate
+planned path (monotone progress); the carrot is the path point
+``TrackingOptions.lookahead`` metres further along (the thesis' "p_{i+a}", eqs
+3.5–3.6: ``TrackingOptions(lookahead_points=a)`` gives ``a`` path steps). Heading: the pure-pursuit turn rate
 ``ψ̇ = 2 V cosγ sin η / L_xy`` (η = bearing of the carrot minus ψ, L_xy its
 horizontal distance; a carrot behind the aircraft commands the maximum rate),
 the thesis' proportional law ρ = K_ψ e(ψ) with gain 2V/L. Flight-path angle:
@@ -30,8 +30,7 @@ import numpy as np
 from ..errors import InputError
 from ..geometry import arc_length, as_path3
 from .airframes import Airframe, FixedWing, get_airframe
-from .tracking import (Carrot, Tracking, check_dt, check_lookahead, check_max_time,
-                       check_steps, finish_tracking)
+from .tracking import Carrot, FlightLog, Tracking, TrackingOptions
 
 __all__ = ["track_dubins"]
 
@@ -40,11 +39,8 @@ def track_dubins(
     path: Any,
     airframe: FixedWing | str,
     *,
-    lookahead: float | None = None,
-    lookahead_points: int | None = None,
     speed: float | None = None,
-    dt: float = 0.05,
-    max_time: float | None = None,
+    tracking: TrackingOptions = TrackingOptions(),
 ) -> Tracking:
     """Fly a fixed-wing Dubins airplane along ``path`` and record what happens.
 
@@ -53,19 +49,12 @@ def track_dubins(
     path : array (N, 2|3)
         Planned path [m], start → goal (2D: flown at z = 0).
     airframe : FixedWing or preset name
-    lookahead : float, optional
-        Carrot distance along the path [m]. Default: the minimum turn radius
-        R_min at the flown speed (at least 2 m).
-    lookahead_points : int, optional
-        The thesis' ``a``: look ``a`` path points ahead (``a`` x median point
-        spacing metres). Exclusive with ``lookahead``.
     speed : float, optional
         Constant airspeed [m/s]; default the airframe's cruise speed. Must lie
         in [min_speed, max_speed].
-    dt : float
-        Integration step [s]. Default 0.05.
-    max_time : float, optional
-        Give up after this long [s]; default ``3 x length / V + 60``.
+    tracking : TrackingOptions
+        Look-ahead (default: the minimum turn radius R_min at the flown speed,
+        at least 2 m), integration step and time limit (``3 x length / V + 60``).
 
     Returns
     -------
@@ -88,31 +77,26 @@ def track_dubins(
     if speed is not None:
         af = af.with_speed(speed)  # validates min <= speed <= max
     V = af.cruise_speed
-    dt = check_dt(dt)
+    dt = tracking.step()
     R = af.turn_radius()
-    L = check_lookahead(path, lookahead, lookahead_points, max(R, 2.0))
+    L = tracking.carrot_distance(path, max(R, 2.0))
     length = float(arc_length(planned)[-1])
-    t_max = check_max_time(max_time, length, V)
-    ds = max(min(0.5, L / 8.0, length / 50.0), 1e-3)
-    carrot = Carrot(planned, L, ds, reach=3.0 * V * dt + L + 2 * ds)
+    t_max = tracking.time_limit(length, V)
+    carrot = Carrot.along(planned, L, length, V, dt)
     rate_max = af.max_turn_rate()
     g_up, g_dn = af.max_climb, af.max_descent
 
     pos = planned[0].copy()
     c0 = carrot.pts[min(carrot.n_ahead, carrot.last)] - pos
     psi = math.atan2(c0[1], c0[0])
-    n_max = check_steps(t_max, dt)  # bounded: refused beyond MAX_STEPS
-    traj = np.empty((n_max, 3))
-    prog = np.empty(n_max)
-    heading = np.empty(n_max)
-    fpa = np.empty(n_max)
-    rate = np.empty(n_max)
-    sat_t = np.zeros(n_max, bool)
-    sat_c = np.zeros(n_max, bool)
-    sat_d = np.zeros(n_max, bool)
+    log = FlightLog(t_max, dt, ("turn", "climb", "descent"),
+                    ("heading", "flight_path_angle", "turn_rate"))
+    traj, prog = log.traj, log.prog
+    sat_t, sat_c, sat_d = log.saturated.values()
+    heading, fpa, rate = log.states.values()
     reached = False
     k = 0
-    for k in range(n_max):
+    for k in range(log.n_max):
         idx, c = carrot.update(pos)
         if idx >= carrot.last and k > 0:
             # abeam of / past the goal: the flight ends at the previous step
@@ -128,12 +112,8 @@ def track_dubins(
         cmd, sat_t[k] = _turn_rate_command(d, lxy, psi, V, g_cmd, rate_max)
         heading[k], fpa[k], rate[k] = psi, g_cmd, cmd
         pos, psi = _integrate_step(pos, psi, cmd, g_cmd, V, dt)
-    return finish_tracking(
-        af, planned, traj, prog, k + 1, dt,
-        saturated={"turn": sat_t, "climb": sat_c, "descent": sat_d},
-        states={"heading": heading, "flight_path_angle": fpa, "turn_rate": rate, "speed": np.full(len(traj), V)},
-        reached=reached, lookahead=L,
-    )
+    log.states["speed"] = np.full(log.n_max, V)
+    return log.tracking(af, planned, k + 1, reached=reached, lookahead=L)
 
 
 def _flight_path_command(dz: float, lxy: float, g_up: float, g_dn: float) -> tuple[float, bool, bool]:

@@ -30,11 +30,6 @@ from ..errors import InputError
 __all__ = ["FlightTime", "EnduranceReport", "flight_time", "check_endurance"]
 
 
-def _positive(name: str, value: Any) -> float:
-    """``value`` as a finite float > 0 (:func:`fm2uav._validate.positive`)."""
-    return positive(value, f"{name}")
-
-
 @dataclass(frozen=True)
 class FlightTime:
     """Time and distance of a flight, leg by leg.
@@ -108,8 +103,8 @@ def flight_time(
     p = np.asarray(points, dtype=float)
     if p.ndim != 2 or p.shape[1] != 3 or len(p) < 1 or not np.all(np.isfinite(p)):
         raise InputError(f"points must be a finite (n, 3) array, got shape {p.shape}")
-    up = _positive("climb_rate [m/s]", climb_rate)
-    down = _positive("descent_rate [m/s]", descent_rate)
+    up = positive(climb_rate, "climb_rate [m/s]")
+    down = positive(descent_rate, "descent_rate [m/s]")
     d = np.diff(p, axis=0)
     horiz = np.hypot(d[:, 0], d[:, 1])
     v = np.broadcast_to(np.asarray(speeds, dtype=float), horiz.shape)
@@ -126,7 +121,8 @@ def flight_time(
     else:
         takeoff_hold = 0.0
     rs = return_speed if return_speed is not None else (float(v[-1]) if v.size else 1.0)
-    ret = float(return_distance) / _positive("return speed [m/s]", rs) if return_distance else 0.0
+    ret = (float(return_distance) / positive(rs, "return speed [m/s]") if return_distance
+           else 0.0)
     climb, descent = max(float(takeoff_climb), 0.0), max(float(final_descent), 0.0)
     return FlightTime(
         leg_time=t, leg_length=np.linalg.norm(d, axis=1),
@@ -210,7 +206,7 @@ def check_endurance(ft: FlightTime, *, endurance_s: float | None, reserve: float
     if endurance_s is None:
         return EnduranceReport(ft.time_s, ft.distance_m, None, r, None, True, ft.distance_m,
                                n - 1, n)
-    usable = _positive("endurance [s]", endurance_s) * (1.0 - r)
+    usable = positive(endurance_s, "endurance [s]") * (1.0 - r)
     ok = ft.time_s <= usable
     if ok:
         return EnduranceReport(ft.time_s, ft.distance_m, float(endurance_s), r, usable, True,

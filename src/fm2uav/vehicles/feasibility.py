@@ -30,7 +30,7 @@ from .dubins_airplane import track_dubins
 from .geometric import GeometricCheck, geometric_check
 from .multirotor import track_multirotor
 from .speed_profile import SpeedProfile, speed_profile
-from .tracking import Tracking
+from .tracking import Tracking, TrackingOptions
 
 __all__ = ["DEFAULT_TOLERANCE", "FeasibilityReport", "check_feasibility", "collision_check"]
 
@@ -142,10 +142,8 @@ def check_feasibility(
     world: World | None = None,
     w: Any = None,
     tolerance: float = DEFAULT_TOLERANCE,
-    lookahead: float | None = None,
-    lookahead_points: int | None = None,
     speed: float | None = None,
-    dt: float = 0.05,
+    tracking: TrackingOptions = TrackingOptions(),
     window: float | None = None,
 ) -> FeasibilityReport:
     """Check whether ``airframe`` can fly ``path``.
@@ -162,12 +160,11 @@ def check_feasibility(
         W along the path (``Plan.w``), for the admissible-speed profile.
     tolerance : float
         Largest admissible separation flown ↔ planned [m]. Default 5.
-    lookahead, lookahead_points : optional
-        Carrot distance [m] or the thesis' ``a`` points (see the trackers).
     speed : float, optional
         Fixed-wing airspeed [m/s] (default cruise).
-    dt : float
-        Simulation step [s].
+    tracking : TrackingOptions
+        Carrot distance [m] or the thesis' ``a`` points, simulation step [s] and
+        time limit of the tracker (see :func:`track_dubins`, :func:`track_multirotor`).
     window : float, optional
         Window of the geometric profiles [m].
 
@@ -192,8 +189,7 @@ def check_feasibility(
         raise InputError(
             f"the path has {raw.shape[1]} coordinates per point but the world is {world.ndim}D"
         )
-    af, tr = _fly(raw, af, w=w, speed=speed, lookahead=lookahead,
-                  lookahead_points=lookahead_points, dt=dt)
+    af, tr = _fly(raw, af, w=w, speed=speed, tracking=tracking)
     geo = geometric_check(raw, af, window=window)
     prof = speed_profile(raw, af, w, window=window)
     ok, reasons, col = _verdict(tr, tol, world)
@@ -203,18 +199,16 @@ def check_feasibility(
     )
 
 
-def _fly(raw: np.ndarray, af: Airframe, *, w: Any, speed: float | None, lookahead: float | None,
-         lookahead_points: int | None, dt: float) -> tuple[Airframe, Tracking]:
+def _fly(raw: np.ndarray, af: Airframe, *, w: Any, speed: float | None,
+         tracking: TrackingOptions) -> tuple[Airframe, Tracking]:
     """Fly ``raw`` with the tracker of ``af``'s kind; the airframe flown (at ``speed``) and its tracking."""
     if isinstance(af, FixedWing):
         if speed is not None:
             af = af.with_speed(speed)
-        return af, track_dubins(raw, af, lookahead=lookahead, lookahead_points=lookahead_points,
-                                dt=dt)
+        return af, track_dubins(raw, af, tracking=tracking)
     if speed is not None:
         raise InputError("speed= applies to fixed-wings; a multirotor flies the W profile")
-    return af, track_multirotor(raw, af, w=w, lookahead=lookahead,
-                                lookahead_points=lookahead_points, dt=dt)
+    return af, track_multirotor(raw, af, w=w, tracking=tracking)
 
 
 def _verdict(tr: Tracking, tol: float, world: World | None,

@@ -21,8 +21,7 @@ from ..errors import InputError
 from ..geometry import arc_length, as_path3
 from .airframes import Multirotor, get_airframe
 from .speed_profile import speed_profile
-from .tracking import (Carrot, Tracking, check_dt, check_lookahead, check_max_time,
-                       check_steps, finish_tracking)
+from .tracking import Carrot, FlightLog, Tracking, TrackingOptions
 
 __all__ = ["track_multirotor"]
 
@@ -34,10 +33,7 @@ def track_multirotor(
     airframe: Multirotor | str,
     *,
     w: Any = None,
-    lookahead: float | None = None,
-    lookahead_points: int | None = None,
-    dt: float = 0.05,
-    max_time: float | None = None,
+    tracking: TrackingOptions = TrackingOptions(),
 ) -> Tracking:
     """Fly a multirotor along ``path`` and record what happens.
 
@@ -48,15 +44,11 @@ def track_multirotor(
     airframe : Multirotor or preset name
     w : array (N,), optional
         W along the path in [0, 1] (speed = W v_max); default: no W limit.
-    lookahead : float, optional
-        Largest carrot distance [m]; default ``max(v_max * 1 s, 2 m)``. The
-        carrot is ``max(v_adm * 1 s, 1 m)`` ahead, capped at this.
-    lookahead_points : int, optional
-        The thesis' ``a`` (points ahead); exclusive with ``lookahead``.
-    dt : float
-        Integration step [s].
-    max_time : float, optional
-        Give up after [s]; default ``3 x length / mean admissible speed + 60``.
+    tracking : TrackingOptions
+        Its ``lookahead`` is the largest carrot distance [m] (default
+        ``max(v_max * 1 s, 2 m)``): the carrot is ``max(v_adm * 1 s, 1 m)``
+        ahead, capped at this. Time limit: ``3 x length / mean admissible
+        speed + 60``.
 
     Returns
     -------
@@ -71,32 +63,27 @@ def track_multirotor(
             "use fm2uav.vehicles.track_dubins for fixed-wings"
         )
     planned = as_path3(path)
-    dt = check_dt(dt)
-    L = check_lookahead(path, lookahead, lookahead_points, max(af.max_speed * 1.0, 2.0))
+    dt = tracking.step()
+    L = tracking.carrot_distance(path, max(af.max_speed * 1.0, 2.0))
     prof = speed_profile(path, af, w)
     s_plan = arc_length(planned)
     length = float(s_plan[-1])
     v_floor = 0.05 * af.max_speed  # W = 0 would never arrive: creep at 5 %
     v_adm = np.maximum(prof.v_admissible, v_floor)
-    t_max = check_max_time(max_time, length, float(np.mean(v_adm)))
-    ds = max(min(0.5, L / 8.0, length / 50.0), 1e-3)
-    carrot = Carrot(planned, L, ds, reach=3.0 * af.max_speed * dt + L + 2 * ds)
+    t_max = tracking.time_limit(length, float(np.mean(v_adm)))
+    carrot = Carrot.along(planned, L, length, af.max_speed, dt)
     v_at = np.interp(carrot.s, prof.s, v_adm)
     a_max = af.max_accel
 
     pos = planned[0].copy()
     vel = np.zeros(3)
-    n_max = check_steps(t_max, dt)  # bounded: refused beyond MAX_STEPS
-    traj = np.empty((n_max, 3))
-    prog = np.empty(n_max)
-    spd = np.empty(n_max)
-    vref = np.empty(n_max)
-    sat_a = np.zeros(n_max, bool)
-    sat_c = np.zeros(n_max, bool)
-    sat_d = np.zeros(n_max, bool)
+    log = FlightLog(t_max, dt, ("accel", "climb", "descent"), ("speed", "v_ref"))
+    traj, prog = log.traj, log.prog
+    sat_a, sat_c, sat_d = log.saturated.values()
+    spd, vref = log.states.values()
     reached = False
     k = 0
-    for k in range(n_max):
+    for k in range(log.n_max):
         # look ahead ~1 s at the admissible speed (>= 1 m, <= lookahead)
         idx, c = carrot.update(pos, ahead=max(float(v_at[carrot.idx]) * 1.0, 1.0))
         goal_d = float(np.linalg.norm(planned[-1] - pos))
@@ -114,12 +101,7 @@ def track_multirotor(
         new_vel = vel + acc * dt
         pos = pos + 0.5 * (vel + new_vel) * dt
         vel = new_vel
-    return finish_tracking(
-        af, planned, traj, prog, k + 1, dt,
-        saturated={"accel": sat_a, "climb": sat_c, "descent": sat_d},
-        states={"speed": spd, "v_ref": vref},
-        reached=reached, lookahead=L,
-    )
+    return log.tracking(af, planned, k + 1, reached=reached, lookahead=L)
 
 
 def _desired_velocity(d: np.ndarray, dn: float, v_ref: float, af: Multirotor) -> tuple[np.ndarray, bool, bool]:

@@ -12,7 +12,7 @@ from ..errors import InputError
 from ..geometry import as_path3, distance_to_polyline, resample_uniform, runs
 from .airframes import Airframe
 
-__all__ = ["Tracking", "Carrot"]
+__all__ = ["Tracking", "TrackingOptions", "Carrot", "FlightLog"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -106,6 +106,48 @@ class Tracking:
         }
 
 
+@dataclass(frozen=True)
+class TrackingOptions:
+    """How a simulated vehicle follows the planned path (both trackers and
+    :func:`~fm2uav.vehicles.check_feasibility`).
+
+    Attributes
+    ----------
+    lookahead : float, optional
+        Carrot distance along the path [m]. Default per vehicle: the minimum
+        turn radius R_min at the flown speed (at least 2 m) for a fixed-wing;
+        ``max(v_max * 1 s, 2 m)`` for a multirotor (its largest carrot).
+    lookahead_points : int, optional
+        The thesis' ``a``: look ``a`` path points ahead (``a`` x median point
+        spacing metres). Exclusive with ``lookahead``.
+    dt : float
+        Integration step [s], in (0, :data:`MAX_DT`]. Default 0.05.
+    max_time : float, optional
+        Give up after this long [s]; default ``3 x length / V + 60`` (V: the
+        fixed-wing's speed, the multirotor's mean admissible speed).
+
+    The values are checked when a tracker uses them (:meth:`step`,
+    :meth:`carrot_distance`, :meth:`time_limit`).
+    """
+
+    lookahead: float | None = None
+    lookahead_points: int | None = None
+    dt: float = 0.05
+    max_time: float | None = None
+
+    def step(self) -> float:
+        """The integration step [s] (:func:`check_dt`)."""
+        return check_dt(self.dt)
+
+    def carrot_distance(self, path: Any, default: float) -> float:
+        """The look-ahead [m] along ``path`` (``default`` when neither is given)."""
+        return check_lookahead(path, self.lookahead, self.lookahead_points, default)
+
+    def time_limit(self, length: float, speed: float) -> float:
+        """The simulation time limit [s] of a path ``length`` [m] flown at ``speed`` [m/s]."""
+        return check_max_time(self.max_time, length, speed)
+
+
 class Carrot:
     """Projection on a planned path and the look-ahead ("carrot") point.
 
@@ -113,6 +155,15 @@ class Carrot:
     forward, searched in a window of ``reach`` metres ahead of the last one, so
     a path that comes back near itself is not short-cut.
     """
+
+    @classmethod
+    def along(cls, planned: np.ndarray, lookahead: float, length: float, speed: float,
+              dt: float) -> Carrot:
+        """The carrot of a tracker: ``planned`` (``length`` [m]) resampled every
+        ``min(0.5 m, lookahead / 8, length / 50)`` (at least 1 mm), searched as far as
+        a vehicle at ``speed`` [m/s] gets in 3 steps of ``dt`` [s] plus the look-ahead."""
+        ds = max(min(0.5, lookahead / 8.0, length / 50.0), 1e-3)
+        return cls(planned, lookahead, ds, reach=3.0 * speed * dt + lookahead + 2 * ds)
 
     def __init__(self, path: np.ndarray, lookahead: float, ds: float, reach: float) -> None:
         self.pts, self.s = resample_uniform(path, ds)
@@ -195,30 +246,38 @@ def check_max_time(max_time: float | None, length: float, speed: float) -> float
     return t_max
 
 
-def finish_tracking(
-    airframe: Airframe,
-    planned: np.ndarray,
-    traj: np.ndarray,
-    progress: np.ndarray,
-    n: int,
-    dt: float,
-    saturated: dict[str, np.ndarray],
-    states: dict[str, np.ndarray],
-    reached: bool,
-    lookahead: float,
-) -> Tracking:
-    """Trim the simulators' preallocated arrays to the ``n`` steps flown and build the result."""
-    flown = traj[:n]
-    return Tracking(
-        airframe=airframe,
-        planned=planned,
-        t=np.arange(n) * dt,
-        trajectory=flown,
-        progress=progress[:n],
-        separation=distance_to_polyline(flown, planned),
-        saturated={k: v[:n] for k, v in saturated.items()},
-        states={k: v[:n] for k, v in states.items()},
-        reached=reached,
-        lookahead=lookahead,
-        dt=dt,
-    )
+class FlightLog:
+    """The arrays a tracker fills step by step, preallocated for the longest flight.
+
+    ``traj`` (n_max, 3) positions [m], ``prog`` arc length of their projection on
+    the plan [m], ``saturated[limit]`` the clipped steps of each of ``limits``,
+    ``states[name]`` the model states; :meth:`tracking` trims them to the steps
+    flown.
+    """
+
+    def __init__(self, t_max: float, dt: float, limits: tuple[str, ...],
+                 states: tuple[str, ...]) -> None:
+        self.dt = dt
+        self.n_max = check_steps(t_max, dt)  # bounded: refused beyond MAX_STEPS
+        self.traj = np.empty((self.n_max, 3))
+        self.prog = np.empty(self.n_max)
+        self.saturated = {k: np.zeros(self.n_max, bool) for k in limits}
+        self.states = {k: np.empty(self.n_max) for k in states}
+
+    def tracking(self, airframe: Airframe, planned: np.ndarray, n: int, *, reached: bool,
+                 lookahead: float) -> Tracking:
+        """The :class:`Tracking` of the first ``n`` steps."""
+        flown = self.traj[:n]
+        return Tracking(
+            airframe=airframe,
+            planned=planned,
+            t=np.arange(n) * self.dt,
+            trajectory=flown,
+            progress=self.prog[:n],
+            separation=distance_to_polyline(flown, planned),
+            saturated={k: v[:n] for k, v in self.saturated.items()},
+            states={k: v[:n] for k, v in self.states.items()},
+            reached=reached,
+            lookahead=lookahead,
+            dt=self.dt,
+        )

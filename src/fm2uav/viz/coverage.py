@@ -16,6 +16,7 @@ from matplotlib.colors import LightSource
 from matplotlib.figure import Figure
 
 from ..geometry import arc_length
+from ._finish import finish
 
 if TYPE_CHECKING:
     from ..experiments.coverage import CoverageRun
@@ -121,9 +122,7 @@ def coverage_figure(cp: CoveragePlan, *, title: str | None = None) -> Figure:
     sub = (f"α = {cp.zigzag.angle_deg:.3f}°, D = {cp.zigzag.spacing:g} m, zigzag cost "
            f"{cp.zigzag.cost:.0f} m, FM² length {cp.plan.length:.0f} m, coverage "
            f"{100 * cp.coverage:.2f} %, |AGL error| mean {e.mean():.1f} m / max {e.max():.1f} m")
-    fig.suptitle(f"{title}\n{sub}" if title else sub, fontsize=10)
-    fig.tight_layout()
-    return fig
+    return finish(fig, title, sub, fontsize=10)
 
 
 def coverage_html(cp: CoveragePlan, *, title: str = "coverage plan") -> str:

@@ -10,6 +10,7 @@ from matplotlib.colors import LightSource
 from matplotlib.figure import Figure
 
 from ..geometry import arc_length
+from ._finish import finish
 
 if TYPE_CHECKING:
     from ..planning import Plan
@@ -76,6 +77,4 @@ def plan_figure(plan: Plan, *, title: str | None = None) -> Figure:
     p = plan.params
     sub = (f"length {plan.length:.0f} m · clearance {plan.clearance:.1f} m · "
            f"α={p.get('saturation', 1):g} β={p.get('exponent', 1):g}")
-    fig.suptitle(f"{title}\n{sub}" if title else sub, fontsize=11)
-    fig.tight_layout()
-    return fig
+    return finish(fig, title, sub)

@@ -27,6 +27,7 @@ from matplotlib.colors import LightSource
 from matplotlib.figure import Figure
 
 from ..geometry import arc_length
+from ._finish import finish
 
 if TYPE_CHECKING:
     from ..experiments.formation import ThesisRun
@@ -142,9 +143,7 @@ def formation_paths_figure(
     sub = (f"{result.shape.name}, dist {result.dist:g} m · min separation "
            f"{s['min_separation_m']:.1f} m (bound {result.dist / 2:g}) · mission "
            f"{s['mission_time_s']:.0f} s · computed in {s['timings_s']['total']:.2f} s")
-    fig.suptitle(f"{title}\n{sub}" if title else sub, fontsize=11)
-    fig.tight_layout()
-    return fig
+    return finish(fig, title, sub)
 
 
 def formation_profiles_figure(result: FormationResult, *, title: str | None = None) -> Figure:

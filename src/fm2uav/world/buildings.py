@@ -277,13 +277,10 @@ def from_buildings(
     roof, outside, off_grid = _roofs(polys, heights, ground, org, cs, all_touched)
     _report_left_out(data, outside, off_grid)
     surface = np.maximum(roof, ground)
-    smax = float(surface.max())
-    nz = _vertical_nodes(terrain, shape, height_cells, org, cs, smax, agl, top)
+    nz = _vertical_nodes(terrain, shape, height_cells, org, cs, float(surface.max()), agl, top)
     check_size((nx, ny, nz), cs)
-    zs = org[2] + np.arange(nz) * cs[2]
-    _check_headroom(smax, zs, heights, ids, org, cs, nz, agl,
-                    height_cells is not None and terrain is None and shape is None)
-    occ = zs[None, None, :] <= surface[:, :, None]
+    occ = _occupancy(surface, org, cs, nz, heights, ids, agl,
+                     height_cells is not None and terrain is None and shape is None)
     georef = _buildings_georef(data, polys, counts, metres_per_level, default_height, outside,
                                off_grid, all_touched, terrain, world_crs, org)
     return World(
@@ -291,6 +288,17 @@ def from_buildings(
         terrain=ground, crs=world_crs, name=name or (terrain.name if terrain is not None else ""),
         filled=None if terrain is None else terrain.filled, georef=georef,
     )
+
+
+def _occupancy(surface: np.ndarray, org: np.ndarray, cs: np.ndarray, nz: int,
+               heights: Sequence[float], ids: list[str], agl: Any,
+               given_height_cells: bool) -> np.ndarray:
+    """The (nx, ny, nz) obstacle grid under ``surface`` [m] (ground and roofs), its top
+    checked to clear the tallest roof (:func:`_check_headroom`)."""
+    smax = float(surface.max())
+    zs = org[2] + np.arange(nz) * cs[2]
+    _check_headroom(smax, zs, heights, ids, org, cs, nz, agl, given_height_cells)
+    return zs[None, None, :] <= surface[:, :, None]
 
 
 def _check_level_and_terrain(metres_per_level: float, terrain: World | None) -> None:

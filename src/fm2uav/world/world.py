@@ -37,6 +37,17 @@ def _fmt_bounds(b: np.ndarray) -> str:
     return ", ".join(f"{axes[i]} in [{lo:.6g}, {hi:.6g}]" for i, (lo, hi) in enumerate(b))
 
 
+def _height_map(value: Any, what: str, heights: str) -> np.ndarray:
+    """A float copy of the height map ``value`` [m]; WorldError naming ``what`` if not numeric."""
+    try:
+        return np.array(value, dtype=float, copy=True)
+    except (TypeError, ValueError):
+        raise WorldError(
+            f"{what} must be a numeric (nx, ny) array of {heights} in metres, "
+            f"got {type(value).__name__}"
+        ) from None
+
+
 def _per_axis(value: Any, ndim: int, what: str, *, positive: bool) -> tuple[float, ...]:
     """A number or ``ndim`` numbers → tuple of ``ndim`` finite floats."""
     try:
@@ -145,13 +156,7 @@ class World:
         )
         terrain = self.terrain
         if terrain is not None:
-            try:
-                t = np.array(terrain, dtype=float, copy=True)
-            except (TypeError, ValueError):
-                raise WorldError(
-                    f"World terrain must be a numeric (nx, ny) array of heights in metres, "
-                    f"got {type(terrain).__name__}"
-                ) from None
+            t = _height_map(terrain, "World terrain", "heights")
             if t.shape != occ.shape[:2]:
                 raise WorldError(
                     f"World terrain must have shape (nx, ny) = {occ.shape[:2]} to match the "
@@ -369,13 +374,7 @@ class World:
         Node ``(i, j, k)`` is an obstacle iff ``z0 + k * dz <= heights_m[i, j]``.
         The height map is stored as :attr:`terrain`.
         """
-        try:
-            h = np.array(heights_m, dtype=float, copy=True)
-        except (TypeError, ValueError):
-            raise WorldError(
-                f"heights_m must be a numeric (nx, ny) array of ground heights in metres, "
-                f"got {type(heights_m).__name__}"
-            ) from None
+        h = _height_map(heights_m, "heights_m", "ground heights")
         if h.ndim != 2:
             raise WorldError(
                 f"heights_m must be a 2D (nx, ny) array of ground heights in metres, got "

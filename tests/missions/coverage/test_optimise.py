@@ -6,6 +6,7 @@ import pytest
 from fm2uav import InputError
 from fm2uav.missions.coverage import (
     FULL_BOUNDS_DEG,
+    DESettings,
     ZigzagCost,
     differential_evolution,
     scipy_de,
@@ -63,7 +64,7 @@ def test_scipy_de_and_full_range_agree_with_sweep():
 def test_bad_options():
     p = [(0, 0), (100, 0), (100, 100)]
     with pytest.raises(InputError):
-        differential_evolution(p, 10.0, population=3)
+        differential_evolution(p, 10.0, settings=DESettings(population=3))
     with pytest.raises(InputError):
         differential_evolution(p, 10.0, bounds_deg=(50, 10))
     with pytest.raises(InputError):

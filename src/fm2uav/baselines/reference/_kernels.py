@@ -9,51 +9,30 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ...eikonal._heap import sift_down, sift_up
+
 __all__ = ["lattice_search"]
 
 
 @njit(cache=True, inline="always")
-def _push(hk, hv, n, key, val):
-    i = n
-    hk[i] = key
-    hv[i] = val
-    while i > 0:
-        p = (i - 1) >> 1
-        if hk[p] <= key:
-            break
-        hk[i] = hk[p]
-        hv[i] = hv[p]
-        i = p
-    hk[i] = key
-    hv[i] = val
+def _push(hk, hv, nopos, n, key, val):
+    """Add ``val`` with ``key`` to the heap of ``n`` entries; the new count."""
+    sift_up(hk, hv, nopos, n, key, val)
     return n + 1
 
 
 @njit(cache=True, inline="always")
-def _pop(hk, hv, n):
+def _pop(hk, hv, nopos, n):
+    """The root ``(key, val)`` taken off the heap of ``n`` entries, and the new count."""
     key = hk[0]
     val = hv[0]
     n -= 1
     if n > 0:
-        lk = hk[n]
-        lv = hv[n]
-        i = 0
-        while True:
-            c = 2 * i + 1
-            if c >= n:
-                break
-            if c + 1 < n and hk[c + 1] < hk[c]:
-                c += 1
-            if hk[c] >= lk:
-                break
-            hk[i] = hk[c]
-            hv[i] = hv[c]
-            i = c
-        hk[i] = lk
-        hv[i] = lv
+        sift_down(hk, hv, nopos, n, hk[n], hv[n])
     return key, val, n
 
 
+# long on purpose: one compiled search loop; helpers would add calls in the hot path
 @njit(cache=True)
 def lattice_search(
     free, K, ptr, pdx, pdy, pend, pcost, cptr, cx, cy,
@@ -100,6 +79,7 @@ def lattice_search(
     cap = 1 << 20
     hk = np.empty(cap, np.float64)
     hv = np.empty(cap, np.int64)
+    nopos = np.empty(0, np.int64)  # no slot index: lazy deletion (stale entries skipped)
     n = 0
     for s in sources:
         if cost[s] > 0.0:
@@ -111,11 +91,11 @@ def lattice_search(
                 cap *= 2
                 hk = np.concatenate((hk, np.empty(cap - hk.size, np.float64)))
                 hv = np.concatenate((hv, np.empty(cap - hv.size, np.int64)))
-            n = _push(hk, hv, n, h, s)
+            n = _push(hk, hv, nopos, n, h, s)
     n_expanded = 0
     goal_state = -1
     while n > 0:
-        key, s, n = _pop(hk, hv, n)
+        key, s, n = _pop(hk, hv, nopos, n)
         if done[s]:
             continue
         done[s] = True
@@ -161,5 +141,5 @@ def lattice_search(
                 hv2[:n] = hv[:n]
                 hk = hk2
                 hv = hv2
-            n = _push(hk, hv, n, nc + h, t)
+            n = _push(hk, hv, nopos, n, nc + h, t)
     return goal_state, cost, parent, n_expanded

@@ -13,17 +13,11 @@ looking straight down over flat ground):
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
 
 from ..._validate import positive
 from ...errors import InputError
 
 __all__ = ["Camera", "band_spacing"]
-
-
-def _positive(name: str, value: Any) -> float:
-    """``value`` as a finite float > 0 (:func:`fm2uav._validate.positive`)."""
-    return positive(value, f"camera {name}")
 
 
 @dataclass(frozen=True)
@@ -52,11 +46,11 @@ class Camera:
     def __post_init__(self) -> None:
         for name in ("sensor_width", "sensor_height", "focal_length", "image_width",
                      "image_height"):
-            _positive(name, getattr(self, name))
+            positive(getattr(self, name), f"camera {name}")
 
     def gsd(self, agl: float) -> float:
         """Ground sample distance [m/px] at ``agl`` metres above the ground."""
-        agl = _positive("altitude AGL", agl)
+        agl = positive(agl, "camera altitude AGL")
         sw, iw = ((self.sensor_width, self.image_width) if self.landscape
                   else (self.sensor_height, self.image_height))
         return sw * agl / (self.focal_length * iw)

@@ -313,6 +313,51 @@ def _on_level(world: World, xy: np.ndarray, layer: np.ndarray, what: str) -> np.
     return np.r_[xy, z]
 
 
+def _checked_level(world: World, grid: str, level: FlightLevel, options: PlanOptions
+                   ) -> FlightLevel:
+    """The coverage flight level (:func:`coverage_level`) once ``grid``, ``world`` and
+    ``options`` are checked.
+
+    Raises
+    ------
+    InputError
+        Unknown grid, not a 3D world, options with a speed map.
+    """
+    if grid not in GRIDS:
+        raise InputError(f"grid must be one of {', '.join(GRIDS)}, got {grid!r}")
+    if not isinstance(world, World) or world.ndim != 3:
+        raise InputError("plan_coverage needs a 3D fm2uav.World with terrain")
+    level = coverage_level(level, world)
+    if not isinstance(options, PlanOptions) or options.speed_map is not None:
+        raise InputError("options must be a fm2uav.PlanOptions without speed_map (the coverage "
+                         "FM² makes its own speed map), e.g. options=PlanOptions(order=1)")
+    return level
+
+
+def _steering(poly: Any, d: float, angle: float | None, search: str,
+              search_options: dict[str, Any] | None, seed: Any
+              ) -> tuple[float, AngleSearch | None]:
+    """``(angle [rad], search)``: the given ``angle`` (no search), else the result of the
+    steering-angle search ``search`` over ``poly`` at spacing ``d`` [m] (the DEs seeded
+    with ``seed`` unless ``search_options`` has one)."""
+    if angle is not None:
+        return angle, None
+    opts = dict(search_options or {})
+    if search.lower() in ("de", "scipy-de"):
+        opts.setdefault("seed", seed)
+    found = optimise_angle(poly, d, method=search, **opts)
+    return found.angle, found
+
+
+def _zigzag_in_map(world: World, poly: Any, d: float, angle: float) -> tuple[Zigzag, np.ndarray]:
+    """The zigzag over ``poly`` at spacing ``d`` [m] and ``angle`` [rad], and its ideal path,
+    checked to stay in the map."""
+    zz = zigzag(poly, d, angle)
+    ideal = zz.path()
+    _check_zigzag_in_map(world, ideal, d)
+    return zz, ideal
+
+
 def plan_coverage(
     world: World,
     area,
@@ -384,28 +429,13 @@ def plan_coverage(
         band grid over very steep relief at a low level: use ``grid="map"``).
     """
     t0 = time.perf_counter()
-    if grid not in GRIDS:
-        raise InputError(f"grid must be one of {', '.join(GRIDS)}, got {grid!r}")
-    if not isinstance(world, World) or world.ndim != 3:
-        raise InputError("plan_coverage needs a 3D fm2uav.World with terrain")
-    level = coverage_level(level, world)
-    if not isinstance(options, PlanOptions) or options.speed_map is not None:
-        raise InputError("options must be a fm2uav.PlanOptions without speed_map (the coverage "
-                         "FM² makes its own speed map), e.g. options=PlanOptions(order=1)")
+    level = _checked_level(world, grid, level, options)
     poly = as_area(area)
     d = check_spacing(poly, spacing)
     check_inside_world(poly, world)
-    found = None
-    if angle is None:
-        opts = dict(search_options or {})
-        if search.lower() in ("de", "scipy-de"):
-            opts.setdefault("seed", seed)
-        found = optimise_angle(poly, d, method=search, **opts)
-        angle = found.angle
+    angle, found = _steering(poly, d, angle, search, search_options, seed)
     t1 = time.perf_counter()
-    zz = zigzag(poly, d, angle)
-    ideal = zz.path()
-    _check_zigzag_in_map(world, ideal, d)
+    zz, ideal = _zigzag_in_map(world, poly, d, angle)
     t2 = time.perf_counter()
     if not (0 < corridor < 0.5):
         raise InputError(f"corridor must be a share of D in (0, 0.5), got {corridor!r}")
@@ -415,20 +445,33 @@ def plan_coverage(
     _check_free(world, fm.path)
     fm = with_flown_heights(world, fm, level)
     t4 = time.perf_counter()
-    cov = coverage_share(poly, fm.path, d / 2.0)
-    zcov = coverage_share(poly, ideal, d / 2.0)
-    err = fm.path[:, 2] - world.ground_height(fm.path[:, 0], fm.path[:, 1]) - level.agl
+    cov, zcov, err = _report(world, poly, fm.path, ideal, d, level)
     t5 = time.perf_counter()
     return CoveragePlan(
         zigzag=zz, search=found, plan=fm, coverage=cov, zigzag_coverage=zcov, agl_error=err,
-        timings={"angle": t1 - t0, "zigzag": t2 - t1, "speed_map": t3 - t2, "fm2": t4 - t3,
-                 "report": t5 - t4, "total": t5 - t0},
+        timings=_timings(t0, t1, t2, t3, t4, t5),
         params={"spacing_m": d, **dataclasses.asdict(level), "corridor": float(corridor),
                 "level_contrast": float(level_contrast), "level_base": level_base,
                 "search": None if found is None else found.method,
                 "order": int(options.order), "step": float(options.step), "grid": grid},
         level=level, grid=cg, grid_plan=grid_plan,
     )
+
+
+def _report(world: World, poly: Any, path: np.ndarray, ideal: np.ndarray, d: float,
+            level: FlightLevel) -> tuple[float, float, np.ndarray]:
+    """Coverage shares (within ``d / 2`` [m]) of the flown ``path`` and of the ``ideal``
+    zigzag, and the path's height above the ground minus ``level.agl`` [m]."""
+    cov = coverage_share(poly, path, d / 2.0)
+    zcov = coverage_share(poly, ideal, d / 2.0)
+    return cov, zcov, path[:, 2] - world.ground_height(path[:, 0], path[:, 1]) - level.agl
+
+
+def _timings(*t: float) -> dict[str, float]:
+    """Wall times [s] of the steps between the clock readings ``t`` of
+    :func:`plan_coverage` (and the total)."""
+    steps = ("angle", "zigzag", "speed_map", "fm2", "report")
+    return {**{k: t[i + 1] - t[i] for i, k in enumerate(steps)}, "total": t[-1] - t[0]}
 
 
 def with_flown_heights(world: World, fm: Plan, level: FlightLevel) -> Plan:

@@ -31,6 +31,7 @@ from .cost import ZigzagCost
 
 __all__ = [
     "AngleSearch",
+    "DESettings",
     "differential_evolution",
     "sweep",
     "scipy_de",
@@ -120,14 +121,56 @@ def _objective(area, spacing) -> ZigzagCost:
     return area if isinstance(area, ZigzagCost) else ZigzagCost.of(area, spacing)
 
 
+@dataclass(frozen=True)
+class DESettings:
+    """The settings of a Differential Evolution, the same for :func:`differential_evolution`
+    and :func:`scipy_de` (defaults: the seeds').
+
+    Attributes
+    ----------
+    population : int
+        Np (>= 4). Default 20.
+    F : float
+        Mutation factor in (0, 2]. Default 0.8.
+    CR : float
+        Crossover probability in [0, 1]. Default 0.7.
+    generations : int
+        Number of generations (>= 0). Default 30.
+
+    Raises
+    ------
+    InputError
+        A value outside its range.
+    """
+
+    population: int = 20
+    F: float = 0.8
+    CR: float = 0.7
+    generations: int = 30
+
+    def __post_init__(self) -> None:
+        population, generations = self.population, self.generations
+        if int(population) != population or population < 4:
+            raise InputError(f"population must be an integer >= 4, got {population!r}")
+        if int(generations) != generations or generations < 0:
+            raise InputError(f"generations must be an integer >= 0, got {generations!r}")
+        if not (0 < self.F <= 2):
+            raise InputError(f"F must be in (0, 2], got {self.F!r}")
+        if not (0 <= self.CR <= 1):
+            raise InputError(f"CR must be in [0, 1], got {self.CR!r}")
+
+    def params(self, seed: Any) -> dict[str, Any]:
+        """The settings and the seed as :attr:`AngleSearch.params`."""
+        return {"population": int(self.population), "F": float(self.F), "CR": float(self.CR),
+                "generations": int(self.generations),
+                "seed": seed if not isinstance(seed, np.random.Generator) else "generator"}
+
+
 def differential_evolution(
     area,
     spacing: float | None = None,
     *,
-    population: int = 20,
-    F: float = 0.8,
-    CR: float = 0.7,
-    generations: int = 30,
+    settings: DESettings = DESettings(),
     bounds_deg: tuple[float, float] = SEEDS_BOUNDS_DEG,
     seed: int | np.random.Generator | None = 0,
 ) -> AngleSearch:
@@ -139,14 +182,8 @@ def differential_evolution(
         The area [m] (or a prepared objective, then ``spacing`` is ignored).
     spacing : float
         Band spacing D [m].
-    population : int, optional
-        Np (>= 4). Default 20.
-    F : float, optional
-        Mutation factor in (0, 2]. Default 0.8.
-    CR : float, optional
-        Crossover probability in [0, 1]. Default 0.7.
-    generations : int, optional
-        Number of generations (>= 0). Default 30.
+    settings : DESettings, optional
+        Np, F, CR and the number of generations. Default the seeds'.
     bounds_deg : (float, float), optional
         Range of α [deg]. Default the seeds' (1, 89); (0, 180) searches every
         band direction.
@@ -160,21 +197,14 @@ def differential_evolution(
     t0 = time.perf_counter()
     f = _objective(area, spacing)
     lo, hi = _bounds(bounds_deg)
-    if int(population) != population or population < 4:
-        raise InputError(f"population must be an integer >= 4, got {population!r}")
-    if int(generations) != generations or generations < 0:
-        raise InputError(f"generations must be an integer >= 0, got {generations!r}")
-    if not (0 < F <= 2):
-        raise InputError(f"F must be in (0, 2], got {F!r}")
-    if not (0 <= CR <= 1):
-        raise InputError(f"CR must be in [0, 1], got {CR!r}")
+    F, CR = settings.F, settings.CR
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
-    npop = int(population)
+    npop = int(settings.population)
     x = lo + (hi - lo) * rng.random(npop)
     fx = np.array([f(v) for v in x])
     hist_a, hist_c = [x.copy()], [fx.copy()]
     others = np.array([[j for j in range(npop) if j != i] for i in range(npop)])
-    for _ in range(int(generations)):
+    for _ in range(int(settings.generations)):
         u = x.copy()
         fu = fx.copy()
         for i in range(npop):
@@ -196,10 +226,7 @@ def differential_evolution(
     return AngleSearch(
         method="de", angle=math.radians(float(x[k])), cost=float(fx[k]),
         evaluated_deg=ea, evaluated_cost=ec, bounds_deg=(lo, hi),
-        seconds=time.perf_counter() - t0,
-        params={"population": npop, "F": float(F), "CR": float(CR),
-                "generations": int(generations),
-                "seed": seed if not isinstance(seed, np.random.Generator) else "generator"},
+        seconds=time.perf_counter() - t0, params=settings.params(seed),
     )
 
 
@@ -237,10 +264,7 @@ def scipy_de(
     area,
     spacing: float | None = None,
     *,
-    population: int = 20,
-    F: float = 0.8,
-    CR: float = 0.7,
-    generations: int = 30,
+    settings: DESettings = DESettings(),
     bounds_deg: tuple[float, float] = SEEDS_BOUNDS_DEG,
     seed: int | None = 0,
 ) -> AngleSearch:
@@ -260,15 +284,14 @@ def scipy_de(
         seen_c.append(c)
         return c
 
-    res = _de(fun, [(lo, hi)], strategy="rand1bin", maxiter=int(generations),
-              popsize=int(population), mutation=float(F), recombination=float(CR),
-              seed=seed, polish=False, tol=0.0, atol=0.0, init="random")
+    res = _de(fun, [(lo, hi)], strategy="rand1bin", maxiter=int(settings.generations),
+              popsize=int(settings.population), mutation=float(settings.F),
+              recombination=float(settings.CR), seed=seed, polish=False, tol=0.0, atol=0.0,
+              init="random")
     return AngleSearch(
         method="scipy-de", angle=math.radians(float(res.x[0])), cost=float(res.fun),
         evaluated_deg=np.array(seen_a), evaluated_cost=np.array(seen_c),
-        bounds_deg=(lo, hi), seconds=time.perf_counter() - t0,
-        params={"population": int(population), "F": float(F), "CR": float(CR),
-                "generations": int(generations), "seed": seed},
+        bounds_deg=(lo, hi), seconds=time.perf_counter() - t0, params=settings.params(seed),
     )
 
 
