@@ -325,3 +325,53 @@ def test_merge_mode_never_swaps(tmp_path):
         assert not (out / "tables.md").exists()  # staged until the end
     assert sorted(p.name for p in out.iterdir()) == ["cases.jsonl", "tables.md"]
     assert _leftovers(tmp_path, "sweep") == []
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+@pytest.mark.parametrize("moment", ["after_new_in_place", "after_old_aside"])
+def test_stop_signal_during_the_swap_is_held(tmp_path, monkeypatch, sig, moment):
+    """A stop signal that arrives while the set is being renamed into place waits until
+    the renames are done: the complete new set, no .tmp-/.old- folder, no exception
+    (the command is ending: a signal after the commit is ignored)."""
+    out = tmp_path / "out"
+    _old_set(out)
+    real_rename = od.os.rename
+    fired = []
+
+    def rename(src, dst):
+        real_rename(src, dst)
+        hit = Path(dst) == out if moment == "after_new_in_place" else Path(src) == out
+        if hit and not fired:
+            fired.append(True)
+            os.kill(os.getpid(), sig)  # delivered at once unless held
+
+    monkeypatch.setattr(od.os, "rename", rename)
+    with od.interrupt_signals():
+        s = OutputDir(out, force=True)
+        with s.open("a.txt") as fh:
+            fh.write("new")
+        od.finish_all()
+    assert fired
+    assert sorted(p.name for p in out.iterdir()) == ["a.txt"]
+    assert _leftovers(tmp_path, "out") == []
+
+
+def test_stop_signal_before_the_commit_still_stops(tmp_path):
+    """Holding signals during the swap does not swallow one sent while the set is written."""
+    out = tmp_path / "out"
+    _old_set(out)
+    before = sorted(p.name for p in out.iterdir())
+    with pytest.raises(od.Interrupted):
+        with od.interrupt_signals():
+            s = OutputDir(out, force=True)
+            try:
+                with s.open("a.txt") as fh:
+                    fh.write("new")
+                    os.kill(os.getpid(), signal.SIGTERM)
+                    time.sleep(0.5)  # the handler raises here
+                od.finish_all()
+            except BaseException:
+                od.abort_all()
+                raise
+    assert sorted(p.name for p in out.iterdir()) == before
+    assert _leftovers(tmp_path, "out") == []

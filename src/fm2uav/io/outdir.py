@@ -56,24 +56,79 @@ class Interrupted(BaseException):  # noqa: N818 (it is a signal, like KeyboardIn
         self.signum = signum
 
 
-def _raise_interrupted(signum: int, frame: Any) -> None:  # noqa: ARG001
+class _Commit:
+    """Whether the command has put its output sets in place (:func:`finish_all`) and
+    opened none since: a stop signal then is too late to undo anything."""
+
+    done = False
+
+
+class _Hold:
+    """Stop signals held while a set is renamed into place or removed."""
+
+    depth = 0
+    pending: int | None = None
+
+
+def _deliver(signum: int) -> None:
+    if _Commit.done and not _ACTIVE:
+        return  # the outputs are in place: the command is ending anyway
+    if signum == signal.SIGINT:
+        raise KeyboardInterrupt
     raise Interrupted(signum)
+
+
+def _on_stop_signal(signum: int, frame: Any) -> None:  # noqa: ARG001
+    if _Hold.depth > 0:
+        _Hold.pending = signum  # delivered when the renames are done
+        return
+    _deliver(signum)
+
+
+@contextmanager
+def _signals_held() -> Iterator[None]:
+    """Hold the stop signals of :func:`interrupt_signals` for the duration.
+
+    A signal arriving meanwhile is delivered when the block ends (and dropped if
+    the block fails: its error is already on its way), so the renames and removals
+    of a set are never cut half-way, which could leave a ``.tmp-``/``.old-`` folder
+    or the new set with an exit code saying "stopped". Python runs signal
+    handlers in the main thread, whichever thread the OS signalled, so a flag is
+    enough (an OS signal mask would not be: other threads would take the signal).
+    """
+    _Hold.depth += 1
+    try:
+        yield
+    except BaseException:
+        _Hold.depth -= 1
+        if _Hold.depth == 0:
+            _Hold.pending = None
+        raise
+    _Hold.depth -= 1
+    if _Hold.depth == 0 and _Hold.pending is not None:
+        signum, _Hold.pending = _Hold.pending, None
+        _deliver(signum)
 
 
 @contextmanager
 def interrupt_signals() -> Iterator[None]:
     """Turn SIGTERM (and SIGHUP) into :class:`Interrupted` for the duration.
 
-    SIGINT already raises :class:`KeyboardInterrupt`. Outside the main thread
+    SIGINT raises :class:`KeyboardInterrupt` as usual. Once the command's output
+    sets are renamed into place (and no other set is open), both are ignored: the
+    new outputs are complete and the command is ending. Outside the main thread
     (where handlers cannot be set) this does nothing.
     """
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     old = {}
-    for sig in (signal.SIGTERM, signal.SIGHUP):
+    stops = [signal.SIGTERM, signal.SIGINT] + ([signal.SIGHUP] if hasattr(signal, "SIGHUP") else [])
+    handlers = {sig: _on_stop_signal for sig in stops}
+    _Commit.done = False
+    for sig, handler in handlers.items():
         try:
-            old[sig] = signal.signal(sig, _raise_interrupted)
+            old[sig] = signal.signal(sig, handler)
         except (ValueError, OSError):  # pragma: no cover - exotic platforms
             pass
     try:
@@ -89,13 +144,19 @@ def active_sets() -> list[OutputDir]:
 
 
 def finish_all() -> None:
-    """Finish every active set (outermost last); on a failure abort the rest."""
-    try:
-        for od in reversed(active_sets()):
-            od.finish()
-    except BaseException:
-        abort_all()
-        raise
+    """Finish every active set (outermost last); on a failure abort the rest.
+
+    The command is ending: from here on a stop signal (under
+    :func:`interrupt_signals`) is ignored, since the outputs are complete.
+    """
+    with _signals_held():
+        try:
+            for od in reversed(active_sets()):
+                od.finish()
+        except BaseException:
+            abort_all()
+            raise
+        _Commit.done = True
 
 
 def abort_all() -> None:
@@ -188,6 +249,7 @@ class OutputDir:
                 break
         if self.parent_set is None:
             _ACTIVE.append(self)
+            _Commit.done = False
 
     # -- context manager ----------------------------------------------------------------
     def __enter__(self) -> OutputDir:
@@ -333,8 +395,9 @@ class OutputDir:
         if self._stage is None:
             parent = self._parent()
             try:
-                self._stage = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.tmp-",
-                                                    dir=parent))
+                with _signals_held():  # no stop between making the folder and knowing it
+                    self._stage = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.tmp-",
+                                                        dir=parent))
             except OSError as exc:
                 raise _os_error(exc, parent, "write into") from None
             _umask_mode(self._stage, directory=True)
@@ -387,15 +450,16 @@ class OutputDir:
         """Rename the set into place (replacing an old set as a whole); release the lock."""
         if self.parent_set is not None or self._done:
             return
-        try:
-            if self._stage is not None:
-                self._swap()
-        except BaseException:
-            self.abort()
-            raise
-        self._done = True
-        self._forget()
-        self._unlock()
+        with _signals_held():  # a stop signal waits until the set is in place (or removed)
+            try:
+                if self._stage is not None:
+                    self._swap()
+            except BaseException:
+                self.abort()
+                raise
+            self._done = True
+            self._forget()
+            self._unlock()
 
     def _swap(self) -> None:
         stage, target = self._stage, self.path
@@ -439,18 +503,19 @@ class OutputDir:
         """Remove the temporary folder (the target is left as it was); release the lock."""
         if self.parent_set is not None or self._done:
             return
-        self._done = True
-        if self._stage is not None:
-            shutil.rmtree(self._stage, ignore_errors=True)
-            self._stage = None
-        self.written.clear()
-        self._unlock()
-        for d in self._made_dirs:  # parents this set created, innermost first
-            try:
-                d.rmdir()
-            except OSError:
-                break
-        self._forget()
+        with _signals_held():  # a second signal must not leave the folder half-removed
+            self._done = True
+            if self._stage is not None:
+                shutil.rmtree(self._stage, ignore_errors=True)
+                self._stage = None
+            self.written.clear()
+            self._unlock()
+            for d in self._made_dirs:  # parents this set created, innermost first
+                try:
+                    d.rmdir()
+                except OSError:
+                    break
+            self._forget()
 
     def _forget(self) -> None:
         if self in _ACTIVE:
