@@ -7,6 +7,8 @@ for scikit-fmm's C++ alike. Times are medians over repeats after a warm-up.
 Bars (issue "Foundation"): FMM ≥ 2× faster than scikit-fmm at the same order
 on 2048² and 256³ (goal ≥ 4×); FM² plan on the open field ≤ 0.1 s after
 warm-up (goal ≤ 0.05 s); 1000×1000×40 terrain plan ≤ 15 s and ≤ 2.5 GB peak.
+Issue 15: the regional case, a 3000×3000-cell DEM (30 m) at 120 m above ground,
+world build + plan ≤ 60 s and ≤ 6 GB peak.
 """
 
 from __future__ import annotations
@@ -169,6 +171,57 @@ def plan_rows(quick: bool) -> list[dict]:
     return rows
 
 
+#: The regional case (issue 15): a synthetic DEM of this many cells a side at 30 m.
+REGIONAL_CELLS = 3000
+
+
+def regional_rows(quick: bool) -> list[dict]:
+    """Terrain following over a 90 km DEM: ``fm2uav.plan`` picks the regional (coarse-to-fine)
+    path by itself (``PlanOptions.storage="auto"``); world build and plan in a fresh child."""
+    n = 600 if quick else REGIONAL_CELLS
+    r = _child(
+        f"""
+        import fm2uav
+        from scipy import ndimage
+        n, cell, dz, agl = {n}, 30.0, 20.0, 120.0
+        rng = np.random.default_rng(0)
+        relief = ndimage.gaussian_filter(rng.standard_normal((n, n)), 40.0, mode="wrap")
+        heights = (relief - relief.min()) / np.ptp(relief) * 1200.0 + 200.0
+        del relief
+        def world_of(h):
+            nz = int(np.ceil((h.max() + agl + 10 * dz - 180.0) / dz)) + 1
+            return fm2uav.World.from_heightmap(h, (cell, cell, dz), nz, origin=(0, 0, 180.0))
+        def at(w, i, j):
+            return [i * cell, j * cell, float(w.ground_height(i * cell, j * cell)) + agl]
+        level = fm2uav.FlightLevel(agl=agl)
+        warm = world_of(heights[:80, :80])                   # JIT warm-up (+ cache fill)
+        fm2uav.plan(warm, at(warm, 5, 5), at(warm, 70, 70), level=level,
+                    options=fm2uav.PlanOptions(storage="regional"))
+        base = rss_mb()
+        t0 = time.perf_counter()
+        world = world_of(heights)
+        t_world = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        p = fm2uav.plan(world, at(world, 10, 10), at(world, n - 11, n - 11), level=level)
+        t_plan = time.perf_counter() - t0
+        hag = p.height_above_ground()[p.phase == "cruise"]
+        print(json.dumps({{"plan": t_plan, "world": t_world, "timings": p.timings,
+                          "peak_mb": peak_mb() - base, "length": p.length,
+                          "shape": list(world.shape), "storage": p.params.get("storage", "full"),
+                          "regional": p.params.get("regional"), "min_cruise_agl": float(hag.min()),
+                          "clearance": p.clearance}}))
+        """
+    )
+    stages = ", ".join(f"{k} {v:.2f} s" for k, v in r["timings"].items() if k != "total")
+    nx, ny, nz = r["shape"]
+    return [{"benchmark": "plan", "case": f"regional {nx}x{ny}x{nz} DEM (30 m, 120 m AGL)",
+             "ours_s": r["plan"] + r["world"], "peak_mb": r["peak_mb"],
+             "bar": "<= 60 s, <= 6 GB",
+             "notes": (f"storage {r['storage']}; world build {r['world']:.2f} s, plan "
+                       f"{r['plan']:.2f} s ({stages}); length {r['length'] / 1e3:.2f} km, "
+                       f"lowest cruise AGL {r['min_cruise_agl']:.1f} m; {r['regional']}")}]
+
+
 def jit_rows(quick: bool) -> list[dict]:
     """Compile time with an empty numba cache, then load time from the cache."""
     cache = tempfile.mkdtemp(prefix="fm2uav-numba-")
@@ -194,7 +247,8 @@ def jit_rows(quick: bool) -> list[dict]:
 def run(quick: bool = False) -> list[dict]:
     """All core benchmark rows (see module docstring)."""
     # the cold-compile measurement takes ~20 s whatever the size: full runs only
-    return fmm_rows(quick) + plan_rows(quick) + ([] if quick else jit_rows(quick))
+    return (fmm_rows(quick) + plan_rows(quick) + regional_rows(quick)
+            + ([] if quick else jit_rows(quick)))
 
 
 if __name__ == "__main__":

@@ -28,6 +28,7 @@ from .altitude import AltitudeProfile, final_profile, height_figures
 from .flight_level import flight_level_speed
 from .geodesic import descend
 from .params import FlightLevel, PlanOptions, Shaping
+from .regional import plan_regional, use_regional
 
 __all__ = ["Plan", "plan", "base_velocity", "shaped_velocity", "max_distance", "plan_params"]
 
@@ -252,9 +253,12 @@ def plan(
         Impose a flight level ``level.agl`` metres above the ground (thesis
         Algorithm 2, see :mod:`fm2uav.planning.flight_level`). Default None.
     options : PlanOptions, optional
-        Fast Marching order, geodesic step [cells], and a custom speed map
+        Fast Marching order, geodesic step [cells], a custom speed map
         (which replaces the shaping and the flight level: the hook for extra
-        shaping such as other UAVs). Default ``PlanOptions()``.
+        shaping such as other UAVs), and the storage: a terrain world too big
+        for one full 3D grid is planned coarse-to-fine by
+        :func:`fm2uav.planning.regional.plan_regional` (``storage="auto"``).
+        Default ``PlanOptions()``.
 
     Returns
     -------
@@ -293,6 +297,9 @@ def plan(
     start_cell = _check_free(world, start_m, "start")
     goal_cell = _check_free(world, goal_m, "goal")
     _check_work(world, start_m, goal_m, start_cell, goal_cell, options)
+    if use_regional(world, shaping, level, options):  # too big for one full grid
+        return plan_regional(world, start_m, goal_m, shaping=shaping, level=level,
+                             options=options, t_all=t_all)
 
     t0 = time.perf_counter()
     W = plan_velocity(world, shaping, level, options)

@@ -1,0 +1,98 @@
+"""Regional (coarse-to-fine) plans against the full-grid plan where the full grid fits."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy import ndimage
+
+import fm2uav
+from fm2uav import FlightLevel, InputError, PlanOptions, World
+from fm2uav.analysis.safety import safety_summary
+from fm2uav.eikonal import _kernels
+from fm2uav.planning import regional
+from fm2uav.planning.planner import max_distance
+from fm2uav.world._columns import column_tops
+
+CELL, DZ, AGL = 30.0, 20.0, 120.0
+
+
+def _relief(n: int, sigma: float, relief_m: float, seed: int = 0) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    r = ndimage.gaussian_filter(rng.standard_normal((n, n)), sigma, mode="wrap")
+    return (r - r.min()) / np.ptp(r) * relief_m + 200.0
+
+
+def _world(heights: np.ndarray) -> World:
+    nz = int(np.ceil((heights.max() + AGL + 10 * DZ - 180.0) / DZ)) + 1
+    return World.from_heightmap(heights, (CELL, CELL, DZ), nz, origin=(0.0, 0.0, 180.0))
+
+
+def _at(world: World, i: int, j: int) -> np.ndarray:
+    x, y = i * CELL, j * CELL
+    return np.array([x, y, float(world.ground_height(x, y)) + AGL])
+
+
+@pytest.fixture(scope="module")
+def medium():
+    return _world(_relief(260, 10.0, 500.0))
+
+
+def test_column_layer_edt_is_the_full_edt_layer(medium):
+    sub = medium.occupancy[:70, :50]
+    full = _kernels.squared_edt(np.ascontiguousarray(sub), CELL, CELL, DZ)
+    top, solid = column_tops(sub)
+    assert solid
+    for k in (0, 7, sub.shape[2] - 1):
+        np.testing.assert_array_equal(
+            _kernels.squared_column_edt_layer(top, k, CELL, CELL, DZ), full[:, :, k])
+
+
+def test_column_tops_matches_numpy():
+    rng = np.random.default_rng(3)
+    occ = rng.random((9, 7, 11)) < 0.3
+    top, solid = column_tops(occ)
+    has = occ.any(axis=2)
+    expect = np.where(has, 10 - np.argmax(occ[:, :, ::-1], axis=2), -1)
+    np.testing.assert_array_equal(top, expect)
+    k = np.arange(11)
+    assert solid == bool(np.array_equal(occ, k[None, None, :] <= top[:, :, None]))
+    assert column_tops(k[None, None, :] <= top[:, :, None])[1]
+
+
+def test_world_max_distance_is_the_full_plans(medium):
+    assert regional.world_max_distance(medium) == max_distance(medium)
+
+
+def test_regional_plan_matches_full_plan(medium):
+    level = FlightLevel(agl=AGL, min_agl=100.0)
+    s, g = _at(medium, 8, 10), _at(medium, 250, 245)
+    full = fm2uav.plan(medium, s, g, level=level, options=PlanOptions(storage="full"))
+    reg = fm2uav.plan(medium, s, g, level=level, options=PlanOptions(storage="regional"))
+    assert "storage" not in full.params and reg.params["storage"] == "regional"
+    assert reg.params["regional"]["windows"] >= 2  # really stitched from several windows
+    np.testing.assert_allclose(reg.path[[0, -1]], full.path[[0, -1]])
+    assert abs(reg.length / full.length - 1.0) < 0.01
+    for p in (full, reg):
+        summary = safety_summary(medium, p.path, requested=AGL, phase=p.phase, level=level)
+        assert summary["checks"] and all(c["ok"] for c in summary["checks"].values())
+        cruise = summary["height_above_ground"]["cruise"]
+        assert cruise["min_m"] >= AGL - level.tolerance - 1e-6
+    assert reg.clearance > 0.5 * AGL
+
+
+def test_auto_storage_picks_regional_when_the_full_grid_is_too_big(medium, monkeypatch):
+    level = FlightLevel(agl=AGL)
+    s, g = _at(medium, 8, 10), _at(medium, 120, 100)
+    monkeypatch.setattr(regional, "FULL_PLAN_MEMORY_SHARE", 0.0)
+    assert fm2uav.plan(medium, s, g, level=level).params["storage"] == "regional"
+    # no flight level: the full grid, whatever its size
+    assert "storage" not in fm2uav.plan(medium, s, g).params
+
+
+def test_regional_storage_refuses_what_it_cannot_plan(medium):
+    s, g = _at(medium, 8, 10), _at(medium, 60, 50)
+    with pytest.raises(InputError, match="needs a flight level.*--storage"):
+        fm2uav.plan(medium, s, g, options=PlanOptions(storage="regional"))
+    with pytest.raises(InputError, match="storage must be one of"):
+        PlanOptions(storage="banded")
