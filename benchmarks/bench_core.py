@@ -178,7 +178,8 @@ REGIONAL_CELLS = 3000
 def regional_rows(quick: bool) -> list[dict]:
     """Terrain following over a 90 km DEM: ``fm2uav.plan`` picks the regional (coarse-to-fine)
     path by itself (``PlanOptions.storage="auto"``); world build and plan in a fresh child."""
-    n = 600 if quick else REGIONAL_CELLS
+    # quick: a small map, where "auto" would pick the full grid, so ask for the regional path
+    n, storage = (300, "regional") if quick else (REGIONAL_CELLS, "auto")
     r = _child(
         f"""
         import fm2uav
@@ -202,7 +203,8 @@ def regional_rows(quick: bool) -> list[dict]:
         world = world_of(heights)
         t_world = time.perf_counter() - t0
         t0 = time.perf_counter()
-        p = fm2uav.plan(world, at(world, 10, 10), at(world, n - 11, n - 11), level=level)
+        p = fm2uav.plan(world, at(world, 10, 10), at(world, n - 11, n - 11), level=level,
+                        options=fm2uav.PlanOptions(storage="{storage}"))
         t_plan = time.perf_counter() - t0
         hag = p.height_above_ground()[p.phase == "cruise"]
         print(json.dumps({{"plan": t_plan, "world": t_world, "timings": p.timings,

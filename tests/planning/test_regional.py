@@ -96,3 +96,49 @@ def test_regional_storage_refuses_what_it_cannot_plan(medium):
         fm2uav.plan(medium, s, g, options=PlanOptions(storage="regional"))
     with pytest.raises(InputError, match="storage must be one of"):
         PlanOptions(storage="banded")
+
+
+def test_auto_storage_names_the_fix_when_nothing_fits(medium, monkeypatch):
+    monkeypatch.setattr(regional, "FULL_PLAN_MEMORY_SHARE", 0.0)
+    monkeypatch.setattr(regional, "_memory_bytes", lambda: 1.0)
+    s, g = _at(medium, 8, 10), _at(medium, 60, 50)
+    with pytest.raises(InputError, match="needs a flight level.*--cell-size"):
+        fm2uav.plan(medium, s, g)
+
+
+def test_with_fields_shares_the_grid(medium):
+    w = medium.with_fields(name="renamed", crs="EPSG:32630")
+    assert w.occupancy is medium.occupancy and w.name == "renamed" and w.crs == "EPSG:32630"
+    assert not w.occupancy.flags.writeable and w._cache == {}
+
+
+def test_cli_plans_a_dem_regionally(tmp_path):
+    import json
+
+    import rasterio
+    from rasterio.transform import from_origin
+    from typer.testing import CliRunner
+
+    from fm2uav.cli import app
+
+    n = 200
+    h = _relief(n, 8.0, 400.0, seed=2).astype(np.float32)
+    dem = tmp_path / "dem.tif"
+    with rasterio.open(dem, "w", driver="GTiff", width=n, height=n, count=1, dtype="float32",
+                       crs="EPSG:32630", transform=from_origin(400000.0, 4500000.0, CELL, CELL)
+                       ) as ds:
+        ds.write(h, 1)
+    from pyproj import Transformer
+
+    to_ll = Transformer.from_crs("EPSG:32630", "EPSG:4326", always_xy=True)
+    (lo0, la0), (lo1, la1) = (to_ll.transform(400300, 4494300), to_ll.transform(405600, 4499700))
+    out = tmp_path / "out"
+    res = CliRunner().invoke(app, [
+        "plan", "--dem", str(dem), "--cell-size", "30", "--agl", "120", "--storage", "regional",
+        "--lonlat", f"--start={lo0:.6f},{la0:.6f},120", f"--goal={lo1:.6f},{la1:.6f},120",
+        "--out", str(out), "--quiet"])
+    assert res.exit_code == 0, res.output
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["params"]["storage"] == "regional"
+    assert all(c["ok"] for c in summary["safety"]["checks"].values())
+    assert summary["safety"]["height_above_ground"]["cruise"]["min_m"] >= 118.0

@@ -119,9 +119,18 @@ def use_regional(world: World, shaping: Shaping, level: FlightLevel | None,
     if options.storage == "full":
         return False
     if options.storage == "auto":
-        if full_plan_bytes(world) <= FULL_PLAN_MEMORY_SHARE * _memory_bytes():
+        need, have = full_plan_bytes(world), _memory_bytes()
+        if need <= FULL_PLAN_MEMORY_SHARE * have:
             return False
-        return _unsupported(world, shaping, level, options) is None
+        why = _unsupported(world, shaping, level, options)
+        if why is not None and need > have:
+            raise InputError(
+                f"the world's {world.occupancy.size:.3g} nodes need about {need / 2**30:.3g} GiB "
+                f"to plan on one full grid (this machine: {have / 2**30:.3g} GiB), and a "
+                f"regional plan cannot take this request: {why}; use a larger "
+                "world.cell_size / world.dz (CLI --cell-size / --dz) or crop with world.bbox "
+                "(CLI --bbox)")
+        return why is None
     why = _unsupported(world, shaping, level, options)
     if why is not None:
         raise InputError(f"storage 'regional' cannot plan this request: {why} (mission file: "

@@ -204,6 +204,23 @@ class World:
             + (f", filled={int(self.filled.sum())}" if self.filled is not None else "") + ")"
         )
 
+    def with_fields(self, **changes: Any) -> World:
+        """``dataclasses.replace(self, **changes)`` sharing the read-only occupancy grid.
+
+        A new world (fresh cache) with other fields, e.g. ``crs``, ``name``, ``georef``;
+        unless ``occupancy`` is among the changes, the grid is not copied (it is
+        read-only in both).
+        """
+        import dataclasses
+
+        if "occupancy" in changes:
+            return dataclasses.replace(self, **changes)
+        _BUILT.add(id(self.occupancy))
+        try:
+            return dataclasses.replace(self, **changes)
+        finally:
+            _BUILT.discard(id(self.occupancy))
+
     # ------------------------------------------------------------------ geometry
     @property
     def ndim(self) -> int:
