@@ -142,3 +142,22 @@ def test_cli_plans_a_dem_regionally(tmp_path):
     assert summary["params"]["storage"] == "regional"
     assert all(c["ok"] for c in summary["safety"]["checks"].values())
     assert summary["safety"]["height_above_ground"]["cruise"]["min_m"] >= 118.0
+
+
+@pytest.mark.parametrize("shaping", [fm2uav.Shaping(), fm2uav.Shaping(saturation_distance=200.0,
+                                                                       exponent=1.5)])
+def test_window_velocity_is_the_worlds_w_away_from_its_sides(medium, shaping):
+    from fm2uav.planning.planner import plan_velocity
+
+    level = FlightLevel(agl=AGL, band=20.0)
+    full = plan_velocity(medium, shaping, level, PlanOptions())
+    top = medium.surface_index()
+    layer = top + int(round(AGL / DZ))
+    xy = np.array([[60 * CELL, 50 * CELL], [140 * CELL, 120 * CELL]])
+    sub = regional._window(medium, top, layer, xy, (np.r_[xy[0], 900.0], np.r_[xy[1], 900.0]))
+    W = regional.window_velocity(sub, regional.world_max_distance(medium), shaping, level)
+    i0, j0, k0 = (int(round(v)) for v in medium.to_index(np.asarray(sub.origin)))
+    nx, ny, nz = W.shape
+    inner = (slice(15, nx - 15), slice(15, ny - 15), slice(None))
+    ref = full[i0:i0 + nx, j0:j0 + ny, k0:k0 + nz]
+    np.testing.assert_array_equal(W[inner], ref[inner])

@@ -57,6 +57,7 @@ __all__ = [
     "use_regional",
     "full_plan_bytes",
     "world_max_distance",
+    "window_velocity",
     "FULL_PLAN_MEMORY_SHARE",
     "COARSE_COLUMNS",
     "SEGMENT_CELLS",
@@ -242,17 +243,29 @@ def _window(world: World, top: np.ndarray, layer: np.ndarray, xy: np.ndarray,
                  terrain=world.terrain[cols], name=f"{world.name} window")
 
 
-def _leg(sub: World, a: np.ndarray, b: np.ndarray, top_distance: float, shaping: Shaping,
-         level: FlightLevel, options: PlanOptions) -> _Leg:
-    """FM² from ``a`` to ``b`` [m] on the window ``sub`` with the whole world's W scale."""
-    t0 = time.perf_counter()
+def window_velocity(sub: World, top_distance: float, shaping: Shaping,
+                    level: FlightLevel) -> np.ndarray:
+    """W of a window: the full plan's W on its nodes (:func:`fm2uav.planning.planner.plan_velocity` of the world).
+
+    The distance to the window's obstacles divided by the *world's* largest distance
+    ``top_distance`` [m] (:func:`world_max_distance`), shaped, flight level imposed. Equal
+    to the world's W except within a few cells of the window's sides, where obstacles
+    outside the window would be nearer.
+    """
     dist = distance_map(sub.occupancy, spacing=sub.spacing)
     W = np.divide(dist, top_distance, out=dist)  # normalise_distance with the world's max
     if shaping.shapes:
         W = shape_velocity(W, saturation=shaping.saturation, exponent=shaping.exponent,
                            saturation_distance=shaping.saturation_distance,
                            max_distance=top_distance)
-    W = flight_level_speed(W, sub, level)
+    return flight_level_speed(W, sub, level)
+
+
+def _leg(sub: World, a: np.ndarray, b: np.ndarray, top_distance: float, shaping: Shaping,
+         level: FlightLevel, options: PlanOptions) -> _Leg:
+    """FM² from ``a`` to ``b`` [m] on the window ``sub`` with the whole world's W scale."""
+    t0 = time.perf_counter()
+    W = window_velocity(sub, top_distance, shaping, level)
     t1 = time.perf_counter()
     ca, cb = sub.to_cell(a), sub.to_cell(b)
     T = fast_marching(W, [cb], spacing=sub.spacing, order=options.order, stop_at=[ca])
