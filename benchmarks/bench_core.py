@@ -253,7 +253,19 @@ def run(quick: bool = False) -> list[dict]:
             + ([] if quick else jit_rows(quick)))
 
 
-if __name__ == "__main__":
-    import pprint
+#: ``python -m benchmarks.bench_core big`` runs only the big-map rows (issue 15, deliverable 3).
+GROUPS = {"fmm": fmm_rows, "plan": plan_rows, "big": lambda quick: big_rows(quick),
+          "jit": jit_rows}
 
-    pprint.pprint(run(quick="--quick" in sys.argv))
+
+def big_rows(quick: bool) -> list[dict]:
+    """The terrain 1000x1000x40 row of :func:`plan_rows` and the regional row."""
+    return [r for r in plan_rows(quick) if r["case"].startswith("terrain")] + regional_rows(quick)
+
+
+if __name__ == "__main__":
+    from benchmarks.run import print_table
+
+    quick = "--quick" in sys.argv
+    names = [a for a in sys.argv[1:] if not a.startswith("--")]
+    print_table(run(quick) if not names else [r for n in names for r in GROUPS[n](quick)])

@@ -166,10 +166,11 @@ def base_velocity(world: World, *, method: str = "edt", walls: bool = False) -> 
     cached = world._cache.get(key)
     if cached is None:
         dist = distance_map(world.occupancy, spacing=world.spacing, method=method, walls=walls)
-        cached = normalise_distance(dist)
+        scale = distance_scale(dist)
+        cached = normalise_distance(dist, overwrite=True)  # dist is ours: no second map
         cached.setflags(write=False)
         world._cache[key] = cached
-        world._cache[("max_distance", method, bool(walls))] = distance_scale(dist)
+        world._cache[("max_distance", method, bool(walls))] = scale
     return cached
 
 
