@@ -53,10 +53,13 @@ class Plan:
         grid nodes, not to no-fly zones; ``inf`` on a 2D map without obstacles).
     timings : dict of str to float
         Wall time of each stage [s]: ``velocity_map``, ``fast_marching``,
-        ``geodesic``, ``metrics``, ``total``.
+        ``geodesic``, ``metrics``, ``total`` (a regional plan adds ``coarse`` and
+        sums its windows' stages).
     W : ndarray
         The velocity map used (after saturation/exponent and any flight-level
-        shaping), same shape as the world.
+        shaping), same shape as the world. A regional plan
+        (``params["storage"] == "regional"``, :mod:`fm2uav.planning.regional`) has no
+        world-sized map: ``W`` and ``T`` are then its coarse stage's.
     T : ndarray
         Arrival times [s·(1/W)] of the wave from the goal; ``inf`` where not
         reached before the start was frozen.
