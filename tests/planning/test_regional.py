@@ -48,18 +48,6 @@ def test_column_layer_edt_is_the_full_edt_layer(medium):
             _kernels.squared_column_edt_layer(top, k, CELL, CELL, DZ), full[:, :, k])
 
 
-def test_column_tops_matches_numpy():
-    rng = np.random.default_rng(3)
-    occ = rng.random((9, 7, 11)) < 0.3
-    top, solid = column_tops(occ)
-    has = occ.any(axis=2)
-    expect = np.where(has, 10 - np.argmax(occ[:, :, ::-1], axis=2), -1)
-    np.testing.assert_array_equal(top, expect)
-    k = np.arange(11)
-    assert solid == bool(np.array_equal(occ, k[None, None, :] <= top[:, :, None]))
-    assert column_tops(k[None, None, :] <= top[:, :, None])[1]
-
-
 def test_world_max_distance_is_the_full_plans(medium):
     assert regional.world_max_distance(medium) == max_distance(medium)
 
@@ -110,38 +98,6 @@ def test_with_fields_shares_the_grid(medium):
     w = medium.with_fields(name="renamed", crs="EPSG:32630")
     assert w.occupancy is medium.occupancy and w.name == "renamed" and w.crs == "EPSG:32630"
     assert not w.occupancy.flags.writeable and w._cache == {}
-
-
-def test_cli_plans_a_dem_regionally(tmp_path):
-    import json
-
-    import rasterio
-    from rasterio.transform import from_origin
-    from typer.testing import CliRunner
-
-    from fm2uav.cli import app
-
-    n = 200
-    h = _relief(n, 8.0, 400.0, seed=2).astype(np.float32)
-    dem = tmp_path / "dem.tif"
-    with rasterio.open(dem, "w", driver="GTiff", width=n, height=n, count=1, dtype="float32",
-                       crs="EPSG:32630", transform=from_origin(400000.0, 4500000.0, CELL, CELL)
-                       ) as ds:
-        ds.write(h, 1)
-    from pyproj import Transformer
-
-    to_ll = Transformer.from_crs("EPSG:32630", "EPSG:4326", always_xy=True)
-    (lo0, la0), (lo1, la1) = (to_ll.transform(400300, 4494300), to_ll.transform(405600, 4499700))
-    out = tmp_path / "out"
-    res = CliRunner().invoke(app, [
-        "plan", "--dem", str(dem), "--cell-size", "30", "--agl", "120", "--storage", "regional",
-        "--lonlat", f"--start={lo0:.6f},{la0:.6f},120", f"--goal={lo1:.6f},{la1:.6f},120",
-        "--out", str(out), "--quiet"])
-    assert res.exit_code == 0, res.output
-    summary = json.loads((out / "summary.json").read_text())
-    assert summary["params"]["storage"] == "regional"
-    assert all(c["ok"] for c in summary["safety"]["checks"].values())
-    assert summary["safety"]["height_above_ground"]["cruise"]["min_m"] >= 118.0
 
 
 @pytest.mark.parametrize("shaping", [fm2uav.Shaping(), fm2uav.Shaping(saturation_distance=200.0,
