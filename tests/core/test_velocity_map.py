@@ -138,4 +138,3 @@ def test_saturation_distance_in_metres():
         velocity_map(occ, saturation_distance=0.0)
     with pytest.raises(InputError, match="max_distance"):
         shape_velocity(np.ones(3), saturation_distance=1.0)
-
