@@ -92,6 +92,10 @@ def test_auto_storage_names_the_fix_when_nothing_fits(medium, monkeypatch):
     s, g = _at(medium, 8, 10), _at(medium, 60, 50)
     with pytest.raises(InputError, match="needs a flight level.*--cell-size"):
         fm2uav.plan(medium, s, g)
+    # any full-grid map of it (coverage, formation, ...) says the same, not MemoryError
+    medium._cache.clear()
+    with pytest.raises(InputError, match="GiB to plan on one full grid.*--agl.*--cell-size"):
+        fm2uav.planning.base_velocity(medium)
 
 
 def test_with_fields_shares_the_grid(medium):

@@ -28,7 +28,7 @@ from .altitude import AltitudeProfile, final_profile, height_figures
 from .flight_level import flight_level_speed
 from .geodesic import descend
 from .params import FlightLevel, PlanOptions, Shaping
-from .regional import plan_regional, use_regional
+from .regional import check_full_grid, plan_regional, use_regional
 
 __all__ = ["Plan", "plan", "base_velocity", "shaped_velocity", "max_distance", "plan_params"]
 
@@ -168,6 +168,7 @@ def base_velocity(world: World, *, method: str = "edt", walls: bool = False) -> 
     key = ("base_velocity", method, bool(walls))
     cached = world._cache.get(key)
     if cached is None:
+        check_full_grid(world)  # a clear error rather than running out of memory
         dist = distance_map(world.occupancy, spacing=world.spacing, method=method, walls=walls)
         scale = distance_scale(dist)
         cached = normalise_distance(dist, overwrite=True)  # dist is ours: no second map

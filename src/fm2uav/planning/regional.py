@@ -56,6 +56,7 @@ __all__ = [
     "plan_regional",
     "use_regional",
     "full_plan_bytes",
+    "check_full_grid",
     "world_max_distance",
     "window_velocity",
     "FULL_PLAN_MEMORY_SHARE",
@@ -88,6 +89,25 @@ def _memory_bytes() -> float:
         return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
     except (ValueError, OSError, AttributeError):  # pragma: no cover - non-POSIX
         return math.inf
+
+
+def check_full_grid(world: World, why: str = "terrain following (planner.agl / --agl) plans "
+                    "such terrain worlds regionally") -> None:
+    """Refuse a full-grid FM² map of ``world`` larger than this machine's memory.
+
+    Raises
+    ------
+    InputError
+        :func:`full_plan_bytes` exceeds the physical memory; the message says how
+        much it would take, ``why``, and what shrinks the world.
+    """
+    need, have = full_plan_bytes(world), _memory_bytes()
+    if need > have:
+        raise InputError(
+            f"the world's {world.occupancy.size:.3g} nodes need about {need / 2**30:.3g} GiB "
+            f"to plan on one full grid (this machine: {have / 2**30:.3g} GiB); {why}; or use "
+            "a larger world.cell_size / world.dz (CLI --cell-size / --dz) or crop with "
+            "world.bbox (CLI --bbox)")
 
 
 def _unsupported(world: World, shaping: Shaping, level: FlightLevel | None,
@@ -124,13 +144,8 @@ def use_regional(world: World, shaping: Shaping, level: FlightLevel | None,
         if need <= FULL_PLAN_MEMORY_SHARE * have:
             return False
         why = _unsupported(world, shaping, level, options)
-        if why is not None and need > have:
-            raise InputError(
-                f"the world's {world.occupancy.size:.3g} nodes need about {need / 2**30:.3g} GiB "
-                f"to plan on one full grid (this machine: {have / 2**30:.3g} GiB), and a "
-                f"regional plan cannot take this request: {why}; use a larger "
-                "world.cell_size / world.dz (CLI --cell-size / --dz) or crop with world.bbox "
-                "(CLI --bbox)")
+        if why is not None:
+            check_full_grid(world, f"a regional plan cannot take this request: {why}")
         return why is None
     why = _unsupported(world, shaping, level, options)
     if why is not None:
