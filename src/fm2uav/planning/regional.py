@@ -302,8 +302,8 @@ def plan_regional(world: World, start: np.ndarray, goal: np.ndarray, *, shaping:
 
     Called by :func:`fm2uav.plan` (``PlanOptions.storage``), which has checked the
     points; returns the same :class:`~fm2uav.planning.planner.Plan`, with
-    ``params["storage"] = "regional"`` and ``params["regional"]`` (coarse factor,
-    windows, window nodes), ``timings`` with a ``coarse`` stage, and ``W`` / ``T``
+    ``params["storage"] = "regional"`` and ``params["regional"]`` (coarse factor and
+    grid, number of windows, largest window's and all windows' nodes), ``timings`` with a ``coarse`` stage, and ``W`` / ``T``
     the *coarse* stage's maps (their shape is not the world's).
     """
     from .planner import Plan, plan_params
@@ -316,10 +316,10 @@ def plan_regional(world: World, start: np.ndarray, goal: np.ndarray, *, shaping:
     t_coarse = time.perf_counter() - t0
     top_distance = world_max_distance(world)
     points, stretches = _waypoints(world, layer, coarse.path[:, :2], start, goal)
-    legs, nodes = [], 0
+    legs, nodes = [], []
     for k, xy in enumerate(stretches):
         sub = _window(world, top, layer, xy, (points[k], points[k + 1]))
-        nodes = max(nodes, sub.occupancy.size)
+        nodes.append(sub.occupancy.size)
         legs.append(_leg(sub, points[k], points[k + 1], top_distance, shaping, level, options))
     path = np.vstack([legs[0].path] + [lg.path[1:] for lg in legs[1:]])
     w = np.concatenate([legs[0].w] + [lg.w[1:] for lg in legs[1:]])
@@ -350,7 +350,7 @@ def plan_regional(world: World, start: np.ndarray, goal: np.ndarray, *, shaping:
     params.update(storage="regional", regional={
         "coarse_factor": round(coarse.world.spacing[0] / world.spacing[0], 3),
         "coarse_shape": list(coarse.world.shape), "windows": len(legs),
-        "largest_window_nodes": int(nodes)})
+        "largest_window_nodes": int(max(nodes)), "window_nodes": int(sum(nodes))})
     return Plan(path=path, w=w, length=length, clearance=clearance, timings=timings,
                 W=coarse.W, T=coarse.T, world=world, params=params, shaping=shaping,
                 level=level, profile=profile)
