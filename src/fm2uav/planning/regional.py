@@ -10,11 +10,14 @@ level, so :func:`plan_regional` plans in three stages:
    while the level stays >= 3 cells above the ground) and planned with the same
    shaping and flight level over the whole map.
 2. **Full-resolution windows.** Waypoints every :data:`SEGMENT_CELLS` cells along
-   the coarse route (on the flight-level node of their column); between two
-   waypoints an ordinary FM² plan on a *window* of the world: the columns of the
-   coarse route between them plus :data:`MARGIN_CELLS` on every side, and only the
-   layers from one below the lowest ground of the window to
-   :data:`TOP_MARGIN_LAYERS` above its highest flight level. The window's nodes are
+   the coarse route (on the flight-level node of their column); from the current
+   point to the waypoint after next, an ordinary FM² plan on a *window* of the world:
+   the columns of those two stretches of the coarse route plus :data:`MARGIN_CELLS`
+   on every side, and only the layers from one below the lowest ground of the window
+   to :data:`TOP_MARGIN_LAYERS` above its highest flight level. Its path is kept up to
+   the point nearest the next waypoint, where the next window starts (receding
+   horizon: the waypoints only pin the discarded halves, so the kept path is the fine
+   route, not forced through points of the coarse one). The window's nodes are
    the world's nodes (same grid, same occupancy), and its W is normalised by the
    *whole world's* largest obstacle distance (:func:`world_max_distance`, exact), so
    W on a window is the full plan's W (except within a few cells of the window's
@@ -27,6 +30,9 @@ level, so :func:`plan_regional` plans in three stages:
 The route is thus the full plan's route wherever the full-resolution optimum stays
 within the corridor of the coarse route (tests/planning/test_regional.py compares
 both on a map where the full grid fits: lengths within 1 %, same safety figures).
+Where the relief's features are finer than the coarse cells, the coarse stage may
+choose another valley than the full plan and the corridor keeps the fine plan in it
+(``python -m benchmarks.bench_core big``, row "rough").
 """
 
 from __future__ import annotations
@@ -296,6 +302,36 @@ def _leg(sub: World, a: np.ndarray, b: np.ndarray, top_distance: float, shaping:
     return _Leg(path=sub.to_world(idx), w=w, timings=(t1 - t0, t2 - t1, t3 - t2))
 
 
+def _windows(world: World, top: np.ndarray, layer: np.ndarray, points: list[np.ndarray],
+             stretches: list[np.ndarray], top_distance: float, shaping: Shaping,
+             level: FlightLevel, options: PlanOptions) -> tuple[list[_Leg], list[int]]:
+    """The full-resolution legs, receding horizon (module docstring, stage 2).
+
+    Each window looks two stretches ahead: it plans from the current point to the waypoint
+    after next, and keeps its path up to the point nearest the next waypoint, where the next
+    window starts. So a waypoint only pins the discarded far half of a window's path, and the
+    kept path is the window's own fine route (the last window plans to the goal).
+    """
+    legs, nodes = [], []
+    here, k, n = points[0], 0, len(stretches)
+    while True:
+        final = k + 2 >= n
+        target = points[n] if final else points[k + 2]
+        xy = np.vstack([here[None, :2], *stretches[k:k + 2]])
+        sub = _window(world, top, layer, xy, (here, target))
+        nodes.append(sub.occupancy.size)
+        leg = _leg(sub, here, target, top_distance, shaping, level, options)
+        if final:
+            legs.append(leg)
+            return legs, nodes
+        d = np.hypot(*(leg.path[:, :2] - points[k + 1][:2]).T)
+        cut = max(1, int(np.argmin(d[:-1])))
+        while cut > 1 and world.occupancy[world.to_cell(leg.path[cut])]:
+            cut -= 1  # the next window starts on a free node
+        legs.append(_Leg(path=leg.path[:cut + 1], w=leg.w[:cut + 1], timings=leg.timings))
+        here, k = leg.path[cut], k + 1
+
+
 def plan_regional(world: World, start: np.ndarray, goal: np.ndarray, *, shaping: Shaping,
                   level: FlightLevel, options: PlanOptions, t_all: float | None = None):
     """FM² from ``start`` to ``goal`` [m] by coarse-to-fine windows (module docstring).
@@ -316,11 +352,8 @@ def plan_regional(world: World, start: np.ndarray, goal: np.ndarray, *, shaping:
     t_coarse = time.perf_counter() - t0
     top_distance = world_max_distance(world)
     points, stretches = _waypoints(world, layer, coarse.path[:, :2], start, goal)
-    legs, nodes = [], []
-    for k, xy in enumerate(stretches):
-        sub = _window(world, top, layer, xy, (points[k], points[k + 1]))
-        nodes.append(sub.occupancy.size)
-        legs.append(_leg(sub, points[k], points[k + 1], top_distance, shaping, level, options))
+    legs, nodes = _windows(world, top, layer, points, stretches, top_distance, shaping, level,
+                           options)
     path = np.vstack([legs[0].path] + [lg.path[1:] for lg in legs[1:]])
     w = np.concatenate([legs[0].w] + [lg.w[1:] for lg in legs[1:]])
     t2 = time.perf_counter()
