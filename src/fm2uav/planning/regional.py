@@ -78,7 +78,7 @@ FULL_PLAN_MEMORY_SHARE = 0.25
 #: Most columns of the coarse stage's grid.
 COARSE_COLUMNS = 250_000
 #: Length of a full-resolution window's stretch of the coarse route [cells].
-SEGMENT_CELLS = 120
+SEGMENT_CELLS = 64
 #: Columns added on every side of a window around its stretch of the coarse route.
 MARGIN_CELLS = 30
 #: Layers a window keeps above its highest flight-level node.
