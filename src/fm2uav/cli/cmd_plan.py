@@ -66,6 +66,10 @@ def plan_cmd(
         "--saturation)."),
     exponent: float = typer.Option(1.0, help="Exponent β > 0 on W (thesis' adjustment)."),
     order: int = typer.Option(2, help="Fast Marching order, 1 or 2."),
+    storage: str = typer.Option(
+        "auto", help="Grid storage: 'full' (one 3D grid), 'regional' (coarse plan, then "
+        "full-resolution windows along it; terrain + --agl) or 'auto' (regional when the full "
+        "grid would not fit in a quarter of the memory)."),
     agl: float | None = typer.Option(
         None, help="Flight level (m) above the ground (terrain-following, thesis "
         "Algorithm 2). Default: none."),
@@ -116,7 +120,7 @@ def plan_cmd(
         cells=cells, agl=agl, anchor=getattr(export_options, "anchor", None))
     shaping, level, options = _planner(
         dict(saturation=saturation, saturation_distance=saturation_distance, exponent=exponent,
-             order=order),
+             order=order, storage=storage),
         dict(agl=agl, p1=p1, p2=p2, band=band, graded=graded, mode=mode, min_agl=min_agl,
              max_agl=max_agl))
     route = plan_route(w, start_m, goal_m, via=via_m,

@@ -920,3 +920,46 @@ def squared_edt(occ, hx, hy, hz):
     if occ.size >= EDT_PARALLEL_MIN_NODES:
         return _squared_edt_parallel(occ, hx, hy, hz)
     return _squared_edt_serial(occ, hx, hy, hz)
+
+
+@njit(cache=True, error_model="numpy")
+def squared_column_edt_layer(top, k, hx, hy, hz):
+    """Exact squared distance [m²] from the nodes of layer ``k`` to a column world's obstacles.
+
+    A column world has obstacle nodes ``(i, j, l)`` for ``l <= top[i, j]`` (``top = -1``:
+    a column without obstacle). The transform is the separable EDT of
+    :func:`squared_edt` restricted to one layer: the pass along z is the closed form
+    ``hz^2 (k - top)^2`` (0 at and below ``top``), then the passes along y and x, in
+    the same order and arithmetic as :func:`squared_edt`, so the values are those of the
+    full 3D transform's layer ``k``. Returns float64 ``(nx, ny)``.
+    """
+    nx, ny = top.shape
+    d = np.empty((nx, ny), dtype=np.float64)
+    nmax = max(nx, ny)
+    f = np.empty(nmax)
+    out = np.empty(nmax)
+    v = np.empty(nmax, dtype=np.int64)
+    z = np.empty(nmax + 1)
+    wz = hz * hz
+    for i in range(nx):
+        for j in range(ny):
+            t = top[i, j]
+            if t < 0:
+                f[j] = np.inf
+            else:
+                m = k - t
+                f[j] = 0.0 if m <= 0 else wz * m * m + 0.0
+        if ny > 1:
+            _edt_line(f, ny, hy * hy, v, z, out)
+            for j in range(ny):
+                d[i, j] = out[j]
+        else:
+            d[i, 0] = f[0]
+    if nx > 1:
+        for j in range(ny):
+            for i in range(nx):
+                f[i] = d[i, j]
+            _edt_line(f, nx, hx * hx, v, z, out)
+            for i in range(nx):
+                d[i, j] = out[i]
+    return d

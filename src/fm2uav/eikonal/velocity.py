@@ -103,14 +103,18 @@ def distance_map(
     return np.asarray(dist, dtype=np.float64)
 
 
-def normalise_distance(dist: np.ndarray) -> np.ndarray:
+def normalise_distance(dist: np.ndarray, *, overwrite: bool = False) -> np.ndarray:
     """Rescale a distance map so that its maximum is 1 (thesis §2.2, step 2).
 
     A map with no obstacle (all ``inf``) becomes all ones; ``inf`` entries of a
-    partly infinite map become 1.
+    partly infinite map become 1. ``overwrite=True`` divides a float64 ``dist`` in
+    place in the usual case (finite, positive maximum): the same values without a
+    second map-sized array (320 MB on a 1000 x 1000 x 40 map).
     """
     top = float(np.max(dist))
     if np.isfinite(top):  # the usual case: one pass for the max, one for the division
+        if top > 0.0 and overwrite and dist.dtype == np.float64:
+            return np.divide(dist, top, out=dist)
         return dist / top if top > 0.0 else np.zeros_like(dist)
     finite = np.isfinite(dist)
     finite_max = float(np.max(dist, initial=0.0, where=finite))
@@ -237,5 +241,6 @@ def velocity_map(
     """
     dist = distance_map(occupancy, spacing=spacing, method=method, walls=walls)
     top = distance_scale(dist) if saturation_distance is not None else None
-    return shape_velocity(normalise_distance(dist), saturation=saturation, exponent=exponent,
+    return shape_velocity(normalise_distance(dist, overwrite=True), saturation=saturation,
+                          exponent=exponent,
                           saturation_distance=saturation_distance, max_distance=top)

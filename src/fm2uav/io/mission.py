@@ -244,6 +244,9 @@ class PlannerSpec(BaseModel):
         None, description="ground: final profile above the continuous ground; fm2: the "
         "FM² layer's own heights")
     step: float = _num(0.5, gt=0, le=1, desc="geodesic step in cells")
+    storage: Literal["auto", "full", "regional"] = Field(
+        "auto", description="grid storage: full 3D grid, regional (coarse-to-fine windows, "
+        "terrain + agl), or auto by memory")
 
     @model_validator(mode="after")
     def _objects(self) -> PlannerSpec:

@@ -122,7 +122,9 @@ def plan_route(
                              f"{pts[k].tolist()} m; remove the repeated via point")
     legs: list[Plan] = []
     for k in range(len(pts) - 1):
-        opts = options if not legs else replace(options, speed_map=legs[0].W)
+        # later legs re-use the first leg's W (a regional leg has no world-sized W)
+        reuse = legs and legs[0].params.get("storage") != "regional"
+        opts = replace(options, speed_map=legs[0].W) if reuse else options
         try:
             legs.append(plan(world, pts[k], pts[k + 1], shaping=shaping, level=level,
                              options=opts))

@@ -36,6 +36,7 @@ __all__ = [
     "PlanOptions",
     "FLIGHT_LEVEL_MODES",
     "SHAPING_METHODS",
+    "STORAGE_MODES",
     "planner_objects",
     "planner_keys",
 ]
@@ -46,6 +47,8 @@ FLIGHT_LEVEL_MODES = ("capped", "literal")
 FLIGHT_LEVEL_HEIGHTS = ("ground", "fm2")
 #: Accepted values of :attr:`Shaping.method`.
 SHAPING_METHODS = ("edt", "fmm")
+#: Accepted values of :attr:`PlanOptions.storage`.
+STORAGE_MODES = ("auto", "full", "regional")
 
 
 def _where(name: str) -> tuple[str, str]:
@@ -225,11 +228,21 @@ class PlanOptions:
         Use this velocity map (one value per node, 0 = impassable) instead of
         computing one; the shaping and the flight level are then ignored. The
         hook for extra shaping (other UAVs, custom costs). Default None.
+    storage : {"auto", "full", "regional"}
+        How the plan holds the map. "full": one 3D grid of the whole world
+        (W, T: ~40 bytes per node). "regional": coarse-to-fine for maps too big
+        for that (a coarse plan over the whole map, then full-resolution plans in
+        windows along its route; needs a 3D terrain world and a flight level;
+        :mod:`fm2uav.planning.regional`). "auto" (default): "regional" when the
+        full grid would take more than
+        :data:`fm2uav.planning.regional.FULL_PLAN_MEMORY_SHARE` of this machine's
+        memory and the world allows it, else "full".
     """
 
     order: Literal[1, 2] = 2
     step: float = 0.5
     speed_map: np.ndarray | None = None
+    storage: Literal["auto", "full", "regional"] = "auto"
 
     def __post_init__(self) -> None:
         _set(self, "order", v.integer(self.order, "order", where=_where("order")))
@@ -246,6 +259,7 @@ class PlanOptions:
                     f"speed_map must be a numeric array (one speed per node), got "
                     f"{type(self.speed_map).__name__}") from None
             _set(self, "speed_map", W)
+        v.choice(self.storage, STORAGE_MODES, "storage", where=_where("storage"))
 
 
 _CLASSES = (Shaping, FlightLevel, PlanOptions)

@@ -28,6 +28,7 @@ from .altitude import AltitudeProfile, final_profile, height_figures
 from .flight_level import flight_level_speed
 from .geodesic import descend
 from .params import FlightLevel, PlanOptions, Shaping
+from .regional import check_full_grid, plan_regional, use_regional
 
 __all__ = ["Plan", "plan", "base_velocity", "shaped_velocity", "max_distance", "plan_params"]
 
@@ -52,10 +53,13 @@ class Plan:
         grid nodes, not to no-fly zones; ``inf`` on a 2D map without obstacles).
     timings : dict of str to float
         Wall time of each stage [s]: ``velocity_map``, ``fast_marching``,
-        ``geodesic``, ``metrics``, ``total``.
+        ``geodesic``, ``metrics``, ``total`` (a regional plan adds ``coarse`` and
+        sums its windows' stages).
     W : ndarray
         The velocity map used (after saturation/exponent and any flight-level
-        shaping), same shape as the world.
+        shaping), same shape as the world. A regional plan
+        (``params["storage"] == "regional"``, :mod:`fm2uav.planning.regional`) has no
+        world-sized map: ``W`` and ``T`` are then its coarse stage's.
     T : ndarray
         Arrival times [s·(1/W)] of the wave from the goal; ``inf`` where not
         reached before the start was frozen.
@@ -164,11 +168,13 @@ def base_velocity(world: World, *, method: str = "edt", walls: bool = False) -> 
     key = ("base_velocity", method, bool(walls))
     cached = world._cache.get(key)
     if cached is None:
+        check_full_grid(world)  # a clear error rather than running out of memory
         dist = distance_map(world.occupancy, spacing=world.spacing, method=method, walls=walls)
-        cached = normalise_distance(dist)
+        scale = distance_scale(dist)
+        cached = normalise_distance(dist, overwrite=True)  # dist is ours: no second map
         cached.setflags(write=False)
         world._cache[key] = cached
-        world._cache[("max_distance", method, bool(walls))] = distance_scale(dist)
+        world._cache[("max_distance", method, bool(walls))] = scale
     return cached
 
 
@@ -252,9 +258,12 @@ def plan(
         Impose a flight level ``level.agl`` metres above the ground (thesis
         Algorithm 2, see :mod:`fm2uav.planning.flight_level`). Default None.
     options : PlanOptions, optional
-        Fast Marching order, geodesic step [cells], and a custom speed map
+        Fast Marching order, geodesic step [cells], a custom speed map
         (which replaces the shaping and the flight level: the hook for extra
-        shaping such as other UAVs). Default ``PlanOptions()``.
+        shaping such as other UAVs), and the storage: a terrain world too big
+        for one full 3D grid is planned coarse-to-fine by
+        :func:`fm2uav.planning.regional.plan_regional` (``storage="auto"``).
+        Default ``PlanOptions()``.
 
     Returns
     -------
@@ -293,6 +302,9 @@ def plan(
     start_cell = _check_free(world, start_m, "start")
     goal_cell = _check_free(world, goal_m, "goal")
     _check_work(world, start_m, goal_m, start_cell, goal_cell, options)
+    if use_regional(world, shaping, level, options):  # too big for one full grid
+        return plan_regional(world, start_m, goal_m, shaping=shaping, level=level,
+                             options=options, t_all=t_all)
 
     t0 = time.perf_counter()
     W = plan_velocity(world, shaping, level, options)

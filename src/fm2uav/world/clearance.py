@@ -40,6 +40,11 @@ def _is_columns(world: World) -> bool:
     """True if the non-zone obstacles are solid columns (terrain, extruded buildings)."""
     key = "base_is_columns"
     if key not in world._cache:
+        from .zones import zone_voxels
+
+        if world.ndim == 3 and zone_voxels(world) is None:  # one compiled pass
+            world._cache[key] = column_surface(world) is not None
+            return world._cache[key]
         occ = base_occupancy(world)
         ok = False
         if world.ndim == 3:
@@ -144,9 +149,13 @@ def column_surface(world: World) -> np.ndarray | None:
     if key not in world._cache:
         surf = None
         if world.ndim == 3:
-            top = world.surface_index().astype(np.int64)
-            k = np.arange(world.shape[2])
-            if np.array_equal(world.occupancy, k[None, None, :] <= top[:, :, None]):
+            top = world.surface_index()  # also finds whether the columns are solid
+            solid = world._cache.get("columns_solid")
+            if solid is None:
+                from ._columns import column_tops
+
+                solid = column_tops(world.occupancy)[1]
+            if solid:
                 surf = top
         world._cache[key] = surf
     return world._cache[key]

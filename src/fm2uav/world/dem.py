@@ -678,7 +678,7 @@ def from_dem(
                 if dem.vertical_crs else f"DEM heights, {dem.vertical_note}")
     heights, vertical, n_sea = _sea_level(heights, sea_level, vertical, gx, gy, dst)
     z0, nz = _vertical_nodes(heights, dz, ceiling, agl, top)
-    check_size((nx, ny, nz), (dx, dy, dz))
+    check_size((nx, ny, nz), (dx, dy, dz), columns=True)
     w = World.from_heightmap(heights, (dx, dy, dz), nz, origin=(west, south, z0), name=name)
     details = {"world_nodes": [nx, ny, nz], "filled_nodes": int(filled.sum()),
                **({"sea_nodes": n_sea} if sea_level is not None else {}),
@@ -688,8 +688,8 @@ def from_dem(
     from .ground_model import ground_model_from_dem
 
     ground = ground_model_from_dem(dem, src, dst, min(dx, dy), sea_level=sea_level)
-    return dataclasses.replace(w, crs=crs_label(dst) if parse_crs(dst).to_epsg() else dst,
-                               name=name or "dem", filled=filled, georef=georef, ground=ground)
+    return w.with_fields(crs=crs_label(dst) if parse_crs(dst).to_epsg() else dst,
+                         name=name or "dem", filled=filled, georef=georef, ground=ground)
 
 
 def _node_counts(west: float, south: float, east: float, north: float, dx: float, dy: float

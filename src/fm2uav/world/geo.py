@@ -272,12 +272,24 @@ def _memory_bytes() -> float:
         return float("inf")
 
 
-def check_size(shape: Any, cell: Any) -> None:
+#: A terrain (column) world planned regionally (coarse-to-fine windows,
+#: :mod:`fm2uav.planning.regional`) holds only its bool grid at full size: bytes per
+#: node, with the building's transient and the windows.
+COLUMN_BYTES_PER_NODE = 3
+#: Largest number of nodes of a terrain (column) world.
+MAX_COLUMN_NODES = 4_000_000_000
+
+
+def check_size(shape: Any, cell: Any, *, columns: bool = False) -> None:
     """Refuse, before anything is allocated, a grid larger than :data:`MAX_NODES` or
-    than this machine's memory, saying how much it would need and what shrinks it."""
+    than this machine's memory, saying how much it would need and what shrinks it.
+
+    ``columns=True``: a terrain world (DEM), which a terrain-following plan may plan
+    regionally, at :data:`COLUMN_BYTES_PER_NODE` (limit :data:`MAX_COLUMN_NODES`)."""
     n = float(np.prod([float(int(v)) for v in shape]))
-    need = n * BYTES_PER_NODE
-    limit = min(float(MAX_NODES), _memory_bytes() / BYTES_PER_NODE)
+    per_node = COLUMN_BYTES_PER_NODE if columns else BYTES_PER_NODE
+    need = n * per_node
+    limit = min(float(MAX_COLUMN_NODES if columns else MAX_NODES), _memory_bytes() / per_node)
     if n > limit:
         raise WorldError(
             f"the world would have {' x '.join(str(int(v)) for v in shape)} = {n:.3g} nodes "
