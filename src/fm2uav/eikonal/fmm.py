@@ -102,7 +102,7 @@ def _as_speed(speed: Any) -> np.ndarray:
         raise InputError(f"speed must not be empty, got shape {arr.shape}")
     arr = np.ascontiguousarray(arr, dtype=np.float64)
     # one compiled pass instead of three numpy passes (matters on 40 M-node maps)
-    bad, n_tiny = _kernels.scan_speed(arr.reshape(-1), MIN_SPEED)
+    bad, n_tiny = _kernels.scan_speed(_kernels._readonly(arr.reshape(-1)), MIN_SPEED)
     if bad >= 0:
         where = [int(w) for w in np.unravel_index(bad, arr.shape)]
         value = float(arr[tuple(where)])
@@ -113,7 +113,7 @@ def _as_speed(speed: Any) -> np.ndarray:
         )
     if n_tiny:
         arr = np.where((arr > 0) & (arr < MIN_SPEED), MIN_SPEED, arr)
-    return arr
+    return _kernels._readonly(arr)  # one compiled flavour of the kernels (see _readonly)
 
 
 def fast_marching(
