@@ -23,6 +23,7 @@ import hashlib
 import os
 import pickle
 import sys
+import tempfile
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
@@ -53,19 +54,33 @@ FIRST_PLAN_KERNELS: tuple[tuple[str, str], ...] = (
 COLD_FIRST_PLAN_S = 12
 
 
-def _cache_dirs(py_file: Path) -> list[Path]:
-    """Directories where numba's cache locators look for ``py_file``'s cache.
+def _usable(path: Path) -> bool:
+    """Can numba keep its cache in ``path`` (created if missing, writable)? As its locators."""
+    try:
+        os.makedirs(path, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError:
+        return False
+    return True
 
-    As ``numba.core.caching``: ``$NUMBA_CACHE_DIR/<dir>_<sha1(dir)>`` when set,
-    else the source's ``__pycache__``, else the user-wide cache directory.
+
+def _cache_dir(py_file: Path) -> Path | None:
+    """The directory where numba keeps ``py_file``'s cache, None if there is none.
+
+    As ``numba.core.caching``'s locators, first usable wins:
+    ``$NUMBA_CACHE_DIR/<dir>_<sha1(dir)>`` when set, the source's ``__pycache__``,
+    the user-wide cache directory (``$XDG_CACHE_HOME/numba/<dir>_<sha1(dir)>``).
     """
     parent = py_file.parent
     sub = f"{parent.name}_{hashlib.sha1(str(parent).encode()).hexdigest()}"
+    candidates = []
     user_dir = os.environ.get("NUMBA_CACHE_DIR")
     if user_dir:
-        return [Path(os.path.abspath(user_dir)) / sub]
+        candidates.append(Path(os.path.abspath(user_dir)) / sub)
     xdg = os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache")
-    return [parent / "__pycache__", Path(xdg) / "numba" / sub]
+    candidates += [parent / "__pycache__", Path(xdg) / "numba" / sub]
+    return next((c for c in candidates if _usable(c)), None)
 
 
 class _Stub:
@@ -118,11 +133,11 @@ def _cached(rel_file: str, func: str, numba_version: str | None) -> bool:
         return False
     tag = f"py{sys.version_info[0]}{sys.version_info[1]}{getattr(sys, 'abiflags', '')}"
     pattern = f"{glob.escape(py_file.stem)}.{glob.escape(func)}-*.{tag}.nbi"
-    for d in _cache_dirs(py_file):
-        for index in glob.glob(str(d / pattern)):
-            if _fresh_index(Path(index), source_hash, numba_version):
-                return True
-    return False
+    d = _cache_dir(py_file)
+    if d is None:
+        return False
+    return any(_fresh_index(Path(index), source_hash, numba_version)
+               for index in glob.glob(str(d / pattern)))
 
 
 def likely_cold(kernels: Iterable[tuple[str, str]] = FIRST_PLAN_KERNELS) -> bool:
