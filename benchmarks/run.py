@@ -143,7 +143,8 @@ def summary(rows: list[dict], report: dict) -> str:
     if warm_plan:
         parts.append(f"an FM² plan on the open field in {_seconds(warm_plan['ours_s'])};")
     for r in rows:
-        if r["benchmark"] == "plan" and r["case"].startswith(("terrain", "regional ")):
+        if r["benchmark"] == "plan" and (r["case"].startswith("terrain") or (
+                r["case"].startswith("regional ") and not r["case"].startswith("regional vs"))):
             peak = f", peak {r['peak_mb'] / 1024:.2f} GB" if r.get("peak_mb") else ""
             parts.append(f"{r['case']}: {_seconds(r['ours_s'])}{peak};")
     cold = by_case.get("first `fm2uav plan`, empty numba cache")
