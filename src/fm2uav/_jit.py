@@ -31,6 +31,7 @@ __all__ = [
     "FIRST_PLAN_KERNELS",
     "COLD_FIRST_PLAN_S",
     "likely_cold",
+    "mark_announced",
     "on_first_compile",
 ]
 
@@ -48,9 +49,9 @@ FIRST_PLAN_KERNELS: tuple[tuple[str, str], ...] = (
 )
 
 #: Wall time [s] of a first ``fm2uav plan`` with an empty numba cache, the
-#: number shown in the notice (rounded up). Measured by ``python -m
-#: benchmarks.run core`` (row "first fm2uav plan, empty numba cache"), see
-#: docs/performance.md.
+#: number shown in the notice: ``python -m benchmarks.run coldstart``, row
+#: "first `fm2uav plan`, empty numba cache" (docs/performance.md), on the
+#: 2-core machine.
 COLD_FIRST_PLAN_S = 12
 
 
