@@ -64,7 +64,7 @@ def main() -> None:
                 from rich.console import Console
 
                 Console(stderr=True).print(
-                    f"compiling kernels, first use only, ~{_jit.COLD_FIRST_PLAN_S} s",
+                    f"compiling kernels, first use only, ~{_jit.cold_estimate_s()} s",
                     style="yellow", highlight=False)
             if command == "plan":
                 child = _spawn([_fmm_group(argv)])

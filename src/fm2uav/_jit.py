@@ -29,7 +29,8 @@ from pathlib import Path
 
 __all__ = [
     "FIRST_PLAN_KERNELS",
-    "COLD_FIRST_PLAN_S",
+    "COLD_FIRST_PLAN_CPU_S",
+    "cold_estimate_s",
     "likely_cold",
     "mark_announced",
     "on_first_compile",
@@ -48,11 +49,24 @@ FIRST_PLAN_KERNELS: tuple[tuple[str, str], ...] = (
     ("world/_clearance_kernels.py", "surface_distance"),
 )
 
-#: Wall time [s] of a first ``fm2uav plan`` with an empty numba cache, the
-#: number shown in the notice: ``python -m benchmarks.run coldstart``, row
-#: "first `fm2uav plan`, empty numba cache" (docs/performance.md), on the
-#: 2-core machine.
-COLD_FIRST_PLAN_S = 12
+#: CPU time [s] of a first ``fm2uav plan`` with an empty numba cache, both
+#: processes together (compilation, imports, the plan): measured 24-28 s on the
+#: 2-core machine (``/usr/bin/time fm2uav plan`` after ``pip install .``; the
+#: ``coldstart`` rows of docs/performance.md give the wall times).
+COLD_FIRST_PLAN_CPU_S = 26.0
+
+
+def cold_estimate_s() -> int:
+    """Seconds a cold first plan will take here: its CPU time over the idle cores.
+
+    The compilation runs in two processes, so it uses up to two cores; the idle
+    ones are the CPU count minus the 1-minute load average (at least one).
+    """
+    try:
+        idle = (os.cpu_count() or 1) - os.getloadavg()[0]
+    except OSError:  # no load average on this platform
+        idle = float(os.cpu_count() or 1)
+    return int(round(COLD_FIRST_PLAN_CPU_S / max(1.0, min(2.0, idle))))
 
 
 def _usable(path: Path) -> bool:

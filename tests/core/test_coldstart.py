@@ -106,3 +106,15 @@ def test_cold_first_plan_says_so_within_a_second_and_a_warm_one_does_not(tmp_pat
     # nothing (the numba-event fallback would print the notice on any compilation)
     _, first_line, err, _ = _first_plan(cache, out)
     assert NOTICE not in err and not first_line.startswith(NOTICE)
+
+
+def test_cold_estimate_spreads_the_cpu_time_over_up_to_two_idle_cores(monkeypatch):
+    monkeypatch.setattr(os, "cpu_count", lambda: 2)
+    monkeypatch.setattr(os, "getloadavg", lambda: (0.0, 0.0, 0.0))
+    idle = _jit.cold_estimate_s()
+    assert idle == round(_jit.COLD_FIRST_PLAN_CPU_S / 2)
+    monkeypatch.setattr(os, "getloadavg", lambda: (3.0, 3.0, 3.0))
+    assert _jit.cold_estimate_s() == round(_jit.COLD_FIRST_PLAN_CPU_S) > idle
+    monkeypatch.setattr(os, "cpu_count", lambda: 16)
+    monkeypatch.setattr(os, "getloadavg", lambda: (0.0, 0.0, 0.0))
+    assert _jit.cold_estimate_s() == idle  # two processes use at most two cores

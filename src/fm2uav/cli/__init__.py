@@ -51,11 +51,11 @@ def main() -> None:
     """
     import sys
 
-    from .._jit import COLD_FIRST_PLAN_S, on_first_compile
+    from .._jit import cold_estimate_s, on_first_compile
     from ._common import err_console
 
     if "--quiet" not in sys.argv:
         on_first_compile(lambda: err_console.print(
-            f"compiling kernels, first use only, ~{COLD_FIRST_PLAN_S} s", style="yellow",
+            f"compiling kernels, first use only, ~{cold_estimate_s()} s", style="yellow",
             highlight=False))
     app()
