@@ -133,7 +133,7 @@ def summary(rows: list[dict], report: dict) -> str:
     for peer in ("scikit-fmm", "eikonalfm", "eikonalfm factored"):
         ratios = [r["ratio"] for r in fmm if r["peer"] == peer]
         if ratios:
-            parts.append(f"FMM {_span(ratios)} as fast as {peer};")
+            parts.append(f"FMM {_span(ratios)} faster than {peer};")
     sizes = sorted({r["case"].split(" ")[0] for r in fmm})
     if sizes:
         parts[-1] = parts[-1].rstrip(";") + f" ({', '.join(sizes)}, order 1 and 2);"

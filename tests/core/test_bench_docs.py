@@ -46,7 +46,7 @@ def test_write_docs_replaces_the_blocks_only(tmp_path):
     readme = (tmp_path / "README.md").read_text()
     assert "| fmm | 2048x2048 order 1 | 0.2 s | scikit-fmm | 0.8 s | 4.00× | 100 / 140 |" in table
     assert "a \\| b" in table and "machine otherwise idle" in table
-    assert "FMM 3.50–4.00× as fast as scikit-fmm (160x160x160, 2048x2048, order 1 and 2)" in readme
+    assert "FMM 3.50–4.00× faster than scikit-fmm (160x160x160, 2048x2048, order 1 and 2)" in readme
     assert "takes 11 s" in readme and "every later one 1.5 s" in readme
     # the prose around the blocks is kept, and a second run gives the same pages
     for name, page in PAGES.items():
