@@ -4,7 +4,7 @@ Each group runs the public functions a plan calls (the same wrappers, hence
 the same argument types and the same compiled specialisations) on a few
 nodes, so the run costs only the compilation. Used by ``make install`` (all
 groups) and by the command line on a cold cache, which compiles the groups in
-two processes at once (see :func:`fm2uav._jit.spawn_warmup`)::
+two processes at once (see :mod:`fm2uav.__main__`)::
 
     python -m fm2uav.planning.warmup            # every group, in this process
     python -m fm2uav.planning.warmup fmm3d_o2   # one group
