@@ -11,8 +11,11 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e '.[test]'
+	@echo "compiling the numba kernels once (cached for every later run) ..."
+	$(PY) -m fm2uav.planning.warmup
 	@touch $(STAMP)
 
+## make install: the venv with the package (editable) and its numba kernels compiled
 install: $(STAMP)
 
 ## make run: the default mission — terrain-following flight (150 m above ground, the
@@ -36,7 +39,8 @@ test-fast: $(STAMP)
 	$(VENV)/bin/lint-imports
 	$(VENV)/bin/pytest -q -m "not slow"
 
-## make bench: speed and memory against peers (writes benchmarks/results/*.json)
+## make bench: speed and memory against peers (writes benchmarks/results/bench.json, the
+## table in docs/performance.md and the summary in README.md)
 bench: $(STAMP)
 	$(PY) -m benchmarks.run
 

@@ -14,46 +14,83 @@ docs/architecture.md): ``errors``, ``geometry`` → ``eikonal`` → ``world`` �
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from .analysis import flight_level_deviation, path_profiles
-from .analysis.tune import tune
-from .eikonal import distance_map, fast_marching, velocity_map
 from . import errors
-from .errors import *  # noqa: F403 -- the error hierarchy, listed once in errors.__all__
-from .missions import (
-    CoveragePlan,
-    FormationConfig,
-    FormationResult,
-    fly_formation,
-    plan_coverage,
-    zigzag,
-)
-from .planning import FlightLevel, Plan, PlanOptions, Shaping, plan
-from .scenarios import Scenario
-from .vehicles import (
-    AIRFRAMES,
-    AirframeLimits,
-    FeasibilityReport,
-    check_feasibility,
-    get_airframe,
-)
-from .world import World
+from .errors import *  # noqa: F403 -- the error hierarchy (pure Python), listed once in errors.__all__
 
 if TYPE_CHECKING:  # loaded on first attribute access (PEP 562), see __getattr__
     from . import baselines, experiments, io, viz
+    from .analysis import flight_level_deviation, path_profiles
+    from .analysis.tune import tune
+    from .eikonal import distance_map, fast_marching, velocity_map
+    from .missions import (
+        CoveragePlan,
+        FormationConfig,
+        FormationResult,
+        fly_formation,
+        plan_coverage,
+        zigzag,
+    )
+    from .planning import FlightLevel, Plan, PlanOptions, Shaping, plan
+    from .scenarios import Scenario
+    from .vehicles import (
+        AIRFRAMES,
+        AirframeLimits,
+        FeasibilityReport,
+        check_feasibility,
+        get_airframe,
+    )
+    from .world import World
 
-#: Subpackages imported on first use: ``viz`` (matplotlib, plotly), ``experiments``
-#: (Dask, Parquet), ``io`` and ``baselines`` (OMPL) stay unloaded by ``import fm2uav``.
-_LAZY_SUBMODULES = ("baselines", "experiments", "io", "viz")
+#: Where each public name lives. ``import fm2uav`` loads none of them (numba,
+#: scipy and the kernels cost ~1 s): each is imported on first access (PEP 562),
+#: so the command line can speak before the heavy imports.
+_LAZY_NAMES = {
+    "flight_level_deviation": "analysis",
+    "path_profiles": "analysis",
+    "tune": "analysis.tune",
+    "distance_map": "eikonal",
+    "fast_marching": "eikonal",
+    "velocity_map": "eikonal",
+    "CoveragePlan": "missions",
+    "FormationConfig": "missions",
+    "FormationResult": "missions",
+    "fly_formation": "missions",
+    "plan_coverage": "missions",
+    "zigzag": "missions",
+    "FlightLevel": "planning",
+    "Plan": "planning",
+    "PlanOptions": "planning",
+    "Shaping": "planning",
+    "plan": "planning",
+    "Scenario": "scenarios",
+    "AIRFRAMES": "vehicles",
+    "AirframeLimits": "vehicles",
+    "FeasibilityReport": "vehicles",
+    "check_feasibility": "vehicles",
+    "get_airframe": "vehicles",
+    "World": "world",
+}
+
+#: Subpackages, also imported on first use (``fm2uav.scenarios.open_field()``
+#: works after a bare ``import fm2uav``).
+_LAZY_SUBMODULES = (
+    "analysis", "baselines", "eikonal", "errors", "experiments", "geometry", "io",
+    "missions", "planning", "scenarios", "vehicles", "viz", "world",
+)
 
 
 def __getattr__(name: str) -> Any:
+    if name in _LAZY_NAMES:
+        value = getattr(importlib.import_module(f".{_LAZY_NAMES[name]}", __name__), name)
+        globals()[name] = value  # later accesses skip __getattr__
+        return value
     if name in _LAZY_SUBMODULES:
         return importlib.import_module(f".{name}", __name__)
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY_SUBMODULES))
+    return sorted(set(globals()) | set(_LAZY_NAMES) | set(_LAZY_SUBMODULES))
 
 
 __version__ = "0.1.0"
@@ -99,7 +136,7 @@ __all__ = [
     "scenarios",
     "vehicles",
     "viz",
-    # errors (Fm2uavError, InputError, WorldError, ...)
+    # errors
     *errors.__all__,
     "__version__",
 ]

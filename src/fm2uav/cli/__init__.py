@@ -44,5 +44,18 @@ _register_all()
 
 
 def main() -> None:
-    """Entry point of the ``fm2uav`` console script."""
+    """Run the command line (the console script enters through :mod:`fm2uav.__main__`).
+
+    Installs the compile notice: right before numba compiles the first kernel
+    of this process (a cold cache), one line on stderr says so.
+    """
+    import sys
+
+    from .._jit import cold_estimate_s, on_first_compile
+    from ._common import err_console
+
+    if "--quiet" not in sys.argv:
+        on_first_compile(lambda: err_console.print(
+            f"compiling kernels, first use only, ~{cold_estimate_s()} s", style="yellow",
+            highlight=False))
     app()

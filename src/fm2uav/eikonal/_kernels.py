@@ -642,6 +642,17 @@ def unpad_grid(Tp, nx, ny, nz, T):
                 T[dst + k] = x if x >= 0.0 else _INF
 
 
+def _readonly(a):
+    """A read-only view of ``a``: numba compiles one specialisation per writeable
+    flag, and the planner's arrays (cached on the world) are read-only, so every
+    caller passes read-only input arrays and each kernel compiles once."""
+    if not a.flags.writeable:
+        return a
+    v = a.view()
+    v.flags.writeable = False
+    return v
+
+
 def march(speed, T, state, shape3, h3, order, stop_mask, n_stop):
     """Run the Fast Marching Method in place on ``T``.
 
@@ -681,7 +692,7 @@ def march(speed, T, state, shape3, h3, order, stop_mask, n_stop):
             f"Fast Marching's {MAX_NODES}; use a coarser spacing or split the map"
         )
     Tp, Vp = _work_pair(npad)
-    pad_grid(speed, T, state, nx, ny, nz, Tp, Vp)
+    pad_grid(_readonly(speed), T, state, nx, ny, nz, Tp, Vp)
     if n_stop > 0:
         stop = np.zeros(npad, dtype=np.uint8)
         idx = np.flatnonzero(stop_mask)
@@ -786,7 +797,7 @@ def scan_speed(v, min_speed):
 
 
 # ------------------------------------------------------- exact distance transform
-@njit(cache=True, error_model="numpy", inline="always")
+@njit(error_model="numpy")
 def _edt_line(f, n, w2, v, z, out):
     """1D squared distance transform (Felzenszwalb & Huttenlocher 2012).
 
@@ -917,6 +928,7 @@ def squared_edt(occ, hx, hy, hz):
     C-contiguous bool array of shape (nx, ny, nz); returns float64 of the same
     shape (``inf`` everywhere if ``occ`` has no True node).
     """
+    occ = _readonly(occ)
     if occ.size >= EDT_PARALLEL_MIN_NODES:
         return _squared_edt_parallel(occ, hx, hy, hz)
     return _squared_edt_serial(occ, hx, hy, hz)

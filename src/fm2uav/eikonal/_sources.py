@@ -220,7 +220,12 @@ def factored_box(sb, bx, by, bz, li, lj, lk, hx, hy, hz):
     ss = 1.0 / sb[li * strides[0] + lj * strides[1] + lk]
     cs = li * strides[0] + lj * strides[1] + lk
     tb[cs] = 0.0
-    size = _heap_push(heap, key, pos, 0, cs, 0.0)
+    # the source as the heap's only entry (what _heap_push does on an empty heap;
+    # a call with the literal size 0 would compile a second specialisation of it)
+    heap[0] = cs
+    key[0] = 0.0
+    pos[cs] = 0
+    size = np.int64(1)  # int64, not the literal 1 (see above)
     while size > 0:
         c, size = _heap_pop(heap, key, pos, size)
         st[c] = 2

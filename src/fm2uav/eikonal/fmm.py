@@ -96,7 +96,7 @@ def as_index_array(points: Any, shape: tuple[int, ...], what: str) -> np.ndarray
 def _as_speed(speed: Any) -> np.ndarray:
     arr = np.ascontiguousarray(grid(speed, "speed"))
     # one compiled pass instead of three numpy passes (matters on 40 M-node maps)
-    bad, n_tiny = _kernels.scan_speed(arr.reshape(-1), MIN_SPEED)
+    bad, n_tiny = _kernels.scan_speed(_kernels._readonly(arr.reshape(-1)), MIN_SPEED)
     if bad >= 0:
         where = [int(w) for w in np.unravel_index(bad, arr.shape)]
         value = float(arr[tuple(where)])
@@ -107,7 +107,7 @@ def _as_speed(speed: Any) -> np.ndarray:
         )
     if n_tiny:
         arr = np.where((arr > 0) & (arr < MIN_SPEED), MIN_SPEED, arr)
-    return arr
+    return _kernels._readonly(arr)  # one compiled flavour of the kernels (see _readonly)
 
 
 def fast_marching(

@@ -460,8 +460,13 @@ def _push(out, n, x, y, z):
     if n > 0 and out[n - 1, 0] == x and out[n - 1, 1] == y and out[n - 1, 2] == z:
         return out, n  # never store a zero-length segment
     if n == out.shape[0]:
+        # element by element: a slice assignment compiles numba's shape-mismatch
+        # error formatting (~3 s of one-off compilation)
         bigger = np.empty((2 * out.shape[0], 3))
-        bigger[:n] = out[:n]
+        for r in range(n):
+            bigger[r, 0] = out[r, 0]
+            bigger[r, 1] = out[r, 1]
+            bigger[r, 2] = out[r, 2]
         out = bigger
     out[n, 0] = x
     out[n, 1] = y
@@ -537,6 +542,26 @@ def _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step):
     return px, py, pz, ref, False
 
 
+@njit(cache=True, inline="always")
+def _fill(a, x):
+    """``a[:] = x`` as a loop (numba's slice assignment compiles error-formatting code)."""
+    for r in range(a.size):
+        a[r] = x
+
+
+@njit(cache=True, inline="always")
+def _nanmax(a):
+    """``a.max()`` with numpy's semantics (NaN if any element is NaN), as a loop."""
+    m = a[0]
+    for r in range(a.size):
+        x = a[r]
+        if math.isnan(x):
+            return x
+        if x > m:
+            m = x
+    return m
+
+
 # --------------------------------------------------------------------------- kernel
 # long on purpose: one compiled loop (numba kernel); helpers would add calls in the hot path
 @njit(cache=True)
@@ -576,11 +601,14 @@ def descend_kernel(T, start, goal, hx, hy, hz, step, max_steps):
     px, py, pz = start[0], start[1], start[2]
     info = np.zeros(3, dtype=np.int64)
     out = np.empty((256, 3))
-    n = 0
-    out, n = _push(out, n, px, py, pz)
+    out[0, 0] = px  # the first point stored directly, and n typed int64 (not the
+    out[0, 1] = py  # literal 1): a call with a literal argument compiles a second
+    out[0, 2] = pz  # specialisation of the callee (~0.3 s each, first use)
+    n = np.int64(1)
     # potential of the current point, and the last _WINDOW accepted ones
     phi = _potential(T, px, py, pz, hx, hy, hz)
-    hist = np.full(_WINDOW, phi)
+    hist = np.empty(_WINDOW)
+    _fill(hist, phi)
     hpos = 0
     iters = 0
     n_fallback = 0
@@ -593,7 +621,7 @@ def descend_kernel(T, start, goal, hx, hy, hz, step, max_steps):
             iters += 1
             # ---- continuous step: midpoint (RK2) on the direction field, with
             #      backtracking on the step length; non-monotone acceptance
-            ref = hist.max()
+            ref = _nanmax(hist)
             qx, qy, qz, tq, ok = _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step)
             if ok:
                 px, py, pz = qx, qy, qz
@@ -627,7 +655,7 @@ def descend_kernel(T, start, goal, hx, hy, hz, step, max_steps):
                     break
             if moved:
                 phi = T[i, j, k]
-                hist[:] = phi
+                _fill(hist, phi)
             elif not _near_goal(T, px, py, pz, gx, gy, gz):
                 info[0], info[1], info[2] = i, j, k
                 return out[:n].copy(), STUCK, info, n_fallback

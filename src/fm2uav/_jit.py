@@ -1,0 +1,224 @@
+"""One-off numba compilation: is it coming, and a hook to say so.
+
+The kernels are compiled by numba on first use and cached on disk
+(``cache=True``); every later process loads them in milliseconds. A cold
+cache (fresh install, new numba, edited kernel source) costs seconds of
+compilation before the first result, so the command line says so at once.
+Library code never prints: this module only *detects* and *calls back*.
+
+* :func:`likely_cold` answers "will the first plan compile?" in a few
+  milliseconds **without importing numba** (~0.5 s): it reads the cache index
+  files of a few kernels the way numba's own cache locators find them.
+* :func:`on_first_compile` registers a callback run once per process, right
+  before numba compiles the first fm2uav function (a cache miss): the reliable
+  fallback for every other path (other commands, stale or foreign caches).
+
+Bottom layer (no fm2uav imports): the kernels are named by file and function.
+"""
+
+from __future__ import annotations
+
+import glob
+import hashlib
+import os
+import pickle
+import sys
+import tempfile
+from collections.abc import Callable, Iterable
+from pathlib import Path
+
+__all__ = [
+    "FIRST_PLAN_KERNELS",
+    "COLD_FIRST_PLAN_CPU_S",
+    "cold_estimate_s",
+    "likely_cold",
+    "mark_announced",
+    "on_first_compile",
+]
+
+_PKG = Path(__file__).resolve().parent
+
+#: Kernels a first ``fm2uav plan`` (built-in 3D scenario, order 2) compiles:
+#: ``(file relative to the package, function name)``. If any has no valid cache
+#: index, the plan will compile.
+FIRST_PLAN_KERNELS: tuple[tuple[str, str], ...] = (
+    ("eikonal/_kernels.py", "_squared_edt_serial"),
+    ("eikonal/_sources.py", "init_sources"),
+    ("eikonal/_kernels.py", "march3d_o2"),
+    ("planning/_geodesic_kernels.py", "descend_kernel"),
+    ("world/_clearance_kernels.py", "surface_distance"),
+)
+
+#: CPU time [s] of a first ``fm2uav plan`` with an empty numba cache, both
+#: processes together (compilation, imports, the plan): measured 24-28 s on the
+#: 2-core machine (``/usr/bin/time fm2uav plan`` after ``pip install .``; the
+#: ``coldstart`` rows of docs/performance.md give the wall times).
+COLD_FIRST_PLAN_CPU_S = 26.0
+
+
+def cold_estimate_s() -> int:
+    """Seconds a cold first plan will take here: its CPU time over the idle cores.
+
+    The compilation runs in two processes, so it uses up to two cores; the idle
+    ones are the CPU count minus the 1-minute load average (at least one).
+    """
+    try:
+        idle = (os.cpu_count() or 1) - os.getloadavg()[0]
+    except OSError:  # no load average on this platform
+        idle = float(os.cpu_count() or 1)
+    return int(round(COLD_FIRST_PLAN_CPU_S / max(1.0, min(2.0, idle))))
+
+
+def _usable(path: Path) -> bool:
+    """Can numba keep its cache in ``path`` (created if missing, writable)? As its locators."""
+    try:
+        os.makedirs(path, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError:
+        return False
+    return True
+
+
+def _cache_dir(py_file: Path) -> Path | None:
+    """The directory where numba keeps ``py_file``'s cache, None if there is none.
+
+    As ``numba.core.caching``'s locators, first usable wins:
+    ``$NUMBA_CACHE_DIR/<dir>_<sha1(dir)>`` when set, the source's ``__pycache__``,
+    the user-wide cache directory (``$XDG_CACHE_HOME/numba/<dir>_<sha1(dir)>``).
+    """
+    parent = py_file.parent
+    sub = f"{parent.name}_{hashlib.sha1(str(parent).encode()).hexdigest()}"
+    candidates = []
+    user_dir = os.environ.get("NUMBA_CACHE_DIR")
+    if user_dir:
+        candidates.append(Path(os.path.abspath(user_dir)) / sub)
+    xdg = os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache")
+    candidates += [parent / "__pycache__", Path(xdg) / "numba" / sub]
+    return next((c for c in candidates if _usable(c)), None)
+
+
+class _Stub:
+    """Stands in for every numba object while unpickling an index (no numba import)."""
+
+    def __init__(self, *args, **kwargs):
+        pass
+
+    def __setstate__(self, state):
+        pass
+
+    def __call__(self, *args, **kwargs):
+        return _Stub()
+
+
+class _IndexUnpickler(pickle.Unpickler):
+    def find_class(self, module, name):
+        if module.split(".")[0] in ("numba", "llvmlite", "numpy"):
+            return _Stub
+        return super().find_class(module, name)
+
+
+def _numba_version() -> str | None:
+    try:
+        from importlib.metadata import version
+
+        return version("numba")
+    except Exception:  # not installed as a distribution: cannot tell
+        return None
+
+
+def _fresh_index(index: Path, source_hash: bytes, numba_version: str | None) -> bool:
+    """True if ``index`` is a numba cache index of this source with an entry."""
+    try:
+        with open(index, "rb") as fh:
+            version = pickle.load(fh)
+            stamp, overloads = _IndexUnpickler(fh).load()  # numba: pickle of (stamp, overloads)
+    except Exception:  # unreadable, truncated, another format: not usable
+        return False
+    if numba_version is not None and version != numba_version:
+        return False
+    return stamp == source_hash and len(overloads) > 0
+
+
+def _cached(rel_file: str, func: str, numba_version: str | None) -> bool:
+    py_file = _PKG / rel_file
+    try:
+        source_hash = hashlib.sha256(py_file.read_bytes()).digest()
+    except OSError:
+        return False
+    tag = f"py{sys.version_info[0]}{sys.version_info[1]}{getattr(sys, 'abiflags', '')}"
+    pattern = f"{glob.escape(py_file.stem)}.{glob.escape(func)}-*.{tag}.nbi"
+    d = _cache_dir(py_file)
+    if d is None:
+        return False
+    return any(_fresh_index(Path(index), source_hash, numba_version)
+               for index in glob.glob(str(d / pattern)))
+
+
+def likely_cold(kernels: Iterable[tuple[str, str]] = FIRST_PLAN_KERNELS) -> bool:
+    """Will calling these kernels compile them (no valid numba cache entry)?
+
+    Cheap (a few ms, numba not imported). It checks that each kernel has a
+    cache index for the current source text and numba version with at least
+    one entry; it does not check the entry's CPU or argument types, so a
+    cache made on another machine reads as warm (numba then recompiles, and
+    :func:`on_first_compile` still fires). Always False when numba's JIT is
+    disabled (``NUMBA_DISABLE_JIT=1``).
+
+    Parameters
+    ----------
+    kernels : iterable of (str, str)
+        ``(file relative to the fm2uav package, function name)``.
+    """
+    if os.environ.get("NUMBA_DISABLE_JIT", "0") not in ("", "0"):
+        return False
+    version = _numba_version()
+    return not all(_cached(f, name, version) for f, name in kernels)
+
+
+_callbacks: list[Callable[[], None]] = []
+_fired = False
+_listener = None
+
+
+def _fire() -> None:
+    global _fired
+    if _fired:
+        return
+    _fired = True
+    for cb in list(_callbacks):
+        cb()
+
+
+def mark_announced() -> None:
+    """Record that the caller has already told the user (no second callback)."""
+    global _fired
+    _fired = True
+
+
+def on_first_compile(callback: Callable[[], None]) -> None:
+    """Call ``callback()`` once, right before numba compiles the first fm2uav function.
+
+    Fires on a real compilation only (numba's ``numba:compile`` event follows
+    a cache miss; loading from the cache does not fire it), at most once per
+    process over all callbacks, and not at all after :func:`mark_announced`.
+    Imports numba.
+    """
+    global _listener
+    _callbacks.append(callback)
+    if _listener is not None:
+        return
+    from numba.core import event
+
+    class _FirstCompile(event.Listener):
+        def on_start(self, ev):
+            disp = ev.data.get("dispatcher") if isinstance(ev.data, dict) else None
+            mod = getattr(getattr(disp, "py_func", None), "__module__", "") or ""
+            if mod == "fm2uav" or mod.startswith("fm2uav."):
+                _fire()
+
+        def on_end(self, ev):
+            pass
+
+    _listener = _FirstCompile()
+    event.register("numba:compile", _listener)

@@ -1,0 +1,112 @@
+"""Fill numba's cache with the kernels of a plan, by running them on tiny inputs.
+
+Each group runs the public functions a plan calls (the same wrappers, hence
+the same argument types and the same compiled specialisations) on a few
+nodes, so the run costs only the compilation. Used by ``make install`` (all
+groups) and by the command line on a cold cache, which compiles the groups in
+two processes at once (see :mod:`fm2uav.__main__`)::
+
+    python -m fm2uav.planning.warmup            # every group, in this process
+    python -m fm2uav.planning.warmup fmm3d_o2   # one group
+
+Groups: ``edt`` (distance map), ``fmm{2,3}d_o{1,2}`` (Fast Marching, one
+dimension and order), ``descent`` (geodesic extraction), ``surface``
+(continuous clearance to a terrain surface). Numbers: docs/performance.md.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from collections.abc import Callable, Iterable
+
+import numpy as np
+
+from ..eikonal import distance_map, fast_marching
+from ..world import World
+from ..world.clearance import surface_clearance
+from .geodesic import descend
+
+__all__ = ["GROUPS", "FIRST_PLAN_MAIN", "FIRST_PLAN_CHILD", "warm"]
+
+
+def _edt() -> None:
+    occ = np.zeros((4, 4, 4), dtype=bool)
+    occ[0, 0, 0] = True
+    distance_map(occ, spacing=1.0)
+
+
+def _fmm(ndim: int, order: int) -> Callable[[], None]:
+    def run() -> None:
+        fast_marching(np.ones((5,) * ndim), [(2,) * ndim], order=order)
+
+    return run
+
+
+def _descent() -> None:
+    g = np.array([4.0, 4.0, 4.0])
+    axes = np.meshgrid(*[np.arange(5.0)] * 3, indexing="ij")
+    T = np.sqrt(sum((a - c) ** 2 for a, c in zip(axes, g)))
+    descend(T, (0.0, 0.0, 0.0), tuple(g), spacing=(1.0, 1.0, 1.0))
+
+
+def _surface() -> None:
+    world = World.from_heightmap(np.zeros((4, 4)), 1.0, 4)
+    surface_clearance(world, np.array([[1.5, 1.5, 2.5]]))
+
+
+#: Group name -> what it runs.
+GROUPS: dict[str, Callable[[], None]] = {
+    "edt": _edt,
+    "fmm2d_o1": _fmm(2, 1),
+    "fmm2d_o2": _fmm(2, 2),
+    "fmm3d_o1": _fmm(3, 1),
+    "fmm3d_o2": _fmm(3, 2),
+    "descent": _descent,
+    "surface": _surface,
+}
+
+#: A first ``fm2uav plan`` (3D, order 2) split in two halves of about equal
+#: compile time (the ``coldstart`` rows of ``make bench``): the child process
+#: compiles the Fast Marching kernels while the command compiles the rest.
+FIRST_PLAN_CHILD: tuple[str, ...] = ("fmm3d_o2",)
+FIRST_PLAN_MAIN: tuple[str, ...] = ("descent", "edt", "surface")
+
+
+def warm(groups: Iterable[str] = tuple(GROUPS)) -> dict[str, float]:
+    """Run the named groups; returns the seconds each took (compile + tiny run).
+
+    Parameters
+    ----------
+    groups : iterable of str
+        Keys of :data:`GROUPS`.
+
+    Raises
+    ------
+    KeyError
+        An unknown group name.
+    """
+    out = {}
+    for name in groups:
+        fn = GROUPS[name]
+        t = time.perf_counter()
+        fn()
+        out[name] = time.perf_counter() - t
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m fm2uav.planning.warmup [GROUP ...]``: print each group's time."""
+    names = (sys.argv[1:] if argv is None else argv) or list(GROUPS)
+    unknown = [n for n in names if n not in GROUPS]
+    if unknown:
+        print(f"unknown warm-up group(s) {unknown}; choose from {sorted(GROUPS)}",
+              file=sys.stderr)
+        return 2
+    for name, seconds in warm(names).items():
+        print(f"{name}: {seconds:.2f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

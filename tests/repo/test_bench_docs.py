@@ -1,0 +1,61 @@
+"""`make bench` writes its table into docs/performance.md and its summary into README.md."""
+
+from __future__ import annotations
+
+import shutil
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT))
+from benchmarks import run as bench  # noqa: E402
+
+PAGES = {"table": ROOT / "docs" / "performance.md", "summary": ROOT / "README.md"}
+
+ROWS = [
+    {"benchmark": "fmm", "case": "2048x2048 order 1", "ours_s": 0.2, "peer": "scikit-fmm",
+     "peer_s": 0.8, "ratio": 4.0, "peak_mb": 100.0, "peer_peak_mb": 140.0, "bar": ">= 3x",
+     "notes": "a | b"},
+    {"benchmark": "fmm", "case": "160x160x160 order 2", "ours_s": 1.0, "peer": "scikit-fmm",
+     "peer_s": 3.5, "ratio": 3.5},
+    {"benchmark": "coldstart", "case": "first `fm2uav plan`, empty numba cache", "ours_s": 11.0,
+     "first_output_s": 0.2},
+    {"benchmark": "coldstart", "case": "first `fm2uav plan`, numba cache filled", "ours_s": 1.5,
+     "first_output_s": 1.2},
+]
+REPORT = {"machine": {"python": "3.11", "cpus": 2, "date": "2026-12-01", "load_before": 0.3,
+                      "load_after": 0.9}}
+
+
+@pytest.mark.parametrize("name", sorted(PAGES))
+def test_each_page_has_its_bench_block_once(name):
+    text = PAGES[name].read_text()
+    start, end = bench.marker(name)
+    assert text.count(start) == 1 and text.count(end) == 1
+    assert text.index(start) < text.index(end)
+
+
+def test_write_docs_replaces_the_blocks_only(tmp_path):
+    (tmp_path / "docs").mkdir()
+    for name, page in PAGES.items():
+        shutil.copy(page, tmp_path / page.relative_to(ROOT))
+    bench.write_docs(ROWS, REPORT, root=tmp_path)
+    table = (tmp_path / "docs" / "performance.md").read_text()
+    readme = (tmp_path / "README.md").read_text()
+    assert "| fmm | 2048x2048 order 1 | 0.2 s | scikit-fmm | 0.8 s | 4.00× | 100 / 140 |" in table
+    assert "a \\| b" in table and "machine otherwise idle" in table
+    assert "FMM 3.50–4.00× faster than scikit-fmm (160x160x160, 2048x2048, order 1 and 2)" in readme
+    assert "takes 11 s" in readme and "every later one 1.5 s" in readme
+    # the prose around the blocks is kept, and a second run gives the same pages
+    for name, page in PAGES.items():
+        before = page.read_text().split(bench.marker(name)[0])[0]
+        assert (tmp_path / page.relative_to(ROOT)).read_text().startswith(before)
+    bench.write_docs(ROWS, REPORT, root=tmp_path)
+    assert (tmp_path / "README.md").read_text() == readme
+
+
+def test_fill_needs_the_markers():
+    with pytest.raises(ValueError):
+        bench.fill("no block here", "table", "x")

@@ -1,0 +1,120 @@
+"""First use without the wait: the compile notice, the cache check, a light import."""
+
+from __future__ import annotations
+
+import os
+import selectors
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from fm2uav import _jit
+
+ROOT = Path(__file__).resolve().parents[1]
+NOTICE = "compiling kernels, first use only"
+
+
+def _env(cache: Path) -> dict:
+    src = str(ROOT / "src")
+    path = os.environ.get("PYTHONPATH")
+    return {**os.environ, "NUMBA_CACHE_DIR": str(cache),
+            "PYTHONPATH": src if not path else f"{src}{os.pathsep}{path}"}
+
+
+def _python(code: str, cache: Path) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=300, env=_env(cache))
+
+
+def test_import_fm2uav_loads_no_numba_scipy_or_matplotlib(tmp_path):
+    res = _python("import sys, fm2uav; print(sorted(m for m in ('numba', 'scipy', "
+                  "'matplotlib') if m in sys.modules)); fm2uav.World; print('numba' in sys.modules)",
+                  tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.split("\n")[:2] == ["[]", "True"]  # lazy, and loaded on first use
+
+
+def test_likely_cold_follows_numba_cache_index(tmp_path, monkeypatch):
+    kernel = [("eikonal/_kernels.py", "scan_speed")]
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    assert _jit.likely_cold(kernel)
+    res = _python("import numpy as np; from fm2uav.eikonal import _kernels as k; "
+                  "k.scan_speed(k._readonly(np.ones(3)), 1e-9)", tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert not _jit.likely_cold(kernel)
+    assert _jit.likely_cold(kernel + [("eikonal/_kernels.py", "unpad_grid")])
+    monkeypatch.setenv("NUMBA_DISABLE_JIT", "1")
+    assert not _jit.likely_cold(kernel + [("eikonal/_kernels.py", "unpad_grid")])
+
+
+def test_first_compile_callback_fires_once_and_only_on_a_cache_miss(tmp_path):
+    code = (
+        "import numpy as np\n"
+        "from fm2uav import _jit\n"
+        "_jit.on_first_compile(lambda: print('FIRED', flush=True))\n"
+        "from fm2uav.eikonal import _kernels as k\n"
+        "k.scan_speed(k._readonly(np.ones(3)), 1e-9)\n"
+        "k.unpad_grid(np.zeros(27), 1, 1, 1, np.zeros(1))\n"
+        "print('DONE')\n"
+    )
+    cold = _python(code, tmp_path)
+    assert cold.returncode == 0, cold.stderr
+    assert cold.stdout.split() == ["FIRED", "DONE"]
+    warm = _python(code, tmp_path)  # both kernels load from the cache now
+    assert warm.returncode == 0, warm.stderr
+    assert warm.stdout.split() == ["DONE"]
+
+
+def _first_plan(cache: Path, out: Path) -> tuple[float, str, str, float]:
+    """Run ``python -m fm2uav plan``: (seconds to the first output, first line, stderr, wall)."""
+    t0 = time.perf_counter()
+    proc = subprocess.Popen([sys.executable, "-m", "fm2uav", "plan", "--out", str(out),
+                             "--force"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            env=_env(cache))
+    sel = selectors.DefaultSelector()
+    sel.register(proc.stdout, selectors.EVENT_READ)
+    sel.register(proc.stderr, selectors.EVENT_READ)
+    first_t, first, err, streams = None, b"", b"", 2
+    while streams:
+        for key, _ in sel.select(timeout=600):
+            chunk = os.read(key.fileobj.fileno(), 65536)
+            if not chunk:
+                sel.unregister(key.fileobj)
+                streams -= 1
+                continue
+            if first_t is None:
+                first_t, first = time.perf_counter() - t0, chunk
+            if key.fileobj is proc.stderr:
+                err += chunk
+    assert proc.wait(timeout=600) == 0, err.decode()[-3000:]
+    return first_t, first.decode().splitlines()[0], err.decode(), time.perf_counter() - t0
+
+
+@pytest.mark.slow
+def test_cold_first_plan_says_so_within_a_second_and_a_warm_one_does_not(tmp_path):
+    cache, out = tmp_path / "numba", tmp_path / "plan"
+    cache.mkdir()
+    first_t, first_line, err, _ = _first_plan(cache, out)
+    assert first_line.startswith(NOTICE)
+    assert first_t < 1.0, f"first output after {first_t:.2f} s"
+    assert err.count(NOTICE) == 1
+    assert (out / "path.csv").is_file()
+    # the cold run cached every kernel the plan needs: a second process compiles
+    # nothing (the numba-event fallback would print the notice on any compilation)
+    _, first_line, err, _ = _first_plan(cache, out)
+    assert NOTICE not in err and not first_line.startswith(NOTICE)
+
+
+def test_cold_estimate_spreads_the_cpu_time_over_up_to_two_idle_cores(monkeypatch):
+    monkeypatch.setattr(os, "cpu_count", lambda: 2)
+    monkeypatch.setattr(os, "getloadavg", lambda: (0.0, 0.0, 0.0))
+    idle = _jit.cold_estimate_s()
+    assert idle == round(_jit.COLD_FIRST_PLAN_CPU_S / 2)
+    monkeypatch.setattr(os, "getloadavg", lambda: (3.0, 3.0, 3.0))
+    assert _jit.cold_estimate_s() == round(_jit.COLD_FIRST_PLAN_CPU_S) > idle
+    monkeypatch.setattr(os, "cpu_count", lambda: 16)
+    monkeypatch.setattr(os, "getloadavg", lambda: (0.0, 0.0, 0.0))
+    assert _jit.cold_estimate_s() == idle  # two processes use at most two cores
