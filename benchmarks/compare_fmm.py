@@ -14,9 +14,12 @@ change of machine load hits both alike. Three speed fields per grid:
 scikit-fmm gets ``phi = |x - centre| - 0.5`` (its zero contour half a cell
 around the centre node) and ``travel_time(phi, speed, order)``; we get
 ``fast_marching(speed, [centre], order=order)``. Prints one markdown table:
-wall-clock min and median [ms] of each solver, and the speed-up
-(scikit-fmm / ours) of the medians and of the minima, with the 1-minute load
-average (``os.getloadavg``) before and after each case.
+wall-clock min and median [ms] of each solver, the speed-up (scikit-fmm /
+ours) of the wall-clock medians and minima, and that of the medians of the
+CPU time of the calling thread (``time.thread_time``; both solvers run on
+this one thread, and on a machine with more runnable processes than cores it
+leaves out the time spent waiting for a core), with the 1-minute load average
+(``os.getloadavg``) before and after each case.
 
 Usage::
 
@@ -54,10 +57,11 @@ def speed(shape: tuple[int, ...], field: str) -> np.ndarray:
     raise ValueError(f"unknown field {field!r}")
 
 
-def _time(fn) -> float:
-    t = time.perf_counter()
+def _time(fn) -> tuple[float, float]:
+    """Wall-clock and thread CPU time of one call [s]."""
+    t, c = time.perf_counter(), time.thread_time()
     fn()
-    return time.perf_counter() - t
+    return time.perf_counter() - t, time.thread_time() - c
 
 
 def compare(shape: tuple[int, ...], field: str, order: int, repeats: int) -> dict:
@@ -84,9 +88,13 @@ def compare(shape: tuple[int, ...], field: str, order: int, repeats: int) -> dic
             t_peer.append(_time(peer))
             t_ours.append(_time(ours))
     load1 = os.getloadavg()[0]
+    wall_o, cpu_o = zip(*t_ours)
+    wall_p, cpu_p = zip(*t_peer)
     return {
-        "ours_min": min(t_ours), "ours_med": statistics.median(t_ours),
-        "peer_min": min(t_peer), "peer_med": statistics.median(t_peer),
+        "ours_min": min(wall_o), "ours_med": statistics.median(wall_o),
+        "peer_min": min(wall_p), "peer_med": statistics.median(wall_p),
+        "cpu_ratio": statistics.median(cpu_p) / statistics.median(cpu_o),
+        "cpu_ratio_min": min(cpu_p) / min(cpu_o),
         "load": (load0, load1),
     }
 
@@ -100,9 +108,9 @@ def main(argv: list[str] | None = None) -> None:
     ap.add_argument("--fields", nargs="+", default=list(FIELDS), choices=FIELDS)
     args = ap.parse_args(argv)
     print(f"load average at start: {' '.join(f'{x:.2f}' for x in os.getloadavg())}, "
-          f"{os.cpu_count()} CPUs, {args.repeats} interleaved repeats, wall clock\n")
+          f"{os.cpu_count()} CPUs, {args.repeats} interleaved repeats\n")
     print("| grid | speed | order | ours min / median [ms] | scikit-fmm min / median [ms] "
-          "| speed-up (medians) | speed-up (minima) | load 1 min |")
+          "| speed-up wall medians / minima | speed-up CPU medians / minima | load 1 min |")
     print("|---|---|---|---|---|---|---|---|")
     for s in args.shapes:
         shape = tuple(int(n) for n in s.split("x"))
@@ -112,8 +120,8 @@ def main(argv: list[str] | None = None) -> None:
                 print(f"| {s} | {field} | {order} "
                       f"| {r['ours_min'] * 1e3:.0f} / {r['ours_med'] * 1e3:.0f} "
                       f"| {r['peer_min'] * 1e3:.0f} / {r['peer_med'] * 1e3:.0f} "
-                      f"| {r['peer_med'] / r['ours_med']:.2f}x "
-                      f"| {r['peer_min'] / r['ours_min']:.2f}x "
+                      f"| {r['peer_med'] / r['ours_med']:.2f}x / {r['peer_min'] / r['ours_min']:.2f}x "
+                      f"| {r['cpu_ratio']:.2f}x / {r['cpu_ratio_min']:.2f}x "
                       f"| {r['load'][0]:.2f} -> {r['load'][1]:.2f} |", flush=True)
 
 

@@ -19,10 +19,15 @@ Layout of the march (see docs/performance.md for the measurements behind it)
   patterns is the order of the values. A key goes into the bucket given by the
   highest 4-bit digit in which it differs from ``last`` (a lower bound of
   every key in the queue) and that digit's value; buckets are ordered, so the
-  smallest key is in the lowest non-empty bucket. A bucket of at most
-  ``SCAN_MAX`` entries is scanned for its exact minimum; a larger one is split
-  one digit down. Keys a rounding error below ``last`` go to bucket 0, which is
-  always scanned, so the popped node is the exact minimum (ties in any order).
+  smallest key is in the lowest non-empty bucket. A level-0 bucket holds one
+  key value (``last`` itself has a level-0 bucket of its own), so its last
+  entry is popped without a scan: ties, frequent where the speed is constant
+  and the grid symmetric, cost O(1) each (measured 0.77x the march time on
+  160^3 order 1 constant speed, unchanged elsewhere). A bucket of higher level
+  with at most ``SCAN_MAX`` entries is scanned for its exact minimum; a larger
+  one is split one digit down. Keys a rounding error below ``last`` go to
+  bucket 0, which is always scanned, so the popped node is the exact minimum
+  (ties in any order).
   Entries (key bits, node) sit in blocks of ``BLOCK`` slots. **No
   decrease-key**: a lowered band node gets a new entry and its old one (a
   larger key) stays behind; a split drops the entries whose key is no longer
@@ -69,12 +74,13 @@ _OPT = dict(cache=True, inline="always", error_model="numpy", _nrt=False)
 _U = np.uint64
 _ZERO = _U(0)
 _ONE = _U(1)
-#: Queue geometry: 4-bit digits, 16 levels of 16 buckets, one sentinel bucket.
+#: Queue geometry: 4-bit digits; bucket 0 for keys below ``last`` (rounding),
+#: then 16 levels of 16 buckets, one sentinel bucket.
 _DIGIT = _U(4)
 _NVAL = _U(16)
-_NOB = _U(256)  # sentinel "no bucket"
-_NB = _U(257)
-_NW = 4  # 64-bit words of the bucket occupancy mask
+_NOB = _U(257)  # sentinel "no bucket"
+_NB = _U(258)
+_NW = 5  # 64-bit words of the bucket occupancy mask
 #: Slots per block of the entry pool.
 BLOCK = 64
 _BS = _U(BLOCK)
@@ -86,7 +92,7 @@ _NIL = _U(0xFFFFFFFF)
 _KEYMAX = _U(0x7FFFFFFFFFFFFFFF)
 #: Free blocks the march keeps in reserve: one split may open a head block in
 #: every bucket, and one pop pushes at most 6 entries.
-RESERVE_BLOCKS = 257 + 8
+RESERVE_BLOCKS = 258 + 8
 #: Largest padded grid the uint32 node indices of the queue can address.
 MAX_NODES = 2**32 - 2
 
@@ -132,11 +138,17 @@ def _prefetch(typingctx, arr, idx):
 
 @njit(**_OPT)
 def _bucket(k, last):
-    """Bucket of key bits ``k`` relative to ``last``: 16 * level + digit value."""
+    """Bucket of key bits ``k`` relative to ``last``.
+
+    ``1 + 16 * level + digit value`` of the highest 4-bit digit in which ``k``
+    differs from ``last``; ``k == last`` goes to level 0 under ``last``'s own
+    lowest digit (which no larger key of level 0 has), so every level-0 bucket
+    holds a single key value. Keys below ``last`` (rounding) go to bucket 0.
+    """
     if k <= last:
-        return _ZERO
+        return _ONE + (last & _U(15)) if k == last else _ZERO
     lev = (_U(63) - leading_zeros(k ^ last)) >> _U(2)
-    return lev * _NVAL + ((k >> (lev * _DIGIT)) & _U(15))
+    return _ONE + lev * _NVAL + ((k >> (lev * _DIGIT)) & _U(15))
 
 
 @njit(**_OPT)
@@ -195,9 +207,13 @@ def _pop(T, pool, nxt, bk, mw, nfree, fh, cur, last):
             cur = _U(w) * _U(64) + trailing_zeros(mw[w])
         hb = _U(bk[cur])
         cnt = _U(bk[_NB + cur])
-        if cur < _NVAL or (nxt[hb] == _NIL and cnt <= SCAN_MAX):
-            # exact minimum by a scan; level-0 buckets hold a single key value
-            # (bucket 0: keys <= last) and may span several blocks
+        if cur - _ONE < _NVAL:  # level 0: one key value, take the last entry (LIFO)
+            bp = hb * _BS + cnt - _ONE
+            c = pool[bp + bp + _ONE]
+            nfree, fh = _remove(bp, cur, pool, nxt, bk, mw, nfree, fh)
+            return c, nfree, fh, cur, last
+        if cur == _ZERO or (nxt[hb] == _NIL and cnt <= SCAN_MAX):
+            # exact minimum by a scan; bucket 0 (keys below last) may span blocks
             bp = hb * _BS
             m = pool[bp + bp]
             b = hb
@@ -218,8 +234,8 @@ def _pop(T, pool, nxt, bk, mw, nfree, fh, cur, last):
         # split one digit level down, relative to the bucket's lower bound: every
         # key of the bucket shares the digits above this level with last and has
         # this digit's value, so the lower bound is <= all of them and > last
-        lev = cur // _NVAL
-        dig = cur - lev * _NVAL
+        lev = (cur - _ONE) // _NVAL
+        dig = cur - _ONE - lev * _NVAL
         hsh = (lev + _ONE) * _DIGIT
         hi = _ZERO if hsh >= _U(64) else (last >> hsh) << hsh
         last = hi | (dig << (lev * _DIGIT))
