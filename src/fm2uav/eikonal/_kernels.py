@@ -662,11 +662,17 @@ def unpad_grid(Tp, nx, ny, nz, T):
     two = nz == 1
     pz = 1 if two else nz + 2
     py = ny + 2
-    off = 0 if two else 1
     for i in range(nx):
+        if two:  # one run of ny nodes per x-slab (the loop vectorises)
+            src = (i + 1) * py + 1
+            dst = i * ny
+            for k in range(ny):
+                x = Tp[src + k]
+                T[dst + k] = x if x >= 0.0 else _INF
+            continue
         for j in range(ny):
             dst = (i * ny + j) * nz
-            src = ((i + 1) * py + j + 1) * pz + off
+            src = ((i + 1) * py + j + 1) * pz + 1
             for k in range(nz):
                 x = Tp[src + k]
                 T[dst + k] = x if x >= 0.0 else _INF
