@@ -50,10 +50,10 @@ FIRST_PLAN_KERNELS: tuple[tuple[str, str], ...] = (
 )
 
 #: CPU time [s] of a first ``fm2uav plan`` with an empty numba cache, both
-#: processes together (compilation, imports, the plan): measured 24-28 s on the
+#: processes together (compilation, imports, the plan): measured 17-18 s on the
 #: 2-core machine (``/usr/bin/time fm2uav plan`` after ``pip install .``; the
 #: ``coldstart`` rows of docs/performance.md give the wall times).
-COLD_FIRST_PLAN_CPU_S = 26.0
+COLD_FIRST_PLAN_CPU_S = 18.0
 
 
 def cold_estimate_s() -> int:

@@ -71,7 +71,12 @@ _INF = np.inf
 ORDER2_MAX_SPEED_RATIO = 2.0
 _ORDER2_MAX_W_RATIO = ORDER2_MAX_SPEED_RATIO**2
 
+#: Small hot helpers are inlined at numba IR level (``inline="always"``); larger
+#: or cold ones (the seeding pass, the march bodies) are compiled as functions of
+#: their own: IR inlining deep-copies the callee per call site, and inlining the
+#: whole march into a per-order wrapper cost 4 s of the 7 s compile of a 3D kernel.
 _OPT = dict(cache=True, inline="always", error_model="numpy", _nrt=False)
+_CALL = dict(cache=True, error_model="numpy", _nrt=False)
 _U = np.uint64
 _ZERO = _U(0)
 _ONE = _U(1)
@@ -417,7 +422,7 @@ def _relax(T, V, c, t, last, pool, nxt, bk, mw, nfree, fh, cur, pf1, pf2, n):
     return nfree, fh, cur
 
 
-@njit(**_OPT)
+@njit(**_CALL)
 def _seed(T, n, pool, nxt, bk, mw, st):
     """Phase 0: queue the band nodes given on entry. False if the pool ran low."""
     nfree = _U(st[_NFREE])
@@ -442,168 +447,169 @@ def _seed(T, n, pool, nxt, bk, mw, st):
     return ok
 
 
-@njit(**_OPT)
-def _march2d(T, V, nx, ny, ihx2, ihy2, order, stop, pool, nxt, bk, mw, st):
-    """March a padded 2D grid ``(nx, ny)`` (ghost ring included) in place.
-
-    Resumable: returns 0 when done, 1 when fewer than ``RESERVE_BLOCKS`` free
-    blocks are left (the caller grows the pool and calls again with the same
-    ``st``). ``stop[c] != 0`` marks stop nodes (1-element array when unused;
-    ``st[_NSTOP]`` counts those not frozen yet, 0 = no stop set).
-    """
-    n = _U(nx) * _U(ny)
-    sx = _U(ny)
-    if st[_PHASE] == 0:
-        if not _seed(T, n, pool, nxt, bk, mw, st):
-            return 1
-        st[_PHASE] = 1
-        st[_SCAN] = 0
-    scan = _U(st[_SCAN])
-    nfree = _U(st[_NFREE])
-    fh = _U(st[_FH])
-    cur = _U(st[_CUR])
-    last = _U(st[_LAST])
-    frozen = _U(st[_FROZEN])
-    n_stop = _U(st[_NSTOP])
-    use_stop = n_stop != _ZERO
-    phase = st[_PHASE]
-    status = 0
-    while True:
-        if nfree < _U(RESERVE_BLOCKS):
-            status = 1
-            break
-        if phase == 1:  # expand the nodes frozen on entry, in index order
-            if scan < n:
-                c = scan
-                scan += _ONE
-                if not T[c] >= 0.0:
-                    continue
-            else:
-                phase = 2
-                continue
-        else:
-            c, nfree, fh, cur, last = _pop(T, pool, nxt, bk, mw, nfree, fh, cur, last)
-            if c == _NIL:
-                phase = 3
-                break
-            if not T[c] < 0.0:  # an outdated entry of a node frozen already
-                continue
-            T[c] = -T[c]
-            frozen += _ONE
-            if use_stop and stop[c] != 0:
-                n_stop -= _ONE
-                if n_stop == _ZERO:
-                    phase = 3
-                    break
-        # one relax site for the four neighbours (unrolled by hand: 4x the
-        # compile time, 17 s instead of 4.5 s, for no measurable speed)
-        for nb in (c - sx, c + sx, c - _ONE, c + _ONE):
-            if T[nb] < 0.0:
-                ta, aa = _axis_term(T, V, nb, sx, ihx2, order)
-                tb, ab = _axis_term(T, V, nb, _ONE, ihy2, order)
-                t = _combine(ta, aa, tb, ab, _INF, 0.0, V[nb])
-                nfree, fh, cur = _relax(T, V, nb, t, last, pool, nxt, bk, mw, nfree, fh, cur,
-                                        sx, _ZERO, n)
-    st[_PHASE] = phase
-    st[_SCAN] = scan
-    st[_NFREE] = nfree
-    st[_FH] = fh
-    st[_CUR] = cur
-    st[_LAST] = last
-    st[_FROZEN] = frozen
-    st[_NSTOP] = n_stop
-    return status
-
-
-@njit(**_OPT)
-def _march3d(T, V, nx, ny, nz, ihx2, ihy2, ihz2, order, stop, pool, nxt, bk, mw, st):
-    """March a padded 3D grid ``(nx, ny, nz)`` in place; as :func:`_march2d`."""
-    n = _U(nx) * _U(ny) * _U(nz)
-    sx = _U(ny) * _U(nz)
-    sy = _U(nz)
-    if st[_PHASE] == 0:
-        if not _seed(T, n, pool, nxt, bk, mw, st):
-            return 1
-        st[_PHASE] = 1
-        st[_SCAN] = 0
-    scan = _U(st[_SCAN])
-    nfree = _U(st[_NFREE])
-    fh = _U(st[_FH])
-    cur = _U(st[_CUR])
-    last = _U(st[_LAST])
-    frozen = _U(st[_FROZEN])
-    n_stop = _U(st[_NSTOP])
-    use_stop = n_stop != _ZERO
-    phase = st[_PHASE]
-    status = 0
-    while True:
-        if nfree < _U(RESERVE_BLOCKS):
-            status = 1
-            break
-        if phase == 1:
-            if scan < n:
-                c = scan
-                scan += _ONE
-                if not T[c] >= 0.0:
-                    continue
-            else:
-                phase = 2
-                continue
-        else:
-            c, nfree, fh, cur, last = _pop(T, pool, nxt, bk, mw, nfree, fh, cur, last)
-            if c == _NIL:
-                phase = 3
-                break
-            if not T[c] < 0.0:  # an outdated entry of a node frozen already
-                continue
-            T[c] = -T[c]
-            frozen += _ONE
-            if use_stop and stop[c] != 0:
-                n_stop -= _ONE
-                if n_stop == _ZERO:
-                    phase = 3
-                    break
-        for nb in (c - sx, c + sx, c - sy, c + sy, c - _ONE, c + _ONE):
-            if T[nb] < 0.0:
-                ta, aa = _axis_term(T, V, nb, sx, ihx2, order)
-                tb, ab = _axis_term(T, V, nb, sy, ihy2, order)
-                tc, ac = _axis_term(T, V, nb, _ONE, ihz2, order)
-                t = _combine(ta, aa, tb, ab, tc, ac, V[nb])
-                nfree, fh, cur = _relax(T, V, nb, t, last, pool, nxt, bk, mw, nfree, fh, cur, sx, sy, n)
-    st[_PHASE] = phase
-    st[_SCAN] = scan
-    st[_NFREE] = nfree
-    st[_FH] = fh
-    st[_CUR] = cur
-    st[_LAST] = last
-    st[_FROZEN] = frozen
-    st[_NSTOP] = n_stop
-    return status
-
-
-# One compiled kernel per (dimension, order), each compiled on first use: with the
-# order a constant, the order-2 branches fold away (measured -7 % on 2048^2 order 1).
+# One compiled kernel per (dimension, order), each compiled on first use: the
+# order is a closure constant of the kernel, so its order-2 branches fold away
+# (measured -7 % on 2048^2 order 1) without a wrapper that inlines the march.
 _KERNEL = dict(cache=True, nogil=True, error_model="numpy", _nrt=False)
 
 
-@njit(**_KERNEL)
-def march2d_o1(T, V, nx, ny, ihx2, ihy2, stop, pool, nxt, bk, mw, st):
-    return _march2d(T, V, nx, ny, ihx2, ihy2, 1, stop, pool, nxt, bk, mw, st)
+def _kernel(march, name):
+    """Jit ``march`` under its own name (its own cache index file)."""
+    march.__name__ = march.__qualname__ = name
+    return njit(**_KERNEL)(march)
 
 
-@njit(**_KERNEL)
-def march2d_o2(T, V, nx, ny, ihx2, ihy2, stop, pool, nxt, bk, mw, st):
-    return _march2d(T, V, nx, ny, ihx2, ihy2, 2, stop, pool, nxt, bk, mw, st)
+def _march2d_kernel(order):
+    """The compiled 2D march of one order (1 or 2)."""
+
+    def march(T, V, nx, ny, ihx2, ihy2, stop, pool, nxt, bk, mw, st):
+        """March a padded 2D grid ``(nx, ny)`` (ghost ring included) in place.
+
+        Resumable: returns 0 when done, 1 when fewer than ``RESERVE_BLOCKS`` free
+        blocks are left (the caller grows the pool and calls again with the same
+        ``st``). ``stop[c] != 0`` marks stop nodes (1-element array when unused;
+        ``st[_NSTOP]`` counts those not frozen yet, 0 = no stop set).
+        """
+        n = _U(nx) * _U(ny)
+        sx = _U(ny)
+        if st[_PHASE] == 0:
+            if not _seed(T, n, pool, nxt, bk, mw, st):
+                return 1
+            st[_PHASE] = 1
+            st[_SCAN] = 0
+        scan = _U(st[_SCAN])
+        nfree = _U(st[_NFREE])
+        fh = _U(st[_FH])
+        cur = _U(st[_CUR])
+        last = _U(st[_LAST])
+        frozen = _U(st[_FROZEN])
+        n_stop = _U(st[_NSTOP])
+        use_stop = n_stop != _ZERO
+        phase = st[_PHASE]
+        status = 0
+        while True:
+            if nfree < _U(RESERVE_BLOCKS):
+                status = 1
+                break
+            if phase == 1:  # expand the nodes frozen on entry, in index order
+                if scan < n:
+                    c = scan
+                    scan += _ONE
+                    if not T[c] >= 0.0:
+                        continue
+                else:
+                    phase = 2
+                    continue
+            else:
+                c, nfree, fh, cur, last = _pop(T, pool, nxt, bk, mw, nfree, fh, cur, last)
+                if c == _NIL:
+                    phase = 3
+                    break
+                if not T[c] < 0.0:  # an outdated entry of a node frozen already
+                    continue
+                T[c] = -T[c]
+                frozen += _ONE
+                if use_stop and stop[c] != 0:
+                    n_stop -= _ONE
+                    if n_stop == _ZERO:
+                        phase = 3
+                        break
+            # one relax site for the four neighbours (unrolled by hand: 4x the
+            # compile time, 17 s instead of 4.5 s, for no measurable speed)
+            for nb in (c - sx, c + sx, c - _ONE, c + _ONE):
+                if T[nb] < 0.0:
+                    ta, aa = _axis_term(T, V, nb, sx, ihx2, order)
+                    tb, ab = _axis_term(T, V, nb, _ONE, ihy2, order)
+                    t = _combine(ta, aa, tb, ab, _INF, 0.0, V[nb])
+                    nfree, fh, cur = _relax(T, V, nb, t, last, pool, nxt, bk, mw, nfree, fh, cur,
+                                            sx, _ZERO, n)
+        st[_PHASE] = phase
+        st[_SCAN] = scan
+        st[_NFREE] = nfree
+        st[_FH] = fh
+        st[_CUR] = cur
+        st[_LAST] = last
+        st[_FROZEN] = frozen
+        st[_NSTOP] = n_stop
+        return status
+
+    return _kernel(march, f"march2d_o{order}")
 
 
-@njit(**_KERNEL)
-def march3d_o1(T, V, nx, ny, nz, ihx2, ihy2, ihz2, stop, pool, nxt, bk, mw, st):
-    return _march3d(T, V, nx, ny, nz, ihx2, ihy2, ihz2, 1, stop, pool, nxt, bk, mw, st)
+def _march3d_kernel(order):
+    """The compiled 3D march of one order (1 or 2); as :func:`_march2d_kernel`."""
+
+    def march(T, V, nx, ny, nz, ihx2, ihy2, ihz2, stop, pool, nxt, bk, mw, st):
+        """March a padded 3D grid ``(nx, ny, nz)`` in place; as :func:`_march2d`."""
+        n = _U(nx) * _U(ny) * _U(nz)
+        sx = _U(ny) * _U(nz)
+        sy = _U(nz)
+        if st[_PHASE] == 0:
+            if not _seed(T, n, pool, nxt, bk, mw, st):
+                return 1
+            st[_PHASE] = 1
+            st[_SCAN] = 0
+        scan = _U(st[_SCAN])
+        nfree = _U(st[_NFREE])
+        fh = _U(st[_FH])
+        cur = _U(st[_CUR])
+        last = _U(st[_LAST])
+        frozen = _U(st[_FROZEN])
+        n_stop = _U(st[_NSTOP])
+        use_stop = n_stop != _ZERO
+        phase = st[_PHASE]
+        status = 0
+        while True:
+            if nfree < _U(RESERVE_BLOCKS):
+                status = 1
+                break
+            if phase == 1:
+                if scan < n:
+                    c = scan
+                    scan += _ONE
+                    if not T[c] >= 0.0:
+                        continue
+                else:
+                    phase = 2
+                    continue
+            else:
+                c, nfree, fh, cur, last = _pop(T, pool, nxt, bk, mw, nfree, fh, cur, last)
+                if c == _NIL:
+                    phase = 3
+                    break
+                if not T[c] < 0.0:  # an outdated entry of a node frozen already
+                    continue
+                T[c] = -T[c]
+                frozen += _ONE
+                if use_stop and stop[c] != 0:
+                    n_stop -= _ONE
+                    if n_stop == _ZERO:
+                        phase = 3
+                        break
+            for nb in (c - sx, c + sx, c - sy, c + sy, c - _ONE, c + _ONE):
+                if T[nb] < 0.0:
+                    ta, aa = _axis_term(T, V, nb, sx, ihx2, order)
+                    tb, ab = _axis_term(T, V, nb, sy, ihy2, order)
+                    tc, ac = _axis_term(T, V, nb, _ONE, ihz2, order)
+                    t = _combine(ta, aa, tb, ab, tc, ac, V[nb])
+                    nfree, fh, cur = _relax(T, V, nb, t, last, pool, nxt, bk, mw, nfree, fh, cur, sx, sy, n)
+        st[_PHASE] = phase
+        st[_SCAN] = scan
+        st[_NFREE] = nfree
+        st[_FH] = fh
+        st[_CUR] = cur
+        st[_LAST] = last
+        st[_FROZEN] = frozen
+        st[_NSTOP] = n_stop
+        return status
+
+    return _kernel(march, f"march3d_o{order}")
 
 
-@njit(**_KERNEL)
-def march3d_o2(T, V, nx, ny, nz, ihx2, ihy2, ihz2, stop, pool, nxt, bk, mw, st):
-    return _march3d(T, V, nx, ny, nz, ihx2, ihy2, ihz2, 2, stop, pool, nxt, bk, mw, st)
+march2d_o1 = _march2d_kernel(1)
+march2d_o2 = _march2d_kernel(2)
+march3d_o1 = _march3d_kernel(1)
+march3d_o2 = _march3d_kernel(2)
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)

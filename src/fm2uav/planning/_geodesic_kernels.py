@@ -58,7 +58,7 @@ _DECREASE = 0.1
 
 
 # --------------------------------------------------------------------------- helpers
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _nearest(x, n):
     """Nearest node index of coordinate ``x`` on an axis of ``n`` nodes (half up)."""
     i = int(math.floor(x + 0.5))
@@ -69,7 +69,7 @@ def _nearest(x, n):
     return i
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _cell(x, n):
     """Lower corner index and fraction of the interpolation cell holding ``x``."""
     if n == 1:
@@ -87,7 +87,7 @@ def _cell(x, n):
     return i0, i0 + 1, f
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _axis_slope(tc, tm, tp, h):
     """Derivative [s/m] of T along one axis at a free node, from its neighbours.
 
@@ -112,7 +112,7 @@ def _axis_slope(tc, tm, tp, h):
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _node_direction(T, i, j, k, hx, hy, hz):
     """Unit physical gradient of T at a free node (0 vector if it vanishes).
 
@@ -136,7 +136,7 @@ def _node_direction(T, i, j, k, hx, hy, hz):
     return gx / g, gy / g, gz / g
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _smoothing(h, hmin):
     """Share ``lam`` of the cubic B-spline in an axis' blend (the rest: linear).
 
@@ -155,7 +155,7 @@ def _smoothing(h, hmin):
     return lam
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _bspline_weights(x, n, lam, w):
     """Uniform cubic B-spline weights of the 4 nodes around ``x`` on an axis of ``n``.
 
@@ -183,7 +183,7 @@ def _bspline_weights(x, n, lam, w):
     return i0 - 1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _direction(T, x, y, z, hx, hy, hz, hmin, smooth):
     """Index-space displacement of one unit-physical-length descent step.
 
@@ -236,7 +236,7 @@ def _direction(T, x, y, z, hx, hy, hz, hmin, smooth):
     return -gx / g * hmin / hx, -gy / g * hmin / hy, -gz / g * hmin / hz, True
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _interp_T(T, x, y, z):
     """Trilinear T at a point, averaged over the finite corners only.
 
@@ -272,7 +272,7 @@ def _interp_T(T, x, y, z):
     return acc / wsum
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _slowness(T, i, j, k, hx, hy, hz):
     """Slowness estimate [s/m] at a free node: ``|grad T|`` of the upwind stencil.
 
@@ -307,7 +307,7 @@ def _slowness(T, i, j, k, hx, hy, hz):
     return low if math.isfinite(low) else 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _potential(T, x, y, z, hx, hy, hz):
     """Descent potential [s] at a point: ``min(trilinear T, cone estimate)``.
 
@@ -344,7 +344,7 @@ def _potential(T, x, y, z, hx, hy, hz):
     return t
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _clamp(x, n):
     if x < 0.0:
         return 0.0
@@ -353,7 +353,7 @@ def _clamp(x, n):
     return x
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _segment_free(T, px, py, pz, qx, qy, qz):
     """True if the segment p-q enters no cell (Voronoi box) of a non-finite node.
 
@@ -410,7 +410,7 @@ def _segment_free(T, px, py, pz, qx, qy, qz):
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _best_neighbour(T, i, j, k):
     """Free 26-neighbour (8 in 2D) with the smallest T, strictly below ``T[i, j, k]``.
 
@@ -454,7 +454,7 @@ def _best_neighbour(T, i, j, k):
     return bi, bj, bk, found
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _push(out, n, x, y, z):
     """Append a point to the growable buffer ``out`` holding ``n`` points."""
     if n > 0 and out[n - 1, 0] == x and out[n - 1, 1] == y and out[n - 1, 2] == z:
@@ -474,7 +474,7 @@ def _push(out, n, x, y, z):
     return out, n + 1
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _near_goal(T, px, py, pz, gx, gy, gz):
     """Within one cell (Chebyshev, index units) of the goal, with a free segment."""
     if abs(px - gx) > 1.0 or abs(py - gy) > 1.0 or abs(pz - gz) > 1.0:
@@ -482,7 +482,7 @@ def _near_goal(T, px, py, pz, gx, gy, gz):
     return _segment_free(T, px, py, pz, gx, gy, gz)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step):
     """One continuous descent step from p; returns ``(qx, qy, qz, phi(q), ok)``.
 
@@ -542,14 +542,14 @@ def _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step):
     return px, py, pz, ref, False
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _fill(a, x):
     """``a[:] = x`` as a loop (numba's slice assignment compiles error-formatting code)."""
     for r in range(a.size):
         a[r] = x
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", error_model="numpy")
 def _nanmax(a):
     """``a.max()`` with numpy's semantics (NaN if any element is NaN), as a loop."""
     m = a[0]
@@ -564,7 +564,7 @@ def _nanmax(a):
 
 # --------------------------------------------------------------------------- kernel
 # long on purpose: one compiled loop (numba kernel); helpers would add calls in the hot path
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def descend_kernel(T, start, goal, hx, hy, hz, step, max_steps):
     """Descend ``T`` from ``start`` to ``goal``; see the module docstring.
 

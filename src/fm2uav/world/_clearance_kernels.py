@@ -75,7 +75,7 @@ def column_clearance(points, surf, hx, hy, hz, ox, oy, oz):
     return out
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, error_model="numpy")
 def _tri_dist2(px, py, pz, ax, ay, az, bx, by, bz, cx, cy, cz):
     """Squared distance from p to triangle abc (Ericson, Real-Time Collision Detection 5.1.5)."""
     abx, aby, abz = bx - ax, by - ay, bz - az
