@@ -63,8 +63,8 @@ def test_band_given_on_entry_larger_than_the_pool(grow_calls):
     c = (n // 2) * n + n // 3
     T[c] = 0.0
     state[c] = _kernels.FROZEN
-    _kernels.march(speed.reshape(-1), T, state, (n, n, 1), (1.0, 1.0, 1.0), 1,
-                   np.zeros(1, np.uint8), 0)
+    T, _ = _kernels.march(speed.reshape(-1), _kernels.Start.whole(T, state, (n, n, 1)),
+                          (n, n, 1), (1.0, 1.0, 1.0), 1, np.zeros((0, 3), np.int64))
     assert grow_calls
     assert_same_field(T.reshape(n, n), plain, RTOL)
 

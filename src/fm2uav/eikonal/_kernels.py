@@ -39,10 +39,17 @@ Layout of the march (see docs/performance.md for the measurements behind it)
 * Unsigned (``uint64``) indices throughout: numba emits negative-index
   wraparound code for signed indices, measured 1.8x slower in the hot loop.
 
-Conventions of the caller's arrays (unpadded, flat, C order of ``(nx, ny, nz)``)
-------------------------------------------------------------------------------
-* ``state``: 0 = unknown (far), 1 = narrow band (trial), 2 = frozen (accepted).
-* ``T``: arrival time in seconds (``inf`` for unknown cells).
+Where a march starts and what it returns
+----------------------------------------
+* :class:`Start`: a box of the grid (the sources and their balls, or the whole
+  grid for a restart) with flat C-ordered ``T`` (seconds, ``inf`` for unknown)
+  and ``state`` (0 = far, 1 = narrow band, 2 = frozen); every node outside the
+  box is far. No grid-sized array is needed before the padded one.
+* :func:`march` returns the flat arrival times of the ``(nx, ny, nz)`` grid
+  (``inf`` where not frozen). Grids over :data:`LEAN_NODES` padded nodes use the
+  lean layout: ``V`` in float32 and the result compacted in place in the padded
+  time buffer, so a march needs ~12 bytes per node beside the caller's speed.
+* Stop nodes are a bit mask over the padded grid (one bit per node).
 """
 
 from __future__ import annotations
@@ -50,6 +57,7 @@ from __future__ import annotations
 import math
 import mmap
 import threading
+from typing import NamedTuple
 
 import numpy as np
 from llvmlite import ir
@@ -467,7 +475,7 @@ def _march2d_kernel(order):
 
         Resumable: returns 0 when done, 1 when fewer than ``RESERVE_BLOCKS`` free
         blocks are left (the caller grows the pool and calls again with the same
-        ``st``). ``stop[c] != 0`` marks stop nodes (1-element array when unused;
+        ``st``). Bit ``c & 7`` of ``stop[c >> 3]`` marks stop nodes (1-element array when unused;
         ``st[_NSTOP]`` counts those not frozen yet, 0 = no stop set).
         """
         n = _U(nx) * _U(ny)
@@ -509,7 +517,7 @@ def _march2d_kernel(order):
                     continue
                 T[c] = -T[c]
                 frozen += _ONE
-                if use_stop and stop[c] != 0:
+                if use_stop and (stop[c >> _U(3)] >> (c & _U(7))) & _ONE != _ZERO:
                     n_stop -= _ONE
                     if n_stop == _ZERO:
                         phase = 3
@@ -581,7 +589,7 @@ def _march3d_kernel(order):
                     continue
                 T[c] = -T[c]
                 frozen += _ONE
-                if use_stop and stop[c] != 0:
+                if use_stop and (stop[c >> _U(3)] >> (c & _U(7))) & _ONE != _ZERO:
                     n_stop -= _ONE
                     if n_stop == _ZERO:
                         phase = 3
@@ -613,16 +621,19 @@ march3d_o2 = _march3d_kernel(2)
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
-def pad_grid(speed, T, state, nx, ny, nz, Tp, Vp):
-    """Copy a flat ``(nx, ny, nz)`` grid into the padded layout with state folded into T.
+def pad_grid(speed, Tb, sb, i0, j0, k0, bx, by, bz, nx, ny, nz, Tp, Vp):
+    """Fill the padded grid with state folded into T, from the speed and a start box.
 
     ``Vp`` gets ``1 / speed^2`` [s^2/m^2], the right-hand side of the local
-    solver (one division per node here instead of one per update).
+    solver (one division per node here instead of one per update), in its own
+    dtype (float64, or float32 in the lean layout).
 
     ``nz == 1`` gives the 2D layout ``(nx + 2, ny + 2)``, else ``(nx + 2, ny + 2,
-    nz + 2)``. Frozen nodes keep ``T``; band nodes get ``-T`` (a band node with
-    ``T = 0`` counts as frozen: nothing can lower it); far nodes ``-inf``;
-    speed-0 nodes that are not frozen, and the ghosts, ``NaN``. The ghosts'
+    nz + 2)``. Nodes of the box ``[i0, i0 + bx) x [j0, j0 + by) x [k0, k0 + bz)``
+    take their time and state from ``Tb``/``sb`` (flat, C order of the box):
+    frozen nodes keep ``T``; band nodes get ``-T`` (a band node with ``T = 0``
+    counts as frozen: nothing can lower it). Every other node is far (``-inf``);
+    speed-0 nodes that are not frozen, and the ghosts, are ``NaN``. The ghosts'
     speeds are never read and stay unset.
     """
     two = nz == 1
@@ -637,30 +648,56 @@ def pad_grid(speed, T, state, nx, ny, nz, Tp, Vp):
         for c in range(pz):  # ghost rows j = -1 and j = ny
             Tp[slab + c] = np.nan
             Tp[slab + (ny + 1) * pz + c] = np.nan
+        in_i = i0 <= i < i0 + bx
         if two:  # one run of ny nodes per x-slab
-            _pad_run(speed, T, state, i * ny, slab + 1, ny, Tp, Vp)
+            if in_i:
+                _pad_row(speed, Tb, sb, i * ny, (i - i0) * by, slab + 1, ny, j0, by,
+                         Tp, Vp)
+            else:
+                _far_run(speed, i * ny, slab + 1, ny, Tp, Vp)
             continue
         for j in range(ny):
             src = (i * ny + j) * nz
             dst = slab + (j + 1) * pz
             Tp[dst] = np.nan  # ghost nodes k = -1 and k = nz
             Tp[dst + nz + 1] = np.nan
-            _pad_run(speed, T, state, src, dst + 1, nz, Tp, Vp)
+            if in_i and j0 <= j < j0 + by:
+                _pad_row(speed, Tb, sb, src, ((i - i0) * by + j - j0) * bz, dst + 1, nz,
+                         k0, bz, Tp, Vp)
+            else:
+                _far_run(speed, src, dst + 1, nz, Tp, Vp)
 
 
-@njit(cache=True, error_model="numpy", _nrt=False, inline="always")
-def _pad_run(speed, T, state, src, dst, m, Tp, Vp):
-    """:func:`pad_grid` for ``m`` consecutive nodes (selects only: the loop
-    vectorises; measured 10 -> 3 ms on 2048^2)."""
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _pad_row(speed, Tb, sb, src, b, dst, m, lo, width, Tp, Vp):
+    """One row of ``m`` nodes crossing the start box on ``[lo, lo + width)``."""
+    _far_run(speed, src, dst, lo, Tp, Vp)
+    _box_run(speed, Tb, sb, src + lo, b, dst + lo, width, Tp, Vp)
+    _far_run(speed, src + lo + width, dst + lo + width, m - lo - width, Tp, Vp)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _far_run(speed, src, dst, m, Tp, Vp):
+    """``m`` consecutive far nodes (selects only: the loop vectorises; measured
+    10 -> 3 ms on 2048^2)."""
     for k in range(m):
-        s = state[src + k]
         v = speed[src + k]
-        t = T[src + k]
+        Tp[dst + k] = -_INF if v > 0.0 else np.nan
+        Vp[dst + k] = 1.0 / (v * v)  # inf for v = 0, never read
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _box_run(speed, Tb, sb, src, b, dst, m, Tp, Vp):
+    """``m`` consecutive nodes of the start box (box index ``b`` on)."""
+    for k in range(m):
+        s = sb[b + k]
+        v = speed[src + k]
+        t = Tb[b + k]
         band = -t if t > 0.0 else t
         other = band if s == 1 else -_INF
         other = np.nan if v <= 0.0 else other
         Tp[dst + k] = t if s == 2 else other
-        Vp[dst + k] = 1.0 / (v * v)  # inf for v = 0, never read
+        Vp[dst + k] = 1.0 / (v * v)
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
@@ -696,33 +733,94 @@ def _readonly(a):
     return v
 
 
-def march(speed, T, state, shape3, h3, order, stop_mask, n_stop):
-    """Run the Fast Marching Method in place on ``T``.
+class Start(NamedTuple):
+    """Where a march starts: a box of the grid with the times and states of its nodes.
+
+    Every node outside the box is far. :func:`fm2uav.eikonal.fast_marching`
+    passes the box around its sources (the source ball), a restart the whole
+    grid (:meth:`whole`).
+
+    Attributes
+    ----------
+    lo : tuple of 3 int
+        Node indices of the box's first corner.
+    shape : tuple of 3 int
+        Box shape (``1`` on the third axis of a 2D grid).
+    T : ndarray, float64, shape (prod(shape),)
+        Times [s] of the box nodes (flat, C order): values of frozen/band
+        nodes, ``inf`` elsewhere.
+    state : ndarray, uint8, shape (prod(shape),)
+        0 far, 1 band, 2 frozen. Band nodes must carry a finite ``T``.
+    """
+
+    lo: tuple[int, int, int]
+    shape: tuple[int, int, int]
+    T: np.ndarray
+    state: np.ndarray
+
+    @classmethod
+    def whole(cls, T, state, shape3):
+        """The start of a march over the whole grid ``shape3`` (flat ``T``/``state``)."""
+        return cls((0, 0, 0), tuple(int(n) for n in shape3), T, state)
+
+    def frozen_times(self, shape3):
+        """Flat times of the grid ``shape3`` with only the box's frozen nodes set (``inf`` elsewhere)."""
+        T = np.full(int(np.prod(shape3)), np.inf)
+        box = T.reshape(shape3)[tuple(slice(a, a + n) for a, n in zip(self.lo, self.shape))]
+        box[...] = np.where(self.state == FROZEN, self.T, np.inf).reshape(self.shape)
+        return T
+
+    def frozen_at(self, cells):
+        """Which of the grid nodes ``cells`` (int array (m, 3)) are frozen in the box."""
+        lo = np.asarray(self.lo)
+        rel = np.asarray(cells, dtype=np.int64).reshape(-1, 3) - lo
+        inside = np.all((rel >= 0) & (rel < np.asarray(self.shape)), axis=1)
+        out = np.zeros(len(rel), dtype=bool)
+        if inside.any():
+            flat = np.ravel_multi_index(tuple(rel[inside].T), self.shape)
+            out[inside] = self.state[flat] == FROZEN
+        return out
+
+
+#: Grids of more padded nodes than this march in the **lean** layout: ``V`` in
+#: float32 (half the memory of the speed copy; ``1 / speed^2`` rounded to 24
+#: bits, so the times differ from the float64 layout by a relative ~1e-8, far
+#: below the scheme's own error) and the result compacted in place in the padded
+#: time buffer instead of copied to a new array. On a 1000 x 1000 x 40 grid that
+#: is 0.5 GB instead of 1.0 GB beside the caller's speed map. Smaller grids use
+#: float64 throughout (the arrival times of every small case are exact to
+#: round-off, as the tests check) and keep their buffers for the next march.
+LEAN_NODES = 2**25
+
+
+def march(speed, start, shape3, h3, order, stop_cells, *, lean=None):
+    """Run the Fast Marching Method from ``start``; returns the arrival times.
 
     Parameters
     ----------
     speed : ndarray, float64, shape (nx*ny*nz,)
         Propagation speed [m/s]; nodes with 0 are never entered.
-    T : ndarray, float64, shape (nx*ny*nz,)
-        Arrival times [s]: values of frozen/band nodes, ``inf`` elsewhere.
-        Overwritten with the result (``inf`` where not frozen).
-    state : ndarray, uint8, shape (nx*ny*nz,)
-        0 far, 1 band, 2 frozen. Band nodes must carry a finite ``T``.
+    start : Start
+        The initial frozen/band nodes (a box of the grid).
     shape3 : tuple of 3 int
         Grid shape ``(nx, ny, nz)`` (``nz = 1`` for 2D).
     h3 : tuple of 3 float
         Spacing per axis [m].
     order : int
         1 or 2.
-    stop_mask : ndarray, uint8
-        ``stop_mask[c] == 1`` marks nodes whose freezing ends the march; a
-        1-element array when unused.
-    n_stop : int
-        Number of marked nodes not frozen yet (0 = march until the band is empty).
+    stop_cells : ndarray, int, shape (m, 3)
+        Nodes whose freezing ends the march (all of them frozen: stop); ``m = 0``
+        marches until the band is empty. Nodes frozen in ``start`` do not count.
+    lean : bool, optional
+        Use the lean layout (see :data:`LEAN_NODES`); default: for grids of more
+        than ``LEAN_NODES`` padded nodes.
 
     Returns
     -------
-    int
+    T : ndarray, float64, shape (nx*ny*nz,)
+        Arrival time [s] of every frozen node, ``inf`` elsewhere (in the lean
+        layout a view of the march's time buffer).
+    frozen : int
         Number of nodes frozen by the march.
     """
     nx, ny, nz = (int(n) for n in shape3)
@@ -734,22 +832,21 @@ def march(speed, T, state, shape3, h3, order, stop_mask, n_stop):
             f"grid {tuple(shape3)} has {npad} nodes with its ghost layer, more than the "
             f"Fast Marching's {MAX_NODES}; use a coarser spacing or split the map"
         )
-    Tp, Vp = _work_pair(npad)
-    pad_grid(_readonly(speed), T, state, nx, ny, nz, Tp, Vp)
-    if n_stop > 0:
-        stop = np.zeros(npad, dtype=np.uint8)
-        idx = np.flatnonzero(stop_mask)
-        i, j, k = np.unravel_index(idx, (nx, ny, nz))
-        if two:
-            stop[(i + 1) * (ny + 2) + j + 1] = 1
-        else:
-            stop[((i + 1) * (ny + 2) + j + 1) * (nz + 2) + k + 1] = 1
+    if lean is None:
+        lean = npad > LEAN_NODES
+    if lean:  # two plain mappings: V goes as soon as the march is done
+        Tp = _work(8 * npad).view(np.float64)
+        Vp = _work(4 * npad).view(np.float32)
     else:
-        stop = np.zeros(1, dtype=np.uint8)
+        Tp, Vp = _work_pair(npad)
+    pad_grid(_readonly(speed), start.T, start.state, *start.lo, *start.shape, nx, ny, nz,
+             Tp, Vp)
+    stop, n_stop = _stop_bits(stop_cells, start, shape3, npad)
     # the pool starts at ~1/16 of the nodes (the band is a surface) and doubles
     # when the march reports that it runs low
     nblk = max(2 * RESERVE_BLOCKS, npad // (16 * BLOCK))
-    pool = _work_kept("pool", 16 * nblk * BLOCK).view(np.uint64)  # huge pages (see _work)
+    pool = (_work(16 * nblk * BLOCK) if lean else _work_kept("pool", 16 * nblk * BLOCK))
+    pool = pool.view(np.uint64)  # huge pages (see _work)
     nxt = np.empty(nblk, dtype=np.uint32)
     bk = np.empty(2 * int(_NB), dtype=np.uint32)
     mw = np.empty(_NW, dtype=np.uint64)
@@ -768,8 +865,33 @@ def march(speed, T, state, shape3, h3, order, stop_mask, n_stop):
         if status == 0:
             break
         pool, nxt = _grow(pool, nxt, st)
-    unpad_grid(Tp, nx, ny, nz, T)
-    return int(st[_FROZEN])
+    del Vp, pool, nxt
+    n = nx * ny * nz
+    if lean:  # in place: every node moves to a lower index, read before written
+        unpad_grid(Tp, nx, ny, nz, Tp)
+        T = Tp[:n]
+    else:
+        T = np.empty(n)
+        unpad_grid(Tp, nx, ny, nz, T)
+    return T, int(st[_FROZEN])
+
+
+def _stop_bits(stop_cells, start, shape3, npad):
+    """The stop nodes as a bit mask over the padded grid, and how many are not frozen yet."""
+    cells = np.asarray(stop_cells, dtype=np.int64).reshape(-1, 3)
+    cells = cells[~start.frozen_at(cells)]
+    if len(cells) == 0:
+        return np.zeros(1, dtype=np.uint8), 0
+    _, ny, nz = (int(n) for n in shape3)
+    i, j, k = cells.T
+    if nz == 1:
+        c = (i + 1) * (ny + 2) + j + 1
+    else:
+        c = ((i + 1) * (ny + 2) + j + 1) * (nz + 2) + k + 1
+    c = np.unique(c)
+    bits = np.zeros(npad // 8 + 1, dtype=np.uint8)
+    np.bitwise_or.at(bits, c >> 3, (1 << (c & 7)).astype(np.uint8))
+    return bits, len(c)
 
 
 def _work(nbytes):

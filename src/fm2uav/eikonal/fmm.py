@@ -188,32 +188,56 @@ def fast_marching(
     src3[:, : v.ndim] = src
 
     flat_speed = v.reshape(-1)
-    T = np.full(flat_speed.size, np.inf)
-    state = np.zeros(flat_speed.size, dtype=np.uint8)
     extent = max((n - 1) * hk for n, hk in zip(shape, h))
     radius = max(SOURCE_INIT_CELLS * max(h), SOURCE_INIT_FRACTION * extent)
     if src.shape[0] > MAX_BALL_SOURCES or not source_ball:
         radius = 0.0
-    # source ball: exact straight-ray times for a constant speed, the factored
-    # eikonal equation on the ball's box otherwise (docs/eikonal.md)
+    start = _source_start(v, src3, shape3, h3, radius, SOURCE_INIT_CELLS * max(h))
+    return run_march(flat_speed, start, shape, h3, order, stop_at)
+
+
+def _source_start(v: np.ndarray, src3: np.ndarray, shape3: tuple[int, ...],
+                  h3: tuple[float, float, float], radius: float,
+                  min_radius: float) -> _kernels.Start:
+    """The march's start: the sources and their balls, on the box that holds them all.
+
+    The source ball (exact straight-ray times for a constant speed, the factored
+    eikonal equation on the ball's box otherwise, docs/eikonal.md) is computed on
+    a copy of that box only, so a single source costs memory for its ball, not
+    for the grid.
+    """
+    reach = np.zeros(3, dtype=np.int64)
+    if radius > 0:
+        reach[:] = [int(np.floor(radius / hk)) for hk in h3]
+        if shape3[2] == 1:
+            reach[2] = 0
+    dims = np.asarray(shape3)
+    lo = np.maximum(src3.min(axis=0) - reach, 0)
+    hi = np.minimum(src3.max(axis=0) + reach, dims - 1) + 1
+    box = tuple(slice(a, b) for a, b in zip(lo, hi))
+    bshape = tuple(int(n) for n in hi - lo)
+    if bshape == tuple(shape3):  # sources all over the grid: no copy
+        speed_box = v.reshape(-1)
+    else:
+        speed_box = np.ascontiguousarray(v.reshape(shape3)[box]).reshape(-1)
+    T = np.full(speed_box.size, np.inf)
+    state = np.zeros(speed_box.size, dtype=np.uint8)
     _sources.init_sources(
-        flat_speed, T, state, *shape3, *h3, src3, radius, SOURCE_INIT_CELLS * max(h),
+        _kernels._readonly(speed_box), T, state, *bshape, *h3, src3 - lo, radius, min_radius,
         BALL_MAX_SPEED_RATIO,
     )
-
-    return run_march(flat_speed, T, state, shape, h3, order, stop_at)
+    return _kernels.Start(tuple(int(a) for a in lo), bshape, T, state)
 
 
 def run_march(
     flat_speed: np.ndarray,
-    T: np.ndarray,
-    state: np.ndarray,
+    start: _kernels.Start,
     shape: tuple[int, ...],
     h3: tuple[float, float, float],
     order: int,
     stop_at: Any,
 ) -> np.ndarray:
-    """March from the frozen/band nodes of ``state`` (in place on ``T``).
+    """March from the frozen/band nodes of ``start`` (a :class:`~fm2uav.eikonal._kernels.Start`).
 
     Shared by :func:`fast_marching` and :func:`fm2uav.eikonal.restart.remarch`:
     nodes frozen on entry (state 2) are expanded first, band nodes (state 1)
@@ -222,20 +246,15 @@ def run_march(
     Returns
     -------
     ndarray
-        ``T`` reshaped to ``shape``.
+        Arrival times, shape ``shape``.
     """
     shape3 = shape + (1,) * (3 - len(shape))
+    stops = np.zeros((0, 3), dtype=np.int64)
     if stop_at is not None:
-        stops = as_index_array(stop_at, shape, "stop_at")
-        stop_mask = np.zeros(flat_speed.size, dtype=np.uint8)
-        stop_mask[np.ravel_multi_index(tuple(stops.T), shape)] = 1
-        n_stop = int(np.count_nonzero(stop_mask & (state != _kernels.FROZEN)))
-        if n_stop == 0:  # every stop node is frozen already (a source or its ball)
-            T[state != _kernels.FROZEN] = np.inf
-            return T.reshape(shape)
-    else:
-        stop_mask = np.zeros(1, dtype=np.uint8)
-        n_stop = 0
-
-    _kernels.march(flat_speed, T, state, shape3, h3, order, stop_mask, n_stop)
+        idx = as_index_array(stop_at, shape, "stop_at")
+        stops = np.zeros((idx.shape[0], 3), dtype=np.int64)
+        stops[:, : len(shape)] = idx
+        if start.frozen_at(stops).all():  # every stop node is a source or in its ball
+            return start.frozen_times(shape3).reshape(shape)
+    T, _ = _kernels.march(flat_speed, start, shape3, h3, order, stops)
     return T.reshape(shape)

@@ -98,7 +98,9 @@ def remarch(
     T = np.where(keep, prev, np.inf).reshape(-1)
     state = np.where(keep.reshape(-1), _kernels.FROZEN, 0).astype(np.uint8)
     h3 = h + (1.0,) * (3 - v.ndim)
-    return run_march(v.reshape(-1), T, state, shape, h3, order, stop_at)
+    shape3 = shape + (1,) * (3 - v.ndim)
+    return run_march(v.reshape(-1), _kernels.Start.whole(T, state, shape3), shape, h3, order,
+                     stop_at)
 
 
 def unaffected(previous: np.ndarray, changed: np.ndarray) -> np.ndarray:

@@ -10,7 +10,8 @@ two processes at once (see :mod:`fm2uav.__main__`)::
     python -m fm2uav.planning.warmup fmm3d_o2   # one group
 
 Groups: ``edt`` (distance map), ``fmm{2,3}d_o{1,2}`` (Fast Marching, one
-dimension and order), ``descent`` (geodesic extraction), ``surface``
+dimension and order), ``fmm3d_o{1,2}_lean`` (the 3D march of big grids, see
+``fm2uav.eikonal._kernels.LEAN_NODES``), ``descent`` (geodesic extraction), ``surface``
 (continuous clearance to a terrain surface). Numbers: docs/performance.md.
 """
 
@@ -22,7 +23,7 @@ from collections.abc import Callable, Iterable
 
 import numpy as np
 
-from ..eikonal import distance_map, fast_marching
+from ..eikonal import _kernels, distance_map, fast_marching
 from ..world import World
 from ..world.clearance import surface_clearance
 from .geodesic import descend
@@ -39,6 +40,18 @@ def _edt() -> None:
 def _fmm(ndim: int, order: int) -> Callable[[], None]:
     def run() -> None:
         fast_marching(np.ones((5,) * ndim), [(2,) * ndim], order=order)
+
+    return run
+
+
+def _fmm_lean(order: int) -> Callable[[], None]:
+    """The 3D march in the lean layout of grids over ``LEAN_NODES`` nodes (float32 V)."""
+    def run() -> None:
+        T = np.full(125, np.inf)
+        state = np.zeros(125, dtype=np.uint8)
+        T[62], state[62] = 0.0, _kernels.FROZEN
+        _kernels.march(np.ones(125), _kernels.Start.whole(T, state, (5, 5, 5)), (5, 5, 5),
+                       (1.0, 1.0, 1.0), order, np.zeros((0, 3), dtype=np.int64), lean=True)
 
     return run
 
@@ -62,6 +75,8 @@ GROUPS: dict[str, Callable[[], None]] = {
     "fmm2d_o2": _fmm(2, 2),
     "fmm3d_o1": _fmm(3, 1),
     "fmm3d_o2": _fmm(3, 2),
+    "fmm3d_o1_lean": _fmm_lean(1),
+    "fmm3d_o2_lean": _fmm_lean(2),
     "descent": _descent,
     "surface": _surface,
 }
