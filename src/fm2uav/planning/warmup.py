@@ -10,9 +10,11 @@ two processes at once (see :mod:`fm2uav.__main__`)::
     python -m fm2uav.planning.warmup fmm3d_o2   # one group
 
 Groups: ``edt`` (distance map), ``fmm{2,3}d_o{1,2}`` (Fast Marching, one
-dimension and order), ``fmm3d_o{1,2}_lean`` (the 3D march of big grids, see
-``fm2uav.eikonal._kernels.LEAN_NODES``), ``descent`` (geodesic extraction), ``surface``
-(continuous clearance to a terrain surface). Numbers: docs/performance.md.
+dimension and order), ``descent`` (geodesic extraction), ``surface``
+(continuous clearance to a terrain surface), and two of big grids only, which
+call their kernels directly: ``edt_parallel`` (the distance map's lines in
+parallel) and ``fmm3d_o{1,2}_lean`` (the 3D march in the lean layout, see
+``fm2uav.eikonal._kernels.LEAN_NODES``). Numbers: docs/performance.md.
 """
 
 from __future__ import annotations
@@ -35,6 +37,13 @@ def _edt() -> None:
     occ = np.zeros((4, 4, 4), dtype=bool)
     occ[0, 0, 0] = True
     distance_map(occ, spacing=1.0)
+
+
+def _edt_parallel() -> None:
+    """The distance transform of big grids (lines in parallel)."""
+    occ = np.zeros((4, 4, 4), dtype=bool)
+    occ[0, 0, 0] = True
+    _kernels._squared_edt_parallel(_kernels._readonly(occ), 1.0, 1.0, 1.0)
 
 
 def _fmm(ndim: int, order: int) -> Callable[[], None]:
@@ -71,6 +80,7 @@ def _surface() -> None:
 #: Group name -> what it runs.
 GROUPS: dict[str, Callable[[], None]] = {
     "edt": _edt,
+    "edt_parallel": _edt_parallel,
     "fmm2d_o1": _fmm(2, 1),
     "fmm2d_o2": _fmm(2, 2),
     "fmm3d_o1": _fmm(3, 1),

@@ -1,0 +1,61 @@
+"""The warm-up groups fill numba's cache with exactly the specialisations later runs use."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from fm2uav.planning import warmup
+
+_LATER_RUN = textwrap.dedent(
+    """
+    import numpy as np
+    from fm2uav import _jit
+    compiled = []
+    _jit.on_first_compile(lambda: compiled.append(1))
+    from fm2uav.eikonal import _kernels, distance_map, fast_marching
+    _kernels.LEAN_NODES = 0          # a big grid's march, on a small one
+    _kernels.EDT_PARALLEL_MIN_NODES = 0
+    rng = np.random.default_rng(0)
+    occ = rng.random((30, 20, 10)) < 0.05
+    occ[0, 0, 0] = True
+    W = distance_map(occ, spacing=(15.0, 15.0, 10.0))
+    T = fast_marching(W / W.max() + 0.01, [(29, 19, 9)], spacing=(15.0, 15.0, 10.0),
+                      stop_at=[(0, 0, 1)])
+    assert np.isfinite(T[0, 0, 1])
+    print("compiled" if compiled else "cached")
+    """
+)
+
+
+def _run(args, cache):
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(cache)}
+    return subprocess.run([sys.executable, *args], capture_output=True, text=True, env=env,
+                          timeout=600)
+
+
+@pytest.mark.slow
+def test_big_grid_groups_cache_what_a_big_plan_compiles(tmp_path):
+    # the groups a big plan needs beyond the small ones: after them a big-grid
+    # march and distance map (forced on a small grid) compile nothing
+    groups = ["edt", "edt_parallel", "fmm3d_o2", "fmm3d_o2_lean"]
+    res = _run(["-m", "fm2uav.planning.warmup", *groups], tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert [line.split(":")[0] for line in res.stdout.splitlines()] == groups
+    res = _run(["-c", _LATER_RUN], tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.split() == ["cached"]
+    # and without the big-grid groups the same run compiles (the check can fail)
+    res = _run(["-m", "fm2uav.planning.warmup", "edt", "fmm3d_o2"], tmp_path / "small")
+    assert res.returncode == 0, res.stderr
+    assert _run(["-c", _LATER_RUN], tmp_path / "small").stdout.split() == ["compiled"]
+
+
+def test_unknown_group_is_refused_with_the_known_names(capsys):
+    assert warmup.main(["fmm9d"]) == 2
+    err = capsys.readouterr().err
+    assert "fmm9d" in err and "fmm3d_o2_lean" in err and "edt_parallel" in err
