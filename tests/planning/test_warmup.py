@@ -59,3 +59,12 @@ def test_unknown_group_is_refused_with_the_known_names(capsys):
     assert warmup.main(["fmm9d"]) == 2
     err = capsys.readouterr().err
     assert "fmm9d" in err and "fmm3d_o2_lean" in err and "edt_parallel" in err
+
+
+def test_the_command_line_child_compiles_the_first_plan_child_groups():
+    # fm2uav.__main__ names the child's group without importing the warm-up
+    from fm2uav import __main__ as entry
+
+    assert (entry._fmm_group(["plan"]),) == warmup.FIRST_PLAN_CHILD
+    assert not set(warmup.FIRST_PLAN_CHILD) & set(warmup.FIRST_PLAN_MAIN)
+    assert set(warmup.FIRST_PLAN_CHILD + warmup.FIRST_PLAN_MAIN) <= set(warmup.GROUPS)

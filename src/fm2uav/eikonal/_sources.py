@@ -199,24 +199,37 @@ def factored_box(sb, bx, by, bz, li, lj, lk, hx, hy, hz):
         Arrival time [s] of every box node (0 at the source).
     """
     n = bx * by * bz
-    dims = np.array([bx, by, bz], dtype=np.int64)
-    strides = np.array([by * bz, bz, 1], dtype=np.int64)
-    h = np.array([hx, hy, hz])
-    lsrc = np.array([li, lj, lk], dtype=np.int64)
-    tb = np.full(n, _INF)
-    tau = np.ones(n)
-    st = np.zeros(n, dtype=np.uint8)
+    # every array from np.empty with one of three dtypes: each distinct numpy
+    # constructor call (np.full, np.ones, np.array of a list, ...) compiles its
+    # own overload on first use (~0.1 s each)
+    three = np.int64(3)
+    dims = np.empty(three, dtype=np.int64)
+    strides = np.empty(three, dtype=np.int64)
+    h = np.empty(three, dtype=np.float64)
+    lsrc = np.empty(three, dtype=np.int64)
+    dims[0], dims[1], dims[2] = bx, by, bz
+    strides[0], strides[1], strides[2] = by * bz, bz, 1
+    h[0], h[1], h[2] = hx, hy, hz
+    lsrc[0], lsrc[1], lsrc[2] = li, lj, lk
+    tb = np.empty(n, dtype=np.float64)
+    tau = np.empty(n, dtype=np.float64)
+    st = np.empty(n, dtype=np.uint8)
     heap = np.empty(n, dtype=np.int64)
-    key = np.empty(n)
-    pos = np.full(n, -1, dtype=np.int64)
-    coord = np.empty(3, dtype=np.int64)
-    ncoord = np.empty(3, dtype=np.int64)
-    x = np.empty(3)
-    alpha = np.empty(3)
-    beta = np.empty(3)
-    sgn = np.empty(3)
-    tnb = np.empty(3)
-    hnb = np.empty(3)
+    key = np.empty(n, dtype=np.float64)
+    pos = np.empty(n, dtype=np.int64)
+    for c in range(n):
+        tb[c] = _INF
+        tau[c] = 1.0
+        st[c] = 0
+        pos[c] = -1
+    coord = np.empty(three, dtype=np.int64)
+    ncoord = np.empty(three, dtype=np.int64)
+    x = np.empty(three, dtype=np.float64)
+    alpha = np.empty(three, dtype=np.float64)
+    beta = np.empty(three, dtype=np.float64)
+    sgn = np.empty(three, dtype=np.float64)
+    tnb = np.empty(three, dtype=np.float64)
+    hnb = np.empty(three, dtype=np.float64)
     ss = 1.0 / sb[li * strides[0] + lj * strides[1] + lk]
     cs = li * strides[0] + lj * strides[1] + lk
     tb[cs] = 0.0
@@ -315,10 +328,13 @@ def init_sources(speed, T, state, nx, ny, nz, hx, hy, hz, src, radius, min_radiu
         return
     # each source's radius: the largest of radius, radius/2, ..., min_radius whose
     # box is clean (speeds > 0, max/min <= max_ratio); none: not clean
-    clean = np.ones(m, dtype=np.uint8)
-    constant = np.zeros(m, dtype=np.uint8)
-    rad = np.empty(m)
-    reach = np.zeros((m, 3), dtype=np.int64)
+    clean = np.empty(m, dtype=np.uint8)  # np.empty only: see factored_box
+    constant = np.empty(m, dtype=np.uint8)
+    rad = np.empty(m, dtype=np.float64)
+    reach = np.empty(m * 3, dtype=np.int64).reshape(m, 3)
+    for s in range(m):
+        clean[s] = 1
+        constant[s] = 0
     for s in range(m):
         r = radius
         ri = rj = rk = 0
@@ -355,9 +371,9 @@ def init_sources(speed, T, state, nx, ny, nz, hx, hy, hz, src, radius, min_radiu
         j0, j1 = max(sj - reach[s, 1], 0), min(sj + reach[s, 1], ny - 1)
         k0, k1 = max(sk - reach[s, 2], 0), min(sk + reach[s, 2], nz - 1)
         bx, by, bz = i1 - i0 + 1, j1 - j0 + 1, k1 - k0 + 1
-        tb = np.empty(0)
+        tb = np.empty(np.int64(0), dtype=np.float64)
         if constant[s] == 0:
-            sb = np.empty(bx * by * bz)
+            sb = np.empty(bx * by * bz, dtype=np.float64)
             for i in range(i0, i1 + 1):
                 for j in range(j0, j1 + 1):
                     for k in range(k0, k1 + 1):
