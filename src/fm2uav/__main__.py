@@ -1,88 +1,119 @@
 """Entry point of the ``fm2uav`` command (console script and ``python -m fm2uav``).
 
-It speaks before the heavy imports (numba, scipy, matplotlib: ~1-2 s): on a
-cold numba cache ``fm2uav plan`` / ``fm2uav run`` print "compiling kernels,
-first use only, ~N s" at once, and ``fm2uav plan`` compiles its kernels in two
-processes (the Fast Marching kernels in a child, the rest here) before
-planning, which halves the first run on a 2-core machine. The command line
-proper is :mod:`fm2uav.cli`.
+The first instructions make the process safe to stop and to print, before any
+import that takes time:
+
+* **stop signals from the first instruction**: SIGINT (Ctrl-C), SIGTERM and
+  SIGHUP raise at once; outside a command (start-up, argument parsing) the run
+  ends with one line and exit code 130, never a traceback. While a command runs
+  its own handlers take over (:func:`fm2uav.io.outdir.interrupt_signals`: the
+  output set is removed, the previous one kept, exit 130);
+* **any output encoding**: text that stdout/stderr cannot encode (``LANG=C``
+  without UTF-8, ``PYTHONIOENCODING=ascii``) is replaced instead of ending the
+  run; a closed pipe (``fm2uav --help | head -1``) ends it quietly.
+
+The command line proper is :mod:`fm2uav.cli`, which imports only typer and
+rich: ``fm2uav --help``, ``fm2uav plan --help`` and a bad flag answer without
+numba, scipy or matplotlib (docs/architecture.md, "The command line stays
+light"). The compile notice and the two-process warm-up of a first ``fm2uav
+plan`` on a cold numba cache run once the arguments are parsed
+(:mod:`fm2uav.cli._first_use`).
 """
 
 from __future__ import annotations
 
 import os
-import subprocess
+import signal
 import sys
 
-#: Commands whose first run compiles kernels (the notice is shown up front).
-_COMPILING_COMMANDS = ("plan", "run")
+#: Signals that stop the command line (exit code 130).
+_STOP_SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP")
 
 
-def _option(argv: list[str], name: str) -> str | None:
-    """Value of ``--name VALUE`` or ``--name=VALUE`` in ``argv`` (last wins)."""
-    value = None
-    for i, a in enumerate(argv):
-        if a == name and i + 1 < len(argv):
-            value = argv[i + 1]
-        elif a.startswith(name + "="):
-            value = a.split("=", 1)[1]
-    return value
+class StartupStop(KeyboardInterrupt):
+    """A stop signal outside a command (start-up, argument parsing, the end)."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
 
 
-def _fmm_group(argv: list[str]) -> str:
-    """The Fast Marching warm-up group a ``fm2uav plan`` command line will use."""
-    order = "1" if _option(argv, "--order") == "1" else "2"
-    ndim = "2" if _option(argv, "--scenario") == "city2d" else "3"
-    return f"fmm{ndim}d_o{order}"
+def _stop(signum: int, frame: object) -> None:  # noqa: ARG001
+    raise StartupStop(signum)
 
 
-def _spawn(groups: list[str]) -> subprocess.Popen | None:
-    """Start ``python -m fm2uav.planning.warmup GROUPS`` in the background (None if it cannot)."""
+def install_stop_signals() -> None:
+    """SIGINT / SIGTERM / SIGHUP raise :class:`StartupStop` (a KeyboardInterrupt).
+
+    A signal the parent shell ignores (``nohup``: SIGHUP; a background job:
+    SIGINT) stays ignored.
+    """
+    for name in _STOP_SIGNALS:
+        sig = getattr(signal, name, None)
+        if sig is None:
+            continue
+        try:
+            if signal.getsignal(sig) is signal.SIG_IGN:
+                continue
+            signal.signal(sig, _stop)
+        except (ValueError, OSError):  # not the main thread, or an exotic platform
+            pass
+
+
+def _printable_streams() -> None:
+    """Replace what stdout/stderr cannot encode instead of failing on it (ASCII locales)."""
+    for stream in (sys.stdout, sys.stderr):
+        encoding = (getattr(stream, "encoding", None) or "").lower().replace("-", "")
+        if encoding != "utf8" and hasattr(stream, "reconfigure"):
+            try:
+                stream.reconfigure(errors="replace" if stream is sys.stdout
+                                   else "backslashreplace")
+            except (ValueError, OSError):  # pragma: no cover - a detached stream
+                pass
+
+
+def _stopped(signum: int) -> int:
+    for sig_name in _STOP_SIGNALS:  # a second signal while reporting the first: no traceback
+        try:
+            signal.signal(getattr(signal, sig_name), signal.SIG_IGN)
+        except (AttributeError, ValueError, OSError):
+            pass
+    name = {int(getattr(signal, n)): n for n in _STOP_SIGNALS if hasattr(signal, n)}.get(
+        signum, f"signal {signum}")
+    what = "SIGINT (Ctrl-C)" if name == "SIGINT" else name
     try:
-        return subprocess.Popen(
-            [sys.executable, "-m", "fm2uav.planning.warmup", *groups],
-            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-            env=os.environ.copy(),
-        )
-    except OSError:  # no fork / exec: the command compiles everything itself
-        return None
+        sys.stderr.write(f"error: interrupted by {what}; nothing was written\n")
+        sys.stderr.flush()
+    except (OSError, ValueError):
+        pass
+    return 130
+
+
+def _quiet_broken_pipe() -> int:
+    """The reader of stdout went away: stop writing, without a traceback."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+    return 141  # 128 + SIGPIPE, as a shell reports a process killed by it
 
 
 def main() -> None:
     """Run the ``fm2uav`` command line."""
-    argv = sys.argv[1:]
-    command = argv[0] if argv else ""
-    child = None
-    cold = False
-    if command in _COMPILING_COMMANDS and not {"--help", "-h"} & set(argv):
-        from . import _jit
+    install_stop_signals()  # the first instruction: no traceback for Ctrl-C from here on
+    try:
+        _printable_streams()
+        from .cli import main as cli_main
 
-        cold = _jit.likely_cold()
-        if cold:
-            _jit.mark_announced()  # the numba-event fallback stays silent
-            if "--quiet" not in argv:
-                from rich.console import Console
-
-                Console(stderr=True).print(
-                    f"compiling kernels, first use only, ~{_jit.cold_estimate_s()} s",
-                    style="yellow", highlight=False)
-            if command == "plan":
-                child = _spawn([_fmm_group(argv)])
-    if child is not None:
-        from .planning.warmup import FIRST_PLAN_MAIN, warm
-
-        try:
-            warm(FIRST_PLAN_MAIN)
-        except Exception:  # a warm-up failure only costs time: the plan compiles what it needs
-            pass
-    from .cli import main as cli_main  # matplotlib & co. while the child finishes
-
-    if child is not None:
-        try:
-            child.wait(timeout=600)
-        except subprocess.TimeoutExpired:  # stuck: plan anyway (numba compiles what is missing)
-            pass
-    cli_main()
+        cli_main()
+    except KeyboardInterrupt as exc:  # start-up or argument parsing (a command reports its own)
+        code = _stopped(getattr(exc, "signum", signal.SIGINT))
+    except BrokenPipeError:
+        code = _quiet_broken_pipe()
+    else:  # pragma: no cover - cli_main always exits
+        code = 0
+    sys.exit(code)
 
 
 if __name__ == "__main__":

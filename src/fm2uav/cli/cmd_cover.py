@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import numpy as np
 import typer
 
 from ..errors import InputError
 from ._common import (
     Output,
-    OutputDir,
     handle_errors,
     write_figure,
     write_json,
@@ -28,6 +27,9 @@ from .options import (
     world_options,
     world_rows,
 )
+
+if TYPE_CHECKING:
+    from ..io.outdir import OutputDir
 
 #: Mission files of a coverage flight (written by fm2uav.io.export_mission).
 COVER_EXPORTS = ("csv", "plan", "wpl", "kml", "kmz", "geojson")
@@ -98,6 +100,8 @@ def _write_cover_outputs(outdir: OutputDir, cp, area: str, *, report: bool, titl
     """The mission files (path.csv, mission.plan, .waypoints, KML/KMZ, GeoJSON), zigzag.csv,
     PNGs, coverage.html and report.html; returns ``(built mission, safety figures)`` (the
     no-fly zones of the world go into the .plan geoFence)."""
+    import numpy as np
+
     from ..io import write_path_csv
     from ..viz.coverage import bands_figure, coverage_figure, coverage_html
     from .cmd_run import write_exports
@@ -244,6 +248,8 @@ def cover_cmd(
     safety: SafetyFlags = None,
 ) -> None:
     """``fm2uav cover``: parse, :func:`~fm2uav.missions.coverage.plan_coverage`, write, print."""
+    import numpy as np
+
     from ..missions.coverage import FULL_BOUNDS_DEG, plan_coverage
     from ..missions.coverage.triggers import camera_plan
     from ..world.load import world_summary
@@ -285,6 +291,8 @@ def cover_cmd(
 
 def _cover_rows(area: str, d: float, cp, mission, world) -> dict:
     """The printed summary of ``fm2uav cover``."""
+    import numpy as np
+
     from .cmd_run import mission_rows
 
     return {

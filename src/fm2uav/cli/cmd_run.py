@@ -8,16 +8,12 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
 import typer
 
-from ..io.exports import EXPORT_FILES
-from ..viz.overlays import zone_overlays  # noqa: F401  (re-exported: was defined here)
 from ._common import (
     Output,
-    OutputDir,
     handle_errors,
     plan_rows,
     write_figure,
@@ -26,6 +22,7 @@ from ._common import (
 )
 from ._mission_options import via_points
 from .options import (
+    MISSION_FLAGS,
     LonLatOpt,
     MissionFlags,
     WorldFlags,
@@ -36,8 +33,12 @@ from .options import (
     world_rows,
 )
 
-#: Output format → file name, for every format a command can write.
-OUTPUT_FILES = {**EXPORT_FILES, "html": "report.html", "png": "plan.png", "json": "summary.json"}
+if TYPE_CHECKING:
+    from ..io.outdir import OutputDir
+
+#: Output formats a plan writes beside the exports (:data:`fm2uav.io.exports.EXPORT_FILES`)
+#: → file name (:func:`output_names`).
+REPORT_FILES = {"html": "report.html", "png": "plan.png", "json": "summary.json"}
 
 
 def write_exports(outdir: OutputDir, files: dict[str, Any],
@@ -120,7 +121,10 @@ def _with_cli_zones(rm: Any, files: Sequence[Path]) -> Any:
 
 def output_names(formats: Sequence[str]) -> list[str]:
     """File names of the given output formats (for ``OutputDir.check``)."""
-    return [OUTPUT_FILES[f] for f in formats]
+    from ..io.exports import EXPORT_FILES
+
+    files = {**EXPORT_FILES, **REPORT_FILES}
+    return [files[f] for f in formats]
 
 
 def plan_outputs(
@@ -142,7 +146,7 @@ def plan_outputs(
     outdir : OutputDir
     plan : fm2uav.Plan
     formats : sequence of str
-        Keys of :data:`OUTPUT_FILES`.
+        Keys of :data:`fm2uav.io.exports.EXPORT_FILES` and :data:`REPORT_FILES`.
     options : fm2uav.io.ExportOptions
         Waypoint thinning, frame, anchor, airframe.
     title, subtitle : str
@@ -160,7 +164,7 @@ def plan_outputs(
         The built mission.
     """
     from ..analysis.safety import safety_summary
-    from ..io import export_mission
+    from ..io import EXPORT_FILES, export_mission
     from ..io.fence import zone_fences
 
     exports = [f for f in formats if f in EXPORT_FILES]
@@ -214,7 +218,9 @@ def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
                  fence_warnings: list[str]) -> str:
     """report.html of a plan and its autopilot mission's waypoints ``wps`` (see
     :func:`plan_outputs`)."""
-    from ..viz.overlays import filled_overlay
+    import numpy as np
+
+    from ..viz.overlays import filled_overlay, zone_overlays
     from ..viz.report import report_html
 
     ms, level = info["autopilot"], getattr(plan, "level", None)
@@ -266,8 +272,7 @@ RUN_HELP = (
 @output_options(None, out_help="Output directory. Default: the mission's outputs.dir, else "
                 "out/<mission file name>.")
 @world_options
-@mission_options("via", "return_to_start", "firmware", "vehicle", "frame", "end",
-                 "speed_changes", "endurance", "reserve")
+@mission_options(*MISSION_FLAGS, "thin", "anchor")
 def run_cmd(
     mission_file: Path = typer.Argument(..., help="Mission YAML file.", show_default=False),
     output: Output = None,
