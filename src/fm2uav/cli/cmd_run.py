@@ -301,7 +301,11 @@ def run_cmd(
 ) -> None:
     """``fm2uav run``: load the mission file (with the flags' overrides),
     :func:`~fm2uav.missions.route.plan_route`, :func:`plan_outputs`, print."""
+    from .._validate import input_file
+
+    input_file(mission_file, "")  # a missing mission file is refused before the heavy imports
     from ..io.mission import load_mission
+
     from ..missions.route import plan_route
     from ..planning.params import planner_objects
     from ..world.load import world_summary
