@@ -176,3 +176,26 @@ def test_a_damaged_cache_without_rerun_says_how(tmp_path):
     assert res.returncode == 2 and "Traceback" not in res.stderr, res.stderr
     assert "deleted its" in res.stderr and "run the command again" in res.stderr
     assert _run(script, NUMBA_CACHE_DIR=str(cache)).returncode == 0  # it was deleted
+
+
+def test_an_error_names_only_the_flags_of_the_command_that_raised_it():
+    import typer
+
+    from fm2uav.cli._common import handle_errors
+    from fm2uav.errors import InputError
+
+    mini = typer.Typer()
+
+    @mini.command()
+    @handle_errors
+    def main(ceiling: float = typer.Option(0.0, "--ceiling")) -> None:
+        raise InputError("the flight level leaves the map; lower it or build a taller world "
+                         "(mission file planner.agl / world.ceiling; CLI --agl / --ceiling); "
+                         "crop with world.bbox (CLI --bbox W,S,E,N) or give --agl too")
+
+    res = runner.invoke(mini, [])
+    assert res.exit_code == 2
+    assert res.output.strip() == (
+        "error: the flight level leaves the map; lower it or build a taller world (mission "
+        "file planner.agl / world.ceiling; CLI --ceiling); crop with world.bbox or give "
+        "planner.agl too")

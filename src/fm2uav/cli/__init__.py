@@ -11,7 +11,7 @@ top only the standard library, typer, rich, :mod:`fm2uav.errors` and the
 light modules of this package (``_common``, ``options``, ``_mission_options``,
 other ``cmd_*``); numpy, numba, scipy, matplotlib, the geodata libraries and the
 rest of fm2uav are imported inside the command's function, by the code path
-that needs them (tests/cli/test_light.py walks every ``cmd_*`` module).
+that needs them (tests/cli/test_init.py checks every ``cli/*.py`` module).
 """
 
 from __future__ import annotations

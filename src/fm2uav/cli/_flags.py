@@ -61,7 +61,9 @@ FLAG_KEYS = {
     # outputs
     "--out": "outputs.dir", "--frame": "outputs.frame", "--end": "outputs.end",
     "--speed-changes": "outputs.speed_changes", "--thin": "outputs.thin_tolerance",
+    "--format": "outputs.formats",
 }
+
 
 _PAREN = re.compile(r"\s*\(([^()]*)\)")
 # the separator before a flag in a list of flags (each item: a flag and its value words)

@@ -23,7 +23,7 @@ from ._common import (
 from ._mission_options import via_points
 from .options import (
     MISSION_FLAGS,
-    LonLatOpt,
+
     MissionFlags,
     WorldFlags,
     mission_options,
@@ -281,7 +281,9 @@ def run_cmd(
         "degrees, metres above ground), else x,y,z metres."),
     goal: str | None = typer.Option(
         None, help="Override the mission's goal (as --start)."),
-    lonlat: LonLatOpt = False,
+    lonlat: bool = typer.Option(
+        False, "--lonlat", help="Read --start/--goal as LON,LAT,AGL (degrees, degrees, metres "
+        "above the ground)."),
     world: WorldFlags = None,
     mission: MissionFlags = None,
     no_fly: list[Path] | None = typer.Option(

@@ -89,7 +89,8 @@ def zone_route_points(world: Any, track: np.ndarray, spacing: float, agl: float,
               if g.geom_type == "LineString" and not g.is_empty and g.length > 0]
     if not pieces:
         raise InputError("the whole zigzag lies in no-fly zones (or outside the operating "
-                            "area); check --no-fly / no_fly_zones against --area")
+                         "area); check the no-fly zones (no_fly_zones / --no-fly) against the "
+                         "survey area (--area)")
     pieces.sort(key=lambda g: line.project(shapely.Point(g.coords[0])))
     cell = float(min(world.spacing[0], world.spacing[1]))
     pts: list[np.ndarray] = []
@@ -124,7 +125,9 @@ def plan_zone_route(world: Any, track: np.ndarray, spacing: float, level: Flight
     pts = zone_route_points(world, track, spacing, level.agl, margin)
     if len(pts) < 2:
         raise InputError("less than one band of the zigzag lies outside the no-fly zones; "
-                            "nothing to cover (check --no-fly / no_fly_zones against --area)")
+                         "nothing to cover: check the no-fly zones (no_fly_zones / --no-fly) "
+                         "against the survey area (--area)")
+
     return plan_route(world, pts[0], pts[-1], via=list(pts[1:-1]),
                       shaping=Shaping() if shaping is None else shaping, level=level,
                       options=options)
