@@ -12,12 +12,16 @@ import that takes time:
   without UTF-8, ``PYTHONIOENCODING=ascii``) is replaced instead of ending the
   run; a closed pipe (``fm2uav --help | head -1``) ends it quietly.
 
+Then, for ``fm2uav plan`` / ``fm2uav run`` on a cold numba cache, the notice
+"compiling kernels, first use only, ~N s" (:func:`fm2uav._jit.likely_cold`: a
+few ms, numba not imported), so it is the first thing on screen; the
+compilation itself (in two processes for ``plan``) starts once the arguments
+are parsed (:mod:`fm2uav.cli._first_use`): a bad flag compiles nothing.
+
 The command line proper is :mod:`fm2uav.cli`, which imports only typer and
 rich: ``fm2uav --help``, ``fm2uav plan --help`` and a bad flag answer without
 numba, scipy or matplotlib (docs/architecture.md, "The command line stays
-light"). The compile notice and the two-process warm-up of a first ``fm2uav
-plan`` on a cold numba cache run once the arguments are parsed
-(:mod:`fm2uav.cli._first_use`).
+light").
 """
 
 from __future__ import annotations
@@ -28,6 +32,9 @@ import sys
 
 #: Signals that stop the command line (exit code 130).
 _STOP_SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP")
+
+#: Commands whose first run compiles kernels (the notice is shown before anything else).
+_COMPILING_COMMANDS = ("plan", "run")
 
 
 class StartupStop(KeyboardInterrupt):
@@ -99,12 +106,30 @@ def _quiet_broken_pipe() -> int:
     return 141  # 128 + SIGPIPE, as a shell reports a process killed by it
 
 
+def _notice_if_cold(argv: list[str]) -> None:
+    """The compile notice of a first ``plan`` / ``run`` on a cold cache, before any import."""
+    if not argv or argv[0] not in _COMPILING_COMMANDS or {"--help", "-h"} & set(argv):
+        return
+    from . import _jit
+
+    if _jit.likely_cold():
+        _jit.mark_announced()  # neither the command nor the numba-event fallback repeats it
+        if "--quiet" not in argv:
+            from rich.console import Console
+
+            Console(stderr=True).print(_jit.NOTICE.format(seconds=_jit.cold_estimate_s()),
+                                       style="yellow", highlight=False)
+
+
+
 def main() -> None:
     """Run the ``fm2uav`` command line."""
     install_stop_signals()  # the first instruction: no traceback for Ctrl-C from here on
     try:
         _printable_streams()
+        _notice_if_cold(sys.argv[1:])
         from .cli import main as cli_main
+
 
         cli_main()
     except KeyboardInterrupt as exc:  # start-up or argument parsing (a command reports its own)

@@ -38,11 +38,15 @@ from typing import Any
 __all__ = [
     "FIRST_PLAN_KERNELS",
     "COLD_FIRST_PLAN_CPU_S",
+    "NOTICE",
+
     "cache_fault",
     "clear_cache",
     "cold_estimate_s",
     "likely_cold",
+    "announced",
     "mark_announced",
+
     "on_first_compile",
 ]
 
@@ -58,6 +62,9 @@ FIRST_PLAN_KERNELS: tuple[tuple[str, str], ...] = (
     ("planning/_geodesic_kernels.py", "descend_kernel"),
     ("world/_clearance_kernels.py", "surface_distance"),
 )
+
+#: What the command line says before the first compilation (``seconds``: :func:`cold_estimate_s`).
+NOTICE = "compiling kernels, first use only, ~{seconds} s"
 
 #: CPU time [s] of a first ``fm2uav plan`` with an empty numba cache, both
 #: processes together (compilation, imports, the plan): measured 17-18 s on the
@@ -277,6 +284,12 @@ def mark_announced() -> None:
     """Record that the caller has already told the user (no second callback)."""
     global _fired
     _fired = True
+
+
+def announced() -> bool:
+    """Whether the compile notice was given in this process (:func:`mark_announced`, or a
+    callback of :func:`on_first_compile` fired)."""
+    return _fired
 
 
 def on_first_compile(callback: Callable[[], None]) -> None:

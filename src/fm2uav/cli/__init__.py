@@ -62,10 +62,10 @@ def main() -> None:
 
     from .. import _jit
     from . import _common
-    from ._first_use import NOTICE
 
     _common.RERUN_ALLOWED = True  # a damaged numba cache: rebuilt by running this again
     if "--quiet" not in sys.argv:  # numba is not imported here: the listener waits for it
         _jit.on_first_compile(lambda: _common.err_console.print(
-            NOTICE.format(seconds=_jit.cold_estimate_s()), style="yellow", highlight=False))
+            _jit.NOTICE.format(seconds=_jit.cold_estimate_s()), style="yellow",
+            highlight=False))
     app()

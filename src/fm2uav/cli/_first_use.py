@@ -21,9 +21,7 @@ import subprocess
 import sys
 from collections.abc import Sequence
 
-__all__ = ["announce_compile", "fmm_group", "NOTICE"]
-
-NOTICE = "compiling kernels, first use only, ~{seconds} s"
+__all__ = ["announce_compile", "fmm_group"]
 
 
 def fmm_group(*, order: int | str, ndim: int) -> str:
@@ -67,12 +65,12 @@ def announce_compile(*, quiet: bool = False, child_group: str | None = None,
 
     if not _jit.likely_cold():
         return False
-    _jit.mark_announced()  # the numba-event fallback stays silent
-    if not quiet:
+    if not quiet and not _jit.announced():  # (fm2uav.__main__ may have said it already)
         from ._common import err_console
 
-        err_console.print(NOTICE.format(seconds=_jit.cold_estimate_s()), style="yellow",
+        err_console.print(_jit.NOTICE.format(seconds=_jit.cold_estimate_s()), style="yellow",
                           highlight=False)
+    _jit.mark_announced()  # the numba-event fallback stays silent
     child = _spawn([child_group]) if child_group else None
     if child is None:
         return True
