@@ -42,7 +42,8 @@ LIBRARY_WARNINGS: tuple[tuple[str, str | None], ...] = (
 
 
 def library_line(origin: str, text: str) -> str | None:
-    """Our line for a library warning / log record (None: drop it), from :data:`LIBRARY_WARNINGS`."""
+    """Our line for a library warning / log record (None: drop it): :data:`LIBRARY_WARNINGS`."""
+
     key = f"{origin}: {text}"
     for pattern, ours in LIBRARY_WARNINGS:
         if re.search(pattern, key):
