@@ -1,6 +1,6 @@
 """Every mission file of a plan, from one function.
 
-:func:`export_mission` builds the mission once (:func:`fm2uav.io.build_mission`:
+:func:`export_mission` builds the mission once (:func:`fm2uav.autopilot.build_mission`:
 altitudes, takeoff, speeds, camera, end, firmware check) and returns a writer per
 requested format, so that the CLI decides where and how files are written
 (atomically, without overwriting) and all formats describe the same mission:
@@ -30,7 +30,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..geometry import path_length
-from .build import CameraPlan, ExportOptions, MissionExport, build_mission
+from ..autopilot.build import CameraPlan, ExportOptions, MissionExport, build_mission
 from .geojson import write_geojson
 from .kml import write_kml, write_kmz
 from .paths import write_path_csv
@@ -132,7 +132,7 @@ def export_mission(
     agl : float, optional
         Requested height above ground (default ``plan.params.get("agl")``).
     via, camera, fences, times, start_hold
-        See :func:`fm2uav.io.build_mission`.
+        See :func:`fm2uav.autopilot.build_mission`.
     prefix : str, optional
         Put before every file name (e.g. ``"leader_"``).
 
@@ -233,11 +233,11 @@ def export_formation(
     fences : optional
         Geofences written into every vehicle's ``.plan`` and checked against its
         waypoints (as :func:`export_mission` ``fences``), e.g. the no-fly zones of
-        :func:`fm2uav.io.fence.zone_fences`.
+        :func:`fm2uav.autopilot.fence.zone_fences`.
     """
     opt = options or ExportOptions()
     opt = replace(opt, speed_step=min(opt.speed_step, 0.1))
-    from .build import DEFAULT_CLIMB
+    from ..autopilot.build import DEFAULT_CLIMB
 
     climb = opt.climb_rate or DEFAULT_CLIMB[opt.vehicle]
     world = result.world

@@ -57,7 +57,8 @@ from pydantic import field_validator, model_validator
 from ..errors import InputError
 from ..world.load import WorldSpec as DataWorldSpec
 from ..world.load import check_points, load_world
-from .exports import EXPORT_FILES, ExportOptions
+from ..autopilot.build import ExportOptions
+from .exports import EXPORT_FILES
 from ..world.geo import DEFAULT_ANCHOR, Anchor, from_lonlat, to_lonlat
 from .zone_spec import ZoneSpec, resolve_zones
 

@@ -42,8 +42,8 @@ from typing import IO, Any
 import numpy as np
 
 from ..errors import InputError
-from .geofence import geofence_document, read_geofence
-from .items import FRAME_GLOBAL, FRAME_RELATIVE, FRAME_TERRAIN, MissionItem
+from ..autopilot.geofence import geofence_document, read_geofence
+from ..autopilot.items import FRAME_GLOBAL, FRAME_RELATIVE, FRAME_TERRAIN, MissionItem
 
 __all__ = [
     "FIRMWARE_TYPES",
@@ -91,7 +91,7 @@ def plan_document(mission: Any) -> dict[str, Any]:
     Parameters
     ----------
     mission : MissionExport
-        From :func:`fm2uav.io.build_mission` (items, home, airframe, fences).
+        From :func:`fm2uav.autopilot.build_mission` (items, home, airframe, fences).
     """
     opt = mission.options
     items = [_item_json(it, k + 1) for k, it in enumerate(mission.items)]

@@ -3,7 +3,7 @@
 :func:`build_mission` turns a dense path (a :class:`~fm2uav.Plan`, a route, a
 coverage path, one UAV of a formation) into the list of MAVLink items every
 mission file is written from, checks it with the firmware's validator
-(:func:`fm2uav.io.validate.check_mission`) and computes flight time and
+(:func:`fm2uav.autopilot.validate.check_mission`) and computes flight time and
 endurance. The items, in order:
 
 1. **Takeoff** to the start's altitude: ``NAV_VTOL_TAKEOFF`` for VTOL airframes,
@@ -96,7 +96,7 @@ class ExportOptions:
     max_points : int or None
         Cap on the number of waypoints.
     frame : {"auto", "terrain", "amsl", "relative"}
-        Altitude frame (:func:`fm2uav.io.waypoints.resolve_frame`).
+        Altitude frame (:func:`fm2uav.autopilot.waypoints.resolve_frame`).
     anchor : Anchor or None
         Placement of a world without CRS (default
         :data:`~fm2uav.world.geo.DEFAULT_ANCHOR`).
@@ -231,7 +231,7 @@ class MissionExport:
     info : dict
         Summary numbers (speed changes, camera, landing, flight time, endurance).
     fences : list
-        Geofences for the ``.plan`` (:mod:`fm2uav.io.geofence`).
+        Geofences for the ``.plan`` (:mod:`fm2uav.autopilot.geofence`).
     """
 
     items: list[MissionItem]

@@ -1,7 +1,7 @@
 """No-fly zones and the operating area of a world as QGroundControl geofences.
 
 :func:`zone_fences` turns ``World.zones`` (:mod:`fm2uav.world.zones`) into the
-fences of the ``.plan`` (:mod:`fm2uav.io.geofence`): each no-fly zone an
+fences of the ``.plan`` (:mod:`fm2uav.autopilot.geofence`): each no-fly zone an
 *exclusion* polygon (or circle, when it is one), the operating area an
 *inclusion* polygon. Fences are written as the zones are, without the
 planning buffer (the buffer is the planner's margin, the fence the boundary

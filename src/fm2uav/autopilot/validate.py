@@ -1,7 +1,7 @@
 """Mission checkers, one per autopilot firmware: what PX4 or ArduPilot would reject.
 
 :func:`validate_mission` returns the problems of a list of
-:class:`~fm2uav.io.items.MissionItem` for a firmware and airframe;
+:class:`~fm2uav.autopilot.items.MissionItem` for a firmware and airframe;
 :func:`check_mission` raises :class:`~fm2uav.errors.MissionError` on the first
 one. Every export goes through :func:`check_mission` before a file is written.
 

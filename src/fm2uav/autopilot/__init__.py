@@ -1,0 +1,56 @@
+"""The mission as the autopilot sees it: MAVLink items, firmware rules, legs, fences.
+
+:func:`build_mission` turns a planned path into the one list of MAVLink items
+(:class:`MissionItem`, :mod:`fm2uav.autopilot.items`) every mission file is
+written from: takeoff, waypoints (:mod:`~fm2uav.autopilot.waypoints`:
+altitudes per frame, Douglas–Peucker thinning in :mod:`~fm2uav.autopilot.thin`,
+straight legs checked against the world), speeds, camera triggers and the end
+(RTL / landing / loiter), checked by the firmware's validator
+(:mod:`~fm2uav.autopilot.validate`). Geofences from the world's zones:
+:mod:`~fm2uav.autopilot.geofence`. This layer computes; it reads and writes no
+file (the formats are :mod:`fm2uav.io`).
+"""
+
+from .build import ENDS, CameraPlan, ExportOptions, MissionExport, build_mission, speed_commands
+from .fence import zone_fences
+from .geofence import Fence, FenceCircle, FencePolygon, as_fences, fences_from_world
+from .items import MissionItem, command_name
+from .thin import refine_legs, thin_indices, thin_path
+from .validate import FIRMWARES, VEHICLES, Problem, check_mission, supported_commands, validate_mission
+from .waypoints import FRAMES, Waypoints, altitude_profile, mission_waypoints, resolve_frame
+
+__all__ = [
+    # building
+    "build_mission",
+    "ExportOptions",
+    "MissionExport",
+    "CameraPlan",
+    "speed_commands",
+    "ENDS",
+    # items
+    "MissionItem",
+    "command_name",
+    # waypoints and legs
+    "Waypoints",
+    "mission_waypoints",
+    "altitude_profile",
+    "resolve_frame",
+    "FRAMES",
+    "thin_path",
+    "thin_indices",
+    "refine_legs",
+    # firmware rules
+    "FIRMWARES",
+    "VEHICLES",
+    "Problem",
+    "validate_mission",
+    "check_mission",
+    "supported_commands",
+    # geofences
+    "Fence",
+    "FencePolygon",
+    "FenceCircle",
+    "fences_from_world",
+    "as_fences",
+    "zone_fences",
+]
