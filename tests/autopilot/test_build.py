@@ -21,6 +21,7 @@ from fm2uav.autopilot import (
     build_mission,
     fences_from_world,
     speed_commands,
+    start_holds,
 )
 from fm2uav.autopilot.items import END_COMMANDS, TAKEOFF_COMMANDS
 from fm2uav.autopilot.validate import validate_mission
@@ -577,3 +578,11 @@ def test_formation_missions_one_per_vehicle_leave_together_and_keep_their_timing
         assert sum(it.command == 178 for it in m.items) >= 1
     _write(files, tmp_path)
     assert read_plan(tmp_path / "follower2_mission.plan")["command"][0] == 22
+
+
+def test_start_holds_let_vehicles_armed_together_leave_together():
+    from fm2uav import World
+
+    flat = World.from_heightmap(np.zeros((5, 5)), 10.0, 10)  # ground at z = 0
+    holds = start_holds([[0.0, 0.0, 25.0], [10.0, 10.0, 10.0]], flat, ExportOptions())
+    np.testing.assert_allclose(holds, [0.0, 6.0])  # 2.5 m/s up: 10 s and 4 s of climb

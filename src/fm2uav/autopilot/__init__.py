@@ -11,11 +11,19 @@ straight legs checked against the world), speeds, camera triggers and the end
 file (the formats are :mod:`fm2uav.io`).
 """
 
-from .build import ENDS, CameraPlan, ExportOptions, MissionExport, build_mission, speed_commands
-from .fence import zone_fences
-from .geofence import Fence, FenceCircle, FencePolygon, as_fences, fences_from_world
+from .build import (
+    ENDS,
+    CameraPlan,
+    ExportOptions,
+    MissionExport,
+    build_mission,
+    speed_commands,
+    start_holds,
+)
+from .geofence import Fence, FenceCircle, FencePolygon, as_fences, fences_from_world, zone_fences
 from .items import MissionItem, command_name
-from .thin import refine_legs, thin_indices, thin_path
+from .legs import refine_legs
+from .thin import thin_indices, thin_path
 from .validate import FIRMWARES, VEHICLES, Problem, check_mission, supported_commands, validate_mission
 from .waypoints import FRAMES, Waypoints, altitude_profile, mission_waypoints, resolve_frame
 
@@ -26,6 +34,7 @@ __all__ = [
     "MissionExport",
     "CameraPlan",
     "speed_commands",
+    "start_holds",
     "ENDS",
     # items
     "MissionItem",

@@ -68,6 +68,7 @@ __all__ = [
     "CameraPlan",
     "MissionExport",
     "speed_commands",
+    "start_holds",
     "build_mission",
 ]
 
@@ -617,6 +618,21 @@ def _end(geo: _Geo, wps: Waypoints, opt: ExportOptions
         items.append(geo.item(CMD_NAV_LOITER_UNLIM, f_route, end_xy, end_z,
                               label="loiter at the end", p3=radius))
     return end, items, landing, warnings
+
+
+def start_holds(starts: Any, world: Any, options: ExportOptions) -> np.ndarray:
+    """Wait at each vehicle's start [s] so that vehicles armed together leave together.
+
+    Each vehicle climbs from the ground (:meth:`World.ground_height`) to its
+    start ``starts[i]`` [m] at ``options.climb_rate`` (default
+    :data:`DEFAULT_CLIMB` of the airframe); the ones with less to climb wait for
+    the one with most.
+    """
+    climb = options.climb_rate or DEFAULT_CLIMB[options.vehicle]
+    starts = np.asarray(starts, dtype=float)
+    ground = np.asarray([world.ground_height(x, y) for x, y in starts[:, :2]], dtype=float)
+    climb_s = (starts[:, 2] - ground) / climb
+    return float(climb_s.max()) - climb_s
 
 
 def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: _Speeds, start_hold: float

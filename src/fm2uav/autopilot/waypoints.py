@@ -126,7 +126,7 @@ class Waypoints:
     requested_agl : float or None
         The plan's requested height above ground [m].
     legs : dict or None
-        What the leg check (:func:`fm2uav.autopilot.thin.refine_legs`) did: waypoints
+        What the leg check (:func:`fm2uav.autopilot.legs.refine_legs`) did: waypoints
         ``added`` where a straight leg dipped below its floor or entered a zone,
         ``lowest_margin_m`` above the floor along the legs, ...
     """
@@ -271,7 +271,7 @@ def mission_waypoints(
     required : array_like, shape (N,), optional
         Lowest admissible height above the surface at each dense point [m]
         (``Plan.profile.required``); legs that would dip below it, or enter a
-        no-fly zone, get more waypoints (:func:`fm2uav.autopilot.thin.refine_legs`).
+        no-fly zone, get more waypoints (:func:`fm2uav.autopilot.legs.refine_legs`).
         Default: no floor (zones are still checked).
     """
     if frame not in FRAME_CODES:
@@ -285,7 +285,7 @@ def mission_waypoints(
     idx = thin_with_keep(space, tolerance, keep=keep, max_points=max_points)
     legs = None
     if p.shape[1] == 3 and getattr(world, "ndim", 3) == 3:
-        from .thin import refine_legs
+        from .legs import refine_legs
 
         req = np.full(len(p), -np.inf) if required is None else np.asarray(required, dtype=float)
         if req.shape != (len(p),):

@@ -143,7 +143,7 @@ def plan_outputs(
     plan : fm2uav.Plan
     formats : sequence of str
         Keys of :data:`OUTPUT_FILES`.
-    options : fm2uav.autopilot.ExportOptions
+    options : fm2uav.io.ExportOptions
         Waypoint thinning, frame, anchor, airframe.
     title, subtitle : str
         Of the HTML report and PNG figure.
@@ -156,12 +156,12 @@ def plan_outputs(
     -------
     info : dict
         The summary (plan numbers, the autopilot mission, waypoints, home, files).
-    mission : fm2uav.autopilot.MissionExport
+    mission : fm2uav.io.MissionExport
         The built mission.
     """
     from ..analysis.safety import safety_summary
     from ..io import export_mission
-    from ..autopilot.fence import zone_fences
+    from ..autopilot.geofence import zone_fences
 
     exports = [f for f in formats if f in EXPORT_FILES]
     zones = tuple(getattr(plan.world, "zones", ()))

@@ -25,7 +25,7 @@ from ..world.geo import DEFAULT_ANCHOR, Anchor, from_lonlat, to_lonlat  # the on
 from .geojson import geojson_document, read_geojson_path, write_geojson
 from .kml import kml_document, read_kml_path, write_kml, write_kmz
 from .paths import read_path_csv, write_path_csv
-from .qgc import plan_document, read_plan, validate_plan, write_plan
+from .qgc import geofence_document, plan_document, read_plan, validate_plan, write_plan
 from .trajectories import (
     read_trajectories_csv,
     write_cycles_csv,
@@ -53,7 +53,6 @@ from ..autopilot import (
     thin_path,
     validate_mission,
 )
-from ..autopilot.geofence import geofence_document
 
 __all__ = [
     "read_path_csv",
