@@ -59,7 +59,8 @@ from .items import (
     FRAME_TERRAIN,
     MissionItem,
 )
-from .validate import FIRMWARES, VEHICLES, check_mission
+from .firmware import FIRMWARES, PROFILES, VEHICLES
+from .validate import check_mission
 from .waypoints import FRAMES, Waypoints, ground_at, mission_waypoints, resolve_frame
 
 __all__ = [
@@ -578,12 +579,13 @@ def _end(geo: _Geo, wps: Waypoints, opt: ExportOptions
     warnings: list[str] = []
     if end == "rtl":
         items.append(MissionItem.do(CMD_NAV_RETURN_TO_LAUNCH, label="return to launch"))
-        if opt.firmware in ("px4", "generic") and opt.vehicle == "fixed_wing":
+        must_land = opt.vehicle in PROFILES[opt.firmware].landing_required
+        if must_land and opt.vehicle == "fixed_wing":
             heading = -_unit_xy(wps.points_m, from_end=False)
             pattern, landing, warnings = _landing_pattern(geo, start_xy, heading, f_route, opt,
                                                           "home landing")
             items += pattern
-        elif opt.firmware in ("px4", "generic") and opt.vehicle == "vtol":
+        elif must_land and opt.vehicle == "vtol":
             items.append(MissionItem.do(CMD_DO_LAND_START, label="home landing start"))
             items.append(geo.item(CMD_NAV_VTOL_LAND, FRAME_RELATIVE if f_route == FRAME_TERRAIN
                                   else f_route, start_xy, float(geo.ground(start_xy)[0]),

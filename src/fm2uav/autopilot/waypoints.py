@@ -37,6 +37,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..world.geo import Anchor, to_lonlat
+from .firmware import PROFILES
 from .items import FRAME_GLOBAL, FRAME_RELATIVE, FRAME_TERRAIN, CMD_NAV_TAKEOFF, CMD_NAV_WAYPOINT
 from .thin import thin_indices
 
@@ -67,9 +68,10 @@ def resolve_frame(frame: str, firmware: str, *, terrain_following: bool,
     """The frame ``"auto"`` stands for, per firmware (other names pass through).
 
     ``auto``: a terrain-following plan over a world with terrain is written in
-    the **terrain** frame for ArduPilot (it follows its terrain database) and
-    in **amsl** for PX4 and generic autopilots (PX4 has no terrain frame for
-    mission items); any other plan in **relative** (above home).
+    the **terrain** frame for a firmware that flies it (its profile's
+    ``terrain_frame``, :mod:`fm2uav.autopilot.firmware`: ArduPilot follows its
+    terrain database) and in **amsl** for the others (PX4 has no terrain frame
+    for mission items; generic); any other plan in **relative** (above home).
 
     Raises
     ------
@@ -82,7 +84,8 @@ def resolve_frame(frame: str, firmware: str, *, terrain_following: bool,
     if frame != "auto":
         return frame
     if terrain_following and has_terrain:
-        return "terrain" if firmware == "ardupilot" else "amsl"
+        profile = PROFILES.get(firmware)
+        return "terrain" if profile is not None and profile.terrain_frame else "amsl"
     return "relative"
 
 

@@ -48,6 +48,7 @@ from typing import IO, Any
 import numpy as np
 
 from ..errors import InputError
+from ..autopilot.firmware import FIRMWARE_TYPES, VEHICLE_TYPES  # MAV_AUTOPILOT, MAV_TYPE
 from ..autopilot.geofence import Fence, FenceCircle, FencePolygon, as_fences
 from ..autopilot.items import FRAME_GLOBAL, FRAME_RELATIVE, FRAME_TERRAIN, MissionItem
 
@@ -63,10 +64,6 @@ __all__ = [
     "read_geofence",
 ]
 
-#: Autopilot firmware name → MAV_AUTOPILOT.
-FIRMWARE_TYPES = {"generic": 0, "ardupilot": 3, "px4": 12}
-#: Airframe kind → MAV_TYPE.
-VEHICLE_TYPES = {"fixed_wing": 1, "multirotor": 2, "vtol": 22}
 #: MAV_FRAME of a position item → QGroundControl AltitudeFrame ("AltitudeMode").
 ALTITUDE_MODES = {FRAME_RELATIVE: 1, FRAME_GLOBAL: 2, FRAME_TERRAIN: 4}
 #: Complex items QGC writes and whether they carry their mission items.
