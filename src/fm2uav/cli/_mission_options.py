@@ -5,7 +5,7 @@
 ``--speed-changes``, ``--endurance``, ...) with the names of the mission file's
 ``airframe:`` / ``outputs:`` keys. Each defaults to None = "not given", so a
 mission file's value (``fm2uav export --mission``) or the library default
-applies; :func:`export_options` builds the :class:`~fm2uav.autopilot.ExportOptions`.
+applies; :func:`export_options` builds the :class:`~fm2uav.io.ExportOptions`.
 """
 
 from __future__ import annotations
@@ -103,7 +103,7 @@ def export_options(base: Any = None, *, firmware: str | None = None, vehicle: st
                    hover_speed: float | None = None, endurance: float | None = None,
                    reserve: float | None = None, **more: Any) -> Any:
     """``base`` (default ``ExportOptions()``) with the flags that were given."""
-    from ..autopilot import ExportOptions
+    from ..io import ExportOptions
 
     given = {"firmware": firmware, "vehicle": vehicle, "frame": frame, "end": end,
              "tolerance": thin, "anchor": parse_anchor(anchor), "speed_changes": speed_changes,
