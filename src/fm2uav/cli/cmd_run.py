@@ -164,8 +164,8 @@ def plan_outputs(
         The built mission.
     """
     from ..analysis.safety import safety_summary
+    from ..autopilot.geofence import zone_fences
     from ..io import EXPORT_FILES, export_mission
-    from ..io.fence import zone_fences
 
     exports = [f for f in formats if f in EXPORT_FILES]
     zones = tuple(getattr(plan.world, "zones", ()))

@@ -1,19 +1,21 @@
-"""Reading and writing: path files, geo-referencing, mission exports, mission files.
+"""File formats: path files, geo-referencing, mission exports, mission files.
 
 Exports (all in WGS84 lon/lat; see :func:`fm2uav.world.geo.to_lonlat` for how worlds
 without a CRS are placed on the Earth): CSV, GeoJSON, KML/KMZ, QGroundControl
 ``.plan`` and MAVLink ``QGC WPL 110``, all written by :func:`export_mission`
-from one list of MAVLink items (:mod:`fm2uav.io.build`: takeoff, waypoints
-thinned with 3D Douglas–Peucker, speeds, camera triggers, RTL/land/loiter),
-checked per firmware (:mod:`fm2uav.io.validate`). Mission files:
-:mod:`fm2uav.io.mission`.
+from one mission built by :mod:`fm2uav.autopilot` (MAVLink items, firmware
+checks, leg checks, geofences). Mission files: :mod:`fm2uav.io.mission`.
+Readers and writers only: they take items and points and compute nothing.
+
+The mission names of :mod:`fm2uav.autopilot` (``build_mission``,
+``ExportOptions``, ``MissionItem``, ``validate_mission``, ...) live there; they
+are re-exported here so that code written before the autopilot layer keeps working.
 """
 
 import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # loaded on first attribute access (PEP 562), see __getattr__
-    from .build import CameraPlan, MissionExport, build_mission, speed_commands
     from .exports import (
         EXPORT_FILES,
         ExportFile,
@@ -24,31 +26,42 @@ if TYPE_CHECKING:  # loaded on first attribute access (PEP 562), see __getattr__
         parse_formats,
     )
     from ..world.geo import DEFAULT_ANCHOR, Anchor, from_lonlat, to_lonlat  # the one conversion
-    from .geofence import FenceCircle, FencePolygon, fences_from_world, geofence_document
-    from .items import MissionItem
-    from .validate import Problem, check_mission, validate_mission
     from .geojson import geojson_document, read_geojson_path, write_geojson
     from .kml import kml_document, read_kml_path, write_kml, write_kmz
     from .paths import read_path_csv, write_path_csv
-    from .qgc import plan_document, read_plan, validate_plan, write_plan
-    from .thin import thin_indices, thin_path
+    from .qgc import geofence_document, plan_document, read_plan, validate_plan, write_plan
     from .trajectories import (
         read_trajectories_csv,
         write_cycles_csv,
         write_formation_metrics_csv,
         write_trajectories_csv,
     )
-    from .waypoints import Waypoints, mission_waypoints, resolve_frame
     from .wpl import read_wpl, write_wpl
+
+    # the mission itself lives in fm2uav.autopilot (re-exported for existing code)
+    from ..autopilot import (
+        CameraPlan,
+        FenceCircle,
+        FencePolygon,
+        MissionExport,
+        MissionItem,
+        Problem,
+        Waypoints,
+        build_mission,
+        check_mission,
+        fences_from_world,
+        mission_waypoints,
+        resolve_frame,
+        speed_commands,
+        thin_indices,
+        thin_path,
+        validate_mission,
+    )
 
 #: Where each public name lives (relative to this package). ``import fm2uav.io.outdir``
 #: (every command's output set) loads none of them: the writers and the mission builder
 #: (numpy, numba, shapely, pyproj) are imported on first access.
 _LAZY_NAMES = {
-    "CameraPlan": ".build",
-    "MissionExport": ".build",
-    "build_mission": ".build",
-    "speed_commands": ".build",
     "EXPORT_FILES": ".exports",
     "ExportFile": ".exports",
     "ExportOptions": ".exports",
@@ -60,14 +73,6 @@ _LAZY_NAMES = {
     "Anchor": "..world.geo",
     "from_lonlat": "..world.geo",
     "to_lonlat": "..world.geo",
-    "FenceCircle": ".geofence",
-    "FencePolygon": ".geofence",
-    "fences_from_world": ".geofence",
-    "geofence_document": ".geofence",
-    "MissionItem": ".items",
-    "Problem": ".validate",
-    "check_mission": ".validate",
-    "validate_mission": ".validate",
     "geojson_document": ".geojson",
     "read_geojson_path": ".geojson",
     "write_geojson": ".geojson",
@@ -77,21 +82,33 @@ _LAZY_NAMES = {
     "write_kmz": ".kml",
     "read_path_csv": ".paths",
     "write_path_csv": ".paths",
+    "geofence_document": ".qgc",
     "plan_document": ".qgc",
     "read_plan": ".qgc",
     "validate_plan": ".qgc",
     "write_plan": ".qgc",
-    "thin_indices": ".thin",
-    "thin_path": ".thin",
     "read_trajectories_csv": ".trajectories",
     "write_cycles_csv": ".trajectories",
     "write_formation_metrics_csv": ".trajectories",
     "write_trajectories_csv": ".trajectories",
-    "Waypoints": ".waypoints",
-    "mission_waypoints": ".waypoints",
-    "resolve_frame": ".waypoints",
     "read_wpl": ".wpl",
     "write_wpl": ".wpl",
+    "CameraPlan": "..autopilot",
+    "FenceCircle": "..autopilot",
+    "FencePolygon": "..autopilot",
+    "MissionExport": "..autopilot",
+    "MissionItem": "..autopilot",
+    "Problem": "..autopilot",
+    "Waypoints": "..autopilot",
+    "build_mission": "..autopilot",
+    "check_mission": "..autopilot",
+    "fences_from_world": "..autopilot",
+    "mission_waypoints": "..autopilot",
+    "resolve_frame": "..autopilot",
+    "speed_commands": "..autopilot",
+    "thin_indices": "..autopilot",
+    "thin_path": "..autopilot",
+    "validate_mission": "..autopilot",
 }
 
 
