@@ -153,6 +153,8 @@ def test_cache_fault_finds_numba_s_cache_loader_and_clear_cache_deletes_its_file
     assert len(files) >= 2
     index = next(f for f in files if f.suffix == ".nbi")
     index.write_bytes(b"\x80\x04")  # truncated
+    in_tree = ROOT / "src" / "fm2uav" / "eikonal" / "__pycache__"
+    others = sorted(in_tree.glob("_kernels.*.nb[ic]"))  # another location's cache
     probe = (
         "import numpy as np\n"
         "from fm2uav import _jit\n"
@@ -171,4 +173,6 @@ def test_cache_fault_finds_numba_s_cache_loader_and_clear_cache_deletes_its_file
     assert lines["OTHER"] == "None"
     assert int(lines["REMOVED"]) >= 2
     assert not list(tmp_path.rglob("_kernels.scan_speed-*.nb[ic]"))
+    assert sorted(in_tree.glob("_kernels.*.nb[ic]")) == others  # only where this process caches
+
     assert _python(code, tmp_path).returncode == 0  # compiles and caches again

@@ -201,11 +201,13 @@ def _fm2uav_sources() -> list[Path]:
 
 
 def clear_cache() -> list[Path]:
-    """Delete every numba cache file of fm2uav's kernels (index ``.nbi`` and data ``.nbc``)
-    that this process can find (the locations of :func:`_cache_candidates`).
+    """Delete the numba cache files of fm2uav's kernels (index ``.nbi`` and data ``.nbc``)
+    where this process keeps them (:func:`_cache_dir`: ``$NUMBA_CACHE_DIR`` when set, else
+    the package's ``__pycache__`` folders or the user-wide cache, as numba chooses).
 
     The next call of each kernel compiles it again and writes a fresh cache.
-    Files that cannot be deleted are left (and not returned).
+    Files that cannot be deleted are left (and not returned). Caches of other
+    locations (another ``$NUMBA_CACHE_DIR``) are not touched.
 
     Returns
     -------
@@ -215,15 +217,16 @@ def clear_cache() -> list[Path]:
     removed = []
     for py_file in _fm2uav_sources():
         stem = glob.escape(py_file.stem)
-        for d in _cache_candidates(py_file):
-            if not d.is_dir():
+        d = _cache_dir(py_file)
+        if d is None or not d.is_dir():
+            continue
+        for f in glob.glob(str(glob.escape(str(d)) + f"/{stem}.*.nb[ic]")):
+            try:
+                os.unlink(f)
+            except OSError:
                 continue
-            for f in glob.glob(str(glob.escape(str(d)) + f"/{stem}.*.nb[ic]")):
-                try:
-                    os.unlink(f)
-                except OSError:
-                    continue
-                removed.append(Path(f))
+            removed.append(Path(f))
+
     return removed
 
 

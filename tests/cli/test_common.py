@@ -189,6 +189,12 @@ def test_an_error_names_only_the_flags_of_the_command_that_raised_it():
     @mini.command()
     @handle_errors
     def main(ceiling: float = typer.Option(0.0, "--ceiling")) -> None:
+        import warnings
+
+        from fm2uav.world.dem import GeodataWarning
+
+        warnings.warn("the DEM is distorted; crop it with world.bbox (CLI --bbox) or raise "
+                      "--ceiling", GeodataWarning, stacklevel=1)
         raise InputError("the flight level leaves the map; lower it or build a taller world "
                          "(mission file planner.agl / world.ceiling; CLI --agl / --ceiling); "
                          "crop with world.bbox (CLI --bbox W,S,E,N) or give --agl too")
@@ -196,6 +202,7 @@ def test_an_error_names_only_the_flags_of_the_command_that_raised_it():
     res = runner.invoke(mini, [])
     assert res.exit_code == 2
     assert res.output.strip() == (
+        "warning: the DEM is distorted; crop it with world.bbox or raise --ceiling\n"
         "error: the flight level leaves the map; lower it or build a taller world (mission "
         "file planner.agl / world.ceiling; CLI --ceiling); crop with world.bbox or give "
         "planner.agl too")

@@ -202,8 +202,9 @@ def debug_enabled() -> bool:
 
 
 def _warning_line(text: str) -> None:
-    err_console.print(f"[bold yellow]warning:[/] {escape(str(text))}", highlight=False,
-                      soft_wrap=True)
+    err_console.print(f"[bold yellow]warning:[/] {escape(_for_this_command(str(text)))}",
+                      highlight=False, soft_wrap=True)
+
 
 
 @contextmanager
