@@ -4,10 +4,14 @@ The first instructions make the process safe to stop and to print, before any
 import that takes time:
 
 * **stop signals from the first instruction**: SIGINT (Ctrl-C), SIGTERM and
-  SIGHUP raise at once; outside a command (start-up, argument parsing) the run
-  ends with one line and exit code 130, never a traceback. While a command runs
-  its own handlers take over (:func:`fm2uav.io.outdir.interrupt_signals`: the
-  output set is removed, the previous one kept, exit 130);
+  SIGHUP raise at once (:func:`fm2uav.io.outdir.install_stop_signals`: a light
+  module, loaded before anything else); outside a command (start-up, argument
+  parsing) the run ends with one line and exit code 130, never a traceback.
+  While a command runs the output sets' rules apply
+  (:func:`fm2uav.io.outdir.interrupt_signals`: the set is removed, the previous
+  one kept, exit 130). A stop that Python swallows (one landing in a weakref
+  callback of the import system, a ``__del__``) is raised again at the next
+  checkpoint (:func:`fm2uav.io.outdir.raise_if_stopped`): never lost;
 * **any output encoding**: text that stdout/stderr cannot encode (``LANG=C``
   without UTF-8, ``PYTHONIOENCODING=ascii``) is replaced instead of ending the
   run; a closed pipe (``fm2uav --help | head -1``) ends it quietly.
@@ -30,41 +34,8 @@ import os
 import signal
 import sys
 
-#: Signals that stop the command line (exit code 130).
-_STOP_SIGNALS = ("SIGINT", "SIGTERM", "SIGHUP")
-
 #: Commands whose first run compiles kernels (the notice is shown before anything else).
 _COMPILING_COMMANDS = ("plan", "run")
-
-
-class StartupStop(KeyboardInterrupt):
-    """A stop signal outside a command (start-up, argument parsing, the end)."""
-
-    def __init__(self, signum: int) -> None:
-        super().__init__(signum)
-        self.signum = signum
-
-
-def _stop(signum: int, frame: object) -> None:  # noqa: ARG001
-    raise StartupStop(signum)
-
-
-def install_stop_signals() -> None:
-    """SIGINT / SIGTERM / SIGHUP raise :class:`StartupStop` (a KeyboardInterrupt).
-
-    A signal the parent shell ignores (``nohup``: SIGHUP; a background job:
-    SIGINT) stays ignored.
-    """
-    for name in _STOP_SIGNALS:
-        sig = getattr(signal, name, None)
-        if sig is None:
-            continue
-        try:
-            if signal.getsignal(sig) is signal.SIG_IGN:
-                continue
-            signal.signal(sig, _stop)
-        except (ValueError, OSError):  # not the main thread, or an exotic platform
-            pass
 
 
 def _printable_streams() -> None:
@@ -79,21 +50,34 @@ def _printable_streams() -> None:
                 pass
 
 
-def _stopped(signum: int) -> int:
-    for sig_name in _STOP_SIGNALS:  # a second signal while reporting the first: no traceback
-        try:
+def _stopped(signum: int) -> None:
+    """Report a stop signal outside a command and end the process with 130, at once.
+
+    ``os._exit``: no interpreter shutdown, which may end the process with SIGINT itself
+    when the KeyboardInterrupt passed through code Python evaluated for it (nothing is
+    open here: a command removes its output sets before it reports its own stop).
+    """
+    for sig_name in ("SIGINT", "SIGTERM", "SIGHUP"):  # a second signal while reporting the
+        try:                                          # first: no traceback
             signal.signal(getattr(signal, sig_name), signal.SIG_IGN)
         except (AttributeError, ValueError, OSError):
             pass
-    name = {int(getattr(signal, n)): n for n in _STOP_SIGNALS if hasattr(signal, n)}.get(
-        signum, f"signal {signum}")
-    what = "SIGINT (Ctrl-C)" if name == "SIGINT" else name
+    what = "SIGINT (Ctrl-C)" if signum == signal.SIGINT else signal.Signals(signum).name
     try:
         sys.stderr.write(f"error: interrupted by {what}; nothing was written\n")
+    except (OSError, ValueError):
+        pass
+    _exit_now(130)
+
+
+def _exit_now(code: int) -> None:
+    """End the process at once with ``code`` (stdio flushed; see :func:`_stopped`)."""
+    try:
+        sys.stdout.flush()
         sys.stderr.flush()
     except (OSError, ValueError):
         pass
-    return 130
+    os._exit(code)
 
 
 def _quiet_broken_pipe() -> int:
@@ -121,23 +105,40 @@ def _notice_if_cold(argv: list[str]) -> None:
                                        style="yellow", highlight=False)
 
 
+def _run() -> int:
+    """The command line's exit code (stop signals: 130 with one line, never a traceback)."""
+    from .io.outdir import Interrupted, install_stop_signals, raise_if_stopped, unreported_stop
+
+    try:
+        install_stop_signals()  # no traceback for a stop signal from here on
+        try:
+            _printable_streams()
+            _notice_if_cold(sys.argv[1:])
+            from .cli import main as cli_main
+
+            cli_main()
+        except SystemExit as exc:
+            raise_if_stopped()  # a stop Python swallowed (start-up, parsing): 130 all the same
+            if exc.code == 130:  # stopped: a command reported it, or typer's parser exited
+                signum = unreported_stop()  # with 130 in silence
+                if signum is not None:
+                    _stopped(signum)
+                _exit_now(130)
+            raise
+        raise_if_stopped()
+    except (KeyboardInterrupt, Interrupted) as exc:  # outside a command (a command reports
+        _stopped(getattr(exc, "signum", signal.SIGINT))  # its own: handle_errors)
+    except BrokenPipeError:
+        return _quiet_broken_pipe()
+    return 0  # pragma: no cover - cli_main always exits
+
 
 def main() -> None:
     """Run the ``fm2uav`` command line."""
-    install_stop_signals()  # the first instruction: no traceback for Ctrl-C from here on
     try:
-        _printable_streams()
-        _notice_if_cold(sys.argv[1:])
-        from .cli import main as cli_main
-
-
-        cli_main()
-    except KeyboardInterrupt as exc:  # start-up or argument parsing (a command reports its own)
-        code = _stopped(getattr(exc, "signum", signal.SIGINT))
-    except BrokenPipeError:
-        code = _quiet_broken_pipe()
-    else:  # pragma: no cover - cli_main always exits
-        code = 0
+        code = _run()
+    except KeyboardInterrupt:  # Ctrl-C before the handlers are in place (Python's own)
+        _stopped(signal.SIGINT)
     sys.exit(code)
 
 

@@ -206,3 +206,36 @@ def test_an_error_names_only_the_flags_of_the_command_that_raised_it():
         "error: the flight level leaves the map; lower it or build a taller world (mission "
         "file planner.agl / world.ceiling; CLI --ceiling); crop with world.bbox or give "
         "planner.agl too")
+
+
+def test_a_stop_swallowed_inside_a_command_still_ends_it_with_130(tmp_path):
+    import signal
+
+    import typer
+
+    from fm2uav.cli._common import handle_errors
+    from fm2uav.io import outdir
+
+    class Victim:
+        def __del__(self):  # Python ignores what is raised here ("Exception ignored in")
+            outdir._on_stop_signal(signal.SIGTERM, None)
+
+    mini = typer.Typer()
+
+    @mini.command()
+    @handle_errors
+    def main(out: str = typer.Option(..., "--out")) -> None:
+        od = outdir.OutputDir(out)
+        od.check(["a.txt"])
+        with od.open("a.txt") as fh:
+            fh.write("new")
+        Victim()  # the stop lands in its __del__ and is swallowed; the command runs on
+
+    out = tmp_path / "out"
+    res = runner.invoke(mini, ["--out", str(out)])
+    assert res.exit_code == 130, res.output
+    assert "interrupted by SIGTERM" in res.output and "Traceback" not in res.output
+    assert not out.exists()  # nothing put in place
+    outdir.raise_if_stopped()  # reported: not raised again
+    res = runner.invoke(mini, ["--out", str(out)])  # the next command is not affected
+    assert res.exit_code == 130  # (its own Victim again)

@@ -314,6 +314,10 @@ def handle_errors(func: F) -> F:
         except interrupted as exc:
             import signal
 
+            from ..io.outdir import stop_reported
+
+            stop_reported()  # reported here: not raised again at the end of the command line
+
             signum = getattr(exc, "signum", signal.SIGINT)
             what = ("SIGINT (Ctrl-C)" if signum == signal.SIGINT
                     else signal.Signals(signum).name)
