@@ -84,10 +84,15 @@ class JobManager:
                 self._ensure_worker()
 
     # -- public ------------------------------------------------------------------------
-    def submit(self, kind: str, payload: dict[str, Any]) -> Job:
+    def new_id(self) -> str:
+        """A fresh job id (to prepare a job's files before :meth:`submit`)."""
+        with self._lock:
+            return f"{next(self._ids)}"
+
+    def submit(self, kind: str, payload: dict[str, Any], job_id: str | None = None) -> Job:
         """Queue a job (see :func:`fm2uav.app.worker.run_job` for the kinds)."""
         with self._lock:
-            job = Job(id=f"{next(self._ids)}", kind=kind, payload=payload)
+            job = Job(id=job_id or f"{next(self._ids)}", kind=kind, payload=payload)
             self._jobs[job.id] = job
             self._queue.append(job.id)
             self._lock.notify_all()

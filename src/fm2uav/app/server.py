@@ -34,6 +34,11 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from fastapi import FastAPI, HTTPException, Request, UploadFile
+from fastapi.responses import (FileResponse, HTMLResponse, JSONResponse, Response,
+                               StreamingResponse)
+from fastapi.staticfiles import StaticFiles
+
 __all__ = ["create_app"]
 
 STATIC = Path(str(resources.files("fm2uav.app") / "static"))
@@ -51,11 +56,6 @@ CHOICES = {
 
 def create_app(session: Any, jobs: Any) -> Any:
     """The FastAPI application of a :class:`~fm2uav.app.session.Session` and its jobs."""
-    from fastapi import FastAPI, HTTPException, Request, UploadFile
-    from fastapi.responses import (FileResponse, HTMLResponse, JSONResponse, Response,
-                                   StreamingResponse)
-    from fastapi.staticfiles import StaticFiles
-
     from .terrain import Terrain
 
     app = FastAPI(title="fm2uav", docs_url=None, redoc_url=None, openapi_url=None)
@@ -96,10 +96,10 @@ def create_app(session: Any, jobs: Any) -> Any:
             doc = body.get("mission")
             if not isinstance(doc, dict):
                 return bad("the request has no mission document")
-            job = jobs.submit("plan", {})
-            mission_file, out = session.job_files(job.id, doc)
-            job.payload.update(mission_file=str(mission_file), out=str(out))
-            return job.public()
+            job_id = jobs.new_id()
+            mission_file, out = session.job_files(job_id, doc)
+            return jobs.submit("plan", {"mission_file": str(mission_file), "out": str(out)},
+                               job_id=job_id).public()
         return bad(f"unknown job kind {kind!r}; allowed: world, plan")
 
     def job_or_404(job_id: str) -> Any:
