@@ -6,7 +6,9 @@ call with :func:`reporting`. Without a listener every call here is a no-op that
 costs a context-variable read, so the numerics never print and never slow down.
 
 Stages nest: :func:`span` gives a part of the enclosing stage's share of the
-whole job, :func:`step` moves on to the next part at the same level. The
+whole job, :func:`step` moves on to the next part at the same level. A function
+that calls :func:`step` runs in a stage of its own (:func:`stage` decorator), so
+its steps divide its caller's current part. The
 callback receives a :class:`ProgressEvent` with the overall fraction done in
 [0, 1] and the names of the open stages, outermost first::
 
@@ -61,7 +63,8 @@ class ProgressEvent:
     @property
     def message(self) -> str:
         """The stages joined by ``": "`` with the count, e.g. ``"planning: leg 2 of 3"``."""
-        text = ": ".join(self.stages) if self.stages else "done"
+        text = ": ".join(self.stages) if self.stages else (
+            "done" if self.fraction >= 1.0 else "working")
         if self.total:
             text += f" ({self.done} of {self.total})"
         return text
@@ -85,7 +88,7 @@ class _Tracker:
 
     def emit(self, fraction: float, done: int | None = None, total: int | None = None) -> None:
         self.last = max(self.last, min(1.0, fraction))
-        self.callback(ProgressEvent(self.last, tuple(f.name for f in self.stack[1:]),
+        self.callback(ProgressEvent(self.last, tuple(f.name for f in self.stack[1:] if f.name),
                                     done, total))
 
     def open(self, name: str, share: float, is_step: bool) -> None:
@@ -94,7 +97,8 @@ class _Tracker:
         frame = _Frame(name, parent.start + parent.width * parent.cursor, parent.width * share,
                        share, is_step)
         self.stack.append(frame)
-        self.emit(frame.start)
+        if name:  # an anonymous stage only divides the work; nothing new to say
+            self.emit(frame.start)
 
     def close(self, depth: int) -> None:
         """Close the frames above ``depth``, each advancing its parent."""
@@ -143,8 +147,13 @@ def span(name: str, share: float = 1.0) -> Iterator[None]:
         tracker.close(depth)
 
 
-def stage(name: str, share: float = 1.0) -> Callable[[F], F]:
-    """Decorator: run the function inside :func:`span` ``(name, share)``."""
+def stage(name: str = "", share: float = 1.0) -> Callable[[F], F]:
+    """Decorator: run the function inside :func:`span` ``(name, share)``.
+
+    A function that marks its parts with :func:`step` runs in a stage of its own,
+    so that its steps divide the caller's current part instead of replacing it;
+    an empty ``name`` adds no word to the messages.
+    """
     def decorate(func: F) -> F:
         @functools.wraps(func)
         def wrapper(*args: Any, **kwargs: Any) -> Any:

@@ -127,7 +127,7 @@ def plan_route(
         reuse = legs and legs[0].params.get("storage") != "regional"
         opts = replace(options, speed_map=legs[0].W) if reuse else options
         try:
-            with progress.span(f"leg {k + 1} of {len(pts) - 1}" if len(pts) > 2 else "route",
+            with progress.span(f"leg {k + 1} of {len(pts) - 1}" if len(pts) > 2 else "",
                                1.0 / (len(pts) - 1)):
                 legs.append(plan(world, pts[k], pts[k + 1], shaping=shaping, level=level,
                                  options=opts))

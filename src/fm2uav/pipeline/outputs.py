@@ -9,7 +9,7 @@ set is complete). Stages are reported through :mod:`fm2uav.progress`.
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -74,14 +74,22 @@ def output_names(formats: Sequence[str]) -> list[str]:
     return [OUTPUT_FILES[f] for f in formats]
 
 
-def write_exports(outdir: Any, files: dict[str, Any]) -> None:
-    """Write :func:`fm2uav.io.export_mission` files into ``outdir`` (atomically each)."""
+@progress.stage()
+def write_exports(outdir: Any, files: dict[str, Any],
+                  step: Callable[[str], None] | None = None) -> None:
+    """Write :func:`fm2uav.io.export_mission` files into ``outdir`` (atomically each).
+
+    Each file is a :mod:`fm2uav.progress` step; ``step(message)`` is also told, if given.
+    """
     for name, f in files.items():
         progress.step(f"writing {name}", 1.0 / max(1, len(files)))
+        if step is not None:
+            step(f"writing {name}")
         with outdir.open(name, mode="wb" if f.binary else "w") as fh:
             f.write(fh)
 
 
+@progress.stage()
 def plan_outputs(
     outdir: Any,
     plan: Any,
@@ -151,8 +159,8 @@ def plan_outputs(
         "thin_tolerance_m": options.tolerance,
         "safety": safety,
     }
-    with progress.span("writing the exports", 0.3):
-        write_exports(outdir, files)
+    progress.step("writing the exports", 0.3)
+    write_exports(outdir, files)
     if "html" in formats:
         progress.step("writing report.html", 0.2)
         write_text(outdir, "report.html", _plan_report(

@@ -70,6 +70,7 @@ def with_zone_files(resolved: Any, files: Sequence[str | Path]) -> Any:
     return dataclasses.replace(resolved, world=world)
 
 
+@progress.stage()
 def run_mission(
     mission: Any,
     outdir: Any,
@@ -123,16 +124,16 @@ def run_mission(
                        return_to_start=rm.return_to_start, shaping=shaping, level=level,
                        options=popts)
     world_name = mission.world.scenario or mission.world.describe()
-    with progress.span("writing the mission files", 1.0):
-        info, built = plan_outputs(
-            outdir, route.plan, formats, options, title=f"{mission.name}",
-            subtitle=f"{world_name} — {mission.description}" if mission.description
-            else world_name,
-            summary={"mission": mission.name,
-                     **({"mission_file": str(mission_file)} if mission_file is not None
-                        else {}),
-                     "world": {**world_summary(rm.world), "name": world_name},
-                     "route": route.summary()},
-            via=route.junctions[1:-1])
+    progress.step("writing the mission files", 0.3)
+    info, built = plan_outputs(
+        outdir, route.plan, formats, options, title=f"{mission.name}",
+        subtitle=f"{world_name} — {mission.description}" if mission.description
+        else world_name,
+        summary={"mission": mission.name,
+                 **({"mission_file": str(mission_file)} if mission_file is not None
+                    else {}),
+                 "world": {**world_summary(rm.world), "name": world_name},
+                 "route": route.summary()},
+        via=route.junctions[1:-1])
     return MissionRun(mission=mission, resolved=rm, route=route, info=info, built=built,
                       world_name=world_name)

@@ -234,7 +234,7 @@ def _check_free(world: World, point: np.ndarray, what: str) -> tuple[int, ...]:
     return cell
 
 
-@progress.stage("FM² plan")
+@progress.stage()
 def plan(
     world: World,
     start: Any,

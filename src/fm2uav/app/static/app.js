@@ -12,7 +12,8 @@
   window.fm2app = S;   // for tests and the curious
 
   // ------------------------------------------------------------------ map
-  const map = L.map("map", { zoomControl: true, zoomSnap: 0.25 }).setView([20, 0], 2);
+  const map = L.map("map", { zoomControl: true, zoomSnap: 0.25, fadeAnimation: false })
+    .setView([20, 0], 2);
   S.map = map;
   L.control.scale({ metric: true, imperial: false, maxWidth: 220, position: "bottomleft" })
     .addTo(map);
@@ -410,7 +411,7 @@
     S.result = Object.assign({ job: job.id }, r); S.stale = false;
     if (S.resultLayer) map.removeLayer(S.resultLayer);
     S.resultLayer = FM2Map.renderMission(map, doc, { points: false });
-    pointLayer.bringToFront && pointLayer.eachLayer(m => m.setZIndexOffset(1000));
+    pointLayer.eachLayer(m => m.setZIndexOffset(1000));
     if (S.legend) S.legend.remove();
     S.legend = FM2Map.aglLegend(s.requested_agl_m).addTo(map);
     const mins = s.flight_time_s / 60;

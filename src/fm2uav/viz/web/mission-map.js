@@ -92,7 +92,7 @@
       const p = f.properties, [lon, lat] = f.geometry.coordinates;
       const icon = L.divIcon({ className: "fm2-item", iconSize: [22, 22],
                                html: `<span>${p.seq}</span>` });
-      L.marker([lat, lon], { icon, keyboard: false, interactive: true })
+      L.marker([lat, lon], { icon, keyboard: false, interactive: true, zIndexOffset: -500 })
         .bindTooltip(`${p.seq} ${p.command}${p.label ? " (" + p.label + ")" : ""}<br>` +
                      `alt ${fmt(p.alt, "m", 1)} (frame ${p.frame}) · ${fmt(p.alt_amsl, "m", 1)} ` +
                      `AMSL · ${fmt(p.agl, "m", 1)} above ground`)
