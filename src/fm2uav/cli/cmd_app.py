@@ -40,12 +40,17 @@ def initial_mission(world: WorldFlags, mission_file: Path | None, agl: float) ->
         world.spec()  # the flags' errors, as fm2uav plan says them
         return {"version": 1, "name": "mission", "world": overrides,
                 "planner": {"agl": agl}}
-    import yaml
+    from ..app.session import file_refs
 
     m = load_mission(mission_file, world_overrides=overrides or None)  # errors as fm2uav run
     doc = m.model_dump(mode="json", by_alias=True, exclude_defaults=True)
-    doc.setdefault("version", 1)
-    return yaml.safe_load(yaml.safe_dump(doc))
+    doc = {"version": 1, **doc}
+    for keys, ref in file_refs(doc):  # the jobs' mission files live elsewhere: absolute paths
+        target = doc
+        for k in keys[:-1]:
+            target = target[k]
+        target[keys[-1]] = str(Path(ref).resolve())
+    return doc
 
 
 @handle_errors

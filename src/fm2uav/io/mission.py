@@ -560,7 +560,8 @@ _TYPE_WORDS = {
 
 def _show(v: Any) -> str:
     text = repr(v)
-    return text if len(text) <= 60 else text[:57] + "..."
+    # a long value keeps its end too: a path's file name says which file is wrong
+    return text if len(text) <= 60 else text[:22] + "..." + text[-35:]
 
 
 def _format_error(err: dict[str, Any]) -> str:

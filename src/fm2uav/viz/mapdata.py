@@ -154,7 +154,7 @@ def mission_map(plan: Any, mission: Any, safety: dict[str, Any] | None = None, *
     ground = np.asarray(world.ground_height(path[:, 0], path[:, 1]), dtype=float)
     agl = path[:, 2] - ground
     amsl_offset = ll[:, 2] - path[:, 2]     # world z -> altitude AMSL (0 on a DEM world)
-    dist = arc_length(path)
+    dist = arc_length(path[:, :2])        # along the ground, as a profile is drawn
     level = getattr(plan, "level", None)
     requested = None if level is None else float(level.agl)
     feats: list[dict[str, Any]] = [{

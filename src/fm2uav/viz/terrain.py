@@ -109,7 +109,7 @@ def contour_lines(elev: np.ndarray, transform: Any, interval: float,
     lo, hi = float(np.nanmin(elev)), float(np.nanmax(elev))
     gen = contourpy.contour_generator(z=np.ma.masked_invalid(elev), line_type="SeparateCode")
     feats = []
-    for level in np.arange(math.ceil(lo / interval) * interval, hi, interval):
+    for level in np.arange(math.floor(lo / interval + 1) * interval, hi, interval):
         segs, _codes = gen.lines(float(level))
         lines = []
         for seg in segs:
