@@ -15,85 +15,15 @@ import json
 import os
 import re
 import subprocess
-import sys
-import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from .browser import SHOTS, chromium_path, launch, route_pixels
-from .dem import make_dem
+from .browser import FM2UAV, SHOTS, click_map, lonlat_at, plan_and_wait, route_pixels
 
-playwright_api = pytest.importorskip("playwright.sync_api",
-                                     reason="Playwright (PyPI 'playwright') is not installed")
-
-FM2UAV = [sys.executable, "-m", "fm2uav"]
 #: The route's colour at the requested height above ground (viz/web/mission-map.js).
 ROUTE_GREEN = (26, 150, 65)
-
-
-@pytest.fixture(scope="module")
-def app_run(tmp_path_factory):
-    """``fm2uav app`` on a free port with a GeoTIFF; yields (url, folder); stopped after."""
-    chromium_path()  # skip before starting anything when there is no browser
-    root = tmp_path_factory.mktemp("app")
-    dem = make_dem(root / "terrain.tif")
-    proc = subprocess.Popen(
-        [*FM2UAV, "app", "--dem", str(dem), "--port", "0", "--no-browser", "--dir",
-         str(root / "session")], cwd=root, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-        text=True, env={**os.environ, "COLUMNS": "200"})
-    line = proc.stdout.readline()
-    url = re.search(r"http://127\.0\.0\.1:\d+/", line)
-    if url is None:
-        proc.kill()
-        pytest.fail(f"fm2uav app printed no URL: {line!r} {proc.stdout.read()}")
-    yield url.group(0), root
-    proc.terminate()
-    try:
-        proc.wait(timeout=10)
-    except subprocess.TimeoutExpired:  # pragma: no cover
-        proc.kill()
-
-
-@pytest.fixture(scope="module")
-def page(app_run, tmp_path_factory):
-    """The app's page, loaded (world checked, DEM tiles shown)."""
-    with playwright_api.sync_playwright() as pw:
-        ctx = launch(pw, tmp_path_factory.mktemp("chromium-profile"),
-                     viewport={"width": 1400, "height": 900})
-        pg = ctx.new_page()
-        errors: list[str] = []
-        pg.on("pageerror", lambda e: errors.append(str(e)))
-        pg.goto(app_run[0])
-        pg.wait_for_function("window.fm2app && window.fm2app.loaded", timeout=60_000)
-        pg.js_errors = errors
-        yield pg
-        ctx.close()
-
-
-def lonlat_at(pg, fx: float, fy: float) -> tuple[float, float]:
-    """Lon/lat at fractions (fx west→east, fy south→north) of the DEM's bounds."""
-    w, s, e, n = pg.evaluate("fm2app.terrain.bounds")
-    return w + fx * (e - w), s + fy * (n - s)
-
-
-def click_map(pg, lon: float, lat: float) -> None:
-    """A real mouse click on the map at lon/lat."""
-    x, y = pg.evaluate(f"(() => {{ const p = fm2app.map.latLngToContainerPoint([{lat}, {lon}]);"
-                       " return [p.x, p.y]; })()")
-    box = pg.locator("#map").bounding_box()
-    pg.mouse.click(box["x"] + x, box["y"] + y)
-
-
-def plan_and_wait(pg, timeout: float = 90_000) -> dict:
-    """Click Plan and wait for the planning job to end; returns the job."""
-    before = pg.evaluate("fm2app.job ? fm2app.job.id : null")
-    pg.click("#btn-plan")
-    pg.wait_for_function(
-        f"fm2app.job && fm2app.job.kind === 'plan' && fm2app.job.id !== {json.dumps(before)}"
-        " && ['done', 'error', 'cancelled'].includes(fm2app.job.state)", timeout=timeout)
-    return pg.evaluate("fm2app.job")
 
 
 def cli(*args: str, cwd: Path) -> subprocess.CompletedProcess:

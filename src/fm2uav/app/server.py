@@ -6,8 +6,9 @@ Endpoints (JSON unless said otherwise):
 ``GET  /``                                  the map page
 ``GET  /api/session``                       the starting mission document, save path, choices
 ``POST /api/upload``                        store a file (multipart ``file``) → ``{path}``
-``POST /api/jobs``                          ``{kind: "world", world, agl}`` or
-                                            ``{kind: "plan", mission}`` → the job
+``POST /api/jobs``                          ``{kind: "world", world, agl}``,
+                                            ``{kind: "plan", mission}`` or
+                                            ``{kind: "cover", mission, area, cover}`` → the job
 ``GET  /api/jobs/{id}``                     the job (state, %, stage, result or error)
 ``GET  /api/jobs/{id}/events``              the job's changes as server-sent events
 ``POST /api/jobs/{id}/cancel``              cancel it
@@ -100,7 +101,19 @@ def create_app(session: Any, jobs: Any) -> Any:
             mission_file, out = session.job_files(job_id, doc)
             return jobs.submit("plan", {"mission_file": str(mission_file), "out": str(out)},
                                job_id=job_id).public()
-        return bad(f"unknown job kind {kind!r}; allowed: world, plan")
+        if kind == "cover":
+            from ..errors import describe_error
+
+            job_id = jobs.new_id()
+            try:
+                payload = session.cover_job(job_id, body)
+            except Exception as exc:  # noqa: BLE001 - the CLI's words
+                known = describe_error(exc)
+                if known is None:
+                    raise
+                return bad(known[0])
+            return jobs.submit("cover", payload, job_id=job_id).public()
+        return bad(f"unknown job kind {kind!r}; allowed: world, plan, cover")
 
     def job_or_404(job_id: str) -> Any:
         job = jobs.get(job_id)

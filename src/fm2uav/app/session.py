@@ -20,7 +20,16 @@ import shutil
 from pathlib import Path
 from typing import Any
 
-__all__ = ["Session", "dump_mission", "file_refs"]
+__all__ = ["Session", "dump_mission", "file_refs", "zones_geojson", "cover_command"]
+
+#: Mission-file ``airframe:`` / ``outputs:`` keys → the command line's mission flags.
+EXPORT_FLAGS = {"firmware": "firmware", "type": "vehicle", "frame": "frame", "end": "end",
+                "thin_tolerance": "thin", "speed_changes": "speed_changes",
+                "cruise_speed": "cruise_speed", "hover_speed": "hover_speed",
+                "endurance": "endurance", "reserve": "reserve"}
+#: The cover fields of the page → ``fm2uav cover`` flags.
+COVER_FLAGS = ("agl", "spacing", "side_overlap", "front_overlap", "trigger_distance",
+               "min_agl", "max_agl", "saturation_distance", "seed")
 
 
 def dump_mission(doc: dict[str, Any]) -> str:
@@ -57,6 +66,68 @@ def file_refs(doc: dict[str, Any]) -> list[tuple[list[Any], str]]:
     elif isinstance(area, dict) and isinstance(area.get("file"), str):
         out.append((["operating_area", "file"], area["file"]))
     return out
+
+
+def zones_geojson(entries: list[Any]) -> tuple[dict[str, Any] | None, list[str]]:
+    """The page's drawn zones (mission-file entries with ``lonlat: true``) as one GeoJSON
+    document for ``--no-fly`` (polygons; circles as points with a ``radius``), and the
+    zone files among the entries."""
+    feats, files = [], []
+    for z in entries or ():
+        if isinstance(z, str) or (isinstance(z, dict) and "file" in z):
+            files.append(z if isinstance(z, str) else z["file"])
+            continue
+        props = {k: z[k] for k in ("name", "floor", "ceiling", "reference", "buffer")
+                 if z.get(k) is not None}
+        if "circle" in z:
+            props["radius"] = z["circle"]["radius"]
+            geom = {"type": "Point", "coordinates": list(z["circle"]["center"])}
+        else:
+            ring = [list(p) for p in z["polygon"]]
+            geom = {"type": "Polygon", "coordinates": [ring + [ring[0]]]}
+        feats.append({"type": "Feature", "properties": props, "geometry": geom})
+    return ({"type": "FeatureCollection", "features": feats} if feats else None), files
+
+
+def _flag(key: str) -> str:
+    return "--" + key.replace("_", "-")
+
+
+def _text(v: Any) -> str:
+    return repr(float(v)) if isinstance(v, float) else str(v)
+
+
+def cover_command(world: dict[str, Any], cover: dict[str, Any], export: dict[str, Any],
+                  zones: list[str], camera: list[float] | None) -> list[str]:
+    """The ``fm2uav cover`` arguments of a coverage job, run in its folder (files
+    ``area.geojson``, ``zones.geojson``; outputs into ``out``)."""
+    argv = ["fm2uav", "cover"]
+    for key, v in world.items():
+        if v is None or v is False:
+            continue
+        if key == "dem":
+            for d in ([v] if isinstance(v, str) else v):
+                argv += ["--dem", d]
+        elif key == "bbox":
+            argv += ["--bbox", ",".join(_text(float(x)) for x in v)]
+        elif v is True:
+            argv.append(_flag(key))
+        else:
+            argv += [_flag(key), _text(v)]
+    argv += ["--area", "area.geojson"]
+    for key in COVER_FLAGS:
+        if cover.get(key) is not None:
+            argv += [_flag(key), _text(cover[key])]
+    if camera is not None:
+        argv += ["--camera", ",".join(_text(v) for v in camera)]
+    for z in zones:
+        argv += ["--no-fly", z]
+    for key, v in export.items():
+        if key == "speed_changes":
+            argv.append("--speed-changes" if v else "--no-speed-changes")
+        else:
+            argv += [_flag(key), _text(v)]
+    return argv + ["--report", "--out", "out"]
 
 
 def _set(doc: Any, keys: list[Any], value: Any) -> None:
@@ -102,6 +173,42 @@ class Session:
         mission_file = folder / "mission.yaml"
         mission_file.write_text(dump_mission(doc), encoding="utf-8")
         return mission_file, folder / "out"
+
+    def cover_job(self, job_id: str, body: dict[str, Any]) -> dict[str, Any]:
+        """Write a coverage job's files (``area.geojson``, ``zones.geojson``, the mission's
+        world) and return the worker's payload with the equivalent command line."""
+        import json
+        import shlex
+
+        from ..errors import InputError
+
+        folder = self.jobs / job_id
+        folder.mkdir(parents=True, exist_ok=True)
+        doc = body.get("mission") or {}
+        area = body.get("area")
+        if not isinstance(area, list) or len(area) < 3:
+            raise InputError("draw the survey area first (Survey panel: Draw area)")
+        ring = [list(map(float, p)) for p in area]
+        (folder / "area.geojson").write_text(json.dumps({
+            "type": "FeatureCollection", "features": [{
+                "type": "Feature", "properties": {"name": "survey area"},
+                "geometry": {"type": "Polygon", "coordinates": [ring + [ring[0]]]}}]}))
+        zones_doc, zone_files = zones_geojson(doc.get("no_fly_zones") or [])
+        zones = list(zone_files)
+        if zones_doc is not None:
+            (folder / "zones.geojson").write_text(json.dumps(zones_doc))
+            zones.insert(0, "zones.geojson")
+        cover = dict(body.get("cover") or {})
+        camera = cover.pop("camera", None)
+        export = {EXPORT_FLAGS[k]: v for part in ("airframe", "outputs")
+                  for k, v in (doc.get(part) or {}).items() if k in EXPORT_FLAGS}
+        world = dict(doc.get("world") or {})
+        argv = cover_command(world, cover, export, zones, camera)
+        return {"world": world, "area": str(folder / "area.geojson"),
+                "zones": [str(folder / z) for z in zones], "cover": {**cover, "camera": camera},
+                "export": export, "out": str(folder / "out"), "folder": str(folder),
+                "command": f"cd {shlex.quote(str(folder))} && "
+                           + " ".join(shlex.quote(a) for a in argv)}
 
     def save(self, doc: dict[str, Any], target: str | Path) -> Path:
         """Write ``doc`` to ``target`` with the uploaded files it names copied beside it.

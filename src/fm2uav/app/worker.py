@@ -6,6 +6,8 @@ Job kinds (``run_job(kind, payload)``):
   (:func:`fm2uav.io.mission.parse_world`) and build the world
   (:func:`fm2uav.world.load.load_world`), as planning will: its summary, the
   building footprints in lon/lat, the ground range;
+* ``"cover"``: ``fm2uav cover`` on the area and zones files the app wrote
+  (:func:`fm2uav.pipeline.cover.run_cover`), with the photo footprints on the map;
 * ``"plan"``: ``fm2uav run`` on a mission file the app wrote
   (:func:`fm2uav.io.mission.load_mission`, :func:`fm2uav.pipeline.run.run_mission`
   into the job's output folder), then the map document of the result
@@ -100,7 +102,75 @@ def _plan_job(payload: dict[str, Any]) -> dict[str, Any]:
     return {"map": doc, "files": files, "out": str(out)}
 
 
-JOBS = {"world": _world_job, "plan": _plan_job}
+def _cover_job(payload: dict[str, Any]) -> dict[str, Any]:
+    """``fm2uav cover`` on the files the server wrote (the area and the zones as GeoJSON)."""
+    from ..io.mission import parse_world
+    from ..io.outdir import OutputDir
+    from ..io.zone_spec import zones_from_cli
+    from ..missions.coverage import Camera
+    from ..missions.coverage.area import load_area
+    from ..pipeline.cover import COVER_FILES, REPORT, cover_rows, run_cover
+    from ..pipeline.outputs import export_options
+    from ..pipeline.rows import safety_rows
+    from ..planning import FlightLevel
+    from ..planning.params import planner_objects
+    from ..progress import step
+    from ..viz.mapdata import coverage_features, mission_map
+    from ..world.load import load_world, world_summary
+    from ..world.zones import with_zones
+
+    c = payload["cover"]
+    agl = float(c["agl"])
+    limits = {k: float(c[k]) for k in ("min_agl", "max_agl") if c.get(k) is not None}
+    level = FlightLevel(agl=agl, p1=float(c.get("p1", 0.5)), p2=float(c.get("p2", 1.3)),
+                        **limits)
+    cam = None if c.get("camera") is None else Camera(
+        *(float(v) * 1e-3 for v in c["camera"][:3]), *(int(v) for v in c["camera"][3:]))
+    if (c.get("spacing") is None) == (cam is None):
+        from ..errors import InputError
+
+        raise InputError("give exactly one of --spacing (metres) or --camera")
+    d = float(c["spacing"]) if cam is None else cam.spacing(agl, float(c.get("side_overlap", 0)))
+    area_name = Path(payload["area"]).name
+    options = export_options(name=f"coverage of {area_name}", **payload.get("export", {}))
+    step("building the map", 0.1)
+    spec = parse_world(payload["world"], source="world")
+    world = load_world(spec, agl=agl)
+    poly, area_source = load_area(payload["area"], world, crs=spec.crs)
+    if payload.get("zones"):
+        world = with_zones(world, zones_from_cli(payload["zones"], world, crs=spec.crs))
+    shaping = (None if c.get("saturation_distance") is None else
+               planner_objects({"saturation_distance": float(c["saturation_distance"])})[0])
+    step("coverage", 0.9)
+    out = Path(payload["out"])
+    with OutputDir(out, force=True) as outdir:
+        outdir.check(COVER_FILES + (REPORT,))
+        run = run_cover(outdir, world, poly, area_label=area_name, spacing=d, level=level,
+                        options=options, camera=cam,
+                        front_overlap=float(c.get("front_overlap", 0.0)),
+                        trigger_distance=c.get("trigger_distance"), seed=int(c.get("seed", 0)),
+                        shaping=shaping, report=True, summary={
+                            "area": payload["area"], "scenario": spec.describe(),
+                            "world": world_summary(world),
+                            **({"area_source": area_source.as_dict()} if area_source else {})})
+    rows = {**cover_rows(area_name, d, run.coverage, run.built, world),
+            **safety_rows(run.safety)}
+    doc = mission_map(run.coverage.plan, run.built, run.safety,
+                      rows={k: str(v) for k, v in rows.items()})
+    doc["features"] += coverage_features(run.coverage, run.shots, cam)
+    cp = run.coverage
+    doc["summary"].update(
+        area_m2=round(float(cp.zigzag.area.area), 1), bands=int(cp.zigzag.n_bands),
+        spacing_m=round(d, 2), angle_deg=round(cp.zigzag.angle_deg, 3),
+        coverage=round(float(cp.coverage), 4),
+        photos=sum(1 for f in doc["features"] if f["properties"]["kind"] == "photo"),
+        gsd_cm_per_px=run.shots.info.get("gsd_cm_per_px"),
+        trigger_distance_m=run.shots.trigger_distance)
+    files = sorted(f.name for f in out.iterdir() if f.is_file())
+    return {"map": doc, "files": files, "out": str(out), "command": payload.get("command")}
+
+
+JOBS = {"world": _world_job, "plan": _plan_job, "cover": _cover_job}
 
 
 def run_job(kind: str, payload: dict[str, Any], send: Any = None) -> tuple[str, Any]:
@@ -149,9 +219,8 @@ def worker_main(conn: Any) -> None:  # pragma: no cover - runs in the child proc
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)   # Ctrl-C stops the server, which stops us
     try:  # load the planner while the page opens
-        from .. import pipeline  # noqa: F401
-        from ..pipeline import run  # noqa: F401
-        from ..viz import mapdata  # noqa: F401
+        from ..pipeline import cover, run  # noqa: F401
+        from ..viz import coverage, mapdata, report  # noqa: F401
     except Exception:  # noqa: BLE001 - a job will report it
         pass
     while True:

@@ -16,10 +16,12 @@ from typing import Any
 import numpy as np
 
 from .. import progress
+from ..errors import InputError
 from .rows import safety_rows
 
 __all__ = ["OUTPUT_FILES", "EXPORT_FILES", "output_names", "write_exports", "plan_outputs",
-           "to_jsonable", "write_json", "write_text", "write_figure"]
+           "to_jsonable", "write_json", "write_text", "write_figure", "export_options",
+           "parse_anchor"]
 
 #: Export format → file name (:data:`fm2uav.io.exports.EXPORT_FILES`, repeated here so that
 #: importing this module loads no exporter; a test keeps both equal).
@@ -213,3 +215,50 @@ def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
         overlays={**filled_overlay(plan.world), **zone_overlays(zones)})
 
 
+def export_options(base: Any = None, *, firmware: str | None = None, vehicle: str | None = None,
+                   frame: str | None = None, end: str | None = None, thin: float | None = None,
+                   anchor: str | None = None, speed_changes: bool | None = None,
+                   min_speed: float | None = None, cruise_speed: float | None = None,
+                   hover_speed: float | None = None, endurance: float | None = None,
+                   reserve: float | None = None, **more: Any) -> Any:
+    """``base`` (default ``ExportOptions()``) with the settings that were given (None =
+    not given): the command line's mission flags, the app's aircraft and mission fields.
+
+    ``thin`` is the waypoint tolerance [m], ``endurance`` in minutes, ``anchor`` the
+    ``lon,lat[,alt]`` text of ``--anchor``.
+
+    Raises
+    ------
+    InputError
+        A negative tolerance, a non-positive endurance (naming the flag).
+    """
+    from dataclasses import replace
+
+    from ..io import ExportOptions
+
+    given = {"firmware": firmware, "vehicle": vehicle, "frame": frame, "end": end,
+             "tolerance": thin, "anchor": parse_anchor(anchor), "speed_changes": speed_changes,
+             "min_speed": min_speed, "cruise_speed": cruise_speed, "hover_speed": hover_speed,
+             "endurance_s": None if endurance is None else 60.0 * float(endurance),
+             "reserve": reserve, **more}
+    if thin is not None and not thin >= 0:
+        raise InputError(f"--thin must be a tolerance >= 0 m, got {thin}")
+    if endurance is not None and not endurance > 0:
+        raise InputError(f"--endurance must be > 0 minutes, got {endurance}")
+    return replace(base or ExportOptions(), **{k: v for k, v in given.items() if v is not None})
+
+
+def parse_anchor(text: str | None) -> Any:
+    """``"lon,lat[,alt]"`` (``--anchor``) → :class:`~fm2uav.io.Anchor` (None → None)."""
+    if text is None:
+        return None
+    from ..io import Anchor
+
+    try:
+        v = [float(x) for x in text.replace(",", " ").split()]
+    except ValueError:
+        v = []
+    if len(v) not in (2, 3):
+        raise InputError(f"--anchor must be lon,lat or lon,lat,alt (degrees, degrees, "
+                         f"metres), got {text!r}")
+    return Anchor(lon=v[0], lat=v[1], alt=v[2] if len(v) == 3 else 0.0)

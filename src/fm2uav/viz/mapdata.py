@@ -17,7 +17,10 @@ Features (``properties.kind``):
 * ``start``, ``goal``, ``via``: the points asked for;
 * ``zone``: no-fly zones and the operating area (``inclusion``), with floor,
   ceiling, reference and buffer; circles keep ``center`` and ``radius``;
-* ``fence``: the geofence written to the ``.plan`` (polygons and circles).
+* ``fence``: the geofence written to the ``.plan`` (polygons and circles);
+* coverage missions (:func:`coverage_features`): ``area`` (the surveyed polygon),
+  ``band`` (the zigzag's bands as planned) and ``photo`` (the ground footprint of
+  each photo the camera takes, numbered).
 
 ``summary`` holds the operator's figures (length, flight time, waypoints, lowest
 height above ground, nearest zone) and ``rows`` the same summary rows the
@@ -30,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["mission_map", "zone_features", "AGL_COLOURS"]
+__all__ = ["mission_map", "zone_features", "coverage_features", "AGL_COLOURS"]
 
 #: Colour scale of the route by height above ground, as a share of the requested
 #: height (shared with the page's legend): below the floor red, at the level green.
@@ -200,3 +203,41 @@ def mission_map(plan: Any, mission: Any, safety: dict[str, Any] | None = None, *
             "bbox": [round(float(lon.min()), 7), round(float(lat.min()), 7),
                      round(float(lon.max()), 7), round(float(lat.max()), 7)],
             "summary": summary, "rows": dict(rows or {})}
+
+
+def coverage_features(coverage: Any, shots: Any, camera: Any = None, anchor: Any = None
+                      ) -> list[dict[str, Any]]:
+    """GeoJSON features of a coverage mission: the area, the bands and the photo footprints.
+
+    Parameters
+    ----------
+    coverage : fm2uav.missions.coverage.CoveragePlan
+    shots : fm2uav.missions.coverage.triggers.CameraPlan
+    camera : fm2uav.missions.coverage.Camera, optional
+        Gives the footprint size; without it each photo is a square of the trigger
+        distance (the band spacing by default).
+    """
+    from ..missions.coverage.triggers import photo_positions
+
+    world = coverage.plan.world
+    area = coverage.zigzag.area
+    feats: list[dict[str, Any]] = [{
+        "type": "Feature", "properties": {"kind": "area", "area_m2": round(float(area.area), 1)},
+        "geometry": _polygons(world, area, anchor)}]
+    for k, band in enumerate(coverage.zigzag.bands()):
+        xy = np.asarray(band.coords, dtype=float)
+        feats.append({"type": "Feature", "properties": {"kind": "band", "band": k + 1},
+                      "geometry": {"type": "LineString", "coordinates": _ring(world, xy, anchor)}})
+    pts, hdg = photo_positions(coverage.path, shots)
+    agl = float(coverage.level.agl)
+    across, along = (camera.footprint(agl) if camera is not None
+                     else (float(shots.trigger_distance), float(shots.trigger_distance)))
+    for k, (p, h) in enumerate(zip(pts, hdg)):
+        t = np.array([np.cos(h), np.sin(h)])          # along the track
+        n = np.array([-t[1], t[0]])                   # across it
+        c = p[:2]
+        ring = np.array([c + a * along / 2 * t + b * across / 2 * n
+                         for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1), (-1, -1))])
+        feats.append({"type": "Feature", "properties": {"kind": "photo", "photo": k + 1},
+                      "geometry": {"type": "Polygon", "coordinates": [_ring(world, ring, anchor)]}})
+    return feats

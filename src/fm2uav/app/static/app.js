@@ -273,9 +273,11 @@
                             pathOptions: { color: "#c0392b", fillColor: "#e74c3c",
                                            fillOpacity: 0.2, weight: 2 } });
   $("tool-zone-polygon").onclick = () => {
-    setTool(null); map.pm.enableDraw("Polygon", { finishOn: null });
+    setTool(null); S.drawing = "zone"; map.pm.enableDraw("Polygon", { finishOn: null });
   };
-  $("tool-zone-circle").onclick = () => { setTool(null); map.pm.enableDraw("Circle"); };
+  $("tool-zone-circle").onclick = () => {
+    setTool(null); S.drawing = "zone"; map.pm.enableDraw("Circle");
+  };
   let zoneIds = 0;
   function addZone(layer, props) {
     const z = Object.assign({ id: ++zoneIds, layer, name: `zone ${zoneIds}`, floor: null,
@@ -288,8 +290,68 @@
   }
   map.on("pm:create", e => {
     map.removeLayer(e.layer);
-    addZone(e.layer);
+    if (S.drawing === "area") setArea(e.layer); else addZone(e.layer);
+    S.drawing = null;
   });
+  const areaLayer = L.featureGroup().addTo(map);
+  function setArea(layer) {
+    areaLayer.clearLayers();
+    S.area = layer;
+    if (layer) {
+      layer.setStyle({ color: "#1f4e9e", weight: 3, fillColor: "#2b83ba", fillOpacity: 0.08,
+                       dashArray: null });
+      layer.addTo(areaLayer);
+      layer.on("pm:edit", () => { markStale(); areaInfo(); });
+      layer.on("click", () => layer.pm.toggleEdit());
+    }
+    areaInfo(); markStale();
+  }
+  function areaInfo() {
+    if (!S.area) { $("area-info").textContent = "no area drawn"; return; }
+    const ring = S.area.getLatLngs()[0];
+    // planar area on the local tangent plane (display only; the plan measures in the map's CRS)
+    const R = 6371008.8, lat0 = ring[0].lat * Math.PI / 180;
+    const xy = ring.map(p => [R * p.lng * Math.PI / 180 * Math.cos(lat0), R * p.lat * Math.PI / 180]);
+    let a = 0;
+    for (let i = 0; i < xy.length; i++) {
+      const [x1, y1] = xy[i], [x2, y2] = xy[(i + 1) % xy.length];
+      a += x1 * y2 - x2 * y1;
+    }
+    $("area-info").textContent = `area: ${ring.length} corners, about ${(Math.abs(a) / 2e4).toFixed(1)} ha`;
+  }
+  $("tool-area").onclick = () => {
+    setTool(null); S.drawing = "area";
+    map.pm.enableDraw("Polygon", { finishOn: null, pathOptions: { color: "#1f4e9e" } });
+  };
+  $("btn-area-clear").onclick = () => setArea(null);
+  $("c-preset").onchange = () => { $("c-camera").value = $("c-preset").value; markStale(); };
+  $("btn-cover").onclick = async () => {
+    if (!S.dem.length && !S.buildings) { showError("load a world first: add a DEM (World panel)"); return; }
+    if (!S.area) { showError("draw the survey area first (Survey panel: Draw area)"); return; }
+    const cam = $("c-camera").value.trim();
+    const cover = { agl: num("p-agl") };
+    for (const k of ["min_agl", "max_agl", "saturation_distance"]) {
+      const v = num(`p-${k}`); if (v !== undefined) cover[k] = v;
+    }
+    if (cam) {
+      const v = cam.split(/[ ,]+/).filter(Boolean).map(Number);
+      if (v.length !== 5 || v.some(x => !(x > 0))) {
+        showError("camera: give 5 numbers sensor_width_mm,sensor_height_mm,focal_mm,image_width_px,image_height_px (e.g. 13.2,8.8,8.8,5472,3648)");
+        return;
+      }
+      cover.camera = v;
+      for (const k of ["side_overlap", "front_overlap", "trigger_distance"]) {
+        const x = num(`c-${k}`); if (x !== undefined) cover[k] = x;
+      }
+    } else {
+      const d = num("c-spacing");
+      if (d === undefined) { showError("give the band spacing [m] or choose a camera (Survey panel)"); return; }
+      cover.spacing = d;
+      const t = num("c-trigger_distance"); if (t !== undefined) cover.trigger_distance = t;
+    }
+    const area = S.area.getLatLngs()[0].map(p => [p.lng, p.lat]);
+    await runJob({ kind: "cover", mission: missionDoc(), area, cover }, j => showResult(j));
+  };
   function renderZones() {
     const refs = S.choices.reference || ["amsl", "agl"];
     const items = S.zones.map(z => `<li data-id="${z.id}">
@@ -416,7 +478,13 @@
     S.legend = FM2Map.aglLegend(s.requested_agl_m).addTo(map);
     const mins = s.flight_time_s / 60;
     const low = s.requested_agl_m !== null && s.min_agl_m < 0.5 * s.requested_agl_m;
+    const survey = s.photos !== undefined ? [
+      card(`${(s.area_m2 / 1e4).toFixed(1)} ha`, `area, ${(100 * s.coverage).toFixed(1)} % covered`),
+      card(`${s.bands} bands`, `${s.spacing_m} m apart, ${s.angle_deg}°`),
+      card(`${s.photos} photos`, s.gsd_cm_per_px ? `every ${s.trigger_distance_m} m, ${s.gsd_cm_per_px} cm/px` : `every ${s.trigger_distance_m} m`),
+    ] : [];
     $("cards").innerHTML = [
+      ...survey,
       card(`${(s.length_m / 1000).toFixed(2)} km`, "route length"),
       card(`${Math.floor(mins)} min ${Math.round((mins % 1) * 60)} s`, "flight time"),
       card(`${s.items} items`, `${s.waypoints} waypoints · ${s.firmware} ${s.vehicle}`),
@@ -427,11 +495,13 @@
       card(`${s.frame} (${s.mav_frame})`, `altitude frame · end ${s.end}`),
     ].join("");
     const order = ["mission.plan", "mission.waypoints", "path.kml", "path.kmz", "path.geojson",
-                   "report.html", "plan.png", "path.csv", "summary.json"];
+                   "report.html", "plan.png", "coverage.html", "coverage.png", "bands.png",
+                   "path.csv", "zigzag.csv", "summary.json"];
     const names = order.filter(n => r.files.includes(n));
     $("downloads").innerHTML = names.map(n =>
       `<a href="/api/jobs/${job.id}/files/${n}" download="${n}" id="dl-${n.replace(".", "-")}">${n}</a>`)
-      .join("") + `<a href="/api/jobs/${job.id}/mission.yaml" download="mission.yaml" id="dl-mission-yaml">mission.yaml</a>`;
+      .join("") + (job.kind === "plan" ? `<a href="/api/jobs/${job.id}/mission.yaml" download="mission.yaml" id="dl-mission-yaml">mission.yaml</a>` : "");
+    $("command").innerHTML = r.command ? `same files from the command line:<br><code>${esc(r.command)}</code>` : "";
     $("rows").innerHTML = Object.entries(doc.rows).map(([k, v]) =>
       `<tr><td>${esc(k)}</td><td>${esc(v)}</td></tr>`).join("") +
       s.warnings.map(w => `<tr><td>warning</td><td>${esc(w)}</td></tr>`).join("");
@@ -498,11 +568,12 @@
       } else S.fileZones.push(z);
     }
     for (const z of S.zones) { delete z.polygon; delete z.circle; delete z.lonlat; }
-    renderWorldList(); renderPoints(); renderZones();
+    renderWorldList(); renderPoints(); renderZones(); areaInfo();
     for (const id of ["p-agl", "p-min_agl", "p-max_agl", "p-saturation_distance", "a-type",
                       "a-firmware", "a-cruise_speed", "a-hover_speed", "a-endurance",
                       "a-reserve", "o-frame", "o-end", "o-thin_tolerance", "o-speed_changes",
-                      "mission-name"]) {
+                      "mission-name", "c-camera", "c-spacing", "c-side_overlap",
+                      "c-front_overlap", "c-trigger_distance"]) {
       $(id).addEventListener("change", markStale);
     }
     S.ready = true;

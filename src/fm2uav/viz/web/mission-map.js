@@ -59,6 +59,21 @@
         L.geoJSON(f, { style: () => style }).addTo(group);
       }
     }
+    for (const f of feature(doc, "photo")) {
+      L.geoJSON(f, { renderer, style: () => ({ color: "#6a3d9a", weight: 0.6, opacity: 0.55,
+                                                 fillColor: "#cab2d6", fillOpacity: 0.12 }),
+                     interactive: false }).addTo(group);
+    }
+    for (const f of feature(doc, "area")) {
+      L.geoJSON(f, { style: () => ({ color: "#1f4e9e", weight: 3, fill: false }) })
+        .bindTooltip(`survey area, ${(f.properties.area_m2 / 1e4).toFixed(1)} ha`, { sticky: true })
+        .addTo(group);
+    }
+    for (const f of feature(doc, "band")) {
+      L.geoJSON(f, { renderer, interactive: false, style: () => ({ color: "#555", weight: 1,
+                                                                  dashArray: "4 4" }) })
+        .addTo(group);
+    }
     for (const f of feature(doc, "zone")) {
       const p = f.properties;
       const style = p.inclusion
