@@ -24,7 +24,7 @@ def client(tmp_path_factory):
     jobs = JobManager()
     session = Session(root / "session", {"version": 1, "world": {"dem": str(dem)}},
                       root / "mission.yaml")
-    with TestClient(create_app(session, jobs)) as c:
+    with TestClient(create_app(session, jobs), base_url="http://127.0.0.1:8765") as c:
         c.dem, c.root = dem, root
         yield c
     jobs.close()
@@ -119,3 +119,16 @@ def test_bind_listens_on_loopback_only_and_names_the_flag_when_busy():
         sock.close()
     with pytest.raises(InputError, match="--port 70000 is not a TCP port"):
         bind(70000)
+
+
+def test_only_this_machines_pages_may_drive_the_app(client):
+    r = client.get("/api/session", headers={"host": "evil.example:8765"})
+    assert r.status_code == 403 and "127.0.0.1 or localhost" in r.json()["error"]
+    r = client.post("/api/mission/save", json={"mission": {}},
+                    headers={"origin": "http://evil.example"})
+    assert r.status_code == 403
+    r = client.post("/api/mission/save", content='{"mission": {}}',
+                    headers={"content-type": "text/plain"})   # a "simple" cross-site request
+    assert r.status_code == 415
+    ok = client.post("/api/jobs", json={"kind": "x"}, headers={"origin": "http://127.0.0.1:1"})
+    assert ok.status_code == 400

@@ -45,6 +45,9 @@ __all__ = ["create_app"]
 STATIC = Path(str(resources.files("fm2uav.app") / "static"))
 WEB = Path(str(resources.files("fm2uav.viz") / "web"))
 
+#: Host names the app answers to (it listens on 127.0.0.1 only).
+LOCAL_HOSTS = ("127.0.0.1", "localhost", "::1")
+
 #: Choices the page offers (the mission file's allowed values).
 CHOICES = {
     "firmware": ["px4", "ardupilot", "generic"],
@@ -60,6 +63,26 @@ def create_app(session: Any, jobs: Any) -> Any:
     from .terrain import Terrain
 
     app = FastAPI(title="fm2uav", docs_url=None, redoc_url=None, openapi_url=None)
+
+    @app.middleware("http")
+    async def local_only(request: Request, call_next: Any) -> Any:
+        # Only this machine's pages may drive the app: a page from elsewhere that the
+        # browser shows (another site, a rebound DNS name) must not write files or plan.
+        host = (request.headers.get("host") or "").rsplit(":", 1)[0].strip("[]")
+        if host not in LOCAL_HOSTS:
+            return JSONResponse({"error": f"requests to the app must name 127.0.0.1 or "
+                                          f"localhost, not {host!r}"}, status_code=403)
+        if request.method not in ("GET", "HEAD"):
+            origin = request.headers.get("origin")
+            if origin is not None and origin.split("://", 1)[-1].rsplit(":", 1)[0].strip(
+                    "[]") not in LOCAL_HOSTS:
+                return JSONResponse({"error": f"the app takes no requests from {origin}"},
+                                    status_code=403)
+            kind = request.headers.get("content-type", "")
+            if not kind.startswith(("application/json", "multipart/form-data")):
+                return JSONResponse({"error": "the app takes JSON (or a file upload)"},
+                                    status_code=415)
+        return await call_next(request)
     app.mount("/static", StaticFiles(directory=STATIC), name="static")
     app.mount("/web", StaticFiles(directory=WEB), name="web")
     terrains: dict[str, Terrain] = {}
