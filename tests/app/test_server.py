@@ -50,6 +50,7 @@ def test_the_page_its_scripts_and_the_session(client):
     s = client.get("/api/session").json()
     assert s["mission"]["world"]["dem"] == str(client.dem)
     assert s["choices"]["firmware"] == ["px4", "ardupilot", "generic"]
+    assert "disco" in s["choices"]["airframes"]
 
 
 def test_a_world_job_streams_its_progress_then_the_terrain_is_served(client):
@@ -90,6 +91,17 @@ def test_a_plan_job_and_its_files(client):
     for bad in ("..%2Fmission.yaml", "..%2F..%2Fjobs", "nope.plan"):
         assert client.get(f"/api/jobs/{job['id']}/files/{bad}").status_code == 404
     assert client.get("/api/jobs/999").status_code == 404
+    # can an airframe fly it? (fm2uav check on the planned path, the mission's world)
+    check = client.post("/api/jobs", json={"kind": "check", "job": job["id"],
+                                           "airframe": "arducopter"}).json()
+    ev = events(client, check["id"])
+    r = ev[-1]["result"]
+    assert ev[-1]["state"] == "done" and r["feasible"] is True
+    assert r["rows"]["verdict"] == "FEASIBLE" and r["rows"]["airframe"] == "arducopter (multirotor)"
+    flown = r["flown"]["geometry"]["coordinates"]
+    assert len(flown) > 10 and 10.29 < flown[0][0] < 10.37
+    bad = client.post("/api/jobs", json={"kind": "check", "job": "999"}).json()
+    assert "plan or cover first" in bad["error"]
     assert "unknown job kind" in client.post("/api/jobs", json={"kind": "x"}).json()["error"]
 
 

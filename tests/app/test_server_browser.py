@@ -114,6 +114,11 @@ def test_plan_round_a_drawn_zone_download_and_reproduce_with_fm2uav_run(page, ap
     assert downloaded.read_bytes() == (tmp_path / "cli" / "mission.plan").read_bytes()
     plan = json.loads(downloaded.read_text())
     assert plan["fileType"] == "Plan" and len(plan["geoFence"]["polygons"]) == 1
+    # can a multirotor fly it? (fm2uav check in the page)
+    page.select_option("#check-airframe", "arducopter")
+    job = plan_and_wait(page, button="#btn-check", kind="check")
+    assert job["state"] == "done", job["error"]
+    assert page.inner_text("#check-verdict").startswith("FLYABLE")
 
 
 def test_a_point_off_the_map_shows_the_cli_error_in_the_page(page, app_run, tmp_path):

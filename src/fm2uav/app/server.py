@@ -8,7 +8,8 @@ Endpoints (JSON unless said otherwise):
 ``POST /api/upload``                        store a file (multipart ``file``) → ``{path}``
 ``POST /api/jobs``                          ``{kind: "world", world, agl}``,
                                             ``{kind: "plan", mission}`` or
-                                            ``{kind: "cover", mission, area, cover}`` → the job
+                                            ``{kind: "cover", mission, area, cover}`` or
+                                            ``{kind: "check", job, airframe}`` → the job
 ``GET  /api/jobs/{id}``                     the job (state, %, stage, result or error)
 ``GET  /api/jobs/{id}/events``              the job's changes as server-sent events
 ``POST /api/jobs/{id}/cancel``              cancel it
@@ -97,8 +98,12 @@ def create_app(session: Any, jobs: Any) -> Any:
 
     @app.get("/api/session")
     def get_session() -> Any:
+        from ..vehicles import AIRFRAMES
+
         return {"mission": session.mission, "mission_path": str(session.mission_path),
-                "folder": str(session.root), "choices": CHOICES}
+                "folder": str(session.root),
+                "choices": {**CHOICES, "airframes": {k: f"{a.name} ({a.kind})"
+                                                     for k, a in AIRFRAMES.items()}}}
 
     @app.post("/api/upload")
     async def upload(file: UploadFile) -> Any:
@@ -136,7 +141,17 @@ def create_app(session: Any, jobs: Any) -> Any:
                     raise
                 return bad(known[0])
             return jobs.submit("cover", payload, job_id=job_id).public()
-        return bad(f"unknown job kind {kind!r}; allowed: world, plan, cover")
+        if kind == "check":
+            src = jobs.get(str(body.get("job")))
+            if src is None or src.state != "done" or src.kind not in ("plan", "cover"):
+                return bad("plan or cover first: the check flies the last planned path")
+            return jobs.submit("check", {
+                "path": str(Path(src.payload["out"]).parent / "path_m.npy"),
+                "mission_file": src.payload.get("mission_file"),
+                "world": src.payload.get("world"),
+                "agl": (src.payload.get("cover") or {}).get("agl"),
+                "airframe": body.get("airframe") or "arducopter"}).public()
+        return bad(f"unknown job kind {kind!r}; allowed: world, plan, cover, check")
 
     def job_or_404(job_id: str) -> Any:
         job = jobs.get(job_id)

@@ -8,6 +8,8 @@ Job kinds (``run_job(kind, payload)``):
   building footprints in lon/lat, the ground range;
 * ``"cover"``: ``fm2uav cover`` on the area and zones files the app wrote
   (:func:`fm2uav.pipeline.cover.run_cover`), with the photo footprints on the map;
+* ``"check"``: ``fm2uav check`` of a planned path with an airframe
+  (:func:`fm2uav.vehicles.check_feasibility`), the flown track in lon/lat;
 * ``"plan"``: ``fm2uav run`` on a mission file the app wrote
   (:func:`fm2uav.io.mission.load_mission`, :func:`fm2uav.pipeline.run.run_mission`
   into the job's output folder), then the map document of the result
@@ -22,6 +24,8 @@ import traceback
 import warnings
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 __all__ = ["worker_main", "run_job"]
 
@@ -89,6 +93,7 @@ def _plan_job(payload: dict[str, Any]) -> dict[str, Any]:
         outdir.check(output_names(list(dict.fromkeys(m.outputs.formats))))
         run = run_mission(m, outdir, mission_file=mission_file)
     p, rm = run.plan, run.resolved
+    np.save(out.parent / "path_m.npy", np.asarray(p.path, dtype=float))  # for a later check
     rows = {"mission": m.name, "world": run.world_name, **plan_rows(p),
             "legs": len(run.route.legs), **safety_rows(run.info["safety"]),
             **mission_rows(run.built), "time [s]": f"{p.timings['total']:.2f}",
@@ -153,6 +158,7 @@ def _cover_job(payload: dict[str, Any]) -> dict[str, Any]:
                             "area": payload["area"], "scenario": spec.describe(),
                             "world": world_summary(world),
                             **({"area_source": area_source.as_dict()} if area_source else {})})
+    np.save(out.parent / "path_m.npy", np.asarray(run.coverage.path, dtype=float))
     rows = {**cover_rows(area_name, d, run.coverage, run.built, world),
             **safety_rows(run.safety)}
     doc = mission_map(run.coverage.plan, run.built, run.safety,
@@ -170,7 +176,35 @@ def _cover_job(payload: dict[str, Any]) -> dict[str, Any]:
     return {"map": doc, "files": files, "out": str(out), "command": payload.get("command")}
 
 
-JOBS = {"world": _world_job, "plan": _plan_job, "cover": _cover_job}
+def _check_job(payload: dict[str, Any]) -> dict[str, Any]:
+    """``fm2uav check`` of a planned path: can this airframe fly it (Dubins airplane /
+    multirotor tracking), on the world it was planned on."""
+    from ..io.mission import load_mission, parse_world
+    from ..progress import step
+    from ..vehicles import check_feasibility, get_airframe
+    from ..world.geo import to_lonlat
+    from ..world.load import load_world
+
+    af = get_airframe(payload["airframe"])
+    path = np.load(payload["path"])
+    step("building the world", 0.3)
+    if payload.get("mission_file"):
+        world = load_mission(payload["mission_file"]).resolve().world
+    else:
+        spec = parse_world(payload["world"], source="world")
+        world = load_world(spec, agl=payload.get("agl"))
+    step(f"simulating the {af.name} along the path", 0.7)
+    rep = check_feasibility(path, af, world=world, tolerance=float(payload.get("tolerance", 5.0)))
+    flown = np.asarray(to_lonlat(world, rep.tracking.trajectory), dtype=float)
+    return {"feasible": bool(rep.feasible), "reason": rep.reason,
+            "rows": {k: str(v) for k, v in rep.summary_rows(af).items()},
+            "flown": {"type": "Feature", "properties": {"kind": "flown", "airframe": af.name},
+                      "geometry": {"type": "LineString", "coordinates": [
+                          [round(float(a), 7), round(float(b), 7), round(float(c), 1)]
+                          for a, b, c in flown]}}}
+
+
+JOBS = {"world": _world_job, "plan": _plan_job, "cover": _cover_job, "check": _check_job}
 
 
 def run_job(kind: str, payload: dict[str, Any], send: Any = None) -> tuple[str, Any]:

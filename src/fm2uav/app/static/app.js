@@ -471,6 +471,8 @@
   function showResult(job) {
     const r = job.result, doc = r.map, s = doc.summary;
     S.result = Object.assign({ job: job.id }, r); S.stale = false;
+    if (S.flown) { map.removeLayer(S.flown); S.flown = null; }
+    $("check-info").innerHTML = "";
     if (S.resultLayer) map.removeLayer(S.resultLayer);
     S.resultLayer = FM2Map.renderMission(map, doc, { points: false });
     pointLayer.eachLayer(m => m.setZIndexOffset(1000));
@@ -519,6 +521,22 @@
     map.fitBounds([[bb[1], bb[0]], [bb[3], bb[2]]], { padding: [40, 40] });
   }
 
+  // ------------------------------------------------------------------ check
+  $("btn-check").onclick = async () => {
+    if (!S.result) { showError("plan or cover first: the check flies the last planned path"); return; }
+    await runJob({ kind: "check", job: S.result.job, airframe: $("check-airframe").value }, j => {
+      const r = j.result;
+      if (S.flown) map.removeLayer(S.flown);
+      S.flown = L.geoJSON(r.flown, { style: () => ({ color: "#111", weight: 2, dashArray: "6 5" }) })
+        .bindTooltip(`flown by the ${r.flown.properties.airframe} (simulated)`, { sticky: true })
+        .addTo(map);
+      $("check-info").innerHTML = `<div class="card${r.feasible ? "" : " bad"}" id="check-verdict">` +
+        `<div class="v">${r.feasible ? "FLYABLE" : "NOT FLYABLE"}</div><div class="k">${esc(r.reason)}</div></div>` +
+        "<table>" + Object.entries(r.rows).map(([k, v]) =>
+          `<tr><td>${esc(k)}</td><td>${esc(v)}</td></tr>`).join("") + "</table>";
+    });
+  };
+
   // ------------------------------------------------------------------ save
   $("btn-save").onclick = async () => {
     try {
@@ -545,6 +563,8 @@
     const p = b.planner || {};
     for (const k of ["agl", "min_agl", "max_agl", "saturation_distance"]) setNum(`p-${k}`, p[k]);
     const a = b.airframe || {}, o = b.outputs || {};
+    $("check-airframe").innerHTML = Object.entries(s.choices.airframes).map(([k, v]) =>
+      `<option value="${k}" ${k === "arducopter" ? "selected" : ""}>${esc(v)}</option>`).join("");
     fill("a-type", s.choices.vehicle, a.type || "multirotor");
     fill("a-firmware", s.choices.firmware, a.firmware || "px4");
     fill("o-frame", s.choices.frame, o.frame || "auto");
