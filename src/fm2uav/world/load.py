@@ -173,7 +173,8 @@ class WorldSpec(BaseModel):
                 with rasterio.open(path) as ds:
                     crs = ds.crs
             except Exception as exc:  # rasterio raises its own error types
-                raise ValueError(f"cannot be read as a raster ({type(exc).__name__}); "
+                which = "" if isinstance(v, str) else f"{path.name} "  # which of the tiles
+                raise ValueError(f"{which}cannot be read as a raster ({type(exc).__name__}); "
                                  "allowed: a raster file GDAL reads (GeoTIFF, VRT, .hgt)") from None
             if crs is None and (info.data or {}).get("crs") is None:
                 raise ValueError(
