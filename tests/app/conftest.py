@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import re
 import subprocess
+import time
 
 import pytest
 
@@ -18,15 +19,19 @@ def app_run(tmp_path_factory):
     chromium_path()  # skip before starting anything when there is no browser
     root = tmp_path_factory.mktemp("app")
     dem = make_dem(root / "terrain.tif")
-    proc = subprocess.Popen(
-        [*FM2UAV, "app", "--dem", str(dem), "--port", "0", "--no-browser", "--dir",
-         str(root / "session")], cwd=root, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-        text=True, env={**os.environ, "COLUMNS": "200"})
-    line = proc.stdout.readline()
-    url = re.search(r"http://127\.0\.0\.1:\d+/", line)
+    log = root / "app.log"   # a file, not a pipe: the server never blocks on its output
+    with open(log, "w") as out:
+        proc = subprocess.Popen(
+            [*FM2UAV, "app", "--dem", str(dem), "--port", "0", "--no-browser", "--dir",
+             str(root / "session")], cwd=root, stdout=out, stderr=subprocess.STDOUT,
+            text=True, env={**os.environ, "COLUMNS": "200"})
+    url, t0 = None, time.time()
+    while url is None and proc.poll() is None and time.time() - t0 < 60:
+        url = re.search(r"http://127\.0\.0\.1:\d+/", log.read_text())
+        time.sleep(0.1)
     if url is None:
         proc.kill()
-        pytest.fail(f"fm2uav app printed no URL: {line!r} {proc.stdout.read()}")
+        pytest.fail(f"fm2uav app printed no URL: {log.read_text()!r}")
     yield url.group(0), root
     proc.terminate()
     try:
