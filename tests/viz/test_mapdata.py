@@ -26,7 +26,7 @@ def planned(tmp_path_factory):
     shaping, level, opts = m.plan_objects()
     route = plan_route(rm.world, rm.start, rm.goal, via=rm.via, shaping=shaping, level=level,
                        options=opts)
-    from fm2uav.io.fence import zone_fences
+    from fm2uav.autopilot.geofence import zone_fences
 
     fences, _ = zone_fences(rm.world.zones, rm.world, None)
     built, _ = export_mission(route.plan, [], ExportOptions(name="t"), via=route.junctions[1:-1],

@@ -126,7 +126,7 @@ def cover_outputs(outdir: Any, cp, area: str, *, report: bool, title: str,
     comment = georef.comment() if georef is not None else None
     from ..analysis.safety import safety_summary
     from ..io import export_mission
-    from ..io.fence import zone_fences
+    from ..autopilot.geofence import zone_fences
 
     zones = tuple(getattr(world, "zones", ()))
     fences, fence_warnings = (zone_fences(zones, world, getattr(options, "anchor", None))

@@ -129,7 +129,7 @@ def plan_outputs(
     """
     from ..analysis.safety import safety_summary
     from ..io import export_mission
-    from ..io.fence import zone_fences
+    from ..autopilot.geofence import zone_fences
 
     exports = [f for f in formats if f in EXPORT_FILES]
     zones = tuple(getattr(plan.world, "zones", ()))
@@ -234,7 +234,7 @@ def export_options(base: Any = None, *, firmware: str | None = None, vehicle: st
     """
     from dataclasses import replace
 
-    from ..io import ExportOptions
+    from ..autopilot import ExportOptions
 
     given = {"firmware": firmware, "vehicle": vehicle, "frame": frame, "end": end,
              "tolerance": thin, "anchor": parse_anchor(anchor), "speed_changes": speed_changes,

@@ -101,7 +101,7 @@ def _item_features(mission: Any) -> list[dict[str, Any]]:
 
 
 def _fence_features(mission: Any) -> list[dict[str, Any]]:
-    from ..io.geofence import geofence_document
+    from ..io.qgc import geofence_document
 
     doc = geofence_document(getattr(mission, "fences", ()) or ())
     feats = []
