@@ -88,3 +88,9 @@ def purple_pixels(png: bytes) -> int:
     a = np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), dtype=int)
     r, g, b = a[..., 0], a[..., 1], a[..., 2]
     return int(((b - g > 12) & (r - g > 4)).sum())
+
+
+def wait_for_tiles(pg, timeout: float = 30_000) -> None:
+    """Wait until the DEM tiles of the current view have all arrived (before a screenshot)."""
+    pg.wait_for_function("fm2app.terrainLayer && !fm2app.terrainLayer.isLoading()",
+                         timeout=timeout)

@@ -20,7 +20,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from .browser import FM2UAV, SHOTS, click_map, lonlat_at, plan_and_wait, route_pixels
+from .browser import (FM2UAV, SHOTS, click_map, lonlat_at, plan_and_wait, route_pixels,
+                      wait_for_tiles)
 
 #: The route's colour at the requested height above ground (viz/web/mission-map.js).
 ROUTE_GREEN = (26, 150, 65)
@@ -85,6 +86,7 @@ def test_plan_round_a_drawn_zone_download_and_reproduce_with_fm2uav_run(page, ap
     assert page.locator(".fm2-item").count() >= 3             # numbered mission items
     assert page.evaluate("fm2app.job.fraction") == 1.0
 
+    wait_for_tiles(page)
     SHOTS.mkdir(parents=True, exist_ok=True)
     shot = page.screenshot(path=str(SHOTS / "app-plan.png"))
     map_shot = page.locator("#map").screenshot(path=str(SHOTS / "app-plan-map.png"))

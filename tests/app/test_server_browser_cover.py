@@ -8,7 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from .browser import SHOTS, click_map, lonlat_at, plan_and_wait, purple_pixels, route_pixels
+from .browser import (SHOTS, click_map, lonlat_at, plan_and_wait, purple_pixels, route_pixels,
+                      wait_for_tiles)
 
 def test_draw_an_area_and_cover_it_with_a_camera(page):
     page.click("#tool-area")
@@ -36,6 +37,7 @@ def test_draw_an_area_and_cover_it_with_a_camera(page):
                  if f["properties"]["kind"] == "route")
     agl = np.array(route["properties"]["agl"])
     assert np.median(agl) == pytest.approx(80, abs=4)
+    wait_for_tiles(page)
     SHOTS.mkdir(parents=True, exist_ok=True)
     page.screenshot(path=str(SHOTS / "app-cover.png"))
     shot = page.locator("#map").screenshot(path=str(SHOTS / "app-cover-map.png"))

@@ -89,3 +89,12 @@ def test_contours_follow_the_interval(dems):
         pts = np.array([p for line in f["geometry"]["coordinates"] for p in line])
         assert (pts[:, 0] >= w - 1e-3).all() and (pts[:, 0] <= e + 1e-3).all()
         assert (pts[:, 1] >= s - 1e-3).all() and (pts[:, 1] <= n + 1e-3).all()
+
+
+def test_tiles_are_cached(dems, monkeypatch):
+    t = Terrain([str(dems[0])])
+    w, s, e, n = t.bounds
+    tile = TMS.tile((w + e) / 2, (s + n) / 2, 13)
+    first = t.tile_png(tile.x, tile.y, tile.z)
+    monkeypatch.setattr(t, "_render", lambda *a: pytest.fail("rendered twice"))
+    assert t.tile_png(tile.x, tile.y, tile.z) == first

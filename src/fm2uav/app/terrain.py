@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import threading
+from collections import OrderedDict
 from collections.abc import Sequence
 from typing import Any
 
@@ -19,6 +20,8 @@ import numpy as np
 __all__ = ["Terrain"]
 
 TILE = 256
+#: Rendered tiles kept in memory per DEM (~40 kB each).
+CACHED_TILES = 2048
 
 
 class Terrain:
@@ -36,6 +39,7 @@ class Terrain:
 
         self.paths = [str(p) for p in paths]
         self._lock = threading.Lock()
+        self._tiles: OrderedDict[tuple[int, int, int], bytes | None] = OrderedDict()
         lo, hi = math.inf, -math.inf
         boxes = []
         for p in self.paths:
@@ -74,7 +78,21 @@ class Terrain:
         return img
 
     def tile_png(self, x: int, y: int, z: int) -> bytes | None:
-        """Shaded relief PNG of Web Mercator tile ``z/x/y`` (None outside the DEM)."""
+        """Shaded relief PNG of Web Mercator tile ``z/x/y`` (None outside the DEM); the
+        last :data:`CACHED_TILES` are kept, so panning back costs nothing."""
+        key = (z, x, y)
+        with self._lock:
+            if key in self._tiles:
+                self._tiles.move_to_end(key)
+                return self._tiles[key]
+        png = self._render(x, y, z)
+        with self._lock:
+            self._tiles[key] = png
+            while len(self._tiles) > CACHED_TILES:
+                self._tiles.popitem(last=False)
+        return png
+
+    def _render(self, x: int, y: int, z: int) -> bytes | None:
         from rio_tiler.utils import render
 
         from ..viz.terrain import shaded_relief

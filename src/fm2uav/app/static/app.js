@@ -181,6 +181,7 @@
       terrainLayer = L.tileLayer(`/api/terrain/${S.terrain.id}/{z}/{x}/{y}.png`, {
         pane: "terrain", maxZoom: 20, maxNativeZoom: 18, bounds: [[s, w], [n, e]],
         attribution: `DEM: ${S.dem.map(p => p.split("/").pop()).join(", ")}` }).addTo(map);
+      S.terrainLayer = terrainLayer;
       layerCtl.addBaseLayer(terrainLayer, "DEM shaded relief");
       const c = await api(`/api/terrain/${S.terrain.id}/contours`);
       contourLayer = L.geoJSON(c, { interactive: false, style: f => ({
