@@ -12,7 +12,8 @@
   window.fm2app = S;   // for tests and the curious
 
   // ------------------------------------------------------------------ map
-  const map = L.map("map", { zoomControl: true, zoomSnap: 0.25, fadeAnimation: false })
+  // whole zoom levels: at fractional ones the browser leaves hairline gaps between tiles
+  const map = L.map("map", { zoomControl: true, zoomSnap: 1, fadeAnimation: false })
     .setView([20, 0], 2);
   S.map = map;
   L.control.scale({ metric: true, imperial: false, maxWidth: 220, position: "bottomleft" })
