@@ -12,10 +12,13 @@
    An array needs ``transform=`` (or ``bounds=``) and ``crs=``. Rows run
    north → south, as in every north-up raster; :func:`from_lonlat_grid` takes
    lon/lat vectors in any order instead.
-2. **Sanity.** Elevations below :data:`MIN_ELEVATION` (-500 m) or above
-   :data:`MAX_ELEVATION` (9000 m) that are not masked are refused: they are
-   almost always an undeclared nodata value (-9999, -32768, 32767), and the
-   message says how to declare it (``world.nodata_value`` / ``--nodata-value``).
+2. **What the numbers mean** (:mod:`fm2uav.world.dem_values`), in this order:
+   crop (the bbox window) → nodata (declared, ``nodata_value``, and undeclared
+   sentinels such as -32768 found and announced) → ``sea_level`` clamp →
+   plausibility judged by *slope* (a step no terrain on Earth can make is a data
+   error; a real sea floor or a 500 m rise over a 2 km pixel is terrain).
+   Rasters that are not elevation (RGB/palette images, complex bands, units
+   that are not lengths) are refused before their pixels are read.
 3. **CRS** (:func:`fm2uav.world.geo.local_metric_crs`). The world is built in
    a metric CRS where lengths are true to 0.5 %: the DEM's own if projected
    and that accurate over the area, else the local UTM zone (geographic DEMs,
@@ -28,11 +31,18 @@
    surrounding pixel centres (``XSCALE=YSCALE=1``: the point value, no
    low-pass kernel when the cells are coarser than the pixels).
 5. **Nodata.** A node is *missing* if any of its four pixels is masked (the
-   validity mask is reprojected alongside the heights). ``nodata="error"``
-   (default) refuses such a DEM with the count and the first missing node's
-   lon/lat; ``nodata="fill"`` keeps GDAL's value from the valid pixels, or the
-   nearest valid node's elevation where there is none, and marks every such
-   node in ``World.filled`` (refused if more than half the nodes are missing).
+   validity mask is reprojected alongside the heights). ``fill`` lists more DEMs
+   in priority order (a 30 m national model under a 1 m survey,
+   :mod:`fm2uav.world.dem_stack`): a node missing in one is taken from the next
+   that measures it. What no DEM measures is *unknown ground*:
+   ``nodata="error"`` (default) refuses such a DEM with the count and the first
+   missing node's lon/lat; ``nodata="fill"`` and ``nodata="error_on_route"``
+   keep GDAL's value from the valid pixels, or the nearest valid node's
+   elevation where there is none, and mark every such node in ``World.filled``
+   (refused if more than half the nodes are missing); the safety figures then
+   split every path into "over measured ground" and "over filled ground", and
+   ``error_on_route`` refuses a plan that crosses filled ground
+   (:mod:`fm2uav.analysis.known_ground`).
 6. **Sea.** With ``sea_level`` [m], the ground is ``max(DEM, sea_level)`` (a
    topo-bathymetric DEM is flown over the water, not the sea floor). Without
    it, a DEM with ground below 0 m gets a :class:`GeodataWarning` naming the
@@ -59,6 +69,14 @@ import numpy as np
 from scipy import ndimage
 
 from ..errors import InputError, WorldError
+from .dem_values import (
+    Sentinel,
+    check_plausible,
+    find_sentinels,
+    length_unit_factor,
+    pixel_sizes,
+    raster_problem,
+)
 from .geo import (
     MAX_SCALE_ERROR,
     WGS84,
@@ -73,6 +91,7 @@ from .geo import (
     sha256_file,
     transformer,
 )
+from .quiet import GeodataWarning, library_warnings
 
 __all__ = [
     "from_dem",
@@ -80,31 +99,27 @@ __all__ = [
     "read_dem",
     "DemRaster",
     "GeodataWarning",
-    "MIN_ELEVATION",
-    "MAX_ELEVATION",
+    "NODATA_RULES",
+    "SEA_LEVEL_RANGE",
 ]
 
-#: Elevations outside [MIN_ELEVATION, MAX_ELEVATION] m are taken for undeclared
-#: nodata (the Dead Sea shore is at -430 m, Everest at 8849 m).
-MIN_ELEVATION = -500.0
-MAX_ELEVATION = 9000.0
+#: The rules for DEM gaps under the map (``world.nodata`` / ``--nodata``).
+NODATA_RULES = ("error", "fill", "error_on_route")
+#: Accepted ``sea_level`` values [m] (the Dead Sea shore is at -430 m).
+SEA_LEVEL_RANGE = (-500.0, 9000.0)
 
 _CRS_HINT = "world.crs (CLI --crs)"
-_FEET = {"ft", "foot", "feet", "us survey foot", "us-ft", "us_survey_foot", "foot_us"}
-
-
-class GeodataWarning(UserWarning):
-    """Something in the input data deserves the operator's attention (not an error)."""
 
 
 @dataclasses.dataclass(frozen=True)
 class DemRaster:
-    """A north-up raster read by :func:`read_dem`.
+    """A raster read by :func:`read_dem` (north-up or with a rotated geotransform).
 
     Attributes
     ----------
     z : ndarray (rows, cols)
-        Elevations [m] (scale/offset and unit applied), NaN where masked.
+        Elevations [m] (scale/offset and unit applied, nodata and undeclared
+        sentinels NaN, ``sea_level`` applied).
     transform : 6 floats
         Affine ``(a, b, c, d, e, f)`` from (col, row) pixel-corner coordinates
         to CRS x/y.
@@ -116,6 +131,10 @@ class DemRaster:
         What the elevations are when no vertical CRS is declared.
     sources : tuple of SourceFile
         The files read (empty for an array).
+    undeclared : tuple of Sentinel
+        Undeclared nodata values found (and taken as nodata).
+    label : str
+        What the raster is, for messages (``"the DEM dem.tif"``).
     """
 
     z: np.ndarray
@@ -124,6 +143,8 @@ class DemRaster:
     vertical_crs: str | None = None
     vertical_note: str = ""
     sources: tuple[SourceFile, ...] = ()
+    undeclared: tuple[Sentinel, ...] = ()
+    label: str = "the DEM"
 
 
 def _affine(transform: Any) -> tuple[float, ...]:
@@ -151,69 +172,12 @@ def _split_crs(crs: Any) -> tuple[Any, str | None, float]:
     return c, vname, factor
 
 
-def _band_unit_factor(unit: str | None) -> float:
-    u = (unit or "").strip().lower()
-    if u in _FEET:
-        return 0.3048006096 if "us" in u else 0.3048
-    return 1.0
-
-
-#: A pixel higher (or lower) than every one of its (at least 3 valid) neighbours by
-#: more than this [m] is an isolated spike (a glitch or undeclared nodata), refused.
-SPIKE_HEIGHT = 250.0
-
-
-def _check_spikes(z: np.ndarray, where: str) -> None:
-    """Refuse isolated one-pixel spikes/pits (issue 17: no silent wrong worlds)."""
-    if z.size > 50_000_000 or min(z.shape) < 2:
-        return
-    pad = np.pad(z.astype(float), 1, constant_values=np.nan)
-    rows, cols = z.shape
-    nb = [pad[1 + di:1 + di + rows, 1 + dj:1 + dj + cols]
-          for di in (-1, 0, 1) for dj in (-1, 0, 1) if (di, dj) != (0, 0)]
-    with np.errstate(invalid="ignore"), warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        stack = np.stack(nb)
-        hi = np.nanmax(stack, axis=0)
-        lo = np.nanmin(stack, axis=0)
-        count = np.isfinite(stack).sum(axis=0)
-        spike = np.isfinite(z) & (count >= 3) & (
-            (z - hi > SPIKE_HEIGHT) | (lo - z > SPIKE_HEIGHT))
-    n = int(spike.sum())
-    if n == 0:
-        return
-    r, c = (int(k[0]) for k in np.nonzero(spike))
-    raise WorldError(
-        f"{where} has {n} isolated spike(s)/pit(s): pixel (row {r}, col {c}) is "
-        f"{float(z[r, c]):g} m while its neighbours lie between {float(lo[r, c]):g} and "
-        f"{float(hi[r, c]):g} m (a single pixel more than {SPIKE_HEIGHT:g} m above/below all "
-        "its neighbours is a data error, not terrain); fix or mask it in the file (gdal_calc), "
-        "or declare its value as nodata with world.nodata_value (CLI --nodata-value) and "
-        "world.nodata: fill (CLI --nodata fill)")
-
-
-def _check_values(z: np.ndarray, where: str) -> None:
-    """Refuse elevations that look like undeclared nodata or a wrong unit, and isolated
-    spikes (:data:`SPIKE_HEIGHT`)."""
-    finite = z[np.isfinite(z)]
-    bad = finite[(finite < MIN_ELEVATION) | (finite > MAX_ELEVATION)]
-    if bad.size == 0:
-        _check_spikes(z, where)
-        return
-    vals, counts = np.unique(bad, return_counts=True)
-    v = float(vals[np.argmax(counts)])
-    n = int(counts.max())
-    side = f"below {MIN_ELEVATION:g} m" if v < MIN_ELEVATION else f"above {MAX_ELEVATION:g} m"
-    if n * 2 >= bad.size:
-        raise WorldError(
-            f"{where} has {bad.size} pixel(s) {side}, {n} of them exactly {v:g}, which looks like "
-            f"an undeclared nodata value; declare it with world.nodata_value: {v:g} (CLI "
-            f"--nodata-value {v:g}) or in the file (gdal_edit.py -a_nodata {v:g} FILE)")
-    raise WorldError(
-        f"{where} has {bad.size} pixel(s) {side} (from {float(bad.min()):g} to "
-        f"{float(bad.max()):g} m), which is no terrain on Earth; are the elevations in another "
-        "unit (feet, centimetres) or is nodata undeclared? Fix the file (gdal_edit.py -scale / "
-        "-a_nodata) or declare the nodata value with world.nodata_value (CLI --nodata-value)")
+def _json_number(v: Any) -> Any:
+    """A nodata value for JSON: NaN and infinities as text (``"nan"``), numbers as they are."""
+    if v is None:
+        return None
+    f = float(v)
+    return f if np.isfinite(f) else str(f)
 
 
 def _bbox_in(crs: Any, bbox: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
@@ -253,25 +217,64 @@ def _rect_in(rect: tuple[float, float, float, float], rect_crs: Any, crs: Any
     return float(u.min()), float(v.min()), float(u.max()), float(v.max())
 
 
-def _read_files(paths: list[Path], crs: Any, nodata: float | None,
-                bbox: tuple[float, float, float, float] | None, window_crs: Any = None
-                ) -> tuple[np.ndarray, tuple[float, ...], Any, str | None, str, list[SourceFile]]:
+@dataclasses.dataclass
+class _Raw:
+    """Stored numbers of a raster (NaN where masked) and how they become metres."""
+
+    z: np.ndarray
+    transform: tuple[float, ...]
+    h_crs: Any
+    vname: str | None
+    note: str
+    sources: list[SourceFile]
+    scale: float = 1.0
+    offset: float = 0.0
+    factor: float = 1.0
+    dtype: Any = None
+
+    def metres(self, v: np.ndarray) -> np.ndarray:
+        """Stored values → elevations [m]."""
+        return (np.asarray(v, dtype=float) * self.scale + self.offset) * self.factor
+
+
+def _open_dem(p: Path) -> Any:
+    """An open rasterio dataset of a DEM file, refused when it is not one."""
     import rasterio
     from rasterio.errors import RasterioIOError
 
+    from .. import _validate as v
+
+    if not p.exists():
+        raise InputError(f"cannot read the DEM {str(p)!r}: the file does not exist; "
+                         "check world.dem / --dem")
+    v.input_file(p, "the DEM", where=("world.dem", "--dem"))  # no folder / pipe
+    try:
+        ds = rasterio.open(p)
+    except RasterioIOError as exc:
+        raise InputError(f"cannot read the DEM {str(p)!r}: {exc}") from None
+    problem = raster_problem(ds, p)
+    if problem is not None:
+        ds.close()
+        raise InputError(problem)
+    return ds
+
+
+def _half_float(ds: Any) -> bool:
+    """Whether a float32 band is stored as half-precision floats (float16, NBITS=16)."""
+    try:
+        nbits = ds.tags(1, ns="IMAGE_STRUCTURE").get("NBITS") or \
+            ds.tags(ns="IMAGE_STRUCTURE").get("NBITS")
+    except Exception:  # drivers without the namespace
+        nbits = None
+    return str(ds.dtypes[0]) == "float32" and str(nbits) == "16"
+
+
+def _read_files(paths: list[Path], crs: Any, bbox: tuple[float, float, float, float] | None,
+                window_crs: Any = None) -> _Raw:
     datasets = []
     try:
         for p in paths:
-            if not p.exists():
-                raise InputError(f"cannot read the DEM {str(p)!r}: the file does not exist; "
-                                 "check world.dem / --dem")
-            from .. import _validate as v
-
-            v.input_file(p, "the DEM", where=("world.dem", "--dem"))  # no folder / pipe
-            try:
-                datasets.append(rasterio.open(p))
-            except RasterioIOError as exc:
-                raise InputError(f"cannot read the DEM {str(p)!r}: {exc}") from None
+            datasets.append(_open_dem(p))
         crss = _tile_crss(paths, datasets, crs)
         scales = {(float(ds.scales[0] or 1.0), float(ds.offsets[0] or 0.0)) for ds in datasets}
         if len(scales) > 1:
@@ -279,7 +282,7 @@ def _read_files(paths: list[Path], crs: Any, nodata: float | None,
                 f"the DEM tiles have different scale/offset values {sorted(scales)}; unscale them "
                 "first (gdal_translate -unscale) so that one merge applies to all")
         scale, offset = scales.pop()
-        units = {_band_unit_factor(ds.units[0] if ds.units else None) for ds in datasets}
+        units = {length_unit_factor(ds.units[0] if ds.units else None) for ds in datasets}
         unit_factor = units.pop() if len(units) == 1 else None
         if unit_factor is None:
             raise WorldError("the DEM tiles have different elevation units; convert them to "
@@ -292,32 +295,34 @@ def _read_files(paths: list[Path], crs: Any, nodata: float | None,
             # source window that covers all of it (a rotated rectangle in the source CRS)
             bx = (_bbox_in(h_crs, bbox) if window_crs is None
                   else _rect_in(_bbox_in(window_crs, bbox), window_crs, h_crs))
-            res = max(abs(first.transform.a), abs(first.transform.e))
+            t0 = first.transform
+            res = max(np.hypot(t0.a, t0.d), np.hypot(t0.b, t0.e))  # rotated: its own axes
             window_bounds = (bx[0] - 2 * res, bx[1] - 2 * res, bx[2] + 2 * res, bx[3] + 2 * res)
         if len(datasets) == 1:
             z, t = _read_one(first, paths[0], window_bounds, bbox, h_crs)
         else:
             z, t = _merge_tiles(datasets, window_bounds, bbox, h_crs)
-        if nodata is not None and np.isfinite(nodata):
-            # an undeclared nodata value, given by the user, compared on the stored numbers
-            raw = z
-            z = np.where(raw == nodata, np.nan, raw)
-        z = z * scale + offset
         factor = unit_factor if unit_factor != 1.0 else vfactor
-        z = z * factor
+        half = _half_float(first)
         sources = []
         for p, ds in zip(paths, datasets):
+            t1 = ds.transform
             sources.append(SourceFile(
                 path=str(p), role="dem", sha256=sha256_file(p), crs=crs_label(crss[0]),
                 crs_rule="declared by the file" if ds.crs is not None else "given (world.crs / --crs)",
                 details={"driver": ds.driver, "size_px": [ds.height, ds.width],
-                         "pixel_size": [abs(ds.transform.a), abs(ds.transform.e)],
+                         "pixel_size": [float(np.hypot(t1.a, t1.d)), float(np.hypot(t1.b, t1.e))],
+                         "dtype": "float16" if _half_float(ds) else str(ds.dtypes[0]),
+                         **({"rotation_deg": round(float(np.degrees(np.arctan2(t1.d, t1.a))), 3)}
+                            if t1.b or t1.d else {}),
                          **({"scale": scale, "offset": offset}
                             if (scale, offset) != (1.0, 0.0) else {}),
                          **({"unit_factor": factor} if factor != 1.0 else {}),
-                         **({"nodata": ds.nodata} if ds.nodata is not None else {})}))
+                         **({"nodata": _json_number(ds.nodata)} if ds.nodata is not None
+                            else {})}))
         note = _vertical_note(first.driver)
-        return z, tuple(t)[:6], h_crs, vname, note, sources
+        return _Raw(z, tuple(t)[:6], h_crs, vname, note, sources, scale, offset, factor,
+                    "float16" if half else first.dtypes[0])
     finally:
         for ds in datasets:
             ds.close()
@@ -422,15 +427,17 @@ def _no_overlap(bbox: Any, crs: Any, bounds: tuple[float, float, float, float]) 
             "world.bbox (CLI --bbox W,S,E,N, lon/lat)")
 
 
-def _read_array(source: Any, crs: Any, transform: Any, bounds: Any, nodata: float | None,
-                ) -> tuple[np.ndarray, Any, Any, str | None, str]:
-    """Elevations [m] of an in-memory DEM, its pixel transform, horizontal CRS, vertical CRS, note."""
+def _read_array(source: Any, crs: Any, transform: Any, bounds: Any) -> _Raw:
+    """The stored numbers of an in-memory DEM, its pixel transform and CRSs."""
     try:
-        z = np.array(source, dtype=float)
+        arr = np.asarray(source)
+        z = np.array(arr, dtype=float)
     except (TypeError, ValueError):
         raise InputError(
             f"DEM must be a raster file path (or a list of tiles) or a 2D array of "
             f"elevations, got {type(source).__name__}") from None
+    if np.iscomplexobj(arr):
+        raise InputError("the DEM array is complex, not elevations; give real elevations [m]")
     if z.ndim != 2:
         raise InputError(f"DEM array must be 2D (rows, cols), got shape {z.shape}")
     if transform is not None:
@@ -448,11 +455,47 @@ def _read_array(source: Any, crs: Any, transform: Any, bounds: Any, nodata: floa
             "the DEM has no coordinate reference system; pass crs= (e.g. crs='EPSG:4326' "
             "for longitude/latitude degrees or the EPSG code of its projection)")
     h_crs, vname, vfactor = _split_crs(crs)
-    z = z.copy()
-    if nodata is not None and np.isfinite(nodata):
-        z[z == nodata] = np.nan
-    z = z * vfactor
-    return z, t, h_crs, vname, _vertical_note("")
+    return _Raw(z.copy(), t, h_crs, vname, _vertical_note(""), [], factor=vfactor,
+                dtype=arr.dtype)
+
+
+def _lonlat_of(t: tuple[float, ...], h_crs: Any) -> Any:
+    """``(row, col)`` → ``"lon ..., lat ..."`` of a pixel centre, for messages."""
+    a, b, c, d, e, f = t
+
+    def locate(r: int, col: int) -> str:
+        x = a * (col + 0.5) + b * (r + 0.5) + c
+        y = d * (col + 0.5) + e * (r + 0.5) + f
+        lon, lat = transformer(h_crs, WGS84).transform(x, y)
+        return f"lon {float(lon):.5f}, lat {float(lat):.5f}"
+    return locate
+
+
+def _undeclared(raw: _Raw, where: str) -> tuple[Sentinel, ...]:
+    """Find undeclared nodata values in ``raw`` (set to NaN) and say so once."""
+    dx, dy = pixel_sizes(raw.transform, raw.h_crs, raw.z.shape)
+    mask, found = find_sentinels(raw.z, None if raw.dtype == "float16" else raw.dtype,
+                                 raw.metres, dx, dy)
+    if found:
+        raw.z[mask] = np.nan
+        v = found[0].value
+        warnings.warn(
+            f"{where} holds {', '.join(s.describe() for s in found)}: nodata the file does not "
+            f"declare, taken as nodata (world.nodata decides what happens under the map); "
+            f"declare it to say so (gdal_edit.py -a_nodata {v:g} FILE, or world.nodata_value: "
+            f"{v:g}, CLI --nodata-value {v:g})", GeodataWarning, stacklevel=3)
+    return tuple(found)
+
+
+def _half_float_note(z: np.ndarray, where: str) -> None:
+    """Warn when half-precision floats round the highest ground to more than a metre."""
+    top = float(np.nanmax(np.abs(z)))
+    step = float(np.spacing(np.float16(top))) if np.isfinite(top) else 0.0
+    if step > 1.0:
+        warnings.warn(
+            f"{where} stores half-precision floats (float16): elevations near {top:.0f} m are "
+            f"rounded to steps of {step:g} m; the heights above ground inherit that rounding",
+            GeodataWarning, stacklevel=3)
 
 
 def _corners(t: tuple[float, ...], shape: tuple[int, int], h_crs: Any,
@@ -482,8 +525,9 @@ def read_dem(
     nodata: float | None = None,
     bbox: Sequence[float] | None = None,
     window_crs: Any = None,
+    sea_level: float | None = None,
 ) -> DemRaster:
-    """Read a DEM into a :class:`DemRaster` (masked pixels → NaN).
+    """Read a DEM into a :class:`DemRaster`: crop → nodata → sea level → plausibility.
 
     Parameters
     ----------
@@ -500,20 +544,26 @@ def read_dem(
         Raster edges in CRS units, instead of ``transform`` for an array.
     nodata : float, optional
         A value meaning "missing" that the file does not declare (besides its
-        own nodata, mask and alpha bands, and NaN).
+        own nodata, mask and alpha bands, NaN, and the sentinels found by
+        :func:`fm2uav.world.dem_values.find_sentinels`).
     bbox : (west, south, east, north), optional
         Lon/lat degrees: read only the window covering this box (files).
     window_crs : optional
         The CRS the box will be used in (the world's): the window then covers
         the box's outer rectangle in that CRS.
+    sea_level : float, optional
+        Water surface [m]: measured pixels below it are raised to it.
 
     Raises
     ------
     InputError
-        Unreadable file, bad array or placement, bbox outside the DEM.
+        Unreadable file, not an elevation raster (RGB/palette image, complex
+        band, a unit that is no length), bad array or placement, bbox outside
+        the DEM.
     WorldError
         Missing or conflicting CRS, tiles in different CRSs, coordinates that
-        do not fit the CRS, implausible elevations (undeclared nodata).
+        do not fit the CRS, elevations no terrain on Earth has
+        (:func:`fm2uav.world.dem_values.check_plausible`).
     """
     box = None if bbox is None else check_lonlat_bbox(bbox, "world.bbox (--bbox)")
     paths: list[Path] | None = None
@@ -522,36 +572,45 @@ def read_dem(
     elif isinstance(source, (list, tuple)) and source and all(
             isinstance(s, (str, PathLike)) for s in source):
         paths = [Path(s) for s in source]
-    vname: str | None = None
-    note = ""
-    sources: list[SourceFile] = []
     if paths is not None:
-        z, t, h_crs, vname, note, sources = _read_files(paths, crs, nodata, box, window_crs)
+        raw = _read_files(paths, crs, box, window_crs)
         if transform is not None:
-            t = _affine(transform)
+            raw.transform = _affine(transform)
         where = f"the DEM {paths[0]}" + (f" (+{len(paths) - 1} tiles)" if len(paths) > 1 else "")
     else:
-        z, t, h_crs, vname, note = _read_array(source, crs, transform, bounds, nodata)
+        raw = _read_array(source, crs, transform, bounds)
         where = "the DEM array"
+    z = raw.z
     if z.size < 4 or min(z.shape) < 2:
         raise InputError(f"DEM must have at least 2 x 2 pixels, got {z.shape}")
     z[~np.isfinite(z)] = np.nan
-    t = _affine(t)
+    t = _affine(raw.transform)
+    t, xs, ys = _corners(t, z.shape, raw.h_crs)
+    raw.transform = t
+    if nodata is not None and np.isfinite(nodata):
+        z[z == nodata] = np.nan  # the user's nodata value, on the stored numbers
+    found = _undeclared(raw, where) if np.isfinite(z).any() else ()
     if not np.isfinite(z).any():
         raise WorldError(f"{where} has no valid elevation (every pixel is nodata) in the area read; "
                          "check the file, world.nodata_value and world.bbox")
-    t, xs, ys = _corners(t, z.shape, h_crs)
-    if h_crs.is_geographic and xs.min() < 180.0 < xs.max():
+    if raw.h_crs.is_geographic and xs.min() < 180.0 < xs.max():
         raise WorldError(
             f"{where} crosses the antimeridian (longitudes {xs.min():g}..{xs.max():g}); crop it "
             "with world.bbox (CLI --bbox) to one side, or shift it (gdalwarp --config "
             "CENTER_LONG 180)")
-    check_fit((xs.min(), ys.min(), xs.max(), ys.max()), h_crs,
+    check_fit((xs.min(), ys.min(), xs.max(), ys.max()), raw.h_crs,
               "declared by the file" if paths is not None else "given", where,
               f"{_CRS_HINT}, or fix the file (gdal_edit.py -a_srs)")
-    _check_values(z, where)
-    return DemRaster(z=z, transform=t, crs=h_crs.to_wkt(), vertical_crs=vname,
-                     vertical_note=note, sources=tuple(sources))
+    z = raw.metres(z)
+    if raw.dtype == "float16":
+        _half_float_note(z, where)
+    if sea_level is not None:
+        z = np.where(np.isfinite(z), np.maximum(z, float(sea_level)), np.nan)
+    dx, dy = pixel_sizes(t, raw.h_crs, z.shape)
+    check_plausible(z, dx, dy, where, _lonlat_of(t, raw.h_crs))
+    return DemRaster(z=z, transform=t, crs=raw.h_crs.to_wkt(), vertical_crs=raw.vname,
+                     vertical_note=raw.note, sources=tuple(raw.sources), undeclared=found,
+                     label=where)
 
 
 def _footprint_lonlat(dem: DemRaster) -> tuple[float, float, float, float]:
@@ -597,6 +656,7 @@ def from_dem(
     cell_size: float | tuple[float, float, float],
     ceiling: float | None = None,
     *,
+    fill: Sequence[Any] = (),
     crs: Any = None,
     transform: Any = None,
     bounds: Any = None,
@@ -613,19 +673,29 @@ def from_dem(
     Parameters
     ----------
     source : str, PathLike, list of paths, or array_like (rows, cols)
-        Raster file(s) GDAL reads, or an elevation array [m] (rows north → south).
+        Raster file(s) GDAL reads (several = tiles of one DEM, merged), or an
+        elevation array [m] (rows north → south).
     cell_size : float or (dx, dy, dz)
         Node spacing of the world [m]; one number for all axes.
     ceiling : float, optional
         Altitude [m, DEM datum] of the top node; default: highest ground +
         ``max(20 dz, agl + 10 dz)``, and at least ``top + 5 dz``.
+    fill : sequence, optional
+        More DEMs in priority order (each a file, a list of tiles, or a
+        :class:`DemRaster`), in any CRS and resolution: a node ``source`` does
+        not measure takes its height from the first of them that does
+        (:mod:`fm2uav.world.dem_stack`). Without ``bbox`` the map is ``source``'s
+        footprint; with it, every DEM's footprint inside the box.
     crs, transform, bounds :
-        Placement of an array, or the CRS of a file that declares none; see
+        Placement of an array, or the CRS of files that declare none; see
         :func:`read_dem`.
-    nodata : {"error", "fill"}
-        What to do with nodes that touch masked pixels. Default "error".
+    nodata : {"error", "fill", "error_on_route"}
+        Nodes no DEM measures: refused (default), or filled (nearest measured
+        node) and marked in ``World.filled``; ``"error_on_route"`` also fills,
+        and the commands refuse a plan that flies over them
+        (:func:`fm2uav.analysis.known_ground.check_known_ground`).
     nodata_value : float, optional
-        An undeclared elevation value meaning "missing" (e.g. -9999).
+        An undeclared elevation value meaning "missing" (e.g. -9999), in every DEM.
     bbox : (west, south, east, north), optional
         Crop to this lon/lat box [deg].
     sea_level : float, optional
@@ -642,22 +712,69 @@ def from_dem(
     World
         With ``terrain`` (resampled elevations), ``crs`` (metric CRS of x/y),
         ``origin`` in that CRS [m], ``filled`` (nodes whose elevation was
-        filled) and ``georef``.
+        filled), ``georef`` and ``ground`` (the DEMs at their own resolution).
 
     Raises
     ------
     WorldError
-        No/unknown/wrong CRS, nodata under the map, ceiling not above the ground.
+        No/unknown/wrong CRS, nodata under the map, ceiling not above the ground,
+        elevations no terrain has.
     InputError
-        Bad cell size or arguments.
+        Bad cell size or arguments, a raster that is not elevation.
     """
-    from .world import World
-
     dx, dy, dz = _check_dem_args(cell_size, nodata, sea_level)
     box = None if bbox is None else check_lonlat_bbox(bbox, "world.bbox (--bbox)")
+    fills = list(fill or ())
+    with library_warnings(_describe(source) + (f" and {len(fills)} fill DEM(s)" if fills
+                                                else "")):
+        return _build(source, fills, (dx, dy, dz), ceiling, crs=crs, transform=transform,
+                      bounds=bounds, nodata=nodata, nodata_value=nodata_value, box=box,
+                      sea_level=sea_level, agl=agl, top=top, name=name)
+
+
+def _describe(source: Any) -> str:
+    """``"the DEM dem.tif"`` (or tiles / an array), for messages."""
+    if isinstance(source, (str, PathLike)):
+        return f"the DEM {Path(source).name}"
+    if isinstance(source, DemRaster):
+        return source.label
+    if isinstance(source, (list, tuple)) and source and isinstance(source[0], (str, PathLike)):
+        return f"the DEM {Path(source[0]).name} (+{len(source) - 1} tiles)"
+    return "the DEM array"
+
+
+def _read_fill(f: Any, k: int, crs: Any, nodata_value: float | None, box: Any, dst: Any,
+               sea_level: float | None) -> DemRaster:
+    """The ``k``-th fill DEM (a file, tiles or a DemRaster), read in the world's window."""
+    if isinstance(f, DemRaster):
+        return f
+    try:
+        d = read_dem(f, crs=crs, nodata=nodata_value, bbox=box, window_crs=dst,
+                     sea_level=sea_level)
+    except InputError as exc:
+        if "does not overlap" not in str(exc):
+            raise
+        raise InputError(f"world.dem_fill (CLI --dem-fill) number {k + 1}, {_describe(f)}, "
+                         f"does not overlap the map, so it fills no gap; remove it or give a "
+                         f"DEM of the mission area ({exc})") from None
+    return dataclasses.replace(d, sources=tuple(
+        dataclasses.replace(s_, role="dem_fill") for s_ in d.sources))
+
+
+def _build(source: Any, fills: list[Any], cell: tuple[float, float, float],
+           ceiling: float | None, *, crs: Any, transform: Any, bounds: Any, nodata: str,
+           nodata_value: float | None, box: Any, sea_level: float | None, agl: float | None,
+           top: float | None, name: str) -> Any:
+    """:func:`from_dem` once its arguments are checked (library warnings captured)."""
+    from .dem_stack import DATUM_WARNING_M, composite
+    from .geo import bounds_lonlat
+    from .world import World
+
+    dx, dy, dz = cell
     pre = _bbox_metric_crs(source, crs, box)
-    dem = read_dem(source, crs=crs, transform=transform, bounds=bounds, nodata=nodata_value,
-                   bbox=box, window_crs=None if pre is None else pre[0])
+    dem = source if isinstance(source, DemRaster) else read_dem(
+        source, crs=crs, transform=transform, bounds=bounds, nodata=nodata_value, bbox=box,
+        window_crs=None if pre is None else pre[0], sea_level=sea_level)
     src = parse_crs(dem.crs)
 
     area_ll = _footprint_lonlat(dem)
@@ -666,14 +783,35 @@ def from_dem(
     dst, err, reason = pre if pre is not None else local_metric_crs(src, area_ll)
     if err > MAX_SCALE_ERROR:
         warnings.warn(f"{reason}; crop the DEM with world.bbox (CLI --bbox) for true lengths",
-                      GeodataWarning, stacklevel=2)
-    fwd = transformer(src, dst)
-    west, south, east, north = _inner_box(dem, fwd, dst, box)
+                      GeodataWarning, stacklevel=3)
+    rect = _inner_box(dem, transformer(src, dst), dst, box)
+    levels, srcs = [dem], [src]
+    read_box = box if box is not None else bounds_lonlat(rect, dst)
+    for k, f in enumerate(fills):
+        d = _read_fill(f, k, crs, nodata_value, read_box, dst, sea_level)
+        levels.append(d)
+        srcs.append(parse_crs(d.crs))
+        if box is not None:  # inside the box, the map spans every DEM's footprint
+            try:
+                r2 = _inner_box(d, transformer(srcs[-1], dst), dst, box)
+            except WorldError:
+                continue
+            rect = (min(rect[0], r2[0]), min(rect[1], r2[1]), max(rect[2], r2[2]),
+                    max(rect[3], r2[3]))
+    west, south, east, north = rect
     nx, ny = _node_counts(west, south, east, north, dx, dy)
     gx = west + np.arange(nx) * dx
     gy = south + np.arange(ny) * dy
-    heights, valid = _resample(dem, src, dst, west, gy[-1], dx, dy, nx, ny)
-    heights, filled = _fill_nodata(heights, valid, nodata, gx, gy, dst)
+    comp = composite(levels, srcs, dst, west, gy[-1], dx, dy, nx, ny)
+    heights, filled = _fill_nodata(comp.heights, comp.valid, nodata, gx, gy, dst, levels)
+    for k, off in enumerate(comp.offsets):
+        if off is not None and abs(off) > DATUM_WARNING_M:
+            warnings.warn(
+                f"where both measure the ground, {levels[k + 1].label} lies {off:+.1f} m "
+                f"(median) from {dem.label}: different vertical datums (ellipsoidal heights "
+                "against heights above the geoid)? The ground steps by that much where the "
+                "fill takes over; convert one of them (gdalwarp -t_srs with a vertical CRS)",
+                GeodataWarning, stacklevel=3)
     vertical = (f"DEM heights, {dem.vertical_crs} (from the raster's vertical CRS)"
                 if dem.vertical_crs else f"DEM heights, {dem.vertical_note}")
     heights, vertical, n_sea = _sea_level(heights, sea_level, vertical, gx, gy, dst)
@@ -681,13 +819,29 @@ def from_dem(
     check_size((nx, ny, nz), (dx, dy, dz), columns=True)
     w = World.from_heightmap(heights, (dx, dy, dz), nz, origin=(west, south, z0), name=name)
     details = {"world_nodes": [nx, ny, nz], "filled_nodes": int(filled.sum()),
+               "nodata_rule": nodata,
+               **({"measured_nodes": comp.measured[0]} if fills else {}),
+               **({"undeclared_nodata": [{"value": s_.value, "pixels": s_.pixels}
+                                         for s_ in dem.undeclared]} if dem.undeclared else {}),
                **({"sea_nodes": n_sea} if sea_level is not None else {}),
                **({"bbox": list(box)} if box is not None else {})}
     georef = _dem_georef(dem, details, src, dst, vertical, err, reason)
-    # the DEM at its own resolution for every height-above-ground question (issue 13)
+    more = []
+    for k, d in enumerate(levels[1:]):
+        extra = {"priority": k + 2, "measured_nodes": comp.measured[k + 1],
+                 **({"offset_to_dem_m": round(comp.offsets[k], 3)}
+                    if comp.offsets[k] is not None else {}),
+                 **({"undeclared_nodata": [{"value": s_.value, "pixels": s_.pixels}
+                                           for s_ in d.undeclared]} if d.undeclared else {})}
+        more += [dataclasses.replace(s_, details={**s_.details, **extra}) for s_ in d.sources] \
+            or [SourceFile(path="<array>", role="dem_fill", crs=crs_label(srcs[k + 1]),
+                           crs_rule="given", details=extra)]
+    if more:
+        georef = georef.with_sources(*more)
+    # the DEMs at their own resolution for every height-above-ground question (issue 13)
     from .ground_model import ground_model_from_dem
 
-    ground = ground_model_from_dem(dem, src, dst, min(dx, dy), sea_level=sea_level)
+    ground = ground_model_from_dem(levels, srcs, dst, min(dx, dy))
     return w.with_fields(crs=crs_label(dst) if parse_crs(dst).to_epsg() else dst,
                          name=name or "dem", filled=filled, georef=georef, ground=ground)
 
@@ -734,10 +888,11 @@ def _check_dem_args(cell_size: Any, nodata: str, sea_level: float | None
         raise InputError(f"world.cell_size (--cell-size) must be > 0 metres (one number or "
                          f"dx, dy, dz), got {cell_size!r}")
     dx, dy, dz = (float(v) for v in np.broadcast_to(cs, (3,)))
-    if nodata not in ("error", "fill"):
-        raise InputError(f"world.nodata (--nodata) must be 'error' or 'fill', got {nodata!r}")
-    if sea_level is not None and not (np.isfinite(sea_level) and MIN_ELEVATION <= sea_level
-                                      <= MAX_ELEVATION):
+    if nodata not in NODATA_RULES:
+        raise InputError(f"world.nodata (--nodata) must be one of {', '.join(NODATA_RULES)}, "
+                         f"got {nodata!r}")
+    if sea_level is not None and not (np.isfinite(sea_level) and SEA_LEVEL_RANGE[0] <= sea_level
+                                      <= SEA_LEVEL_RANGE[1]):
         raise InputError(f"world.sea_level (--sea-level) must be an altitude in metres, e.g. 0, "
                          f"got {sea_level!r}")
     return dx, dy, dz
@@ -757,7 +912,13 @@ def _overlap_with_bbox(area_ll: tuple[float, float, float, float], box: Any
 
 
 def _inner_box(dem: DemRaster, fwd: Any, dst: Any, box: Any) -> tuple[float, float, float, float]:
-    """Largest axis-aligned box [m] (in ``dst``) inside the DEM's pixel-centre footprint and ``box``."""
+    """An axis-aligned box [m] (in ``dst``) inside the DEM's pixel-centre footprint and ``box``.
+
+    Each footprint edge is classified by where its middle lies (the westernmost is the west
+    side, ...), so north-up, south-up and rotated geotransforms (up to 45°) give the box
+    between the four sides; a footprint turned near 45° (a diamond) gets the largest box of
+    its bounding box's shape, centred on it, that fits inside.
+    """
     rows, cols = dem.z.shape
     a, b, c, d, e, f = dem.transform
     # footprint of the pixel centres in the metric CRS, then an inner box
@@ -767,44 +928,88 @@ def _inner_box(dem: DemRaster, fwd: Any, dst: Any, box: Any) -> tuple[float, flo
     ex, ey = fwd.transform(a * (c_idx + 0.5) + b * (r_idx + 0.5) + c,
                            d * (c_idx + 0.5) + e * (r_idx + 0.5) + f)
     ex, ey = np.asarray(ex), np.asarray(ey)
-    top_e, right, bottom, left = (slice(0, 64), slice(64, 128), slice(128, 192), slice(192, 256))
-    # rows may run south -> north (e > 0): then "top" edge is the southern one
-    ys_first, ys_last = ey[top_e].mean(), ey[bottom].mean()
-    xs_first, xs_last = ex[left].mean(), ex[right].mean()
-    lo_x, hi_x = (left, right) if xs_first <= xs_last else (right, left)
-    lo_y, hi_y = (bottom, top_e) if ys_last <= ys_first else (top_e, bottom)
-    west, east = ex[lo_x].max(), ex[hi_x].min()
-    south, north = ey[lo_y].max(), ey[hi_y].min()
+    sides = [slice(0, 64), slice(64, 128), slice(128, 192), slice(192, 256)]
+    mx = [float(ex[s_].mean()) for s_ in sides]
+    my = [float(ey[s_].mean()) for s_ in sides]
+    w_, e_ = int(np.argmin(mx)), int(np.argmax(mx))
+    s_, n_ = int(np.argmin(my)), int(np.argmax(my))
+    rect = None
+    if len({w_, e_, s_, n_}) == 4:
+        rect = (ex[sides[w_]].max(), ey[sides[s_]].max(), ex[sides[e_]].min(),
+                ey[sides[n_]].min())
+    # the footprint as a ring: top, right, then bottom and left walked backwards
+    ring_x = np.concatenate([ex[sides[0]], ex[sides[1]], ex[sides[2]][::-1], ex[sides[3]][::-1]])
+    ring_y = np.concatenate([ey[sides[0]], ey[sides[1]], ey[sides[2]][::-1], ey[sides[3]][::-1]])
+    if rect is None or not _inside(rect, ring_x, ring_y):
+        rect = _centred_box(ring_x, ring_y)
+    west, south, east, north = rect
     if box is not None:
         bw, bs, be, bn = _bbox_in(dst, box)
         west, south, east, north = max(west, bw), max(south, bs), min(east, be), min(north, bn)
     if not (east > west and north > south):
         raise WorldError(f"the DEM footprint in {crs_label(dst)} is degenerate (or outside "
                          "world.bbox); is the transform/CRS right?")
-    return west, south, east, north
+    return float(west), float(south), float(east), float(north)
+
+
+def _inside(rect: tuple[float, ...], ex: np.ndarray, ey: np.ndarray) -> bool:
+    """Whether the box ``rect`` is non-empty and inside the polygon of the footprint edges."""
+    import shapely
+
+    w, s, e, n = rect
+    if not (e > w and n > s):
+        return False
+    poly = shapely.Polygon(np.column_stack([ex, ey])).buffer(1e-6 * max(e - w, n - s))
+    return bool(poly.contains(shapely.box(w, s, e, n)))
+
+
+def _centred_box(ex: np.ndarray, ey: np.ndarray) -> tuple[float, float, float, float]:
+    """The largest box of the footprint's bounding-box shape, centred on its centroid, inside it."""
+    import shapely
+
+    poly = shapely.Polygon(np.column_stack([ex, ey]))
+    if not poly.is_valid or poly.area <= 0:
+        return (0.0, 0.0, 0.0, 0.0)
+    cx, cy = poly.centroid.x, poly.centroid.y
+    hw, hh = 0.5 * (ex.max() - ex.min()), 0.5 * (ey.max() - ey.min())
+    lo, hi = 0.0, 1.0
+    for _ in range(40):
+        m = 0.5 * (lo + hi)
+        if poly.contains(shapely.box(cx - m * hw, cy - m * hh, cx + m * hw, cy + m * hh)):
+            lo = m
+        else:
+            hi = m
+    return (cx - lo * hw, cy - lo * hh, cx + lo * hw, cy + lo * hh)
 
 
 def _fill_nodata(heights: np.ndarray, valid: np.ndarray, nodata: str, gx: np.ndarray,
-                 gy: np.ndarray, dst: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Heights with nodata nodes refused (``nodata="error"``) or filled from the nearest valid
-    node (at most half of them); and the mask of filled nodes."""
+                 gy: np.ndarray, dst: Any, levels: Sequence[DemRaster] = ()
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """Heights with the nodes no DEM measures refused (``nodata="error"``) or filled from the
+    nearest measured node (at most half of them); and the mask of filled nodes."""
     missing = ~valid
     n_miss = int(missing.sum())
     filled = np.zeros(valid.shape, dtype=bool)
     if n_miss:
         i, j = np.argwhere(missing)[0]
         lon, lat = transformer(dst, WGS84).transform(float(gx[i]), float(gy[j]))
+        found = [s_ for d in levels for s_ in d.undeclared]
+        why = (f" (among the gaps: {', '.join(s_.describe() for s_ in found)}, nodata the file "
+               "does not declare)" if found else "")
+        fill_hint = ("" if len(levels) > 1 else
+                     ", fill them from another DEM with world.dem_fill (CLI --dem-fill FILE)")
         if nodata == "error":
             raise WorldError(
-                f"the DEM has nodata/NaN under {n_miss} of {missing.size} world nodes, first at "
-                f"node ({i}, {j}) = lon {lon:.5f}, lat {lat:.5f}; crop it to its data with "
-                "world.bbox (CLI --bbox W,S,E,N), fill the gaps first, or set world.nodata: fill "
-                "(CLI --nodata fill) to take the nearest valid elevation")
+                f"the DEM has nodata/NaN under {n_miss} of {missing.size} world nodes{why}, first "
+                f"at node ({i}, {j}) = lon {lon:.5f}, lat {lat:.5f}; crop it to its data with "
+                f"world.bbox (CLI --bbox W,S,E,N){fill_hint}, or set world.nodata: fill (CLI "
+                "--nodata fill) to take the nearest valid elevation, reported as unknown ground "
+                "(error_on_route: the same, refusing plans that fly over it)")
         if n_miss * 2 > missing.size:
             raise WorldError(
                 f"the DEM has nodata under {n_miss} of {missing.size} world nodes (more than "
-                "half); world.nodata: fill would invent most of the terrain — crop the DEM to "
-                "its data with world.bbox (CLI --bbox W,S,E,N)")
+                f"half){why}; world.nodata: {nodata} would invent most of the terrain — crop the "
+                f"DEM to its data with world.bbox (CLI --bbox W,S,E,N){fill_hint}")
         none = ~np.isfinite(heights)
         if none.any():
             _, (ii, jj) = ndimage.distance_transform_edt(none, return_indices=True)
@@ -813,23 +1018,33 @@ def _fill_nodata(heights: np.ndarray, valid: np.ndarray, nodata: str, gx: np.nda
     return heights, filled
 
 
+#: Ground deeper than this [m] is no dry land (the Dead Sea shore is at -430 m): sea floor.
+DRY_LAND_LOWEST = -500.0
+
+
 def _sea_level(heights: np.ndarray, sea_level: float | None, vertical: str, gx: np.ndarray,
                gy: np.ndarray, dst: Any) -> tuple[np.ndarray, str, int]:
     """Ground raised to ``sea_level`` [m] (or a warning about ground below 0 m); the heights, the
-    vertical description and the number of nodes below the sea level."""
-    below = heights < (0.0 if sea_level is None else float(sea_level))
-    n_sea = int(below.sum())
+    vertical description and the number of nodes over water (at or below the sea level)."""
     if sea_level is not None:
+        n_sea = int((heights <= float(sea_level) + 1e-9).sum())
         heights = np.maximum(heights, float(sea_level))
         vertical += f"; ground raised to world.sea_level = {float(sea_level):g} m over water"
-    elif n_sea:
+        return heights, vertical, n_sea
+    n_sea = int((heights < 0.0).sum())
+    if n_sea:
         i, j = np.unravel_index(int(np.argmin(heights)), heights.shape)
         lon, lat = transformer(dst, WGS84).transform(float(gx[i]), float(gy[j]))
+        low = float(heights[i, j])
+        what = (f"deeper than any dry land (the Dead Sea shore is at -430 m): sea floor (or a "
+                f"data error), and the flight would follow it under the water"
+                if low < DRY_LAND_LOWEST else
+                "if that is sea or lake floor, the flight would follow it under the water")
         warnings.warn(
             f"the DEM has ground below 0 m under {n_sea} of {heights.size} nodes (lowest "
-            f"{heights[i, j]:.1f} m at lon {lon:.5f}, lat {lat:.5f}); if that is sea or lake "
-            "floor, set world.sea_level: 0 (CLI --sea-level 0) to fly over the water surface — "
-            "it is kept as terrain otherwise", GeodataWarning, stacklevel=3)
+            f"{low:.1f} m at lon {lon:.5f}, lat {lat:.5f}), {what}; set world.sea_level: 0 (CLI "
+            "--sea-level 0) to fly over the water surface — without it the ground is kept as "
+            "the DEM says (polders and the Dead Sea are real)", GeodataWarning, stacklevel=3)
     return heights, vertical, n_sea
 
 
@@ -872,32 +1087,6 @@ def _ceiling(ceiling: float | None, hmax: float, dz: float, agl: float | None,
             f"world.ceiling (--ceiling) = {alt:g} m is below a requested altitude of "
             f"{float(top):g} m (start/goal); raise it or leave it out")
     return alt
-
-
-def _resample(dem: DemRaster, src: Any, dst: Any, west: float, north: float, dx: float,
-              dy: float, nx: int, ny: int) -> tuple[np.ndarray, np.ndarray]:
-    """Bilinear heights and validity (all four pixels valid) at the world nodes, (nx, ny)."""
-    from affine import Affine
-    from rasterio.crs import CRS as RioCRS
-    from rasterio.warp import Resampling, reproject
-
-    src_t = Affine(*dem.transform)
-    dst_t = Affine(dx, 0.0, west - 0.5 * dx, 0.0, -dy, north + 0.5 * dy)
-    src_rio = RioCRS.from_wkt(parse_crs(src).to_wkt())
-    dst_rio = RioCRS.from_wkt(parse_crs(dst).to_wkt())
-    out = np.full((ny, nx), np.nan)
-    opts = {"XSCALE": 1, "YSCALE": 1}  # point bilinear: no low-pass kernel when downsampling
-    reproject(dem.z, out, src_transform=src_t, src_crs=src_rio, dst_transform=dst_t,
-              dst_crs=dst_rio, resampling=Resampling.bilinear, src_nodata=np.nan,
-              dst_nodata=np.nan, **opts)
-    ok = np.isfinite(dem.z).astype(np.float64)
-    vout = np.zeros((ny, nx))
-    reproject(ok, vout, src_transform=src_t, src_crs=src_rio, dst_transform=dst_t,
-              dst_crs=dst_rio, resampling=Resampling.bilinear, src_nodata=None,
-              dst_nodata=None, init_dest_nodata=False, **opts)
-    heights = out[::-1].T.copy()
-    valid = (vout[::-1].T >= 1.0 - 1e-6) & np.isfinite(heights)
-    return heights, valid
 
 
 # ---------------------------------------------------------------------- lon/lat grids

@@ -44,6 +44,7 @@ __all__ = [
     "scale_error",
     "local_metric_crs",
     "crs_label",
+    "crs_token",
     "check_lonlat_bbox",
     "bounds_lonlat",
     "check_fit",
@@ -305,7 +306,11 @@ MAX_SCALE_ERROR = 0.005
 
 
 def crs_label(crs: Any) -> str:
-    """Short name of a CRS: ``"EPSG:32630"`` when it has an EPSG code, else its PROJ string."""
+    """Short name of a CRS: ``"EPSG:32630"`` when it has an authority code, a PROJ string
+    when it was given as one (the world's own transverse Mercator), else its name and
+    projection, e.g. ``'"Custom TM South" (Transverse Mercator; WKT without an EPSG code)'``
+    — never a whole WKT, and never through ``to_proj4`` (which warns and loses datum
+    shifts)."""
     c = parse_crs(crs)
     code = c.to_epsg(min_confidence=90)
     if code is not None:
@@ -313,7 +318,33 @@ def crs_label(crs: Any) -> str:
     auth = c.to_authority(min_confidence=90)
     if auth is not None:
         return f"{auth[0]}:{auth[1]}"
-    return c.to_proj4() or c.to_wkt()
+    text = c.to_string()
+    if text.startswith("+proj"):
+        return text
+    base = c.source_crs if c.is_bound and c.source_crs is not None else c
+    name = base.name if base.name and base.name.lower() not in ("unknown", "unnamed") else ""
+    op = getattr(base, "coordinate_operation", None)
+    method = getattr(op, "method_name", "") if op is not None else ""
+    kind = method or ("geographic" if base.is_geographic else base.type_name)
+    shown = f'"{name}"' if name else "unnamed CRS"
+    return f"{shown} ({kind}; WKT without an EPSG code)"
+
+
+def crs_token(crs: Any) -> str:
+    """One word naming a CRS exactly, for file headers (``# crs=...``): its authority code
+    (``"EPSG:32630"``), else ``"wkt-sha256:"`` and 16 hex digits of its WKT.
+
+    Two files on the same world carry the same token, so ``fm2uav export`` can tell a
+    path planned on another world even when the CRS has no EPSG code.
+    """
+    c = parse_crs(crs)
+    code = c.to_epsg(min_confidence=90)
+    if code is not None:
+        return f"EPSG:{code}"
+    auth = c.to_authority(min_confidence=90)
+    if auth is not None:
+        return f"{auth[0]}:{auth[1]}"
+    return "wkt-sha256:" + hashlib.sha256(c.to_wkt().encode()).hexdigest()[:16]
 
 
 def _lonlat_samples(bbox: tuple[float, float, float, float], n: int = 7) -> tuple[np.ndarray, np.ndarray]:
@@ -595,9 +626,15 @@ class Georef:
     scale_error: float = 0.0
     sources: tuple[SourceFile, ...] = ()
 
+    @property
+    def name(self) -> str:
+        """Short name of :attr:`crs` (:func:`crs_label`), for summaries."""
+        return crs_label(self.crs)
+
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready dict (``summary.json`` ``"georef"``; exports' metadata)."""
-        return {"crs": self.crs, "epsg": self.epsg, "vertical": self.vertical,
+        return {"crs": self.crs, "crs_name": self.name, "crs_token": crs_token(self.crs),
+                "epsg": self.epsg, "vertical": self.vertical,
                 "vertical_crs": self.vertical_crs, "vertical_assumed": self.vertical_assumed,
                 "reprojection": self.reprojection,
                 "scale_error_pct": round(100.0 * float(self.scale_error), 4),
@@ -607,8 +644,10 @@ class Georef:
         """One line for file headers, e.g. ``"crs=EPSG:32630; z=DEM heights, ..."``."""
         srcs = ", ".join(f"{s.role} {Path(s.path).name} sha256={s.sha256[:12] if s.sha256 else '-'}"
                          for s in self.sources)
-        return (f"crs={self.epsg and f'EPSG:{self.epsg}' or self.crs}; z={self.vertical}"
-                + (f"; sources: {srcs}" if srcs else ""))
+        token = crs_token(self.crs)
+        name = self.name
+        return (f"crs={token}" + (f" ({name})" if name != token else "")
+                + f"; z={self.vertical}" + (f"; sources: {srcs}" if srcs else ""))
 
     def with_sources(self, *more: SourceFile) -> Georef:
         """A copy with more sources appended."""
