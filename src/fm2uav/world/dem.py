@@ -84,6 +84,7 @@ from .geo import (
     check_fit,
     check_lonlat_bbox,
     check_size,
+    crs_epsg,
     crs_label,
     local_metric_crs,
     make_georef,
@@ -842,7 +843,7 @@ def _build(source: Any, fills: list[Any], cell: tuple[float, float, float],
     from .ground_model import ground_model_from_dem
 
     ground = ground_model_from_dem(levels, srcs, dst, min(dx, dy))
-    return w.with_fields(crs=crs_label(dst) if parse_crs(dst).to_epsg() else dst,
+    return w.with_fields(crs=crs_label(dst) if crs_epsg(dst) else dst,
                          name=name or "dem", filled=filled, georef=georef, ground=ground)
 
 

@@ -276,12 +276,14 @@ def find_sentinels(raw: np.ndarray, dtype: Any, to_metres: Callable[[np.ndarray]
         return mask, found
     lo, hi = float(np.nanmin(raw)), float(np.nanmax(raw))
     metres = None
-    for v in _candidates(dtype):
+    cands = _candidates(dtype)
+    if dtype is not None and np.dtype(dtype) == np.float32:  # as a float32 file stores them
+        cands = sorted(set(cands) | {float(np.float32(v)) for v in cands
+                                     if abs(v) <= float(np.finfo(np.float32).max)})
+    for v in cands:
         if v < lo or v > hi:
             continue
         hit = raw == v
-        if dtype is not None and np.dtype(dtype) == np.float32:
-            hit |= raw == float(np.float32(v))
         n = int(hit.sum())
         if n == 0:
             continue
