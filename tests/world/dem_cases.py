@@ -267,15 +267,12 @@ def measured_mask(tif, world, points):
 
 def length_over(points, unknown_at, step=0.5):
     """3D length [m] of the polyline ``points`` over ground where ``unknown_at(pts)`` is True,
-    each sub-segment of at most ``step`` metres classified at its middle."""
+    each sub-segment of at most ``step`` metres classified at its middle; and the total."""
     p = np.asarray(points, dtype=float)
-    total = 0.0
-    over = 0.0
-    for a, b in zip(p[:-1], p[1:]):
-        L = float(np.linalg.norm(b - a))
-        n = max(1, int(np.ceil(L / step)))
-        t = (np.arange(n) + 0.5) / n
-        mid = a + t[:, None] * (b - a)
-        over += L / n * float(np.sum(unknown_at(mid)))
-        total += L
-    return over, total
+    seg = np.linalg.norm(np.diff(p, axis=0), axis=1)
+    n = np.maximum(np.ceil(seg / step).astype(int), 1)
+    i = np.repeat(np.arange(len(seg)), n)
+    k = np.concatenate([np.arange(m) for m in n])
+    mid = p[i] + ((k + 0.5) / n[i])[:, None] * (p[i + 1] - p[i])
+    over = float(np.sum((seg[i] / n[i])[np.asarray(unknown_at(mid), dtype=bool)]))
+    return over, float(seg.sum())

@@ -389,7 +389,17 @@ def _merge_tiles(datasets: list[Any], window_bounds: tuple[float, ...] | None, b
     from rasterio.errors import RasterioIOError
     from rasterio.merge import merge
 
-    kw = {"bounds": window_bounds} if window_bounds is not None else {}
+    kw = {}
+    if window_bounds is not None:
+        # on the tiles' own pixel grid: bounds off it make merge resample (nearest), which
+        # moves the ground by up to half a pixel
+        t0 = datasets[0].transform
+        a, c, e, f = t0.a, t0.c, t0.e, t0.f
+        left = c + np.floor((window_bounds[0] - c) / a) * a
+        right = c + np.ceil((window_bounds[2] - c) / a) * a
+        top = f + np.floor((window_bounds[3] - f) / e) * e
+        bottom = f + np.ceil((window_bounds[1] - f) / e) * e
+        kw = {"bounds": (left, min(bottom, top), right, max(bottom, top))}
     try:
         arr, t = merge(datasets, masked=True, dtype="float64", **kw)
     except ValueError as exc:
