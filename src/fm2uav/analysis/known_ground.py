@@ -11,9 +11,12 @@ lowest point), clearance — into "over measured ground" and "over filled
 ground", with the filled stretches located in lon/lat. With DEMs in priority
 order (``world.dem_fill``) it also says how much each DEM measured.
 
-Lengths are 3D along the path (as ``Plan.length``), each sub-segment of at
-most :data:`SPLIT_STEP` (1 m; finer on DEMs of finer pixels) classified at its
-middle, so the split is exact to a metre per boundary crossing.
+Lengths are 3D along the path (as ``Plan.length``), split exactly where the
+classification can change: each path segment is cut into pieces of at most
+:data:`SPLIT_STEP` (so that the map projection is linear over a piece), and each
+piece at every crossing of a DEM's pixel-centre lines (of the planning grid's
+nodes without a ground model); the parts between are classified at their
+middle.
 
 **DEM resolution** (:func:`dem_resolution`). A DEM cannot show relief finer
 than its pixel: between two pixel centres ``p`` metres apart, on ground that
@@ -45,9 +48,10 @@ from ..world.quiet import GeodataWarning
 __all__ = ["SPLIT_STEP", "RESOLUTION_MARGIN", "MAX_SPLIT_SAMPLES", "ground_split",
            "filled_mask", "dem_resolution", "ground_notes", "check_ground", "nodata_rule"]
 
-#: Longest sub-segment [m] classified as over measured or filled ground.
-SPLIT_STEP = 1.0
-#: Most sub-segments classified along one path (the step grows beyond).
+#: Longest piece [m] of a path segment taken as straight in a DEM's own CRS (then cut at
+#: the crossings of its pixel-centre lines).
+SPLIT_STEP = 25.0
+#: Most pieces along one path (the step grows beyond).
 MAX_SPLIT_SAMPLES = 2_000_000
 #: Share of the flight height above ground that relief hidden between DEM pixels may take.
 RESOLUTION_MARGIN = 0.5
@@ -93,21 +97,65 @@ def _lonlat(world: Any, xy: np.ndarray) -> list[float] | None:
     return [round(float(ll[0]), 6), round(float(ll[1]), 6)]
 
 
-def _subsegments(p: np.ndarray, pixel: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Midpoints, lengths [m] and arc length at the start of each sub-segment of ``p``."""
+def _crossings(a0: np.ndarray, a1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(piece index, t in (0, 1)) where the coordinate going from ``a0`` to ``a1`` crosses an
+    integer (a pixel-centre line)."""
+    lo, hi = np.minimum(a0, a1), np.maximum(a0, a1)
+    ok = np.isfinite(lo) & np.isfinite(hi)
+    first = np.where(ok, np.floor(lo) + 1, 0)
+    count = np.where(ok, np.maximum(np.ceil(hi) - first, 0), 0).astype(np.int64)
+    idx = np.repeat(np.arange(len(a0)), count)
+    k = first[idx] + (np.arange(int(count.sum())) - np.repeat(np.cumsum(count) - count, count))
+    d = (a1 - a0)[idx]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t = (k - a0[idx]) / d
+    keep = np.isfinite(t) & (t > 0) & (t < 1)
+    return idx[keep], t[keep]
+
+
+def _grids(world: Any) -> list[Any]:
+    """Functions (x, y) -> (row, col) of the pixel grids the classification depends on."""
+    model = getattr(world, "ground", None)
+    if model is not None:
+        return [layer.pixel_coords for layer in model.layers]
+    x0, y0 = float(world.origin[0]), float(world.origin[1])
+    dx, dy = float(world.spacing[0]), float(world.spacing[1])
+    return [lambda x, y: ((np.asarray(y) - y0) / dy, (np.asarray(x) - x0) / dx)]
+
+
+def _subsegments(world: Any, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Midpoints, lengths [m] and start arc length [m] of the parts of ``p`` between the
+    crossings of the pixel-centre lines of every DEM (see the module docstring)."""
     seg = np.linalg.norm(np.diff(p, axis=0), axis=1)
     total = float(seg.sum())
-    step = min(SPLIT_STEP, pixel / 8.0) if pixel > 0 else SPLIT_STEP
-    step = max(step, total / MAX_SPLIT_SAMPLES, 1e-6)
+    step = max(SPLIT_STEP, total / MAX_SPLIT_SAMPLES, 1e-6)
     n = np.maximum(np.ceil(seg / step).astype(np.int64), 1)
     i = np.repeat(np.arange(len(seg)), n)
     k = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
-    t0 = k / n[i]
-    t = (k + 0.5) / n[i]
-    mid = p[i] + t[:, None] * (p[i + 1] - p[i])
-    length = seg[i] / n[i]
-    s0 = np.concatenate([[0.0], np.cumsum(seg)])[i] + t0 * seg[i]
-    return mid, length, s0
+    a = p[i] + (k / n[i])[:, None] * (p[i + 1] - p[i])      # pieces: a -> b
+    b = p[i] + ((k + 1) / n[i])[:, None] * (p[i + 1] - p[i])
+    s_a = np.concatenate([[0.0], np.cumsum(seg)])[i] + k / n[i] * seg[i]
+    L = seg[i] / n[i]
+    cuts_i = [np.arange(len(a)), np.arange(len(a))]
+    cuts_t = [np.zeros(len(a)), np.ones(len(a))]
+    for to_pixels in _grids(world):
+        r0, c0 = to_pixels(a[:, 0], a[:, 1])
+        r1, c1 = to_pixels(b[:, 0], b[:, 1])
+        for u0, u1 in ((np.asarray(r0, float), np.asarray(r1, float)),
+                       (np.asarray(c0, float), np.asarray(c1, float))):
+            ci, ct = _crossings(u0, u1)
+            cuts_i.append(ci)
+            cuts_t.append(ct)
+    ci = np.concatenate(cuts_i)
+    ct = np.concatenate(cuts_t)
+    order = np.lexsort((ct, ci))
+    ci, ct = ci[order], ct[order]
+    same = ci[1:] == ci[:-1]
+    j = ci[:-1][same]
+    t0, t1 = ct[:-1][same], ct[1:][same]
+    tm = 0.5 * (t0 + t1)
+    mid = a[j] + tm[:, None] * (b[j] - a[j])
+    return mid, L[j] * (t1 - t0), s_a[j] + t0 * L[j]
 
 
 def ground_split(world: Any, path: Any, agl: np.ndarray, clearance: np.ndarray | None = None,
@@ -145,17 +193,15 @@ def ground_split(world: Any, path: Any, agl: np.ndarray, clearance: np.ndarray |
     p = np.asarray(path, dtype=float)
     if p.ndim != 2 or p.shape[1] != 3 or len(p) < 2:
         return None
-    model = getattr(world, "ground", None)
-    pixel = float(model.pixel_m) if model is not None else float(min(world.spacing[:2]))
-    mid, length, s0 = _subsegments(p, pixel)
+    mid, length, s0 = _subsegments(world, p)
     src = np.asarray(world.ground_source(mid[:, 0], mid[:, 1]))
     total = float(length.sum())
     point_filled = filled_mask(world, p)
     out: dict[str, Any] = {
         "rule": "over filled ground where any DEM pixel of the bilinear ground height is "
-                "filled nodata (no DEM measures it); 3D length classified every "
-                f"{min(SPLIT_STEP, pixel / 8.0):g} m at most",
-        "step_m": round(float(total / max(len(length), 1)), 4),
+                "filled nodata (no DEM measures it); the 3D length cut at every crossing of "
+                "the DEMs' pixel-centre lines and classified between them",
+        "parts": int(len(length)),
         "length_m": round(total, 3),
     }
     for name, sel_seg, sel_pt in (("measured", src >= 0, ~point_filled),
