@@ -240,16 +240,18 @@ def temperature(path):
 # ---------------------------------------------------------------- independent reading
 
 def measured_mask(tif, world, points):
-    """Independently of fm2uav: whether the ground under each world point (x, y) is measured
-    by the GeoTIFF ``tif``, i.e. every pixel of its bilinear stencil (non-zero weight) is
-    valid and the point is within the pixel-centre footprint (rasterio + pyproj)."""
+    """Independently of fm2uav: whether the ground under each point (x, y) is measured by
+    the GeoTIFF ``tif``, i.e. every pixel of its bilinear stencil (non-zero weight) is valid
+    and the point is within the pixel-centre footprint (rasterio + pyproj). ``world`` is a
+    World (points in its CRS) or a CRS (e.g. ``"EPSG:4326"`` for lon/lat points)."""
     p = np.asarray(points, dtype=float)
+    src_crs = getattr(world, "crs", world)
     with rasterio.open(tif) as ds:
         valid = ~np.ma.getmaskarray(ds.read(1, masked=True))
         valid &= np.isfinite(ds.read(1).astype(float))
         inv = ~ds.transform
         crs = ds.crs.to_wkt()
-    x, y = Transformer.from_crs(world.crs, crs, always_xy=True).transform(p[:, 0], p[:, 1])
+    x, y = Transformer.from_crs(src_crs, crs, always_xy=True).transform(p[:, 0], p[:, 1])
     col, row = inv * (np.asarray(x), np.asarray(y))
     col, row = np.asarray(col) - 0.5, np.asarray(row) - 0.5
     rows, cols = valid.shape
