@@ -176,6 +176,14 @@ def test_rotated_geotransforms(tmp_path, degrees):
     assert not w.filled.any()  # the map lies inside the rotated footprint
     ext = w.bounds[:2, 1] - w.bounds[:2, 0]
     assert ext.min() > 1500.0  # 3.6 km square: a real box, not a sliver
+    # a bbox reads the window of a rotated raster too (rasterio's from_bounds refuses it)
+    b = w.bounds
+    ll = to_lonlat(w, [[b[0, 0], b[1, 0], 0], [b[0, 1], b[1, 1], 0]])
+    box = (ll[0, 0] + 0.003, ll[0, 1] + 0.003, ll[1, 0] - 0.003, ll[1, 1] - 0.003)
+    w2 = World.from_dem(p, 30.0, bbox=box)
+    assert w2.terrain.size < w.terrain.size
+    x, y = _inside(w2, seed=7)
+    np.testing.assert_allclose(w2.ground_height(x, y), _sampled(p, w2, x, y), atol=1e-3)
 
 
 def test_world_crs_is_honoured_for_a_dem_without_one(tmp_path):

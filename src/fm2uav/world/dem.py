@@ -356,13 +356,17 @@ def _read_one(first: Any, path: Path, window_bounds: tuple[float, ...] | None, b
               h_crs: Any) -> tuple[np.ndarray, Any]:
     """Pixels (masked → NaN) and transform of one open DEM, in ``window_bounds`` if given."""
     from rasterio.errors import RasterioIOError
-    from rasterio.windows import Window, from_bounds
+    from rasterio.windows import Window
 
     win = None
     if window_bounds is not None:
         full = Window(0, 0, first.width, first.height)
-        w = from_bounds(*window_bounds, transform=first.transform)
-        w = w.round_offsets(op="floor").round_lengths(op="ceil")
+        # the pixel box of the bounds' four corners: any affine, rotated ones included
+        # (rasterio's from_bounds refuses a rotated geotransform)
+        x0, y0, x1, y1 = window_bounds
+        cols, rows = ~first.transform * (np.array([x0, x1, x0, x1]), np.array([y0, y0, y1, y1]))
+        c0, r0 = np.floor(np.min(cols)), np.floor(np.min(rows))
+        w = Window(c0, r0, np.ceil(np.max(cols)) - c0, np.ceil(np.max(rows)) - r0)
         try:
             win = w.intersection(full)
         except Exception:  # rasterio.errors.WindowError: no overlap

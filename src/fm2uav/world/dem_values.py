@@ -212,6 +212,17 @@ def _implausible_counts(z: np.ndarray, dx: Any, dy: Any) -> tuple[np.ndarray, np
 _BLOCK = 4_000_000
 
 
+def _any_step_above(z: np.ndarray, limit: float) -> bool:
+    """Whether any two neighbouring pixels (8-neighbourhood) differ by more than ``limit``."""
+    with np.errstate(invalid="ignore"):
+        if not (np.nanmax(z) - np.nanmin(z) > limit):
+            return False
+        return bool(np.any(np.abs(z[:, 1:] - z[:, :-1]) > limit)
+                    or np.any(np.abs(z[1:] - z[:-1]) > limit)
+                    or np.any(np.abs(z[1:, 1:] - z[:-1, :-1]) > limit)
+                    or np.any(np.abs(z[1:, :-1] - z[:-1, 1:]) > limit))
+
+
 def _worst_step(z: np.ndarray, dx: Any, dy: Any
                 ) -> tuple[int, int, int, float, bool] | None:
     """The pixel stepping impossibly from the largest share of its neighbours, scanned in
@@ -224,9 +235,15 @@ def _worst_step(z: np.ndarray, dx: Any, dy: Any
     best: tuple[float, int, int] | None = None
     n_bad = 0
     values: list[np.ndarray] = []
+    lo, hi = np.nanmin(z), np.nanmax(z)
+    if not hi - lo > MAX_WALL:  # no step can be impossible: every bound is >= MAX_WALL
+        return None
     for r0 in range(0, rows, per):
         a, b = max(r0 - 1, 0), min(r0 + per + 1, rows)
-        bad, near = _implausible_counts(z[a:b], dxr[a:b], dyr[a:b])
+        blk = z[a:b]
+        if not _any_step_above(blk, MAX_WALL):
+            continue
+        bad, near = _implausible_counts(blk, dxr[a:b], dyr[a:b])
         own = slice(r0 - a, r0 - a + min(per, rows - r0))
         bad, near = bad[own], near[own]
         if not bad.any():
