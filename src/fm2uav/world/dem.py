@@ -1051,13 +1051,13 @@ def _sea_level(heights: np.ndarray, sea_level: float | None, vertical: str, gx: 
         i, j = np.unravel_index(int(np.argmin(heights)), heights.shape)
         lon, lat = transformer(dst, WGS84).transform(float(gx[i]), float(gy[j]))
         low = float(heights[i, j])
-        what = (f"deeper than any dry land (the Dead Sea shore is at -430 m): sea floor (or a "
-                f"data error), and the flight would follow it under the water"
+        what = ("that is deeper than any dry land (the Dead Sea shore is at -430 m): sea "
+                "floor (or a data error), which the flight would follow under the water"
                 if low < DRY_LAND_LOWEST else
                 "if that is sea or lake floor, the flight would follow it under the water")
         warnings.warn(
             f"the DEM has ground below 0 m under {n_sea} of {heights.size} nodes (lowest "
-            f"{low:.1f} m at lon {lon:.5f}, lat {lat:.5f}), {what}; set world.sea_level: 0 (CLI "
+            f"{low:.1f} m at lon {lon:.5f}, lat {lat:.5f}); {what}; set world.sea_level: 0 (CLI "
             "--sea-level 0) to fly over the water surface — without it the ground is kept as "
             "the DEM says (polders and the Dead Sea are real)", GeodataWarning, stacklevel=3)
     return heights, vertical, n_sea
