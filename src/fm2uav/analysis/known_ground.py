@@ -332,7 +332,8 @@ def ground_notes(world: Any, safety: dict[str, Any], *, what: str = "the path"
             f"~{res['hidden_relief_m']:.0f} m higher than the DEM shows can hide between pixel "
             f"centres, more than half of the {res['agl_m']:g} m flown above it; for this height "
             + (f"use a DEM with pixels of at most ~{need:.0f} m (world.dem / --dem, or a finer "
-               "world.dem_fill) " if need else "use a finer DEM ")
+               "world.dem_fill; slopes measured on this DEM, finer data show them steeper) "
+               if need else "use a finer DEM ")
             + "or fly higher (planner.agl / --agl)")
     return notes
 
