@@ -169,10 +169,7 @@ def world_spec(
         return WorldSpec.model_validate({k: v for k, v in values.items() if v is not None})
     except ValidationError as exc:
         err = exc.errors()[0]
-        if not err["loc"]:  # a rule across keys (a DEM without CRS and no --crs)
-            raise InputError("--dem: " + str(err.get("ctx", {}).get("error", err["msg"]))
-                             .removeprefix("Value error, ")) from None
-        key = str(err["loc"][0])
+        key = str(err["loc"][0]) if err["loc"] else "dem"
         msg = str(err.get("ctx", {}).get("error", err["msg"])).removeprefix("Value error, ")
         if err["type"] in ("greater_than", "greater_than_equal", "less_than",
                            "less_than_equal", "literal_error"):

@@ -41,7 +41,6 @@ from typing import Any, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator
-from pydantic import model_validator
 
 from ..errors import InputError, PointError, WorldError
 from .quiet import GeodataWarning, library_warnings
@@ -133,11 +132,17 @@ def _raster_file(item: str, info: ValidationInfo | None) -> str:
     try:
         with library_warnings(f"the DEM {path.name}"), rasterio.open(path) as ds:
             problem = raster_problem(ds, path.name)
+            crs = ds.crs
     except Exception as exc:  # rasterio raises its own error types
         raise ValueError(f"cannot be read as a raster ({type(exc).__name__}); "
                          "allowed: a raster file GDAL reads (GeoTIFF, VRT, .hgt)") from None
     if problem is not None:
         raise ValueError(problem.removeprefix(f"the DEM {path.name} "))
+    if crs is None and (info is None or (info.data or {}).get("crs") is None):
+        raise ValueError(
+            f"{path.name} has no coordinate reference system (CRS); give it with world.crs "
+            "(CLI --crs), e.g. EPSG:32630, or assign one in the file (gdal_edit.py -a_srs "
+            "EPSG:32630 FILE)")
     return str(path)
 
 
@@ -149,6 +154,8 @@ class WorldSpec(BaseModel):
     """
 
     model_config = _STRICT
+    # first: the DEM and buildings validators below read it (fields validate in this order)
+    crs: str | None = Field(None, description="CRS of input files that declare none")
     dem: str | list[str] | None = Field(
         None, description="DEM raster file(s) GDAL reads (GeoTIFF, VRT, .hgt); several = tiles "
         "of one DEM (merged, one CRS)")
@@ -171,7 +178,6 @@ class WorldSpec(BaseModel):
         "error", description="ground no DEM measures: refuse the DEM, fill it (reported as "
         "unknown ground), or fill it and refuse plans that fly over it")
     nodata_value: float | None = _num(None, unit="m", desc="an undeclared DEM nodata value")
-    crs: str | None = Field(None, description="CRS of input files that declare none")
     default_height: float | None = _num(None, unit="m", gt=0, le=1000,
                                         desc="height of buildings without one")
     metres_per_level: float = _num(3.0, unit="m", gt=0, le=20,
@@ -211,23 +217,6 @@ class WorldSpec(BaseModel):
             else:
                 out.append(_raster_file(item, info))
         return out
-
-    @model_validator(mode="after")
-    def _dem_crs(self) -> WorldSpec:
-        """Every DEM file declares a CRS, or ``crs`` gives it (checked once all keys are read)."""
-        if self.crs is not None:
-            return self
-        for path in self.dem_files():
-            import rasterio
-
-            with library_warnings(f"the DEM {Path(path).name}"), rasterio.open(path) as ds:
-                crs = ds.crs
-            if crs is None:
-                raise ValueError(
-                    f"{Path(path).name} has no coordinate reference system (CRS); give it with "
-                    "world.crs (CLI --crs), e.g. EPSG:32630, or assign one in the file "
-                    "(gdal_edit.py -a_srs EPSG:32630 FILE)")
-        return self
 
     def fill_sources(self) -> list[Any]:
         """``dem_fill`` as a list (each entry a file or a list of tiles), priority order."""
