@@ -344,7 +344,7 @@ def _relief_of(path: str, spec: WorldSpec) -> tuple[float, float] | None:
         with library_warnings(f"the DEM {Path(path).name}"), rasterio.open(path) as ds:
             win = None
             if spec.bbox is not None and ds.crs is not None:
-                from .dem import _bbox_in
+                from .dem_read import _bbox_in
                 from .geo import parse_crs
 
                 b = _bbox_in(parse_crs(ds.crs.to_wkt()), tuple(spec.bbox))
