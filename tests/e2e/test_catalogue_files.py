@@ -89,7 +89,20 @@ DEM_CASES = [
     ("dem-fifo", _fifo("dem.tif"), InputError, "named pipe"),
     ("dem-directory", _dir("dem.tif"), InputError, "is a directory"),
     ("dem-missing", lambda tmp: tmp / "nowhere.tif", InputError, "does not exist"),
+    # rasters that are not elevation (issue 25)
+    ("dem-rgb", lambda tmp: _dc().rgb(tmp / "map.tif"), InputError, "RGB colour image"),
+    ("dem-palette", lambda tmp: _dc().palette(tmp / "lc.tif"), InputError, "colour-indexed"),
+    ("dem-complex", lambda tmp: _dc().complex_raster(tmp / "ifg.tif"), InputError,
+     "complex complex64"),
+    ("dem-celsius", lambda tmp: _dc().temperature(tmp / "t.tif"), InputError,
+     "unit 'degC', which is not a length"),
 ]
+
+
+def _dc():
+    from tests.world import dem_cases
+
+    return dem_cases
 
 
 @pytest.mark.parametrize("make, exc, fragment", [c[1:] for c in DEM_CASES],

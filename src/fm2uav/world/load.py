@@ -218,6 +218,14 @@ class WorldSpec(BaseModel):
                 out.append(_raster_file(item, info))
         return out
 
+    @field_validator("dem_fill")
+    @classmethod
+    def _fill_needs_dem(cls, v: Any, info: ValidationInfo) -> Any:
+        if v is not None and (info.data or {}).get("dem") is None:
+            raise ValueError("fills the gaps of world.dem (CLI --dem), which is not given; "
+                             "give the DEM first, or make this DEM world.dem")
+        return v
+
     def fill_sources(self) -> list[Any]:
         """``dem_fill`` as a list (each entry a file or a list of tiles), priority order."""
         if self.dem_fill is None:
