@@ -147,7 +147,7 @@ def test_the_dem_resolution_rule_is_the_hidden_relief_against_the_flight_height(
         assert r["needed_pixel_m"] == pytest.approx(60.0 / tan95, rel=0.06)
     if not ok:
         sf = {"dem_resolution": r}
-        with pytest.warns(GeodataWarning, match=rf"the DEM's {pixel:g} m pixels cannot resolve "
+        with pytest.warns(GeodataWarning, match=rf"the DEM's {pixel:.0f} m pixels cannot resolve "
                                                 r"the relief.*pixels of at most ~1\d\d m"):
             check_ground(w, sf)
 

@@ -304,6 +304,10 @@ def _where(stretch: dict[str, Any]) -> str:
             f"lon {a[0]:.5f}, lat {a[1]:.5f} to lon {b[0]:.5f}, lat {b[1]:.5f}")
 
 
+def _metres(v: float) -> str:
+    return f"{v:.0f}" if v >= 10 else f"{v:.1f}"
+
+
 def ground_notes(world: Any, safety: dict[str, Any], *, what: str = "the path"
                  ) -> dict[str, str]:
     """What the ground figures of a safety summary mean, in words: ``{"filled": ...,
@@ -327,7 +331,7 @@ def ground_notes(world: Any, safety: dict[str, Any], *, what: str = "the path"
     if res and not res["ok"]:
         need = res.get("needed_pixel_m")
         notes["resolution"] = (
-            f"the DEM's {res['pixel_m']:g} m pixels cannot resolve the relief under {what}: at "
+            f"the DEM's {_metres(res['pixel_m'])} m pixels cannot resolve the relief under {what}: at "
             f"its slopes (95th percentile {res['slope_p95_deg']:.0f}°) ground up to "
             f"~{res['hidden_relief_m']:.0f} m higher than the DEM shows can hide between pixel "
             f"centres, more than half of the {res['agl_m']:g} m flown above it; for this height "

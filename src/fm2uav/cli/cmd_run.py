@@ -139,7 +139,7 @@ def ground_rows(safety: dict[str, Any]) -> dict[str, str]:
     r = safety.get("dem_resolution")
     if r:
         rows["DEM resolution"] = (
-            f"{r['pixel_m']:g} m pixels, slope p95 {r['slope_p95_deg']:.0f}°: up to "
+            f"{r['pixel_m']:.0f} m pixels, slope p95 {r['slope_p95_deg']:.0f}°: up to "
             f"{r['hidden_relief_m']:.0f} m of relief can hide between pixels ("
             + ("ok" if r["ok"] else "TOO COARSE") + f" for {r['agl_m']:g} m above ground"
             + ("" if r["ok"] or not r.get("needed_pixel_m") else
