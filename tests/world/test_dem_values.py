@@ -145,6 +145,12 @@ def test_elevation_rasters_pass_and_units_become_metres(tmp_path):
     assert length_unit_factor("US survey foot") == pytest.approx(1200 / 3937)
     assert length_unit_factor("ft") == 0.3048 and length_unit_factor("cm") == 0.01
     assert length_unit_factor("degC") is None and length_unit_factor("K") is None
+    # unit texts as files write them
+    assert length_unit_factor("m above mean sea level") == 1.0
+    assert length_unit_factor("Meters (EGM2008)") == 1.0
+    assert length_unit_factor("elevation (m)") == 1.0
+    assert length_unit_factor("height [ft]") == 0.3048
+    assert length_unit_factor("temperature (K)") is None
 
 
 def test_pixel_sizes_on_the_ground():

@@ -99,12 +99,27 @@ def max_step(distance_m: Any) -> np.ndarray:
 
 
 def length_unit_factor(unit: str | None) -> float | None:
-    """Metres per unit of a band's unit text (``""`` → 1), or None when it is no length."""
+    """Metres per unit of a band's unit text (``""`` → 1), or None when it is no length.
+
+    The whole text is looked up first, then its first word, then a unit in brackets, so
+    that ``"m above mean sea level"``, ``"Meters (EGM2008)"``, ``"feet, NAVD88"`` or
+    ``"elevation (m)"`` are read as the lengths they name.
+
+    >>> length_unit_factor("m above mean sea level"), length_unit_factor("degC")
+    (1.0, None)
+    """
     u = " ".join((unit or "").strip().lower().replace("_", " ").split())
     if u in _UNITS:
         return _UNITS[u]
-    u2 = u.replace(" ", "_")
-    return _UNITS.get(u2)
+    if u.replace(" ", "_") in _UNITS:
+        return _UNITS[u.replace(" ", "_")]
+    import re
+
+    first = re.split(r"[\s,;:()\[\]/]+", u, maxsplit=1)[0]
+    if first in _UNITS and first not in ("elevation", "height"):
+        return _UNITS[first]
+    inner = re.search(r"[(\[]\s*([a-z _-]+?)\s*[)\]]", u)  # "elevation (m)", "height [ft]"
+    return _UNITS.get(inner.group(1)) if inner else None
 
 
 def raster_problem(ds: Any, path: Any) -> str | None:
