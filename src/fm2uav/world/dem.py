@@ -244,9 +244,11 @@ def _read_fill(f: Any, k: int, crs: Any, nodata_value: float | None, box: Any, d
     except InputError as exc:
         if "does not overlap" not in str(exc):
             raise
+        w, s_, e, n = box
         raise InputError(f"world.dem_fill (CLI --dem-fill) number {k + 1}, {_describe(f)}, "
-                         f"does not overlap the map, so it fills no gap; remove it or give a "
-                         f"DEM of the mission area ({exc})") from None
+                         f"does not overlap the map (lon {w:.4f}..{e:.4f}, lat {s_:.4f}.."
+                         f"{n:.4f}), so it fills no gap; remove it or give a DEM of the mission "
+                         "area") from None
     return dataclasses.replace(d, sources=tuple(
         dataclasses.replace(s_, role="dem_fill") for s_ in d.sources))
 
