@@ -49,6 +49,8 @@ __all__ = ["GroundModel", "GroundLayer", "MAX_SAMPLES", "ground_model_from_dem",
 #: Largest raster (pixels, all layers together) kept as a ground model (about 200 MB of
 #: float64).
 MAX_SAMPLES = 25_000_000
+#: Points evaluated at a time by a model of several DEMs (bounds the temporaries).
+_CHUNK = 1_000_000
 
 
 @dataclass(frozen=True, eq=False)
@@ -184,8 +186,18 @@ class GroundModel:
         return float(min(layer.pixel_m for layer in self.layers))
 
     def _evaluate(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray, tuple[int, ...]]:
+        """(heights, measuring layer or -1, shape) of world points, in chunks of
+        :data:`_CHUNK` points (a clearance grid asks for millions)."""
         xa, ya = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         xs, ys = xa.ravel(), ya.ravel()
+        h = np.empty(xs.shape)
+        src = np.empty(xs.shape, dtype=np.int8)
+        for a in range(0, len(xs), _CHUNK):
+            h[a:a + _CHUNK], src[a:a + _CHUNK] = self._evaluate_flat(xs[a:a + _CHUNK],
+                                                                     ys[a:a + _CHUNK])
+        return h, src, xa.shape
+
+    def _evaluate_flat(self, xs: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         h = np.full(xs.shape, np.nan)
         src = np.full(xs.shape, -1, dtype=np.int8)
         fallback = np.full(xs.shape, np.nan)
@@ -206,7 +218,7 @@ class GroundModel:
                 fallback[idx[rest]] = hk[rest]
         unknown = src < 0
         h[unknown] = fallback[unknown]
-        return h, src, xa.shape
+        return h, src
 
     def height(self, x: Any, y: Any) -> np.ndarray:
         """Bilinear DEM height [m] at world ``(x, y)`` [m] (see the module docstring)."""
