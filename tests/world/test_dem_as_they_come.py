@@ -210,3 +210,28 @@ def test_rasters_that_are_not_elevation_are_refused(d, name, says):
         World.from_dem(d[name], 30.0)
     with pytest.raises(ValueError, match=says):
         WorldSpec(dem=str(d[name]))
+
+
+def test_a_hole_smaller_than_a_cell_is_unknown_ground_too(tmp_path):
+    """A 2 x 2-pixel NaN hole between the world's 60 m nodes: nodata: error refuses it (the
+    ground model would fill it silently otherwise), fill reports it where the path crosses."""
+    from fm2uav.analysis.known_ground import ground_split
+    from fm2uav.world.ground import has_unknown_ground
+
+    rows, cols = 120, 150
+    t = rasterio.transform.from_origin(500000.0, 4500000.0, 10.0, 10.0)
+    c, r = np.meshgrid(np.arange(cols) + 0.5, np.arange(rows) + 0.5)
+    z = dc.hills((c - 75) / 100, (60 - r) / 100, seed=2)
+    z[62:64, 74:76] = np.nan  # pixel centres 745..755 m east, 615..625 m south of the top
+    p = dc.write(tmp_path / "lidar.tif", z, "EPSG:32630", t, nodata=np.nan)
+    with pytest.raises(WorldError, match=r"4 nodata/NaN pixel\(s\) inside the map.*between the "
+                                         r"world's nodes.*world.nodata: fill"):
+        World.from_dem(p, 60.0)
+    w = World.from_dem(p, 60.0, nodata="fill")
+    assert not w.filled.any() and has_unknown_ground(w)
+    assert w.georef.sources[0].details["filled_pixels_between_nodes"] == 4
+    y = 4500000.0 - 620.0
+    path = np.column_stack([np.linspace(500100, 501400, 60), np.full(60, y), np.full(60, 900.0)])
+    g = ground_split(w, path, path[:, 2] - w.ground_height(path[:, 0], path[:, 1]))
+    over, _ = dc.length_over(path, lambda q: ~dc.measured_mask(p, w, q), step=0.05)
+    assert over > 10.0 and g["filled"]["length_m"] == pytest.approx(over, abs=0.2)

@@ -68,11 +68,6 @@ def nodata_rule(world: Any) -> str | None:
     return None
 
 
-def _has_unknown(world: Any) -> bool:
-    filled = getattr(world, "filled", None)
-    return filled is not None and bool(np.asarray(filled).any())
-
-
 def _sources(world: Any) -> list[str]:
     model = getattr(world, "ground", None)
     if model is not None:

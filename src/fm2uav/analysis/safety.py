@@ -37,6 +37,7 @@ from ..errors import InputError
 from ..geometry import densify
 from ..planning.altitude import height_figures
 from ..world.clearance import surface_clearance
+from ..world.ground import has_unknown_ground
 from ..world.ground_model import sampling_step
 from ..world.zones import zone_distances, zone_violations
 from .known_ground import dem_resolution, filled_mask, ground_split
@@ -126,7 +127,7 @@ def leg_figures(world: Any, waypoints: Any, *, requested: float | None = None,
         sel = cl[leg] & inner
         if sel.any():
             out["cruise"] = height_figures(h[sel], requested, points=dense[sel])
-    if getattr(world, "filled", None) is not None and np.asarray(world.filled).any():
+    if has_unknown_ground(world):
         unknown = filled_mask(world, dense)
         out["ground"] = {
             "measured_min_m": round(float(h[~unknown].min()), 3) if (~unknown).any() else None,

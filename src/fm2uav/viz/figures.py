@@ -110,7 +110,9 @@ def plan_figure(plan: Plan, *, title: str | None = None,
     p = plan.params
     sub = (f"length {plan.length:.0f} m · clearance {plan.clearance:.1f} m · "
            f"α={p.get('saturation', 1):g} β={p.get('exponent', 1):g}")
-    has_gaps = getattr(world, "filled", None) is not None and bool(np.asarray(world.filled).any())
+    from ..world.ground import has_unknown_ground
+
+    has_gaps = getattr(world, "filled", None) is not None and has_unknown_ground(world)
     note = _ground_note(ground, unknown) if has_gaps or (ground or {}).get("sources") else ""
     return finish(fig, title, sub + (f"\n{note}" if note else ""))
 

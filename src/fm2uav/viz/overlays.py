@@ -27,7 +27,9 @@ def filled_path_overlay(world: Any, paths: Any) -> dict[str, Any]:
     """``{FILLED_PATH_NAME: overlay}``: the stretches of the 3D ``paths`` (one (N, 3) array or
     a list) over filled (unknown) ground, as 3D polylines with NaN rows between them; empty
     when no path crosses filled ground."""
-    if getattr(world, "filled", None) is None or not np.asarray(world.filled).any():
+    from ..world.ground import has_unknown_ground
+
+    if getattr(world, "filled", None) is None or not has_unknown_ground(world):
         return {}
     parts: list[np.ndarray] = []
     for p in ([paths] if isinstance(paths, np.ndarray) else list(paths)):

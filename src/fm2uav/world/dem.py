@@ -295,7 +295,13 @@ def _build(source: Any, fills: list[Any], cell: tuple[float, float, float],
     gx = west + np.arange(nx) * dx
     gy = south + np.arange(ny) * dy
     comp = composite(levels, srcs, dst, west, gy[-1], dx, dy, nx, ny)
-    heights, filled = _fill_nodata(comp.heights, comp.valid, nodata, gx, gy, dst, levels)
+    # the DEMs at their own resolution for every height-above-ground question (issue 13)
+    from .ground_model import ground_model_from_dem
+
+    ground = ground_model_from_dem(levels, srcs, dst, min(dx, dy))
+    hidden = _hidden_gaps(levels, srcs, dst, (west, south, gx[-1], gy[-1]), ground)
+    heights, filled = _fill_nodata(comp.heights, comp.valid, nodata, gx, gy, dst, levels,
+                                   hidden=hidden)
     for k, off in enumerate(comp.offsets):
         if off is not None and abs(off) > DATUM_WARNING_M:
             warnings.warn(
@@ -312,6 +318,7 @@ def _build(source: Any, fills: list[Any], cell: tuple[float, float, float],
     w = World.from_heightmap(heights, (dx, dy, dz), nz, origin=(west, south, z0), name=name)
     details = {"world_nodes": [nx, ny, nz], "filled_nodes": int(filled.sum()),
                "nodata_rule": nodata,
+               **({"filled_pixels_between_nodes": hidden[0]} if hidden[0] else {}),
                **({"measured_nodes": comp.measured[0]} if fills else {}),
                **({"undeclared_nodata": [{"value": s_.value, "pixels": s_.pixels}
                                          for s_ in dem.undeclared]} if dem.undeclared else {}),
@@ -330,10 +337,6 @@ def _build(source: Any, fills: list[Any], cell: tuple[float, float, float],
                            crs_rule="given", details=extra)]
     if more:
         georef = georef.with_sources(*more)
-    # the DEMs at their own resolution for every height-above-ground question (issue 13)
-    from .ground_model import ground_model_from_dem
-
-    ground = ground_model_from_dem(levels, srcs, dst, min(dx, dy))
     return w.with_fields(crs=crs_label(dst) if crs_epsg(dst) else dst,
                          name=name or "dem", filled=filled, georef=georef, ground=ground)
 
@@ -474,14 +477,60 @@ def _centred_box(ex: np.ndarray, ey: np.ndarray) -> tuple[float, float, float, f
     return (cx - lo * hw, cy - lo * hh, cx + lo * hw, cy + lo * hh)
 
 
+def _hidden_gaps(levels: Sequence[DemRaster], srcs: Sequence[Any], dst: Any,
+                 rect: tuple[float, float, float, float], ground: Any
+                 ) -> tuple[int, tuple[float, float] | None]:
+    """Nodata pixels inside the map whose ground no DEM measures, counted at the DEMs' own
+    resolution (holes smaller than a cell fall between the world's nodes): (count, lon/lat
+    of the first). Without a ground model (rasters too large) the nodes alone count."""
+    if ground is None:
+        return 0, None
+    west, south, east, north = rect
+    count, first = 0, None
+    for dem, src in zip(levels, srcs):
+        bad = np.argwhere(~np.isfinite(dem.z))
+        if not bad.size:
+            continue
+        a, b, c, d, e, f = dem.transform
+        x = a * (bad[:, 1] + 0.5) + b * (bad[:, 0] + 0.5) + c
+        y = d * (bad[:, 1] + 0.5) + e * (bad[:, 0] + 0.5) + f
+        X, Y = (np.asarray(v) for v in transformer(src, dst).transform(x, y))
+        inside = (X >= west) & (X <= east) & (Y >= south) & (Y <= north)
+        if not inside.any():
+            continue
+        unknown = np.asarray(ground.source(X[inside], Y[inside])) < 0
+        count += int(unknown.sum())
+        if first is None and unknown.any():
+            k = int(np.flatnonzero(unknown)[0])
+            lon, lat = transformer(dst, WGS84).transform(float(X[inside][k]),
+                                                         float(Y[inside][k]))
+            first = (float(lon), float(lat))
+    return count, first
+
+
 def _fill_nodata(heights: np.ndarray, valid: np.ndarray, nodata: str, gx: np.ndarray,
-                 gy: np.ndarray, dst: Any, levels: Sequence[DemRaster] = ()
-                 ) -> tuple[np.ndarray, np.ndarray]:
+                 gy: np.ndarray, dst: Any, levels: Sequence[DemRaster] = (), *,
+                 hidden: tuple[int, Any] = (0, None)) -> tuple[np.ndarray, np.ndarray]:
     """Heights with the nodes no DEM measures refused (``nodata="error"``) or filled from the
-    nearest measured node (at most half of them); and the mask of filled nodes."""
+    nearest measured node (at most half of them); and the mask of filled nodes. ``hidden``
+    (:func:`_hidden_gaps`): nodata pixels between the nodes, refused under ``"error"`` too."""
     missing = ~valid
     n_miss = int(missing.sum())
     filled = np.zeros(valid.shape, dtype=bool)
+    if not n_miss and hidden[0] and nodata == "error":
+        found = [s_ for d in levels for s_ in d.undeclared]
+        why = (f" (among them: {', '.join(s_.describe() for s_ in found)}, nodata the file "
+               "does not declare)" if found else "")
+        lon, lat = hidden[1]
+        raise WorldError(
+            f"the DEM has {hidden[0]} nodata/NaN pixel(s) inside the map{why}, between the "
+            f"world's nodes, first at lon {lon:.5f}, lat {lat:.5f}: ground no DEM measures; "
+            "crop it to its data with world.bbox (CLI --bbox W,S,E,N)"
+            + ("" if len(levels) > 1 else ", fill them from another DEM with world.dem_fill "
+               "(CLI --dem-fill FILE)")
+            + ", or set world.nodata: fill (CLI --nodata fill) to take the nearest valid "
+            "elevation, reported as unknown ground (error_on_route: the same, refusing plans "
+            "that fly over it)")
     if n_miss:
         i, j = np.argwhere(missing)[0]
         lon, lat = transformer(dst, WGS84).transform(float(gx[i]), float(gy[j]))

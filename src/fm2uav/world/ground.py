@@ -28,8 +28,8 @@ from scipy import ndimage
 if TYPE_CHECKING:
     from .world import World
 
-__all__ = ["ground_height", "ground_filled", "ground_source", "surface_height", "roof_heights",
-           "terrain_along"]
+__all__ = ["ground_height", "ground_filled", "ground_source", "has_unknown_ground",
+           "surface_height", "roof_heights", "terrain_along"]
 
 
 def _xy(world: World, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray, bool]:
@@ -99,6 +99,17 @@ def ground_source(world: World, x: Any, y: Any) -> np.ndarray:
         bad |= (w > 1e-12) & filled[ii, jj]
     out[bad] = -1
     return out
+
+
+def has_unknown_ground(world: World) -> bool:
+    """Whether some ground of the map is unknown (filled): a filled node, or nodata pixels
+    of the DEM between the nodes (counted when the world was built)."""
+    filled = getattr(world, "filled", None)
+    if filled is not None and bool(np.asarray(filled).any()):
+        return True
+    g = getattr(world, "georef", None)
+    return any(s.role == "dem" and s.details.get("filled_pixels_between_nodes", 0) > 0
+               for s in (getattr(g, "sources", ()) or ()))
 
 
 def ground_filled(world: World, x: Any, y: Any) -> np.ndarray:

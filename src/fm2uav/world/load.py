@@ -548,7 +548,8 @@ def load_world(spec: WorldSpec, *, agl: float | None = None, top: float | None =
 
 
 def check_points(world: World, points: dict[str, Any], *, allow_filled: bool = False) -> None:
-    """Refuse named points (``{"start": p, "goal": q}``) over filled DEM cells.
+    """Refuse named points (``{"start": p, "goal": q}``) over filled DEM nodata (ground no DEM
+    measures, :func:`fm2uav.world.ground.ground_source`).
 
     Parameters
     ----------
@@ -561,16 +562,18 @@ def check_points(world: World, points: dict[str, Any], *, allow_filled: bool = F
     Raises
     ------
     PointError
-        A point whose nearest column has a filled (invented) ground height;
-        the message names ``--allow-filled`` / ``world.allow_filled``.
+        A point whose ground height is filled (invented); the message names
+        ``--allow-filled`` / ``world.allow_filled``.
     """
-    filled = getattr(world, "filled", None)
-    if filled is None or not filled.any():
+    from .ground import has_unknown_ground
+
+    if not has_unknown_ground(world):
         return
     for what, p in points.items():
         q = np.asarray(p, dtype=float)
-        cell = world.to_cell(q, what=what)
-        if filled[cell[0], cell[1]]:
+        world.to_cell(q, what=what)  # outside the map: named as such
+        # the rule of every safety figure: the ground under the point is measured by no DEM
+        if bool(np.asarray(world.ground_filled(q[0], q[1]))):
             lonlat = ""
             if world.crs is not None:
                 from .geo import to_lonlat
