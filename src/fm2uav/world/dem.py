@@ -84,7 +84,7 @@ from .geo import (
     parse_crs,
     transformer,
 )
-from .lonlat_grid import from_lonlat_grid
+from .lonlat_grid import lonlat_raster
 from .quiet import GeodataWarning, library_warnings
 
 __all__ = [
@@ -628,3 +628,42 @@ def _ceiling(ceiling: float | None, hmax: float, dz: float, agl: float | None,
             f"world.ceiling (--ceiling) = {alt:g} m is below a requested altitude of "
             f"{float(top):g} m (start/goal); raise it or leave it out")
     return alt
+
+
+def from_lonlat_grid(
+    z: Any,
+    lon: Any,
+    lat: Any,
+    cell_size: float | tuple[float, float, float],
+    ceiling: float | None = None,
+    **kwargs: Any,
+) -> Any:
+    """Build a world from a plain elevation array and its lon/lat coordinate vectors.
+
+    The shape of an xarray ``DataArray`` of a DEM or bathymetry grid
+    (``da.values, da.lon.values, da.lat.values``): ``z[i_lat, i_lon]`` [m],
+    with ``lon`` in 0..360 or -180..180 degrees and ``lat`` in either order
+    (south-up or north-up). Pixel centres sit at the given coordinates.
+    Irregular rows or columns (e.g. rows regular in Mercator) are first
+    interpolated linearly onto a regular grid of their finest step
+    (:func:`fm2uav.world.lonlat_grid.lonlat_raster`). Then the grid goes through
+    :func:`from_dem` (EPSG:4326 → local UTM).
+
+    Parameters
+    ----------
+    z : array_like (n_lat, n_lon)
+        Elevations [m]; NaN = missing.
+    lon, lat : array_like (n_lon,), (n_lat,)
+        Pixel-centre coordinates [deg], each strictly monotonic.
+    cell_size, ceiling, **kwargs :
+        As :func:`from_dem` (``nodata``, ``nodata_value``, ``bbox``, ``sea_level``,
+        ``agl``, ``top``, ``name``, ``fill``).
+
+    Raises
+    ------
+    InputError
+        Shapes that do not match (a transposed array is named), coordinates not
+        monotonic or out of range, a grid across the antimeridian.
+    """
+    zz, transform = lonlat_raster(z, lon, lat)
+    return from_dem(zz, cell_size, ceiling, crs="EPSG:4326", transform=transform, **kwargs)

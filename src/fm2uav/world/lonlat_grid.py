@@ -1,8 +1,8 @@
 """DEMs given as a plain elevation array with lon/lat coordinate vectors (the xarray layout).
 
-:func:`from_lonlat_grid` turns ``z[i_lat, i_lon]`` with its ``lon`` (0..360 or
+:func:`lonlat_raster` turns ``z[i_lat, i_lon]`` with its ``lon`` (0..360 or
 -180..180) and ``lat`` (either order) vectors into a north-up raster in
-EPSG:4326 and builds the world with :func:`fm2uav.world.dem.from_dem`.
+EPSG:4326; :func:`fm2uav.world.dem.from_lonlat_grid` builds the world from it.
 Irregular rows or columns (e.g. rows regular in Mercator) are first
 interpolated linearly onto a regular grid of their finest step.
 """
@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["from_lonlat_grid"]
+__all__ = ["lonlat_raster"]
 
 
 def _regular(v: np.ndarray) -> bool:
@@ -40,33 +40,12 @@ def _to_regular(z: np.ndarray, coord: np.ndarray, axis: int) -> tuple[np.ndarray
     return np.moveaxis(out, 0, axis), reg
 
 
-def from_lonlat_grid(
-    z: Any,
-    lon: Any,
-    lat: Any,
-    cell_size: float | tuple[float, float, float],
-    ceiling: float | None = None,
-    **kwargs: Any,
-) -> Any:
-    """Build a world from a plain elevation array and its lon/lat coordinate vectors.
+def lonlat_raster(z: Any, lon: Any, lat: Any) -> tuple[np.ndarray, tuple[float, ...]]:
+    """A north-up EPSG:4326 raster ``(z, transform)`` from ``z[i_lat, i_lon]`` [m] and its
+    pixel-centre ``lon`` (0..360 or -180..180) and ``lat`` (either order) vectors [deg].
 
-    The shape of an xarray ``DataArray`` of a DEM or bathymetry grid
-    (``da.values, da.lon.values, da.lat.values``): ``z[i_lat, i_lon]`` [m],
-    with ``lon`` in 0..360 or -180..180 degrees and ``lat`` in either order
-    (south-up or north-up). Pixel centres sit at the given coordinates.
-    Irregular rows or columns (e.g. rows regular in Mercator) are first
-    interpolated linearly onto a regular grid of their finest step. Then the
-    grid goes through :func:`from_dem` (EPSG:4326 → local UTM).
-
-    Parameters
-    ----------
-    z : array_like (n_lat, n_lon)
-        Elevations [m]; NaN = missing.
-    lon, lat : array_like (n_lon,), (n_lat,)
-        Pixel-centre coordinates [deg], each strictly monotonic.
-    cell_size, ceiling, **kwargs :
-        As :func:`from_dem` (``nodata``, ``nodata_value``, ``bbox``, ``sea_level``,
-        ``agl``, ``top``, ``name``).
+    Irregular rows or columns (e.g. rows regular in Mercator) are first interpolated
+    linearly onto a regular grid of their finest step.
 
     Raises
     ------
@@ -119,6 +98,4 @@ def from_lonlat_grid(
     # north-up raster: row 0 = northernmost latitude
     zz = zz[::-1]
     transform = (rx, 0.0, float(lo[0]) - 0.5 * rx, 0.0, -ry, float(la[-1]) + 0.5 * ry)
-    from .dem import from_dem
-
-    return from_dem(zz, cell_size, ceiling, crs="EPSG:4326", transform=transform, **kwargs)
+    return zz, transform
