@@ -94,6 +94,7 @@ def safety_rows(safety: dict[str, Any]) -> dict[str, str]:
                                                  f"{lc['min_m']:.1f})")
     if "clearance_m" in safety:
         rows["clearance to the surface [m]"] = f"{safety['clearance_m']:.1f}"
+    rows.update(ground_rows(safety))
     z = safety.get("zones")
     if z:
         near = min(z["distance_m"].values()) if z["distance_m"] else float("inf")
@@ -102,6 +103,47 @@ def safety_rows(safety: dict[str, Any]) -> dict[str, str]:
     bad = [k for k, c in safety.get("checks", {}).items() if not c.get("ok", True)]
     if bad:
         rows["limits NOT met"] = ", ".join(bad)
+    return rows
+
+
+def ground_rows(safety: dict[str, Any]) -> dict[str, str]:
+    """Printed / report rows of the known/unknown ground split and the DEM resolution
+    (:mod:`fm2uav.analysis.known_ground`)."""
+    rows: dict[str, str] = {}
+    g = safety.get("ground")
+    if g:
+        m, f = g["measured"], g["filled"]
+        km = lambda v: f"{v / 1000:.2f} km"  # noqa: E731
+        parts = [f"measured {km(m['length_m'])} ({100 * m['share']:.0f} %)"]
+        for src in g.get("sources", [])[1:]:
+            parts[0] += f"; of it from the fill DEM {src['dem']}: {km(src['length_m'])}"
+        parts.append(f"FILLED (unknown, heights invented) {km(f['length_m'])} "
+                     f"({100 * f['share']:.0f} %)" if f["length_m"] > 0 else "filled 0 km")
+        rows["ground under the path"] = ", ".join(parts)
+        if f["length_m"] > 0:
+            for name, part in (("over measured ground", m), ("over FILLED ground", f)):
+                hag = part.get("height_above_ground")
+                if not hag:
+                    continue
+                band = hag.get("within_band")
+                share = "" if band is None else f", {100 * band:.0f} % within ±{hag['band_m']:g} m"
+                clr = f", clearance {part['clearance_m']:.1f}" if "clearance_m" in part else ""
+                rows[f"height above ground {name} [m]"] = (
+                    f"min {hag['min_m']:.1f}, median {hag['median_m']:.1f}{share}{clr}"
+                    + (" (against invented ground)" if part is f else ""))
+        legs = (safety.get("legs") or {}).get("ground")
+        if legs and legs.get("filled_min_m") is not None:
+            rows["lowest AGL along the legs, measured / FILLED ground [m]"] = (
+                f"{legs['measured_min_m'] if legs['measured_min_m'] is not None else '-'} / "
+                f"{legs['filled_min_m']}")
+    r = safety.get("dem_resolution")
+    if r:
+        rows["DEM resolution"] = (
+            f"{r['pixel_m']:.0f} m pixels, slope p95 {r['slope_p95_deg']:.0f}°: up to "
+            f"{r['hidden_relief_m']:.0f} m of relief can hide between pixels ("
+            + ("ok" if r["ok"] else "TOO COARSE") + f" for {r['agl_m']:g} m above ground"
+            + ("" if r["ok"] or not r.get("needed_pixel_m") else
+               f"; needs pixels of <= {r['needed_pixel_m']:.0f} m") + ")")
     return rows
 
 
@@ -159,6 +201,7 @@ def plan_outputs(
     mission : fm2uav.io.MissionExport
         The built mission.
     """
+    from ..analysis.known_ground import check_ground
     from ..analysis.safety import safety_summary
     from ..io import export_mission
     from ..autopilot.geofence import zone_fences
@@ -182,6 +225,7 @@ def plan_outputs(
     if zones:
         safety["geofence"] = {"fences": len(mission_inputs.get("fences") or ()),
                               "warnings": fence_warnings}
+    check_ground(plan.world, safety)  # filled ground: warned, or refused (error_on_route)
     info = {
         **(summary or {}),
         **plan.summary(),
@@ -202,7 +246,8 @@ def plan_outputs(
         from ..viz import plan_figure
 
         step("writing plan.png")
-        write_figure(outdir, plan_figure(plan, title=title), "plan.png")
+        write_figure(outdir, plan_figure(plan, title=title, ground=safety.get("ground")),
+                     "plan.png")
     if "json" in formats:
         write_json(outdir, "summary.json", {**info, "files": [str(p.name) for p in outdir.written]
                                             + ["summary.json"]})
@@ -214,7 +259,8 @@ def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
                  fence_warnings: list[str]) -> str:
     """report.html of a plan and its autopilot mission's waypoints ``wps`` (see
     :func:`plan_outputs`)."""
-    from ..viz.overlays import filled_overlay
+    from ..analysis.known_ground import ground_notes
+    from ..viz.overlays import filled_overlay, filled_path_overlay
     from ..viz.report import report_html
 
     ms, level = info["autopilot"], getattr(plan, "level", None)
@@ -242,7 +288,9 @@ def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
         speeds={"FM² path": plan.w}, waypoints={"FM² path": wps.points_m},
         params=params, metrics=metrics, files=output_names(formats),
         agl=None if level is None else level.agl,
-        overlays={**filled_overlay(plan.world), **zone_overlays(zones)})
+        overlays={**filled_overlay(plan.world), **filled_path_overlay(plan.world, plan.path),
+                  **zone_overlays(zones)},
+        notes=list(ground_notes(plan.world, info["safety"]).values()))
 
 
 RUN_HELP = (
