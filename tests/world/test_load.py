@@ -167,19 +167,3 @@ def test_automatic_cells_keep_the_grid_small(dem):
     assert np.prod(w.shape) <= AUTO_NODES
     assert "million nodes" in w.georef.sources[0].details["cell_size_rule"]
     assert w.spacing[2] <= 20.0
-
-
-def test_a_bad_tile_in_a_list_of_dems_is_named(tmp_path):
-    import rasterio
-    from rasterio.transform import from_origin
-
-    from fm2uav.world.load import WorldSpec
-
-    good = tmp_path / "good.tif"
-    with rasterio.open(good, "w", driver="GTiff", height=4, width=4, count=1, dtype="float32",
-                       crs="EPSG:32632", transform=from_origin(600000, 5100000, 30, 30)) as ds:
-        ds.write(np.zeros((4, 4), "float32"), 1)
-    bad = tmp_path / "bad.tif"
-    bad.write_text("no raster")
-    with pytest.raises(ValidationError, match="bad.tif cannot be read as a raster"):
-        WorldSpec.model_validate({"dem": [str(good), str(bad)]})

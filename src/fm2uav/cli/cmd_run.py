@@ -17,7 +17,7 @@ from ..pipeline.outputs import (  # noqa: F401  (re-exported: were defined here)
     plan_outputs,
     write_exports,
 )
-from ..pipeline.rows import mission_rows, safety_rows  # noqa: F401  (re-exported)
+from ..pipeline.rows import ground_rows, mission_rows, safety_rows  # noqa: F401  (re-exported)
 from ._common import (
     Output,
     handle_errors,

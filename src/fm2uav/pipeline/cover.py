@@ -95,20 +95,21 @@ def run_cover(outdir: Any, world: Any, area: Any, *, area_label: str, spacing: f
 
 
 def _cover_report(outdir: Any, cp, *, title: str, subtitle: str, metrics: dict,
-                  waypoints=None, files=()) -> None:
+                  waypoints=None, files=(), notes=()) -> None:
     from ..viz.coverage import coverage_overlays
-    from ..viz.overlays import filled_overlay, zone_overlays
+    from ..viz.overlays import filled_overlay, filled_path_overlay, zone_overlays
     from ..viz.report import report_html
 
     name = "FM² path"
     world = cp.plan.world
-    overlays = {**filled_overlay(world), **coverage_overlays(cp),
+    overlays = {**filled_overlay(world), **filled_path_overlay(world, cp.path),
+                **coverage_overlays(cp),
                 **zone_overlays(getattr(world, "zones", ()))}
     html = report_html(
         world, {name: cp.path}, title=title, subtitle=subtitle,
         speeds={name: cp.plan.w}, ideal_agl={name: cp.level.agl},
         waypoints=None if waypoints is None else {name: waypoints},
-        overlays=overlays, params=cp.params, metrics=metrics, files=files)
+        overlays=overlays, params=cp.params, metrics=metrics, files=files, notes=notes)
     with outdir.open(REPORT) as fh:
         fh.write(html)
 
@@ -140,6 +141,9 @@ def cover_outputs(outdir: Any, cp, area: str, *, report: bool, title: str,
         waypoint_agl=wps.agl, level=cp.level)
     if zones:
         safety["geofence"] = {"fences": len(fences), "warnings": fence_warnings}
+    from ..analysis.known_ground import check_ground, ground_notes
+
+    check_ground(world, safety, what="the survey path")
     progress.step("writing the mission files", 0.3)
     write_exports(outdir, files)
     progress.step("writing the figures", 0.7)
@@ -170,7 +174,8 @@ def cover_outputs(outdir: Any, cp, area: str, *, report: bool, title: str,
         _cover_report(outdir, cp, title=title,
                       subtitle=f"zigzag bands over {area}, FM² at "
                                f"{cp.level.agl:g} m above the terrain",
-                      metrics=metrics, waypoints=wps.points_m, files=list(COVER_FILES))
+                      metrics=metrics, waypoints=wps.points_m, files=list(COVER_FILES),
+                      notes=list(ground_notes(world, safety, what="the survey path").values()))
     return mission, safety
 
 

@@ -127,9 +127,10 @@ def plan_outputs(
     mission : fm2uav.io.MissionExport
         The built mission.
     """
+    from ..analysis.known_ground import check_ground
     from ..analysis.safety import safety_summary
-    from ..io import export_mission
     from ..autopilot.geofence import zone_fences
+    from ..io import export_mission
 
     exports = [f for f in formats if f in EXPORT_FILES]
     zones = tuple(getattr(plan.world, "zones", ()))
@@ -151,6 +152,7 @@ def plan_outputs(
     if zones:
         safety["geofence"] = {"fences": len(mission_inputs.get("fences") or ()),
                               "warnings": fence_warnings}
+    check_ground(plan.world, safety)  # filled ground: warned, or refused (error_on_route)
     info = {
         **(summary or {}),
         **plan.summary(),
@@ -172,7 +174,8 @@ def plan_outputs(
         from ..viz import plan_figure
 
         progress.step("writing plan.png", 0.1)
-        write_figure(outdir, plan_figure(plan, title=title), "plan.png")
+        write_figure(outdir, plan_figure(plan, title=title, ground=safety.get("ground")),
+                     "plan.png")
     if "json" in formats:
         write_json(outdir, "summary.json", {**info, "files": [str(p.name) for p in outdir.written]
                                             + ["summary.json"]})
@@ -184,7 +187,8 @@ def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
                  fence_warnings: list[str]) -> str:
     """report.html of a plan and its autopilot mission's waypoints ``wps`` (see
     :func:`plan_outputs`)."""
-    from ..viz.overlays import filled_overlay, zone_overlays
+    from ..analysis.known_ground import ground_notes
+    from ..viz.overlays import filled_overlay, filled_path_overlay, zone_overlays
     from ..viz.report import report_html
 
     ms, level = info["autopilot"], getattr(plan, "level", None)
@@ -212,7 +216,9 @@ def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
         speeds={"FM² path": plan.w}, waypoints={"FM² path": wps.points_m},
         params=params, metrics=metrics, files=output_names(formats),
         agl=None if level is None else level.agl,
-        overlays={**filled_overlay(plan.world), **zone_overlays(zones)})
+        overlays={**filled_overlay(plan.world), **filled_path_overlay(plan.world, plan.path),
+                  **zone_overlays(zones)},
+        notes=list(ground_notes(plan.world, info["safety"]).values()))
 
 
 def export_options(base: Any = None, *, firmware: str | None = None, vehicle: str | None = None,

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["plan_rows", "world_rows", "mission_rows", "safety_rows"]
+__all__ = ["plan_rows", "world_rows", "mission_rows", "safety_rows", "ground_rows"]
 
 
 def mission_rows(mission: Any) -> dict[str, str]:
@@ -56,6 +56,7 @@ def safety_rows(safety: dict[str, Any]) -> dict[str, str]:
                                                  f"{lc['min_m']:.1f})")
     if "clearance_m" in safety:
         rows["clearance to the surface [m]"] = f"{safety['clearance_m']:.1f}"
+    rows.update(ground_rows(safety))
     z = safety.get("zones")
     if z:
         near = min(z["distance_m"].values()) if z["distance_m"] else float("inf")
@@ -82,7 +83,7 @@ def world_rows(world: Any) -> dict[str, str]:
     g = getattr(world, "georef", None)
     if g is None:
         return {}
-    rows = {"CRS": f"{g.crs}" + (f" — {g.reprojection}" if g.reprojection else ""),
+    rows = {"CRS": f"{g.name}" + (f" — {g.reprojection}" if g.reprojection else ""),
             "vertical": g.vertical}
     for s in g.sources:
         d = s.details
@@ -105,4 +106,45 @@ def world_rows(world: Any) -> dict[str, str]:
                                 f"{world.spacing[0]:g} m, dz {world.spacing[2]:g} m")
     rows["sources"] = ", ".join(f"{Path(s.path).name} (sha256 {s.sha256[:12]})"
                                 for s in g.sources if s.sha256)
+    return rows
+
+
+def ground_rows(safety: dict[str, Any]) -> dict[str, str]:
+    """Printed / report rows of the known/unknown ground split and the DEM resolution
+    (:mod:`fm2uav.analysis.known_ground`)."""
+    rows: dict[str, str] = {}
+    g = safety.get("ground")
+    if g:
+        m, f = g["measured"], g["filled"]
+        km = lambda v: f"{v / 1000:.2f} km"  # noqa: E731
+        parts = [f"measured {km(m['length_m'])} ({100 * m['share']:.0f} %)"]
+        for src in g.get("sources", [])[1:]:
+            parts[0] += f"; of it from the fill DEM {src['dem']}: {km(src['length_m'])}"
+        parts.append(f"FILLED (unknown, heights invented) {km(f['length_m'])} "
+                     f"({100 * f['share']:.0f} %)" if f["length_m"] > 0 else "filled 0 km")
+        rows["ground under the path"] = ", ".join(parts)
+        if f["length_m"] > 0:
+            for name, part in (("over measured ground", m), ("over FILLED ground", f)):
+                hag = part.get("height_above_ground")
+                if not hag:
+                    continue
+                band = hag.get("within_band")
+                share = "" if band is None else f", {100 * band:.0f} % within ±{hag['band_m']:g} m"
+                clr = f", clearance {part['clearance_m']:.1f}" if "clearance_m" in part else ""
+                rows[f"height above ground {name} [m]"] = (
+                    f"min {hag['min_m']:.1f}, median {hag['median_m']:.1f}{share}{clr}"
+                    + (" (against invented ground)" if part is f else ""))
+        legs = (safety.get("legs") or {}).get("ground")
+        if legs and legs.get("filled_min_m") is not None:
+            rows["lowest AGL along the legs, measured / FILLED ground [m]"] = (
+                f"{legs['measured_min_m'] if legs['measured_min_m'] is not None else '-'} / "
+                f"{legs['filled_min_m']}")
+    r = safety.get("dem_resolution")
+    if r:
+        rows["DEM resolution"] = (
+            f"{r['pixel_m']:.0f} m pixels, slope p95 {r['slope_p95_deg']:.0f}°: up to "
+            f"{r['hidden_relief_m']:.0f} m of relief can hide between pixels ("
+            + ("ok" if r["ok"] else "TOO COARSE") + f" for {r['agl_m']:g} m above ground"
+            + ("" if r["ok"] or not r.get("needed_pixel_m") else
+               f"; needs pixels of <= {r['needed_pixel_m']:.0f} m") + ")")
     return rows
