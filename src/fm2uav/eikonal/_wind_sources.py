@@ -98,10 +98,9 @@ def _one_source(grid: wm.WindGrid, src: np.ndarray, radius: float, min_radius: f
             return None
         r = max(r / 2, min_radius)
     bshape = tuple(int(n) for n in hi - lo)
-    axes = [np.arange(n) * hk for n, hk in zip(bshape, h)]
-    X, Y, Z = np.meshgrid(*axes, indexing="ij")
+    axes = [(np.arange(n) - (s - a)) * hk for n, s, a, hk in zip(bshape, src, lo, h)]
+    dx, dy, dz = np.meshgrid(*axes, indexing="ij")  # [m] from the source
     xs = (src - lo) * h
-    dx, dy, dz = X - xs[0], Y - xs[1], Z - xs[2]
     inside = np.sqrt(dx * dx + dy * dy + dz * dz) <= r
     vbox = speed[box]
     if np.all(vbox == Vs) and np.all(wbox == ws):
