@@ -256,16 +256,14 @@ def _roots(ax, ay, az, bx, by, bz, U0, V, wx, wy, wz):
 
 
 @njit(**_INL)
-def _face2(fm, f, u0, s0, u1, s1, U0, gx, gy, V, wx, wy):
+def _face2(fm, f, u0, i0, u1, i1, U0, gx, gy, V, wx, wy):
     """Full-face solve in 2D: ``(time, ground velocity)``, ``inf`` outside the cone.
 
     ``fm[f]`` = E^-T of the face (its vertices' offsets as columns), ``u_i`` the
     (order-2, factored) values of its two vertices in ``fvert[f]`` order and
-    ``s_i`` their offset scales (1 or 2/3), ``U0`` a reference value subtracted
-    for accuracy, ``g`` the factored gradient (0 unfactored).
+    ``i_i`` the inverses of their offset scales (1 or 3/2), ``U0`` a reference
+    value subtracted for accuracy, ``g`` the factored gradient (0 unfactored).
     """
-    i0 = 1.0 / s0
-    i1 = 1.0 / s1
     r0 = (u0 - U0) * i0
     r1 = (u1 - U0) * i1
     m00 = fm[f, 0, 0]
@@ -285,11 +283,8 @@ def _face2(fm, f, u0, s0, u1, s1, U0, gx, gy, V, wx, wy):
 
 
 @njit(**_INL)
-def _face3(fm, f, u0, s0, u1, s1, u2, s2, U0, gx, gy, gz, V, wx, wy, wz):
+def _face3(fm, f, u0, i0, u1, i1, u2, i2, U0, gx, gy, gz, V, wx, wy, wz):
     """Full-face solve in 3D (as :func:`_face2`, three vertices)."""
-    i0 = 1.0 / s0
-    i1 = 1.0 / s1
-    i2 = 1.0 / s2
     r0 = (u0 - U0) * i0
     r1 = (u1 - U0) * i1
     r2 = (u2 - U0) * i2
@@ -363,11 +358,12 @@ def _grad_t0(px, py, pz, src, Vs, ws):
     t = zermelo_time(dx, dy, dz, Vs, ws[0], ws[1], ws[2])
     if t <= 0.0:
         return 0.0, 0.0, 0.0
-    nx = (dx - ws[0] * t) / (Vs * t)
-    ny = (dy - ws[1] * t) / (Vs * t)
-    nz = (dz - ws[2] * t) / (Vs * t)
-    den = Vs + ws[0] * nx + ws[1] * ny + ws[2] * nz
-    return nx / den, ny / den, nz / den
+    ivt = 1.0 / (Vs * t)
+    nx = (dx - ws[0] * t) * ivt
+    ny = (dy - ws[1] * t) * ivt
+    nz = (dz - ws[2] * t) * ivt
+    iden = 1.0 / (Vs + ws[0] * nx + ws[1] * ny + ws[2] * nz)
+    return nx * iden, ny * iden, nz * iden
 
 
 # --------------------------------------------------------------------------- heap
@@ -549,7 +545,7 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
         at physical point ``fsrc`` [m] with airspeed ``fV`` and wind ``fw``.
     track : (n, 3) ground-track direction (not normalised) of each node's
         last improvement, or (0, 3) not to record it.
-    scratch : float[6, K] per-vertex cache of one evaluation.
+    scratch : float[7, K] per-vertex cache of one evaluation.
     """
     doff, uoff, oph, fvert, fminv, fptr, fid, evert, eptr, eid, bptr, bdoff, fbig, ebig, ndim = st
     K = doff.shape[0]
@@ -563,6 +559,7 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
     Fv = scratch[3]  # order-2 value, factored (tau + T0(y))
     Dv = scratch[4]  # slope of the face objective from vertex k towards vertex j
     Bv = scratch[5]  # box of vertex j passable: epoch (yes), -epoch (no), else unknown
+    Iv = scratch[6]  # 1 / Sv
     for j in range(K):
         seen[j] = -1.0
         Bv[j] = 0.0
@@ -614,6 +611,7 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
             seen[k] = epoch
             Uv[k] = Uk
             Sv[k] = sk
+            Iv[k] = 1.5 if sk != 1.0 else 1.0
             Fv[k] = Fk
             okx = -oph[k, 0]
             oky = -oph[k, 1]
@@ -623,20 +621,22 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
             # F(v) - g.v: the vertex candidate is Fv_k + s_k (F(-o_k) + g.o_k)
             best = np.inf
             bvx, bvy, bvz = okx, oky, okz
+            Gk = Fk + sk * (tk - (gx * okx + gy * oky + gz * okz))
             if _box_ok(T, y, k, bptr, bdoff, Bv, epoch):
-                best = Fk + sk * (tk - (gx * okx + gy * oky + gz * okz))
+                best = Gk
             # grad F at -o_k: n / (V + w.n), n the heading flying along -o_k (minus
             # g, factored). The face objective (interpolated value + F) is convex:
             # it can only be below vertex k's value on a face where it decreases
             # from k towards another vertex j, i.e. where
             # slope_j = U_j - U_k - (gradF - g) . (s_j o_j - s_k o_k) < 0.
-            hx = (okx - wx * tk) / (V * tk)
-            hy = (oky - wy * tk) / (V * tk)
-            hz = (okz - wz * tk) / (V * tk)
-            den = V + wx * hx + wy * hy + wz * hz
-            fx = hx / den - gx
-            fy = hy / den - gy
-            fz = hz / den - gz
+            ivt = 1.0 / (V * tk)
+            hx = (okx - wx * tk) * ivt
+            hy = (oky - wy * tk) * ivt
+            hz = (okz - wz * tk) * ivt
+            iden = 1.0 / (V + wx * hx + wy * hy + wz * hz)
+            fx = hx * iden - gx
+            fy = hy * iden - gy
+            fz = hz * iden - gz
             nf = fptr[k + 1] - fptr[k]
             ne = eptr[k + 1] - eptr[k]
             for q in range(nf + ne):
@@ -646,7 +646,8 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
                 else:
                     f = eid[eptr[k] + q - nf]
                     nv = 2
-                down = False
+                down = np.inf  # the most negative slope from k (convexity: the face's
+                # minimum is at least Gk + that slope, so it cannot beat best if that is higher)
                 ok = True
                 for i in range(nv):
                     j = fvert[f, i] if q < nf else evert[f, i]
@@ -661,6 +662,7 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
                         if fj:
                             Uv[j] = uv
                             Sv[j] = s
+                            Iv[j] = 1.5 if s != 1.0 else 1.0
                             Fv[j] = fv
                             Dv[j] = fv - Fk - (fx * (s * oph[j, 0] - sk * oph[k, 0])
                                                + fy * (s * oph[j, 1] - sk * oph[k, 1])
@@ -668,9 +670,9 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
                     if not (Uv[j] == Uv[j]):  # not frozen
                         ok = False
                         break
-                    if Dv[j] < 0.0:
-                        down = True
-                if not ok or not down:
+                    if Dv[j] < down:
+                        down = Dv[j]
+                if not ok or not (down < 0.0) or not (Gk + down < best):
                     continue
                 if not _box_ok(T, y, fbig[f] if q < nf else ebig[f], bptr, bdoff, Bv, epoch):
                     continue
@@ -678,12 +680,12 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
                     a = fvert[f, 0]
                     b = fvert[f, 1]
                     if ndim == 2:
-                        cand, vx, vy, vz = _face2(fminv, f, Fv[a], Sv[a], Fv[b], Sv[b], Fk,
+                        cand, vx, vy, vz = _face2(fminv, f, Fv[a], Iv[a], Fv[b], Iv[b], Fk,
                                                   gx, gy, V, wx, wy)
                     else:
                         d = fvert[f, 2]
-                        cand, vx, vy, vz = _face3(fminv, f, Fv[a], Sv[a], Fv[b], Sv[b],
-                                                  Fv[d], Sv[d], Fk, gx, gy, gz, V, wx, wy, wz)
+                        cand, vx, vy, vz = _face3(fminv, f, Fv[a], Iv[a], Fv[b], Iv[b], Fv[d],
+                                                  Iv[d], Fk, gx, gy, gz, V, wx, wy, wz)
                 else:
                     a = evert[f, 0]
                     b = evert[f, 1]

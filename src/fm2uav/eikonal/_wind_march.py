@@ -110,8 +110,12 @@ def run(grid: WindGrid, start_idx: np.ndarray, start_t: np.ndarray, start_fixed:
     doff = st.off[:, 0] * sx + st.off[:, 1] * sy + st.off[:, 2]
     uoff = st.off[:, 0] * ny * nz + st.off[:, 1] * nz + st.off[:, 2]
     bdoff = st.boff[:, 0] * sx + st.boff[:, 1] * sy + st.boff[:, 2]
-    tables = (doff, uoff, st.oph, st.fvert, st.fminv, st.fptr, st.fid, st.evert, st.eptr,
-              st.eid, st.bptr, bdoff, st.fbig, st.ebig, grid.ndim)
+    # unsigned flat offsets (two's complement: index + offset wraps to the right
+    # node): numba emits negative-index wraparound code for signed indices
+    u64 = np.uint64
+    tables = (doff.astype(u64), uoff.astype(u64), st.oph, st.fvert, st.fminv, st.fptr, st.fid,
+              st.evert, st.eptr, st.eid, st.bptr, bdoff.astype(u64), st.fbig, st.ebig,
+              grid.ndim)
 
     start_idx = np.asarray(start_idx, dtype=np.int64)
     pidx = padded(start_idx)
@@ -121,8 +125,8 @@ def run(grid: WindGrid, start_idx: np.ndarray, start_t: np.ndarray, start_fixed:
     order_ = np.lexsort((pidx, start_t))  # a sorted array is a heap (key, padded index)
     cap = max(4096, 2 * start_idx.size)
     hk = np.empty(cap)
-    hc = np.empty(cap, dtype=np.int64)
-    hu = np.empty(cap, dtype=np.int64)
+    hc = np.empty(cap, dtype=np.uint64)
+    hu = np.empty(cap, dtype=np.uint64)
     hn = start_idx.size
     hk[:hn] = start_t[order_]
     hc[:hn] = pidx[order_]
@@ -147,18 +151,18 @@ def run(grid: WindGrid, start_idx: np.ndarray, start_t: np.ndarray, start_fixed:
         (fsrc, fV, fw), fac = factor, True
     acute2 = st.acute ** 2
     cnt = np.array([hn, nstop, 0, 0], dtype=np.int64)
-    scratch = np.zeros((6, st.off.shape[0]))
+    scratch = np.zeros((7, st.off.shape[0]))
     fsrc = np.asarray(fsrc, dtype=float)
     fw = np.asarray(fw, dtype=float)
-    shape3 = np.asarray(grid.shape3, dtype=np.int64)
+    shape3 = np.asarray(grid.shape3, dtype=np.uint64)
     h3 = np.asarray(grid.h3, dtype=float)
     while not wk.march(T, flag, grid.speed, grid.wind, grid.wconst, shape3, h3, tables, order,
                        hk, hc, hu, pos, cnt, can_stop, acute2, fac, fsrc, float(fV), fw, track,
                        scratch):
         n = int(cnt[0])  # the heap is full: double it and resume
         hk = np.concatenate([hk[:n], np.empty(hk.size)])
-        hc = np.concatenate([hc[:n], np.empty(hc.size, dtype=np.int64)])
-        hu = np.concatenate([hu[:n], np.empty(hu.size, dtype=np.int64)])
+        hc = np.concatenate([hc[:n], np.empty(hc.size, dtype=np.uint64)])
+        hu = np.concatenate([hu[:n], np.empty(hu.size, dtype=np.uint64)])
     pops, reopened = int(cnt[2]), int(cnt[3])
     inner = T.reshape(pshape)[PAD:PAD + nx, PAD:PAD + ny, pz:pz + nz]
     times = np.where(inner >= 0, inner, np.inf).reshape(-1)

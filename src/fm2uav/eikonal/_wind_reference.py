@@ -120,9 +120,10 @@ def travel_gradient(d: Vec, V: float, w: Vec) -> Vec:
     t = travel_time(d, V, w)
     if t <= 0:
         return (0.0, 0.0, 0.0)
-    n = [(d[i] - w[i] * t) / (V * t) for i in range(3)]
-    den = V + w[0] * n[0] + w[1] * n[1] + w[2] * n[2]
-    return (n[0] / den, n[1] / den, n[2] / den)
+    ivt = 1.0 / (V * t)
+    n = [(d[i] - w[i] * t) * ivt for i in range(3)]
+    iden = 1.0 / (V + w[0] * n[0] + w[1] * n[1] + w[2] * n[2])
+    return (n[0] * iden, n[1] * iden, n[2] * iden)
 
 
 def _stencil(ndim: int):
