@@ -37,7 +37,8 @@ minimum is found in closed form:
 * an *edge* of a 3D triangle: the 1D minimum of the interpolated value plus
   ``F_y`` along the segment, in closed form (the Randers form of ``F``).
 
-Order 2 (as the isotropic solver's): a vertex value ``U1`` whose next node
+Order 2 (as the isotropic solver's), at nodes where the stencil is acute (see
+below): a vertex value ``U1`` whose next node
 outward, ``U2`` at ``y + 2 o``, is frozen and not later, with the speed varying
 by at most ``ORDER2_MAX_SPEED_RATIO`` and the wind by at most
 ``ORDER2_MAX_WIND_CHANGE`` times the lowest of the three speeds, is replaced
@@ -58,7 +59,12 @@ labels: when a node is popped, its frozen non-acute neighbours are re-evaluated
 with the faces through it and re-opened if that lowers them, and a re-opened
 node, when popped again, re-evaluates all its frozen neighbours. The result is
 the exact solution of the discrete equations for any ``|w| < V`` (checked by
-the fixed-point test), at the price of the re-opened nodes' extra work.
+the fixed-point test), at the price of the re-opened nodes' extra work. Label
+correction needs a monotone update (values only ever go down), and the order-2
+value ``(4 U1 - U2) / 3`` grows when ``U2`` is lowered later, so non-acute
+nodes use order 1 (their accuracy is first order), and a grid with non-acute
+nodes is marched to the end even with stop nodes (a stop node's time is then
+final too).
 
 Storage
 -------
@@ -540,7 +546,8 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
         the heap holds every start node (frozen or band), sorted.
     cnt : int64[4] ``(heap size, STOP nodes not popped yet, pops, re-opened
         nodes)``; the march ends when no STOP node is left if ``can_stop``.
-    acute2 : ``acute**2``; a node with ``|w|^2 > acute2 V^2`` is non-acute.
+    acute2 : ``acute**2``; a node with ``|w|^2 > acute2 V^2`` is non-acute
+        (label correction, order 1).
     fac, fsrc, fV, fw : factored mode (the source box): the cone of the source
         at physical point ``fsrc`` [m] with airspeed ``fV`` and wind ``fw``.
     track : (n, 3) ground-track direction (not normalised) of each node's
@@ -590,14 +597,18 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
             left -= 1
         for k in range(K):
             y = c - doff[k]
+            yu = cu - uoff[k]
             ty = T[y]
             if not (ty == ty) or (flag[y] & FIXED) != 0:
                 continue
-            yu = cu - uoff[k]
             V = speed[yu]
             wx, wy, wz = _wind_at(wind, wconst, yu)
-            if ty >= 0.0 and not again and (wx * wx + wy * wy + wz * wz) <= acute2 * V * V:
+            acute = (wx * wx + wy * wy + wz * wz) <= acute2 * V * V
+            if ty >= 0.0 and not again and acute:
                 continue  # frozen and acute: a node popped later cannot lower it
+            # order 2 only where the stencil is causal: label correction lowers values
+            # only, and (4 U1 - U2) / 3 grows when a non-final U2 is lowered later
+            oy = order if acute else 1
             epoch += 1
             gx = gy = gz = 0.0
             T0y = 0.0
@@ -606,7 +617,7 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
                 T0y = _t0(pyx, pyy, pyz, fsrc, fV, fw)
                 gx, gy, gz = _grad_t0(pyx, pyy, pyz, fsrc, fV, fw)
             # vertex k alone: U_k + s_k F(-o_k)
-            _, Uk, sk, Fk = _vertex(T, speed, wind, wconst, y, yu, k, doff, uoff, order,
+            _, Uk, sk, Fk = _vertex(T, speed, wind, wconst, y, yu, k, doff, uoff, oy,
                                     V, wx, wy, wz, fac, T0y, ny, nz, h, fsrc, fV, fw)
             seen[k] = epoch
             Uv[k] = Uk
@@ -655,7 +666,7 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
                         continue
                     if seen[j] != epoch:
                         fj, uv, s, fv = _vertex(T, speed, wind, wconst, y, yu, j, doff, uoff,
-                                                order, V, wx, wy, wz, fac, T0y, ny, nz, h,
+                                                oy, V, wx, wy, wz, fac, T0y, ny, nz, h,
                                                 fsrc, fV, fw)
                         seen[j] = epoch
                         Uv[j] = np.nan

@@ -134,6 +134,7 @@ def run(grid: WindGrid, start_idx: np.ndarray, start_t: np.ndarray, start_fixed:
     pos = np.full(T.size, -1, dtype=np.int64)
     pos[hc[:hn]] = np.arange(hn)
 
+    any_na = bool(np.any(nonacute(grid)))
     nstop = 0
     can_stop = False
     if stop_idx is not None and len(stop_idx):
@@ -141,7 +142,7 @@ def run(grid: WindGrid, start_idx: np.ndarray, start_t: np.ndarray, start_fixed:
         sp = sp[T[sp] == T[sp]]  # impassable stop nodes are never reached
         flag[sp] |= wk.STOP
         nstop = int(sp.size)
-        can_stop = nstop > 0 and not bool(np.any(nonacute(grid)))
+        can_stop = nstop > 0 and not any_na
     track = np.zeros((grid.speed.size if want_track else 0, 3))
     if want_track and start_track is not None:
         track[start_idx] = start_track

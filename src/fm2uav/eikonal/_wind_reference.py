@@ -27,7 +27,8 @@ Stencil
 
 Vertex values (order 2)
     The value of a frozen vertex ``v = y + o`` is ``U1 = T(v)`` with scale 1,
-    unless the order is 2, ``v + o`` is frozen with ``U2 = T(v + o) <= U1``,
+    unless the order is 2, ``y`` is acute (below), ``v + o`` is frozen with
+    ``U2 = T(v + o) <= U1``,
     the speeds at ``y``, ``v``, ``v + o`` have ``max <= 2 min`` and (for a
     wind given per node) the winds at ``v`` and ``v + o`` differ from ``y``'s
     by at most ``0.5 min`` in norm: then ``(4 U1 - U2) / 3`` with scale 2/3.
@@ -216,7 +217,7 @@ class _March:
         x = tuple(y[i] * self.g.h[i] if i < self.g.ndim else 0.0 for i in range(3))
         return travel_gradient(tuple(x[i] - src[i] for i in range(3)), Vs, ws)
 
-    def vertex(self, T, y, j):
+    def vertex(self, T, y, j, order):
         """(value, scale, factored value) of frozen vertex ``j`` of ``y``, or None."""
         o = self.offs[j]
         v = _add(y, o)
@@ -225,7 +226,7 @@ class _March:
             return None
         value, scale, second = t1, 1.0, False
         v2 = _add(v, o)
-        if self.order == 2 and self.frozen.get(v2, False) and T[v2] <= t1:
+        if order == 2 and self.frozen.get(v2, False) and T[v2] <= t1:
             speeds = [self.g.V(y), self.g.V(v), self.g.V(v2)]
             second = max(speeds) <= ORDER2_MAX_SPEED_RATIO * min(speeds)
             if second and self.g.wind_varies:
@@ -303,11 +304,12 @@ class _March:
         """Smallest candidate at ``y`` through its frozen vertex ``k``."""
         V, w = self.g.V(y), self.g.w(y)
         g = self.grad_t0(y)
+        order = self.order if not self.non_acute(y) else 1
         data = {}
 
         def get(j):
             if j not in data:
-                data[j] = self.vertex(T, y, j)
+                data[j] = self.vertex(T, y, j, order)
             return data[j]
 
         _, sk, fk = get(k)
@@ -341,6 +343,10 @@ class _March:
                 best = min(best, cand)
         return best
 
+    def non_acute(self, p) -> bool:
+        w = self.g.w(p)
+        return w[0] ** 2 + w[1] ** 2 + w[2] ** 2 > self.acute ** 2 * self.g.V(p) ** 2
+
     # --- the march --------------------------------------------------------------
     def run(self, starts, stops=None):
         """``starts``: {node: (time, fixed)}; returns {node: time} of frozen nodes."""
@@ -358,10 +364,8 @@ class _March:
             heapq.heappush(heap, (t, p))
         nonacute_any = False
         for p in itertools.product(*(range(n) for n in g.shape)):
-            if g.passable(p):
-                w = g.w(p)
-                if w[0] ** 2 + w[1] ** 2 + w[2] ** 2 > self.acute ** 2 * g.V(p) ** 2:
-                    nonacute_any = True
+            if g.passable(p) and self.non_acute(p):
+                nonacute_any = True
         left = set(stops) if stops else set()
         left = {p for p in left if g.passable(p)}
         can_stop = bool(left) and not nonacute_any
@@ -380,9 +384,7 @@ class _March:
                 y = _add(x, o, -1)
                 if not g.passable(y) or y in fixed:
                     continue
-                w = g.w(y)
-                non_acute = w[0] ** 2 + w[1] ** 2 + w[2] ** 2 > self.acute ** 2 * g.V(y) ** 2
-                if self.frozen.get(y, False) and not (again or non_acute):
+                if self.frozen.get(y, False) and not (again or self.non_acute(y)):
                     continue
                 best = self.evaluate(T, y, k)
                 if self.frozen.get(y, False):
