@@ -603,7 +603,9 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
                 continue
             V = speed[yu]
             wx, wy, wz = _wind_at(wind, wconst, yu)
-            acute = (wx * wx + wy * wy + wz * wz) <= acute2 * V * V
+            # (factored, the shifted metric F(v) - g.v may be negative where the wind
+            # differs from the source's: no label correction, a plain march)
+            acute = fac or (wx * wx + wy * wy + wz * wz) <= acute2 * V * V
             if ty >= 0.0 and not again and acute:
                 continue  # frozen and acute: a node popped later cannot lower it
             # order 2 only where the stencil is causal: label correction lowers values
@@ -633,7 +635,7 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
             best = np.inf
             bvx, bvy, bvz = okx, oky, okz
             Gk = Fk + sk * (tk - (gx * okx + gy * oky + gz * okz))
-            if _box_ok(T, y, k, bptr, bdoff, Bv, epoch):
+            if _box_ok(T, y, k, bptr, bdoff, Bv, epoch) and not (fac and Gk < Uk):
                 best = Gk
             # grad F at -o_k: n / (V + w.n), n the heading flying along -o_k (minus
             # g, factored). The face objective (interpolated value + F) is convex:
@@ -711,6 +713,15 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
                     cand, vx, vy, vz = _edge(Fv[a] + gx * ax_ + gy * ay_ + gz * az_, ax_, ay_,
                                              az_, Fv[b] + gx * bx_ + gy * by_ + gz * bz_, bx_,
                                              by_, bz_, V, wx, wy, wz)
+                if fac:
+                    # factored, F(v) - g.v may be negative: never earlier than every
+                    # vertex the candidate comes through (as an unfactored one)
+                    lo = min(Uv[fvert[f, 0]], Uv[fvert[f, 1]]) if q < nf else min(
+                        Uv[evert[f, 0]], Uv[evert[f, 1]])
+                    if q < nf and ndim == 3:
+                        lo = min(lo, Uv[fvert[f, 2]])
+                    if cand < lo:
+                        cand = np.inf
                 if cand < best:
                     best = cand
                     bvx, bvy, bvz = vx, vy, vz

@@ -36,7 +36,9 @@ Vertex values (order 2)
 Factored values (only in the source box, below)
     With the source's cone ``T0`` and ``g = grad T0(y)``, a vertex's factored
     value is its (order-2 extrapolated) ``tau = T - T0`` plus ``T0(y)``;
-    unfactored, ``g = 0`` and the factored value is the value.
+    unfactored, ``g = 0`` and the factored value is the value. A factored
+    candidate earlier than all of its vertices (below their smallest value) is
+    dropped: the shifted travel time ``F(v) - g . v`` may be negative.
 
 Candidates at ``y`` when its stencil vertex ``k`` (the popped node) is frozen
     * vertex: ``Fk + s_k (F_y(-o_k) + g . o_k)``;
@@ -71,10 +73,13 @@ Source ball
     As the isotropic solver: ``R = max(2 max(h), 0.05 * extent)`` (none with
     more than 64 sources); each source tries ``R, R/2, ...`` down to
     ``2 max(h)`` until its box (``floor(r / h)`` nodes either side, clipped) is
-    clean: all passable, speeds ``max <= 1.5 min``, winds within ``0.5 min``
-    speed of the source's. Ball nodes (distance ``<= r``) get the exact cone
+    clean: all passable, and the ground speed ``g`` of ``|g d - w| = V`` at
+    every node within a factor 1.5 of the source's along each direction ``d``
+    (16 at 22.5 degrees in 2D, the 26 neighbour directions in 3D). Ball nodes (distance ``<= r``) get the exact cone
     ``F_s(x - x_s)`` if speed and wind are constant in the box, else the time
-    of the factored march (above) on the box from the source alone; the
+    of the factored march (above) on the box from the source alone (every node
+    counts as acute there: the shifted metric may be negative, so no label
+    correction); the
     smallest over the sources wins. They are fixed when every source is clean,
     else only band nodes.
 """
@@ -96,7 +101,6 @@ SOURCE_RADIUS_CELLS = 2.0
 SOURCE_RADIUS_FRACTION = 0.05
 MAX_BALL_SOURCES = 64
 BALL_MAX_SPEED_RATIO = 1.5
-BALL_MAX_WIND_CHANGE = 0.5
 ORDER2_MAX_SPEED_RATIO = 2.0
 ORDER2_MAX_WIND_CHANGE = 0.5
 CONE_TOL = 1e-9
@@ -316,8 +320,11 @@ class _March:
         ok = self.oph[k]
         minus = (-ok[0], -ok[1], -ok[2])
         best = math.inf
+        guard = self.factor is not None  # factored: never earlier than the vertices
         if self.box_ok(y, self.offs[k]):
-            best = fk + sk * (travel_time(minus, V, w) + sum(g[i] * ok[i] for i in range(3)))
+            cand = fk + sk * (travel_time(minus, V, w) + sum(g[i] * ok[i] for i in range(3)))
+            if not (guard and cand < data[k][0]):
+                best = cand
         grad = travel_gradient(minus, V, w)
         slope_dir = [grad[i] - g[i] for i in range(3)]
 
@@ -340,10 +347,14 @@ class _March:
                 if not self.box_ok(y, self.offs[big]):
                     continue
                 cand, _ = solve(idx, data, fk, g, V, w)
+                if guard and cand < min(data[j][0] for j in verts):
+                    continue
                 best = min(best, cand)
         return best
 
     def non_acute(self, p) -> bool:
+        if self.factor is not None:
+            return False  # factored: F(v) - g.v may be negative, so no label correction
         w = self.g.w(p)
         return w[0] ** 2 + w[1] ** 2 + w[2] ** 2 > self.acute ** 2 * self.g.V(p) ** 2
 
@@ -400,6 +411,23 @@ class _March:
         return {p: T[p] for p, f in self.frozen.items() if f}
 
 
+def _directions(ndim: int) -> list[Vec]:
+    """Unit directions of the ground-speed comparison: 16 in 2D, 26 in 3D."""
+    if ndim == 2:
+        return [(math.cos(k * math.pi / 8), math.sin(k * math.pi / 8), 0.0) for k in range(16)]
+    out = []
+    for o in itertools.product((-1, 0, 1), repeat=3):
+        if any(o):
+            n = math.sqrt(sum(c * c for c in o))
+            out.append(tuple(c / n for c in o))
+    return out
+
+
+def _ground_speed(V: float, w: Vec, d: Vec) -> float:
+    wd = w[0] * d[0] + w[1] * d[1] + w[2] * d[2]
+    return wd + math.sqrt(wd * wd + V * V - (w[0] ** 2 + w[1] ** 2 + w[2] ** 2))
+
+
 def _ball(grid: _Grid, src, radius, min_radius, order):
     """{node: time} of the ball of one source, or None if no radius is clean."""
     h = grid.h
@@ -410,13 +438,14 @@ def _ball(grid: _Grid, src, radius, min_radius, order):
         lo = [max(src[i] - reach[i], 0) for i in range(3)]
         hi = [min(src[i] + reach[i], grid.shape[i] - 1) for i in range(3)]
         box = list(itertools.product(*(range(lo[i], hi[i] + 1) for i in range(3))))
-        speeds = [grid.V(p) for p in box]
         clean = all(grid.passable(p) for p in box)
         if clean:
-            vmin = min(speeds)
-            clean = max(speeds) <= BALL_MAX_SPEED_RATIO * vmin and all(
-                sum((grid.w(p)[i] - ws[i]) ** 2 for i in range(3))
-                <= (BALL_MAX_WIND_CHANGE * vmin) ** 2 for p in box)
+            for d in _directions(grid.ndim):
+                gs = _ground_speed(Vs, ws, d)
+                for p in box:
+                    ratio = _ground_speed(grid.V(p), grid.w(p), d) / gs
+                    if not 1 / BALL_MAX_SPEED_RATIO <= ratio <= BALL_MAX_SPEED_RATIO:
+                        clean = False
         if clean:
             break
         if r <= min_radius:

@@ -16,15 +16,20 @@ What the ball holds
   box alone with the same stencil: ``T = T0 + tau`` with ``T0(x) = F_s(x -
   x_s)`` the source's constant-wind cone, so that in each full-face solve the
   vertex values are replaced by ``tau`` (smooth where ``T`` is not) plus
-  ``T0(y)``, and the gradient by ``grad T0(y) + grad tau``. Vertex and edge
-  candidates stay unfactored (they only win on a face side, where they equal
-  the face's value).
+  ``T0(y)``: in the semi-Lagrangian form the same minimum with the factored
+  vertex values and the travel time shifted by the linear term, ``F(v) -
+  grad T0(y) . v``, for vertex, edge and face candidates alike (on a constant
+  box: ``T0`` to rounding). That shifted metric may be negative where the wind
+  differs from the source's, so the box march corrects no labels (a plain
+  march; the box is small and near the source).
 
 Which sources, which radius (as the isotropic ball): the nominal radius is
 ``R = max(2 cells, 5 % of the grid's largest extent)``; a source's box is
-*clean* when every node in it is passable (speed > 0, ``|w| < V``), its speeds
-vary by at most ``BALL_MAX_SPEED_RATIO`` (max/min) and its winds differ from
-the source's by at most ``BALL_MAX_WIND_CHANGE`` times the box's lowest speed.
+*clean* when every node in it is passable (speed > 0, ``|w| < V``) and its
+ground speeds, in each of 16 (2D) / 26 (3D) directions, are within
+``BALL_MAX_SPEED_RATIO`` of the source's (with no wind: its speeds, as the
+isotropic ball; near ``|w| = V`` a small change of the airspeed changes the
+upwind ground speed many times over, and the source's cone is then no guide).
 Each source takes the largest of ``R, R/2, ...`` (last try: 2 cells) whose box
 is clean, else no ball. Ball nodes (distance ``<= r``) keep the smallest time
 over the sources; they are frozen when every source is clean, else they start
@@ -37,21 +42,41 @@ import numpy as np
 
 from . import _wind_march as wm
 
-#: A ball's box is clean only if its speeds vary by at most this factor ...
+#: A ball's box is clean only if, in every direction of :func:`directions`, the
+#: ground speed at each of its nodes is within this factor of the source's.
 BALL_MAX_SPEED_RATIO = 1.5
-#: ... and its winds differ from the source's by at most this share of its
-#: lowest speed.
-BALL_MAX_WIND_CHANGE = 0.5
 
 
-def _clean(speed: np.ndarray, wind: np.ndarray, ok: np.ndarray, ws: np.ndarray) -> bool:
+def directions(ndim: int) -> np.ndarray:
+    """Unit directions (3 components) in which a box's ground speeds are compared:
+    16 at 22.5 degrees in 2D, the 26 neighbour directions in 3D."""
+    if ndim == 2:
+        a = np.arange(16) * (np.pi / 8)
+        return np.stack([np.cos(a), np.sin(a), np.zeros(16)], axis=-1)
+    d = np.array([(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)
+                  if (i, j, k) != (0, 0, 0)], dtype=float)
+    return d / np.linalg.norm(d, axis=1)[:, None]
+
+
+def ground_speeds(speed: np.ndarray, wind: np.ndarray, dirs: np.ndarray) -> np.ndarray:
+    """Ground speed [m/s] along each unit direction (last axis) at airspeed ``speed``
+    in ``wind`` (3 components): the ``g`` of ``|g d - w| = V``."""
+    wd = wind @ dirs.T
+    lam = speed * speed - np.einsum("...i,...i->...", wind, wind)
+    return wd + np.sqrt(wd * wd + lam[..., None])
+
+
+def _clean(speed: np.ndarray, wind: np.ndarray, ok: np.ndarray, Vs: float,
+           ws: np.ndarray, ndim: int) -> bool:
+    # near |w| = V a small change of V changes the upwind ground speed manifold, so
+    # the box is judged on ground speeds (with no wind: on speeds, as the isotropic ball)
     if not ok.all():
         return False
-    vmin = float(speed.min())
-    if float(speed.max()) > BALL_MAX_SPEED_RATIO * vmin:
-        return False
-    dw2 = np.einsum("...i,...i->...", wind - ws, wind - ws)
-    return float(dw2.max()) <= (BALL_MAX_WIND_CHANGE * vmin) ** 2
+    dirs = directions(ndim)
+    g = ground_speeds(speed, wind, dirs)
+    gs = ground_speeds(np.asarray(Vs), np.asarray(ws, dtype=float), dirs)
+    r = g / gs
+    return float(r.max()) <= BALL_MAX_SPEED_RATIO and float(r.min()) >= 1 / BALL_MAX_SPEED_RATIO
 
 
 def cone(dx: np.ndarray, dy: np.ndarray, dz: np.ndarray, V: float,
@@ -92,7 +117,7 @@ def _one_source(grid: wm.WindGrid, src: np.ndarray, radius: float, min_radius: f
         box = tuple(slice(a, b) for a, b in zip(lo, hi))
         wbox = (np.broadcast_to(ws, tuple(hi - lo) + (3,)) if grid.wconst
                 else grid.wind.reshape(shape + (3,))[box])
-        if _clean(speed[box], wbox, ok[box], ws):
+        if _clean(speed[box], wbox, ok[box], Vs, ws, grid.ndim):
             break
         if r <= min_radius:
             return None
