@@ -87,7 +87,7 @@ def export_cmd(
     level = (FlightLevel(agl=agl) if agl is not None and mission_level is None else
              mission_level if agl is None else replace(mission_level, agl=agl))
     # a path with a final altitude profile (its floor column): heights as they are, legs
-    # checked against the floor (see fm2uav.io.build_mission)
+    # checked against the floor (see fm2uav.autopilot.build_mission)
     profile = None if floor is None else SimpleNamespace(
         required=floor, level=level if level is not None else FlightLevel(agl=1.0))
     track = SimpleNamespace(
@@ -111,10 +111,12 @@ def _read_path(path_file: Path, header: dict, world, where: str):
     from ..io import read_path_csv
     from ..io.path_header import read_path_floor, read_path_w
 
+    from ..world.geo import crs_label, crs_token
+
     crs = getattr(world, "crs", None)
-    if header["crs"] and crs and header["crs"] != crs:
+    if header["crs"] and crs and header["crs"] not in (crs, crs_token(crs)):
         raise InputError(f"{path_file} says crs={header['crs']} but the {where} world is in "
-                         f"{crs}: give the mission or scenario the path was planned on")
+                         f"{crs_label(crs)}: give the mission or scenario the path was planned on")
     if header["crs"] and not crs:
         raise InputError(f"{path_file} says crs={header['crs']} but the {where} world has "
                          "no CRS: give the mission file of that DEM (--mission)")

@@ -93,6 +93,18 @@ def as_index_array(points: Any, shape: tuple[int, ...], what: str) -> np.ndarray
     return arr
 
 
+#: ``(is_calm(wind, shape), march(speed, sources, wind, **options) -> times)`` of the wind
+#: march, registered by :mod:`fm2uav.eikonal.wind` (which the package imports): that module
+#: uses this one's input checks, so the dependency goes one way and ``fast_marching``
+#: finds the wind march here.
+_WIND_MARCH: list = []
+
+
+def register_wind_march(is_calm: Any, march: Any) -> None:
+    """Make ``fast_marching(wind=...)`` call ``march`` unless ``is_calm(wind, shape)``."""
+    _WIND_MARCH[:] = [(is_calm, march)]
+
+
 def _as_speed(speed: Any) -> np.ndarray:
     arr = np.ascontiguousarray(grid(speed, "speed"))
     # one compiled pass instead of three numpy passes (matters on 40 M-node maps)
@@ -184,11 +196,10 @@ def fast_marching(
     v = _as_speed(speed)
     shape = v.shape
     if wind is not None:
-        from . import wind as _wind  # here: wind.py imports this module's helpers
-
-        if not _wind.is_calm(wind, shape):
-            return _wind.zermelo_march(v, sources, wind, spacing=spacing, order=order,
-                                       stop_at=stop_at, source_ball=source_ball).times
+        is_calm, wind_march = _WIND_MARCH[0]
+        if not is_calm(wind, shape):
+            return wind_march(v, sources, wind, spacing=spacing, order=order, stop_at=stop_at,
+                              source_ball=source_ball)
     h = as_spacing(spacing, v.ndim)
     if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or order not in (1, 2):
         shown = order.item() if isinstance(order, np.generic) else order

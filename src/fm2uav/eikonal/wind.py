@@ -43,6 +43,7 @@ from .fmm import (
     _as_speed,
     as_index_array,
     as_spacing,
+    register_wind_march,
 )
 
 __all__ = [
@@ -359,3 +360,10 @@ def zermelo_march(
         times=res.times.reshape(shape), track=tr, refused=refused, pops=res.pops,
         reopened=res.reopened, acute_limit=wm.get_stencil(ndim, h3).acute,
     )
+
+
+def _times(speed: Any, sources: Any, wind: Any, **options: Any) -> np.ndarray:
+    return zermelo_march(speed, sources, wind, **options).times
+
+
+register_wind_march(is_calm, _times)  # fast_marching(wind=...) calls the march above

@@ -10,13 +10,14 @@ the start gives the path.
 from __future__ import annotations
 
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from scipy import ndimage
 
 from .. import _validate
+from .. import progress
 from ..eikonal.fmm import fast_marching
 from ..eikonal.velocity import distance_map, distance_scale, normalise_distance, shape_velocity
 from ..errors import InputError, PlanningError, PointError, UnreachableError
@@ -27,7 +28,7 @@ from ..world.zones import check_points_allowed, zone_violations
 from .altitude import AltitudeProfile, final_profile, height_figures
 from .flight_level import flight_level_speed
 from .geodesic import descend
-from .params import FlightLevel, PlanOptions, Shaping
+from .params import FlightLevel, PlanOptions, Shaping, plan_params
 from .regional import check_full_grid, plan_regional, use_regional
 
 __all__ = ["Plan", "plan", "base_velocity", "shaped_velocity", "max_distance", "plan_params"]
@@ -201,22 +202,6 @@ def shaped_velocity(world: World, shaping: Shaping = Shaping()) -> np.ndarray:
                           saturation_distance=shaping.saturation_distance, max_distance=top)
 
 
-def plan_params(shaping: Shaping, level: FlightLevel | None, options: PlanOptions) -> dict[str, Any]:
-    """Flat JSON-friendly record of the planner's parameters (``Plan.params``).
-
-    The field names of the objects (one spelling): ``saturation``, ...,
-    ``order``, ``step``, ``custom_speed_map`` and, with a level, ``agl``, ``p1``,
-    ``p2``, ``band``, ... ``max_descent``. With a custom speed map the level
-    was not applied and is left out.
-    """
-    custom = options.speed_map is not None
-    out: dict[str, Any] = asdict(shaping)
-    out.update(order=int(options.order), step=float(options.step), custom_speed_map=custom)
-    if level is not None and not custom:
-        out.update(asdict(level))
-    return out
-
-
 def _check_free(world: World, point: np.ndarray, what: str) -> tuple[int, ...]:
     # World.to_cell validates "inside the map" with a clear message and uses the
     # same nearest-node rule as the geodesic
@@ -233,6 +218,7 @@ def _check_free(world: World, point: np.ndarray, what: str) -> tuple[int, ...]:
     return cell
 
 
+@progress.stage()
 def plan(
     world: World,
     start: Any,
@@ -304,9 +290,10 @@ def plan(
     _check_work(world, start_m, goal_m, start_cell, goal_cell, options)
     if use_regional(world, shaping, level, options):  # too big for one full grid
         return plan_regional(world, start_m, goal_m, shaping=shaping, level=level,
-                             options=options, t_all=t_all)
+                             options=options, t_all=t_all, full_plan=plan)
 
     t0 = time.perf_counter()
+    progress.step("velocity map W", 0.3)
     W = plan_velocity(world, shaping, level, options)
     t1 = time.perf_counter()
     if W[start_cell] <= 0 or W[goal_cell] <= 0:
@@ -314,6 +301,7 @@ def plan(
         raise PointError(
             f"the velocity map is 0 at the {which} node; move the {which} away from obstacles"
         )
+    progress.step("arrival times T (Fast Marching)", 0.45)
     T = fast_marching(W, [goal_cell], spacing=world.spacing, order=options.order,
                       stop_at=[start_cell])
     t2 = time.perf_counter()
@@ -392,6 +380,7 @@ def trace_plan(world: World, W: np.ndarray, T: np.ndarray, start_m: np.ndarray,
     # T = inf, unless a custom speed map gave them a speed: only then pass the
     # mask (it costs a copy of T, ~1 s on a 40M-node map).
     blocked = world.occupancy if np.isfinite(T[world.occupancy]).any() else None
+    progress.step("path (geodesic descent)", 0.6)
     try:
         path_idx = descend(
             T,
@@ -413,6 +402,7 @@ def trace_plan(world: World, W: np.ndarray, T: np.ndarray, start_m: np.ndarray,
     if level is not None and level.heights == "ground" and world.ndim == 3:
         # heights from the continuous ground along the FM² route (issue 13); with a
         # custom speed map (route legs re-use the first leg's W) the level still sets them
+        progress.step("heights above the ground", 1.0)
         profile = final_profile(world, path, level)
         path = profile.path
         path_idx = world.to_index(path)
