@@ -24,11 +24,16 @@ HEAVY = ("numpy", "numba", "llvmlite", "scipy", "matplotlib", "plotly", "rasteri
          "pyproj", "pyogrio", "dask", "distributed", "pyarrow", "yaml", "PIL", "ompl",
          "fm2uav.eikonal", "fm2uav.world", "fm2uav.planning", "fm2uav.missions",
          "fm2uav.vehicles", "fm2uav.analysis", "fm2uav.scenarios", "fm2uav.experiments",
-         "fm2uav.io", "fm2uav.viz", "fm2uav.baselines", "fm2uav._validate")
+         "fm2uav.io", "fm2uav.viz", "fm2uav.baselines", "fm2uav._validate",
+         "fm2uav.autopilot", "fm2uav.pipeline.run", "fm2uav.pipeline.cover", "fm2uav.app",
+         "fastapi", "starlette", "uvicorn", "rio_tiler")
 
 #: Top-level imports a ``cli/*.py`` module may have: the standard library, typer, rich,
-#: fm2uav.errors and the light modules of fm2uav.cli (the cmd_* modules among them).
-ALLOWED_TOP = ("typer", "rich", "fm2uav.errors", "fm2uav.cli")
+#: fm2uav.errors, the light modules of fm2uav.cli (the cmd_* modules among them) and the two
+#: pipeline modules the commands share with the app, light by the same rule (numpy inside
+#: their functions; the jobs, fm2uav.pipeline.run / .cover, are imported by the commands).
+ALLOWED_TOP = ("typer", "rich", "fm2uav.errors", "fm2uav.cli", "fm2uav.pipeline.outputs",
+               "fm2uav.pipeline.rows")
 
 # In a fresh interpreter: import the app, render every help page and the usage errors,
 # then list what got loaded.
