@@ -151,7 +151,15 @@ def summary(rows: list[dict], report: dict) -> str:
                 r["case"].startswith("regional ") and not r["case"].startswith("regional vs"))):
             peak = f", peak {r['peak_mb'] / 1024:.2f} GB" if r.get("peak_mb") else ""
             parts.append(f"{r['case']}: {_seconds(r['ours_s'])}{peak};")
+    cli = {r["case"].split("`")[1]: r for r in rows if r["benchmark"] == "cli" and "`" in r["case"]}
+    if "fm2uav --help" in cli:
+        parts.append("`fm2uav --help` answers in " + _seconds(cli["fm2uav --help"]["ours_s"])
+                     + "".join(f", `{k}` in {_seconds(r['ours_s'])}" for k, r in cli.items()
+                               if k != "fm2uav --help")
+                     + " (warm, CPU " + "/".join(f"{r['cpu_s']:.2f}" for r in cli.values())
+                     + " s);")
     cold = by_case.get("first `fm2uav plan`, empty numba cache")
+
     warm = by_case.get("first `fm2uav plan`, numba cache filled")
     if cold and warm:
         parts.append(

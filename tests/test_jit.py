@@ -118,3 +118,61 @@ def test_cold_estimate_spreads_the_cpu_time_over_up_to_two_idle_cores(monkeypatc
     monkeypatch.setattr(os, "cpu_count", lambda: 16)
     monkeypatch.setattr(os, "getloadavg", lambda: (0.0, 0.0, 0.0))
     assert _jit.cold_estimate_s() == idle  # two processes use at most two cores
+
+
+def test_a_bad_flag_on_a_cold_cache_compiles_nothing(tmp_path):
+    cache = tmp_path / "numba"
+    cache.mkdir()
+    res = subprocess.run([sys.executable, "-m", "fm2uav", "plan", "--bogus"],
+                         capture_output=True, text=True, timeout=300, env=_env(cache))
+    assert res.returncode == 2 and "No such option" in res.stderr
+    assert not list(cache.rglob("*.nbi"))  # neither this process nor a warm-up child compiled
+
+
+def test_on_first_compile_waits_for_numba_without_importing_it(tmp_path):
+    code = (
+        "import sys\n"
+        "from fm2uav import _jit\n"
+        "_jit.on_first_compile(lambda: print('FIRED', flush=True))\n"
+        "print('numba' in sys.modules, flush=True)\n"
+        "import numpy as np\n"
+        "from fm2uav.eikonal import _kernels as k\n"  # imports numba: the listener is installed
+        "k.scan_speed(k._readonly(np.ones(3)), 1e-9)\n"
+        "print('DONE')\n"
+    )
+    res = _python(code, tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.split() == ["False", "FIRED", "DONE"]
+
+
+def test_cache_fault_finds_numba_s_cache_loader_and_clear_cache_deletes_its_files(tmp_path):
+    code = ("import numpy as np; from fm2uav.eikonal import _kernels as k; "
+            "k.scan_speed(k._readonly(np.ones(3)), 1e-9)")
+    assert _python(code, tmp_path).returncode == 0
+    files = sorted(tmp_path.rglob("_kernels.scan_speed-*.nb[ic]"))
+    assert len(files) >= 2
+    index = next(f for f in files if f.suffix == ".nbi")
+    index.write_bytes(b"\x80\x04")  # truncated
+    in_tree = ROOT / "src" / "fm2uav" / "eikonal" / "__pycache__"
+    others = sorted(in_tree.glob("_kernels.*.nb[ic]"))  # another location's cache
+    probe = (
+        "import numpy as np\n"
+        "from fm2uav import _jit\n"
+        "from fm2uav.eikonal import _kernels as k\n"
+        "try:\n"
+        "    k.scan_speed(k._readonly(np.ones(3)), 1e-9)\n"
+        "except Exception as exc:\n"
+        "    print('FAULT', _jit.cache_fault(exc))\n"
+        "    print('OTHER', _jit.cache_fault(ValueError('x')))\n"
+        "    print('REMOVED', len(_jit.clear_cache()))\n"
+    )
+    res = _python(probe, tmp_path)
+    assert res.returncode == 0, res.stderr
+    lines = dict(line.split(" ", 1) for line in res.stdout.splitlines())
+    assert lines["FAULT"] == str(index)
+    assert lines["OTHER"] == "None"
+    assert int(lines["REMOVED"]) >= 2
+    assert not list(tmp_path.rglob("_kernels.scan_speed-*.nb[ic]"))
+    assert sorted(in_tree.glob("_kernels.*.nb[ic]")) == others  # only where this process caches
+
+    assert _python(code, tmp_path).returncode == 0  # compiles and caches again

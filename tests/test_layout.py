@@ -39,7 +39,7 @@ def _module_names(package: Path) -> set[str]:
     names = {"init"}
     for p in package.iterdir():
         if p.suffix == ".py" and p.stem != "__init__":
-            names.add(p.stem.lstrip("_"))
+            names.add(p.stem.strip("_"))  # __main__.py -> test_main.py
         elif p.is_dir() and (p / "__init__.py").exists():
             names.add(p.name)
     return names

@@ -1,88 +1,145 @@
 """Entry point of the ``fm2uav`` command (console script and ``python -m fm2uav``).
 
-It speaks before the heavy imports (numba, scipy, matplotlib: ~1-2 s): on a
-cold numba cache ``fm2uav plan`` / ``fm2uav run`` print "compiling kernels,
-first use only, ~N s" at once, and ``fm2uav plan`` compiles its kernels in two
-processes (the Fast Marching kernels in a child, the rest here) before
-planning, which halves the first run on a 2-core machine. The command line
-proper is :mod:`fm2uav.cli`.
+The first instructions make the process safe to stop and to print, before any
+import that takes time:
+
+* **stop signals from the first instruction**: SIGINT (Ctrl-C), SIGTERM and
+  SIGHUP raise at once (:func:`fm2uav.io.outdir.install_stop_signals`: a light
+  module, loaded before anything else); outside a command (start-up, argument
+  parsing) the run ends with one line and exit code 130, never a traceback.
+  While a command runs the output sets' rules apply
+  (:func:`fm2uav.io.outdir.interrupt_signals`: the set is removed, the previous
+  one kept, exit 130). A stop that Python swallows (one landing in a weakref
+  callback of the import system, a ``__del__``) is raised again at the next
+  checkpoint (:func:`fm2uav.io.outdir.raise_if_stopped`): never lost;
+* **any output encoding**: text that stdout/stderr cannot encode (``LANG=C``
+  without UTF-8, ``PYTHONIOENCODING=ascii``) is replaced instead of ending the
+  run; a closed pipe (``fm2uav --help | head -1``) ends it quietly.
+
+Then, for ``fm2uav plan`` / ``fm2uav run`` on a cold numba cache, the notice
+"compiling kernels, first use only, ~N s" (:func:`fm2uav._jit.likely_cold`: a
+few ms, numba not imported), so it is the first thing on screen; the
+compilation itself (in two processes for ``plan``) starts once the arguments
+are parsed (:mod:`fm2uav.cli._first_use`): a bad flag compiles nothing.
+
+The command line proper is :mod:`fm2uav.cli`, which imports only typer and
+rich: ``fm2uav --help``, ``fm2uav plan --help`` and a bad flag answer without
+numba, scipy or matplotlib (docs/architecture.md, "The command line stays
+light").
 """
 
 from __future__ import annotations
 
 import os
-import subprocess
+import signal
 import sys
 
-#: Commands whose first run compiles kernels (the notice is shown up front).
+#: Commands whose first run compiles kernels (the notice is shown before anything else).
 _COMPILING_COMMANDS = ("plan", "run")
 
 
-def _option(argv: list[str], name: str) -> str | None:
-    """Value of ``--name VALUE`` or ``--name=VALUE`` in ``argv`` (last wins)."""
-    value = None
-    for i, a in enumerate(argv):
-        if a == name and i + 1 < len(argv):
-            value = argv[i + 1]
-        elif a.startswith(name + "="):
-            value = a.split("=", 1)[1]
-    return value
+def _printable_streams() -> None:
+    """Replace what stdout/stderr cannot encode instead of failing on it (ASCII locales)."""
+    for stream in (sys.stdout, sys.stderr):
+        encoding = (getattr(stream, "encoding", None) or "").lower().replace("-", "")
+        if encoding != "utf8" and hasattr(stream, "reconfigure"):
+            try:
+                stream.reconfigure(errors="replace" if stream is sys.stdout
+                                   else "backslashreplace")
+            except (ValueError, OSError):  # pragma: no cover - a detached stream
+                pass
 
 
-def _fmm_group(argv: list[str]) -> str:
-    """The Fast Marching warm-up group a ``fm2uav plan`` command line will use."""
-    order = "1" if _option(argv, "--order") == "1" else "2"
-    ndim = "2" if _option(argv, "--scenario") == "city2d" else "3"
-    return f"fmm{ndim}d_o{order}"
+def _stopped(signum: int) -> None:
+    """Report a stop signal outside a command and end the process with 130, at once.
 
-
-def _spawn(groups: list[str]) -> subprocess.Popen | None:
-    """Start ``python -m fm2uav.planning.warmup GROUPS`` in the background (None if it cannot)."""
+    ``os._exit``: no interpreter shutdown, which may end the process with SIGINT itself
+    when the KeyboardInterrupt passed through code Python evaluated for it (nothing is
+    open here: a command removes its output sets before it reports its own stop).
+    """
+    for sig_name in ("SIGINT", "SIGTERM", "SIGHUP"):  # a second signal while reporting the
+        try:                                          # first: no traceback
+            signal.signal(getattr(signal, sig_name), signal.SIG_IGN)
+        except (AttributeError, ValueError, OSError):
+            pass
+    what = "SIGINT (Ctrl-C)" if signum == signal.SIGINT else signal.Signals(signum).name
     try:
-        return subprocess.Popen(
-            [sys.executable, "-m", "fm2uav.planning.warmup", *groups],
-            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-            env=os.environ.copy(),
-        )
-    except OSError:  # no fork / exec: the command compiles everything itself
-        return None
+        sys.stderr.write(f"error: interrupted by {what}; nothing was written\n")
+    except (OSError, ValueError):
+        pass
+    _exit_now(130)
+
+
+def _exit_now(code: int) -> None:
+    """End the process at once with ``code`` (stdio flushed; see :func:`_stopped`)."""
+    try:
+        sys.stdout.flush()
+        sys.stderr.flush()
+    except (OSError, ValueError):
+        pass
+    os._exit(code)
+
+
+def _quiet_broken_pipe() -> int:
+    """The reader of stdout went away: stop writing, without a traceback."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+    return 141  # 128 + SIGPIPE, as a shell reports a process killed by it
+
+
+def _notice_if_cold(argv: list[str]) -> None:
+    """The compile notice of a first ``plan`` / ``run`` on a cold cache, before any import."""
+    if not argv or argv[0] not in _COMPILING_COMMANDS or {"--help", "-h"} & set(argv):
+        return
+    from . import _jit
+
+    if _jit.likely_cold():
+        _jit.mark_announced()  # neither the command nor the numba-event fallback repeats it
+        if "--quiet" not in argv:
+            from rich.console import Console
+
+            Console(stderr=True).print(_jit.NOTICE.format(seconds=_jit.cold_estimate_s()),
+                                       style="yellow", highlight=False)
+
+
+def _run() -> int:
+    """The command line's exit code (stop signals: 130 with one line, never a traceback)."""
+    from .io.outdir import Interrupted, install_stop_signals, raise_if_stopped, unreported_stop
+
+    try:
+        install_stop_signals()  # no traceback for a stop signal from here on
+        try:
+            _printable_streams()
+            _notice_if_cold(sys.argv[1:])
+            from .cli import main as cli_main
+
+            cli_main()
+        except SystemExit as exc:
+            raise_if_stopped()  # a stop Python swallowed (start-up, parsing): 130 all the same
+            if exc.code == 130:  # stopped: a command reported it, or typer's parser exited
+                signum = unreported_stop()  # with 130 in silence
+                if signum is not None:
+                    _stopped(signum)
+                _exit_now(130)
+            raise
+        raise_if_stopped()
+    except (KeyboardInterrupt, Interrupted) as exc:  # outside a command (a command reports
+        _stopped(getattr(exc, "signum", signal.SIGINT))  # its own: handle_errors)
+    except BrokenPipeError:
+        return _quiet_broken_pipe()
+    return 0  # pragma: no cover - cli_main always exits
 
 
 def main() -> None:
     """Run the ``fm2uav`` command line."""
-    argv = sys.argv[1:]
-    command = argv[0] if argv else ""
-    child = None
-    cold = False
-    if command in _COMPILING_COMMANDS and not {"--help", "-h"} & set(argv):
-        from . import _jit
-
-        cold = _jit.likely_cold()
-        if cold:
-            _jit.mark_announced()  # the numba-event fallback stays silent
-            if "--quiet" not in argv:
-                from rich.console import Console
-
-                Console(stderr=True).print(
-                    f"compiling kernels, first use only, ~{_jit.cold_estimate_s()} s",
-                    style="yellow", highlight=False)
-            if command == "plan":
-                child = _spawn([_fmm_group(argv)])
-    if child is not None:
-        from .planning.warmup import FIRST_PLAN_MAIN, warm
-
-        try:
-            warm(FIRST_PLAN_MAIN)
-        except Exception:  # a warm-up failure only costs time: the plan compiles what it needs
-            pass
-    from .cli import main as cli_main  # matplotlib & co. while the child finishes
-
-    if child is not None:
-        try:
-            child.wait(timeout=600)
-        except subprocess.TimeoutExpired:  # stuck: plan anyway (numba compiles what is missing)
-            pass
-    cli_main()
+    try:
+        code = _run()
+    except KeyboardInterrupt:  # Ctrl-C before the handlers are in place (Python's own)
+        _stopped(signal.SIGINT)
+    sys.exit(code)
 
 
 if __name__ == "__main__":

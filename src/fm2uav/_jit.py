@@ -11,7 +11,14 @@ Library code never prints: this module only *detects* and *calls back*.
   files of a few kernels the way numba's own cache locators find them.
 * :func:`on_first_compile` registers a callback run once per process, right
   before numba compiles the first fm2uav function (a cache miss): the reliable
-  fallback for every other path (other commands, stale or foreign caches).
+  fallback for every other path (other commands, stale or foreign caches). It
+  does not import numba either: the listener is installed when numba is first
+  imported.
+* :func:`cache_fault` tells a damaged cache file (truncated, overwritten, a
+  foreign format: numba fails to load it, every run, until it is deleted) from
+  other errors, and :func:`clear_cache` deletes fm2uav's cache files so that the
+  kernels are compiled again (the command line does both, see
+  :func:`fm2uav.cli._common.handle_errors`).
 
 Bottom layer (no fm2uav imports): the kernels are named by file and function.
 """
@@ -26,13 +33,20 @@ import sys
 import tempfile
 from collections.abc import Callable, Iterable
 from pathlib import Path
+from typing import Any
 
 __all__ = [
     "FIRST_PLAN_KERNELS",
     "COLD_FIRST_PLAN_CPU_S",
+    "NOTICE",
+
+    "cache_fault",
+    "clear_cache",
     "cold_estimate_s",
     "likely_cold",
+    "announced",
     "mark_announced",
+
     "on_first_compile",
 ]
 
@@ -48,6 +62,9 @@ FIRST_PLAN_KERNELS: tuple[tuple[str, str], ...] = (
     ("planning/_geodesic_kernels.py", "descend_kernel"),
     ("world/_clearance_kernels.py", "surface_distance"),
 )
+
+#: What the command line says before the first compilation (``seconds``: :func:`cold_estimate_s`).
+NOTICE = "compiling kernels, first use only, ~{seconds} s"
 
 #: CPU time [s] of a first ``fm2uav plan`` with an empty numba cache, both
 #: processes together (compilation, imports, the plan): measured 17-18 s on the
@@ -80,13 +97,10 @@ def _usable(path: Path) -> bool:
     return True
 
 
-def _cache_dir(py_file: Path) -> Path | None:
-    """The directory where numba keeps ``py_file``'s cache, None if there is none.
-
-    As ``numba.core.caching``'s locators, first usable wins:
+def _cache_candidates(py_file: Path) -> list[Path]:
+    """Where numba may keep ``py_file``'s cache, in the order its locators try them:
     ``$NUMBA_CACHE_DIR/<dir>_<sha1(dir)>`` when set, the source's ``__pycache__``,
-    the user-wide cache directory (``$XDG_CACHE_HOME/numba/<dir>_<sha1(dir)>``).
-    """
+    the user-wide cache directory (``$XDG_CACHE_HOME/numba/<dir>_<sha1(dir)>``)."""
     parent = py_file.parent
     sub = f"{parent.name}_{hashlib.sha1(str(parent).encode()).hexdigest()}"
     candidates = []
@@ -95,7 +109,13 @@ def _cache_dir(py_file: Path) -> Path | None:
         candidates.append(Path(os.path.abspath(user_dir)) / sub)
     xdg = os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache")
     candidates += [parent / "__pycache__", Path(xdg) / "numba" / sub]
-    return next((c for c in candidates if _usable(c)), None)
+    return candidates
+
+
+def _cache_dir(py_file: Path) -> Path | None:
+    """The directory where numba keeps ``py_file``'s cache (first usable candidate of
+    :func:`_cache_candidates`, as ``numba.core.caching``'s locators), None if none is."""
+    return next((c for c in _cache_candidates(py_file) if _usable(c)), None)
 
 
 class _Stub:
@@ -176,9 +196,82 @@ def likely_cold(kernels: Iterable[tuple[str, str]] = FIRST_PLAN_KERNELS) -> bool
     return not all(_cached(f, name, version) for f, name in kernels)
 
 
+def _fm2uav_sources() -> list[Path]:
+    return sorted(p for p in _PKG.rglob("*.py") if "__pycache__" not in p.parts)
+
+
+def clear_cache() -> list[Path]:
+    """Delete the numba cache files of fm2uav's kernels (index ``.nbi`` and data ``.nbc``)
+    where this process keeps them (:func:`_cache_dir`: ``$NUMBA_CACHE_DIR`` when set, else
+    the package's ``__pycache__`` folders or the user-wide cache, as numba chooses).
+
+    The next call of each kernel compiles it again and writes a fresh cache.
+    Files that cannot be deleted are left (and not returned). Caches of other
+    locations (another ``$NUMBA_CACHE_DIR``) are not touched.
+
+    Returns
+    -------
+    list of Path
+        The files deleted.
+    """
+    removed = []
+    for py_file in _fm2uav_sources():
+        stem = glob.escape(py_file.stem)
+        d = _cache_dir(py_file)
+        if d is None or not d.is_dir():
+            continue
+        for f in glob.glob(str(glob.escape(str(d)) + f"/{stem}.*.nb[ic]")):
+            try:
+                os.unlink(f)
+            except OSError:
+                continue
+            removed.append(Path(f))
+
+    return removed
+
+
+def _chain(exc: BaseException) -> Iterable[BaseException]:
+    seen: set[int] = set()
+    while exc is not None and id(exc) not in seen:
+        seen.add(id(exc))
+        yield exc
+        exc = exc.__cause__ or exc.__context__
+
+
+def cache_fault(exc: BaseException) -> str | None:
+    """The cache file numba failed to load if ``exc`` comes from loading its cache, else None.
+
+    A numba cache file that cannot be read back (truncated by a full disk or a
+    killed writer, overwritten, from another numba build) makes numba raise
+    from ``numba.core.caching`` (``UnpicklingError``, ``EOFError``, ...) at
+    the first call of the kernel, in every process, until the file is deleted.
+    This looks for a frame of ``numba/core/caching.py`` in the traceback of
+    ``exc`` or of the errors it was raised from.
+
+    Returns
+    -------
+    str or None
+        The file being read when known, else ``"numba cache"``; None if ``exc`` did
+        not come from numba's cache.
+    """
+    for e in _chain(exc):
+        tb, found = e.__traceback__, None
+        while tb is not None:
+            code = tb.tb_frame.f_code
+            if code.co_filename.replace(os.sep, "/").endswith("numba/core/caching.py"):
+                loc = tb.tb_frame.f_locals
+                path = loc.get("path") or getattr(loc.get("self"), "_index_path", None)
+                found = str(path) if path else (found or "numba cache")
+            tb = tb.tb_next
+        if found is not None:
+            return found
+    return None
+
+
 _callbacks: list[Callable[[], None]] = []
 _fired = False
 _listener = None
+_hook = None
 
 
 def _fire() -> None:
@@ -196,16 +289,73 @@ def mark_announced() -> None:
     _fired = True
 
 
+def announced() -> bool:
+    """Whether the compile notice was given in this process (:func:`mark_announced`, or a
+    callback of :func:`on_first_compile` fired)."""
+    return _fired
+
+
 def on_first_compile(callback: Callable[[], None]) -> None:
     """Call ``callback()`` once, right before numba compiles the first fm2uav function.
 
     Fires on a real compilation only (numba's ``numba:compile`` event follows
     a cache miss; loading from the cache does not fire it), at most once per
     process over all callbacks, and not at all after :func:`mark_announced`.
-    Imports numba.
+    Does not import numba: if it is not imported yet, the listener is
+    installed right after its first import (an import hook that watches for
+    ``numba`` only), so a command that never needs a kernel never loads it.
     """
-    global _listener
+    global _hook
     _callbacks.append(callback)
+    if _listener is not None or _hook is not None:
+        return
+    if "numba" in sys.modules:
+        _listen()
+        return
+    _hook = _AfterImport("numba", _listen)
+    sys.meta_path.insert(0, _hook)
+
+
+class _AfterImport:
+    """A meta-path finder that runs ``then()`` once, right after module ``name`` is imported
+    (it finds the module as the other finders do and wraps its loader's ``exec_module``)."""
+
+    def __init__(self, name: str, then: Callable[[], None]) -> None:
+        self.name, self.then = name, then
+
+    def find_spec(self, name: str, path: Any = None, target: Any = None) -> Any:
+        if name != self.name:
+            return None
+        import importlib.util
+
+        _remove_hook()
+        spec = importlib.util.find_spec(name)
+        loader = getattr(spec, "loader", None)
+        if loader is None or not hasattr(loader, "exec_module"):
+            return spec
+        exec_module, then = loader.exec_module, self.then
+
+        def exec_then(module: Any) -> None:
+            exec_module(module)
+            then()
+
+        loader.exec_module = exec_then
+        return spec
+
+
+def _remove_hook() -> None:
+    global _hook
+    if _hook is not None:
+        try:
+            sys.meta_path.remove(_hook)
+        except ValueError:
+            pass
+        _hook = None
+
+
+def _listen() -> None:
+    """Register the ``numba:compile`` listener of :func:`on_first_compile` (imports numba)."""
+    global _listener
     if _listener is not None:
         return
     from numba.core import event

@@ -116,7 +116,8 @@ def describe_error(exc: BaseException) -> tuple[str, int] | None:
                 "flatten it"), EXIT_INPUT
     if isinstance(exc, MemoryError):
         return ("out of memory: the grid or the input is too large for this machine; use a "
-                "coarser --cell-size/--spacing or a smaller area (--bbox)"), EXIT_INPUT
+                "coarser grid (world.cell_size / --cell-size) or a smaller area (world.bbox / "
+                "--bbox)"), EXIT_INPUT
     mod = type(exc).__module__ or ""
     if mod.startswith("yaml"):
         return f"an input file is not valid YAML: {str(exc).splitlines()[0]}", EXIT_INPUT

@@ -34,7 +34,8 @@ SLOW = textwrap.dedent("""
 
     @app.command()
     @handle_errors
-    def main(out: str, n: int = 6, pause: float = 0.3, force: bool = False) -> None:
+    def main(out: str = typer.Option(..., "--out"), n: int = 6, pause: float = 0.3,
+             force: bool = False) -> None:
         od = OutputDir(out, force=force)
         od.check([f"f{i}.txt" for i in range(n)])
         for i in range(n):
@@ -54,7 +55,7 @@ def _slow(tmp_path: Path) -> Path:
 
 
 def _spawn(script: Path, out: Path, *args: str) -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, str(script), str(out), *args],
+    return subprocess.Popen([sys.executable, str(script), "--out", str(out), *args],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 

@@ -487,3 +487,16 @@ def test_dask_killed_worker_tasks_rerun(tmp_path, baseline):
         by = {o.unit: o for o in outs}
         assert len(outs) == 3 and by["a"].ok and by["c"].ok
         assert not by["boom"].ok and "KilledWorker" in by["boom"].value
+
+
+def test_a_signal_deferred_while_closing_is_raised_when_the_block_ends():
+    """A Ctrl-C that arrives while the sweep closes its workers is never swallowed."""
+    from fm2uav.experiments.runner import SweepInterrupted, raise_on_signals
+
+    with pytest.raises(SweepInterrupted) as exc:
+        with raise_on_signals() as signals:
+            signals.closing = True  # cleaning up: a signal waits
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.05)  # the handler ran (and deferred it)
+            assert signals.pending == signal.SIGINT
+    assert exc.value.signum == signal.SIGINT

@@ -62,9 +62,10 @@ def test_unknown_group_is_refused_with_the_known_names(capsys):
 
 
 def test_the_command_line_child_compiles_the_first_plan_child_groups():
-    # fm2uav.__main__ names the child's group without importing the warm-up
-    from fm2uav import __main__ as entry
+    # the command line names the child's group of a default `fm2uav plan` (3D, order 2)
+    from fm2uav.cli._first_use import fmm_group
 
-    assert (entry._fmm_group(["plan"]),) == warmup.FIRST_PLAN_CHILD
+    assert (fmm_group(order=2, ndim=3),) == warmup.FIRST_PLAN_CHILD
+
     assert not set(warmup.FIRST_PLAN_CHILD) & set(warmup.FIRST_PLAN_MAIN)
     assert set(warmup.FIRST_PLAN_CHILD + warmup.FIRST_PLAN_MAIN) <= set(warmup.GROUPS)

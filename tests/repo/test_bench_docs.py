@@ -27,6 +27,10 @@ ROWS = [
      "first_output_s": 0.2},
     {"benchmark": "coldstart", "case": "first `fm2uav plan`, numba cache filled", "ours_s": 1.5,
      "first_output_s": 1.2},
+    {"benchmark": "cli", "case": "`fm2uav --help`", "ours_s": 0.21, "cpu_s": 0.19,
+     "peer": "one-command typer app (framework floor)", "peer_s": 0.18, "ratio": 0.86},
+    {"benchmark": "cli", "case": "`fm2uav plan --bogus` (a bad flag)", "ours_s": 0.26,
+     "cpu_s": 0.24},
 ]
 REPORT = {"machine": {"python": "3.11", "cpus": 2, "date": "2026-12-01", "load_before": 0.3,
                       "load_after": 0.9}}
@@ -52,6 +56,10 @@ def test_write_docs_replaces_the_blocks_only(tmp_path):
     assert "FMM 3.50–4.00× faster than scikit-fmm (160x160x160, 2048x2048, order 1 and 2)" in readme
     assert "3.00× on FM²-shaped maps" in readme  # apart: not mixed into the smooth field's span
     assert "takes 11 s" in readme and "every later one 1.5 s" in readme
+    assert ("`fm2uav --help` answers in 0.21 s, `fm2uav plan --bogus` in 0.26 s (warm, CPU "
+            "0.19/0.24 s)") in readme
+    assert "| cli | `fm2uav --help` | 0.21 s | one-command typer app (framework floor) |" in table
+
     # the prose around the blocks is kept, and a second run gives the same pages
     for name, page in PAGES.items():
         before = page.read_text().split(bench.marker(name)[0])[0]

@@ -3,6 +3,15 @@
 The application is assembled from the modules ``fm2uav/cli/cmd_*.py``: each
 defines ``register(app, reproduce_app)`` and adds its commands. Commands are
 thin: parse, call the library, print a summary (see :mod:`._common`).
+
+The command line stays light: importing this package (and so ``fm2uav --help``,
+``fm2uav <cmd> --help`` and every error typer reports while parsing) loads
+typer, rich and the ``cmd_*`` modules only. A ``cmd_*`` module imports at its
+top only the standard library, typer, rich, :mod:`fm2uav.errors` and the
+light modules of this package (``_common``, ``options``, ``_mission_options``,
+other ``cmd_*``); numpy, numba, scipy, matplotlib, the geodata libraries and the
+rest of fm2uav are imported inside the command's function, by the code path
+that needs them (tests/cli/test_init.py checks every ``cli/*.py`` module).
 """
 
 from __future__ import annotations
@@ -51,11 +60,12 @@ def main() -> None:
     """
     import sys
 
-    from .._jit import cold_estimate_s, on_first_compile
-    from ._common import err_console
+    from .. import _jit
+    from . import _common
 
-    if "--quiet" not in sys.argv:
-        on_first_compile(lambda: err_console.print(
-            f"compiling kernels, first use only, ~{cold_estimate_s()} s", style="yellow",
+    _common.RERUN_ALLOWED = True  # a damaged numba cache: rebuilt by running this again
+    if "--quiet" not in sys.argv:  # numba is not imported here: the listener waits for it
+        _jit.on_first_compile(lambda: _common.err_console.print(
+            _jit.NOTICE.format(seconds=_jit.cold_estimate_s()), style="yellow",
             highlight=False))
     app()

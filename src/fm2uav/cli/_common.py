@@ -30,13 +30,11 @@ from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
-import numpy as np
 import typer
 from rich.console import Console
 from rich.markup import escape
-from rich.table import Table
 from rich.text import Text
 
 from ..errors import (  # noqa: F401  (exit codes and describe_error: re-exported)
@@ -48,14 +46,18 @@ from ..errors import (  # noqa: F401  (exit codes and describe_error: re-exporte
     InputError,
     describe_error,
 )
-from ..pipeline.rows import plan_rows  # noqa: F401  (re-exported: was defined here)
-from ..pipeline.outputs import (  # noqa: F401  (re-exported: were defined here)
+from ..pipeline.outputs import (  # noqa: F401  (re-exported; light: numpy inside)
     to_jsonable,
     write_figure,
     write_json,
     write_text,
 )
-from ..io.outdir import Interrupted, OutputDir, abort_all, finish_all, interrupt_signals
+from ..pipeline.rows import plan_rows  # noqa: F401  (re-exported; light: numpy inside)
+
+if TYPE_CHECKING:  # imported when a command runs (fm2uav.io loads numpy & co.)
+    import numpy as np
+
+    from ..io.outdir import OutputDir
 
 __all__ = [
     "EXIT_OK",
@@ -66,6 +68,7 @@ __all__ = [
     "describe_error",
     "console",
     "err_console",
+    "debug_enabled",
     "handle_errors",
     "warning_lines",
     "OutputDir",
@@ -84,6 +87,15 @@ console = Console()
 err_console = Console(stderr=True)
 
 F = TypeVar("F", bound=Callable[..., Any])
+
+
+def __getattr__(name: str) -> Any:
+    """``OutputDir`` on first use (PEP 562): importing it loads :mod:`fm2uav.io`."""
+    if name == "OutputDir":
+        from ..io.outdir import OutputDir
+
+        return OutputDir
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def _fail(message: str, code: int) -> None:
@@ -105,25 +117,81 @@ def _internal(exc: BaseException) -> None:
     raise typer.Exit(EXIT_INTERNAL)
 
 
+def debug_enabled() -> bool:
+    """Whether ``FM2UAV_DEBUG`` asks for tracebacks: only ``1``, ``true`` or ``yes`` (any case).
+
+    Anything else — unset, empty, ``0``, ``false``, ``no`` — keeps the one-line errors.
+    """
+    return os.environ.get("FM2UAV_DEBUG", "").strip().lower() in ("1", "true", "yes")
+
+
+def _warning_line(text: str) -> None:
+    err_console.print(f"[bold yellow]warning:[/] {escape(_for_this_command(str(text)))}",
+                      highlight=False, soft_wrap=True)
+
+
+
 @contextmanager
 def warning_lines() -> Iterator[None]:
-    """Show fm2uav's warnings (e.g. a DEM below sea level) as one ``warning:`` line each."""
-    import warnings
+    """Warnings while a command runs: fm2uav's as one ``warning:`` line each, library
+    warnings and log records in our words or not at all (:func:`fm2uav.cli._noise.captured`)."""
+    from ._noise import captured
 
-    original = warnings.showwarning
-
-    def show(message, category, filename, lineno, file=None, line=None):  # noqa: ANN001
-        if str(getattr(category, "__module__", "")).startswith("fm2uav"):
-            err_console.print(f"[bold yellow]warning:[/] {escape(str(message))}",
-                              highlight=False, soft_wrap=True)
-        else:
-            original(message, category, filename, lineno, file, line)
-
-    warnings.showwarning = show
-    try:
+    with captured(_warning_line, debug=debug_enabled(),
+                  raw=lambda text: err_console.print(Text(text), highlight=False,
+                                                     soft_wrap=True)):
         yield
-    finally:
-        warnings.showwarning = original
+
+
+#: Set by :func:`fm2uav.cli.main` (the real command line): a damaged numba cache may be
+#: rebuilt by running the same command line again in this process (``os.execv``).
+RERUN_ALLOWED = False
+_RERUN_ENV = "FM2UAV_CACHE_REBUILT"
+
+
+def _cache_fault(path: str) -> None:
+    """A damaged numba cache: delete fm2uav's cache files, then run the command again
+    (once, :data:`RERUN_ALLOWED`) or say how. Never returns."""
+    from .. import _jit
+
+    removed = _jit.clear_cache()
+    what = f"the numba cache of fm2uav's compiled kernels is damaged ({path})"
+    if RERUN_ALLOWED and removed and not os.environ.get(_RERUN_ENV):
+        _warning_line(f"{what}; deleted its {len(removed)} files, compiling the kernels "
+                      "again (once) and running the command again")
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os.environ[_RERUN_ENV] = "1"
+        os.execv(sys.executable, [sys.executable, *sys.orig_argv[1:]])
+    if removed:
+        _fail(f"{what}; deleted its {len(removed)} files: run the command again (the kernels "
+              "compile once, then load from a fresh cache)", EXIT_INPUT)
+    _fail(f"{what} and could not be deleted; delete the numba cache files of fm2uav "
+          "(*.nbi, *.nbc in fm2uav's __pycache__ folders, $NUMBA_CACHE_DIR or "
+          "~/.cache/numba) and run the command again", EXIT_INPUT)
+
+
+def _accepted_flags() -> set[str] | None:
+    """The flags of the command being run (None outside a command line context)."""
+    try:
+        from typer.main import get_current_context
+    except ImportError:  # typer versions that use click directly
+        from click import get_current_context
+    ctx = get_current_context(silent=True)
+    if ctx is None:
+        return None
+    return {o for p in ctx.command.params for o in (*p.opts, *p.secondary_opts)
+            if o.startswith("-")}
+
+
+def _for_this_command(message: str) -> str:
+    """``message`` naming only flags this command accepts (:func:`._flags.for_command`)."""
+    accepted = _accepted_flags()
+    if accepted is None:
+        return message
+    from ._flags import for_command
+
+    return for_command(message, accepted)
 
 
 def handle_errors(func: F) -> F:
@@ -136,13 +204,22 @@ def handle_errors(func: F) -> F:
     or exits deliberately (``typer.Exit``, e.g. 1 = infeasible with its report);
     on any error they are removed and the previous sets stay. Warnings
     of fm2uav (:class:`fm2uav.world.dem.GeodataWarning`, ...) are shown as one
-    ``warning:`` line each on stderr.
+    ``warning:`` line each on stderr; library warnings and log records are never
+    printed raw (:mod:`fm2uav.cli._noise`). An error message names only flags the
+    command accepts (:mod:`fm2uav.cli._flags`: a flag it lacks becomes the
+    mission-file key). A damaged numba cache is deleted and the command run again
+    once (:func:`fm2uav._jit.cache_fault`). ``FM2UAV_DEBUG=1`` (:func:`debug_enabled`)
+    lets errors through with their traceback.
     """
 
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
-        debug = bool(os.environ.get("FM2UAV_DEBUG"))
+        debug = debug_enabled()
+        interrupted: tuple[type[BaseException], ...] = (KeyboardInterrupt,)
         try:
+            from ..io.outdir import Interrupted, abort_all, finish_all, interrupt_signals
+
+            interrupted = (KeyboardInterrupt, Interrupted)
             with interrupt_signals(), warning_lines():
                 try:
                     result = func(*args, **kwargs)
@@ -158,24 +235,39 @@ def handle_errors(func: F) -> F:
                 return result
         except typer.Exit:
             raise
-        except (KeyboardInterrupt, Interrupted) as exc:
-            what = "SIGTERM" if isinstance(exc, Interrupted) else "SIGINT (Ctrl-C)"
+        except interrupted as exc:
+            import signal
+
+            from ..io.outdir import stop_reported
+
+            stop_reported()  # reported here: not raised again at the end of the command line
+
+            signum = getattr(exc, "signum", signal.SIGINT)
+            what = ("SIGINT (Ctrl-C)" if signum == signal.SIGINT
+                    else signal.Signals(signum).name)
             _fail(f"interrupted by {what}; no partial outputs were left (an earlier output set "
                   "is as it was)", EXIT_INTERRUPTED)
         except Exception as exc:  # noqa: BLE001 - the one place errors become exit codes
             if debug:
                 raise
+            from .._jit import cache_fault
+
+            damaged = cache_fault(exc)
+            if damaged is not None:
+                _cache_fault(damaged)
             known = describe_error(exc)
             if known is None:
                 _internal(exc)
             else:
-                _fail(*known)
+                _fail(_for_this_command(known[0]), known[1])
 
     return wrapper  # type: ignore[return-value]
 
 
 def parse_point(text: str, ndim: int, what: str) -> np.ndarray:
     """Parse ``"x,y,z"`` (commas or spaces) into a float array of length ``ndim``."""
+    import numpy as np
+
     parts = [p for p in text.replace(",", " ").split() if p]
     try:
         values = np.array([float(p) for p in parts])
@@ -203,6 +295,8 @@ def print_summary(
             payload["files"] = [str(f) for f in files]
         sys.stdout.write(json.dumps(to_jsonable(payload), indent=2) + "\n")
         return
+    from rich.table import Table
+
     table = Table(title=escape(title), show_header=False, title_justify="left")
     table.add_column("what", style="bold")
     table.add_column("value")
@@ -264,7 +358,10 @@ class Output:
         """The command's :class:`OutputDir` at ``path`` (default ``--out``), checked for
         ``names`` when given."""
         if self.outdir is None:
-            self.outdir = OutputDir(path if path is not None else self.out, force=self.force)
+            from ..io.outdir import OutputDir
+
+            self.outdir = OutputDir(
+path if path is not None else self.out, force=self.force)
         if names is not None:
             self.outdir.check(names)
         return self.outdir

@@ -3,12 +3,16 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import numpy as np
 import typer
 
 from ._common import EXIT_PLANNING, Output, handle_errors, write_json, write_text
-from .options import WorldFlags, output_options, world_options, world_rows
+from .options import AIRFRAME_NAMES, WorldFlags, output_options, world_options, world_rows
+
+
+if TYPE_CHECKING:
+    import numpy as np
 
 CHECK_FILES = ("report.json", "flown.csv", "check.png")
 REPORT = "report.html"
@@ -29,8 +33,6 @@ def _report(rep, world, rows: dict, *, title: str, subtitle: str, params: dict) 
 
 
 def _help() -> str:
-    from ..vehicles import AIRFRAMES
-
     return (
         "Check whether an airframe can fly a path file (x_m,y_m[,z_m] CSV): simulate the "
         "Dubins airplane (fixed-wing) or a multirotor following it, report the separation "
@@ -43,7 +45,7 @@ def _help() -> str:
         "  fm2uav check path.csv --airframe crosswind --scenario city --tolerance 3 --json\n\n"
         "  fm2uav check out/dem/path.csv --dem dem.tif --bbox 10.05,45.54,10.2,45.66 "
         "--out out/check-dem   (the world of the plan: same DEM options)\n\n"
-        f"Airframes: {', '.join(AIRFRAMES)}."
+        f"Airframes: {', '.join(AIRFRAME_NAMES)}."
     )
 
 

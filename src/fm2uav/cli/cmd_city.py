@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 import csv
+from typing import TYPE_CHECKING
 
 import typer
 
-from ._common import Output, OutputDir, handle_errors, write_figure, write_json, write_text
+from ._common import Output, handle_errors, write_figure, write_json, write_text
 from .options import output_options
+
+if TYPE_CHECKING:
+    from ..io.outdir import OutputDir
 
 CITY_FILES = (
     "table.csv", "table.md", "rrt.csv", "summary.json", "low_paths.png", "high_paths.png",

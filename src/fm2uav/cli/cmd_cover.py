@@ -3,19 +3,18 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from ..errors import InputError
 from ._common import (
     Output,
-    OutputDir,
     handle_errors,
     write_figure,
     write_json,
     write_text,
 )
-from ..pipeline.cover import COVER_EXPORTS, COVER_FILES, REPORT  # noqa: F401  (re-exported)
 from .options import (
     MissionFlags,
     SafetyFlags,
@@ -27,6 +26,10 @@ from .options import (
     safety_options,
     world_options,
 )
+
+if TYPE_CHECKING:
+    from ..io.outdir import OutputDir
+
 
 def _camera(camera: str):
     """``--camera`` text → :class:`~fm2uav.missions.coverage.Camera`."""
@@ -153,7 +156,7 @@ def cover_cmd(
 ) -> None:
     """``fm2uav cover``: parse, :func:`~fm2uav.pipeline.cover.run_cover`, print."""
     from ..missions.coverage import FULL_BOUNDS_DEG
-    from ..pipeline.cover import cover_rows, run_cover
+    from ..pipeline.cover import COVER_FILES, REPORT, cover_rows, run_cover
     from ..pipeline.rows import safety_rows
     from ..progress import reporting
     from ..world.load import world_summary
@@ -199,6 +202,7 @@ def reproduce_coverage_cmd(
         table_csv,
         tables_markdown,
     )
+    from ..pipeline.cover import REPORT
     from ..scenarios.coverage import COVERAGE_AREAS
 
     names = list(COVERAGE_AREAS)

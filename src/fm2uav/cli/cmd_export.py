@@ -6,11 +6,9 @@ from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
 
-import numpy as np
 import typer
 
 from ..errors import InputError
-from ..geometry import path_length
 from ._common import Output, handle_errors, write_json
 from .options import MissionFlags, mission_options, output_options
 from .cmd_run import mission_rows, write_exports
@@ -71,6 +69,7 @@ def export_cmd(
     output: Output = None,
 ) -> None:
     """``fm2uav export``: read the path, :func:`~fm2uav.io.export_mission`, write, print."""
+    from ..geometry import path_length
     from ..io import EXPORT_FILES, export_mission, parse_formats
     from ..io.path_header import read_path_header
     from ..planning import FlightLevel
@@ -108,6 +107,8 @@ def export_cmd(
 
 def _read_path(path_file: Path, header: dict, world, where: str):
     """``(path, W or None, floor or None)`` of a path CSV, checked against the world."""
+    import numpy as np
+
     from ..io import read_path_csv
     from ..io.path_header import read_path_floor, read_path_w
 

@@ -3,22 +3,20 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
 import typer
 
-from ..scenarios import SCENARIOS, get_scenario
 from ._common import (
     EXIT_PLANNING,
     Output,
-    OutputDir,
     handle_errors,
     print_summary,
     write_json,
     write_text,
 )
 from .options import (
+    SCENARIO_NAMES,
     LonLatOpt,
     MissionFlags,
     SafetyFlags,
@@ -31,6 +29,9 @@ from .options import (
     world_options,
     world_rows,
 )
+
+if TYPE_CHECKING:
+    from ..io.outdir import OutputDir
 
 FIGURES = ("paths.png", "profiles.png", "metrics.png")
 #: Mission files written per UAV (``leader_mission.plan``, ``follower1_mission.waypoints``,
@@ -109,7 +110,7 @@ FORMATION_HELP = (
     "  fm2uav formation --shape v --followers 4 --dist 45 --no-gif --out out/v4\n\n"
     "  fm2uav formation --dem dem.tif --bbox 10.05,45.54,10.2,45.66 --lonlat --start "
     "10.06,45.55 --goal 10.19,45.65 --agl 120 --no-gif --out out/formation-dem\n\n"
-    f"Scenarios: {', '.join(SCENARIOS)}."
+    f"Scenarios: {', '.join(SCENARIO_NAMES)}."
 )
 
 REPRODUCE_HELP = (
@@ -129,8 +130,8 @@ REPRODUCE_HELP = (
                 report_help="Also write report.html (interactive, self-contained).")
 @world_options
 @safety_options
-@mission_options("firmware", "vehicle", "frame", "end", "thin", "anchor", "endurance",
-                 "reserve")
+@mission_options("firmware", "vehicle", "frame", "end", "thin", "anchor", "min_speed",
+                 "cruise_speed", "hover_speed", "endurance", "reserve")
 def formation_cmd(
     scenario: ScenarioOpt = None,
     start: str | None = typer.Option(None, help="Leader start x,y,z (m) (cells with --cells; "
@@ -164,6 +165,8 @@ def formation_cmd(
 ) -> None:
     """``fm2uav formation``: parse, :func:`~fm2uav.experiments.formation.fly_and_summarise`,
     one mission per UAV, write, print."""
+    import numpy as np
+
     from ..errors import InputError
     from ..experiments.formation import fly_and_summarise, summary_rows
     from ..io.exports import EXPORT_FILES, export_formation, file_prefix
@@ -226,6 +229,8 @@ def formation_cmd(
 def _safety(result, missions: dict[str, Any], level, fences, fence_warnings) -> dict[str, Any]:
     """summary.json 'safety': :func:`~fm2uav.analysis.safety.safety_summary` of every UAV's
     flown trajectory and its mission's legs (and the geofence count with zones)."""
+    import numpy as np
+
     from ..analysis.known_ground import check_ground
     from ..analysis.safety import safety_summary
 
@@ -284,6 +289,9 @@ def reproduce_formation_cmd(
     """``fm2uav reproduce formation``: :func:`~fm2uav.experiments.formation.reproduce_formation`,
     one folder per case, table.md."""
     from ..experiments.formation import THESIS_CASES, reproduce_formation, thesis_markdown
+    from ..scenarios import get_scenario
+    from ..io.outdir import OutputDir
+
 
     out, report = output.out, output.report
     root = output.dir(["table.md", "summary.json"] + ([REPORT] if report else []))

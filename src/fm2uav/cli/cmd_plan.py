@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-import numpy as np
 import typer
 
-from ..planning.params import planner_objects
-from ..scenarios import SCENARIOS
 from ..errors import InputError
 from ._common import Output, handle_errors, plan_rows, write_json
 from .options import (
+    SCENARIO_NAMES,
     LonLatOpt,
     MissionFlags,
     ScenarioOpt,
@@ -40,7 +38,7 @@ PLAN_HELP = (
     "  fm2uav plan --dem coast.tif --sea-level 0 --buildings osm.geojson "
     "--default-height 10 --lonlat --start 10.06,45.55,60 --goal 10.19,45.65,60 "
     "--out out/city\n\n"
-    f"Scenarios: {', '.join(SCENARIOS)}."
+    f"Scenarios: {', '.join(SCENARIO_NAMES)}."
 )
 
 
@@ -106,6 +104,11 @@ def plan_cmd(
     mission: MissionFlags = None,
 ) -> None:
     """``fm2uav plan``: parse, :func:`~fm2uav.missions.route.plan_route`, write, print."""
+    from ._first_use import announce_compile, fmm_group
+
+    announce_compile(quiet=output.quiet,
+                     child_group=fmm_group(order=order, ndim=2 if scenario == "city2d" else 3),
+                     preload=("fm2uav.missions.route", "fm2uav.viz", "fm2uav.io"))
     from ..missions.route import plan_route
     from ..world.load import world_summary
 
@@ -154,6 +157,8 @@ def plan_cmd(
 def _planner(shaping: dict, level: dict) -> tuple:
     """``(Shaping, FlightLevel or None, PlanOptions)`` of the planner flags (the flight-level
     ones only with ``--agl``; unset ``--min-agl``/``--max-agl`` left out)."""
+    from ..planning.params import planner_objects
+
     if level["agl"] is None:
         if level["min_agl"] is not None or level["max_agl"] is not None:
             raise InputError("--min-agl / --max-agl limit a terrain-following flight; give "
@@ -167,6 +172,8 @@ def _points(w, sc, start: str | None, goal: str | None, via: list[str] | None, *
             world: WorldFlags, no_fly: list[str] | None, **how) -> tuple:
     """``(world, start, goal, via points)`` in metres, checked (free, not over filled
     nodata, outside the ``--no-fly`` zones, which become obstacles of the world)."""
+    import numpy as np
+
     from ..world.load import check_points
 
     def point(text: str | None, default: np.ndarray | None, what: str) -> np.ndarray:
@@ -189,6 +196,8 @@ def _points(w, sc, start: str | None, goal: str | None, via: list[str] | None, *
 def _write_plan(outdir, p, world, *, title: str, ground: dict | None = None) -> None:
     """plan.png (with the known/unknown ground split ``ground``) and path.csv (with the final
     profile's floor) of a plan on ``world``."""
+    import numpy as np
+
     from ..io import write_path_csv
     from ..viz import plan_figure
 
@@ -244,6 +253,8 @@ def _extra_formats(export: str, report: bool) -> list[str]:
 
 
 def _export_options(anchor: str | None, thin: float):
+    import numpy as np
+
     from ..autopilot import ExportOptions
 
     if not np.isfinite(thin) or thin < 0:

@@ -25,7 +25,7 @@ from ._common import (
 )
 from ._mission_options import via_points
 from .options import (
-    LonLatOpt,
+    MISSION_FLAGS,
     MissionFlags,
     WorldFlags,
     mission_options,
@@ -56,8 +56,7 @@ RUN_HELP = (
 @output_options(None, out_help="Output directory. Default: the mission's outputs.dir, else "
                 "out/<mission file name>.")
 @world_options
-@mission_options("via", "return_to_start", "firmware", "vehicle", "frame", "end",
-                 "speed_changes", "endurance", "reserve")
+@mission_options(*MISSION_FLAGS, "thin", "anchor")
 def run_cmd(
     mission_file: Path = typer.Argument(..., help="Mission YAML file.", show_default=False),
     output: Output = None,
@@ -66,7 +65,9 @@ def run_cmd(
         "degrees, metres above ground), else x,y,z metres."),
     goal: str | None = typer.Option(
         None, help="Override the mission's goal (as --start)."),
-    lonlat: LonLatOpt = False,
+    lonlat: bool = typer.Option(
+        False, "--lonlat", help="Read --start/--goal as LON,LAT,AGL (degrees, degrees, metres "
+        "above the ground)."),
     world: WorldFlags = None,
     mission: MissionFlags = None,
     no_fly: list[Path] | None = typer.Option(
@@ -86,6 +87,9 @@ def run_cmd(
 ) -> None:
     """``fm2uav run``: load the mission file (with the flags' overrides),
     :func:`~fm2uav.pipeline.run.run_mission`, print."""
+    from .._validate import input_file
+
+    input_file(mission_file, "")  # a missing mission file is refused before the heavy imports
     from ..io.mission import load_mission
     from ..pipeline.run import run_mission
     from ..progress import reporting

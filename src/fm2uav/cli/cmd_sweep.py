@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import typer
 from rich.markup import escape
@@ -13,13 +13,15 @@ from rich.text import Text
 from ._common import (
     EXIT_INTERRUPTED,
     Output,
-    OutputDir,
     err_console,
     handle_errors,
     print_summary,
     to_jsonable,
 )
 from .options import output_options
+
+if TYPE_CHECKING:
+    from ..io.outdir import OutputDir
 
 #: Exit code of a sweep that finished but has failed cases (0 ok, 1 planning, 2 bad input,
 #: 130 interrupted, 70 internal error).
@@ -81,6 +83,8 @@ def run_and_report(config, out: Path, *, force: bool, scheduler: str | None, wor
     """
     from ..errors import InputError
     from ..experiments.runner import SweepInterrupted, raise_on_signals, same_sweep, sweep_lock
+    from ..io.outdir import OutputDir
+
 
     try:
         same = same_sweep(config, out)

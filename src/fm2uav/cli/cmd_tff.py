@@ -4,12 +4,12 @@
 from __future__ import annotations
 
 import time
+from typing import TYPE_CHECKING
 
-import numpy as np
 import typer
 
 from ..errors import InputError
-from ._common import Output, OutputDir, handle_errors, write_figure, write_json, write_text
+from ._common import Output, handle_errors, write_figure, write_json, write_text
 from .options import (
     LonLatOpt,
     ScenarioOpt,
@@ -19,6 +19,9 @@ from .options import (
     world_options,
     world_rows,
 )
+
+if TYPE_CHECKING:
+    from ..io.outdir import OutputDir
 
 TFF_FILES = (
     "tff_table.md",
@@ -35,6 +38,8 @@ REPORT = "report.html"
 
 def _write_tff_outputs(outdir: OutputDir, run, *, report: bool) -> None:
     """The figures, tff_table.md, tff_summary.json (and report.html) of a TFF run."""
+    import numpy as np
+
     from ..experiments.tff import tff_markdown
     from ..viz.tff import tff_figures, tff_report_html
 

@@ -21,21 +21,24 @@ import inspect
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, fields
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
-import numpy as np
 import typer
 
 from ..errors import InputError
 from ..pipeline.rows import world_rows  # noqa: F401  (re-exported: was defined here)
 
+if TYPE_CHECKING:
+    import numpy as np
+
 __all__ = [
     "DemOpt", "DemFillOpt", "BuildingsOpt", "BboxOpt", "SeaLevelOpt", "CellSizeOpt", "DzOpt", "CeilingOpt",
     "NodataOpt", "NodataValueOpt", "CrsOpt", "DefaultHeightOpt", "AllowFilledOpt", "LonLatOpt",
-    "ScenarioOpt", "WORLD_FLAGS", "world_spec", "build_world", "cli_point", "world_rows",
-    "requested_heights", "world_overrides", "point_overrides", "option_group", "WorldFlags",
-    "world_options", "MissionFlags", "mission_options", "output_options", "NoFlyOpt",
-    "MinAglOpt", "MaxAglOpt", "SaturationDistanceOpt", "SafetyFlags", "safety_options",
+    "ScenarioOpt", "SCENARIO_NAMES", "AIRFRAME_NAMES", "WORLD_FLAGS", "world_spec",
+    "build_world", "cli_point", "world_rows", "requested_heights", "world_overrides",
+    "point_overrides", "option_group", "WorldFlags", "world_options", "MissionFlags",
+    "MISSION_FLAGS", "mission_options", "output_options", "NoFlyOpt", "MinAglOpt", "MaxAglOpt",
+    "SaturationDistanceOpt", "SafetyFlags", "safety_options",
 ]
 
 _P = "World (real data)"
@@ -96,7 +99,15 @@ AllowFilledOpt = _option(bool, "--allow-filled", panel=_P, show_default=True,
 LonLatOpt = Annotated[bool, typer.Option(
     "--lonlat", help="Read --start/--goal as LON,LAT[,AGL] (degrees, degrees, metres above "
                      "the ground; default AGL: --agl).")]
+#: The built-in scenarios (:data:`fm2uav.scenarios.SCENARIOS`) and airframe presets
+#: (:data:`fm2uav.vehicles.AIRFRAMES`) by name, for ``--help`` without importing them
+#: (tests/cli/test_light.py keeps them equal to the library's).
+SCENARIO_NAMES = ("open-field", "fissure", "jacksboro", "city", "city-high", "coverage",
+                  "city2d")
+AIRFRAME_NAMES = ("disco", "crosswind", "plane-jet", "arducopter")
+
 ScenarioOpt = Annotated[str | None, typer.Option(
+
     "--scenario", show_default=False,
     help="Built-in scenario (when no --dem/--buildings is given).")]
 
@@ -275,6 +286,8 @@ def cli_point(text: str | None, what: str, world: Any, *, lonlat: bool = False,
         Wrong count of numbers, a lon/lat point without a height, both
         ``--lonlat`` and ``--cells``.
     """
+    import numpy as np
+
     from ._common import parse_point
 
     if text is None:

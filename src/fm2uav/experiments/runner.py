@@ -347,10 +347,13 @@ class _Signals:
                 self._old[s] = signal.signal(s, self._handler)
         return self
 
-    def __exit__(self, *exc: Any) -> None:
+    def __exit__(self, exc_type: Any, *exc: Any) -> None:
         for s, h in self._old.items():
             signal.signal(s, h)
         self._old = {}
+        if exc_type is None and self.pending:  # deferred and not raised yet: never swallowed
+            signum, self.pending = self.pending, None
+            raise SweepInterrupted(signum)
 
     def _handler(self, signum: int, frame: Any) -> None:
         if self.closing or self.critical:

@@ -12,47 +12,117 @@ The mission names of :mod:`fm2uav.autopilot` (``build_mission``,
 are re-exported here so that code written before the autopilot layer keeps working.
 """
 
-from .exports import (
-    EXPORT_FILES,
-    ExportFile,
-    ExportOptions,
-    export_formation,
-    export_mission,
-    export_writers,
-    parse_formats,
-)
-from ..world.geo import DEFAULT_ANCHOR, Anchor, from_lonlat, to_lonlat  # the one conversion
-from .geojson import geojson_document, read_geojson_path, write_geojson
-from .kml import kml_document, read_kml_path, write_kml, write_kmz
-from .paths import read_path_csv, write_path_csv
-from .qgc import geofence_document, plan_document, read_plan, validate_plan, write_plan
-from .trajectories import (
-    read_trajectories_csv,
-    write_cycles_csv,
-    write_formation_metrics_csv,
-    write_trajectories_csv,
-)
-from .wpl import read_wpl, write_wpl
+import importlib
+from typing import TYPE_CHECKING, Any
 
-# the mission itself lives in fm2uav.autopilot (re-exported for existing code)
-from ..autopilot import (
-    CameraPlan,
-    FenceCircle,
-    FencePolygon,
-    MissionExport,
-    MissionItem,
-    Problem,
-    Waypoints,
-    build_mission,
-    check_mission,
-    fences_from_world,
-    mission_waypoints,
-    resolve_frame,
-    speed_commands,
-    thin_indices,
-    thin_path,
-    validate_mission,
-)
+if TYPE_CHECKING:  # loaded on first attribute access (PEP 562), see __getattr__
+    from .exports import (
+        EXPORT_FILES,
+        ExportFile,
+        ExportOptions,
+        export_formation,
+        export_mission,
+        export_writers,
+        parse_formats,
+    )
+    from ..world.geo import DEFAULT_ANCHOR, Anchor, from_lonlat, to_lonlat  # the one conversion
+    from .geojson import geojson_document, read_geojson_path, write_geojson
+    from .kml import kml_document, read_kml_path, write_kml, write_kmz
+    from .paths import read_path_csv, write_path_csv
+    from .qgc import geofence_document, plan_document, read_plan, validate_plan, write_plan
+    from .trajectories import (
+        read_trajectories_csv,
+        write_cycles_csv,
+        write_formation_metrics_csv,
+        write_trajectories_csv,
+    )
+    from .wpl import read_wpl, write_wpl
+
+    # the mission itself lives in fm2uav.autopilot (re-exported for existing code)
+    from ..autopilot import (
+        CameraPlan,
+        FenceCircle,
+        FencePolygon,
+        MissionExport,
+        MissionItem,
+        Problem,
+        Waypoints,
+        build_mission,
+        check_mission,
+        fences_from_world,
+        mission_waypoints,
+        resolve_frame,
+        speed_commands,
+        thin_indices,
+        thin_path,
+        validate_mission,
+    )
+
+#: Where each public name lives (relative to this package). ``import fm2uav.io.outdir``
+#: (every command's output set) loads none of them: the writers and the mission builder
+#: (numpy, numba, shapely, pyproj) are imported on first access.
+_LAZY_NAMES = {
+    "EXPORT_FILES": ".exports",
+    "ExportFile": ".exports",
+    "ExportOptions": ".exports",
+    "export_formation": ".exports",
+    "export_mission": ".exports",
+    "export_writers": ".exports",
+    "parse_formats": ".exports",
+    "DEFAULT_ANCHOR": "..world.geo",
+    "Anchor": "..world.geo",
+    "from_lonlat": "..world.geo",
+    "to_lonlat": "..world.geo",
+    "geojson_document": ".geojson",
+    "read_geojson_path": ".geojson",
+    "write_geojson": ".geojson",
+    "kml_document": ".kml",
+    "read_kml_path": ".kml",
+    "write_kml": ".kml",
+    "write_kmz": ".kml",
+    "read_path_csv": ".paths",
+    "write_path_csv": ".paths",
+    "geofence_document": ".qgc",
+    "plan_document": ".qgc",
+    "read_plan": ".qgc",
+    "validate_plan": ".qgc",
+    "write_plan": ".qgc",
+    "read_trajectories_csv": ".trajectories",
+    "write_cycles_csv": ".trajectories",
+    "write_formation_metrics_csv": ".trajectories",
+    "write_trajectories_csv": ".trajectories",
+    "read_wpl": ".wpl",
+    "write_wpl": ".wpl",
+    "CameraPlan": "..autopilot",
+    "FenceCircle": "..autopilot",
+    "FencePolygon": "..autopilot",
+    "MissionExport": "..autopilot",
+    "MissionItem": "..autopilot",
+    "Problem": "..autopilot",
+    "Waypoints": "..autopilot",
+    "build_mission": "..autopilot",
+    "check_mission": "..autopilot",
+    "fences_from_world": "..autopilot",
+    "mission_waypoints": "..autopilot",
+    "resolve_frame": "..autopilot",
+    "speed_commands": "..autopilot",
+    "thin_indices": "..autopilot",
+    "thin_path": "..autopilot",
+    "validate_mission": "..autopilot",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY_NAMES:
+        value = getattr(importlib.import_module(_LAZY_NAMES[name], __name__), name)
+        globals()[name] = value  # later accesses skip __getattr__
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY_NAMES))
+
 
 __all__ = [
     "read_path_csv",

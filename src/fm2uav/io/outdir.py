@@ -33,6 +33,7 @@ import errno
 import os
 import shutil
 import signal
+import sys
 import tempfile
 import threading
 from collections.abc import Iterable, Iterator
@@ -43,7 +44,8 @@ from typing import Any
 from ..errors import InputError
 
 __all__ = ["OutputDir", "Interrupted", "active_sets", "finish_all", "abort_all",
-           "interrupt_signals"]
+           "interrupt_signals", "install_stop_signals", "raise_if_stopped", "stop_reported",
+           "unreported_stop"]
 
 _ACTIVE: list[OutputDir] = []
 
@@ -70,12 +72,95 @@ class _Hold:
     pending: int | None = None
 
 
+class _Stop:
+    """A stop signal that was swallowed and not reported yet (:func:`stop_reported`).
+
+    Python ignores an exception raised where it cannot propagate — a weakref callback
+    (the import system has some), a ``__del__``, the garbage collector — and hands it to
+    ``sys.unraisablehook`` ("Exception ignored in ..."): a stop signal that lands there
+    would be lost and the command would run on. :func:`_unraisable` records it instead,
+    and :func:`raise_if_stopped` raises it again at the next checkpoint (a command's
+    start, before its sets are put in place, the end of the command line), so a stop is
+    never swallowed. A stop held during the renames of a set that then fail is recorded
+    the same way.
+    """
+
+    signum: int | None = None
+    delivered: int | None = None  # the last stop raised, until reported
+    previous_hook: Any = None
+
+
+def _stop_exception(signum: int) -> BaseException:
+    return KeyboardInterrupt() if signum == signal.SIGINT else Interrupted(signum)
+
+
 def _deliver(signum: int) -> None:
     if _Commit.done and not _ACTIVE:
         return  # the outputs are in place: the command is ending anyway
-    if signum == signal.SIGINT:
-        raise KeyboardInterrupt
-    raise Interrupted(signum)
+    _Stop.delivered = signum
+    raise _stop_exception(signum)
+
+
+def _keep_swallowed_stops(unraisable: Any) -> None:
+    """``sys.unraisablehook``: a stop signal Python could not raise is kept for the next
+    checkpoint; anything else goes to the hook this one replaced."""
+    exc = unraisable.exc_value
+    if isinstance(exc, (KeyboardInterrupt, Interrupted)):
+        _Stop.signum = getattr(exc, "signum", signal.SIGINT)
+        return
+    (_Stop.previous_hook or sys.__unraisablehook__)(unraisable)
+
+
+def _unraisable_stops() -> None:
+    """Install :func:`_keep_swallowed_stops` in front of the current ``sys.unraisablehook``."""
+    if sys.unraisablehook is not _keep_swallowed_stops:
+        _Stop.previous_hook = sys.unraisablehook
+        sys.unraisablehook = _keep_swallowed_stops
+
+
+def raise_if_stopped() -> None:
+    """Raise the stop signal that arrived and was not reported (see :class:`_Stop`), if any.
+
+    Raises
+    ------
+    KeyboardInterrupt
+        SIGINT.
+    Interrupted
+        SIGTERM, SIGHUP.
+    """
+    if _Stop.signum is not None:
+        raise _stop_exception(_Stop.signum)
+
+
+def stop_reported() -> None:
+    """The stop signal was reported to the user (the process ends with 130): forget it."""
+    _Stop.signum = _Stop.delivered = None
+
+
+def unreported_stop() -> int | None:
+    """The last stop signal raised in this process that nobody reported (e.g. one that a
+    library turned into an exit code of its own, as typer's parser does), or None."""
+    return _Stop.delivered if _Stop.signum is None else _Stop.signum
+
+
+def _stop_signals() -> list[int]:
+    return [signal.SIGTERM, signal.SIGINT] + ([signal.SIGHUP] if hasattr(signal, "SIGHUP")
+                                              else [])
+
+
+def install_stop_signals() -> None:
+    """SIGINT raises :class:`KeyboardInterrupt`, SIGTERM and SIGHUP :class:`Interrupted`,
+    from now on (the command line's first instruction; :func:`interrupt_signals` adds the
+    output sets' rules while a command runs). A signal the parent shell ignores (``nohup``:
+    SIGHUP, a background job: SIGINT) stays ignored."""
+    _unraisable_stops()
+    for sig in _stop_signals():
+        try:
+            if signal.getsignal(sig) is signal.SIG_IGN:
+                continue
+            signal.signal(sig, _on_stop_signal)
+        except (ValueError, OSError):  # not the main thread, or an exotic platform
+            pass
 
 
 def _on_stop_signal(signum: int, frame: Any) -> None:  # noqa: ARG001
@@ -102,7 +187,8 @@ def _signals_held() -> Iterator[None]:
     except BaseException:
         _Hold.depth -= 1
         if _Hold.depth == 0:
-            _Hold.pending = None
+            if _Hold.pending is not None:  # its error goes first; the stop is raised after
+                _Stop.signum, _Hold.pending = _Hold.pending, None
         raise
     _Hold.depth -= 1
     if _Hold.depth == 0 and _Hold.pending is not None:
@@ -123,15 +209,15 @@ def interrupt_signals() -> Iterator[None]:
         yield
         return
     old = {}
-    stops = [signal.SIGTERM, signal.SIGINT] + ([signal.SIGHUP] if hasattr(signal, "SIGHUP") else [])
-    handlers = {sig: _on_stop_signal for sig in stops}
     _Commit.done = False
-    for sig, handler in handlers.items():
+    _unraisable_stops()
+    for sig in _stop_signals():
         try:
-            old[sig] = signal.signal(sig, handler)
+            old[sig] = signal.signal(sig, _on_stop_signal)
         except (ValueError, OSError):  # pragma: no cover - exotic platforms
             pass
     try:
+        raise_if_stopped()  # a stop Python swallowed before the command started
         yield
     finally:
         for sig, handler in old.items():
@@ -151,6 +237,7 @@ def finish_all() -> None:
     """
     with _signals_held():
         try:
+            raise_if_stopped()  # a stop swallowed while the command ran: nothing is put in place
             for od in reversed(active_sets()):
                 od.finish()
         except BaseException:

@@ -13,8 +13,6 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from .. import progress
 from ..errors import InputError
 from .rows import safety_rows
@@ -33,6 +31,8 @@ OUTPUT_FILES = {**EXPORT_FILES, "html": "report.html", "png": "plan.png", "json"
 
 def to_jsonable(obj: Any) -> Any:
     """Convert numpy scalars/arrays and paths into plain JSON types."""
+    import numpy as np
+
     if isinstance(obj, dict):
         return {str(k): to_jsonable(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
@@ -187,6 +187,8 @@ def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
                  fence_warnings: list[str]) -> str:
     """report.html of a plan and its autopilot mission's waypoints ``wps`` (see
     :func:`plan_outputs`)."""
+    import numpy as np
+
     from ..analysis.known_ground import ground_notes
     from ..viz.overlays import filled_overlay, filled_path_overlay, zone_overlays
     from ..viz.report import report_html

@@ -6,8 +6,6 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 __all__ = ["plan_rows", "world_rows", "mission_rows", "safety_rows", "ground_rows"]
 
 
@@ -70,6 +68,8 @@ def safety_rows(safety: dict[str, Any]) -> dict[str, str]:
 
 def plan_rows(p: Any) -> dict[str, Any]:
     """The printed summary rows every planning command shows of a plan."""
+    import numpy as np
+
     return {
         "start [m]": np.round(p.start, 1).tolist(),
         "goal [m]": np.round(p.goal, 1).tolist(),

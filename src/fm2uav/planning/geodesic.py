@@ -73,7 +73,7 @@ import numpy as np
 
 from .._validate import grid
 from ..eikonal.fmm import as_spacing
-from ..errors import InputError, PlanningError, UnreachableError
+from ..errors import InputError, PlanningError, PointError, UnreachableError
 from . import _geodesic_kernels as _k
 
 __all__ = ["descend", "nearest_node", "default_max_steps"]
@@ -137,7 +137,7 @@ def _as_point(p: Any, shape: tuple[int, ...], what: str) -> np.ndarray:
     upper = np.asarray(shape, dtype=float) - 1.0
     tol = 1e-9
     if np.any(arr < -tol) or np.any(arr > upper + tol):
-        raise PlanningError(
+        raise PointError(
             f"{what} {arr.tolist()} (index coordinates) lies outside the grid, whose "
             f"coordinates run from 0 to {upper.tolist()} on each axis; move it inside the map"
         )
@@ -182,9 +182,9 @@ def _with_blocked(field: np.ndarray, blocked: Any) -> tuple[np.ndarray, np.ndarr
 
 def _refuse_blocked(mask: np.ndarray | None, node: tuple[int, ...], p: np.ndarray, what: str
                     ) -> None:
-    """PlanningError when the ``what`` point ``p`` [m] has its nearest ``node`` blocked."""
+    """PointError when the ``what`` point ``p`` [m] has its nearest ``node`` blocked."""
     if mask is not None and mask[node]:
-        raise PlanningError(
+        raise PointError(
             f"{what} {p.tolist()} lies in blocked node {list(node)}; move the {what} to free space"
         )
 

@@ -41,7 +41,7 @@ import shapely
 from shapely.geometry import Point, Polygon
 from shapely.geometry.base import BaseGeometry
 
-from ..errors import InputError, PlanningError, WorldError
+from ..errors import InputError, PointError, WorldError
 from ..geometry import densify
 
 if TYPE_CHECKING:
@@ -591,12 +591,14 @@ def check_points_allowed(world: World, points: Mapping[str, Any]) -> None:
 
     Raises
     ------
-    PlanningError
+    PointError
+        A point inside a zone is bad input (exit code 2 on the command line), like a
+        point inside an obstacle.
     """
     for what, pt in points.items():
         v = zone_violations(world, np.atleast_2d(np.asarray(pt, dtype=float)), buffered=True)
         if v:
-            raise PlanningError(
+            raise PointError(
                 f"the {what} {np.round(np.asarray(pt, dtype=float), 1).tolist()} m lies in "
                 f"{v[0].zone!r} (or its buffer); move the {what} or change {_NO_FLY} / "
                 "operating_area")

@@ -33,7 +33,7 @@ import numpy as np
 import shapely
 from shapely.geometry import LineString, box
 
-from ...errors import PlanningError
+from ...errors import InputError
 from ...planning import FlightLevel, PlanOptions, Shaping
 
 __all__ = ["allowed_region", "meets_zones", "zone_route_points", "plan_zone_route"]
@@ -79,16 +79,18 @@ def zone_route_points(world: Any, track: np.ndarray, spacing: float, agl: float,
 
     Raises
     ------
-    PlanningError
-        Nothing of the zigzag lies outside the zones.
+    InputError
+        Nothing of the zigzag lies outside the zones: the area and the zones
+        contradict each other (bad input, exit code 2 on the command line).
     """
     line = LineString(np.asarray(track, dtype=float)[:, :2])
     inside = line.intersection(allowed_region(world, margin))
     pieces = [g for g in getattr(inside, "geoms", [inside])
               if g.geom_type == "LineString" and not g.is_empty and g.length > 0]
     if not pieces:
-        raise PlanningError("the whole zigzag lies in no-fly zones (or outside the operating "
-                            "area); check --no-fly / no_fly_zones against --area")
+        raise InputError("the whole zigzag lies in no-fly zones (or outside the operating "
+                         "area); check the no-fly zones (no_fly_zones / --no-fly) against the "
+                         "survey area (--area)")
     pieces.sort(key=lambda g: line.project(shapely.Point(g.coords[0])))
     cell = float(min(world.spacing[0], world.spacing[1]))
     pts: list[np.ndarray] = []
@@ -114,15 +116,18 @@ def plan_zone_route(world: Any, track: np.ndarray, spacing: float, level: Flight
     Raises
     ------
     PlanningError
-        A leg cannot be planned (its message names the leg), or fewer than two
-        points of the zigzag lie outside the zones.
+        A leg cannot be planned (its message names the leg).
+    InputError
+        Fewer than two points of the zigzag lie outside the zones.
     """
     from ..route import plan_route
 
     pts = zone_route_points(world, track, spacing, level.agl, margin)
     if len(pts) < 2:
-        raise PlanningError("less than one band of the zigzag lies outside the no-fly zones; "
-                            "nothing to cover (check --no-fly / no_fly_zones against --area)")
+        raise InputError("less than one band of the zigzag lies outside the no-fly zones; "
+                         "nothing to cover: check the no-fly zones (no_fly_zones / --no-fly) "
+                         "against the survey area (--area)")
+
     return plan_route(world, pts[0], pts[-1], via=list(pts[1:-1]),
                       shaping=Shaping() if shaping is None else shaping, level=level,
                       options=options)

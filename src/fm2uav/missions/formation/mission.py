@@ -368,8 +368,9 @@ def _cycle_settings(world: World, cfg: FormationConfig, options: PlanOptions, ma
             f"the formation flight would take {max_cycles + settle} re-planning cycles of "
             f"{n_sub} sub-steps (limits {MAX_CYCLES}, {MAX_SUBSTEPS}) for a {length:.0f} m "
             f"route at {v_lead:g} m/s with cycles of {cycle:g} s on {float(h.min()):g} m cells; "
-            "use a faster --speed, a longer --cycle (or a shorter one for fast vehicles), "
-            "or a coarser grid")
+            "use a faster leader (--speed), a longer re-planning cycle (--cycle; a shorter one "
+            "for fast vehicles) or a coarser grid")
+
     return CycleSettings(
         cycle=cycle, speeds=np.array([v_lead] + [v_fol] * cfg.n_followers),
         radius=bound + v_max * cycle + maps.half_diagonal + 1e-6,

@@ -1,0 +1,148 @@
+"""The command line stays light (issue 27): help, usage errors and the assembly of the app
+import typer and rich only; every ``cli/*.py`` module keeps its heavy imports inside the
+functions that need them (docs/architecture.md, "The command line stays light").
+
+Import checks, not timings: the seconds are measured by ``make bench`` (benchmarks/bench_cli.py).
+"""
+
+from __future__ import annotations
+
+import ast
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+from fm2uav.cli.options import AIRFRAME_NAMES, SCENARIO_NAMES
+
+ROOT = Path(__file__).resolve().parents[2]
+CLI = ROOT / "src" / "fm2uav" / "cli"
+
+#: What `fm2uav --help` must not load (the libraries of the issue, and fm2uav's own heavy
+#: layers, which import them).
+HEAVY = ("numpy", "numba", "llvmlite", "scipy", "matplotlib", "plotly", "rasterio", "shapely",
+         "pyproj", "pyogrio", "dask", "distributed", "pyarrow", "yaml", "PIL", "ompl",
+         "fm2uav.eikonal", "fm2uav.world", "fm2uav.planning", "fm2uav.missions",
+         "fm2uav.vehicles", "fm2uav.analysis", "fm2uav.scenarios", "fm2uav.experiments",
+         "fm2uav.io", "fm2uav.viz", "fm2uav.baselines", "fm2uav._validate",
+         "fm2uav.autopilot", "fm2uav.pipeline.run", "fm2uav.pipeline.cover", "fm2uav.app",
+         "fastapi", "starlette", "uvicorn", "rio_tiler")
+
+#: Top-level imports a ``cli/*.py`` module may have: the standard library, typer, rich,
+#: fm2uav.errors, the light modules of fm2uav.cli (the cmd_* modules among them) and the two
+#: pipeline modules the commands share with the app, light by the same rule (numpy inside
+#: their functions; the jobs, fm2uav.pipeline.run / .cover, are imported by the commands).
+ALLOWED_TOP = ("typer", "rich", "fm2uav.errors", "fm2uav.cli", "fm2uav.pipeline.outputs",
+               "fm2uav.pipeline.rows")
+
+# In a fresh interpreter: import the app, render every help page and the usage errors,
+# then list what got loaded.
+PROBE = """
+import json, sys
+import typer
+from typer.testing import CliRunner
+from fm2uav.cli import app
+
+heavy = {heavy!r}
+loaded = lambda: sorted(m for m in heavy if m in sys.modules or
+                        any(k.startswith(m + ".") for k in sys.modules))
+report = {{"import": loaded() + (["pydantic"] if "pydantic" in sys.modules else [])}}
+runner = CliRunner()
+cmd = typer.main.get_command(app)
+
+def pages(c, prefix):
+    yield prefix
+    for name, sub in sorted(getattr(c, "commands", {{}}).items()):
+        yield from pages(sub, prefix + [name])
+
+codes = {{}}
+for words in pages(cmd, []):
+    res = runner.invoke(app, [*words, "--help"])
+    codes[" ".join(words) + " --help"] = res.exit_code
+for words in (["plan", "--bogus"], ["plan", "--order", "x"], ["run"], ["nonsense"],
+              ["cover", "--angle", "north"], []):
+    codes[" ".join(words)] = runner.invoke(app, words).exit_code
+report["help"] = loaded()
+report["codes"] = codes
+print(json.dumps(report))
+"""
+
+
+def _probe() -> dict:
+    res = subprocess.run([sys.executable, "-c", PROBE.format(heavy=HEAVY)], capture_output=True,
+                         text=True, timeout=300)
+    assert res.returncode == 0, res.stderr
+    return json.loads(res.stdout.strip().splitlines()[-1])
+
+
+def test_help_and_usage_errors_load_no_heavy_library():
+    report = _probe()
+    assert report["import"] == [], f"`import fm2uav.cli` loads {report['import']}"
+    assert report["help"] == [], f"help pages / usage errors load {report['help']}"
+    codes = report["codes"]
+    assert len(codes) > 20  # every command's help page was rendered
+    assert all(code == 0 for k, code in codes.items() if k.endswith("--help")), codes
+    assert [codes[k] for k in ("plan --bogus", "plan --order x", "run", "nonsense",
+                               "cover --angle north")] == [2] * 5
+    assert codes[""] in (0, 2)  # no arguments: the help (no_args_is_help)
+
+
+def _top_level_imports(path: Path) -> list[tuple[int, str]]:
+    """``(line, absolute module)`` of the imports a module runs when it is imported (not those
+    inside functions or under ``if TYPE_CHECKING:``)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    out = []
+
+    def visit(body):
+        for node in body:
+            if isinstance(node, ast.Import):
+                out.extend((node.lineno, a.name) for a in node.names)
+            elif isinstance(node, ast.ImportFrom):
+                if node.level:
+                    base = ["fm2uav", "cli"][:3 - node.level] if node.level <= 2 else []
+                    mod = ".".join(base + ([node.module] if node.module else []))
+                else:
+                    mod = node.module or ""
+                out.append((node.lineno, mod))
+            elif isinstance(node, ast.If):
+                test = ast.unparse(node.test)
+                if "TYPE_CHECKING" not in test:
+                    visit(node.body)
+                visit(node.orelse)
+            elif isinstance(node, (ast.Try, ast.With)):
+                visit(node.body)
+    visit(tree.body)
+    return out
+
+
+def _allowed(module: str) -> bool:
+    top = module.split(".")[0]
+    return (top in sys.stdlib_module_names or top == "__future__"
+            or any(module == a or module.startswith(a + ".") for a in ALLOWED_TOP))
+
+
+def test_every_cli_module_imports_only_light_modules_at_its_top():
+    modules = sorted(CLI.glob("*.py"))
+    assert any(p.name.startswith("cmd_") for p in modules)
+    bad = [f"{p.relative_to(ROOT)}:{line}: {mod}" for p in modules
+           for line, mod in _top_level_imports(p) if not _allowed(mod)]
+    assert not bad, ("heavy imports at the top of a cli module (move them into the command "
+                     "function that needs them; docs/architecture.md): " + "; ".join(bad))
+
+
+def test_the_import_rule_sees_relative_imports_and_type_checking_blocks(tmp_path):
+    f = tmp_path / "cmd_x.py"
+    f.write_text("from typing import TYPE_CHECKING\nimport typer\nfrom ..world import World\n"
+                 "from ._common import Output\nif TYPE_CHECKING:\n    import numpy\n"
+                 "def run():\n    import scipy\n")
+    mods = [m for _, m in _top_level_imports(f)]
+    assert mods == ["typing", "typer", "fm2uav.world", "fm2uav.cli._common"]
+    assert [m for m in mods if not _allowed(m)] == ["fm2uav.world"]
+
+
+def test_the_help_lists_the_library_s_scenarios_and_airframes():
+    from fm2uav.scenarios import SCENARIOS
+    from fm2uav.vehicles import AIRFRAMES
+
+    assert SCENARIO_NAMES == tuple(SCENARIOS)
+    assert AIRFRAME_NAMES == tuple(AIRFRAMES)
