@@ -143,7 +143,9 @@ BAD = [
     ("order", OK_WORLD + "planner: {order: 3}\n", ["planner.order = 3", "1 or 2"]),
     ("agl-neg", OK_WORLD + "planner: {agl: -10}\n",
      ["planner.agl = -10", "0 < agl <= 5000 m"]),
-    ("agl-bool", OK_WORLD + "planner: {agl: yes}\n", ["planner.agl = True", "wrong type"]),
+    ("agl-bool", OK_WORLD + "planner: {agl: true}\n", ["planner.agl = True", "wrong type"]),
+    # YAML 1.2 core: yes is text, not a boolean (and 5e-1 is a number, below)
+    ("agl-yes", OK_WORLD + "planner: {agl: yes}\n", ["planner.agl = 'yes'", "wrong type"]),
     ("seed", "world: {scenario: open-field, seed: -1}\n", ["world.seed = -1", "0 <= seed"]),
     ("seed-type", "world: {scenario: open-field, seed: 1.5}\n",
      ["world.seed = 1.5", "integer"]),

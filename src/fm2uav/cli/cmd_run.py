@@ -263,8 +263,9 @@ RUN_HELP = (
 
 
 @handle_errors
-@output_options(None, out_help="Output directory. Default: the mission's outputs.dir, else "
-                "out/<mission file name>.")
+@output_options(None, out_help="Output directory. Default: the mission's outputs.dir "
+                "(relative to the mission file), else out/<mission file name> in the current "
+                "folder.")
 @world_options
 @mission_options("via", "return_to_start", "firmware", "vehicle", "frame", "end",
                  "speed_changes", "endurance", "reserve")
@@ -309,7 +310,15 @@ def run_cmd(
     m = load_mission(mission_file, world_overrides=world.overrides(),
                      point_overrides=points or None)
     options = mission.export_options(m.export_options())
-    target = output.out or Path(m.outputs.dir or Path("out") / mission_file.stem)
+    # outputs.dir is relative to the mission file, like every path in it (io/mission.py)
+    target = output.out or m.output_dir() or Path("out") / mission_file.stem
+    notice = None if output.out else m.output_dir_notice()
+    if notice:
+        import warnings
+
+        from ..io.mission import MissionWarning
+
+        warnings.warn(notice, MissionWarning, stacklevel=1)
     formats = list(dict.fromkeys(m.outputs.formats))
     outdir = output.dir(output_names(formats), path=target)
     with output.progress() as step:

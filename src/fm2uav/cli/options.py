@@ -500,7 +500,57 @@ def output_options(out: str | None, *, out_help: str = "Output directory.",
     if report_help is not None:
         params.append(("report", Annotated[bool, typer.Option("--report", help=report_help)],
                        False))
-    return option_group("output", params, Output)
+    group = option_group("output", params, Output)
+
+    def decorate(func: Callable[..., Any]) -> Callable[..., Any]:
+        inner = group(func)
+        labels = _param_labels(inner)
+
+        @functools.wraps(inner)
+        def wrapper(*args: Any, **kwargs: Any) -> Any:
+            from .. import _validate
+
+            # every input the command reads is noted (here: its path arguments, up front;
+            # the readers note theirs), so --force never replaces a folder holding one
+            with _validate.input_log():
+                for key, value in kwargs.items():
+                    if key != "out":
+                        for path, label in _paths_in(value, labels.get(key, key)):
+                            _validate.note_input(path, label)
+                return inner(*args, **kwargs)
+
+        return wrapper
+
+    return decorate
+
+
+def _param_labels(func: Callable[..., Any]) -> dict[str, str]:
+    """Parameter name -> how the user spells it (``--no-fly``, ``MISSION_FILE``)."""
+    out: dict[str, str] = {}
+    for name, p in inspect.signature(func).parameters.items():
+        infos = [p.default, *getattr(p.annotation, "__metadata__", ())]
+        label = "--" + name.replace("_", "-")
+        for info in infos:
+            if isinstance(info, typer.models.ArgumentInfo):
+                label = name.upper()
+            elif isinstance(info, typer.models.OptionInfo):
+                decls = [d for d in (info.param_decls or ()) if d.startswith("--")]
+                if decls:
+                    label = decls[0].split("/")[0]
+        out[name] = label
+    return out
+
+
+def _paths_in(value: Any, label: str) -> list[tuple[Path, str]]:
+    """The paths in a command argument: a Path, a list of them, or a flag group's fields."""
+    if isinstance(value, Path):
+        return [(value, label)]
+    if isinstance(value, (list, tuple)):
+        return [e for v in value for e in _paths_in(v, label)]
+    if hasattr(value, "__dataclass_fields__") and not isinstance(value, type):
+        return [e for f in fields(value)
+                for e in _paths_in(getattr(value, f.name), "--" + f.name.replace("_", "-"))]
+    return []
 
 
 # -- flight safety (issue 13): no-fly zones, AGL limits, saturation in metres ------------------

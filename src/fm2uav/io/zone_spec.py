@@ -42,7 +42,7 @@ from ..errors import InputError
 
 __all__ = ["ZoneSpec", "CircleSpec", "resolve_zones", "zones_from_cli"]
 
-_STRICT = ConfigDict(strict=True, extra="forbid", frozen=True)
+_STRICT = ConfigDict(strict=True, extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 def _base(info: ValidationInfo | None) -> Path | None:
@@ -89,8 +89,13 @@ class ZoneSpec(BaseModel):
         base = _base(info)
         if not p.is_absolute() and base is not None:
             p = base / p
-        if not p.is_file():
+        if not p.exists():
             raise ValueError(f"file not found ({p}); allowed: a GeoJSON/KML/GPKG/SHP file")
+        _validate.note_input(p, "a zone file (no_fly_zones / operating_area)")
+        try:  # no folder, no named pipe (a reader would block on it), readable
+            _validate.input_file(p, "file")
+        except InputError as exc:
+            raise ValueError(str(exc).removeprefix("file ")) from None
         return str(p)
 
     @field_validator("polygon")
