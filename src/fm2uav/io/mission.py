@@ -322,6 +322,16 @@ class AirframeSpec(BaseModel):
                                    desc="flight endurance (battery / fuel)")
     reserve: float = _num(0.2, ge=0, lt=1, desc="share of the endurance kept in reserve")
 
+    @model_validator(mode="after")
+    def _speeds(self) -> AirframeSpec:
+        key = "hover_speed" if self.type == "multirotor" else "cruise_speed"
+        if self.min_speed is not None and self.min_speed > getattr(self, key):
+            raise ValueError(
+                f"min_speed {self.min_speed:g} m/s is above {key} {getattr(self, key):g} m/s, "
+                f"the speed this {self.type.replace('_', '-')} flies the mission at; allowed: "
+                f"min_speed <= {key}")
+        return self
+
 
 class OutputSpec(BaseModel):
     """What to write and where."""
@@ -632,7 +642,7 @@ def _format_error(err: dict[str, Any]) -> str:
     path = "".join(f"[{k}]" if isinstance(k, int) else (("." if i else "") + str(k))
                    for i, k in enumerate(loc)) or "mission"
     info, name = _field_info(loc)
-    allowed = _allowed(info, name) if not any(isinstance(k, int) for k in loc) else ""
+    allowed = _allowed(info, name) if loc and isinstance(loc[-1], str) else ""
     value = err.get("input")
     if typ == "missing":
         return f"{path} is missing; add it" + (f" (allowed: {allowed})" if allowed else "")

@@ -207,7 +207,9 @@ def _fly(raw: np.ndarray, af: Airframe, *, w: Any, speed: float | None,
             af = af.with_speed(speed)
         return af, track_dubins(raw, af, tracking=tracking)
     if speed is not None:
-        raise InputError("speed= applies to fixed-wings; a multirotor flies the W profile")
+        raise InputError(f"speed= (CLI --speed) applies to fixed-wings; the {af.name} is a "
+                         "multirotor, which flies the planned W profile up to its max_speed; "
+                         "remove --speed")
     return af, track_multirotor(raw, af, w=w, tracking=tracking)
 
 
