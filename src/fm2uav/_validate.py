@@ -35,6 +35,7 @@ __all__ = [
     "in_range",
     "optional",
     "integer",
+    "seed_value",
     "choice",
     "flag",
     "point",
@@ -161,6 +162,29 @@ def integer(
         raise InputError(f"{what} must be an integer, got {value!r}{where_text(where)}")
     if minimum is not None and v < minimum:
         raise InputError(f"{what} must be an integer >= {minimum}, got {value!r}{where_text(where)}")
+    return v
+
+
+#: Largest seed (numpy's generators take any integer >= 0; 2**63 - 1 keeps it one int64).
+MAX_SEED = 2**63 - 1
+
+
+def seed_value(value: Any, what: str = "seed", *, where: Where = None) -> int:
+    """``value`` as a random seed: an integer in [0, 2**63 - 1].
+
+    Examples
+    --------
+    >>> seed_value(7)
+    7
+    >>> seed_value(-1, where=("world.seed", "--seed"))
+    Traceback (most recent call last):
+    ...
+    fm2uav.errors.InputError: seed must be an integer in [0, 9223372036854775807], got -1 (mission file: world.seed; CLI: --seed)
+    """
+    v = integer(value, what, where=where)
+    if not 0 <= v <= MAX_SEED:
+        raise InputError(f"{what} must be an integer in [0, {MAX_SEED}], got {value!r}"
+                         f"{where_text(where)}")
     return v
 
 

@@ -80,8 +80,15 @@ def run_and_report(config, out: Path, *, force: bool, scheduler: str | None, wor
     cases are kept, the report is not written).
     """
     from ..errors import InputError
-    from ..experiments.runner import SweepInterrupted, raise_on_signals, same_sweep, sweep_lock
+    from ..experiments.runner import (
+        SweepInterrupted,
+        check_workers,
+        raise_on_signals,
+        same_sweep,
+        sweep_lock,
+    )
 
+    workers = check_workers(workers)  # before anything is written into `out`
     try:
         same = same_sweep(config, out)
     except InputError:  # a damaged config.json: --force starts over
