@@ -135,13 +135,17 @@ def test_cli_sweep_and_resume(tmp_path):
     )
     out = tmp_path / "out"
     runner = CliRunner()
-    r = runner.invoke(app, ["sweep", str(cfg), "--out", str(out), "--workers", "1", "--json"])
+    r = runner.invoke(app, ["sweep", str(cfg), "--out", str(out), "--workers", "1", "--json",
+                            "--report"])
     assert r.exit_code == 0, r.output
     summary = json.loads(r.output)
     assert summary["cases"] == {"run": 4, "resumed": 0, "failed": 0}
     for name in ("tables.md", "heatmap_frechet.png", "heatmap_area.png", "curvature_area.png",
-                 "best_paths_area.png", "results.csv"):
+                 "best_paths_area.png", "results.csv", "report.html"):
         assert (out / name).exists()
+    html = (out / "report.html").read_text(encoding="utf-8")  # --report (README: every command)
+    assert "FM² best area vs Dubins, pair 1" in html and "Dubins references" in html
+    assert "Best (α, β) per metric and model" in html
     assert "Table 3" in (out / "tables.md").read_text()
     kept = {n: (out / n).read_bytes() for n in ("cases.jsonl", "references.npz", "results.csv")}
     r = runner.invoke(app, ["sweep", str(cfg), "--out", str(out), "--workers", "1", "--json"])

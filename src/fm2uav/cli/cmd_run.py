@@ -265,7 +265,8 @@ RUN_HELP = (
 @handle_errors
 @output_options(None, out_help="Output directory. Default: the mission's outputs.dir "
                 "(relative to the mission file), else out/<mission file name> in the current "
-                "folder.")
+                "folder.", report_help="Also write report.html (interactive, self-contained) "
+                "when outputs.formats leaves it out (the default formats include it).")
 @world_options
 @mission_options("via", "return_to_start", "firmware", "vehicle", "frame", "end",
                  "speed_changes", "endurance", "reserve")
@@ -319,7 +320,7 @@ def run_cmd(
         from ..io.mission import MissionWarning
 
         warnings.warn(notice, MissionWarning, stacklevel=1)
-    formats = list(dict.fromkeys(m.outputs.formats))
+    formats = list(dict.fromkeys(m.outputs.formats + (["html"] if output.report else [])))
     outdir = output.dir(output_names(formats), path=target)
     with output.progress() as step:
         step("building the world")
