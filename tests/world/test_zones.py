@@ -123,3 +123,72 @@ def test_surface_clearance_to_a_building_box():
     d = surface_clearance(w, np.array([[10.0, 10.0, 8.0], [15.0, 10.0, 3.0]]))
     assert d[0] == pytest.approx(3.0)          # above the roof
     assert d[1] == pytest.approx(15.0 - 12.5)  # beside the wall (box edge at 12.5)
+
+
+# --------------------------------------------------------- points and zones (issue 25)
+def test_points_in_a_zone_or_outside_the_area_are_bad_input_saying_which(field):
+    from fm2uav.errors import PointError
+
+    nofly = zone_from_mapping({"polygon": [[700, 300], [900, 300], [900, 1000], [700, 1000]],
+                               "buffer": 30, "name": "range"})
+    area = zone_from_mapping({"polygon": [[0, 0], [900, 0], [900, 900], [0, 900]],
+                              "buffer": 50}, inclusion=True)
+    w = with_zones(field, [nofly])
+    with pytest.raises(PointError, match=r"the goal \[800.0, 500.0, 450.0\] m lies in the "
+                       r"no-fly zone 'range' \(inside it\)"):
+        check_points_allowed(w, {"goal": [800.0, 500.0, 450.0]})
+    with pytest.raises(PointError, match=r"'range' \(in its buffer\)"):
+        check_points_allowed(w, {"goal": [680.0, 500.0, 450.0]})
+    a = with_zones(field, [area])
+    with pytest.raises(PointError, match=r"the goal \[1500.0, 1200.0, 450.0\] m is not inside "
+                       r"the operating area .*outside it, 671 m from its edge.*enlarge "
+                       r"operating_area"):
+        check_points_allowed(a, {"goal": [1500.0, 1200.0, 450.0]})
+    with pytest.raises(PointError, match="within its buffer of 50 m from the edge"):
+        check_points_allowed(a, {"start": [880.0, 450.0, 450.0]})
+    check_points_allowed(a, {"start": [450.0, 450.0, 450.0]})  # well inside: fine
+
+
+def test_a_zone_file_wholly_off_the_map_is_warned_about(tmp_path):
+    import json
+    import warnings
+
+    from fm2uav.world.dem import GeodataWarning
+
+    jb = get_scenario("jacksboro").world
+    far = [[-80.6, 36.25], [-80.55, 36.25], [-80.55, 36.3], [-80.6, 36.25]]
+    p = tmp_path / "far.geojson"
+    p.write_text(json.dumps({"type": "FeatureCollection", "features": [
+        {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon",
+                                                           "coordinates": [far]}}]}))
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        zs = read_zones(str(p), jb)
+    msgs = [str(r.message) for r in rec if issubclass(r.category, GeodataWarning)]
+    assert len(zs) == 1 and len(msgs) == 1
+    assert "its zone lies off the map" in msgs[0] and "km from its edge" in msgs[0]
+
+
+def test_a_zone_file_with_lat_lon_swapped_is_refused_with_the_fix(tmp_path):
+    import json
+
+    jb = get_scenario("jacksboro").world
+    ring = [[36.55, -84.30], [36.55, -84.25], [36.60, -84.25], [36.55, -84.30]]  # [lat, lon]
+    p = tmp_path / "swapped.geojson"
+    p.write_text(json.dumps({"type": "FeatureCollection", "features": [
+        {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon",
+                                                           "coordinates": [ring]}}] * 2}))
+    with pytest.raises(InputError, match=r"all of its 2 zones lie off the map, but with "
+                       r"longitude and latitude swapped they would lie on it.*\[lat, lon\].*"
+                       r"swap the two coordinates"):
+        read_zones(str(p), jb)
+    # the same swap in an inline lon/lat zone of a mission file
+    from fm2uav.io.zone_spec import ZoneSpec, resolve_zones
+
+    spec = ZoneSpec(polygon=ring, lonlat=True)
+    with pytest.raises(InputError, match=r"^no_fly_zones\[0\] lies off the map, but with "
+                       "longitude and latitude swapped"):
+        resolve_zones([spec], None, jb)
+    # written the right way round it is on the map: no error, no warning
+    ok = ZoneSpec(polygon=[[b, a] for a, b in ring], lonlat=True)
+    assert len(resolve_zones([ok], None, jb)) == 1

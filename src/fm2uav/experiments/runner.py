@@ -281,8 +281,10 @@ def load_config(path: str | os.PathLike[str]) -> SweepConfig:
 
     p = Path(path)
     data = _validate.load_yaml(p, "sweep configuration")
-    if data is None:
-        data = {}
+    if data is None:  # an empty file is a mistake (a failed copy), not "the defaults"
+        raise InputError(f"sweep configuration {p} is empty; write the settings (e.g. pairs: 4, "
+                         "alpha: {start: 0.1, stop: 1, step: 0.1}), or {} for the seed's full "
+                         "sweep of 60 000 cases")
     if not isinstance(data, dict):
         raise InputError(f"{p} must hold a YAML mapping of sweep settings (scenario:, pairs:, "
                          f"alpha:, ...), got {type(data).__name__}")

@@ -144,6 +144,14 @@ def read_path_csv(file: str | Path) -> np.ndarray:
         if len(idx) < 2:
             raise InputError(f"path file {file} has 1 column; a path needs x,y[,z] in metres")
     else:
+        known = {a for al in _NAMES.values() for a in al} | set(_KNOWN)
+        unknown = [c for c in names if c not in known]
+        geo = {"lon", "lat", "longitude", "latitude"} & set(unknown)
+        if geo:
+            raise InputError(
+                f"path file {file}: the header has {', '.join(sorted(geo))} ({', '.join(names)}), "
+                "but a path is read in world metres (x_m, y_m[, z_m]), as fm2uav writes it; "
+                f"unknown column {sorted(geo)[0]!r} — lon/lat degrees are not read")
         idx, labels = [], []
         for axis, aliases in _NAMES.items():
             col = next((names.index(a) for a in aliases if a in names), None)
@@ -155,14 +163,10 @@ def read_path_csv(file: str | Path) -> np.ndarray:
             if col is not None:
                 idx.append(col)
                 labels.append(names[col])
-        known = {a for al in _NAMES.values() for a in al} | set(_KNOWN)
-        unknown = [c for c in names if c not in known]
         if unknown:
-            hint = (" (lon/lat degrees are not read: give world metres, as fm2uav writes "
-                    "them)" if {"lon", "lat", "longitude", "latitude"} & set(unknown) else "")
             raise InputError(
                 f"path file {file}: unknown column {unknown[0]!r} in the header "
-                f"({', '.join(names)}){hint}; allowed: x_m, y_m, z_m (or x, y, z), speed, "
+                f"({', '.join(names)}); allowed: x_m, y_m, z_m (or x, y, z), speed, "
                 "floor_agl_m")
     if len(rows) < 2:
         raise InputError(f"path file {file} needs at least 2 points, got {len(rows)}")

@@ -106,6 +106,20 @@ def _num(default: Any = None, *, unit: str = "", desc: str = "", **bounds: float
 MAX_ASPECT = 1000.0
 
 
+def _not_there(path: Path, allowed: str) -> str:
+    """The message of a missing data file (a dangling symbolic link named as such)."""
+    import os
+
+    from .._validate import cwd_gone, missing
+
+    v = cwd_gone(path)
+    if v:
+        return v
+    if os.path.islink(path):
+        return f"{path} {missing(path)}; allowed: {allowed}"
+    return f"file not found ({path}); allowed: {allowed}"
+
+
 def _regular_file(path: Path, key: str) -> None:
     """A directory, named pipe or unreadable file as a ValueError (pydantic) — never a hang.
 
@@ -168,8 +182,8 @@ class WorldSpec(BaseModel):
         for item in items:
             path = _resolve(item, info)
             if not path.exists():
-                raise ValueError(f"file not found ({path}); allowed: an existing raster file "
-                                 "(GeoTIFF, VRT, .hgt, ...)")
+                raise ValueError(_not_there(path, "an existing raster file (GeoTIFF, VRT, "
+                                            ".hgt, ...)"))
             _regular_file(path, "world.dem")
             try:
                 import rasterio
@@ -194,8 +208,8 @@ class WorldSpec(BaseModel):
             return v
         path = _resolve(v, info)
         if not path.exists():
-            raise ValueError(f"file not found ({path}); allowed: an existing vector file "
-                             "(GeoJSON, GeoPackage, Shapefile, KML/KMZ)")
+            raise ValueError(_not_there(path, "an existing vector file (GeoJSON, GeoPackage, "
+                                        "Shapefile, KML/KMZ)"))
         _regular_file(path, "world.buildings")
         return str(path)
 

@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import shapely
+import shapely.validation
 from shapely.geometry import Point, Polygon
 from shapely.geometry.base import BaseGeometry
 
@@ -124,11 +125,22 @@ class Zone:
         if g.is_empty:
             raise InputError(f"{where}: the polygon is empty")
         if not g.is_valid:
+            import warnings
+
+            from .dem import GeodataWarning
+
+            why = shapely.validation.explain_validity(g)
             g = shapely.make_valid(g)
             polys = [p for p in getattr(g, "geoms", [g]) if p.geom_type == "Polygon"]
             if not polys:
-                raise InputError(f"{where}: the polygon is invalid and cannot be repaired")
+                raise InputError(f"{where}: the polygon is invalid ({why}) and cannot be "
+                                 "repaired; fix its outline")
             g = shapely.MultiPolygon(polys) if len(polys) > 1 else polys[0]
+            warnings.warn(GeodataWarning(
+                f"{where}: the polygon is invalid ({why}); it was repaired into "
+                f"{len(polys)} part{'s' if len(polys) > 1 else ''} of {g.area:.0f} m² in all "
+                "(the areas its outline encloses) — check that this is the zone meant"),
+                stacklevel=2)
         if g.area <= 0:
             raise InputError(f"{where}: the polygon has no area")
         object.__setattr__(self, "geometry", g)
