@@ -220,6 +220,9 @@ CASES = [
     (["check", "{tmp}/loop.csv"], "a loop of links"),
     (["export", "{tmp}/lonlat.csv", "--scenario", "open-field"], "lon/lat degrees"),
     (["export", "{tmp}/ragged.csv", "--scenario", "open-field"], "line 3"),
+    # ---- output folders
+    (["plan", "--out", "{tmp}/path.csv/sub"], "path.csv is a file, not a folder"),
+    (["plan", "--out", "/"], "is the root of the file system"),
     # ---- sizes refused up front with what they would need
     (["sweep", "{tmp}/sweep_huge.yaml"], "the sweep would have 1e+17 cases (1000 pairs x "
      "10000000 alpha x 10000000 beta values)"),

@@ -543,12 +543,30 @@ def test_a_deleted_current_folder_says_so(tmp_path):
     and the message says why (not "file not found"); absolute paths still do."""
     gone = tmp_path / "gone"
     gone.mkdir()
-    code = ("import os, sys; os.chdir(sys.argv[1]); os.rmdir(sys.argv[1]); "
-            "from fm2uav.cli import app; app(sys.argv[2:])")
-    for args in (["run", "m.yaml"], ["plan", "--out", "o", "--quiet"]):
-        gone.mkdir(exist_ok=True)
-        r = subprocess.run([sys.executable, "-c", code, str(gone), *args],
-                           capture_output=True, text=True, timeout=120)
-        assert r.returncode == 2, r.stderr
-        assert "the current folder no longer exists" in r.stderr and "cd " in r.stderr
-        assert "Traceback" not in r.stderr and r.stderr.count("\n") == 1
+    code = textwrap.dedent("""
+        import os, sys
+        os.chdir(sys.argv[1]); os.rmdir(sys.argv[1])
+        from fm2uav.cli import app
+        for args in (["run", "m.yaml"], ["plan", "--out", "o", "--quiet"]):
+            try:
+                app(args)
+            except SystemExit as exc:
+                print(exc.code, file=sys.stderr)
+    """)
+    r = subprocess.run([sys.executable, "-c", code, str(gone)], capture_output=True, text=True,
+                       timeout=300)
+    lines = r.stderr.splitlines()
+    assert len(lines) == 4 and lines[1] == lines[3] == "2", r.stderr
+    for line in (lines[0], lines[2]):
+        assert "the current folder no longer exists" in line and "cd " in line, r.stderr
+    assert "Traceback" not in r.stderr
+
+
+def test_a_tilde_out_is_the_home_folder_not_a_folder_named_tilde(tmp_path, monkeypatch):
+    """"~/out" given in quotes (or from outputs.dir) means the home folder, as in a shell."""
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    monkeypatch.chdir(tmp_path)
+    res = runner.invoke(app, ["plan", "--out", "~/plans/a", "--quiet"])
+    assert res.exit_code == 0, res.output
+    assert (tmp_path / "home" / "plans" / "a" / "path.csv").exists()
+    assert not (tmp_path / "~").exists()

@@ -269,14 +269,29 @@ class OutputDir:
     def __init__(self, path: str | os.PathLike[str], *, force: bool = False,
                  merge: bool = False, inputs: Iterable[Any] = (),
                  owned: Iterable[str] = ()) -> None:
+        if str(path).strip() == "":
+            raise InputError("--out is empty; give the folder to write into (e.g. --out "
+                             "out/mission)")
+        path = os.path.expanduser(path)  # "~/out" in quotes, or a mission's outputs.dir
         gone = _validate.cwd_gone(path)
         if gone:
             raise InputError(f"--out {path}: {gone}")
         #: The folder as given (messages, :attr:`written`).
         self.given = Path(path)
-        #: The folder written: the given one, or the folder a symbolic link points to.
+        #: The folder written: the given one, or the folder a symbolic link points to
+        #: (``.`` and ``..`` by their absolute name: the set is staged beside the folder).
         self.path = (Path(os.path.realpath(self.given)) if os.path.islink(self.given)
+                     else Path(os.path.abspath(self.given)) if self.given.name in ("", "..")
                      else self.given)
+        if self.path.name == "":
+            raise InputError(f"--out {self.given} is the root of the file system; give a "
+                             "dedicated folder (e.g. --out out/mission)")
+        for parent in self.path.parents:  # a file where a folder of the path should be
+            if parent.exists() or os.path.islink(parent):
+                if not parent.is_dir():
+                    raise InputError(f"--out {self.given}: {parent} is a file, not a folder; "
+                                     "choose another --out")
+                break
         self.force = force
         self.merge = merge
         self.inputs: list[tuple[Path, str]] = [
