@@ -175,8 +175,7 @@ def formation_cmd(
     from ..viz.formation import check_frames
     from .cmd_run import write_exports
 
-    if gif:
-        check_frames(frames)
+    check_frames(frames)  # also with --no-gif: a given value is never silently garbage
     if not 1 <= followers <= MAX_FOLLOWERS:  # before a name per follower is made
         FormationConfig(n_followers=followers)  # raises the one-line error naming --followers
     w, sc, scenario = world.build(scenario, start, goal, seed=seed, lonlat=lonlat, agl=agl,

@@ -484,7 +484,8 @@ def mission_options(*names: str) -> Callable[[Callable[..., Any]], Callable[...,
 
 
 def output_options(out: str | None, *, out_help: str = "Output directory.",
-                   force_help: str = "Overwrite existing outputs.",
+                   force_help: str = "Replace an existing --out folder as a whole (never "
+                                     "one that holds an input of the command).",
                    json_help: str = "Print the summary as JSON.",
                    report_help: str | None = None
                    ) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
@@ -613,9 +614,12 @@ class SafetyFlags:
             One line naming ``--max-agl`` / ``--min-agl`` when ``agl`` is outside the limits.
         """
         limits = self.limits(agl)
-        if agl is None:
-            return None
         from ..planning import FlightLevel
+
+        if agl is None:
+            if keys:  # unused without --agl, but never silently garbage (--p1 nan)
+                FlightLevel(agl=1.0, **keys)
+            return None
 
         return FlightLevel(agl=agl, **keys, **limits)
 
