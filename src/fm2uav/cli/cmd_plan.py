@@ -247,7 +247,7 @@ def _extra_formats(export: str, report: bool) -> list[str]:
 
 
 def _export_options(anchor: str | None, thin: float):
-    from ..io import ExportOptions
+    from ..autopilot import ExportOptions
 
     if not (np.isfinite(thin) and 0 <= thin <= 1000):
         raise InputError(f"--thin must be a tolerance in [0, 1000] m (mission file: "
