@@ -153,7 +153,7 @@ def test_a_zone_file_wholly_off_the_map_is_warned_about(tmp_path):
     import json
     import warnings
 
-    from fm2uav.world.dem import GeodataWarning
+    from fm2uav.world.zones import ZoneWarning
 
     jb = get_scenario("jacksboro").world
     far = [[-80.6, 36.25], [-80.55, 36.25], [-80.55, 36.3], [-80.6, 36.25]]
@@ -164,7 +164,7 @@ def test_a_zone_file_wholly_off_the_map_is_warned_about(tmp_path):
     with warnings.catch_warnings(record=True) as rec:
         warnings.simplefilter("always")
         zs = read_zones(str(p), jb)
-    msgs = [str(r.message) for r in rec if issubclass(r.category, GeodataWarning)]
+    msgs = [str(r.message) for r in rec if issubclass(r.category, ZoneWarning)]
     assert len(zs) == 1 and len(msgs) == 1
     assert "its zone lies off the map" in msgs[0] and "km from its edge" in msgs[0]
 
@@ -192,3 +192,17 @@ def test_a_zone_file_with_lat_lon_swapped_is_refused_with_the_fix(tmp_path):
     # written the right way round it is on the map: no error, no warning
     ok = ZoneSpec(polygon=[[b, a] for a, b in ring], lonlat=True)
     assert len(resolve_zones([ok], None, jb)) == 1
+
+
+def test_a_self_intersecting_zone_is_repaired_with_a_warning():
+    import warnings
+
+    from fm2uav.world.zones import ZoneWarning
+
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        z = zone_from_mapping({"polygon": [[0, 0], [100, 100], [100, 0], [0, 100]],
+                               "name": "bow tie"})
+    msgs = [str(r.message) for r in rec if issubclass(r.category, ZoneWarning)]
+    assert len(msgs) == 1 and "Self-intersection" in msgs[0] and "2 parts" in msgs[0]
+    assert z.geometry.geom_type == "MultiPolygon" and abs(z.geometry.area - 5000) < 1e-6

@@ -82,6 +82,11 @@ def _num(value: Any, what: str, where: str, *, minimum: float | None = None,
     return v
 
 
+class ZoneWarning(UserWarning):
+    """A zone that changes nothing or not what it says: wholly off the map, or a polygon
+    crossing itself that was repaired (shown by the CLI as one ``warning:`` line)."""
+
+
 @dataclass(frozen=True, eq=False)
 class Zone:
     """A no-fly zone (or, with ``inclusion=True``, the operating area).
@@ -127,8 +132,6 @@ class Zone:
         if not g.is_valid:
             import warnings
 
-            from .dem import GeodataWarning
-
             why = shapely.validation.explain_validity(g)
             g = shapely.make_valid(g)
             polys = [p for p in getattr(g, "geoms", [g]) if p.geom_type == "Polygon"]
@@ -136,7 +139,7 @@ class Zone:
                 raise InputError(f"{where}: the polygon is invalid ({why}) and cannot be "
                                  "repaired; fix its outline")
             g = shapely.MultiPolygon(polys) if len(polys) > 1 else polys[0]
-            warnings.warn(GeodataWarning(
+            warnings.warn(ZoneWarning(
                 f"{where}: the polygon is invalid ({why}); it was repaired into "
                 f"{len(polys)} part{'s' if len(polys) > 1 else ''} of {g.area:.0f} m² in all "
                 "(the areas its outline encloses) — check that this is the zone meant"),
@@ -658,8 +661,7 @@ def check_zones_on_map(zones: Sequence[Zone], world: World, label: str, *,
     detected: when the bounds with longitude and latitude exchanged meet the map, the
     zones are refused (InputError, the fix named). ``label`` names the file (or, with
     ``inline``, the mission-file entry of one zone). Otherwise a
-    :class:`~fm2uav.world.dem.GeodataWarning` names the file and how far its nearest
-    zone is.
+    :class:`ZoneWarning` names the file and how far its nearest zone is.
 
     Raises
     ------
@@ -667,8 +669,6 @@ def check_zones_on_map(zones: Sequence[Zone], world: World, label: str, *,
         The coordinates are ``[lat, lon]`` (swapped).
     """
     import warnings
-
-    from .dem import GeodataWarning
 
     if not zones:
         return
@@ -705,10 +705,10 @@ def check_zones_on_map(zones: Sequence[Zone], world: World, label: str, *,
                 "mission files write [lon, lat] — swap the two coordinates")
     near = min((float(rect.distance(g)) for g in shapes), default=float("inf"))
     dist = f"the nearest is {near / 1000:.1f} km from its edge" if np.isfinite(near) else         "its coordinates fall outside the map's coordinate system"
-    warnings.warn(GeodataWarning(
+    warnings.warn(ZoneWarning(
         f"{off} ({dist}), so {'it changes' if n == 1 else 'they change'} nothing in "
         "this plan; check that it is the file meant for this area and that its coordinates "
         "are [lon, lat] (or give its CRS)"), stacklevel=2)
 
 
-__all__ += ["ZoneViolation", "check_points_allowed", "check_zones_on_map"]
+__all__ += ["ZoneViolation", "check_points_allowed", "check_zones_on_map", "ZoneWarning"]
