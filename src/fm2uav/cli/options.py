@@ -496,7 +496,8 @@ def output_options(out: str | None, *, out_help: str = "Output directory.",
 
     params = [
         ("out", Annotated[Path | None if out is None else Path,
-                          typer.Option(help=out_help)], None if out is None else Path(out)),
+                          typer.Option(help=out_help, readable=False)],
+         None if out is None else Path(out)),
         ("force", Annotated[bool, typer.Option("--force", help=force_help)], False),
         ("as_json", Annotated[bool, typer.Option("--json", help=json_help)], False),
         ("quiet", Annotated[bool, typer.Option("--quiet", help="Print nothing but errors.")],
@@ -510,6 +511,7 @@ def output_options(out: str | None, *, out_help: str = "Output directory.",
     def decorate(func: Callable[..., Any]) -> Callable[..., Any]:
         inner = group(func)
         labels = _param_labels(inner)
+        _own_path_checks(inner)
 
         @functools.wraps(inner)
         def wrapper(*args: Any, **kwargs: Any) -> Any:
@@ -527,6 +529,21 @@ def output_options(out: str | None, *, out_help: str = "Output directory.",
         return wrapper
 
     return decorate
+
+
+def _own_path_checks(func: Callable[..., Any]) -> None:
+    """Let fm2uav, not click, check the command's path parameters.
+
+    click's ``Path(readable=True)`` refuses an unreadable file with a usage box of
+    several lines; fm2uav's readers (:func:`fm2uav._validate.input_file`) refuse it
+    with one line naming the flag and the fix, as they do a folder or a named pipe.
+    """
+    for p in inspect.signature(func).parameters.values():
+        if "Path" not in str(p.annotation):
+            continue
+        for info in (p.default, *getattr(p.annotation, "__metadata__", ())):
+            if isinstance(info, (typer.models.ArgumentInfo, typer.models.OptionInfo)):
+                info.readable = False
 
 
 def _param_labels(func: Callable[..., Any]) -> dict[str, str]:
