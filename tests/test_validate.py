@@ -84,3 +84,23 @@ def test_a_deleted_current_folder_is_named_for_relative_paths(in_deleted_folder)
 def test_seed_value_refuses_what_numpy_cannot_seed(value):
     with pytest.raises(InputError, match="seed"):
         v.seed_value(value, where=(None, "--seed"))
+
+
+def _laughs(levels: int, width: int = 9) -> str:
+    lines = ['a0: &a0 [' + ", ".join(['"lol"'] * width) + ']']
+    lines += [f"a{i}: &a{i} [" + ", ".join([f"*a{i - 1}"] * width) + "]"
+              for i in range(1, levels)]
+    return "\n".join(lines) + "\n"
+
+
+def test_a_billion_laughs_file_is_refused_before_anything_walks_it():
+    with pytest.raises(InputError, match=r"expands to 4.41e\+09 values through its aliases"):
+        v.load_yaml(_laughs(10), "mission", source="bomb.yaml")
+    small = v.load_yaml(_laughs(3, 3), "mission", source="ok.yaml")  # a few aliases: fine
+    assert small["a2"] == [[["lol"] * 3] * 3] * 3
+
+
+@pytest.mark.parametrize("text", ["a: &x [1, *x]\n", "a: &x {b: *x}\n"])
+def test_a_document_that_contains_itself_is_refused(text):
+    with pytest.raises(InputError, match="refers to itself through an alias"):
+        v.load_yaml(text, "mission", source="loop.yaml")

@@ -445,6 +445,41 @@ def read_text(path: Any, what: str, *, where: Where = None) -> str:
 _YAML_LOADER: Any = None
 
 
+#: Most values a YAML document may hold once its aliases are expanded (a mission file has
+#: a few hundred; a "billion laughs" file nests aliases to blow up whoever walks it).
+MAX_YAML_VALUES = 1_000_000
+
+
+def _expanded_size(root: Any) -> float:
+    """How many scalars and collections ``root`` (a composed YAML node) holds with every
+    alias expanded, counted in linear time over the node graph (aliases are shared nodes)."""
+    import yaml
+
+    def kids(node: Any) -> list[Any]:
+        if isinstance(node, yaml.SequenceNode):
+            return list(node.value)
+        if isinstance(node, yaml.MappingNode):
+            return [v for kv in node.value for v in kv]
+        return []
+
+    memo: dict[int, float] = {}
+    opened: set[int] = set()
+    stack: list[tuple[Any, bool]] = [(root, False)]
+    while stack:  # post-order without recursion (a deep file must not exhaust the stack)
+        node, done = stack.pop()
+        if id(node) in memo:
+            continue
+        if done:  # every child is counted by now
+            memo[id(node)] = 1.0 + sum(memo[id(k)] for k in kids(node))
+            continue
+        if id(node) in opened:  # met again inside itself: an alias to its own anchor
+            return float("inf")
+        opened.add(id(node))
+        stack.append((node, True))
+        stack.extend((k, False) for k in kids(node) if id(k) not in memo)
+    return memo[id(root)]
+
+
 def _yaml_int(loader: Any, node: Any) -> int:
     text = loader.construct_scalar(node)
     return int(text, 0) if text.startswith(("0x", "0o")) else int(text, 10)
@@ -550,7 +585,23 @@ def load_yaml(text_or_path: Any, what: str, *, where: Where = None, source: str 
     else:
         text = str(text_or_path)
     try:
-        return yaml.load(text, Loader=_unique_key_loader())  # noqa: S506 (SafeLoader subclass)
+        loader = _unique_key_loader()(text)
+        try:
+            node = loader.get_single_node()
+            if node is None:
+                return None
+            n = _expanded_size(node)
+            if n > MAX_YAML_VALUES:
+                raise InputError(
+                    f"{_named(what, source)}: the document refers to itself through an alias "
+                    f"(*name inside its own &name); write the values out{where_text(where)}"
+                    if n == float("inf") else
+                    f"{_named(what, source)}: the document expands to {n:.3g} values through "
+                    f"its aliases (*name), more than {MAX_YAML_VALUES:,} (a \"billion laughs\" "
+                    f"file); write the values out or use fewer aliases{where_text(where)}")
+            return loader.construct_document(node)
+        finally:
+            loader.dispose()
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         at = f", at line {mark.line + 1}, column {mark.column + 1}" if mark else ""

@@ -655,7 +655,7 @@ def _format_error(err: dict[str, Any]) -> str:
             for cand in (parent_info.annotation, *getattr(parent_info.annotation, "__args__", ())):
                 if isinstance(cand, type) and issubclass(cand, BaseModel):
                     model = cand
-        keys = ", ".join(model.model_fields)
+        keys = ", ".join(f.alias or k for k, f in model.model_fields.items())
         return f"{path} is not a known field; allowed fields here: {keys}"
     if typ in ("greater_than", "greater_than_equal", "less_than", "less_than_equal"):
         return f"{path} = {_show(value)} is out of range; allowed: {allowed}"
