@@ -75,6 +75,11 @@ def _files_25(tmp):
         "sweep_dup.yaml": "pairs: 2\npairs: 3\n",
         "sweep_cell.yaml": "cell: 0.01\n",
         "sweep_list.yaml": "- pairs\n",
+        "swapped_start.yaml": JACKSBORO + "start: {lon: 36.53435, lat: -84.36016, agl: 300}\n"
+                              "goal: {lon: -84.12133, lat: 36.65048, agl: 300}\n",
+        "laughs.yaml": "a0: &a0 [1, 1, 1, 1, 1, 1, 1, 1, 1, 1]\n" + "".join(
+            f"a{i}: &a{i} [{', '.join([f'*a{i - 1}'] * 10)}]\n" for i in range(1, 9)),
+        "self_alias.yaml": OPEN + "via: &v [*v]\n",
         "lonlat.csv": "lon,lat,alt\n-3.70,40.30,100\n-3.69,40.31,100\n",
         "unknown_col.csv": "x_m,y_m,z_m,heading\n0,0,100,1\n100,0,100,2\n",
         "no_y.csv": "x_m,north,z_m\n0,0,100\n100,0,100\n",
@@ -220,6 +225,12 @@ CASES = [
     (["check", "{tmp}/loop.csv"], "a loop of links"),
     (["export", "{tmp}/lonlat.csv", "--scenario", "open-field"], "lon/lat degrees"),
     (["export", "{tmp}/ragged.csv", "--scenario", "open-field"], "line 3"),
+    (["plan", "--scenario", "jacksboro", "--lonlat", "--start", "36.53435,-84.36016,300",
+      "--goal", "-84.12133,36.65048,300"], "lon and lat look swapped: lon -84.3602, lat 36.5344"),
+    (["run", "{tmp}/swapped_start.yaml"], "lon and lat look swapped"),
+    (["run", "{tmp}/laughs.yaml"], "billion laughs"),
+    (["run", "{tmp}/self_alias.yaml"], "refers to itself through an alias"),
+    (["sweep", "{tmp}/laughs.yaml"], "billion laughs"),
     # ---- output folders
     (["plan", "--out", "{tmp}/path.csv/sub"], "path.csv is a file, not a folder"),
     (["plan", "--out", "/"], "is the root of the file system"),

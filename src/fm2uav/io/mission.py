@@ -547,8 +547,24 @@ def _resolve_point(p: PointSpec, world: Any, anchor: Anchor, what: str) -> np.nd
         raise InputError(
             f"{what} = ({point[0]:.1f}, {point[1]:.1f}, {point[2]:.1f}) m{where} lies outside "
             f"the map; allowed: x in [{b[0, 0]:.1f}, {b[0, 1]:.1f}], y in [{b[1, 0]:.1f}, "
-            f"{b[1, 1]:.1f}], z in [{b[2, 0]:.1f}, {b[2, 1]:.1f}] m")
+            f"{b[1, 1]:.1f}], z in [{b[2, 0]:.1f}, {b[2, 1]:.1f}] m{_swap_hint(p, world, anchor)}")
     return point
+
+
+def _swap_hint(p: PointSpec, world: Any, anchor: Anchor) -> str:
+    """``"; lon and lat look swapped ..."`` when the lon/lat point ``p`` lies off the map but
+    would lie on it with its two coordinates exchanged, else ``""``."""
+    if p.lon is None or not (abs(p.lat) <= 180 and abs(p.lon) <= 90):
+        return ""
+    try:
+        xy = from_lonlat(world, [[p.lat, p.lon]], anchor=anchor)[0]
+    except Exception:  # noqa: BLE001 - a transform that fails is no hint
+        return ""
+    b = world.bounds
+    if b[0, 0] <= xy[0] <= b[0, 1] and b[1, 0] <= xy[1] <= b[1, 1]:
+        return (f"; lon and lat look swapped: lon {p.lat:g}, lat {p.lon:g} lies on the map "
+                "(write {lon: .., lat: ..} / LON,LAT)")
+    return ""
 
 
 def resolve_point(p: PointSpec, world: Any, anchor: Anchor | None = None,
