@@ -491,7 +491,14 @@ def output_options(out: str | None, *, out_help: str = "Output directory.",
                    ) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
     """``@output_options("out/plan", ...)``: ``--out``, ``--force``, ``--json``, ``--quiet``
     (and ``--report`` with ``report_help``) in place of the command's ``output`` parameter,
-    passed as one :class:`~fm2uav.cli._common.Output`."""
+    passed as one :class:`~fm2uav.cli._common.Output`.
+
+    The command runs inside an :func:`fm2uav._validate.input_log` in which its path
+    arguments (``MISSION_FILE``, ``--dem``, ``--no-fly``, ...) are noted up front and
+    every file reader notes its file: the command's output sets refuse an ``--out``
+    that holds one of them (:class:`~fm2uav.io.outdir.OutputDir`). Its path parameters
+    are checked by fm2uav's readers (one line), not by click (:func:`_own_path_checks`).
+    """
     from ._common import Output
 
     params = [

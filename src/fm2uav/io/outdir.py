@@ -341,20 +341,22 @@ class OutputDir:
         merged set (``merge``) only replaces the files of ``names`` (and ``owned``).
         """
         if self.merge:
-            doomed = {_real(self.path / n) for n in (*names, *self._owned,
-                                                     *(os.path.relpath(w, self.given) for w in self.written))}
+            written = (os.path.relpath(w, self.given) for w in self.written)
+            doomed = {_real(self.path / n) for n in (*names, *self._owned, *written)}
         for path, what in self._all_inputs():
             if self.merge:
                 hit = bool(_spellings(path) & doomed)
             else:
                 hit = any(_under(q, _real(self.path)) for q in _spellings(path))
-            if hit:
-                verb = "is" if _real(path) == _real(self.path) else "holds"
-                raise InputError(
-                    f"--out {self.given} {verb} an input of this command: {path} ({what}); "
-                    "the output set replaces the folder as a whole (with --force), which would "
-                    "delete it — choose another --out (a new folder) or move the input out of "
-                    f"{self.given}")
+            if not hit:
+                continue
+            verb = "is" if _real(path) == _real(self.path) else "holds"
+            why = ("an output of the same name would replace it" if self.merge else
+                   "the output set replaces the folder as a whole (with --force), which would "
+                   "delete it")
+            raise InputError(
+                f"--out {self.given} {verb} an input of this command: {path} ({what}); {why} "
+                f"— choose another --out (a new folder) or move the input out of {self.given}")
 
     def _relative(self) -> Path:
         assert self.parent_set is not None
