@@ -251,6 +251,8 @@ CASES = [
     (["reproduce", "curvature", "--pairs", "0"], "pairs must be at least 1"),
     (["reproduce", "tracking", "--workers", "-3"], "--workers"),
     (["formation", "--followers", "1000000", "--no-gif"], "the limit is 50 followers"),
+    (["tune", "--p2", ",".join(f"{0.6 + k / 1000:g}" for k in range(1000))],
+     "the tuning grid has 3000 combinations (3 p1 x 1000 p2"),
     (["formation", "--frames", "1000000000"], "the limit is 1000 frames"),
     # ---- seeds, unused-but-given flags, airframe speeds
     (["plan", "--seed", "-1"], "seed must be an integer in [0, 9223372036854775807]"),

@@ -34,13 +34,18 @@ SLOW = textwrap.dedent("""
 
     @app.command()
     @handle_errors
-    def main(out: str, n: int = 6, pause: float = 0.3, force: bool = False) -> None:
+    def main(out: str, n: int = 6, pause: float = 0.3, force: bool = False,
+             hold: str = "") -> None:
+        import os
+
         od = OutputDir(out, force=force)
         od.check([f"f{i}.txt" for i in range(n)])
         for i in range(n):
             with od.open(f"f{i}.txt") as fh:
                 fh.write(f"new {i}\\n")
             print(f"wrote {i}", flush=True)
+            while hold and not os.path.exists(hold):  # until the test lets it go on
+                time.sleep(0.05)
             time.sleep(pause)
 
     app()
@@ -115,11 +120,14 @@ def test_killed_run_leftovers_are_cleaned_by_the_next_run(tmp_path):
 def test_two_concurrent_runs_one_is_refused(tmp_path):
     out = tmp_path / "out"
     script = _slow(tmp_path)
-    first = _spawn(script, out, "--n", "4", "--pause", "1.5")  # ~6 s: the second starts
+    go = tmp_path / "go"
+    # the first run holds the folder until the second has tried (however slow its start-up)
+    first = _spawn(script, out, "--n", "4", "--pause", "0", "--hold", str(go))
     assert first.stdout.readline().startswith("wrote 0")
     second = _spawn(script, out, "--n", "4", "--force", "--pause", "0")
-    _, err2 = second.communicate(timeout=60)
-    _, err1 = first.communicate(timeout=60)
+    _, err2 = second.communicate(timeout=300)
+    go.write_text("")
+    _, err1 = first.communicate(timeout=300)
     assert first.returncode == 0, err1
     assert second.returncode == 2, err2
     assert "being written by another fm2uav run" in err2 and "--out" in err2
