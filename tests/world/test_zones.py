@@ -206,3 +206,28 @@ def test_a_self_intersecting_zone_is_repaired_with_a_warning():
     msgs = [str(r.message) for r in rec if issubclass(r.category, ZoneWarning)]
     assert len(msgs) == 1 and "Self-intersection" in msgs[0] and "2 parts" in msgs[0]
     assert z.geometry.geom_type == "MultiPolygon" and abs(z.geometry.area - 5000) < 1e-6
+
+
+def test_an_inline_zone_off_the_map_names_the_map_in_its_own_units():
+    """A mission-file entry is no file and may be in metres: the warning says in which units
+    the map lies (metres for lonlat: false, lon/lat degrees for lonlat: true)."""
+    import warnings
+
+    from fm2uav.io.zone_spec import ZoneSpec, resolve_zones
+    from fm2uav.world.zones import ZoneWarning
+
+    jb = get_scenario("jacksboro").world
+    b = np.asarray(jb.bounds)
+    far_m = ZoneSpec(polygon=[[b[0, 1] + 5e4, 0], [b[0, 1] + 6e4, 0], [b[0, 1] + 6e4, 1e4]])
+    far_ll = ZoneSpec(polygon=[[-80.6, 36.25], [-80.55, 36.25], [-80.55, 36.3]], lonlat=True)
+    msgs = []
+    for spec in (far_m, far_ll):
+        with warnings.catch_warnings(record=True) as rec:
+            warnings.simplefilter("always")
+            assert len(resolve_zones([spec], None, jb)) == 1
+        msgs += [str(r.message) for r in rec if issubclass(r.category, ZoneWarning)]
+    assert len(msgs) == 2 and all(m.startswith("no_fly_zones[0] lies off the map") for m in msgs)
+    assert f"world metres (lonlat: false) and the map covers x {b[0, 0]:.0f}..{b[0, 1]:.0f} m" \
+        in msgs[0] and "file" not in msgs[0]
+    assert "check its [lon, lat] coordinates: the map covers lon -84." in msgs[1]
+    assert "file" not in msgs[1]

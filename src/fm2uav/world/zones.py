@@ -686,6 +686,7 @@ def check_zones_on_map(zones: Sequence[Zone], world: World, label: str, *,
     off = (f"{label} lies off the map" if inline else
            f"{label}: its {kind} lies off the map" if n == 1 else
            f"{label}: all of its {n} {kind}s lie off the map")
+    covers = ""  # the map's lon/lat extent, when the zones were given in lon/lat
     if lonlat_bounds is not None and len(lonlat_bounds) == 4:
         w, s, e, nn = (float(v) for v in lonlat_bounds)
         corners = np.array([[b[0, 0], b[1, 0]], [b[0, 1], b[1, 0]], [b[0, 0], b[1, 1]],
@@ -695,20 +696,28 @@ def check_zones_on_map(zones: Sequence[Zone], world: World, label: str, *,
         ll = to_lonlat(world, corners, anchor=anchor)
         mw, me = float(ll[:, 0].min()), float(ll[:, 0].max())
         ms, mn = float(ll[:, 1].min()), float(ll[:, 1].max())
+        covers = f"the map covers lon {mw:.5f}..{me:.5f}, lat {ms:.5f}..{mn:.5f}"
         # swapped: the file's "longitudes" are latitudes and the other way round
         if abs(w) <= 90 and abs(e) <= 90 and s <= me and nn >= mw and w <= mn and e >= ms:
             raise InputError(
                 f"{off}, but with longitude and latitude swapped "
                 f"{'it' if n == 1 else 'they'} would lie on it: the coordinates are written "
-                f"[lat, lon] (x {w:.5f}..{e:.5f}, y {s:.5f}..{nn:.5f}; the map covers lon "
-                f"{mw:.5f}..{me:.5f}, lat {ms:.5f}..{mn:.5f}); GeoJSON (RFC 7946), KML and "
-                "mission files write [lon, lat] — swap the two coordinates")
+                f"[lat, lon] (x {w:.5f}..{e:.5f}, y {s:.5f}..{nn:.5f}; {covers}); GeoJSON "
+                "(RFC 7946), KML and mission files write [lon, lat] — swap the two coordinates")
     near = min((float(rect.distance(g)) for g in shapes), default=float("inf"))
-    dist = f"the nearest is {near / 1000:.1f} km from its edge" if np.isfinite(near) else         "its coordinates fall outside the map's coordinate system"
+    dist = (f"the nearest is {near / 1000:.1f} km from its edge" if np.isfinite(near) else
+            "its coordinates fall outside the map's coordinate system")
+    if not inline:
+        fix = ("check that it is the file meant for this area and that its coordinates are "
+               "[lon, lat] (or give its CRS)")
+    elif covers:
+        fix = f"check its [lon, lat] coordinates: {covers}"
+    else:  # an entry in world metres, like start and goal
+        fix = (f"check its coordinates: they are world metres (lonlat: false) and the map covers "
+               f"x {b[0, 0]:.0f}..{b[0, 1]:.0f} m, y {b[1, 0]:.0f}..{b[1, 1]:.0f} m")
     warnings.warn(ZoneWarning(
         f"{off} ({dist}), so {'it changes' if n == 1 else 'they change'} nothing in "
-        "this plan; check that it is the file meant for this area and that its coordinates "
-        "are [lon, lat] (or give its CRS)"), stacklevel=2)
+        f"this plan; {fix}"), stacklevel=2)
 
 
 __all__ += ["ZoneViolation", "check_points_allowed", "check_zones_on_map", "ZoneWarning"]
