@@ -462,6 +462,19 @@ def test_an_out_holding_an_input_is_refused_naming_it(tmp_path, name, force):
     assert not [p for p in tmp_path.rglob(".*") if ".tmp-" in p.name or ".old-" in p.name]
 
 
+def test_an_out_holding_several_inputs_names_every_one(tmp_path):
+    """The user learns in one go every file to move out, not one per attempt."""
+    zone = _zone(tmp_path / "proj" / "zones" / "z.geojson")
+    mission = _mission(tmp_path / "proj", f"no_fly_zones: [{zone}]\n")
+    before = _tree(tmp_path)
+    res = runner.invoke(app, ["run", str(mission), "--out", str(tmp_path / "proj"), "--force"])
+    assert res.exit_code == 2, res.output
+    msg = " ".join(res.output.split())
+    assert "holds 2 inputs of this command:" in msg and "which would delete them" in msg
+    assert "m.yaml (MISSION_FILE)" in msg and "z.geojson (" in msg and "move the inputs out" in msg
+    assert _tree(tmp_path) == before
+
+
 def test_an_input_read_after_the_check_is_caught_before_the_swap(tmp_path):
     """A reader that notes its file only after the early check (a new command forgetting
     to declare it): the old set is not moved aside; exit 2 naming the file."""

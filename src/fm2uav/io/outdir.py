@@ -335,7 +335,7 @@ class OutputDir:
         return self.inputs + [e for e in (self._noted or ()) if e not in self.inputs]
 
     def _check_inputs(self, names: Iterable[str] = ()) -> None:
-        """Refuse (InputError) a target that holds one of the command's inputs.
+        """Refuse (InputError) a target that holds any of the command's inputs, naming each.
 
         A swapped set replaces the whole folder, so any input inside it counts; a
         merged set (``merge``) only replaces the files of ``names`` (and ``owned``).
@@ -343,20 +343,27 @@ class OutputDir:
         if self.merge:
             written = (os.path.relpath(w, self.given) for w in self.written)
             doomed = {_real(self.path / n) for n in (*names, *self._owned, *written)}
+        hits = []
         for path, what in self._all_inputs():
             if self.merge:
                 hit = bool(_spellings(path) & doomed)
             else:
                 hit = any(_under(q, _real(self.path)) for q in _spellings(path))
-            if not hit:
-                continue
-            verb = "is" if _real(path) == _real(self.path) else "holds"
-            why = ("an output of the same name would replace it" if self.merge else
-                   "the output set replaces the folder as a whole (with --force), which would "
-                   "delete it")
-            raise InputError(
-                f"--out {self.given} {verb} an input of this command: {path} ({what}); {why} "
-                f"— choose another --out (a new folder) or move the input out of {self.given}")
+            if hit and all(_real(path) != _real(p) for p, _ in hits):
+                hits.append((path, what))
+        if not hits:
+            return
+        many = len(hits) > 1
+        verb = "is" if not many and _real(hits[0][0]) == _real(self.path) else "holds"
+        them = "them" if many else "it"
+        why = (f"an output of the same name would replace {them}" if self.merge else
+               "the output set replaces the folder as a whole (with --force), which would "
+               f"delete {them}")
+        some = (f"{len(hits)} inputs of this command: " if many else
+                "an input of this command: ") + ", ".join(f"{p} ({w})" for p, w in hits)
+        raise InputError(
+            f"--out {self.given} {verb} {some}; {why} — choose another --out (a new folder) or "
+            f"move the input{'s' if many else ''} out of {self.given}")
 
     def _relative(self) -> Path:
         assert self.parent_set is not None
