@@ -54,9 +54,9 @@ def test_check_bad_input_exit_2(tmp_path):
     cases = [
         ([str(good), "--airframe", "concorde"], "unknown airframe"),
         ([str(one)], "at least 2 points"),
-        ([str(nan)], "non-finite"),
+        ([str(nan)], "not a finite number"),
         ([str(good), "--speed", "-4"], "speed"),
-        ([str(tmp_path / "missing.csv")], "does not exist"),
+        ([str(tmp_path / "missing.csv")], "not found"),
     ]
     for i, (args, msg) in enumerate(cases):
         res = runner.invoke(app, ["check", *args, "--out", str(tmp_path / f"o{i}")])

@@ -13,8 +13,11 @@ def test_reproduce_tracking_cli_tiny_grid(tmp_path):
     out = tmp_path / "tracking"
     res = CliRunner().invoke(app, ["reproduce", "tracking", "--step", "0.5", "--pairs", "2",
                                    "--out", str(out), "--sweep-dir", str(tmp_path / "sw"),
-                                   "--quiet"])
+                                   "--quiet", "--report"])
     assert res.exit_code == 0, res.output
+    html = (out / "report.html").read_text(encoding="utf-8")  # --report: paths and table
+    assert 'pair 1"' in html and '"Dubins references"' in html
+    assert "Tracking error per pair, vehicle and look-ahead" in html
     s = json.loads((out / "summary.json").read_text())
     assert s["alpha"] in (0.5, 1.0) and s["beta"] in (0.5, 1.0)
     assert s["paths"] == 2 and len(s["rows"]) == 2 * 2 * 2  # pairs x vehicles x look-aheads

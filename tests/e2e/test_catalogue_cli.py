@@ -36,6 +36,63 @@ def _files(tmp):
     (tmp / "area.geojson").write_text("{broken")
     (tmp / "b[red]x[").mkdir()  # a path containing "[/b]"
     (tmp / "b[red]x[/b].yaml").write_text("version: 1\nversion: 2\n")
+    _files_25(tmp)
+
+
+OPEN = "world: {scenario: open-field}\nstart: {cell: [20, 20, 20]}\ngoal: {cell: [100, 80, 30]}\n"
+JACKSBORO = "world: {scenario: jacksboro}\n"
+SWAPPED = ('{"type": "FeatureCollection", "features": [{"type": "Feature", "properties": {}, '
+           '"geometry": {"type": "Polygon", "coordinates": [[[36.55, -84.30], [36.55, -84.25], '
+           '[36.60, -84.25], [36.55, -84.30]]]}}]}')
+
+
+def _files_25(tmp):
+    """Issue 25's bad inputs: YAML types, airframe speeds, zones, CSV columns, sizes."""
+    texts = {
+        "order_true.yaml": OPEN + "planner: {order: true}\n",
+        "version_true.yaml": "version: true\n" + OPEN,
+        "walls_yes.yaml": OPEN + "planner: {walls: yes}\n",
+        "min_speed.yaml": OPEN + "airframe: {min_speed: 8, hover_speed: 5}\n",
+        "min_speed_fw.yaml": OPEN + "airframe: {type: fixed_wing, cruise_speed: 15, "
+                             "min_speed: 18}\n",
+        "area_leaves_goal.yaml": OPEN + "operating_area: {polygon: [[0, 0], [900, 0], [900, 900], "
+                                 "[0, 900]]}\n",
+        "goal_in_zone.yaml": OPEN + "no_fly_zones: [{polygon: [[1400, 1100], [1600, 1100], "
+                             "[1600, 1300], [1400, 1300]], name: range}]\n",
+        "circle_negative.yaml": OPEN + "no_fly_zones: [{circle: {center: [500, 500], "
+                                "radius: -5}}]\n",
+        "swapped_inline.yaml": JACKSBORO + "no_fly_zones: [{polygon: [[36.55, -84.30], "
+                               "[36.55, -84.25], [36.60, -84.25]], lonlat: true}]\n",
+        "swapped_file.yaml": JACKSBORO + "no_fly_zones: [swapped.geojson]\n",
+        "agl_nan.yaml": OPEN + "planner: {agl: .nan}\n",
+        "agl_text.yaml": OPEN + "planner: {agl: 1e3 m}\n",
+        "comment_only.yaml": "# nothing here\n",
+        "swapped.geojson": SWAPPED,
+        "sweep_huge.yaml": "pairs: 1000\nalpha: {start: 1.0e-7, stop: 1, step: 1.0e-7}\n"
+                           "beta: {start: 1e-7, stop: 1, step: 1e-7}\n",
+        "sweep_pairs_bool.yaml": "pairs: true\n",
+        "sweep_empty.yaml": "",
+        "sweep_dup.yaml": "pairs: 2\npairs: 3\n",
+        "sweep_cell.yaml": "cell: 0.01\n",
+        "sweep_list.yaml": "- pairs\n",
+        "swapped_start.yaml": JACKSBORO + "start: {lon: 36.53435, lat: -84.36016, agl: 300}\n"
+                              "goal: {lon: -84.12133, lat: 36.65048, agl: 300}\n",
+        "laughs.yaml": "a0: &a0 [1, 1, 1, 1, 1, 1, 1, 1, 1, 1]\n" + "".join(
+            f"a{i}: &a{i} [{', '.join([f'*a{i - 1}'] * 10)}]\n" for i in range(1, 9)),
+        "self_alias.yaml": OPEN + "via: &v [*v]\n",
+        "lonlat.csv": "lon,lat,alt\n-3.70,40.30,100\n-3.69,40.31,100\n",
+        "unknown_col.csv": "x_m,y_m,z_m,heading\n0,0,100,1\n100,0,100,2\n",
+        "no_y.csv": "x_m,north,z_m\n0,0,100\n100,0,100\n",
+        "ragged.csv": "x_m,y_m,z_m\n0,0,100\n100,0\n",
+        "nan.csv": "x_m,y_m,z_m\n0,0,100\nnan,0,100\n",
+        "text_value.csv": "x_m,y_m,z_m\n0,0,100\n100,zero,100\n",
+    }
+    for name, text in texts.items():
+        (tmp / name).write_text(text)
+    (tmp / "utf16.csv").write_bytes("x_m,y_m,z_m\n0,0,100\n".encode("utf-16"))
+    (tmp / "utf16.yaml").write_bytes(OPEN.encode("utf-16"))
+    (tmp / "dangling.yaml").symlink_to(tmp / "nowhere.yaml")
+    (tmp / "loop.csv").symlink_to(tmp / "loop.csv")
 
 
 CASES = [
@@ -136,6 +193,86 @@ CASES = [
     (["export", "{tmp}/path.csv", "--format", "pdf"], "pdf"),
     (["export", "{tmp}/path.csv", "--format", "plan", "--mission", "{tmp}/dup.yaml"],
      "duplicate key"),
+    # ---- issue 25: mission-file types (YAML 1.2), speeds, zones, relative paths
+    (["run", "{tmp}/order_true.yaml"], "planner.order = True has the wrong type (bool)"),
+    (["run", "{tmp}/version_true.yaml"], "version = True has the wrong type (bool)"),
+    (["run", "{tmp}/walls_yes.yaml"], "planner.walls = 'yes'"),
+    (["run", "{tmp}/agl_nan.yaml"], "planner.agl = nan is not a finite number"),
+    (["run", "{tmp}/agl_text.yaml"], "planner.agl = '1e3 m' has the wrong type"),
+    (["run", "{tmp}/comment_only.yaml"], "the mission file is empty"),
+    (["run", "{tmp}/utf16.yaml"], "is UTF-16 text"),
+    (["run", "{tmp}/dangling.yaml"], "is a symbolic link to"),
+    (["run", "{tmp}/min_speed.yaml"], "min_speed 8 m/s is above hover_speed 5 m/s"),
+    (["run", "{tmp}/min_speed_fw.yaml"], "min_speed 18 m/s is above cruise_speed 15 m/s"),
+    (["plan", "--min-speed", "7", "--hover-speed", "5", "--export", "plan"],
+     "airframe.min_speed = 7 m/s (CLI --min-speed) is above airframe.hover_speed = 5 m/s"),
+    (["run", "{tmp}/area_leaves_goal.yaml"],
+     "the goal [1500.0, 1200.0, 450.0] m is not inside the operating area"),
+    (["run", "{tmp}/goal_in_zone.yaml"], "lies in the no-fly zone 'range'"),
+    (["run", "{tmp}/circle_negative.yaml"], "no_fly_zones[0].circle.radius = -5 is out of range"),
+    (["run", "{tmp}/swapped_inline.yaml"], "with longitude and latitude swapped"),
+    (["run", "{tmp}/swapped_file.yaml"], "the coordinates are written [lat, lon]"),
+    (["plan", "--scenario", "jacksboro", "--no-fly", "{tmp}/swapped.geojson"],
+     "--no-fly {tmp}/swapped.geojson: its zone lies off the map, but with longitude"),
+    # ---- path CSVs read by name
+    (["check", "{tmp}/lonlat.csv"], "lon/lat degrees are not read"),
+    (["check", "{tmp}/unknown_col.csv"], "unknown column 'heading'"),
+    (["check", "{tmp}/no_y.csv"], "no y column in the header"),
+    (["check", "{tmp}/ragged.csv"], "line 3: 2 values where the first row has 3"),
+    (["check", "{tmp}/nan.csv"], "line 3: x_m = 'nan' is not a finite number"),
+    (["check", "{tmp}/text_value.csv"], "line 3: y_m = 'zero' is not a number"),
+    (["check", "{tmp}/utf16.csv"], "is UTF-16 text"),
+    (["check", "{tmp}/loop.csv"], "a loop of links"),
+    (["export", "{tmp}/lonlat.csv", "--scenario", "open-field"], "lon/lat degrees"),
+    (["export", "{tmp}/ragged.csv", "--scenario", "open-field"], "line 3"),
+    (["plan", "--scenario", "jacksboro", "--lonlat", "--start", "36.53435,-84.36016,300",
+      "--goal", "-84.12133,36.65048,300"], "lon and lat look swapped: lon -84.3602, lat 36.5344"),
+    (["run", "{tmp}/swapped_start.yaml"], "lon and lat look swapped"),
+    (["run", "{tmp}/laughs.yaml"], "billion laughs"),
+    (["run", "{tmp}/self_alias.yaml"], "refers to itself through an alias"),
+    (["sweep", "{tmp}/laughs.yaml"], "billion laughs"),
+    # ---- output folders
+    (["plan", "--out", "{tmp}/path.csv/sub"], "path.csv is a file, not a folder"),
+    (["plan", "--out", "/"], "is the root of the file system"),
+    # ---- sizes refused up front with what they would need
+    (["sweep", "{tmp}/sweep_huge.yaml"], "the sweep would have 1e+17 cases (1000 pairs x "
+     "10000000 alpha x 10000000 beta values)"),
+    (["sweep", "{tmp}/sweep_pairs_bool.yaml"], "pairs = True"),
+    (["sweep", "{tmp}/sweep_empty.yaml"], "is empty"),
+    (["sweep", "{tmp}/sweep_dup.yaml"], "duplicate key 'pairs'"),
+    (["sweep", "{tmp}/sweep_cell.yaml"], "cell = 0.01"),
+    (["sweep", "{tmp}/sweep_list.yaml"], "must hold a YAML mapping"),
+    (["sweep", "{tmp}/dir.tif"], "is a directory"),
+    (["sweep", "{tmp}/pipe.yaml"], "named pipe"),
+    (["sweep", "examples/sweeps/city2d_small.yaml", "--workers", "100000"],
+     "--workers 100000 would start 100000 worker processes"),
+    (["sweep", "examples/sweeps/city2d_small.yaml", "--workers", "0"], "--workers"),
+    (["reproduce", "curvature", "--step", "1e-9"], "the limit is 2,000,000 cases"),
+    (["reproduce", "curvature", "--pairs", "0"], "pairs must be at least 1"),
+    (["reproduce", "tracking", "--workers", "-3"], "--workers"),
+    (["formation", "--followers", "1000000", "--no-gif"], "the limit is 50 followers"),
+    (["tune", "--p2", ",".join(f"{0.6 + k / 1000:g}" for k in range(1000))],
+     "the tuning grid has 3000 combinations (3 p1 x 1000 p2"),
+    (["formation", "--frames", "1000000000"], "the limit is 1000 frames"),
+    # ---- seeds, unused-but-given flags, airframe speeds
+    (["plan", "--seed", "-1"], "seed must be an integer in [0, 9223372036854775807]"),
+    (["tune", "--seed", "-1"], "--seed"),
+    (["reproduce", "urban", "--seed", "-1"], "--seed"),
+    (["reproduce", "coverage", "--seed", "-1"], "--seed"),
+    (["plan", "--p1", "nan"], "p1 must be a finite number"),
+    (["plan", "--band", "-1"], "band must be in [0, 5000]"),
+    (["check", "{tmp}/good.csv", "--speed", "5"], "below its stall (minimum) speed"),
+    (["check", "{tmp}/good.csv", "--tolerance", "1e308"], "tolerance must be in (0, 10000] m"),
+    (["cover", "--area", "S3", "--spacing", "80", "--side-overlap", "nan"], "--side-overlap"),
+    (["cover", "--area", "S3", "--spacing", "80", "--angle", "1e308"], "--angle"),
+    (["cover", "--area", "S3", "--spacing", "80", "--thin", "1e308"], "[0, 1000] m"),
+    (["formation", "--p1", "nan", "--no-gif"], "p1 must be a finite number"),
+    (["formation", "--frames", "0", "--no-gif"], "--frames"),
+    (["plan", "--agl", "1e308"], "agl = 1e+308 m is too large; allowed: at most 5000 m"),
+    (["plan", "--saturation-distance", "1e308"], "--saturation-distance"),
+    (["plan", "--thin", "1e308", "--export", "plan"], "outputs.thin_tolerance"),
+    (["check", "{tmp}/good.csv", "--airframe", "arducopter", "--speed", "5"],
+     "applies to fixed-wings"),
 ]
 
 
@@ -150,7 +287,7 @@ def bad_files(tmp_path_factory):
 def test_cli_bad_input(bad_files, tmp_path, args, fragment):
     argv = [a.replace("{tmp}", str(bad_files)) for a in args]
     if "--out" not in argv and argv[0] in ("plan", "run", "cover", "export", "check",
-                                           "formation"):
+                                           "formation", "sweep", "reproduce", "tune"):
         argv += ["--out", str(tmp_path / "out")]
     res = runner.invoke(app, argv)
     out = res.output

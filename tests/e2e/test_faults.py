@@ -35,13 +35,17 @@ SLOW = textwrap.dedent("""
     @app.command()
     @handle_errors
     def main(out: str = typer.Option(..., "--out"), n: int = 6, pause: float = 0.3,
-             force: bool = False) -> None:
+             force: bool = False, hold: str = "") -> None:
+        import os
+
         od = OutputDir(out, force=force)
         od.check([f"f{i}.txt" for i in range(n)])
         for i in range(n):
             with od.open(f"f{i}.txt") as fh:
                 fh.write(f"new {i}\\n")
             print(f"wrote {i}", flush=True)
+            while hold and not os.path.exists(hold):  # until the test lets it go on
+                time.sleep(0.05)
             time.sleep(pause)
 
     app()
@@ -116,11 +120,14 @@ def test_killed_run_leftovers_are_cleaned_by_the_next_run(tmp_path):
 def test_two_concurrent_runs_one_is_refused(tmp_path):
     out = tmp_path / "out"
     script = _slow(tmp_path)
-    first = _spawn(script, out, "--n", "4", "--pause", "1.5")  # ~6 s: the second starts
+    go = tmp_path / "go"
+    # the first run holds the folder until the second has tried (however slow its start-up)
+    first = _spawn(script, out, "--n", "4", "--pause", "0", "--hold", str(go))
     assert first.stdout.readline().startswith("wrote 0")
     second = _spawn(script, out, "--n", "4", "--force", "--pause", "0")
-    _, err2 = second.communicate(timeout=60)
-    _, err1 = first.communicate(timeout=60)
+    _, err2 = second.communicate(timeout=300)
+    go.write_text("")
+    _, err1 = first.communicate(timeout=300)
     assert first.returncode == 0, err1
     assert second.returncode == 2, err2
     assert "being written by another fm2uav run" in err2 and "--out" in err2
@@ -376,3 +383,211 @@ def test_stop_signal_before_the_commit_still_stops(tmp_path):
                 raise
     assert sorted(p.name for p in out.iterdir()) == before
     assert _leftovers(tmp_path, "out") == []
+
+
+# ------------------------------------------------- --force never deletes an input (issue 25)
+def _mission(folder: Path, extra: str = "") -> Path:
+    folder.mkdir(parents=True, exist_ok=True)
+    m = folder / "m.yaml"
+    m.write_text("world: {scenario: open-field}\nstart: {cell: [20, 20, 20]}\n"
+                 "goal: {cell: [100, 80, 30]}\n" + extra)
+    return m
+
+
+def _tree(folder: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*"))
+            if p.is_file()}
+
+
+def _dem(path: Path) -> Path:
+    from .conftest import relief, write_dem
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return write_dem(path, relief(30))
+
+
+def _zone(path: Path) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text('{"type": "FeatureCollection", "features": [{"type": "Feature", '
+                    '"properties": {}, "geometry": {"type": "Polygon", "coordinates": '
+                    '[[[600, 600], [700, 600], [700, 700], [600, 600]]]}}]}')
+    return path
+
+
+def _path_csv(path: Path) -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("x_m,y_m,z_m\n300,300,540\n600,300,540\n900,600,540\n")
+    return path
+
+
+# (name, make(tmp) -> (args, the input in --out), the fragment naming the input)
+INPUT_CASES = {
+    "mission file": lambda t: (["run", str(_mission(t / "proj"))], t / "proj", "m.yaml"),
+    "mission file, ancestor": lambda t: (["run", str(_mission(t / "proj" / "a" / "b"))],
+                                         t / "proj", "m.yaml"),
+    "mission file, outputs.dir '.'": lambda t: (
+        ["run", str(_mission(t / "proj", "outputs: {dir: .}\n"))], None, "m.yaml"),
+    "zone file of the mission": lambda t: (
+        ["run", str(_mission(t / "proj2", f"no_fly_zones: [{_zone(t / 'proj' / 'z.geojson')}]"
+                             "\n"))], t / "proj", "z.geojson"),
+    "--dem": lambda t: (["plan", "--dem", str(_dem(t / "proj" / "dem.tif")), "--start",
+                         "500100,4499500,150", "--goal", "500700,4499200,150"],
+                        t / "proj", "dem.tif"),
+    "--no-fly": lambda t: (["plan", "--no-fly", str(_zone(t / "proj" / "z.geojson"))],
+                           t / "proj", "z.geojson"),
+    "check PATH": lambda t: (["check", str(_path_csv(t / "proj" / "p.csv"))], t / "proj",
+                             "p.csv"),
+    "export PATH": lambda t: (["export", str(_path_csv(t / "proj" / "p.csv")), "--scenario",
+                               "open-field"], t / "proj", "p.csv"),
+    "export --mission": lambda t: (["export", str(_path_csv(t / "csv" / "p.csv")), "--mission",
+                                    str(_mission(t / "proj"))], t / "proj", "m.yaml"),
+}
+
+
+@pytest.mark.parametrize("force", [True, False], ids=["force", "no-force"])
+@pytest.mark.parametrize("name", list(INPUT_CASES))
+def test_an_out_holding_an_input_is_refused_naming_it(tmp_path, name, force):
+    """--out = the folder of an input (or an ancestor): exit 2 before any work, the input
+    and --out named, every file as it was, no temporary folder left."""
+    args, out, fragment = INPUT_CASES[name](tmp_path)
+    (tmp_path / "proj" / "old_output.txt").write_text("an earlier run's file")
+    before = _tree(tmp_path)
+    argv = args + (["--out", str(out)] if out is not None else []) + (
+        ["--force"] if force else [])
+    res = runner.invoke(app, argv)
+    assert res.exit_code == 2, res.output
+    assert "holds an input of this command" in res.output and fragment in res.output
+    assert "--out" in res.output and "Traceback" not in res.output
+    assert _tree(tmp_path) == before
+    assert not [p for p in tmp_path.rglob(".*") if ".tmp-" in p.name or ".old-" in p.name]
+
+
+def test_an_out_holding_several_inputs_names_every_one(tmp_path):
+    """The user learns in one go every file to move out, not one per attempt."""
+    zone = _zone(tmp_path / "proj" / "zones" / "z.geojson")
+    mission = _mission(tmp_path / "proj", f"no_fly_zones: [{zone}]\n")
+    before = _tree(tmp_path)
+    res = runner.invoke(app, ["run", str(mission), "--out", str(tmp_path / "proj"), "--force"])
+    assert res.exit_code == 2, res.output
+    msg = " ".join(res.output.split())
+    assert "holds 2 inputs of this command:" in msg and "which would delete them" in msg
+    assert "m.yaml (MISSION_FILE)" in msg and "z.geojson (" in msg and "move the inputs out" in msg
+    assert _tree(tmp_path) == before
+
+
+def test_an_input_read_after_the_check_is_caught_before_the_swap(tmp_path):
+    """A reader that notes its file only after the early check (a new command forgetting
+    to declare it): the old set is not moved aside; exit 2 naming the file."""
+    from fm2uav import _validate
+
+    out = tmp_path / "out"
+    _old_set(out)
+    (out / "late.tif").write_text("an input read late")
+    before = _tree(out)
+    with _validate.input_log():
+        s = OutputDir(out, force=True)
+        s.check(["f0.txt"])
+        with s.open("f0.txt") as fh:
+            fh.write("new")
+        _validate.input_file(out / "late.tif", "the DEM")  # read while the set is staged
+        with pytest.raises(InputError, match=r"holds an input of this command: .*late.tif "
+                           r"\(the DEM\)"):
+            s.finish()
+    assert _tree(out) == before and _leftovers(tmp_path, "out") == []
+
+
+def test_declared_inputs_and_merge_mode(tmp_path):
+    out = tmp_path / "out"
+    _old_set(out)
+    with pytest.raises(InputError, match="f1.txt .the sweep configuration."):
+        OutputDir(out, force=True, inputs=[(out / "f1.txt", "the sweep configuration")]).check()
+    # merge mode replaces only the files it writes: another input may stay in the folder
+    keep = OutputDir(out, force=True, merge=True, inputs=[(out / "f1.txt", "config")])
+    keep.check(["report.md"])
+    keep.abort()
+    clash = OutputDir(out, force=True, merge=True, owned=["f2.txt"],
+                      inputs=[(out / "f2.txt", "config")])
+    with pytest.raises(InputError, match="f2.txt"):
+        clash.check(["report.md"])
+    assert (out / "f1.txt").read_text() == "old 1\n" and _leftovers(tmp_path, "out") == []
+
+
+def test_a_link_to_an_input_inside_out_is_refused_too(tmp_path):
+    """The input given through a symbolic link that lives in --out: deleting --out would
+    break the path the user gave."""
+    data = tmp_path / "data"
+    m = _mission(data)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "m.yaml").symlink_to(m)
+    res = runner.invoke(app, ["run", str(out / "m.yaml"), "--out", str(out), "--force"])
+    assert res.exit_code == 2 and "holds an input" in res.output, res.output
+    assert (out / "m.yaml").is_symlink() and m.exists()
+
+
+# ---------------------------------------------------------- a symbolic link as --out
+def test_force_through_a_symlinked_out_replaces_the_folder_it_points_to(tmp_path):
+    real = tmp_path / "real"
+    _old_set(real)
+    link = tmp_path / "link"
+    link.symlink_to(real, target_is_directory=True)
+    res = runner.invoke(app, ["plan", "--out", str(link), "--force", "--quiet"])
+    assert res.exit_code == 0, res.output
+    assert link.is_symlink() and link.resolve() == real.resolve()
+    assert sorted(p.name for p in real.iterdir()) == ["path.csv", "plan.png", "summary.json"]
+    # no stray link, no old set, no temporary folder beside either
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link", "real"]
+
+
+def test_a_symlinked_out_without_force_is_refused_and_left_alone(tmp_path):
+    real = tmp_path / "real"
+    _old_set(real)
+    link = tmp_path / "link"
+    link.symlink_to(real, target_is_directory=True)
+    res = runner.invoke(app, ["plan", "--out", str(link), "--quiet"])
+    assert res.exit_code == 2 and "already exists" in res.output
+    assert link.is_symlink() and sorted(p.name for p in real.iterdir()) == [
+        "f0.txt", "f1.txt", "f2.txt", "old_only.plan"]
+
+
+def test_a_dangling_symlink_out_is_created_where_it_points(tmp_path):
+    link = tmp_path / "link"
+    link.symlink_to(tmp_path / "made", target_is_directory=True)
+    res = runner.invoke(app, ["plan", "--out", str(link), "--quiet"])
+    assert res.exit_code == 0, res.output
+    assert link.is_symlink() and (tmp_path / "made" / "path.csv").exists()
+
+
+# ------------------------------------------------------------ a deleted current folder
+def test_a_deleted_current_folder_says_so(tmp_path):
+    """The shell sits in a folder another program removed: relative paths cannot work,
+    and the message says why (not "file not found"); absolute paths still do."""
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    code = textwrap.dedent("""
+        import os, sys
+        os.chdir(sys.argv[1]); os.rmdir(sys.argv[1])
+        from fm2uav.cli import app
+        for args in (["run", "m.yaml"], ["plan", "--out", "o", "--quiet"]):
+            try:
+                app(args)
+            except SystemExit as exc:
+                print(exc.code, file=sys.stderr)
+    """)
+    r = subprocess.run([sys.executable, "-c", code, str(gone)], capture_output=True, text=True,
+                       timeout=300)
+    lines = r.stderr.splitlines()
+    assert len(lines) == 4 and lines[1] == lines[3] == "2", r.stderr
+    for line in (lines[0], lines[2]):
+        assert "the current folder no longer exists" in line and "cd " in line, r.stderr
+    assert "Traceback" not in r.stderr
+
+
+def test_a_tilde_out_is_the_home_folder_not_a_folder_named_tilde(tmp_path, monkeypatch):
+    """"~/out" given in quotes (or from outputs.dir) means the home folder, as in a shell."""
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    monkeypatch.chdir(tmp_path)
+    res = runner.invoke(app, ["plan", "--out", "~/plans/a", "--quiet"])
+    assert res.exit_code == 0, res.output
+    assert (tmp_path / "home" / "plans" / "a" / "path.csv").exists()
+    assert not (tmp_path / "~").exists()

@@ -9,6 +9,7 @@ from __future__ import annotations
 import hashlib
 import json
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -32,6 +33,10 @@ def _bent_path(tmp_path):
 # name -> (arguments before --out, report files to check, trace names expected in the first,
 #          table titles expected in the first)
 CASES = {
+    "run": (["run", "{mission}", "--report"],
+            ["report.html"], ["FM² path", "terrain"], []),
+    "export": (["export", "{bent}", "--scenario", "open-field", "--agl", "150"],
+               ["report.html"], ["path", "terrain"], []),
     "cover": (["cover", "--area", "S3", "--spacing", "80", "--agl", "100"],
               ["report.html"],
               ["FM² path", "area", "bands", "terrain", "FM² path ideal (100 m AGL)",
@@ -78,6 +83,27 @@ CASES = {
 }
 
 
+#: The default mission; the run case writes it with ``outputs.formats: [csv, json]`` (no
+#: html), so that ``run --report`` must add report.html.
+MISSION = Path(__file__).resolve().parents[2] / "examples" / "open_field_tff.yaml"
+
+
+def test_every_command_accepts_report():
+    """README: "Every command that writes files accepts --report" — every command and
+    reproduction with an --out (``fm2uav app`` serves pages and writes no output set)."""
+    from typer.main import get_command
+
+    cli = get_command(app)
+    seen = []
+    for name, cmd in cli.commands.items():
+        subs = getattr(cmd, "commands", None) or {name: cmd}
+        for sub_name, sub in subs.items():
+            opts = {o for p in sub.params for o in getattr(p, "opts", [])}
+            if "--out" in opts:
+                seen.append((name, sub_name, "--report" in opts))
+    assert len(seen) >= 14 and all(ok for *_, ok in seen), [s for s in seen if not s[2]]
+
+
 #: the reproductions take tens of seconds each: their cases are marked slow
 SLOW = {name for name in CASES if name.startswith("reproduce-")}
 
@@ -97,7 +123,11 @@ def runs(tmp_path_factory, cli_once):
 
     class Runs(dict):
         def __missing__(self, name):
-            args = [bent if a == "{bent}" else a for a in CASES[name][0]]
+            mission = tmp / "mission.yaml"
+            mission.write_text(MISSION.read_text().split("outputs:")[0]
+                               + "outputs: {formats: [csv, json]}\n")
+            subs = {"{bent}": bent, "{mission}": str(mission)}
+            args = [subs.get(a, a) for a in CASES[name][0]]
             r = cli_once(args + ["--report", "--json"])
             self[name] = (r.result, r.out, args)
             return self[name]

@@ -135,13 +135,17 @@ def test_cli_sweep_and_resume(tmp_path):
     )
     out = tmp_path / "out"
     runner = CliRunner()
-    r = runner.invoke(app, ["sweep", str(cfg), "--out", str(out), "--workers", "1", "--json"])
+    r = runner.invoke(app, ["sweep", str(cfg), "--out", str(out), "--workers", "1", "--json",
+                            "--report"])
     assert r.exit_code == 0, r.output
     summary = json.loads(r.output)
     assert summary["cases"] == {"run": 4, "resumed": 0, "failed": 0}
     for name in ("tables.md", "heatmap_frechet.png", "heatmap_area.png", "curvature_area.png",
-                 "best_paths_area.png", "results.csv"):
+                 "best_paths_area.png", "results.csv", "report.html"):
         assert (out / name).exists()
+    html = (out / "report.html").read_text(encoding="utf-8")  # --report (README: every command)
+    assert "best area vs Dubins, pair 1" in html and "Dubins references" in html
+    assert "Best (α, β) per metric and model" in html
     assert "Table 3" in (out / "tables.md").read_text()
     kept = {n: (out / n).read_bytes() for n in ("cases.jsonl", "references.npz", "results.csv")}
     r = runner.invoke(app, ["sweep", str(cfg), "--out", str(out), "--workers", "1", "--json"])
@@ -154,3 +158,29 @@ def test_cli_sweep_and_resume(tmp_path):
     bad.write_text("xi: -1\n")
     r = runner.invoke(app, ["sweep", str(bad), "--out", str(tmp_path / "o2")])
     assert r.exit_code == 2
+
+
+def test_size_limits_refused_up_front_as_the_doc_says(tmp_path):
+    """docs/sweeps.md's limits are the code's, and its example message is the one printed."""
+    import re
+    from pathlib import Path
+
+    from fm2uav.experiments.runner import MAX_SWEEP_CASES, MAX_SWEEP_PAIRS
+
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "sweeps.md").read_text()
+    flat = " ".join(doc.split())
+    assert f"more than {MAX_SWEEP_CASES:,} cases" in flat
+    assert f"more than {MAX_SWEEP_PAIRS} pairs" in flat
+    shown = re.search(r"error: huge.yaml: (the sweep would have .*)", doc).group(1)
+    cfg = tmp_path / "huge.yaml"
+    cfg.write_text("pairs: 1000\nalpha: {start: 1e-7, stop: 1, step: 1e-7}\n"
+                   "beta: {start: 1e-7, stop: 1, step: 1e-7}\n")
+    with pytest.raises(InputError) as err:
+        load_config(cfg)  # counted, never made: 1e7 values a side would be 80 MB each
+    assert str(err.value) == f"{cfg}: {shown}"
+    with pytest.raises(InputError, match="1001 pairs would need"):
+        make_config({"pairs": 1001})
+    for bad in ({"pairs": True}, {"cell": "2"}, {"xi": float("nan")}, {"order": 2.5},
+                {"alpha": {"start": 0.5, "stop": 0.1}}):
+        with pytest.raises(InputError):
+            make_config(bad)

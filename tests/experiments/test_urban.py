@@ -23,8 +23,12 @@ def test_seed_keeps_the_margin_and_the_layers_fit():
 
 def test_reproduce_urban_cli_writes_the_table_and_the_thesis_story_holds(tmp_path):
     out = tmp_path / "urban"
-    res = CliRunner().invoke(app, ["reproduce", "urban", "--out", str(out), "--quiet"])
+    res = CliRunner().invoke(app, ["reproduce", "urban", "--out", str(out), "--quiet",
+                                   "--report"])
     assert res.exit_code == 0, res.output
+    html = (out / "report.html").read_text(encoding="utf-8")  # --report: six paths, the table
+    assert '"case 6: level 30 (p1=0.5, p2=1.5)"' in html
+    assert "Flight levels (thesis §4.4)" in html
     rows = json.loads((out / "summary.json").read_text())["cases"]
     assert len(rows) == 6 and (out / "case6.csv").exists()
     assert "plan, warm [s]" in (out / "table.md").read_text()

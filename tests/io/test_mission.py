@@ -144,7 +144,9 @@ BAD = [
     ("order", OK_WORLD + "planner: {order: 3}\n", ["planner.order = 3", "1 or 2"]),
     ("agl-neg", OK_WORLD + "planner: {agl: -10}\n",
      ["planner.agl = -10", "0 < agl <= 5000 m"]),
-    ("agl-bool", OK_WORLD + "planner: {agl: yes}\n", ["planner.agl = True", "wrong type"]),
+    ("agl-bool", OK_WORLD + "planner: {agl: true}\n", ["planner.agl = True", "wrong type"]),
+    # YAML 1.2 core: yes is text, not a boolean (and 5e-1 is a number, below)
+    ("agl-yes", OK_WORLD + "planner: {agl: yes}\n", ["planner.agl = 'yes'", "wrong type"]),
     ("seed", "world: {scenario: open-field, seed: -1}\n", ["world.seed = -1", "0 <= seed"]),
     ("seed-type", "world: {scenario: open-field, seed: 1.5}\n",
      ["world.seed = 1.5", "integer"]),
@@ -191,6 +193,23 @@ BAD = [
      ["either scenario or real data"]),
     ("heights-on-dem", "world: {dem: dem.tif, height_cells: 30}\nstart: [0, 0, 0]\n"
      "goal: [1, 1, 1]\n", ["height_cells only applies to a world with buildings"]),
+    # issue 25: integers are never booleans or floats; no NaN/inf; speeds consistent
+    ("order-bool", OK_WORLD + "planner: {order: true}\n",
+     ["planner.order = True", "wrong type (bool)", "1, 2"]),
+    ("order-float", OK_WORLD + "planner: {order: 2.0}\n", ["planner.order = 2.0", "integer"]),
+    ("version-bool", "version: true\n" + OK_WORLD, ["version = True", "wrong type (bool)"]),
+    ("agl-nan", OK_WORLD + "planner: {agl: .nan}\n", ["planner.agl = nan", "not a finite"]),
+    ("start-inf", OK_WORLD + "start: {x: .inf, y: 1, z: 1}\n", ["start.x = inf", "finite"]),
+    ("nodata-value-nan", "world: {dem: dem.tif, nodata_value: .nan}\nstart: [0, 0, 0]\n"
+     "goal: [1, 1, 1]\n", ["world.nodata_value = nan", "finite"]),
+    ("min-speed-multirotor", OK_WORLD + "airframe: {min_speed: 8, hover_speed: 5}\n",
+     ["airframe", "min_speed 8 m/s is above hover_speed 5 m/s"]),
+    ("min-speed-fixed-wing", OK_WORLD + "airframe: {type: fixed_wing, min_speed: 20, "
+     "cruise_speed: 15}\n", ["min_speed 20 m/s is above cruise_speed 15 m/s"]),
+    ("walls-yes", OK_WORLD + "planner: {walls: on}\n",
+     ["planner.walls = 'on'", "true or false", "YAML 1.2"]),
+    ("circle-radius", OK_WORLD + "no_fly_zones: [{circle: {center: [500, 500], radius: -5}}]\n",
+     ["no_fly_zones[0].circle.radius = -5", "0 < radius"]),
 ]
 
 
@@ -346,6 +365,48 @@ def test_run_flags_override_the_mission_export_and_route(examples, tmp_path):
     res = runner.invoke(app, ["run", str(examples / "open_field_tff.yaml"), "--out",
                               str(tmp_path / "q"), "--via", "1,2"])
     assert res.exit_code == 2 and "--via 1 must be x,y,z" in res.output
+
+
+# ------------------------------------------------------------ YAML 1.2 numbers (issue 25)
+def test_exponent_numbers_are_numbers(tmp_path):
+    f = tmp_path / "m.yaml"
+    f.write_text(OK_WORLD + "planner: {exponent: 5e-1, saturation: 1E-1, agl: 1.5e2}\n")
+    m = load_mission(f)
+    assert (m.planner.exponent, m.planner.saturation, m.planner.agl) == (0.5, 0.1, 150.0)
+
+
+# ------------------------------------------- one rule for relative paths (issue 25)
+def test_outputs_dir_is_relative_to_the_mission_file(tmp_path, monkeypatch):
+    """outputs.dir is read like world.dem: against the mission file's folder, wherever
+    the command runs; where that differs from the old reading, a warning says so."""
+    proj = tmp_path / "proj"
+    proj.mkdir()
+    f = proj / "m.yaml"
+    f.write_text(OK_WORLD + "outputs: {dir: results, formats: [csv]}\n")
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    m = load_mission(f)
+    assert m.output_dir() == proj / "results"
+    notice = m.output_dir_notice()
+    assert "relative to the mission file's folder" in notice
+    assert str(proj / "results") in notice and str(elsewhere / "results") in notice
+    res = runner.invoke(app, ["run", str(f)])
+    assert res.exit_code == 0, res.output
+    assert (proj / "results" / "path.csv").exists() and list(elsewhere.iterdir()) == []
+    assert "warning: outputs.dir 'results' is relative to the mission file's folder" \
+        in res.output
+    # run from the mission's folder: both readings agree, no warning
+    monkeypatch.chdir(proj)
+    assert load_mission("m.yaml").output_dir_notice() is None
+    res = runner.invoke(app, ["run", "m.yaml", "--force"])
+    assert res.exit_code == 0 and "warning: outputs.dir" not in res.output, res.output
+    # --out and absolute paths are taken as given
+    assert parse_mission({"world": {"scenario": "open-field"},
+                          "outputs": {"dir": str(tmp_path / "abs")}},
+                         base_dir=proj).output_dir() == tmp_path / "abs"
+    assert parse_mission({"world": {"scenario": "open-field"},
+                          "outputs": {"dir": "rel"}}).output_dir() == Path("rel")
 
 
 def test_parse_world_checks_the_world_section_alone_in_the_mission_words(tmp_path):

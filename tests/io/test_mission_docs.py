@@ -32,3 +32,20 @@ def test_speed_and_flight_time_defaults_in_the_guide():
     assert f"| `airframe.reserve` | 0 ≤ r < 1 (share of the endurance kept) | " \
            f"{_g(AirframeSpec().reserve)} |" in DOC
     assert f"| `outputs.speed_step` | 0 < step ≤ 20 m/s | {_g(OutputSpec().speed_step)} |" in DOC
+
+
+def test_the_files_the_guide_lists_are_the_ones_its_run_writes():
+    """Section 1 lists the files of `fm2uav run examples/jacksboro_tff.yaml`: exactly the
+    example's outputs.formats (path.kmz was listed while the example did not write it)."""
+    import re
+
+    from fm2uav.cli.cmd_run import output_names
+    from fm2uav.io.mission import load_mission
+
+    section = DOC.split("## 1.", 1)[1].split("## 2.", 1)[0]
+    assert "fm2uav run examples/jacksboro_tff.yaml" in section
+    table = section.split("| file | what it is |", 1)[1].split("\n\n", 1)[0]
+    listed = {name for row in table.splitlines()[2:]
+              for name in re.findall(r"`([^`]+)`", row.split("|")[1])}
+    example = Path(__file__).resolve().parents[2] / "examples" / "jacksboro_tff.yaml"
+    assert listed == set(output_names(load_mission(example).outputs.formats))

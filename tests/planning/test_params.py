@@ -103,3 +103,25 @@ def test_validate_helpers():
                 lambda: v.point((1, 2), 3, "goal"), lambda: v.point((1, np.nan, 2), 3, "goal")):
         with pytest.raises(InputError):
             bad()
+
+
+def test_upper_bounds_are_the_mission_files():
+    """One spelling, one range: the library's upper bounds are PlannerSpec's `le`."""
+    from fm2uav.io.mission import PlannerSpec
+    from fm2uav.planning.params import UPPER
+
+    for name, hi in UPPER.items():
+        les = [m.le for m in PlannerSpec.model_fields[name].metadata
+               if getattr(m, "le", None) is not None]
+        assert les == [hi], name
+
+
+@pytest.mark.parametrize("kw, flag", [({"agl": 1e308}, "--agl"), ({"agl": 100, "p2": 11},
+                                                                     "--p2"),
+                                      ({"saturation_distance": 1e6}, "--saturation-distance")])
+def test_values_beyond_the_upper_bounds_are_refused(kw, flag):
+    from fm2uav.errors import InputError
+    from fm2uav.planning.params import planner_objects
+
+    with pytest.raises(InputError, match=f"too large.*CLI: {flag}"):
+        planner_objects(kw)

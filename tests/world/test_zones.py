@@ -123,3 +123,111 @@ def test_surface_clearance_to_a_building_box():
     d = surface_clearance(w, np.array([[10.0, 10.0, 8.0], [15.0, 10.0, 3.0]]))
     assert d[0] == pytest.approx(3.0)          # above the roof
     assert d[1] == pytest.approx(15.0 - 12.5)  # beside the wall (box edge at 12.5)
+
+
+# --------------------------------------------------------- points and zones (issue 25)
+def test_points_in_a_zone_or_outside_the_area_are_bad_input_saying_which(field):
+    from fm2uav.errors import PointError
+
+    nofly = zone_from_mapping({"polygon": [[700, 300], [900, 300], [900, 1000], [700, 1000]],
+                               "buffer": 30, "name": "range"})
+    area = zone_from_mapping({"polygon": [[0, 0], [900, 0], [900, 900], [0, 900]],
+                              "buffer": 50}, inclusion=True)
+    w = with_zones(field, [nofly])
+    with pytest.raises(PointError, match=r"the goal \[800.0, 500.0, 450.0\] m lies in the "
+                       r"no-fly zone 'range' \(inside it\)"):
+        check_points_allowed(w, {"goal": [800.0, 500.0, 450.0]})
+    with pytest.raises(PointError, match=r"'range' \(in its buffer\)"):
+        check_points_allowed(w, {"goal": [680.0, 500.0, 450.0]})
+    a = with_zones(field, [area])
+    with pytest.raises(PointError, match=r"the goal \[1500.0, 1200.0, 450.0\] m is not inside "
+                       r"the operating area .*outside it, 671 m from its edge.*enlarge "
+                       r"operating_area"):
+        check_points_allowed(a, {"goal": [1500.0, 1200.0, 450.0]})
+    with pytest.raises(PointError, match="within its buffer of 50 m from the edge"):
+        check_points_allowed(a, {"start": [880.0, 450.0, 450.0]})
+    check_points_allowed(a, {"start": [450.0, 450.0, 450.0]})  # well inside: fine
+
+
+def test_a_zone_file_wholly_off_the_map_is_warned_about(tmp_path):
+    import json
+    import warnings
+
+    from fm2uav.world.zones import ZoneWarning
+
+    jb = get_scenario("jacksboro").world
+    far = [[-80.6, 36.25], [-80.55, 36.25], [-80.55, 36.3], [-80.6, 36.25]]
+    p = tmp_path / "far.geojson"
+    p.write_text(json.dumps({"type": "FeatureCollection", "features": [
+        {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon",
+                                                           "coordinates": [far]}}]}))
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        zs = read_zones(str(p), jb)
+    msgs = [str(r.message) for r in rec if issubclass(r.category, ZoneWarning)]
+    assert len(zs) == 1 and len(msgs) == 1
+    assert "its zone lies off the map" in msgs[0] and "km from its edge" in msgs[0]
+
+
+def test_a_zone_file_with_lat_lon_swapped_is_refused_with_the_fix(tmp_path):
+    import json
+
+    jb = get_scenario("jacksboro").world
+    ring = [[36.55, -84.30], [36.55, -84.25], [36.60, -84.25], [36.55, -84.30]]  # [lat, lon]
+    p = tmp_path / "swapped.geojson"
+    p.write_text(json.dumps({"type": "FeatureCollection", "features": [
+        {"type": "Feature", "properties": {}, "geometry": {"type": "Polygon",
+                                                           "coordinates": [ring]}}] * 2}))
+    with pytest.raises(InputError, match=r"all of its 2 zones lie off the map, but with "
+                       r"longitude and latitude swapped they would lie on it.*\[lat, lon\].*"
+                       r"swap the two coordinates"):
+        read_zones(str(p), jb)
+    # the same swap in an inline lon/lat zone of a mission file
+    from fm2uav.io.zone_spec import ZoneSpec, resolve_zones
+
+    spec = ZoneSpec(polygon=ring, lonlat=True)
+    with pytest.raises(InputError, match=r"^no_fly_zones\[0\] lies off the map, but with "
+                       "longitude and latitude swapped"):
+        resolve_zones([spec], None, jb)
+    # written the right way round it is on the map: no error, no warning
+    ok = ZoneSpec(polygon=[[b, a] for a, b in ring], lonlat=True)
+    assert len(resolve_zones([ok], None, jb)) == 1
+
+
+def test_a_self_intersecting_zone_is_repaired_with_a_warning():
+    import warnings
+
+    from fm2uav.world.zones import ZoneWarning
+
+    with warnings.catch_warnings(record=True) as rec:
+        warnings.simplefilter("always")
+        z = zone_from_mapping({"polygon": [[0, 0], [100, 100], [100, 0], [0, 100]],
+                               "name": "bow tie"})
+    msgs = [str(r.message) for r in rec if issubclass(r.category, ZoneWarning)]
+    assert len(msgs) == 1 and "Self-intersection" in msgs[0] and "2 parts" in msgs[0]
+    assert z.geometry.geom_type == "MultiPolygon" and abs(z.geometry.area - 5000) < 1e-6
+
+
+def test_an_inline_zone_off_the_map_names_the_map_in_its_own_units():
+    """A mission-file entry is no file and may be in metres: the warning says in which units
+    the map lies (metres for lonlat: false, lon/lat degrees for lonlat: true)."""
+    import warnings
+
+    from fm2uav.io.zone_spec import ZoneSpec, resolve_zones
+    from fm2uav.world.zones import ZoneWarning
+
+    jb = get_scenario("jacksboro").world
+    b = np.asarray(jb.bounds)
+    far_m = ZoneSpec(polygon=[[b[0, 1] + 5e4, 0], [b[0, 1] + 6e4, 0], [b[0, 1] + 6e4, 1e4]])
+    far_ll = ZoneSpec(polygon=[[-80.6, 36.25], [-80.55, 36.25], [-80.55, 36.3]], lonlat=True)
+    msgs = []
+    for spec in (far_m, far_ll):
+        with warnings.catch_warnings(record=True) as rec:
+            warnings.simplefilter("always")
+            assert len(resolve_zones([spec], None, jb)) == 1
+        msgs += [str(r.message) for r in rec if issubclass(r.category, ZoneWarning)]
+    assert len(msgs) == 2 and all(m.startswith("no_fly_zones[0] lies off the map") for m in msgs)
+    assert f"world metres (lonlat: false) and the map covers x {b[0, 0]:.0f}..{b[0, 1]:.0f} m" \
+        in msgs[0] and "file" not in msgs[0]
+    assert "check its [lon, lat] coordinates: the map covers lon -84." in msgs[1]
+    assert "file" not in msgs[1]

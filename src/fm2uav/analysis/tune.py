@@ -35,7 +35,7 @@ from ..world import World
 from ..planning import FlightLevel, Plan, PlanOptions, Shaping, plan
 from ..vehicles.airframes import AirframeLimits, FixedWing, Multirotor, get_airframe
 
-__all__ = ["TuneResult", "tune", "as_limits", "DEFAULT_GRID"]
+__all__ = ["TuneResult", "tune", "as_limits", "DEFAULT_GRID", "MAX_TUNE_PLANS"]
 
 #: Default search grid.
 DEFAULT_GRID: dict[str, tuple[float, ...]] = {
@@ -168,6 +168,10 @@ def _grid_values(name: str, values: Any, lo: float, hi: float | None) -> tuple[f
     return vals
 
 
+#: Most grid combinations of one :func:`tune` (each is an FM² plan).
+MAX_TUNE_PLANS = 2000
+
+
 def _tune_grid(grid: dict[str, Any] | None) -> tuple[tuple[float, ...], ...]:
     """The p1, p2, saturation and exponent values of the search (``grid`` over the defaults)."""
     g = dict(DEFAULT_GRID)
@@ -179,6 +183,13 @@ def _tune_grid(grid: dict[str, Any] | None) -> tuple[tuple[float, ...], ...]:
     p2s = _grid_values("p2", g["p2"], 0.0, None)
     sats = _grid_values("saturation", g["saturation"], 0.0, 1.0)
     exps = _grid_values("exponent", g["exponent"], 0.0, None)
+    n = len(p1s) * len(p2s) * len(sats) * len(exps)
+    if n > MAX_TUNE_PLANS:  # refused before the first plan, with what it would take
+        raise InputError(
+            f"the tuning grid has {n} combinations ({len(p1s)} p1 x {len(p2s)} p2 x "
+            f"{len(sats)} saturation x {len(exps)} exponent values), one FM² plan each "
+            f"(~1-10 s); the limit is {MAX_TUNE_PLANS}: give fewer values (CLI --p1, --p2, "
+            "--saturation, --exponent)")
     return p1s, p2s, sats, exps
 
 

@@ -201,6 +201,14 @@ class ExportOptions:
                 raise InputError(f"export option {name} must be a number > 0, got {v!r}")
         if self.speed_step <= 0:
             raise InputError(f"speed_step must be > 0 m/s, got {self.speed_step!r}")
+        if self.min_speed is not None and self.min_speed > self.forward_speed:
+            key, flag = (("hover_speed", "--hover-speed") if self.vehicle == "multirotor"
+                         else ("cruise_speed", "--cruise-speed"))
+            raise InputError(
+                f"airframe.min_speed = {self.min_speed:g} m/s (CLI --min-speed) is above "
+                f"airframe.{key} = {self.forward_speed:g} m/s ({flag}), the speed this "
+                f"{self.vehicle.replace('_', '-')} flies the mission at: no commanded speed "
+                f"may be below the one or above the other; allowed: min_speed <= {key}")
         if not 0 < self.land_slope_deg <= self.max_land_slope_deg:
             raise InputError(f"land_slope_deg must be in (0, {self.max_land_slope_deg:g}] "
                              f"(FW_LND_ANG), got {self.land_slope_deg!r}")
@@ -474,7 +482,7 @@ def _speeds(opt: ExportOptions, wps: Waypoints, w: Any, times: Any,
     idx = wps.indices
     vmax = opt.forward_speed
     floor = opt.min_speed if opt.min_speed is not None else (
-        DEFAULT_MIN_SPEED if opt.vehicle != "fixed_wing" else None)
+        min(DEFAULT_MIN_SPEED, vmax) if opt.vehicle != "fixed_wing" else None)
     holds = np.zeros(len(idx))
     changes: list[tuple[int, float]] = []
     timing = None

@@ -162,11 +162,22 @@ def cover_cmd(
     from ..world.load import world_summary
 
     level = safety.level(agl, p1=p1, p2=p2)  # refuses agl outside --min-agl/--max-agl
+    from .. import _validate
+
+    for name, share in (("--side-overlap", side_overlap), ("--front-overlap", front_overlap)):
+        _validate.in_range(share, name.lstrip("-").replace("-", "_"), 0.0, 1.0,
+                           high_open=True, where=(None, name))  # also without --camera
     if (spacing is None) == (camera is None):
         raise InputError("give exactly one of --spacing (metres) or --camera")
     cam = None if camera is None else _camera(camera)
     d = spacing if spacing is not None else cam.spacing(agl, side_overlap)
     mission_options = mission.export_options(name=f"coverage of {area}")
+    from ..scenarios.coverage import COVERAGE_AREAS
+
+    if area.strip().upper() not in COVERAGE_AREAS:  # a file: an input --force never deletes
+        from .. import _validate
+
+        _validate.note_input(Path(area), "--area")
     outdir = output.dir(COVER_FILES + ((REPORT,) if output.report else ()))
     opts = {"bounds_deg": FULL_BOUNDS_DEG} if full_range else {}
     with output.progress() as step, reporting(lambda e: step(e.message)):

@@ -9,7 +9,7 @@ from types import SimpleNamespace
 import typer
 
 from ..errors import InputError
-from ._common import Output, handle_errors, write_json
+from ._common import Output, handle_errors, write_json, write_text
 from .options import MissionFlags, mission_options, output_options
 from .cmd_run import mission_rows, write_exports
 
@@ -51,7 +51,8 @@ EXPORT_HELP = (
 @handle_errors
 @mission_options("firmware", "vehicle", "frame", "end", "thin", "anchor", "speed_changes",
                  "min_speed", "cruise_speed", "hover_speed", "endurance", "reserve")
-@output_options("out/export")
+@output_options("out/export", report_help="Also write report.html (interactive, "
+                "self-contained: the path, its waypoints and the mission's numbers on the world).")
 def export_cmd(
     path_file: Path = typer.Argument(..., help="Path CSV (as written by fm2uav)."),
     fmt: list[str] = typer.Option(
@@ -75,7 +76,8 @@ def export_cmd(
     from ..planning import FlightLevel
 
     formats = parse_formats(",".join(fmt))
-    outdir = output.dir([EXPORT_FILES[f] for f in formats] + ["summary.json"])
+    outdir = output.dir([EXPORT_FILES[f] for f in formats] + ["summary.json"]
+                        + (["report.html"] if output.report else []))
     world, base, mission_level, where = _world(mission_file, scenario, seed)
     header = read_path_header(path_file)
     path, w, floor = _read_path(path_file, header, world, where)
@@ -98,10 +100,21 @@ def export_cmd(
     summary = {"path_file": str(path_file), "world": where, "path_crs": header["crs"],
                "points": len(path), "length_m": round(track.length, 3),
                "autopilot": built.summary()}
-    write_json(outdir, "summary.json", {**summary, "files": [p.name for p in outdir.written]
-                                        + ["summary.json"]})
     rows = {"path": f"{path_file} ({len(path)} points, {track.length:.1f} m)",
             "world": where, **mission_rows(built)}
+    if output.report:
+        from ..viz.report import report_html
+
+        write_text(outdir, "report.html", report_html(
+            world, {"path": path}, speeds={"path": w} if w is not None else None,
+            waypoints={"path": built.waypoints.points_m}, title=f"fm2uav export — {path_file.name}",
+            subtitle=f"{built.summary()['firmware']} {built.summary()['vehicle']} mission on "
+                     f"the {where} world", agl=None if level is None else level.agl,
+            params={"path file": str(path_file), "formats": ", ".join(formats),
+                    "waypoint tolerance [m]": options.tolerance},
+            metrics=rows, files=[p.name for p in outdir.written] + ["summary.json"]))
+    write_json(outdir, "summary.json", {**summary, "files": [p.name for p in outdir.written]
+                                        + ["summary.json"]})
     output.summary("fm2uav export", rows, summary)
 
 

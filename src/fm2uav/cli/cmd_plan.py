@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import typer
 
 from ..errors import InputError
@@ -85,7 +87,7 @@ def plan_cmd(
         "the take-off/landing points (with --agl)."),
     max_agl: float | None = typer.Option(
         None, "--max-agl", help="Hard ceiling (m) above the ground, e.g. 120 (with --agl)."),
-    no_fly: list[str] | None = typer.Option(
+    no_fly: list[Path] | None = typer.Option(
         None, "--no-fly", help="No-fly zones file (GeoJSON lon/lat, KML/KMZ, GPKG, SHP; points "
         "need a 'radius' in metres); the plan keeps out of them and the .plan carries them "
         "as geofences. Repeatable.", show_default=False),
@@ -163,13 +165,19 @@ def _planner(shaping: dict, level: dict) -> tuple:
         if level["min_agl"] is not None or level["max_agl"] is not None:
             raise InputError("--min-agl / --max-agl limit a terrain-following flight; give "
                              "--agl too (the requested height above ground)")
+        from .. import _validate
+
+        # unused without --agl, but never silently garbage (the mission file's ranges)
+        for k, hi, low_open in (("p1", 10.0, True), ("p2", 10.0, True), ("band", 5000.0, False)):
+            _validate.in_range(level[k], k, 0.0, hi, low_open=low_open,
+                               where=(f"planner.{k}", f"--{k}"))
         level = {}
     level = {k: v for k, v in level.items() if v is not None or k not in ("min_agl", "max_agl")}
     return planner_objects({**shaping, **level})
 
 
 def _points(w, sc, start: str | None, goal: str | None, via: list[str] | None, *,
-            world: WorldFlags, no_fly: list[str] | None, **how) -> tuple:
+            world: WorldFlags, no_fly: list[Path] | None, **how) -> tuple:
     """``(world, start, goal, via points)`` in metres, checked (free, not over filled
     nodata, outside the ``--no-fly`` zones, which become obstacles of the world)."""
     import numpy as np
@@ -257,6 +265,7 @@ def _export_options(anchor: str | None, thin: float):
 
     from ..autopilot import ExportOptions
 
-    if not np.isfinite(thin) or thin < 0:
-        raise InputError(f"--thin must be a tolerance >= 0 m, got {thin}")
+    if not (np.isfinite(thin) and 0 <= thin <= 1000):
+        raise InputError(f"--thin must be a tolerance in [0, 1000] m (mission file: "
+                         f"outputs.thin_tolerance), got {thin}")
     return ExportOptions(tolerance=thin, anchor=parse_anchor(anchor))

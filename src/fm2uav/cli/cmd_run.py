@@ -53,8 +53,10 @@ RUN_HELP = (
 
 
 @handle_errors
-@output_options(None, out_help="Output directory. Default: the mission's outputs.dir, else "
-                "out/<mission file name>.")
+@output_options(None, out_help="Output directory. Default: the mission's outputs.dir "
+                "(relative to the mission file), else out/<mission file name> in the current "
+                "folder.", report_help="Also write report.html (interactive, self-contained) "
+                "when outputs.formats leaves it out (the default formats include it).")
 @world_options
 @mission_options(*MISSION_FLAGS, "thin", "anchor")
 def run_cmd(
@@ -102,14 +104,22 @@ def run_cmd(
     m = load_mission(mission_file, world_overrides=world.overrides(),
                      point_overrides=points or None)
     options = mission.export_options(m.export_options())
-    target = output.out or Path(m.outputs.dir or Path("out") / mission_file.stem)
-    formats = list(dict.fromkeys(m.outputs.formats))
+    # outputs.dir is relative to the mission file, like every path in it (io/mission.py)
+    target = output.out or m.output_dir() or Path("out") / mission_file.stem
+    notice = None if output.out else m.output_dir_notice()
+    if notice:
+        import warnings
+
+        from ..io.mission import MissionWarning
+
+        warnings.warn(notice, MissionWarning, stacklevel=1)
+    formats = list(dict.fromkeys(m.outputs.formats + (["html"] if output.report else [])))
     outdir = output.dir(output_names(formats), path=target)
     planner = {k: v for k, v in (("min_agl", min_agl), ("max_agl", max_agl),
                                  ("saturation_distance", saturation_distance)) if v is not None}
     with output.progress() as step, reporting(lambda e: step(e.message)):
         run = run_mission(m, outdir, mission_file=mission_file, options=options,
-                          planner=planner, no_fly=no_fly or ())
+                          planner=planner, no_fly=no_fly or (), formats=formats)
     p = run.plan
     rows = {
         "mission": m.name,

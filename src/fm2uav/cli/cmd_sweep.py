@@ -35,6 +35,7 @@ EXIT_CODES_HELP = (
     "the same command resumes); 70 an internal error."
 )
 
+REPORT = "report.html"
 REPORT_FILES = (
     "tables.md",
     "summary.json",
@@ -69,7 +70,8 @@ def _warning(message: str) -> None:
 
 
 def run_and_report(config, out: Path, *, force: bool, scheduler: str | None, workers: int | None,
-                   retry_failed: bool, as_json: bool, quiet: bool, title: str) -> None:
+                   retry_failed: bool, as_json: bool, quiet: bool, title: str,
+                   report: bool = False) -> None:
     """Run (or resume) a sweep holding its folder, then write tables and figures into ``out``.
 
     The report files are one output set (:class:`~fm2uav.io.outdir.OutputDir`): staged
@@ -82,10 +84,16 @@ def run_and_report(config, out: Path, *, force: bool, scheduler: str | None, wor
     cases are kept, the report is not written).
     """
     from ..errors import InputError
-    from ..experiments.runner import SweepInterrupted, raise_on_signals, same_sweep, sweep_lock
+    from ..experiments.runner import (
+        SweepInterrupted,
+        check_workers,
+        raise_on_signals,
+        same_sweep,
+        sweep_lock,
+    )
     from ..io.outdir import OutputDir
 
-
+    workers = check_workers(workers)  # before anything is written into `out`
     try:
         same = same_sweep(config, out)
     except InputError:  # a damaged config.json: --force starts over
@@ -94,13 +102,13 @@ def run_and_report(config, out: Path, *, force: bool, scheduler: str | None, wor
         same = False
     # the report files belong to the sweep in `out`: a resume rewrites them
     outdir = OutputDir(out, force=force or same)
-    outdir.check(REPORT_FILES)  # before the sweep writes into `out`
+    outdir.check(REPORT_FILES + ((REPORT,) if report else ()))  # before the sweep writes
     try:
         with sweep_lock(out), raise_on_signals():
             result = _run_and_report(config, out, outdir, fresh=force and not same,
                                      scheduler=scheduler, workers=workers,
                                      retry_failed=retry_failed, as_json=as_json, quiet=quiet,
-                                     title=title)
+                                     title=title, report=report)
     except SweepInterrupted as exc:
         message = exc.message
         if "resume" not in message:  # stopped while the report was being written
@@ -124,7 +132,7 @@ def _fail(message: str, code: int, prefix: str = "error: ") -> None:
 
 def _run_and_report(config, out: Path, outdir: OutputDir, *, fresh: bool, scheduler: str | None,
                     workers: int | None, retry_failed: bool, as_json: bool, quiet: bool,
-                    title: str) -> Any:
+                    title: str, report: bool = False) -> Any:
     from ..experiments.curvature import summarise_run, sweep_payload, tables_markdown
     from ..experiments.runner import run_sweep
 
@@ -157,6 +165,18 @@ def _run_and_report(config, out: Path, outdir: OutputDir, *, fresh: bool, schedu
             outdir.commit(tmp, name)
     with outdir.open("tables.md") as fh:
         fh.write(tables_markdown(summary, result))
+    if report:
+        from ..viz.sweep import sweep_report_html
+
+        n_pairs = config.pairs if isinstance(config.pairs, int) else len(config.pairs)
+        with outdir.open(REPORT) as fh:
+            fh.write(sweep_report_html(
+                world, summary, title=title,
+                subtitle=f"{len(result.alphas)} x {len(result.betas)} (α, β), {n_pairs} pairs, "
+                         f"ξ = {config.xi:g} m",
+                params={k: v for k, v in config.identity().items()
+                        if k not in ("alpha", "beta", "pairs")},
+                files=list(REPORT_FILES) + [config.results]))
     payload = sweep_payload(summary, result, config, out)
     payload["faults"] = {"cases_retried": result.cases_retried,
                          "worker_deaths": result.worker_deaths, "log_warnings": result.warnings}
@@ -221,9 +241,13 @@ CURVATURE_HELP = (
 _FORCE_HELP = "Discard a different sweep in --out."
 
 
+_REPORT_HELP = ("Also write report.html (interactive, self-contained: the best FM² paths and "
+                "the references on the map, the best-parameter and timing tables).")
+
+
 @handle_errors
 @output_options("out/sweep", out_help="Output directory (resumed if it holds the same sweep).",
-                force_help=_FORCE_HELP)
+                force_help=_FORCE_HELP, report_help=_REPORT_HELP)
 def sweep_cmd(
     config: Path = typer.Argument(..., help="YAML sweep configuration."),
     scheduler: str | None = typer.Option(
@@ -242,11 +266,11 @@ def sweep_cmd(
 
     run_and_report(load_config(config), output.out, force=output.force, scheduler=scheduler,
                    workers=workers, retry_failed=retry_failed, as_json=output.as_json,
-                   quiet=output.quiet, title="α–β sweep")
+                   quiet=output.quiet, title="α–β sweep", report=output.report)
 
 
 @handle_errors
-@output_options("out/curvature", force_help=_FORCE_HELP)
+@output_options("out/curvature", force_help=_FORCE_HELP, report_help=_REPORT_HELP)
 def curvature_cmd(
     full: bool = typer.Option(False, "--full", help="Force the seed's grid 0.02:0.02:1 "
                               "(the default; overrides --step)."),
@@ -263,7 +287,8 @@ def curvature_cmd(
     cfg = curvature_config(step=None if full else step, pairs=pairs, xi=xi)
     run_and_report(cfg, output.out, force=output.force, scheduler=scheduler, workers=workers,
                    retry_failed=True, as_json=output.as_json, quiet=output.quiet,
-                   title="Seed 004: FM² vs curvature-penalised references")
+                   title="Seed 004: FM² vs curvature-penalised references",
+                   report=output.report)
 
 
 def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:

@@ -36,7 +36,9 @@ def _tracking_rows(s: dict) -> dict[str, str]:
 
 
 @handle_errors
-@output_options("out/tracking")
+@output_options("out/tracking", report_help="Also write report.html (interactive, "
+                "self-contained: the FM² paths flown and the Dubins references on the map, "
+                "the tracking table).")
 def tracking_cmd(
     step: float = typer.Option(0.1, help="Grid step of α and β (the seed's: 0.02)."),
     pairs: int = typer.Option(24, help="Number of start/goal pairs."),
@@ -50,7 +52,7 @@ def tracking_cmd(
     write, print."""
     from ..experiments.tracking import reproduce_tracking, tracking_markdown, tracking_summary
 
-    outdir = output.dir(TRACKING_FILES)
+    outdir = output.dir(TRACKING_FILES + (("report.html",) if output.report else ()))
     out = output.out
     sweep = sweep_dir if sweep_dir is not None else out.with_name(out.name + "-sweep")
     with output.progress() as stage:
@@ -59,6 +61,21 @@ def tracking_cmd(
         stage("writing the tables")
         write_text(outdir, "table.md", "# Seed 004 §3.5 — tracking the best Dubins-like FM² "
                    "paths\n\n" + tracking_markdown(run) + "\n")
+        if output.report and run.tracks:
+            from ..experiments.runner import sweep_world
+            from ..experiments.curvature import curvature_config
+            from ..viz.report import join_polylines, report_html
+
+            world = sweep_world(curvature_config(step, pairs=pairs, xi=xi))[0]
+            write_text(outdir, "report.html", report_html(
+                world, {f"FM² pair {k + 1}": fm2 for k, (fm2, _ref) in enumerate(run.tracks)},
+                overlays={"Dubins references": {"points": join_polylines(
+                    [ref for _fm2, ref in run.tracks]), "color": "#d62728", "dash": "dash"}},
+                title="Seed 004 §3.5: tracking the best Dubins-like FM² paths",
+                subtitle=f"α = {run.alpha:g}, β = {run.beta:g} (best area match), ξ = "
+                         f"{run.xi:g} m", params={"grid step": step, "pairs": pairs, "xi [m]": xi},
+                tables={"Tracking error per pair, vehicle and look-ahead": run.rows},
+                files=list(TRACKING_FILES)))
     s = tracking_summary(run)
     summary = {**s, "rows": run.rows, "paths_curvature": run.paths, "sweep_dir": str(sweep)}
     write_json(outdir, "summary.json", summary)

@@ -21,7 +21,8 @@ URBAN_HELP = (
 
 
 @handle_errors
-@output_options("out/urban")
+@output_options("out/urban", report_help="Also write report.html (interactive, self-contained: "
+                "the six paths among the buildings and the table).")
 def urban_cmd(
     seed: int = typer.Option(
         None, help="City seed (default: the first whose buildings keep 20 m from the "
@@ -33,7 +34,7 @@ def urban_cmd(
     from ..experiments.urban import reproduce_urban, urban_markdown
     from ..io import write_path_csv
 
-    outdir = output.dir(URBAN_FILES)
+    outdir = output.dir(URBAN_FILES + (("report.html",) if output.report else ()))
     with output.progress() as step:
         run = reproduce_urban(seed, on_step=step)
         step("writing the table and paths")
@@ -42,6 +43,18 @@ def urban_cmd(
                 write_path_csv(fh, p.path, p.w)
         write_text(outdir, "table.md", "# Thesis §4.4 — flight levels in the city\n\n"
                    + urban_markdown(run) + "\n")
+        if output.report:
+            from ..viz.report import report_html
+
+            names = [f"case {i + 1}: level {r['level']} (p1={r['p1']:g}, p2={r['p2']:g})"
+                     for i, r in enumerate(run.rows)]
+            write_text(outdir, "report.html", report_html(
+                run.world, {n: p.path for n, p in zip(names, run.plans)},
+                speeds={n: p.w for n, p in zip(names, run.plans)},
+                title="Thesis §4.4: flight levels in the city",
+                subtitle=f"city seed {run.seed}, start {run.start.tolist()} m, goal "
+                         f"{run.goal.tolist()} m", params={"city seed": run.seed},
+                tables={"Flight levels (thesis §4.4)": run.rows}, files=list(URBAN_FILES)))
     summary = {"seed": run.seed, "start_m": run.start, "goal_m": run.goal, "cases": run.rows}
     write_json(outdir, "summary.json", summary)
     show = {f"level {r['level']} (p1={r['p1']:g}, p2={r['p2']:g})":

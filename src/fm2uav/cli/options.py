@@ -477,18 +477,27 @@ def mission_options(*names: str) -> Callable[[Callable[..., Any]], Callable[...,
 
 
 def output_options(out: str | None, *, out_help: str = "Output directory.",
-                   force_help: str = "Overwrite existing outputs.",
+                   force_help: str = "Replace an existing --out folder as a whole (never "
+                                     "one that holds an input of the command).",
                    json_help: str = "Print the summary as JSON.",
                    report_help: str | None = None
                    ) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
     """``@output_options("out/plan", ...)``: ``--out``, ``--force``, ``--json``, ``--quiet``
     (and ``--report`` with ``report_help``) in place of the command's ``output`` parameter,
-    passed as one :class:`~fm2uav.cli._common.Output`."""
+    passed as one :class:`~fm2uav.cli._common.Output`.
+
+    The command runs inside an :func:`fm2uav._validate.input_log` in which its path
+    arguments (``MISSION_FILE``, ``--dem``, ``--no-fly``, ...) are noted up front and
+    every file reader notes its file: the command's output sets refuse an ``--out``
+    that holds one of them (:class:`~fm2uav.io.outdir.OutputDir`). Its path parameters
+    are checked by fm2uav's readers (one line), not by click (:func:`_own_path_checks`).
+    """
     from ._common import Output
 
     params = [
         ("out", Annotated[Path | None if out is None else Path,
-                          typer.Option(help=out_help)], None if out is None else Path(out)),
+                          typer.Option(help=out_help, readable=False)],
+         None if out is None else Path(out)),
         ("force", Annotated[bool, typer.Option("--force", help=force_help)], False),
         ("as_json", Annotated[bool, typer.Option("--json", help=json_help)], False),
         ("quiet", Annotated[bool, typer.Option("--quiet", help="Print nothing but errors.")],
@@ -497,7 +506,73 @@ def output_options(out: str | None, *, out_help: str = "Output directory.",
     if report_help is not None:
         params.append(("report", Annotated[bool, typer.Option("--report", help=report_help)],
                        False))
-    return option_group("output", params, Output)
+    group = option_group("output", params, Output)
+
+    def decorate(func: Callable[..., Any]) -> Callable[..., Any]:
+        inner = group(func)
+        labels = _param_labels(inner)
+        _own_path_checks(inner)
+
+        @functools.wraps(inner)
+        def wrapper(*args: Any, **kwargs: Any) -> Any:
+            from .. import _validate
+
+            # every input the command reads is noted (here: its path arguments, up front;
+            # the readers note theirs), so --force never replaces a folder holding one
+            with _validate.input_log():
+                for key, value in kwargs.items():
+                    if key != "out":
+                        for path, label in _paths_in(value, labels.get(key, key)):
+                            _validate.note_input(path, label)
+                return inner(*args, **kwargs)
+
+        return wrapper
+
+    return decorate
+
+
+def _own_path_checks(func: Callable[..., Any]) -> None:
+    """Let fm2uav, not click, check the command's path parameters.
+
+    click's ``Path(readable=True)`` refuses an unreadable file with a usage box of
+    several lines; fm2uav's readers (:func:`fm2uav._validate.input_file`) refuse it
+    with one line naming the flag and the fix, as they do a folder or a named pipe.
+    """
+    for p in inspect.signature(func).parameters.values():
+        if "Path" not in str(p.annotation):
+            continue
+        for info in (p.default, *getattr(p.annotation, "__metadata__", ())):
+            if isinstance(info, (typer.models.ArgumentInfo, typer.models.OptionInfo)):
+                info.readable = False
+
+
+def _param_labels(func: Callable[..., Any]) -> dict[str, str]:
+    """Parameter name -> how the user spells it (``--no-fly``, ``MISSION_FILE``)."""
+    out: dict[str, str] = {}
+    for name, p in inspect.signature(func).parameters.items():
+        infos = [p.default, *getattr(p.annotation, "__metadata__", ())]
+        label = "--" + name.replace("_", "-")
+        for info in infos:
+            if isinstance(info, typer.models.ArgumentInfo):
+                label = name.upper()
+            elif isinstance(info, typer.models.OptionInfo):
+                decls = [d for d in (info.param_decls or ()) if d.startswith("--")]
+                if decls:
+                    label = decls[0].split("/")[0]
+        out[name] = label
+    return out
+
+
+def _paths_in(value: Any, label: str) -> list[tuple[Path, str]]:
+    """The paths in a command argument: a Path, a list of them, or a flag group's fields."""
+    if isinstance(value, Path):
+        return [(value, label)]
+    if isinstance(value, (list, tuple)):
+        return [e for v in value for e in _paths_in(v, label)]
+    if hasattr(value, "__dataclass_fields__") and not isinstance(value, type):
+        return [e for f in fields(value)
+                for e in _paths_in(getattr(value, f.name), "--" + f.name.replace("_", "-"))]
+    return []
 
 
 # -- flight safety (issue 13): no-fly zones, AGL limits, saturation in metres ------------------
@@ -556,9 +631,12 @@ class SafetyFlags:
             One line naming ``--max-agl`` / ``--min-agl`` when ``agl`` is outside the limits.
         """
         limits = self.limits(agl)
-        if agl is None:
-            return None
         from ..planning import FlightLevel
+
+        if agl is None:
+            if keys:  # unused without --agl, but never silently garbage (--p1 nan)
+                FlightLevel(agl=1.0, **keys)
+            return None
 
         return FlightLevel(agl=agl, **keys, **limits)
 

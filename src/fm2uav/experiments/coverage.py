@@ -111,6 +111,9 @@ def reproduce_coverage(seed: int = 0, *,
 
     ``on_step`` is called with a one-line description before each stage.
     """
+    from .._validate import seed_value
+
+    seed = seed_value(seed, "seed", where=(None, "--seed"))
     run = CoverageRun(seed=seed, world=coverage_world(seed))
     for n in COVERAGE_AREAS:
         on_step(f"area {n}: DE, 0.1° sweep, scipy DE and FM² along the bands")

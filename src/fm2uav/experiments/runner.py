@@ -70,8 +70,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import model_validator
 
 from ..errors import InputError
 from ..world import World
@@ -104,6 +104,8 @@ __all__ = [
     "SweepWarning",
     "load_config",
     "make_config",
+    "check_workers",
+    "max_workers",
     "run_sweep",
     "same_sweep",
     "sweep_lock",
@@ -117,13 +119,38 @@ _CONFIG_NAME = "config.json"
 _REFS_NAME = "references.npz"
 
 
+#: Largest number of FM² cases a sweep may have (33 times the seed's 60 000, which take
+#: about 3 minutes on 2 cores: ~400 cases/s).
+MAX_SWEEP_CASES = 2_000_000
+#: Largest number of start/goal pairs (each needs one reference path per model, ~1-2 s each).
+MAX_SWEEP_PAIRS = 1000
+#: Measured FM² sweep throughput on the 2-core development machine [cases/s] (the seed's
+#: 60 000 cases in ~2.5 min of FM²), for the time a refused sweep would take.
+SWEEP_CASES_PER_S = 400.0
+#: Bytes of one case in the log (a checksummed JSON line with the metrics).
+SWEEP_LOG_BYTES = 350
+
+_SWEEP_CONFIG = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
+
+
 class GridSpec(BaseModel):
     """``start:step:stop`` (inclusive) of α or β."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = _SWEEP_CONFIG
     start: float = Field(0.02, gt=0, le=1)
     stop: float = Field(1.0, gt=0, le=1)
-    step: float = Field(0.02, gt=0)
+    step: float = Field(0.02, gt=0, le=1)
+
+    @model_validator(mode="after")
+    def _ordered(self) -> GridSpec:
+        if self.start > self.stop:
+            raise ValueError(f"start {self.start:g} is above stop {self.stop:g}; give "
+                             "start <= stop")
+        return self
+
+    def count(self) -> int:
+        """How many values :meth:`values` has (without making them)."""
+        return int(math.floor((self.stop - self.start) / self.step + 1e-9)) + 1
 
     def values(self) -> np.ndarray:
         return parameter_grid(self.start, self.stop, self.step)
@@ -158,19 +185,48 @@ class SweepConfig(BaseModel):
         Summary file name in the output directory: ``*.csv`` or ``*.parquet``.
     """
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = _SWEEP_CONFIG
     scenario: str = "city2d"
-    cell: float = Field(2.0, gt=0)
+    cell: float = Field(2.0, ge=0.25, le=20)
     pairs: int | list[list[float]] = 24
-    pair_seed: int = 0
+    pair_seed: int = Field(0, ge=0, le=2**32 - 1)
     alpha: GridSpec = GridSpec()
     beta: GridSpec = GridSpec()
     models: list[str] = Field(default_factory=lambda: list(MODELS))
-    xi: float = Field(10.0, gt=0)
+    xi: float = Field(10.0, gt=0, le=1000)
     max_int: int = Field(4, ge=1, le=6)
-    ds: float = Field(1.0, gt=0)
+    ds: float = Field(1.0, ge=0.1, le=100)
     order: int = Field(2, ge=1, le=2)
     results: str = "results.parquet"
+
+    @field_validator("pairs")
+    @classmethod
+    def _pairs(cls, v: int | list[list[float]]) -> int | list[list[float]]:
+        n = v if isinstance(v, int) else len(v)
+        if isinstance(v, int) and v < 1:
+            raise ValueError(f"pairs must be at least 1, got {v}")
+        if n > MAX_SWEEP_PAIRS:
+            raise ValueError(
+                f"{n} pairs would need {n} reference paths per model (~1-2 s each: "
+                f"{n * 1.5 / 3600:.3g} h per model); the limit is {MAX_SWEEP_PAIRS} pairs")
+        return v
+
+    @model_validator(mode="after")
+    def _size(self) -> SweepConfig:
+        """Refuse, before anything runs, a sweep beyond :data:`MAX_SWEEP_CASES`, saying
+        what it would take."""
+        n_pairs = self.pairs if isinstance(self.pairs, int) else len(self.pairs)
+        na, nb = self.alpha.count(), self.beta.count()
+        cases = float(n_pairs) * na * nb
+        if cases > MAX_SWEEP_CASES:
+            hours = cases / SWEEP_CASES_PER_S / 3600
+            raise ValueError(
+                f"the sweep would have {cases:.3g} cases ({n_pairs} pairs x {na} alpha x {nb} "
+                f"beta values): about {hours:.3g} hours of FM² on 2 cores (~"
+                f"{SWEEP_CASES_PER_S:.0f} cases/s) and {cases * SWEEP_LOG_BYTES / 1e9:.3g} GB "
+                f"of log; the limit is {MAX_SWEEP_CASES:,} cases — use a larger alpha/beta "
+                "step (or a narrower start..stop) or fewer pairs")
+        return self
 
     @field_validator("models")
     @classmethod
@@ -214,35 +270,39 @@ class SweepConfig(BaseModel):
 
 
 def load_config(path: str | os.PathLike[str]) -> SweepConfig:
-    """Read a YAML sweep configuration (unknown keys are errors)."""
+    """Read a YAML sweep configuration (unknown keys are errors).
+
+    Read like a mission file (:func:`fm2uav._validate.load_yaml`: YAML 1.2 numbers,
+    duplicate keys refused, a regular UTF-8 file); types are strict (``pairs: true``
+    or ``cell: "2"`` are refused), and a sweep too large to run is refused with the
+    size it would need (:data:`MAX_SWEEP_CASES`).
+    """
+    from .. import _validate
+
     p = Path(path)
-    if not p.is_file():
-        what = "a directory" if p.is_dir() else "not found"
-        raise InputError(f"config file {p} is {what}; give the path of a YAML file")
-    try:
-        data = yaml.safe_load(p.read_text(encoding="utf-8")) or {}
-    except UnicodeDecodeError:
-        raise InputError(f"{p} is not a UTF-8 text file; give a YAML sweep configuration") from None
-    except OSError as exc:
-        raise InputError(f"cannot read {p}: {exc.strerror}; check the path and permissions") from None
-    except yaml.YAMLError as exc:
-        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise InputError(f"{p} is not valid YAML ({first}); fix the file") from None
-    except RecursionError:
-        raise InputError(f"{p} is nested too deeply to be a sweep configuration; fix the file") from None
+    data = _validate.load_yaml(p, "sweep configuration")
+    if data is None:  # an empty file is a mistake (a failed copy), not "the defaults"
+        raise InputError(f"sweep configuration {p} is empty; write the settings (e.g. pairs: 4, "
+                         "alpha: {start: 0.1, stop: 1, step: 0.1}), or {} for the seed's full "
+                         "sweep of 60 000 cases")
     if not isinstance(data, dict):
-        raise InputError(f"{p} must hold a YAML mapping of sweep settings")
+        raise InputError(f"{p} must hold a YAML mapping of sweep settings (scenario:, pairs:, "
+                         f"alpha:, ...), got {type(data).__name__}")
     return make_config(data, where=str(p))
 
 
 def make_config(data: dict[str, Any], where: str = "config") -> SweepConfig:
-    """A :class:`SweepConfig` from a mapping; errors name ``where`` and the key."""
+    """A :class:`SweepConfig` from a mapping; errors name ``where``, the key, the value
+    and what is allowed."""
     try:
         return SweepConfig(**data)
     except ValidationError as exc:
         first = exc.errors()[0]
-        loc = ".".join(str(x) for x in first["loc"])
-        raise InputError(f"{where}: {loc}: {first['msg']}") from None
+        loc = ".".join(str(x) for x in first["loc"] if not str(x).startswith(("int", "list[")))
+        msg = str(first.get("ctx", {}).get("error", first["msg"]))
+        value = first.get("input")
+        shown = "" if isinstance(value, dict) or not loc else f" = {value!r}"
+        raise InputError(f"{where}: {loc}{shown}: {msg}" if loc else f"{where}: {msg}") from None
     except TypeError as exc:  # e.g. non-string keys
         raise InputError(f"{where}: {exc}") from None
 
@@ -436,6 +496,33 @@ class SweepResult:
 
 
 # ----------------------------------------------------------------- run
+def max_workers() -> int:
+    """Most local worker processes a sweep may start: 4 per core (at least 8); each is a
+    Python process with numba's kernels loaded (~150 MB)."""
+    return max(8, 4 * (os.cpu_count() or 1))
+
+
+def check_workers(workers: Any) -> int | None:
+    """``workers`` (None = all cores) as a count of local worker processes.
+
+    Raises
+    ------
+    InputError
+        Not an integer >= 1, or more than :func:`max_workers` (names ``--workers``).
+    """
+    from .. import _validate
+
+    if workers is None:
+        return None
+    n = _validate.integer(workers, "workers", minimum=1, where=(None, "--workers"))
+    if n > max_workers():
+        raise InputError(
+            f"--workers {n} would start {n} worker processes (~150 MB each: "
+            f"{n * 0.15:.3g} GB) on {os.cpu_count() or 1} cores; the limit is {max_workers()} "
+            "(4 per core); for more, run a Dask cluster and give --scheduler")
+    return n
+
+
 def _executor(workers: int | None, scheduler: str | None, client: Any) -> Any:
     if scheduler is not None or client is not None:
         try:
@@ -496,6 +583,7 @@ def run_sweep(
         SIGINT/SIGTERM: the workers were stopped and every finished case kept.
     """
     out = Path(out_dir)
+    workers = check_workers(workers)
     warnings_seen: list[str] = []
 
     def warn(message: str) -> None:

@@ -65,6 +65,8 @@ class TrackingRun:
     step: float
     rows: list[dict[str, Any]] = field(default_factory=list)
     paths: list[dict[str, Any]] = field(default_factory=list)
+    #: ``(FM² path, Dubins reference)`` [m] of each pair flown, as in ``paths``.
+    tracks: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list, repr=False)
 
 
 def reproduce_tracking(out_dir: str | Path, *, step: float = 0.1, pairs: int = 24,
@@ -98,6 +100,7 @@ def reproduce_tracking(out_dir: str | Path, *, step: float = 0.1, pairs: int = 2
                 "reference_peak_kappa": float(np.abs(kr["kappa"]).max()) if len(kr["kappa"]) else 0.0,
                 "above_bound": peak > bound, "smooth_above_bound": peak_s > bound}
         run.paths.append(info)
+        run.tracks.append((np.asarray(fm2, dtype=float), np.asarray(ref, dtype=float)))
         for label, preset, fly in VEHICLES:
             af = get_airframe(preset)
             for la in LOOKAHEADS:

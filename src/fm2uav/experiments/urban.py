@@ -134,7 +134,9 @@ def _xy_frechet(a: np.ndarray, b: np.ndarray) -> float:
 def reproduce_urban(seed: int | None = None, *,
                     on_step: Any = lambda message: None) -> UrbanRun:
     """Plan and measure the six cases of thesis §4.4 (``seed=None``: :func:`urban_seed`)."""
-    seed = urban_seed() if seed is None else int(seed)
+    from .._validate import seed_value
+
+    seed = urban_seed() if seed is None else seed_value(seed, "seed", where=(None, "--seed"))
     world = urban_world(seed)
     start, goal = _points(world)
     for what, p in (("start", start), ("goal", goal)):

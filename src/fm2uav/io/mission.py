@@ -32,13 +32,26 @@ Schema (pydantic v2, strict types, unknown keys rejected)::
     airframe: {type: multirotor, firmware: px4, cruise_speed: 12, hover_speed: 5,
                endurance: 25, reserve: 0.2}   # [min] endurance checked with a 20 % reserve
     outputs:
-      dir: out/my-mission           # default out/<file name>; `fm2uav run --out` overrides
+      dir: out/my-mission           # relative to this file; default out/<file name> in the
+                                    # current folder; `fm2uav run --out` overrides
       formats: [csv, geojson, kml, plan, wpl, html, png, json]
       thin_tolerance: 5             # [m] Douglas–Peucker tolerance of the waypoints
       frame: auto                   # auto | terrain | amsl | relative (MAVLink 10 / 0 / 3);
                                     # auto: ArduPilot terrain, PX4 amsl (DEM ground + AGL)
       end: auto                     # auto | rtl | land | loiter (auto: airframe-aware)
       speed_changes: false          # DO_CHANGE_SPEED from the planned speed W
+
+**Relative paths** in a mission file (``world.dem``, ``world.buildings``, zone
+files, ``outputs.dir``) are relative to the folder of the mission file, whatever
+the current folder (:meth:`Mission.output_dir`); before fm2uav 0.2 ``outputs.dir``
+alone was read against the current folder, and ``fm2uav run`` says so where the
+two differ (:class:`MissionWarning`). Paths given on the command line are
+relative to the current folder.
+
+**Types are strict**: numbers are numbers (``5e-1`` and ``1e3`` too: the file is
+read with YAML 1.2's core schema for numbers, :func:`fm2uav._validate.load_yaml`),
+never text, booleans or NaN/infinity; integers (``order``, ``version``, ``seed``)
+are never ``true``/``false``.
 
 The full field reference with ranges is in docs/operator.md. Every validation
 error is reported on one line naming the field, the bad
@@ -53,7 +66,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, PrivateAttr, ValidationError
 from pydantic import field_validator, model_validator
 
 from ..errors import InputError
@@ -67,6 +80,7 @@ from .zone_spec import ZoneSpec, resolve_zones
 
 __all__ = [
     "Mission",
+    "MissionWarning",
     "WorldSpec",
     "PointSpec",
     "PlannerSpec",
@@ -83,7 +97,26 @@ __all__ = [
 #: Output formats a mission can ask for (exports + report + figure + summary).
 OUTPUT_FORMATS = (*EXPORT_FILES, "html", "png", "json")
 
-_STRICT = ConfigDict(strict=True, extra="forbid", frozen=True)
+_STRICT = ConfigDict(strict=True, extra="forbid", frozen=True, allow_inf_nan=False)
+
+
+class MissionWarning(UserWarning):
+    """Something about a mission file the user should know (shown as a ``warning:`` line)."""
+
+
+def _no_bool(v: Any) -> Any:
+    """Refuse ``true``/``false`` and ``2.0`` where an integer is expected (``True == 1``
+    and ``2.0 == 2`` in Python, so a ``Literal[1, 2]`` would take them)."""
+    if isinstance(v, (bool, float)):
+        raise ValueError(f"has the wrong type ({type(v).__name__}), expected an integer")
+    return v
+
+
+#: An integer literal that is never a boolean (``order: true`` is refused).
+def _int_choice(*values: int) -> Any:
+    from typing import Annotated
+
+    return Annotated[Literal[values], BeforeValidator(_no_bool)]  # type: ignore[valid-type]
 
 
 def _num(default: Any = None, *, unit: str = "", desc: str = "", **bounds: float) -> Any:
@@ -228,7 +261,7 @@ class PlannerSpec(BaseModel):
     exponent: float = _num(1.0, gt=0, le=10, desc="exponent β on W")
     saturation_distance: float | None = _num(None, unit="m", gt=0, le=100000,
                                              desc="distance from obstacles with W = 1")
-    order: Literal[1, 2] = Field(2, description="Fast Marching order")
+    order: _int_choice(1, 2) = Field(2, description="Fast Marching order")  # type: ignore[valid-type]
     method: Literal["edt", "fmm"] = Field("edt", description="distance to obstacles")
     walls: bool = Field(False, description="treat the map border as an obstacle")
     agl: float | None = _num(None, unit="m", gt=0, le=5000, desc="flight level above ground")
@@ -295,6 +328,16 @@ class AirframeSpec(BaseModel):
                                    desc="flight endurance (battery / fuel)")
     reserve: float = _num(0.2, ge=0, lt=1, desc="share of the endurance kept in reserve")
 
+    @model_validator(mode="after")
+    def _speeds(self) -> AirframeSpec:
+        key = "hover_speed" if self.type == "multirotor" else "cruise_speed"
+        if self.min_speed is not None and self.min_speed > getattr(self, key):
+            raise ValueError(
+                f"min_speed {self.min_speed:g} m/s is above {key} {getattr(self, key):g} m/s, "
+                f"the speed this {self.type.replace('_', '-')} flies the mission at; allowed: "
+                f"min_speed <= {key}")
+        return self
+
 
 class OutputSpec(BaseModel):
     """What to write and where."""
@@ -316,7 +359,7 @@ class Mission(BaseModel):
     """A whole mission file."""
 
     model_config = _STRICT
-    version: Literal[1] = Field(1, description="schema version")
+    version: _int_choice(1) = Field(1, description="schema version")  # type: ignore[valid-type]
     name: str = Field("mission", description="mission name")
     description: str = Field("", description="free text")
     world: WorldSpec = Field(..., description="the map: scenario, dem or buildings")
@@ -332,6 +375,7 @@ class Mission(BaseModel):
     operating_area: ZoneSpec | None = Field(None, description="area the mission stays in")
     airframe: AirframeSpec = Field(default_factory=AirframeSpec)
     outputs: OutputSpec = Field(default_factory=OutputSpec)
+    _base_dir: Path | None = PrivateAttr(None)
 
     @model_validator(mode="after")
     def _points_needed(self) -> Mission:
@@ -344,6 +388,35 @@ class Mission(BaseModel):
         return self
 
     # ------------------------------------------------------------------ resolving
+    def output_dir(self) -> Path | None:
+        """``outputs.dir`` relative to the mission file's folder (None when not given).
+
+        Like every path in a mission file (``world.dem``, zone files); a mission given
+        as a dict without ``base_dir`` keeps it relative to the current folder.
+        """
+        if self.outputs.dir is None:
+            return None
+        p = Path(self.outputs.dir).expanduser()
+        return p if p.is_absolute() or self._base_dir is None else self._base_dir / p
+
+    def output_dir_notice(self) -> str | None:
+        """The one-line notice that ``outputs.dir`` now lands elsewhere than before
+        fm2uav 0.2 (read against the current folder), or None where both agree."""
+        new = self.output_dir()
+        if new is None or Path(self.outputs.dir).expanduser().is_absolute():
+            return None
+        import os
+
+        try:
+            old = Path(os.path.abspath(Path(self.outputs.dir).expanduser()))
+        except FileNotFoundError:  # no current folder: nothing to compare with
+            return None
+        if os.path.realpath(old) == os.path.realpath(new):
+            return None
+        return (f"outputs.dir {self.outputs.dir!r} is relative to the mission file's folder, "
+                f"like world.dem: writing to {new} (before fm2uav 0.2 it meant {old}, relative "
+                "to the current folder); give --out or an absolute outputs.dir to choose")
+
     def anchor(self) -> Anchor:
         """The :class:`Anchor` of a world without CRS (default :data:`DEFAULT_ANCHOR`)."""
         a = self.world.anchor
@@ -478,8 +551,24 @@ def _resolve_point(p: PointSpec, world: Any, anchor: Anchor, what: str) -> np.nd
         raise InputError(
             f"{what} = ({point[0]:.1f}, {point[1]:.1f}, {point[2]:.1f}) m{where} lies outside "
             f"the map; allowed: x in [{b[0, 0]:.1f}, {b[0, 1]:.1f}], y in [{b[1, 0]:.1f}, "
-            f"{b[1, 1]:.1f}], z in [{b[2, 0]:.1f}, {b[2, 1]:.1f}] m")
+            f"{b[1, 1]:.1f}], z in [{b[2, 0]:.1f}, {b[2, 1]:.1f}] m{_swap_hint(p, world, anchor)}")
     return point
+
+
+def _swap_hint(p: PointSpec, world: Any, anchor: Anchor) -> str:
+    """``"; lon and lat look swapped ..."`` when the lon/lat point ``p`` lies off the map but
+    would lie on it with its two coordinates exchanged, else ``""``."""
+    if p.lon is None or not (abs(p.lat) <= 180 and abs(p.lon) <= 90):
+        return ""
+    try:
+        xy = from_lonlat(world, [[p.lat, p.lon]], anchor=anchor)[0]
+    except Exception:  # noqa: BLE001 - a transform that fails is no hint
+        return ""
+    b = world.bounds
+    if b[0, 0] <= xy[0] <= b[0, 1] and b[1, 0] <= xy[1] <= b[1, 1]:
+        return (f"; lon and lat look swapped: lon {p.lat:g}, lat {p.lon:g} lies on the map "
+                "(write {lon: .., lat: ..} / LON,LAT)")
+    return ""
 
 
 def resolve_point(p: PointSpec, world: Any, anchor: Anchor | None = None,
@@ -576,7 +665,7 @@ def _format_error(err: dict[str, Any]) -> str:
     path = "".join(f"[{k}]" if isinstance(k, int) else (("." if i else "") + str(k))
                    for i, k in enumerate(loc)) or "mission"
     info, name = _field_info(loc)
-    allowed = _allowed(info, name) if not any(isinstance(k, int) for k in loc) else ""
+    allowed = _allowed(info, name) if loc and isinstance(loc[-1], str) else ""
     value = err.get("input")
     if typ == "missing":
         return f"{path} is missing; add it" + (f" (allowed: {allowed})" if allowed else "")
@@ -587,7 +676,7 @@ def _format_error(err: dict[str, Any]) -> str:
             for cand in (parent_info.annotation, *getattr(parent_info.annotation, "__args__", ())):
                 if isinstance(cand, type) and issubclass(cand, BaseModel):
                     model = cand
-        keys = ", ".join(model.model_fields)
+        keys = ", ".join(f.alias or k for k, f in model.model_fields.items())
         return f"{path} is not a known field; allowed fields here: {keys}"
     if typ in ("greater_than", "greater_than_equal", "less_than", "less_than_equal"):
         return f"{path} = {_show(value)} is out of range; allowed: {allowed}"
@@ -603,12 +692,20 @@ def _format_error(err: dict[str, Any]) -> str:
                 f"at least {lo}" if hi is None else f"{lo} to {hi}")
         desc = f" ({info.description})" if info is not None and info.description else ""
         return f"{path} = {_show(value)} has {n} item(s); allowed: {want} item(s){desc}"
+    if typ == "finite_number":
+        return f"{path} = {_show(value)} is not a finite number" + (
+            f"; allowed: {allowed}" if allowed else "")
     if typ in _TYPE_WORDS:
         extra = (f"; allowed: {allowed}" if allowed and allowed != _TYPE_WORDS[typ] else "")
+        if typ == "bool_type" and isinstance(value, str) and value.lower() in (
+                "yes", "no", "on", "off", "y", "n"):
+            extra += "; write true or false (in YAML 1.2 yes/no/on/off are text)"
         return (f"{path} = {_show(value)} has the wrong type ({type(value).__name__}), "
                 f"expected {_TYPE_WORDS[typ]}{extra}")
     if typ == "value_error":
         msg = str(ctx.get("error", err["msg"]))
+        if msg.startswith("has the wrong type"):
+            return f"{path} = {_show(value)} {msg}" + (f"; allowed: {allowed}" if allowed else "")
         if isinstance(value, (str, int, float)) and not isinstance(value, bool):
             return f"{path} = {_show(value)} {msg}" if msg.startswith(("has ", "cannot ")) \
                 else f"{path} = {_show(value)}: {msg}"
@@ -630,11 +727,14 @@ def parse_mission(data: Any, *, source: str = "mission", base_dir: str | Path | 
         raise InputError(f"{source}: a mission file must be a mapping of keys (world:, start:, "
                          f"goal:, ...), got {type(data).__name__}")
     try:
-        return Mission.model_validate(data, context={"base_dir": base_dir})
+        m = Mission.model_validate(data, context={"base_dir": base_dir})
     except ValidationError as exc:
         errs = exc.errors()
         more = f" (+{len(errs) - 1} more)" if len(errs) > 1 else ""
         raise InputError(f"{source}: {_format_error(errs[0])}{more}") from None
+    if base_dir is not None:
+        m._base_dir = Path(base_dir)
+    return m
 
 
 def parse_world(data: Any, *, source: str = "mission", base_dir: str | Path | None = None

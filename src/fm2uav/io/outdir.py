@@ -16,7 +16,17 @@ writes through:
   end) refuses a second run into the same folder while one is writing;
 * an ``OutputDir`` inside the target of an active one (a per-case subfolder)
   writes into the parent's temporary folder, so the subfolders belong to the
-  parent's set.
+  parent's set;
+* **inputs are never inside what is replaced**: a target that holds (or is) one of
+  the command's inputs — given to ``OutputDir(inputs=...)``, or noted by any
+  reader in the running :func:`fm2uav._validate.input_log` (every file reader
+  calls :func:`fm2uav._validate.input_file`; the command line opens the log for
+  every command, so a new command cannot forget one) — is refused, naming the input
+  and ``--out``/``--force``: before any work for the inputs known then, and again
+  just before the old set is moved aside for every input read meanwhile;
+* a target that is a **symbolic link** to a folder is followed: the set replaces
+  the folder the link points to (staged beside it, so the rename stays atomic),
+  and the link is left as it was, pointing at the new set.
 
 If files appear in the target *while* the run writes (a library that writes
 into the folder directly, e.g. a resumable sweep's results log), the target is
@@ -41,6 +51,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+from .. import _validate
 from ..errors import InputError
 
 __all__ = ["OutputDir", "Interrupted", "active_sets", "finish_all", "abort_all",
@@ -259,16 +270,35 @@ def _umask_mode(path: Path, directory: bool = False) -> None:
     os.chmod(path, (0o777 if directory else 0o666) & ~mask)
 
 
+def _real(path: Path) -> str:
+    return os.path.realpath(path)
+
+
+def _spellings(path: Path) -> set[str]:
+    """The absolute names of ``path``: as written (a link itself) and resolved (its file)."""
+    link = os.path.join(os.path.realpath(os.path.dirname(os.path.abspath(path))),
+                        os.path.basename(os.path.abspath(path)))
+    return {link, os.path.realpath(path)}
+
+
+def _under(path: str, folder: str) -> bool:
+    """Whether the absolute ``path`` is ``folder`` or lies inside it."""
+    return path == folder or path.startswith(folder.rstrip(os.sep) + os.sep)
+
+
 def _is_dangerous(target: Path) -> str | None:
     """Why replacing ``target`` as a whole would be a mistake, or None."""
     t = target.resolve()
-    cwd = Path.cwd().resolve()
     home = Path.home().resolve()
     if t == Path(t.anchor):
         return "it is the root of the file system"
     if t == home or t in home.parents:
         return "it is (or contains) your home folder"
-    if t == cwd or t in cwd.parents:
+    try:
+        cwd = Path.cwd().resolve()
+    except FileNotFoundError:  # the current folder was deleted: it is not inside anything
+        cwd = None
+    if cwd is not None and (t == cwd or t in cwd.parents):
         return "it is (or contains) the current folder"
     if (t / ".git").exists():
         return "it holds a git repository"
@@ -304,6 +334,13 @@ class OutputDir:
         Never swap the folder: move the staged files into it one by one at the end
         (for folders a library also writes into directly, e.g. a resumable sweep).
         The staged files still appear only when the run succeeds.
+    inputs : iterable of path or (path, what)
+        The command's input files and folders (``what`` names one in a message,
+        e.g. ``"the mission file"``); added to those of the running
+        :func:`~fm2uav._validate.input_log`. None may lie inside the target.
+    owned : iterable of str
+        With ``merge``: names of files a library writes into the folder directly
+        (they replace an input of that name, so one is refused).
 
     Examples
     --------
@@ -317,10 +354,38 @@ class OutputDir:
     """
 
     def __init__(self, path: str | os.PathLike[str], *, force: bool = False,
-                 merge: bool = False) -> None:
-        self.path = Path(path)
+                 merge: bool = False, inputs: Iterable[Any] = (),
+                 owned: Iterable[str] = ()) -> None:
+        if str(path).strip() == "":
+            raise InputError("--out is empty; give the folder to write into (e.g. --out "
+                             "out/mission)")
+        path = os.path.expanduser(path)  # "~/out" in quotes, or a mission's outputs.dir
+        gone = _validate.cwd_gone(path)
+        if gone:
+            raise InputError(f"--out {path}: {gone}")
+        #: The folder as given (messages, :attr:`written`).
+        self.given = Path(path)
+        #: The folder written: the given one, or the folder a symbolic link points to
+        #: (``.`` and ``..`` by their absolute name: the set is staged beside the folder).
+        self.path = (Path(os.path.realpath(self.given)) if os.path.islink(self.given)
+                     else Path(os.path.abspath(self.given)) if self.given.name in ("", "..")
+                     else self.given)
+        if self.path.name == "":
+            raise InputError(f"--out {self.given} is the root of the file system; give a "
+                             "dedicated folder (e.g. --out out/mission)")
+        for parent in self.path.parents:  # a file where a folder of the path should be
+            if parent.exists() or os.path.islink(parent):
+                if not parent.is_dir():
+                    raise InputError(f"--out {self.given}: {parent} is a file, not a folder; "
+                                     "choose another --out")
+                break
         self.force = force
         self.merge = merge
+        self.inputs: list[tuple[Path, str]] = [
+            (Path(i[0]), str(i[1])) if isinstance(i, tuple) else (Path(i), "an input")
+            for i in inputs]
+        self._noted = _validate.noted_inputs()  # the live list of the command's reads
+        self._owned = list(owned)
         self.written: list[Path] = []
         self.parent_set: OutputDir | None = None
         self._stage: Path | None = None
@@ -350,13 +415,47 @@ class OutputDir:
 
     # -- checks -------------------------------------------------------------------------
     def _contains(self, other: Path) -> bool:
-        a, b = os.path.abspath(self.path), os.path.abspath(other)
+        a, b = os.path.realpath(self.path), os.path.realpath(other)
         return b != a and b.startswith(a.rstrip(os.sep) + os.sep)
+
+    def _all_inputs(self) -> list[tuple[Path, str]]:
+        return self.inputs + [e for e in (self._noted or ()) if e not in self.inputs]
+
+    def _check_inputs(self, names: Iterable[str] = ()) -> None:
+        """Refuse (InputError) a target that holds any of the command's inputs, naming each.
+
+        A swapped set replaces the whole folder, so any input inside it counts; a
+        merged set (``merge``) only replaces the files of ``names`` (and ``owned``).
+        """
+        if self.merge:
+            written = (os.path.relpath(w, self.given) for w in self.written)
+            doomed = {_real(self.path / n) for n in (*names, *self._owned, *written)}
+        hits = []
+        for path, what in self._all_inputs():
+            if self.merge:
+                hit = bool(_spellings(path) & doomed)
+            else:
+                hit = any(_under(q, _real(self.path)) for q in _spellings(path))
+            if hit and all(_real(path) != _real(p) for p, _ in hits):
+                hits.append((path, what))
+        if not hits:
+            return
+        many = len(hits) > 1
+        verb = "is" if not many and _real(hits[0][0]) == _real(self.path) else "holds"
+        them = "them" if many else "it"
+        why = (f"an output of the same name would replace {them}" if self.merge else
+               "the output set replaces the folder as a whole (with --force), which would "
+               f"delete {them}")
+        some = (f"{len(hits)} inputs of this command: " if many else
+                "an input of this command: ") + ", ".join(f"{p} ({w})" for p, w in hits)
+        raise InputError(
+            f"--out {self.given} {verb} {some}; {why} — choose another --out (a new folder) or "
+            f"move the input{'s' if many else ''} out of {self.given}")
 
     def _relative(self) -> Path:
         assert self.parent_set is not None
-        return Path(os.path.relpath(os.path.abspath(self.path),
-                                    os.path.abspath(self.parent_set.path)))
+        return Path(os.path.relpath(os.path.realpath(self.path),
+                                    os.path.realpath(self.parent_set.path)))
 
     def check(self, names: Iterable[str] = ()) -> None:
         """Refuse (InputError) before any work: a target that is a file, a folder that
@@ -376,26 +475,27 @@ class OutputDir:
             raise
 
     def _check(self, names: list[str]) -> None:
-        p = self.path
+        p, shown = self.path, self.given
         if p.exists() and not p.is_dir():
-            raise InputError(f"--out {p} exists and is not a folder; choose another --out")
+            raise InputError(f"--out {shown} exists and is not a folder; choose another --out")
         if p.is_dir() and not os.access(p, os.W_OK | os.X_OK):
-            raise InputError(f"--out {p} is read-only (permission denied); nothing was "
+            raise InputError(f"--out {shown} is read-only (permission denied); nothing was "
                              "written; fix its permissions or choose another --out")
+        self._check_inputs(names)
         self._lock()
         entries = sorted(_listing(p))
         if entries:
             clashes = [n for n in names if (p / n).exists()] or entries
-            first = p / clashes[0]
+            first = shown / clashes[0]
             more = len(entries) - 1
             if not self.force:
                 raise InputError(
-                    f"{first} already exists" + (f" (and {more} more in {p})" if more else "")
+                    f"{first} already exists" + (f" (and {more} more in {shown})" if more else "")
                     + "; pass --force to replace the whole output folder or choose another "
                     "--out")
             why = _is_dangerous(p)
             if why:
-                raise InputError(f"--force would replace the whole folder {p}, but {why}; "
+                raise InputError(f"--force would replace the whole folder {shown}, but {why}; "
                                  "give a dedicated --out folder")
         self._before = _listing(p)
         self._checked = True
@@ -418,7 +518,7 @@ class OutputDir:
             except BlockingIOError:
                 os.close(fd)
                 raise InputError(
-                    f"--out {self.path} is being written by another fm2uav run (lock {lock} "
+                    f"--out {self.given} is being written by another fm2uav run (lock {lock} "
                     "is held); wait for it to finish or choose another --out") from None
             try:  # the holder before us may have removed the file: lock the live one
                 same = os.fstat(fd).st_ino == os.stat(lock).st_ino
@@ -491,7 +591,7 @@ class OutputDir:
         return self._stage
 
     def _final(self, name: str) -> Path:
-        return self.path / name
+        return self.given / name
 
     @contextmanager
     def open(self, name: str, mode: str = "w", **kwargs: Any) -> Iterator[Any]:
@@ -551,6 +651,7 @@ class OutputDir:
     def _swap(self) -> None:
         stage, target = self._stage, self.path
         assert stage is not None
+        self._check_inputs()  # every input read since the first check, before anything moves
         changed = _listing(target) != (self._before or {})
         try:
             if (changed or self.merge) and target.is_dir():

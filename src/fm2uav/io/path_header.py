@@ -59,18 +59,22 @@ def read_path_floor(file: str | Path) -> np.ndarray | None:
 
 
 def read_path_column(file: str | Path, names: tuple[str, ...]) -> np.ndarray | None:
-    """The first of the columns ``names`` in a path CSV, as floats, or None."""
+    """The first of the columns ``names`` in a path CSV, as floats, or None (read by
+    name, like the coordinates: :func:`fm2uav.io.paths.read_path_table`)."""
+    from .paths import read_path_table
+
     file = Path(file)
-    rows = [ln.strip() for ln in _lines(file) if ln.strip() and not ln.lstrip().startswith("#")]
-    if not rows:
+    header, rows = read_path_table(file)
+    if header is None:
         return None
-    header = [c.strip().lower() for c in rows[0].split(",")]
     col = next((header.index(n) for n in names if n in header), None)
     if col is None:
         return None
-    try:
-        w = np.array([float(r.split(",")[col]) for r in rows[1:]], dtype=float)
-    except (ValueError, IndexError):
-        raise InputError(f"path file {file}: the {header[col]!r} column has a non-numeric "
-                         "value") from None
-    return w
+    out = np.empty(len(rows))
+    for r, (n, cells) in enumerate(rows):
+        try:
+            out[r] = float(cells[col])
+        except ValueError:
+            raise InputError(f"path file {file}, line {n}: the {header[col]!r} column has a "
+                             f"non-numeric value {cells[col]!r}") from None
+    return out

@@ -42,7 +42,7 @@ from ..errors import InputError
 
 __all__ = ["ZoneSpec", "CircleSpec", "resolve_zones", "zones_from_cli"]
 
-_STRICT = ConfigDict(strict=True, extra="forbid", frozen=True)
+_STRICT = ConfigDict(strict=True, extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 def _base(info: ValidationInfo | None) -> Path | None:
@@ -89,8 +89,13 @@ class ZoneSpec(BaseModel):
         base = _base(info)
         if not p.is_absolute() and base is not None:
             p = base / p
-        if not p.is_file():
+        if not p.exists():
             raise ValueError(f"file not found ({p}); allowed: a GeoJSON/KML/GPKG/SHP file")
+        _validate.note_input(p, "a zone file (no_fly_zones / operating_area)")
+        try:  # no folder, no named pipe (a reader would block on it), readable
+            _validate.input_file(p, "file")
+        except InputError as exc:
+            raise ValueError(str(exc).removeprefix("file ")) from None
         return str(p)
 
     @field_validator("polygon")
@@ -133,13 +138,21 @@ def _one(spec: ZoneSpec, world: Any, anchor: Any, *, inclusion: bool, where: str
     opts["reference"] = spec.reference
     if spec.file is not None:
         return read_zones(spec.file, world, crs=spec.crs, defaults=opts, inclusion=inclusion)
+    from ..world.zones import check_zones_on_map
+
+    raw = np.asarray(spec.polygon if spec.polygon is not None else [spec.circle.center],
+                     dtype=float)
     if spec.polygon is not None:
-        pts = _to_metres(np.asarray(spec.polygon, dtype=float), spec, world, anchor)
+        pts = _to_metres(raw, spec, world, anchor)
         mapping = {"polygon": pts.tolist(), **opts}
     else:
-        c = _to_metres(np.asarray([spec.circle.center], dtype=float), spec, world, anchor)[0]
+        c = _to_metres(raw, spec, world, anchor)[0]
         mapping = {"circle": {"center": c.tolist(), "radius": spec.circle.radius}, **opts}
-    return [zone_from_mapping(mapping, inclusion=inclusion, where=where)]
+    zones = [zone_from_mapping(mapping, inclusion=inclusion, where=where)]
+    ll = ((raw[:, 0].min(), raw[:, 1].min(), raw[:, 0].max(), raw[:, 1].max())
+          if spec.lonlat else None)
+    check_zones_on_map(zones, world, where, lonlat_bounds=ll, anchor=anchor, inline=True)
+    return zones
 
 
 def resolve_zones(no_fly: Any, operating_area: Any, world: Any, anchor: Any = None) -> list[Any]:
@@ -166,14 +179,16 @@ def resolve_zones(no_fly: Any, operating_area: Any, world: Any, anchor: Any = No
         try:
             zs = _one(spec, world, anchor, inclusion=False, where=where)
         except InputError as exc:
-            raise InputError(f"{where}: {exc}") from None
+            raise InputError(str(exc) if str(exc).startswith(where) else f"{where}: {exc}"
+                             ) from None
         out.extend(z if z.name else replace(z, name=f"no-fly {k + 1}" + (
             f".{j + 1}" if len(zs) > 1 else "")) for j, z in enumerate(zs))
     if operating_area is not None:
         try:
             zs = _one(operating_area, world, anchor, inclusion=True, where="operating_area")
         except InputError as exc:
-            raise InputError(f"operating_area: {exc}") from None
+            raise InputError(str(exc) if str(exc).startswith("operating_area") else
+                             f"operating_area: {exc}") from None
         if len(zs) > 1:  # one area: the union of the file's polygons
             zs = [replace(zs[0], geometry=shapely.union_all([z.geometry for z in zs]),
                           circle=None)]
@@ -190,5 +205,8 @@ def zones_from_cli(files: Any, world: Any, *, crs: Any = None) -> list[Any]:
         # a missing file, a folder, a FIFO: one line each, naming the flag (no hang on a pipe)
         p = _validate.input_file(f, "the no-fly file (GeoJSON/KML/GPKG/SHP)",
                                  where=(None, "--no-fly"))
-        out.extend(read_zones(str(p), world, crs=crs))
+        try:
+            out.extend(read_zones(str(p), world, crs=crs))
+        except InputError as exc:
+            raise InputError(f"--no-fly {exc}") from None
     return out

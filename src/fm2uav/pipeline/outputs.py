@@ -238,7 +238,8 @@ def export_options(base: Any = None, *, firmware: str | None = None, vehicle: st
     Raises
     ------
     InputError
-        A negative tolerance, a non-positive endurance (naming the flag).
+        A tolerance outside [0, 1000] m (the mission file's range), a non-positive
+        endurance (naming the flag).
     """
     from dataclasses import replace
 
@@ -249,8 +250,9 @@ def export_options(base: Any = None, *, firmware: str | None = None, vehicle: st
              "min_speed": min_speed, "cruise_speed": cruise_speed, "hover_speed": hover_speed,
              "endurance_s": None if endurance is None else 60.0 * float(endurance),
              "reserve": reserve, **more}
-    if thin is not None and not thin >= 0:
-        raise InputError(f"--thin must be a tolerance >= 0 m, got {thin}")
+    if thin is not None and not 0 <= thin <= 1000:
+        raise InputError(f"--thin must be a tolerance in [0, 1000] m (mission file: "
+                         f"outputs.thin_tolerance), got {thin}")
     if endurance is not None and not endurance > 0:
         raise InputError(f"--endurance must be > 0 minutes, got {endurance}")
     return replace(base or ExportOptions(), **{k: v for k, v in given.items() if v is not None})

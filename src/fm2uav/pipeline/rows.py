@@ -88,9 +88,11 @@ def world_rows(world: Any) -> dict[str, str]:
     for s in g.sources:
         d = s.details
         if s.role == "dem":
+            def rule(key: str) -> str:  # why the size was chosen, when the loader says
+                return f" ({d[key]})" if d.get(key) else ""
             rows["grid"] = (f"{' x '.join(str(n) for n in world.shape)} nodes, cells "
-                            f"{d.get('cell_size', world.spacing[0]):g} m ({d.get('cell_size_rule', '')}), "
-                            f"dz {d.get('dz', world.spacing[2]):g} m ({d.get('dz_rule', '')})")
+                            f"{d.get('cell_size', world.spacing[0]):g} m{rule('cell_size_rule')}, "
+                            f"dz {d.get('dz', world.spacing[2]):g} m{rule('dz_rule')}")
             if d.get("filled_nodes"):
                 rows["filled nodata"] = f"{d['filled_nodes']} columns"
         if s.role == "buildings":
@@ -104,8 +106,10 @@ def world_rows(world: Any) -> dict[str, str]:
             if "grid" not in rows:
                 rows["grid"] = (f"{' x '.join(str(n) for n in world.shape)} nodes, cells "
                                 f"{world.spacing[0]:g} m, dz {world.spacing[2]:g} m")
-    rows["sources"] = ", ".join(f"{Path(s.path).name} (sha256 {s.sha256[:12]})"
-                                for s in g.sources if s.sha256)
+    sources = ", ".join(f"{Path(s.path).name} (sha256 {s.sha256[:12]})"
+                        for s in g.sources if s.sha256)
+    if sources:  # a built-in scenario's data carry no checksum
+        rows["sources"] = sources
     return rows
 
 

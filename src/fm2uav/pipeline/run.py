@@ -79,6 +79,7 @@ def run_mission(
     options: Any = None,
     planner: dict[str, Any] | None = None,
     no_fly: Sequence[str | Path] = (),
+    formats: Sequence[str] | None = None,
 ) -> MissionRun:
     """Plan ``mission`` and write its output set (``outputs.formats``) into ``outdir``.
 
@@ -96,6 +97,9 @@ def run_mission(
         Planner keys overriding ``mission.plan_kwargs()`` (the CLI's ``--min-agl``, ...).
     no_fly : sequence of paths, optional
         More no-fly zone files (``--no-fly``).
+    formats : sequence of str, optional
+        The output formats (default ``outputs.formats``; ``fm2uav run --report`` adds
+        ``html``).
 
     Returns
     -------
@@ -112,7 +116,7 @@ def run_mission(
     from ..world.load import world_summary
 
     options = mission.export_options() if options is None else options
-    formats = list(dict.fromkeys(mission.outputs.formats))
+    formats = list(dict.fromkeys(mission.outputs.formats if formats is None else formats))
     progress.step("building the world", 0.15)
     rm = mission.resolve()
     if no_fly:

@@ -39,6 +39,7 @@ __all__ = [
     "STORAGE_MODES",
     "planner_objects",
     "planner_keys",
+    "UPPER",
     "plan_params",
 ]
 
@@ -50,6 +51,23 @@ FLIGHT_LEVEL_HEIGHTS = ("ground", "fm2")
 SHAPING_METHODS = ("edt", "fmm")
 #: Accepted values of :attr:`PlanOptions.storage`.
 STORAGE_MODES = ("auto", "full", "regional")
+
+
+#: Upper bounds of the planner's numbers, the same in Python, the mission file
+#: (:class:`fm2uav.io.mission.PlannerSpec`) and on the command line: beyond them a value is
+#: a typo (``--agl 1e308``), never a plan.
+UPPER = {"exponent": 10.0, "saturation_distance": 100_000.0, "agl": 5000.0, "p1": 10.0,
+         "p2": 10.0, "band": 5000.0, "tolerance": 1000.0, "min_agl": 5000.0,
+         "max_agl": 5000.0}
+
+
+def _upper(obj: Any, name: str, unit: str = "") -> None:
+    """Refuse ``obj.name`` above :data:`UPPER` (names the key and the flag)."""
+    value = getattr(obj, name)
+    if value is not None and value > UPPER[name]:
+        u = f" {unit}" if unit else ""
+        raise InputError(f"{name} = {value:g}{u} is too large; allowed: at most "
+                         f"{UPPER[name]:g}{u}{v.where_text(_where(name))}")
 
 
 def _where(name: str) -> tuple[str, str]:
@@ -105,6 +123,8 @@ class Shaping:
             where=_where("saturation_distance")))
         v.choice(self.method, SHAPING_METHODS, "method", where=_where("method"))
         _set(self, "walls", v.flag(self.walls, "walls", where=_where("walls")))
+        _upper(self, "exponent")
+        _upper(self, "saturation_distance", "m")
 
     @property
     def shapes(self) -> bool:
@@ -192,6 +212,9 @@ class FlightLevel:
             v.non_negative, self.min_agl, "min_agl", unit="m", where=_where("min_agl")))
         _set(self, "max_agl", v.optional(
             v.positive, self.max_agl, "max_agl", unit="m", where=_where("max_agl")))
+        for name, unit in (("agl", "m"), ("p1", ""), ("p2", ""), ("band", "m"),
+                           ("tolerance", "m"), ("min_agl", "m"), ("max_agl", "m")):
+            _upper(self, name, unit)
         if self.min_agl is not None and self.min_agl > self.agl:
             raise InputError(
                 f"agl = {self.agl:g} m is below min_agl = {self.min_agl:g} m (the altitude "

@@ -70,4 +70,8 @@ def get_scenario(name: str, seed: int | np.random.Generator = 0, **kwargs: Any) 
         raise WorldError(
             f"unknown scenario {name!r}; valid names are: {', '.join(sorted(SCENARIOS))}"
         )
+    if not isinstance(seed, np.random.Generator):
+        from .._validate import seed_value
+
+        seed = seed_value(seed, "seed", where=("world.seed", "--seed"))
     return SCENARIOS[key](seed=seed, **kwargs)

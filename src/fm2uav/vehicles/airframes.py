@@ -161,8 +161,10 @@ class FixedWing:
             object.__setattr__(self, attr, v)
         if not self.min_speed <= self.cruise_speed <= self.max_speed:
             raise InputError(
-                f"airframe speeds must satisfy min <= cruise <= max, got min {self.min_speed} "
-                f"cruise {self.cruise_speed} max {self.max_speed} m/s"
+                f"airframe {self.name} speeds must satisfy min_speed <= cruise_speed <= "
+                f"max_speed, got min_speed {self.min_speed:g}, cruise_speed "
+                f"{self.cruise_speed:g}, max_speed {self.max_speed:g} m/s; fix the one out of "
+                "order"
             )
 
     def turn_radius(self, speed: float | None = None) -> float:
@@ -180,8 +182,22 @@ class FixedWing:
         return AirframeLimits(min(self.max_climb, self.max_descent), self.turn_radius())
 
     def with_speed(self, cruise_speed: float) -> FixedWing:
-        """The same airframe flown at another cruise speed [m/s] (validated)."""
-        return replace(self, cruise_speed=cruise_speed)
+        """The same airframe flown at another cruise speed [m/s] (validated).
+
+        Raises
+        ------
+        InputError
+            Not a number, or outside the airframe's stall .. maximum speed (names
+            ``speed=`` / the CLI's ``--speed`` and the range).
+        """
+        v = _positive("speed [m/s] (CLI --speed)", cruise_speed)
+        if not self.min_speed <= v <= self.max_speed:
+            side = ("below its stall (minimum) speed" if v < self.min_speed
+                    else "above its maximum speed")
+            raise InputError(
+                f"speed {v:g} m/s is {side} for the {self.name}; allowed: {self.min_speed:g} <= "
+                f"speed <= {self.max_speed:g} m/s (speed= / CLI --speed; or another --airframe)")
+        return replace(self, cruise_speed=v)
 
     def summary(self) -> dict[str, Any]:
         """JSON-friendly numbers, angles in degrees."""

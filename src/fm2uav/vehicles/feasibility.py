@@ -32,7 +32,8 @@ from .multirotor import track_multirotor
 from .speed_profile import SpeedProfile, speed_profile
 from .tracking import Tracking, TrackingOptions
 
-__all__ = ["DEFAULT_TOLERANCE", "FeasibilityReport", "check_feasibility", "collision_check"]
+__all__ = ["DEFAULT_TOLERANCE", "MAX_TOLERANCE", "FeasibilityReport", "check_feasibility",
+           "collision_check"]
 
 #: Default largest admissible separation flown ↔ planned [m]: about the
 #: horizontal accuracy of a GNSS-guided small UAV plus margin.
@@ -135,6 +136,10 @@ class FeasibilityReport:
         return rows
 
 
+#: Largest tracking tolerance [m] (a larger one accepts any path).
+MAX_TOLERANCE = 10_000.0
+
+
 def check_feasibility(
     path: Any,
     airframe: Airframe | str,
@@ -178,9 +183,11 @@ def check_feasibility(
         Unknown airframe, bad path (< 2 points, NaN), negative speed or tolerance.
     """
     af = get_airframe(airframe)
-    tol = float(tolerance)
-    if not (math.isfinite(tol) and tol > 0):
-        raise InputError(f"tolerance must be a positive distance in metres, got {tolerance!r}")
+    from .. import _validate
+
+    # above 10 km any path "keeps within tolerance": a typo, never a check
+    tol = _validate.in_range(tolerance, "tolerance", 0.0, MAX_TOLERANCE, low_open=True,
+                             unit="m", where=(None, "--tolerance"))
     raw = np.asarray(path, dtype=float) if not isinstance(path, np.ndarray) else path
     as_path3(raw)  # validate once, with the user's view of the path
     if world is not None and not isinstance(world, World):
@@ -207,7 +214,9 @@ def _fly(raw: np.ndarray, af: Airframe, *, w: Any, speed: float | None,
             af = af.with_speed(speed)
         return af, track_dubins(raw, af, tracking=tracking)
     if speed is not None:
-        raise InputError("speed= applies to fixed-wings; a multirotor flies the W profile")
+        raise InputError(f"speed= (CLI --speed) applies to fixed-wings; the {af.name} is a "
+                         "multirotor, which flies the planned W profile up to its max_speed; "
+                         "remove --speed")
     return af, track_multirotor(raw, af, w=w, tracking=tracking)
 
 

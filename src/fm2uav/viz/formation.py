@@ -40,7 +40,12 @@ __all__ = [
     "formation_animation",
     "formation_report_html",
     "thesis_report_html",
+    "MAX_FRAMES",
+    "check_frames",
 ]
+
+#: Most frames of a formation animation (each is a drawn figure, ~0.1 MB in a GIF).
+MAX_FRAMES = 1000
 
 #: One colour per UAV (leader first).
 COLOURS = ("crimson", "royalblue", "darkorange", "seagreen", "purple", "teal", "olive")
@@ -222,6 +227,24 @@ def formation_metrics_figure(result: FormationResult, *, title: str | None = Non
     return fig
 
 
+def check_frames(max_frames: Any) -> int:
+    """``max_frames`` of :func:`formation_animation` as an int in [1, :data:`MAX_FRAMES`].
+
+    Raises
+    ------
+    InputError
+        Not an integer >= 1, or more than :data:`MAX_FRAMES` (names ``--frames``).
+    """
+    from .. import _validate as v
+    from ..errors import InputError
+
+    n = v.integer(max_frames, "max_frames", minimum=1, where=(None, "--frames"))
+    if n > MAX_FRAMES:
+        raise InputError(f"max_frames = {n} would draw {n} figures (a GIF of ~{n * 0.1:.3g} "
+                         f"MB); the limit is {MAX_FRAMES} frames (CLI: --frames)")
+    return n
+
+
 def formation_animation(
     result: FormationResult,
     filename: str | Path,
@@ -256,6 +279,7 @@ def formation_animation(
     """
     from ..errors import InputError
 
+    max_frames = check_frames(max_frames)
     path = Path(filename)
     suffix = "".join(path.suffixes[-1:]).lower()
     if suffix == ".gif":

@@ -12,7 +12,7 @@ import numpy as np
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 
-__all__ = ["heatmap_figure", "best_paths_figure", "curvature_figure"]
+__all__ = ["heatmap_figure", "best_paths_figure", "curvature_figure", "sweep_report_html"]
 
 _TITLES = {"dubins": "Dubins", "elastica": "Euler–Mumford elastica", "rs": "Reeds–Shepp forward"}
 _UNITS = {"frechet": "mean Fréchet distance [m]", "area": "mean area between curves [m²]"}
@@ -119,3 +119,40 @@ def curvature_figure(profiles: Mapping[str, Mapping[str, Mapping[str, np.ndarray
             ax.legend(loc="upper right", fontsize=7)
     fig.suptitle(f"Curvature profiles, first pair ({metric} best match)")
     return fig
+
+
+def sweep_report_html(world, summary: Mapping[str, Any], *, title: str, subtitle: str = "",
+                      params: Mapping[str, Any] | None = None,
+                      files: Sequence[str] = ()) -> str:
+    """report.html of a sweep (``fm2uav sweep --report``): on the map, the FM² paths at
+    the best (α, β) by area and the references of every pair (one trace per model), and
+    the best-parameter and timing tables of ``summary``
+    (:func:`fm2uav.experiments.sweep.summarise_sweep`)."""
+    from .report import join_polylines, report_html
+
+    paths: dict[str, np.ndarray] = {}
+    overlays: dict[str, Any] = {}
+    colours = {"dubins": "#d62728", "elastica": "#9467bd", "rs": "#8c564b"}
+    for model, pairs in summary.get("paths", {}).get("area", {}).items():
+        done = [pp for pp in (pairs or []) if pp is not None]
+        if not done:
+            continue
+        name = _TITLES.get(model, model)
+        paths[f"FM² best area vs {name}, pair 1"] = np.asarray(done[0][0], dtype=float)
+        overlays[f"FM² best area vs {name}, all pairs"] = {
+            "points": join_polylines([d[0] for d in done]), "color": "#e6b800"}
+        overlays[f"{name} references"] = {"points": join_polylines([d[1] for d in done]),
+                                          "color": colours.get(model, "#d62728"),
+                                          "dash": "dash"}
+    if not paths:
+        raise ValueError("the sweep has no finished case to draw (every case failed)")
+    best_rows = [{"metric": metric, "model": _TITLES.get(model, model),
+                  "alpha": b["alpha"], "beta": b["beta"], "value": round(float(b["value"]), 4)}
+                 for metric, by_model in summary.get("best", {}).items()
+                 for model, b in by_model.items()]
+    timing = summary.get("timing", {})
+    return report_html(
+        world, paths, title=title, subtitle=subtitle, overlays=overlays, params=params or {},
+        metrics={k: (round(v, 4) if isinstance(v, float) else v) for k, v in timing.items()},
+        tables={"Best (α, β) per metric and model (Tables 2 and 3)": best_rows},
+        files=files)

@@ -95,7 +95,7 @@ def _resolve(v: str, info: ValidationInfo | None) -> Path:
     return p
 
 
-_STRICT = ConfigDict(strict=True, extra="forbid", frozen=True)
+_STRICT = ConfigDict(strict=True, extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 def _num(default: Any = None, *, unit: str = "", desc: str = "", **bounds: float) -> Any:
@@ -106,11 +106,29 @@ def _num(default: Any = None, *, unit: str = "", desc: str = "", **bounds: float
 MAX_ASPECT = 1000.0
 
 
-def _regular_file(path: Path) -> None:
-    """A directory, named pipe or unreadable file as a ValueError (pydantic) — never a hang."""
+def _not_there(path: Path, allowed: str) -> str:
+    """The message of a missing data file (a dangling symbolic link named as such)."""
+    import os
+
+    from .._validate import cwd_gone, missing
+
+    v = cwd_gone(path)
+    if v:
+        return v
+    if os.path.islink(path):
+        return f"{path} {missing(path)}; allowed: {allowed}"
+    return f"file not found ({path}); allowed: {allowed}"
+
+
+def _regular_file(path: Path, key: str) -> None:
+    """A directory, named pipe or unreadable file as a ValueError (pydantic) — never a hang.
+
+    The file is noted as an input of the command (``key`` names it), so that an output
+    folder holding it is never replaced (:func:`fm2uav._validate.input_log`)."""
     from .. import _validate as v
     from ..errors import InputError
 
+    v.note_input(path, key)
     try:
         v.input_file(path, "file")
     except InputError as exc:
@@ -122,9 +140,8 @@ def _raster_file(item: str, info: ValidationInfo | None) -> str:
     raster GDAL reads (as a ValueError for pydantic)."""
     path = _resolve(item, info)
     if not path.exists():
-        raise ValueError(f"file not found ({path}); allowed: an existing raster file "
-                         "(GeoTIFF, VRT, .hgt, ...)")
-    _regular_file(path)
+        raise ValueError(_not_there(path, "an existing raster file (GeoTIFF, VRT, .hgt, ...)"))
+    _regular_file(path, "world.dem")
     import rasterio
 
     from .dem_values import raster_problem
@@ -248,9 +265,9 @@ class WorldSpec(BaseModel):
             return v
         path = _resolve(v, info)
         if not path.exists():
-            raise ValueError(f"file not found ({path}); allowed: an existing vector file "
-                             "(GeoJSON, GeoPackage, Shapefile, KML/KMZ)")
-        _regular_file(path)
+            raise ValueError(_not_there(path, "an existing vector file (GeoJSON, GeoPackage, "
+                                        "Shapefile, KML/KMZ)"))
+        _regular_file(path, "world.buildings")
         return str(path)
 
     @field_validator("bbox")

@@ -85,6 +85,9 @@ class VectorData:
         The file, its checksum, the CRS it was read in and the rule that gave it.
     skipped : dict
         Features left out, by reason (e.g. ``{"Point": 12, "empty": 1}``).
+    source_bounds : tuple or None
+        Bounds (minx, miny, maxx, maxy) of the kept features as read, in the CRS they
+        were read in (``source.crs``), before any reprojection.
     """
 
     geometries: tuple[Any, ...]
@@ -92,6 +95,7 @@ class VectorData:
     crs: str | None
     source: SourceFile
     skipped: dict[str, int] = field(default_factory=dict)
+    source_bounds: tuple[float, float, float, float] | None = None
 
     def __len__(self) -> int:
         return len(self.geometries)
@@ -346,7 +350,8 @@ def read_vectors(
     src = _source_file(shown, role, sha, src_crs, rule, len(kept_g), skipped, reason, layers,
                        driver)
     return VectorData(geometries=tuple(kept_g), properties=tuple(kept_p), crs=out_crs,
-                      source=src, skipped=skipped)
+                      source=src, skipped=skipped,
+                      source_bounds=tuple(float(v) for v in bounds) if kept_g else None)
 
 
 def _read_source(source: Any, role: str, layer: str | None) -> tuple[Any, ...]:

@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import shapely
+import shapely.validation
 from shapely.geometry import Point, Polygon
 from shapely.geometry.base import BaseGeometry
 
@@ -79,6 +80,11 @@ def _num(value: Any, what: str, where: str, *, minimum: float | None = None,
         bound = "> 0" if positive else f">= {minimum:g}" if minimum is not None else "finite"
         raise InputError(f"{where}: {what} must be {bound} metres, got {value!r}")
     return v
+
+
+class ZoneWarning(UserWarning):
+    """A zone that changes nothing or not what it says: wholly off the map, or a polygon
+    crossing itself that was repaired (shown by the CLI as one ``warning:`` line)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -124,11 +130,20 @@ class Zone:
         if g.is_empty:
             raise InputError(f"{where}: the polygon is empty")
         if not g.is_valid:
+            import warnings
+
+            why = shapely.validation.explain_validity(g)
             g = shapely.make_valid(g)
             polys = [p for p in getattr(g, "geoms", [g]) if p.geom_type == "Polygon"]
             if not polys:
-                raise InputError(f"{where}: the polygon is invalid and cannot be repaired")
+                raise InputError(f"{where}: the polygon is invalid ({why}) and cannot be "
+                                 "repaired; fix its outline")
             g = shapely.MultiPolygon(polys) if len(polys) > 1 else polys[0]
+            warnings.warn(ZoneWarning(
+                f"{where}: the polygon is invalid ({why}); it was repaired into "
+                f"{len(polys)} part{'s' if len(polys) > 1 else ''} of {g.area:.0f} m² in all "
+                "(the areas its outline encloses) — check that this is the zone meant"),
+                stacklevel=2)
         if g.area <= 0:
             raise InputError(f"{where}: the polygon has no area")
         object.__setattr__(self, "geometry", g)
@@ -326,6 +341,17 @@ def read_zones(source: Any, world: World, *, crs: Any = None, defaults: Mapping[
     if not out:
         raise InputError(f"{label}: no polygon or circle (point with a radius) to use as a "
                          f"{'operating area' if inclusion else 'no-fly zone'}")
+    src = getattr(data.source, "crs", None)
+    geographic = False
+    if src is not None:
+        from .geo import parse_crs
+
+        try:
+            geographic = bool(parse_crs(src).is_geographic)
+        except Exception:  # noqa: BLE001 - a CRS read from the file; no swap test then
+            geographic = False
+    check_zones_on_map(out, world, label, lonlat_bounds=(
+        getattr(data, "source_bounds", None) if geographic else None))
     return out
 
 
@@ -587,21 +613,110 @@ def zone_distances(world: World, points: Any) -> dict[str, float]:
 
 
 def check_points_allowed(world: World, points: Mapping[str, Any]) -> None:
-    """Refuse a start/goal inside a zone (or outside the operating area), naming it.
+    """Refuse a start/goal inside a no-fly zone or outside the operating area, naming it.
 
     Raises
     ------
     PointError
-        A point inside a zone is bad input (exit code 2 on the command line), like a
-        point inside an obstacle.
+        Bad input (exit code 2): the message names the point, the zone, what is wrong
+        (inside the zone, its buffer, its vertical extent; outside the area) and how far
+        it is from the allowed air.
     """
+
     for what, pt in points.items():
-        v = zone_violations(world, np.atleast_2d(np.asarray(pt, dtype=float)), buffered=True)
-        if v:
+        p = np.asarray(pt, dtype=float)
+        v = zone_violations(world, np.atleast_2d(p), buffered=True)
+        if not v:
+            continue
+        zone = next((z for z in world.zones if (z.name or z.kind) == v[0].zone), None)
+        at = np.round(p, 1).tolist()
+        if zone is not None and zone.inclusion:
+            d = float(zone.geometry.exterior.distance(Point(p[0], p[1]))) if hasattr(
+                zone.geometry, "exterior") else float(zone.geometry.boundary.distance(
+                    Point(p[0], p[1])))
+            inside = bool(zone.geometry.contains(Point(p[0], p[1])))
+            why = ((f"within its buffer of {zone.buffer:g} m from the edge ({d:.0f} m "
+                    "from it)") if inside and zone.buffer > 0 and d < zone.buffer else
+                   "above its ceiling or below its floor" if inside else
+                   f"outside it, {d:.0f} m from its edge")
             raise PointError(
-                f"the {what} {np.round(np.asarray(pt, dtype=float), 1).tolist()} m lies in "
-                f"{v[0].zone!r} (or its buffer); move the {what} or change {_NO_FLY} / "
-                "operating_area")
+                f"the {what} {at} m is not inside the operating area {v[0].zone!r}: it lies "
+                f"{why}; the whole flight must stay inside the area — move the {what} into "
+                "it, or enlarge operating_area (or lower its buffer)")
+        where = ("in its buffer" if v[0].inside_buffer_only else "inside it")
+        raise PointError(
+            f"the {what} {at} m lies in the no-fly zone {v[0].zone!r} ({where}); move the "
+            f"{what} out of it, or change {_NO_FLY}")
 
 
-__all__ += ["ZoneViolation", "check_points_allowed"]
+def check_zones_on_map(zones: Sequence[Zone], world: World, label: str, *,
+                       lonlat_bounds: Sequence[float] | None = None, anchor: Any = None,
+                       inline: bool = False) -> None:
+    """Say so when none of ``zones`` (one file or entry) touches the map.
+
+    A zone file whose zones all lie off the map changes nothing in the plan; most
+    often it is the wrong file or its coordinates are written ``[lat, lon]``. With
+    ``lonlat_bounds`` (the zones' lon/lat bounds W, S, E, N as read), the swap is
+    detected: when the bounds with longitude and latitude exchanged meet the map, the
+    zones are refused (InputError, the fix named). ``label`` names the file (or, with
+    ``inline``, the mission-file entry of one zone). Otherwise a
+    :class:`ZoneWarning` names the file and how far its nearest zone is.
+
+    Raises
+    ------
+    InputError
+        The coordinates are ``[lat, lon]`` (swapped).
+    """
+    import warnings
+
+    if not zones:
+        return
+    b = np.asarray(world.bounds, dtype=float)
+    rect = shapely.box(b[0, 0], b[1, 0], b[0, 1], b[1, 1])
+    shapes = []
+    for z in zones:
+        g = z.geometry.buffer(z.buffer) if z.buffer > 0 and not z.inclusion else z.geometry
+        if np.all(np.isfinite(g.bounds)):
+            shapes.append(g)
+            if g.intersects(rect):
+                return
+    kind = "operating area" if zones[0].inclusion else "zone"
+    n = len(zones)
+    off = (f"{label} lies off the map" if inline else
+           f"{label}: its {kind} lies off the map" if n == 1 else
+           f"{label}: all of its {n} {kind}s lie off the map")
+    covers = ""  # the map's lon/lat extent, when the zones were given in lon/lat
+    if lonlat_bounds is not None and len(lonlat_bounds) == 4:
+        w, s, e, nn = (float(v) for v in lonlat_bounds)
+        corners = np.array([[b[0, 0], b[1, 0]], [b[0, 1], b[1, 0]], [b[0, 0], b[1, 1]],
+                            [b[0, 1], b[1, 1]]])
+        from .geo import to_lonlat
+
+        ll = to_lonlat(world, corners, anchor=anchor)
+        mw, me = float(ll[:, 0].min()), float(ll[:, 0].max())
+        ms, mn = float(ll[:, 1].min()), float(ll[:, 1].max())
+        covers = f"the map covers lon {mw:.5f}..{me:.5f}, lat {ms:.5f}..{mn:.5f}"
+        # swapped: the file's "longitudes" are latitudes and the other way round
+        if abs(w) <= 90 and abs(e) <= 90 and s <= me and nn >= mw and w <= mn and e >= ms:
+            raise InputError(
+                f"{off}, but with longitude and latitude swapped "
+                f"{'it' if n == 1 else 'they'} would lie on it: the coordinates are written "
+                f"[lat, lon] (x {w:.5f}..{e:.5f}, y {s:.5f}..{nn:.5f}; {covers}); GeoJSON "
+                "(RFC 7946), KML and mission files write [lon, lat] — swap the two coordinates")
+    near = min((float(rect.distance(g)) for g in shapes), default=float("inf"))
+    dist = (f"the nearest is {near / 1000:.1f} km from its edge" if np.isfinite(near) else
+            "its coordinates fall outside the map's coordinate system")
+    if not inline:
+        fix = ("check that it is the file meant for this area and that its coordinates are "
+               "[lon, lat] (or give its CRS)")
+    elif covers:
+        fix = f"check its [lon, lat] coordinates: {covers}"
+    else:  # an entry in world metres, like start and goal
+        fix = (f"check its coordinates: they are world metres (lonlat: false) and the map covers "
+               f"x {b[0, 0]:.0f}..{b[0, 1]:.0f} m, y {b[1, 0]:.0f}..{b[1, 1]:.0f} m")
+    warnings.warn(ZoneWarning(
+        f"{off} ({dist}), so {'it changes' if n == 1 else 'they change'} nothing in "
+        f"this plan; {fix}"), stacklevel=2)
+
+
+__all__ += ["ZoneViolation", "check_points_allowed", "check_zones_on_map", "ZoneWarning"]

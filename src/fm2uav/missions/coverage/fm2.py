@@ -342,7 +342,12 @@ def _steering(poly: Any, d: float, angle: float | None, search: str,
     steering-angle search ``search`` over ``poly`` at spacing ``d`` [m] (the DEs seeded
     with ``seed`` unless ``search_options`` has one)."""
     if angle is not None:
-        return angle, None
+        from ... import _validate
+
+        # any finite angle is a direction, but beyond one turn it is a typo (--angle 1e308)
+        a = _validate.in_range(angle, "angle", -2 * np.pi, 2 * np.pi, unit="rad",
+                               where=(None, "--angle (degrees, within ±360)"))
+        return a, None
     opts = dict(search_options or {})
     if search.lower() in ("de", "scipy-de"):
         opts.setdefault("seed", seed)

@@ -145,6 +145,12 @@ def camera_plan(
     trig = round(float(trig), 3)  # mm: what a mission item needs
     if not (math.isfinite(trig) and trig > 0):
         raise InputError(f"trigger distance must be > 0 m, got {trig!r}")
+    total = float(np.linalg.norm(np.diff(np.asarray(coverage.path)[:, :2], axis=0),
+                                 axis=1).sum())
+    if trig > total:
+        raise InputError(f"trigger distance {trig:g} m is longer than the whole coverage path "
+                         f"({total:.0f} m): the camera would take no photo along the bands; "
+                         f"give at most {total:.0f} m (CLI --trigger-distance)")
     bands, worst = band_indices(coverage.zigzag, coverage.path)
     info["band_end_mismatch_m"] = round(worst, 3)
     return CameraPlan(trigger_distance=float(trig), bands=tuple(bands), info=info)

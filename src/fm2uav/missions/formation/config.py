@@ -14,9 +14,13 @@ import dataclasses
 from dataclasses import dataclass
 
 from ... import _validate as v
+from ...errors import InputError
 from .shapes import SHAPES
 
-__all__ = ["FormationConfig", "GREY_MODES"]
+__all__ = ["FormationConfig", "GREY_MODES", "MAX_FOLLOWERS"]
+
+#: Largest formation (followers): each re-plans with FM² every cycle.
+MAX_FOLLOWERS = 50
 
 #: How the grey level ``B`` of a follower is measured (see ``grey_levels``).
 GREY_MODES = ("goal", "follower")
@@ -95,6 +99,11 @@ class FormationConfig:
     def __post_init__(self) -> None:
         _set(self, "n_followers", v.integer(self.n_followers, "n_followers", minimum=1,
                                             where=_where("n_followers", "--followers")))
+        if self.n_followers > MAX_FOLLOWERS:
+            raise InputError(
+                f"n_followers = {self.n_followers} would re-plan {self.n_followers} FM² paths "
+                f"(each a full arrival-time field) every cycle; the limit is {MAX_FOLLOWERS} "
+                f"followers{v.where_text(_where('n_followers', '--followers'))}")
         _set(self, "shape", v.choice(str(self.shape).strip().lower(), tuple(SHAPES), "shape",
                                      where=_where("shape")))
         _set(self, "dist", v.positive(self.dist, "dist", unit="m", where=_where("dist")))
