@@ -41,6 +41,8 @@ RAISED_ONLY_WITH_THE_FLAG = {
         "cli_point(lonlat=..., cells=...): only plan and formation pass cells=True",
     ("fm2uav.experiments.runner", "cannot reach the Dask scheduler {}: {}; check --scheduler"):
         "a Dask pool is made only from a --scheduler (sweep, reproduce curvature)",
+    ("fm2uav.missions.coverage.fm2", "--angle (degrees, within ±360)"):
+        "checked only for a given angle: cover --angle (reproduce coverage searches it)",
 }
 
 

@@ -519,7 +519,7 @@ def check_workers(workers: Any) -> int | None:
         raise InputError(
             f"--workers {n} would start {n} worker processes (~150 MB each: "
             f"{n * 0.15:.3g} GB) on {os.cpu_count() or 1} cores; the limit is {max_workers()} "
-            "(4 per core); for more, run a Dask cluster and give --scheduler")
+            "(4 per core); for more, run a Dask cluster and give its scheduler address")
     return n
 
 

@@ -216,7 +216,7 @@ def _fly(raw: np.ndarray, af: Airframe, *, w: Any, speed: float | None,
     if speed is not None:
         raise InputError(f"speed= (CLI --speed) applies to fixed-wings; the {af.name} is a "
                          "multirotor, which flies the planned W profile up to its max_speed; "
-                         "remove --speed")
+                         "remove it")
     return af, track_multirotor(raw, af, w=w, tracking=tracking)
 
 
