@@ -158,8 +158,8 @@ def rally_points(world: Any, given: Any, *, agl: float, reach: ReturnField | Non
     ----------
     world : World
     given : sequence of (x, y[, agl])
-        Sites [m]; the third value, when given, is the approach height above the
-        ground [m] (default ``agl``).
+        Sites [m]; the third value, when given (not None), is the approach height
+        above the ground [m] (default ``agl``).
     agl : float
         Default approach height above the ground [m].
     reach : ReturnField, optional
@@ -174,7 +174,8 @@ def rally_points(world: Any, given: Any, *, agl: float, reach: ReturnField | Non
         nodata, in an obstacle or a no-fly zone, or cut off from home — naming the
         point and ``--rally``.
     """
-    pts = [np.asarray(g, dtype=float).ravel() for g in given]
+    pts = [np.asarray([v for v in np.asarray(g, dtype=object).ravel() if v is not None],
+                      dtype=float) for g in given]
     if len(pts) > MAX_RALLY:
         raise InputError(f"{len(pts)} rally points given; at most {MAX_RALLY} ({_FLAG}): "
                          "ArduPilot and MAVProxy keep 10")

@@ -67,8 +67,8 @@ from .returns import FirmwareReturns, RouteSamples, firmware_returns, route_samp
 from .thin import thin_path
 from .validate import check_mission
 
-__all__ = ["ReturnOptions", "ReturnsReport", "build_with_returns", "RETURN_THIN_M",
-           "DEFAULT_MAX_RETURNS"]
+__all__ = ["ReturnOptions", "ReturnsReport", "build_with_returns", "flown_plan",
+           "RETURN_THIN_M", "DEFAULT_MAX_RETURNS"]
 
 #: Douglas–Peucker tolerance of the written (and timed) return paths [m].
 RETURN_THIN_M = 1.0
@@ -177,6 +177,8 @@ class ReturnsReport:
     notes: list[str] = field(default_factory=list)
     speeds: dict[str, float] = field(default_factory=dict)
     endurance_s: float | None = None
+    flight_w: np.ndarray | None = field(default=None, repr=False)
+    flight_profile: Any = field(default=None, repr=False)
 
     def waypoint_paths(self) -> dict[int, np.ndarray]:
         """Waypoint index → its way back [m]."""
@@ -332,22 +334,23 @@ def _markers(items: list[MissionItem], models: Any) -> list[MissionItem]:
 
 
 def _embed(mission: MissionExport, plan: Any, home: ReturnField, inputs: dict[str, Any],
-           models: Any) -> tuple[MissionExport, str, str]:
+           models: Any) -> tuple[MissionExport, str, str, Any, Any]:
     """The mission carrying its planned safe return (module docstring, step 5):
-    (mission, kind, note)."""
+    (mission, kind, note, W along the flight, the flight's altitude profile)."""
     opt = mission.options
     world = mission.world
     path = np.asarray(mission.path_m, dtype=float)
+    w = inputs.get("w")
+    profile = inputs.get("profile")
     if inputs.get("times") is not None:
-        return mission, "", "a timed (formation) mission keeps its timing: no return appended"
+        return (mission, "", "a timed (formation) mission keeps its timing: no return appended",
+                w, profile)
     if opt.end == "land":
         kind = "landing"
         m2 = mission
     else:
         kind = "return"
         start, end = path[0], path[-1]
-        w = inputs.get("w")
-        profile = inputs.get("profile")
         if np.hypot(*(end[:2] - start[:2])) > max(10.0, opt.tolerance):
             back = home.path(end[:world.ndim])
             ext = np.vstack([path, back.path[1:]])
@@ -376,7 +379,7 @@ def _embed(mission: MissionExport, plan: Any, home: ReturnField, inputs: dict[st
             (" and DO_RETURN_PATH_START after the takeoff" if any(m.return_path_start
                                                                    for m in models) else "") +
             "; " + "; ".join(m.mission_note for m in models if m.mission_note))
-    return replace(m2, items=items, end=end), kind, note
+    return replace(m2, items=items, end=end), kind, note, w, profile
 
 
 # ---------------------------------------------------------------- the point of no return
@@ -514,12 +517,15 @@ def build_with_returns(path_m: Any, world: Any, options: Any, returns: ReturnOpt
     fw = firmware_returns(mission, rally=rally, min_agl=min_agl, min_agl_source=min_src,
                           max_agl=max_agl)
     embedded = ""
+    flight_w, flight_profile = inputs.get("w"), inputs.get("profile")
     if not fw.feasible:
         try:
-            new, embedded, note = _embed(mission, plan, home, {**inputs}, models)
+            new, embedded, note, fw_w, fw_p = _embed(mission, plan, home, {**inputs}, models)
         except (UnreachableError, PlanningError) as exc:
             new, note = mission, f"the planned safe return could not be added: {exc}"
             warnings.append(note)
+        if embedded:
+            flight_w, flight_profile = fw_w, fw_p
         if embedded:
             mission = new
             notes.append(note)
@@ -584,6 +590,27 @@ def build_with_returns(path_m: Any, world: Any, options: Any, returns: ReturnOpt
         fields=fields, rally=rally, samples=samples, to=to, time=t_back, length=length,
         paths=paths, energy_wh=energy, pnr=pnr, pnr_path=pnr_path, firmware=fw, params=params,
         embedded=embedded, rally_report=rally_report, warnings=warnings, notes=notes,
-        speeds=speeds, endurance_s=endurance)
+        speeds=speeds, endurance_s=endurance, flight_w=flight_w, flight_profile=flight_profile)
     info = {**mission.info, "notes": list(mission.info.get("notes", [])) + notes}
     return replace(mission, warnings=[*mission.warnings, *warnings], info=info, returns=report)
+
+
+def flown_plan(plan: Any, mission: MissionExport) -> Any:
+    """``plan`` as the mission flies it: with the planned safe return appended when the
+    mission carries one (path, W along it, length, altitude profile), else ``plan``."""
+    from ..geometry import path_length
+
+    p = np.asarray(mission.path_m, dtype=float)
+    if len(p) == len(plan.path) and np.array_equal(p, np.asarray(plan.path, dtype=float)):
+        return plan
+    rep = mission.returns
+    w = rep.flight_w if rep is not None else None
+    if w is None or np.shape(w) != (len(p),):
+        W = np.asarray(plan.W)
+        w = (_interp_w(W, plan.world, p) if W.shape == plan.world.shape
+             else np.concatenate([plan.w, np.full(len(p) - len(plan.w), np.nan)]))
+    profile = rep.flight_profile if rep is not None else None
+    if profile is not None and len(profile.path) != len(p):
+        profile = None
+    return replace(plan, path=p, w=np.asarray(w, dtype=float), length=path_length(p),
+                   profile=profile)

@@ -25,6 +25,7 @@ from ._common import (
     write_text,
 )
 from ._mission_options import via_points
+from ._return_options import ReturnFlags, return_options
 from .options import (
     LonLatOpt,
     MissionFlags,
@@ -133,6 +134,7 @@ def plan_outputs(
     subtitle: str = "",
     summary: dict[str, Any] | None = None,
     step: Callable[[str], None] = lambda message: None,
+    returns: Any = None,
     **mission_inputs: Any,
 ) -> tuple[dict[str, Any], Any]:
     """Write the requested outputs of a plan into ``outdir`` (atomically each).
@@ -149,6 +151,9 @@ def plan_outputs(
         Of the HTML report and PNG figure.
     summary : dict, optional
         Extra entries of ``summary.json``.
+    returns : ReturnOptions, optional
+        Compute the safe returns (:mod:`fm2uav.autopilot.safe_return`): ``returns`` and
+        ``point_of_no_return`` in the summary, the return files, the report's ways back.
     **mission_inputs
         ``via``, ``camera``, ``fences``, ``agl`` of :func:`fm2uav.io.export_mission`.
 
@@ -169,8 +174,11 @@ def plan_outputs(
     if zones and "fences" not in mission_inputs:  # no-fly zones -> the .plan geoFence
         mission_inputs["fences"], fence_warnings = zone_fences(
             zones, plan.world, getattr(options, "anchor", None))
-    step("building the mission (altitudes, waypoints, takeoff, end, firmware checks)")
-    mission, files = export_mission(plan, exports, options, **mission_inputs)
+    step("building the mission (altitudes, waypoints, takeoff, end, firmware checks)"
+         + ("; the ways back, rally points, firmware return settings"
+            if returns is not None and returns.enabled else ""))
+    mission, files = export_mission(plan, exports, options, returns=returns, **mission_inputs)
+    plan = _flown(plan, mission)
     wps = mission.waypoints
     step("measuring the flight against the ground, the zones and the limits")
     level = getattr(plan, "level", None)
@@ -192,12 +200,15 @@ def plan_outputs(
         "thin_tolerance_m": options.tolerance,
         "safety": safety,
     }
+    if mission.returns is not None:
+        info["returns"] = mission.returns.summary(plan.world, options.anchor)
+        info["point_of_no_return"] = mission.returns.pnr
     write_exports(outdir, files, step)
     if "html" in formats:
         step("writing report.html")
         write_text(outdir, "report.html", _plan_report(
             plan, info, wps, options, formats, title=title, subtitle=subtitle, zones=zones,
-            fence_warnings=fence_warnings))
+            fence_warnings=fence_warnings, returns=mission.returns))
     if "png" in formats:
         from ..viz import plan_figure
 
@@ -209,9 +220,89 @@ def plan_outputs(
     return info, mission
 
 
+def _flown(plan: Any, mission: Any) -> Any:
+    """The plan as the mission flies it (with a planned safe return appended)."""
+    if getattr(mission, "returns", None) is None:
+        return plan
+    from ..autopilot.safe_return import flown_plan
+
+    return flown_plan(plan, mission)
+
+
+def returns_rows(info: dict[str, Any]) -> dict[str, str]:
+    """Printed / report rows of the safe returns (``returns`` of the summary)."""
+    r = info.get("returns")
+    if not r:
+        return {}
+    rows: dict[str, str] = {}
+    w = r["worst"]
+    if w.get("time_s") is not None:
+        rows["longest way back"] = (f"{w['time_s'] / 60:.1f} min to {w['to']} from "
+                                    f"{w['distance_m'] / 1000:.2f} km along the route")
+    rally = [d for d in r["destinations"] if d.get("name") != "home"]
+    if rally:
+        rows["rally points"] = ", ".join(
+            f"{d['name']} ({d.get('chosen_by', 'user')}) {d.get('lon', 0):.5f}, "
+            f"{d.get('lat', 0):.5f}" for d in rally)
+    p = r["point_of_no_return"]
+    if not p.get("computed"):
+        rows["point of no return"] = "not computed: " + p.get("why", "")
+    elif p.get("reached"):
+        rows["point of no return"] = (f"{p['distance_m'] / 1000:.2f} km along the route "
+                                      f"(after waypoint {p['after_waypoint']}, "
+                                      f"{p['t_mission_s'] / 60:.1f} min)"
+                                      + (" — BEFORE the route's end" if p["passed_before_end"]
+                                         else ""))
+    else:
+        rows["point of no return"] = (f"none on the route (smallest margin "
+                                      f"{p['smallest_margin_s'] / 60:.1f} min)")
+    fw = r.get("firmware")
+    if fw:
+        alts = "; ".join(
+            f"{m['firmware']} {m['return_altitude_m']:g} m" if m["feasible"] else
+            f"{m['firmware']}: no safe altitude" for m in fw["models"])
+        rows["firmware return"] = (alts + f" (>= {fw['min_agl_m']:g} m above the surface on "
+                                   f"{fw['start_points']['count']} straight lines)")
+    if r.get("mission_carries_safe_return"):
+        rows["safe return in the mission"] = str(r["mission_carries_safe_return"])
+    return rows
+
+
+def _return_overlays(returns: Any) -> dict[str, Any]:
+    """Report overlays: the way back from every waypoint, the point of no return's, rally
+    points (small crosses)."""
+    if returns is None:
+        return {}
+    out: dict[str, Any] = {}
+    lines = [p for p in returns.waypoint_paths().values() if len(p) >= 2]
+    if lines:
+        gap = np.full((1, 3), np.nan)
+        pts = np.concatenate([np.vstack([p[:, :3], gap]) for p in lines])[:-1]
+        out["ways back (from each waypoint)"] = {"points": pts, "color": "#9467bd",
+                                                 "width": 2, "dash": "dot"}
+    if returns.pnr_path is not None and len(returns.pnr_path) >= 2:
+        out["point of no return: way back"] = {"points": returns.pnr_path[:, :3],
+                                               "color": "#d62728", "width": 5}
+        x, y, z = (float(v) for v in returns.pnr_path[0, :3])
+        d = 40.0
+        out["point of no return"] = {"points": np.array([
+            [x - d, y, z], [x + d, y, z], [np.nan] * 3, [x, y - d, z], [x, y + d, z],
+            [np.nan] * 3, [x, y, z - d], [x, y, z + d]]), "color": "#d62728", "width": 8}
+    marks = []
+    for r in returns.rally:
+        x, y = float(r.point[0]), float(r.point[1])
+        d = 25.0
+        marks += [np.array([[x - d, y], [x + d, y]]), np.full((1, 2), np.nan),
+                  np.array([[x, y - d], [x, y + d]]), np.full((1, 2), np.nan)]
+    if marks:
+        out["rally points"] = {"points": np.concatenate(marks[:-1]), "color": "#ff7f0e",
+                               "width": 5}
+    return out
+
+
 def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
                  formats: Sequence[str], *, title: str, subtitle: str, zones: Any,
-                 fence_warnings: list[str]) -> str:
+                 fence_warnings: list[str], returns: Any = None) -> str:
     """report.html of a plan and its autopilot mission's waypoints ``wps`` (see
     :func:`plan_outputs`)."""
     from ..viz.overlays import filled_overlay
@@ -235,6 +326,7 @@ def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
         "flight time [min]": round(ms["flight"]["flight_time_s"] / 60, 2),
         "planning time [s]": round(float(plan.timings.get("total", 0.0)), 3),
         **safety_rows(info["safety"]),
+        **returns_rows(info),
         **{f"warning {k + 1}": w for k, w in enumerate(ms["warnings"] + fence_warnings)},
     }
     return report_html(
@@ -242,7 +334,8 @@ def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
         speeds={"FM² path": plan.w}, waypoints={"FM² path": wps.points_m},
         params=params, metrics=metrics, files=output_names(formats),
         agl=None if level is None else level.agl,
-        overlays={**filled_overlay(plan.world), **zone_overlays(zones)})
+        overlays={**filled_overlay(plan.world), **zone_overlays(zones),
+                  **_return_overlays(returns)})
 
 
 RUN_HELP = (
@@ -268,6 +361,7 @@ RUN_HELP = (
 @world_options
 @mission_options("via", "return_to_start", "firmware", "vehicle", "frame", "end",
                  "speed_changes", "endurance", "reserve")
+@return_options
 def run_cmd(
     mission_file: Path = typer.Argument(..., help="Mission YAML file.", show_default=False),
     output: Output = None,
@@ -293,6 +387,7 @@ def run_cmd(
         None, "--saturation-distance", help="Override planner.saturation_distance: the "
         "distance (m) from obstacles beyond which W = 1 (a margin that means the same on "
         "any map)."),
+    returns: ReturnFlags = None,
 ) -> None:
     """``fm2uav run``: load the mission file (with the flags' overrides),
     :func:`~fm2uav.missions.route.plan_route`, :func:`plan_outputs`, print."""
@@ -328,6 +423,8 @@ def run_cmd(
                            level=level, options=popts)
         p = route.plan
         world_desc = m.world.scenario or m.world.describe()
+        ret = returns.options(rm.world, base=m.return_options(rm.world), anchor=m.anchor(),
+                              crs=m.world.crs)
         info, built = plan_outputs(
             outdir, p, formats, options,
             title=f"{m.name}", subtitle=f"{world_desc} — {m.description}"
@@ -335,14 +432,16 @@ def run_cmd(
             summary={"mission": m.name, "mission_file": str(mission_file),
                      "world": {**world_summary(rm.world), "name": world_desc},
                      "route": route.summary()},
-            step=step, via=route.junctions[1:-1],
+            step=step, via=route.junctions[1:-1], returns=ret,
         )
+    p = _flown(p, built)
     rows = {
         "mission": m.name,
         "world": world_desc,
         **plan_rows(p),
         "legs": len(route.legs),
         **safety_rows(info["safety"]),
+        **returns_rows(info),
         **mission_rows(built),
         "time [s]": f"{p.timings['total']:.2f}",
         **world_rows(rm.world),
