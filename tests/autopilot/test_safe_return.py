@@ -3,8 +3,6 @@
 import numpy as np
 import pytest
 
-from fm2uav import FlightLevel, World
-from fm2uav.autopilot.build import ExportOptions
 from fm2uav.autopilot.items import (
     CMD_DO_LAND_START,
     CMD_DO_RETURN_PATH_START,
@@ -12,37 +10,23 @@ from fm2uav.autopilot.items import (
     CMD_NAV_TAKEOFF,
 )
 from fm2uav.autopilot.returns import route_samples
-from fm2uav.autopilot.safe_return import ReturnOptions, build_with_returns, flown_plan
+from fm2uav.autopilot.safe_return import ReturnOptions, flown_plan
 from fm2uav.autopilot.validate import validate_mission
 from fm2uav.errors import PlanningError
-from fm2uav.missions.route import plan_route
 from fm2uav.vehicles.endurance import return_time
 
-
-def ridge_world():
-    """1200 x 800 m in 20 m columns: a valley at 0 m, a 150 m ridge across x = 620 m."""
-    x = np.arange(60) * 20.0
-    h = (150.0 * np.exp(-((x - 620.0) / 200.0) ** 2))[:, None] * np.ones((1, 40))
-    return World.from_heightmap(h, (20.0, 20.0, 10.0), 32)
+from .return_cases import build
+from .return_cases import ridge_plan as _ridge_plan
 
 
 @pytest.fixture(scope="module")
 def ridge_plan():
-    w = ridge_world()
-    lev = FlightLevel(agl=40.0, min_agl=30.0, max_agl=120.0)
-    return plan_route(w, (100.0, 400.0, 40.0), (1000.0, 400.0, 40.0), level=lev).plan
-
-
-def build(p, **kw):
-    ret = kw.pop("returns", ReturnOptions())
-    opt = ExportOptions(**{"firmware": "ardupilot", "endurance_s": 600.0, **kw})
-    return build_with_returns(p.path, p.world, opt, ret, plan=p, w=p.w, agl=40.0,
-                              profile=p.profile)
+    return _ridge_plan()
 
 
 @pytest.fixture(scope="module")
 def embedded(ridge_plan):
-    return build(ridge_plan)
+    return build(ridge_plan, end="rtl")
 
 
 def test_no_return_altitude_under_the_ceiling_so_the_mission_carries_the_return(embedded,
@@ -95,8 +79,9 @@ def test_without_an_endurance_there_is_no_point_of_no_return(ridge_plan):
     assert "--endurance" in m.returns.pnr["why"]
 
 
-def test_an_explicit_landing_at_the_goal_is_marked_as_the_safe_return(ridge_plan):
-    m = build(ridge_plan, end="land", firmware="px4")
+@pytest.mark.parametrize("end", ["land", "auto"])
+def test_a_landing_at_the_goal_is_marked_as_the_safe_return(ridge_plan, end):
+    m = build(ridge_plan, end=end, firmware="px4")
     assert m.returns.embedded == "landing" and m.end == "land"
     assert len(m.path_m) == len(ridge_plan.path)
     cmds = [it.command for it in m.items]
@@ -110,7 +95,7 @@ def test_ways_back_from_every_waypoint_and_a_rally_point_chosen_to_shorten_them(
     s = rep.summary()
     assert [r["waypoint"] for r in s["waypoints"]] == list(range(len(embedded.waypoints)))
     assert all(np.isfinite(rep.time)) and rep.time[0] < rep.time.max()
-    auto = build(ridge_plan, returns=ReturnOptions(auto_rally=1))
+    auto = build(ridge_plan, end="rtl", returns=ReturnOptions(auto_rally=1))
     chosen = auto.returns.rally
     assert len(chosen) == 1 and chosen[0].chosen_by == "planner"
     assert chosen[0].facts["slope_deg"] <= 8.0

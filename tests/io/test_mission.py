@@ -253,7 +253,8 @@ def test_plan_command_report_and_exports(tmp_path):
                               "--anchor", "2.35,48.85,35", "--thin", "10", "--json"])
     assert res.exit_code == 0, res.output
     data = json.loads(res.output)
-    assert len(data["files"]) == 9 and data["waypoints"] < 60  # + path.kmz
+    # + path.kmz, and the safe returns: returns.geojson, mission.param
+    assert len(data["files"]) == 11 and data["waypoints"] < 60
     plan = read_plan(out / "mission.plan")
     assert plan["home"][:2] == pytest.approx((48.85, 2.35), abs=0.05)
     assert (out / "report.html").stat().st_size > 1_000_000
@@ -346,3 +347,27 @@ def test_run_flags_override_the_mission_export_and_route(examples, tmp_path):
     res = runner.invoke(app, ["run", str(examples / "open_field_tff.yaml"), "--out",
                               str(tmp_path / "q"), "--via", "1,2"])
     assert res.exit_code == 2 and "--via 1 must be x,y,z" in res.output
+
+
+def test_rally_and_returns_keys(tmp_path):
+    from fm2uav.io.mission import parse_mission
+    from fm2uav.scenarios import get_scenario
+
+    base = {"world": {"scenario": "open-field"}}
+    m = parse_mission({**base, "rally": "auto:2", "returns": {"strict": True, "min_agl": 25}})
+    w = get_scenario("open-field").world
+    ro = m.return_options(w)
+    assert ro.auto_rally == 2 and ro.strict and ro.min_agl == 25 and ro.rally == ()
+    m = parse_mission({**base, "rally": [{"x": 300, "y": 400, "agl": 50},
+                                         {"lon": -3.76, "lat": 40.336}]})
+    ro = m.return_options(w)
+    assert ro.rally[0] == (300.0, 400.0, 50.0) and ro.rally[1][2] is None
+    (tmp_path / "r.csv").write_text("-3.76,40.336\n")
+    m = parse_mission({**base, "rally": "r.csv"}, base_dir=tmp_path)
+    assert len(m.return_options(w).rally) == 1
+    assert parse_mission({**base, "returns": {"enabled": False}}).returns.enabled is False
+    for bad, part in (({"rally": "auto:11"}, "auto:K"), ({"rally": "missing.csv"},
+                      "file not found"), ({"rally": [{"x": 1}]}, "lon and lat"),
+                      ({"returns": {"min_agl": -1}}, "returns.min_agl")):
+        with pytest.raises(InputError, match=part):
+            parse_mission({**base, **bad}, base_dir=tmp_path)

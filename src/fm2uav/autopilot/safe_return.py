@@ -25,13 +25,14 @@ and then, on the plan's own map:
    mission warns (``strict``: refuses).
 5. **The firmware's return** (:func:`~fm2uav.autopilot.returns.firmware_returns`):
    the lowest safe return altitude per firmware and airframe (``mission.param``).
-   When none is safe, the mission carries the planned safe return instead: the FM²
-   way back from the route's end is appended to the route and the mission ends with
-   a landing at home, marked with ``DO_LAND_START`` (and, for ArduPilot,
-   ``DO_RETURN_PATH_START`` after the takeoff), and the parameters make the
-   firmware's return follow it (ArduPlane ``RTL_AUTOLAND`` 4, ArduCopter failsafe
-   action 6, PX4 ``RTL_TYPE`` 2). An explicit ``end: land`` keeps its landing at the
-   goal (marked the same way: the failsafe continues the planned route to it).
+   When none is safe, the mission carries a planned safe return instead, marked with
+   ``DO_LAND_START`` before its landing (and, for ArduPilot, ``DO_RETURN_PATH_START``
+   after the takeoff), and the parameters make the firmware's return follow the
+   mission (ArduPlane ``RTL_AUTOLAND`` 4, ArduCopter failsafe action 6, PX4
+   ``RTL_TYPE`` 2): a mission that ends with a landing (multirotor and VTOL by
+   default) keeps it — the return continues the planned route to that landing; a
+   mission that ends with an RTL (fixed-wing by default) or a loiter gets the FM² way
+   back from the route's end appended and ends with a landing at home instead.
 
 The report (:class:`ReturnsReport`) is kept on the mission (``MissionExport.returns``);
 its :meth:`~ReturnsReport.summary` is ``returns:`` in ``summary.json``.
@@ -345,10 +346,10 @@ def _embed(mission: MissionExport, plan: Any, home: ReturnField, inputs: dict[st
     if inputs.get("times") is not None:
         return (mission, "", "a timed (formation) mission keeps its timing: no return appended",
                 w, profile)
-    if opt.end == "land":
+    if mission.end == "land":  # the route's own landing (auto for multirotor / VTOL)
         kind = "landing"
         m2 = mission
-    else:
+    else:  # an RTL or a loiter end: the planned way back and a landing at home
         kind = "return"
         start, end = path[0], path[-1]
         if np.hypot(*(end[:2] - start[:2])) > max(10.0, opt.tolerance):

@@ -67,11 +67,12 @@ def returns_document(mission: Any) -> dict[str, Any]:
                                    "coordinates": _line(world, anchor, rep.paths[i])}})
     pnr = rep.pnr
     if pnr.get("reached") and "point_m" in pnr:
+        at = rep.pnr_path[:1] if rep.pnr_path is not None and len(rep.pnr_path) else \
+            np.asarray([pnr["point_m"]])
         feats.append({"type": "Feature",
                       "properties": {"name": "point of no return", "kind": "pnr",
                                      **{k: v for k, v in pnr.items() if k != "point_m"}},
-                      "geometry": {"type": "Point", "coordinates": _line(
-                          world, anchor, np.asarray([pnr["point_m"]]))[0]}})
+                      "geometry": {"type": "Point", "coordinates": _line(world, anchor, at)[0]}})
         if rep.pnr_path is not None and len(rep.pnr_path) >= 2:
             feats.append({"type": "Feature",
                           "properties": {"name": "return from the point of no return",
