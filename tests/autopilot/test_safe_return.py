@@ -110,3 +110,16 @@ def test_returns_off_or_a_user_rally_point(ridge_plan):
     m = build(ridge_plan, returns=ReturnOptions(rally=((1100.0, 700.0),)))
     assert [r.name for r in m.returns.rally] == ["rally 1"]
     assert m.returns.rally[0].chosen_by == "user"
+
+
+def test_a_plane_gets_the_way_back_and_loiters_over_home_on_ardupilot_lands_on_px4(ridge_plan):
+    ardu = build(ridge_plan, vehicle="fixed_wing", min_speed=12.0)
+    assert ardu.returns.embedded == "return" and ardu.end == "return"
+    cmds = [it.command for it in ardu.items]
+    assert cmds[1] == CMD_DO_RETURN_PATH_START and cmds[-1] == 17  # NAV_LOITER_UNLIM
+    assert CMD_DO_LAND_START not in cmds
+    assert ardu.returns.params.as_dict()["RTL_AUTOLAND"] == 4
+    px4 = build(ridge_plan, vehicle="fixed_wing", firmware="px4")
+    cmds = [it.command for it in px4.items]
+    assert cmds[-1] == CMD_NAV_LAND and cmds.count(CMD_DO_LAND_START) == 1
+    assert validate_mission(px4.items, "px4", vehicle="fixed_wing") == []

@@ -57,10 +57,13 @@ __all__ = [
     "firmware_returns",
     "rtl_end_notes",
     "MAX_LINES",
+    "RTL_WARNING",
 ]
 
 #: Most straight return lines checked per model (the sampling step grows beyond it).
 MAX_LINES = 20_000
+#: How the warning about an unchecked RTL end starts (:func:`rtl_end_notes`).
+RTL_WARNING = "RTL flies a straight line home"
 
 
 # ---------------------------------------------------------------- the mission's route
@@ -674,7 +677,7 @@ def rtl_end_notes(world: Any, start_xy: np.ndarray, end_xy: np.ndarray, firmware
     if back > max(10.0, tolerance):  # the route did not come back home itself
         rises = (f" — the ground under it rises {rise:.0f} m above home"
                  if np.isfinite(rise) and rise > 0 else "")
-        warnings.append("RTL flies a straight line home at the firmware's return altitude "
+        warnings.append(f"{RTL_WARNING} at the firmware's return altitude "
                         "(PX4 RTL_RETURN_ALT, ArduPilot RTL_ALT / RTL_ALTITUDE)"
                         f"{rises}: fly it only with the return altitude fm2uav checked "
                         "(mission.param, returns.firmware in the summary), or use return: true "

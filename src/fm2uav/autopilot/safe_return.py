@@ -32,7 +32,9 @@ and then, on the plan's own map:
    ``RTL_TYPE`` 2): a mission that ends with a landing (multirotor and VTOL by
    default) keeps it — the return continues the planned route to that landing; a
    mission that ends with an RTL (fixed-wing by default) or a loiter gets the FM² way
-   back from the route's end appended and ends with a landing at home instead.
+   back from the route's end appended and ends with a landing at home instead (an
+   ArduPilot fixed-wing, which needs no landing in a mission, loiters over home: an
+   automatic landing pattern needs a runway and an approach the operator chose).
 
 The report (:class:`ReturnsReport`) is kept on the mission (``MissionExport.returns``);
 its :meth:`~ReturnsReport.summary` is ``returns:`` in ``summary.json``.
@@ -64,7 +66,13 @@ from .items import (
 )
 from .params import ParamSet, param_set
 from .rally import DEFAULT_AUTO_RALLY, RallyPoint, choose_rally, rally_points
-from .returns import FirmwareReturns, RouteSamples, firmware_returns, route_samples
+from .returns import (
+    RTL_WARNING,
+    FirmwareReturns,
+    RouteSamples,
+    firmware_returns,
+    route_samples,
+)
 from .thin import thin_path
 from .validate import check_mission
 
@@ -315,11 +323,20 @@ def _interp_w(W: np.ndarray, world: Any, path: np.ndarray) -> np.ndarray:
 
 
 # ---------------------------------------------------------------- embedding the safe return
+def _return_end(opt: Any) -> str:
+    """How the appended return ends: a landing at home, but a fixed-wing that may end
+    without one (ArduPilot) loiters over home instead — an automatic landing pattern needs
+    a runway and an approach the operator chose."""
+    required = opt.vehicle in PROFILES[opt.firmware].landing_required
+    return "loiter" if opt.vehicle == "fixed_wing" and not required else "land"
+
+
 def _markers(items: list[MissionItem], models: Any) -> list[MissionItem]:
     """``items`` with DO_RETURN_PATH_START after the takeoff (ArduPilot) and DO_LAND_START
-    before the final approach of the landing (unless the landing pattern has one)."""
+    before the final approach of a landing (unless the landing pattern has one)."""
     out = list(items)
-    if not any(it.command == CMD_DO_LAND_START for it in out):
+    lands = any(it.command in (CMD_NAV_LAND, CMD_NAV_VTOL_LAND) for it in out)
+    if lands and not any(it.command == CMD_DO_LAND_START for it in out):
         land = max(i for i, it in enumerate(out) if it.command in (CMD_NAV_LAND,
                                                                    CMD_NAV_VTOL_LAND))
         approach = max((i for i in range(land) if out[i].command == CMD_NAV_WAYPOINT),
@@ -368,15 +385,17 @@ def _embed(mission: MissionExport, plan: Any, home: ReturnField, inputs: dict[st
                 profile = None
             path = ext
         new_in = {**inputs, "w": w, "profile": profile}
-        m2 = build_mission(path, world, replace(opt, end="land"), **new_in)
+        m2 = build_mission(path, world, replace(opt, end=_return_end(opt)), **new_in)
     items = _markers(m2.items, models)
     check_mission(items, opt.firmware, vehicle=opt.vehicle, home_alt=m2.waypoints.home[2],
                   max_land_slope_deg=opt.max_land_slope_deg, fences=m2.fences)
     end = "return" if kind == "return" else m2.end
+    loiter = m2.end == "loiter"
     note = ("the mission carries the planned safe return: " +
-            ("after the route, the FM² way back to home and a landing there" if kind == "return"
-             else "the route's own landing at its end") +
-            ", marked with DO_LAND_START" +
+            ("after the route, the FM² way back to home and " +
+             ("a loiter over home (land it yourself)" if loiter else "a landing there")
+             if kind == "return" else "the route's own landing at its end") +
+            ("" if loiter else ", marked with DO_LAND_START") +
             (" and DO_RETURN_PATH_START after the takeoff" if any(m.return_path_start
                                                                    for m in models) else "") +
             "; " + "; ".join(m.mission_note for m in models if m.mission_note))
@@ -593,7 +612,10 @@ def build_with_returns(path_m: Any, world: Any, options: Any, returns: ReturnOpt
         embedded=embedded, rally_report=rally_report, warnings=warnings, notes=notes,
         speeds=speeds, endurance_s=endurance, flight_w=flight_w, flight_profile=flight_profile)
     info = {**mission.info, "notes": list(mission.info.get("notes", [])) + notes}
-    return replace(mission, warnings=[*mission.warnings, *warnings], info=info, returns=report)
+    kept = list(mission.warnings)
+    if fw.feasible:  # the RTL line is checked now: the note says how (mission.param)
+        kept = [w for w in kept if not w.startswith(RTL_WARNING)]
+    return replace(mission, warnings=[*kept, *warnings], info=info, returns=report)
 
 
 def flown_plan(plan: Any, mission: MissionExport) -> Any:
