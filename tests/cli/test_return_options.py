@@ -30,3 +30,25 @@ def test_flags_become_return_options(world, tmp_path):
     assert len(ReturnFlags(rally_file=tmp_path / "r.csv").options(world).rally) == 1
     with pytest.raises(InputError, match="--rally"):
         ReturnFlags(rally=["nowhere"]).options(world)
+
+
+def test_strict_refuses_a_mission_past_its_point_of_no_return(tmp_path):
+    from typer.testing import CliRunner
+
+    from fm2uav.cli import app
+
+    out = tmp_path / "p"
+    args = ["plan", "--agl", "150", "--export", "plan", "--endurance", "6", "--out", str(out)]
+    res = CliRunner().invoke(app, [*args, "--strict"])
+    assert res.exit_code == 1, res.output
+    assert "point of no return" in res.output and "--strict" in res.output
+    assert not out.exists()  # nothing written
+    res = CliRunner().invoke(app, [*args, "--rally", "nowhere"])
+    assert res.exit_code == 2 and res.output.startswith("error: --rally 'nowhere'")
+    assert not out.exists()
+    res = CliRunner().invoke(app, [*args, "--no-returns", "--json"])
+    assert res.exit_code == 0
+    import json
+
+    data = json.loads(res.output)
+    assert "returns" not in data and not (out / "mission.param").exists()

@@ -54,6 +54,17 @@ class ReturnFlags:
     strict: bool = False
     enabled: bool | None = None
 
+    def check(self) -> None:
+        """Refuse a malformed ``--rally`` before any work (InputError naming it)."""
+        from ..io.rally import parse_rally_text
+
+        for text in self.rally or ():
+            parse_rally_text(text)
+        if self.return_min_agl is not None and not self.return_min_agl >= 0:
+            from ..errors import InputError
+
+            raise InputError(f"--return-min-agl must be >= 0 m, got {self.return_min_agl:g}")
+
     def options(self, world: Any, *, base: Any = None, anchor: Any = None,
                 crs: str | None = None) -> Any:
         """The :class:`~fm2uav.autopilot.safe_return.ReturnOptions`: ``base`` (a mission

@@ -112,6 +112,7 @@ def plan_cmd(
     from ..missions.route import plan_route
     from ..world.load import world_summary
 
+    returns.check()
     w, sc, scenario = world.build(scenario, start, goal, seed=seed, lonlat=lonlat, agl=agl)
     description = sc.description if sc is not None else f"real data: {scenario}"
     extra = _extra_formats(export, output.report)

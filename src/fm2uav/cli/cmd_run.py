@@ -396,6 +396,7 @@ def run_cmd(
     from ..planning.params import planner_objects
     from ..world.load import world_summary
 
+    returns.check()
     points = point_overrides(start=start, goal=goal, lonlat=lonlat) or {}
     if mission.via:
         points["via"] = via_points(mission.via, lonlat=lonlat)

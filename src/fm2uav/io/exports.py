@@ -117,7 +117,8 @@ def _description(m: MissionExport) -> str:
              f"home {s['home']['lat']:.7f}, {s['home']['lon']:.7f}, "
              f"{s['home']['alt_amsl_m']:.1f} m AMSL ({s['home']['source']})",
              f"CRS {s['crs']}; altitudes: {s['vertical_reference']}"]
-    return "\n".join(lines + [f"warning: {w}" for w in m.warnings])
+    return "\n".join(lines + [f"warning: {w}" for w in m.warnings]
+                     + [f"note: {n}" for n in m.info.get("notes", [])])
 
 
 def export_mission(
@@ -199,6 +200,7 @@ def export_mission(
              "crs": s["crs"], "vertical_reference": s["vertical_reference"],
              "home": [s["home"]["lat"], s["home"]["lon"], s["home"]["alt_amsl_m"]],
              "home_source": s["home"]["source"], "warnings": list(mission.warnings),
+             "notes": list(mission.info.get("notes", [])),
              **{k: v for k, v in params.items() if isinstance(v, (int, float, str, bool))}}
     wpm = mission.waypoints.points_m
     floor = getattr(getattr(plan, "profile", None), "required", None)
