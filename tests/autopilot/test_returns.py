@@ -165,3 +165,16 @@ def test_every_firmware_and_airframe_has_a_return_model():
             assert prof.returns[v], (name, v)
             for m in prof.returns[v]:
                 assert m.altitude and m.sources
+
+
+def test_on_a_2d_map_a_line_through_an_obstacle_is_not_safe():
+    occ = np.zeros((60, 40), bool)
+    occ[30, 5:35] = True  # a building of unknown height between the route and home
+    w = World(occ, spacing=10.0)
+    m = build_mission(np.array([[100.0, 200.0], [100.0, 380.0], [500.0, 380.0],
+                                [500.0, 200.0]]), w, ExportOptions(firmware="ardupilot"))
+    r = firmware_returns(m, min_agl=30.0).results[0]
+    assert not r.feasible and "2D map" in r.reasons[-1]
+    ok = firmware_returns(build_mission(np.array([[100.0, 200.0], [200.0, 200.0]]), w,
+                                        ExportOptions(firmware="ardupilot")), min_agl=30.0)
+    assert ok.feasible and ok.results[0].altitude_m == 30.0

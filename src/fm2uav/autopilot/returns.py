@@ -421,7 +421,23 @@ def _evaluate(model: ReturnModel, lines: _Lines, A: np.ndarray, grad: float,
                 if v.zone not in zones:
                     zones.append(v.zone)
     out["zones_entered"] = zones
+    out["obstacle_lines"] = _flat_obstacles(world, lines) if world.ndim == 2 else 0
     return out
+
+
+def _flat_obstacles(world: Any, lines: _Lines) -> int:
+    """Lines that cross an obstacle of a 2D map (its height is unknown), sampled every
+    quarter cell at the nearest node."""
+    step = 0.25 * float(min(world.spacing))
+    bad = 0
+    for i in range(len(lines.a)):
+        a, b = lines.a[i, :2], lines.dest[i].xy
+        n = max(int(np.ceil(np.hypot(*(b - a)) / step)), 1)
+        pts = a + (np.arange(n + 1) / n)[:, None] * (b - a)
+        idx = np.floor(world.to_index(pts) + 0.5).astype(int)
+        idx = np.clip(idx, 0, np.asarray(world.shape) - 1)
+        bad += bool(world.occupancy[idx[:, 0], idx[:, 1]].any())
+    return bad
 
 
 def _model_result(model: ReturnModel, world: Any, starts: np.ndarray, home: Destination,
@@ -481,6 +497,9 @@ def _model_result(model: ReturnModel, world: Any, starts: np.ndarray, home: Dest
                        f"{max_agl:g} m (up to {figs['max_agl_m']:.0f} m above the ground): the "
                        "ground between the route and the destination is too uneven for one "
                        "altitude (a ridge)")
+    if figs["obstacle_lines"]:
+        reasons.append(f"{figs['obstacle_lines']} line(s) cross obstacles of the 2D map, whose "
+                       "height is unknown: no altitude is known to clear them")
     if figs["zones_entered"]:
         reasons.append("straight return lines cross no-fly zones: "
                        + ", ".join(figs["zones_entered"]))

@@ -531,7 +531,7 @@ def build_with_returns(path_m: Any, world: Any, options: Any, returns: ReturnOpt
     min_agl, min_src = ((float(returns.min_agl), "returns.min_agl (--return-min-agl)")
                         if returns.min_agl is not None else _default_min_agl(level))
     if returns.min_agl is None and world.ndim == 2:
-        min_agl, min_src = 0.0, "a 2D map has no ground relief"
+        min_agl, min_src = float(opt.flight_alt), "a 2D mission's flight altitude (flight_alt)"
     max_agl = None if level is None else level.max_agl
     models = PROFILES[opt.firmware].returns.get(opt.vehicle, ())
     fw = firmware_returns(mission, rally=rally, min_agl=min_agl, min_agl_source=min_src,
