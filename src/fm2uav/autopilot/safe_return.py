@@ -151,7 +151,8 @@ class ReturnsReport:
     time, length : ndarray
         Its time [s] (landing included) and length [m].
     paths : list of ndarray
-        Each way back, thinned (:data:`RETURN_THIN_M`), as timed [m].
+        Each way back as timed [m]: thinned (:data:`RETURN_THIN_M`) from the waypoints (the
+        ways back written), dense between them.
     energy_wh : ndarray or None
         Energy of each way back with an ``energy`` model.
     pnr : dict
@@ -279,40 +280,50 @@ class _Backs:
         self.land = {n: (_landing_height(world, f) if world.ndim == 3 else flight_alt)
                      for n, f in fields.items()}
 
-    def timed(self, rp: ReturnPath) -> tuple[float, float, np.ndarray]:
-        p = rp.path
+    def timed(self, path: np.ndarray, destination: str, *, thin: bool = False
+              ) -> tuple[float, float, np.ndarray]:
+        """(time, length, path) of a way back; ``thin``: the path thinned to
+        :data:`RETURN_THIN_M` first (the polyline written), timed as written."""
+        p = np.asarray(path, dtype=float)
         if p.shape[1] == 2:
             p = np.column_stack([p, np.full(len(p), self.flight_alt)])
-        thin = thin_path(p, RETURN_THIN_M) if len(p) > 2 else p
-        t, L = return_time(thin, speed=self.sp["forward_mps"], climb_rate=self.sp["climb_mps"],
+        if thin and len(p) > 2:
+            p = thin_path(p, RETURN_THIN_M)
+        t, L = return_time(p, speed=self.sp["forward_mps"], climb_rate=self.sp["climb_mps"],
                            descent_rate=self.sp["descent_mps"],
-                           landing_height=self.land[rp.destination])
-        return t, L, thin
+                           landing_height=self.land[destination])
+        return t, L, p
 
     def best(self, points: np.ndarray) -> list[tuple[str, float, float, np.ndarray]]:
-        """(destination, time, length, thinned path) of each point's fastest way back."""
+        """(destination, time, length, path) of each point's fastest way back (the dense
+        path; :meth:`timed` with ``thin`` for the one written)."""
         nd = self.world.ndim
         pts = np.atleast_2d(points)[:, :nd]
         costs = {n: f.cost(pts) for n, f in self.fields.items()}
         names = list(costs)
         C = np.array([costs[n] for n in names])
         low = C.min(axis=0)
-        out = []
-        for i in range(len(pts)):
-            if not np.isfinite(low[i]):
-                out.append(("", math.inf, math.inf, np.zeros((0, 3))))
+        out: list[tuple[str, float, float, np.ndarray]] = [
+            ("", math.inf, math.inf, np.zeros((0, 3))) for _ in range(len(pts))]
+        for k, n in enumerate(names):  # one batch of descents per destination
+            want = np.flatnonzero(np.isfinite(low) & (C[k] <= 1.25 * low + 1e-9))
+            if not len(want):
                 continue
-            best = ("", math.inf, math.inf, np.zeros((0, 3)))
-            for k, n in enumerate(names):
-                if C[k, i] <= 1.25 * low[i] + 1e-9:
+            try:
+                rps = self.fields[n].paths(pts[want])
+            except (UnreachableError, PlanningError):  # one by one: skip the ones that fail
+                rps = []
+                for i in want:
                     try:
-                        rp = self.fields[n].path(pts[i])
+                        rps.append(self.fields[n].path(pts[i]))
                     except (UnreachableError, PlanningError):
-                        continue
-                    t, L, thin = self.timed(rp)
-                    if t < best[1]:
-                        best = (n, t, L, thin)
-            out.append(best)
+                        rps.append(None)
+            for i, rp in zip(want, rps):
+                if rp is None:
+                    continue
+                t, L, dense = self.timed(rp.path, n)
+                if t < out[i][1]:
+                    out[i] = (n, t, L, dense)
         return out
 
 
@@ -444,6 +455,8 @@ def _pnr(mission: MissionExport, samples: RouteSamples, t_back: np.ndarray, to: 
     f, pt, dist, t_out, back = lo
     if back[3] is None:  # the sample itself: its way back again, with the path
         back = backs.best(np.asarray(pt)[None, :])[0]
+    t_b, l_b, thin = backs.timed(back[3], back[0], thin=True)  # as written
+    back = (back[0], t_b, l_b, thin)
     from ..world.geo import to_lonlat
 
     lo_, la_, amsl = to_lonlat(mission.world, [pt], anchor=mission.options.anchor)[0]
@@ -565,6 +578,9 @@ def build_with_returns(path_m: Any, world: Any, options: Any, returns: ReturnOpt
     samples = route_samples(mission, step=float(min(world.spacing[:2])),
                             max_points=returns.max_returns)
     best = backs.best(samples.points)
+    for i in np.flatnonzero(samples.waypoint >= 0):  # written: thinned, timed as written
+        if best[i][0]:
+            best[i] = (best[i][0], *backs.timed(best[i][3], best[i][0], thin=True))
     to = [b[0] for b in best]
     t_back = np.array([b[1] for b in best])
     length = np.array([b[2] for b in best])

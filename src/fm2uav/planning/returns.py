@@ -32,7 +32,7 @@ from ..eikonal.fmm import fast_marching
 from ..errors import InputError, PlanningError, UnreachableError
 from ..geometry import path_length
 from .altitude import AltitudeProfile, final_profile
-from .geodesic import descend
+from .geodesic import descend_batch
 from .params import FlightLevel
 
 __all__ = ["ReturnPath", "ReturnField", "descend_many", "return_fields"]
@@ -65,11 +65,11 @@ def descend_many(T: np.ndarray, starts: Sequence[Any], goal: Any, *, spacing: An
                  step: float = 0.5, blocked: Any = None) -> list[np.ndarray]:
     """Descents of one arrival-time field from many starts, in index coordinates.
 
-    Each start gets :func:`fm2uav.planning.geodesic.descend` of ``T`` to ``goal``
-    (``T``'s source); a start on the goal's node gets the straight two-point path.
-    The one place that runs many descents of one wave: a batched descent (the
-    many-routes entry point of issue 27) replaces this loop without changing its
-    callers.
+    Each start gets the descent of ``T`` to ``goal`` (``T``'s source;
+    :func:`fm2uav.planning.geodesic.descend_batch`: the field checked once); a start on
+    the goal's node gets the straight two-point path. The one place that runs many
+    descents of one wave: a batched many-routes descent (issue 27) replaces it without
+    changing its callers.
 
     Parameters
     ----------
@@ -89,13 +89,13 @@ def descend_many(T: np.ndarray, starts: Sequence[Any], goal: Any, *, spacing: An
     """
     g = np.asarray(goal, dtype=float)
     gn = np.floor(g + 0.5)
-    out = []
-    for s in starts:
-        s = np.asarray(s, dtype=float)
-        if np.array_equal(np.floor(s + 0.5), gn):
-            out.append(np.vstack([s, g]))
-            continue
-        out.append(descend(T, s, g, spacing=spacing, blocked=blocked, step=step))
+    pts = [np.asarray(s, dtype=float) for s in starts]
+    far = [k for k, s in enumerate(pts) if not np.array_equal(np.floor(s + 0.5), gn)]
+    paths = descend_batch(T, [pts[k] for k in far], g, spacing=spacing, blocked=blocked,
+                          step=step)
+    out: list[np.ndarray] = [np.vstack([s, g]) for s in pts]
+    for k, p in zip(far, paths):
+        out[k] = p
     return out
 
 
@@ -143,6 +143,7 @@ class ReturnField:
                                 f"{np.round(self.source, 1).tolist()} m lies in an obstacle or "
                                 "a no-fly zone; move it to free air")
         self._cell = cell
+        self._blocked: Any = None
         self.T = fast_marching(W, [cell], spacing=world.spacing, order=self.order)
 
     @classmethod
@@ -183,12 +184,14 @@ class ReturnField:
         """
         pts = np.atleast_2d(np.asarray(starts, dtype=float))
         w = self.world
-        for k, p in enumerate(pts):
-            if not np.isfinite(self.cost(p)[0]):
-                raise UnreachableError(
-                    f"no way back to {self.name} from {np.round(p, 1).tolist()} m: the point is "
-                    "cut off from it on the mission's map")
-        blocked = w.occupancy if np.isfinite(self.T[w.occupancy]).any() else None
+        cut = np.flatnonzero(~np.isfinite(self.cost(pts)))
+        if len(cut):
+            raise UnreachableError(
+                f"no way back to {self.name} from {np.round(pts[cut[0]], 1).tolist()} m: the "
+                "point is cut off from it on the mission's map")
+        if self._blocked is None:  # obstacles need the mask only if W gave them a speed
+            self._blocked = (w.occupancy if np.isfinite(self.T[w.occupancy]).any() else False)
+        blocked = self._blocked if self._blocked is not False else None
         raw = descend_many(self.T, list(w.to_index(pts)), w.to_index(self.source),
                            spacing=w.spacing, step=self.step, blocked=blocked)
         return [self._finish(pts[k], w.to_world(q)) for k, q in enumerate(raw)]
