@@ -11,7 +11,7 @@ from typer.testing import CliRunner
 from fm2uav.cli import app
 from fm2uav.cli.options import WorldFlags, option_group, world_options
 
-WORLD = ["--dem", "--buildings", "--bbox", "--sea-level", "--cell-size", "--dz", "--ceiling",
+WORLD = ["--dem", "--dem-fill", "--buildings", "--bbox", "--sea-level", "--cell-size", "--dz", "--ceiling",
          "--nodata", "--nodata-value", "--crs", "--default-height", "--allow-filled"]
 
 

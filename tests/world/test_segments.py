@@ -66,3 +66,37 @@ def test_a_flat_world_and_zero_length_segments():
     w = World(np.zeros((10, 10, 4), bool), spacing=1.0, origin=(0, 0, 7.0))
     lp = ground_points(w, [[1, 1], [3, 3]], [[5, 5], [3, 3]])
     assert np.all(lp.z == 7.0) and lp.reduce(np.maximum, 2).tolist() == [7.0, 7.0]
+
+
+def test_exact_on_a_reprojected_geotiff(rough_tif):
+    w = World.from_dem(str(rough_tif), (120.0, 120.0, 40.0))
+    assert w.ground is not None
+    rng = np.random.default_rng(2)
+    b = w.bounds
+    a, c = (rng.uniform([b[0, 0], b[1, 0]], [b[0, 1], b[1, 1]], (6, 2)) for _ in range(2))
+    mx = ground_points(w, a, c).reduce(np.maximum, 6)
+    for k in range(6):
+        g = _brute(w, a[k], c[k], n=20_001)
+        assert g.max() <= mx[k] + 1e-6 and g.max() >= mx[k] - 0.05
+
+
+def test_two_dems_in_priority_order_are_read_on_both_sides_of_their_seam():
+    from fm2uav.world.ground_model import GroundLayer, GroundModel
+
+    rng = np.random.default_rng(4)
+    z1 = rng.uniform(0, 50, (20, 20))
+    valid = np.ones_like(z1, bool)
+    valid[:, 10:] = False  # the first DEM measures the western half only
+    z2 = rng.uniform(100, 150, (20, 20))  # the fill DEM, much higher
+    tr = (10.0, 0.0, 0.0, 0.0, -10.0, 200.0)  # 10 m pixels, north-up, x 0..200, y 0..200
+    crs = "EPSG:32630"
+    layers = (GroundLayer(z1, valid, tr, crs, crs, 10.0, "a"),
+              GroundLayer(z2, np.ones_like(z2, bool), tr, crs, crs, 10.0, "b"))
+    occ = np.zeros((20, 20, 30), bool)
+    w = World(occ, spacing=10.0, terrain=np.zeros((20, 20)), crs=crs,
+              ground=GroundModel(layers))
+    a, c = np.array([[5.0, 100.0], [5.0, 20.0]]), np.array([[195.0, 110.0], [60.0, 180.0]])
+    mx = ground_points(w, a, c).reduce(np.maximum, 2)
+    for k in range(2):
+        g = _brute(w, a[k], c[k], n=100_001)
+        assert g.max() <= mx[k] + 1e-6 and g.max() >= mx[k] - 0.05

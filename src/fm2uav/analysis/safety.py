@@ -15,7 +15,12 @@ bilinearly — and :meth:`World.surface_height` with roofs), never on grid nodes
   quarter of a horizontal cell (the autopilot flies those, not the dense
   path): lowest AGL along them and where, and the zones they enter;
 * **zones**: horizontal distance to every no-fly zone / the operating area and
-  any point inside (:mod:`fm2uav.world.zones`).
+  any point inside (:mod:`fm2uav.world.zones`);
+* **known and unknown ground** (:mod:`fm2uav.analysis.known_ground`): every
+  figure above split into over measured ground and over filled (unknown)
+  ground, length and share, the lowest AGL along the legs over each, which
+  DEM measured how much; and whether the DEM's pixels resolve the relief for
+  the requested flight level.
 
 :func:`safety_summary` gathers them in one JSON-friendly dict; the CLI puts it
 into ``summary.json`` and the report, and the tests recompute the same numbers
@@ -32,8 +37,10 @@ from ..errors import InputError
 from ..geometry import densify
 from ..planning.altitude import height_figures
 from ..world.clearance import surface_clearance
+from ..world.ground import has_unknown_ground
 from ..world.ground_model import sampling_step
 from ..world.zones import zone_distances, zone_violations
+from .known_ground import dem_resolution, filled_mask, ground_split
 
 __all__ = ["height_above_ground", "leg_figures", "safety_summary"]
 
@@ -120,6 +127,12 @@ def leg_figures(world: Any, waypoints: Any, *, requested: float | None = None,
         sel = cl[leg] & inner
         if sel.any():
             out["cruise"] = height_figures(h[sel], requested, points=dense[sel])
+    if has_unknown_ground(world):
+        unknown = filled_mask(world, dense)
+        out["ground"] = {
+            "measured_min_m": round(float(h[~unknown].min()), 3) if (~unknown).any() else None,
+            "filled_min_m": round(float(h[unknown].min()), 3) if unknown.any() else None,
+            "filled_samples": int(unknown.sum()), "samples": int(len(h))}
     hits = zone_violations(world, dense if terrain_frame else p, step=step)
     out["zone_entries"] = [{"zone": v.zone, "leg": int(leg[min(v.segment, len(leg) - 1)])
                             if terrain_frame else v.segment,
@@ -158,7 +171,9 @@ def safety_summary(world: Any, path: Any, *, requested: float | None = None,
     dict
         ``height_above_ground`` {``path``, ``cruise``}, ``cruise_points``
         (first and last index of the cruise in ``path``), ``clearance_m``,
-        ``legs``, ``zones``, ``checks`` (each limit with pass/fail).
+        ``ground`` (:func:`~fm2uav.analysis.known_ground.ground_split`, DEM
+        worlds), ``dem_resolution`` (with a flight level), ``legs``, ``zones``,
+        ``checks`` (each limit with pass/fail).
     """
     p = np.asarray(path, dtype=float)
     if p.ndim != 2 or p.shape[1] != 3:
@@ -195,6 +210,13 @@ def safety_summary(world: Any, path: Any, *, requested: float | None = None,
     k = int(np.argmin(clr))
     out["clearance_m"] = round(float(clr[k]), 3)
     out["clearance_point_m"] = [round(float(v), 3) for v in p[k]]
+    split = ground_split(world, p, agl, clr, requested=requested, s=s)
+    if split is not None:
+        out["ground"] = split
+    res = dem_resolution(world, p, getattr(level, "agl", None) if level is not None
+                         else requested, cruise=cruise)
+    if res is not None:
+        out["dem_resolution"] = res
     if getattr(world, "zones", ()):
         out["zones"] = {
             "count": len(world.zones),

@@ -22,7 +22,7 @@ from .options import (
 )
 from ._mission_options import parse_anchor
 from ._return_options import ReturnFlags, return_options
-from .cmd_run import _flown, mission_rows, output_names, plan_outputs, returns_rows, safety_rows
+from .cmd_run import mission_rows, output_names, plan_outputs, safety_rows
 
 PLAN_FILES = ("path.csv", "plan.png", "summary.json")
 
@@ -134,19 +134,25 @@ def plan_cmd(
     built = None
     info: dict = {}
     if extra:
+        from ..pipeline.outputs import flown
+
         ret = returns.options(w, anchor=getattr(export_options, "anchor", None), crs=world.crs)
         info, built = plan_outputs(outdir, p, extra, export_options,
                                    title=f"FM² plan — {scenario}", subtitle=description,
                                    via=route.junctions[1:-1], returns=ret)
-        p = _flown(p, built)  # with the planned safe return when the mission carries one
+        p = flown(p, built)  # with the planned safe return when the mission carries one
     summary = {"scenario": scenario, "world": world_summary(w), **p.summary(),
                "route": route.summary()}
     if p.path.shape[1] == 3:  # measured on the continuous ground (legs: with the exports)
+        from ..analysis.known_ground import check_ground
         from ..analysis.safety import safety_summary
 
         summary["safety"] = safety_summary(w, p.path, requested=agl, phase=p.phase,
                                            level=p.level)
-    _write_plan(outdir, p, w, title=f"FM² plan — {scenario}")
+        if not extra:  # else plan_outputs measures the legs too, and says it there
+            check_ground(w, summary["safety"])
+    _write_plan(outdir, p, w, title=f"FM² plan — {scenario}",
+                ground=summary.get("safety", {}).get("ground"))
     if built is not None:
         summary.update(waypoints=info["waypoints"], mavlink_frame=info["mavlink_frame"],
                        home_lat_lon_alt=info["home_lat_lon_alt"], autopilot=info["autopilot"],
@@ -193,13 +199,14 @@ def _points(w, sc, start: str | None, goal: str | None, via: list[str] | None, *
     return w, start_m, goal_m, via_m
 
 
-def _write_plan(outdir, p, world, *, title: str) -> None:
-    """plan.png and path.csv (with the final profile's floor) of a plan on ``world``."""
+def _write_plan(outdir, p, world, *, title: str, ground: dict | None = None) -> None:
+    """plan.png (with the known/unknown ground split ``ground``) and path.csv (with the final
+    profile's floor) of a plan on ``world``."""
     from ..io import write_path_csv
     from ..viz import plan_figure
 
     georef = getattr(world, "georef", None)
-    fig = plan_figure(p, title=title)
+    fig = plan_figure(p, title=title, ground=ground)
     tmp_png = outdir.target("plan.png")
     fig.savefig(tmp_png, dpi=110)
     with outdir.open("path.csv") as fh:
@@ -211,6 +218,8 @@ def _write_plan(outdir, p, world, *, title: str) -> None:
 
 def _rows(scenario: str, route, world, summary: dict, built, p) -> dict:
     """The printed summary of ``fm2uav plan`` (``p``: the plan as flown)."""
+    from ..pipeline.rows import returns_rows
+
     rows = {
         "scenario": scenario,
         **plan_rows(p),

@@ -11,8 +11,10 @@ column and at the vertex of every parabola between them: the maximum and the
 minimum of these are the exact maximum and minimum of the DEM (bilinear) along the
 line, the numbers an independent sampler converges to from below.
 
-The DEM is the world's ground (:meth:`World.ground_height`): the source raster
-(:class:`~fm2uav.world.ground_model.GroundModel`, in its own CRS) or the world's
+The DEM is the world's ground (:meth:`World.ground_height`): the source rasters
+(:class:`~fm2uav.world.ground_model.GroundModel`, each in its own CRS; with several
+DEMs in priority order the critical points of every one are taken, and both sides of
+each crossing, where the ground may change from one DEM to the next) or the world's
 terrain grid. A segment is cut into pieces of at most ``max_piece`` metres whose
 ends are transformed into the raster exactly; a straight world line is straight in
 the raster up to the curvature of the map projection over one piece (sub-millimetre
@@ -56,12 +58,13 @@ class LinePoints:
         return fn.reduceat(self.z, starts)
 
 
-def _grid(world: Any) -> tuple[np.ndarray, Any] | None:
-    """(heights, world xy → continuous (i, j) index of ``heights``) of the world's ground,
-    or None when the ground is flat (no terrain)."""
+def _grids(world: Any) -> list[tuple[np.ndarray, Any]] | None:
+    """The rasters the world's ground is made of, each as (heights, world xy → continuous
+    (i, j) index of ``heights``): the source DEMs of its ground model (priority order), or
+    its terrain grid; None when the ground is flat (no terrain)."""
     model = getattr(world, "ground", None)
     if model is not None:
-        return model.z, model.index
+        return [(layer.z, layer.pixel_coords) for layer in model.layers]
     if world.terrain is None:
         return None
     ox, oy = float(world.origin[0]), float(world.origin[1])
@@ -70,7 +73,7 @@ def _grid(world: Any) -> tuple[np.ndarray, Any] | None:
     def index(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return (np.asarray(x, dtype=float) - ox) / dx, (np.asarray(y, dtype=float) - oy) / dy
 
-    return world.terrain, index
+    return [(world.terrain, index)]
 
 
 def _pieces(a: np.ndarray, b: np.ndarray, max_piece: float
@@ -101,14 +104,16 @@ def _crossings(u0: np.ndarray, u1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def _piece_points(z: np.ndarray, i0: np.ndarray, j0: np.ndarray, i1: np.ndarray,
                   j1: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(piece, local t, height) at the ends, the crossings and the parabola vertices."""
+    """(piece, local t, is a crossing) of the ends, the crossings and the parabola vertices
+    of the raster ``z`` along straight pieces."""
     pa, ta = _crossings(i0, i1)
     pb, tb = _crossings(j0, j1)
     n = len(i0)
     piece = np.concatenate([np.arange(n), np.arange(n), pa, pb])
     t = np.concatenate([np.zeros(n), np.ones(n), ta, tb])
+    cross = np.concatenate([np.zeros(2 * n, bool), np.ones(len(pa) + len(pb), bool)])
     order = np.lexsort((t, piece))
-    piece, t = piece[order], t[order]
+    piece, t, cross = piece[order], t[order], cross[order]
 
     def at(pp: np.ndarray, tt: np.ndarray) -> np.ndarray:
         ii = i0[pp] + tt * (i1 - i0)[pp]
@@ -129,11 +134,36 @@ def _piece_points(z: np.ndarray, i0: np.ndarray, j0: np.ndarray, i1: np.ndarray,
     with np.errstate(divide="ignore", invalid="ignore"):
         u = np.where(np.abs(C) > 1e-12, -B / (2.0 * C), -1.0)
     inside = (u > 0.0) & (u < 1.0)
-    uv = u[inside]
-    fv = fa[inside] + B[inside] * uv + C[inside] * uv * uv
-    tv = ta_[inside] + uv * (tb_ - ta_)[inside]
+    tv = ta_[inside] + u[inside] * (tb_ - ta_)[inside]
     return (np.concatenate([piece, pm[inside]]), np.concatenate([t, tv]),
-            np.concatenate([h, fv]))
+            np.concatenate([cross, np.zeros(int(inside.sum()), bool)]))
+
+
+def _critical(z: np.ndarray, coords: Any, a: np.ndarray, b: np.ndarray, max_piece: float
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(segment, t, is a crossing) of one raster's critical points along segments a → b."""
+    seg, t0, t1, _ = _pieces(a, b, max_piece)
+    pa = a[seg] + t0[:, None] * (b - a)[seg]
+    pb = a[seg] + t1[:, None] * (b - a)[seg]
+    i0, j0 = (np.asarray(v, dtype=float) for v in coords(pa[:, 0], pa[:, 1]))
+    i1, j1 = (np.asarray(v, dtype=float) for v in coords(pb[:, 0], pb[:, 1]))
+    # batches of pieces so that the crossings stay within memory
+    est = np.abs(i1 - i0) + np.abs(j1 - j0) + 2.0
+    bounds = np.searchsorted(np.cumsum(est), np.arange(1, int(est.sum() // _BATCH) + 2) * _BATCH)
+    out_s, out_t, out_c = [], [], []
+    start = 0
+    for stop in list(bounds) + [len(seg)]:
+        stop = int(min(max(stop, start), len(seg)))
+        if stop <= start:
+            continue
+        sl = slice(start, stop)
+        p, tl, cr = _piece_points(z, i0[sl], j0[sl], i1[sl], j1[sl])
+        gp = p + start
+        out_s.append(seg[gp])
+        out_t.append(t0[gp] + tl * (t1 - t0)[gp])
+        out_c.append(cr)
+        start = stop
+    return np.concatenate(out_s), np.concatenate(out_t), np.concatenate(out_c)
 
 
 def ground_points(world: Any, a: Any, b: Any, *, max_piece: float = MAX_PIECE_M) -> LinePoints:
@@ -155,40 +185,25 @@ def ground_points(world: Any, a: Any, b: Any, *, max_piece: float = MAX_PIECE_M)
     """
     a = np.asarray(a, dtype=float)[:, :2]
     b = np.asarray(b, dtype=float)[:, :2]
-    grid = _grid(world)
+    grids = _grids(world)
     n = len(a)
-    if grid is None or n == 0:
+    if grids is None or n == 0:
         floor = float(world.origin[2]) if world.ndim == 3 else 0.0
         seg = np.repeat(np.arange(n), 2)
         return LinePoints(seg, np.tile([0.0, 1.0], n), np.full(2 * n, floor))
-    z, index = grid
-    seg, t0, t1, _ = _pieces(a, b, max_piece)
-    pa = a[seg] + t0[:, None] * (b - a)[seg]
-    pb = a[seg] + t1[:, None] * (b - a)[seg]
-    i0, j0 = index(pa[:, 0], pa[:, 1])
-    i1, j1 = index(pb[:, 0], pb[:, 1])
-    i0, j0, i1, j1 = (np.asarray(v, dtype=float) for v in (i0, j0, i1, j1))
-    # batches of pieces so that the crossings stay within memory
-    est = np.abs(i1 - i0) + np.abs(j1 - j0) + 2.0
-    bounds = np.searchsorted(np.cumsum(est), np.arange(1, int(est.sum() // _BATCH) + 2) * _BATCH)
-    out_s, out_t, out_z = [], [], []
-    start = 0
-    for stop in list(bounds) + [len(seg)]:
-        stop = int(min(max(stop, start), len(seg)))
-        if stop <= start:
-            continue
-        sl = slice(start, stop)
-        p, tl, h = _piece_points(z, i0[sl], j0[sl], i1[sl], j1[sl])
-        gp = p + start
-        out_s.append(seg[gp])
-        out_t.append(t0[gp] + tl * (t1 - t0)[gp])
-        out_z.append(h)
-        start = stop
-    s = np.concatenate(out_s)
-    t = np.concatenate(out_t)
-    zz = np.concatenate(out_z)
+    parts = [_critical(z, coords, a, b, max_piece) for z, coords in grids]
+    s = np.concatenate([p[0] for p in parts])
+    t = np.concatenate([p[1] for p in parts])
+    if len(grids) > 1:  # the ground changes DEM at a crossing: read both sides of it
+        cross = np.concatenate([p[2] for p in parts])
+        eps = 1e-9
+        s = np.concatenate([s, s[cross], s[cross]])
+        t = np.clip(np.concatenate([t, t[cross] - eps, t[cross] + eps]), 0.0, 1.0)
     order = np.lexsort((t, s))
-    return LinePoints(s[order], t[order], zz[order])
+    s, t = s[order], t[order]
+    pts = a[s] + t[:, None] * (b - a)[s]
+    z = np.asarray(world.ground_height(pts[:, 0], pts[:, 1]), dtype=float)
+    return LinePoints(s, t, z)
 
 
 def surface_points(world: Any, a: Any, b: Any, *, max_piece: float = MAX_PIECE_M,
