@@ -87,6 +87,22 @@ def test_a_plane_too_close_below_the_wall_cannot_climb_over_it_copter_can(world)
     assert copter.feasible and copter.results[0].altitude_m == 130.0
 
 
+def test_a_plane_taking_off_below_the_floor_keeps_its_own_height_not_min_agl(world):
+    # the route starts 10 m above home and climbs out east of the wall: from there a plane
+    # cannot be 30 m up at once, and need not be; it must not come closer to the ground
+    climb = [[700.0, 200.0, 10.0], [650.0, 200.0, 20.0], [560.0, 200.0, 150.0],
+             [200.0, 200.0, 150.0], [200.0, 50.0, 150.0]]
+    plane = firmware_returns(mission(world, climb, firmware="ardupilot", vehicle="fixed_wing",
+                                     end="loiter"), min_agl=30.0).results[0]
+    assert plane.feasible and plane.altitude_m == 130.0, plane.reasons
+    assert plane.summary["unsafe_lines"] == 0
+    # but 10 m up right in front of the wall it cannot climb over it
+    low = [[700.0, 200.0, 150.0], [380.0, 200.0, 150.0], [380.0, 150.0, 10.0]]
+    plane = firmware_returns(mission(world, low, firmware="ardupilot", vehicle="fixed_wing",
+                                     end="loiter"), min_agl=30.0).results[0]
+    assert not plane.feasible and "climb" in plane.reasons[0]
+
+
 def test_rally_points_compete_with_home_and_get_their_own_transit_altitude(world):
     m = mission(world, HIGH, firmware="ardupilot")
     # a rally point west of the wall: the lines from the west never cross the wall

@@ -24,7 +24,10 @@ line needs ``A >= max(surface + min_agl)`` along it; and a plane (ArduPlane, ``c
 = along``) climbs at its climb gradient ``g`` (climb rate / cruise speed) while it
 flies home, ``z = min(A, z0 + g s)`` from the route's altitude ``z0``: every point
 of the line must be reachable at that gradient, else no altitude works (the obstacle
-is too close ahead). Above the ceiling: ``A - ground <= max_agl`` wherever the line
+is too close ahead). From a start below the floor (the take-off climb, the landing
+approach: ``h0`` above the surface) a plane must keep ``min(min_agl, h0)`` above the
+surface instead — it cannot be ``min_agl`` up at the runway, but its return must never
+bring it closer to the surface than it starts. Above the ceiling: ``A - ground <= max_agl`` wherever the line
 flies at ``A``.
 
 When no altitude works (a ridge higher than the ceiling allows, an obstacle too
@@ -368,15 +371,32 @@ def _flown_z(model: ReturnModel, A: np.ndarray, z0: np.ndarray, t: np.ndarray,
     return np.where(z0 >= A, A, np.minimum(A, z0 + grad * t * L))
 
 
+def _floor(model: ReturnModel, lines: _Lines, min_agl: float, grad: float) -> np.ndarray:
+    """The height above the surface each surface point of the lines must keep: ``min_agl``;
+    for a plane climbing along its line (``climb = along``) from a start below the floor
+    (the take-off climb, the landing approach, a goal asked lower), the start's own height
+    above the surface: a plane taking off from home cannot be ``min_agl`` above the runway,
+    but its return must never bring it closer to the surface than it starts."""
+    s = lines.surf
+    if model.climb == "vertical":
+        return np.full(len(s.z), float(min_agl))
+    seg = s.segment
+    first = s.t == 0.0
+    z_start = np.full(len(lines.a), np.nan)
+    z_start[seg[first]] = s.z[first]
+    agl0 = np.maximum(lines.a[:, 2] - z_start, 0.0)
+    return np.minimum(float(min_agl), agl0[seg])
+
+
 def _lowest(model: ReturnModel, lines: _Lines, min_agl: float, grad: float) -> np.ndarray:
     """The lowest absolute return altitude each line needs (inf: none works): the highest
-    surface + ``min_agl`` on it, and for a plane climbing along the line, every point
-    reachable at its climb gradient from the route's altitude."""
+    surface + floor (:func:`_floor`) on it, and for a plane climbing along the line, every
+    point reachable at its climb gradient from the route's altitude."""
     s = lines.surf
     seg = s.segment
     n = len(lines.a)
     z0 = lines.a[:, 2]
-    need = s.z + min_agl
+    need = s.z + _floor(model, lines, min_agl, grad)
     starts = np.searchsorted(seg, np.arange(n))
     need_max = np.maximum.reduceat(need, starts)
     if model.climb == "vertical":
@@ -406,7 +426,8 @@ def _evaluate(model: ReturnModel, lines: _Lines, A: np.ndarray, grad: float,
     out["max_agl_m"] = round(float(agl[own].max()), 2) if own.any() else None
     out["over_ceiling"] = int(np.unique(g.segment[own & (agl > max_agl + 1e-6)]).size) \
         if max_agl is not None else 0
-    out["unsafe_lines"] = int(np.unique(s.segment[clear < min_agl - 1e-6]).size)
+    floor = _floor(model, lines, min_agl, grad)
+    out["unsafe_lines"] = int(np.unique(s.segment[clear < floor - 1e-6]).size)
     zones: list[str] = []
     if getattr(world, "zones", ()):
         from ..world.zones import zone_violations
