@@ -106,5 +106,19 @@ def test_the_docs_commands_run(tmp_path, doc, after):
         assert row in res.output
 
 
+@pytest.mark.slow
+def test_the_python_block_runs_and_its_ways_back_end_at_home(capsys):
+    text = DOC.read_text()
+    block = re.search(r"```python\n(.*?)```", text[text.index("## From Python"):], re.S).group(1)
+    ns: dict = {}
+    exec(compile(block, str(DOC), "exec"), ns)
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].endswith("home") and ns["ways"][-1].length > 1000.0
+    import numpy as np
+
+    assert all(np.allclose(w.path[-1], ns["plan"].path[0]) for w in ns["ways"])
+    assert np.isfinite(ns["home"].cost(ns["plan"].path[-1:])).all()
+
+
 if __name__ == "__main__":
     print(table_markdown(table_rows()))
