@@ -85,3 +85,14 @@ def corridor_world(width_cells: int = 8, length: tuple[int, int] = (20, 40)):
 def corridor():
     """The corridor world (``corridor_world()``), shared by the formation and viz tests."""
     return corridor_world()
+
+
+@pytest.fixture(scope="session")
+def returns_mission():
+    """An ArduPilot mission over a ridge with its safe returns (tests/autopilot/return_cases.py):
+    one rally point, an RTL end but no return altitude under the ceiling (so the mission carries
+    its planned return home instead), 10 min endurance; read by the autopilot and io tests."""
+    from fm2uav.autopilot.safe_return import ReturnOptions
+    from tests.autopilot.return_cases import build, ridge_plan
+
+    return build(ridge_plan(), ReturnOptions(rally=((1100.0, 700.0),)), end="rtl")

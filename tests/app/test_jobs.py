@@ -57,11 +57,14 @@ def test_a_plan_job_writes_the_outputs_and_the_map(jobs, dem, tmp_path):
     seen = wait(jobs, job)
     j = jobs.get(job.id)
     assert j.state == "done", j.error
-    assert j.result["files"] == ["mission.plan", "mission.waypoints", "path.geojson",
-                                 "summary.json"]
+    # the mission files and, with the safe returns (on by default), their two files
+    assert j.result["files"] == ["mission.param", "mission.plan", "mission.waypoints",
+                                 "path.geojson", "returns.geojson", "summary.json"]
     kinds = {f["properties"]["kind"] for f in j.result["map"]["features"]}
-    assert {"route", "item", "start", "goal"} <= kinds
-    assert j.result["map"]["rows"]["mission"] == "app test"
+    assert {"route", "item", "start", "goal", "return"} <= kinds
+    rows = j.result["map"]["rows"]
+    assert rows["mission"] == "app test"
+    assert "longest way back" in rows and "point of no return" in rows
     stages = [st for _, st in seen]
     assert "planning (FM²): arrival times T (Fast Marching)" in stages
     fractions = [f for f, _ in seen]

@@ -82,7 +82,11 @@ def test_a_plan_job_and_its_files(client):
     job = client.post("/api/jobs", json={"kind": "plan", "mission": doc}).json()
     ev = events(client, job["id"])
     assert ev[-1]["state"] == "done", ev[-1]["error"]
-    assert ev[-1]["result"]["files"] == ["mission.plan", "mission.waypoints", "summary.json"]
+    # with the safe returns (on by default): the firmware's return settings and the ways back
+    assert ev[-1]["result"]["files"] == ["mission.param", "mission.plan", "mission.waypoints",
+                                         "returns.geojson", "summary.json"]
+    r = client.get(f"/api/jobs/{job['id']}/files/mission.param")
+    assert r.status_code == 200 and b"RTL_RETURN_ALT" in r.content  # PX4, the default
     r = client.get(f"/api/jobs/{job['id']}/files/mission.plan")
     assert r.status_code == 200 and json.loads(r.content)["fileType"] == "Plan"
     assert "attachment" in r.headers["content-disposition"]

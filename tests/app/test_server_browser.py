@@ -80,6 +80,10 @@ def test_plan_round_a_drawn_zone_download_and_reproduce_with_fm2uav_run(page, ap
     assert line.length > LineString([start, goal]).length
     agl = np.array(route["properties"]["agl"])
     assert np.median(agl) == pytest.approx(60.0, abs=3.0)
+    # the safe returns on the map: a way back from every waypoint, as returns.geojson has them
+    ways = [f for f in result["map"]["features"] if f["properties"]["kind"] == "return"]
+    assert len(ways) >= 2 and all(f["properties"]["to"] == "home" for f in ways)
+    assert "returns.geojson" in result["files"] and page.locator("#dl-mission-param").count() == 1
     cards = page.inner_text("#cards")
     assert "km" in cards and "flight time" in cards and "min" in cards
     assert page.locator("#profile canvas").count() >= 1       # the profile chart is drawn
@@ -121,6 +125,30 @@ def test_plan_round_a_drawn_zone_download_and_reproduce_with_fm2uav_run(page, ap
     job = plan_and_wait(page, button="#btn-check", kind="check")
     assert job["state"] == "done", job["error"]
     assert page.inner_text("#check-verdict").startswith("FLYABLE")
+
+
+def test_rally_and_returns_of_the_mission_file_are_saved_as_given(page, tmp_path):
+    """The page keeps the ``rally:`` / ``returns:`` keys of the mission it started from."""
+    from fm2uav.io.mission import load_mission
+
+    lon, lat = lonlat_at(page, 0.5, 0.3)
+    page.evaluate(f"fm2app.base.rally = [{{lon: {lon}, lat: {lat}, agl: 50}}];"
+                  "fm2app.base.returns = {min_agl: 35, strict: true}")
+    try:
+        doc = page.evaluate("fm2app.missionDoc()")
+        assert doc["rally"] == [{"lon": lon, "lat": lat, "agl": 50}]
+        assert doc["returns"] == {"min_agl": 35, "strict": True}
+        saved = tmp_path / "rally.yaml"
+        page.fill("#save-path", str(saved))
+        page.click("#btn-save")
+        page.wait_for_function(f"document.getElementById('saved-path') && "
+                               f"document.getElementById('saved-path').textContent === "
+                               f"{json.dumps(str(saved))}", timeout=20_000)
+        m = load_mission(saved)
+        assert [(p.lon, p.lat, p.agl) for p in m.rally.points] == [(lon, lat, 50.0)]
+        assert (m.returns.min_agl, m.returns.strict) == (35.0, True)
+    finally:
+        page.evaluate("delete fm2app.base.rally; delete fm2app.base.returns")
 
 
 def test_a_point_off_the_map_shows_the_cli_error_in_the_page(page, app_run, tmp_path):

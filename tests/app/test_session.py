@@ -61,3 +61,33 @@ def test_job_files_write_the_mission_the_job_runs(tmp_path):
     mf, out = s.job_files("7", {"version": 1, "name": "x"})
     assert mf == tmp_path / "jobs" / "7" / "mission.yaml" and out == mf.parent / "out"
     assert yaml.safe_load(mf.read_text()) == {"version": 1, "name": "x"}
+
+
+def test_rally_and_returns_keys_round_trip_through_a_saved_mission(tmp_path):
+    """``rally:`` (sites, ``auto:K``, or a file — copied beside the mission like the other
+    uploaded files) and ``returns:`` are saved as given and read back by ``fm2uav run``."""
+    s = Session(tmp_path / "session", {}, tmp_path / "m.yaml")
+    dem = s.upload("dem.tif", make_dem(tmp_path / "x.tif").read_bytes())
+    rally = s.upload("rally.csv", b"lon,lat,agl\n10.33,46.035,50\n")
+    base = {"version": 1, "world": {"dem": str(dem)},
+            "start": {"lon": 10.30, "lat": 46.03, "agl": 60},
+            "goal": {"lon": 10.355, "lat": 46.03, "agl": 60},
+            "returns": {"enabled": True, "min_agl": 35.0, "strict": True}}
+    assert file_refs({"rally": "auto:2"}) == [] and file_refs({"rally": [{"lon": 1}]}) == []
+    assert file_refs({"rally": str(rally)}) == [(["rally"], str(rally))]
+    for form in ({"file": str(rally)}, str(rally)):
+        target = s.save({**base, "rally": form}, tmp_path / "saved" / "mission.yaml")
+        saved = yaml.safe_load(target.read_text())
+        assert saved["rally"] in ({"file": "rally.csv"}, "rally.csv")
+        assert (target.parent / "rally.csv").read_bytes() == rally.read_bytes()
+        assert saved["returns"] == base["returns"]
+        m = load_mission(target)
+        assert m.rally.file == str(target.parent / "rally.csv")
+        assert (m.returns.min_agl, m.returns.strict) == (35.0, True)
+    sites = [{"lon": 10.33, "lat": 46.035, "agl": 50.0}]
+    for rally_key, check in ((sites, lambda r: [(p.lon, p.lat, p.agl) for p in r.points]
+                              == [(10.33, 46.035, 50.0)]),
+                             ("auto:2", lambda r: r.auto == 2)):
+        target = s.save({**base, "rally": rally_key}, tmp_path / "again.yaml")
+        assert yaml.safe_load(target.read_text())["rally"] == rally_key
+        assert check(load_mission(target).rally)

@@ -469,8 +469,14 @@ def test_validators_accept_our_missions_and_name_each_defect():
     rtl_do = [replace(it, frame=3) if it.command == 178 else it for it in items]
     assert "px4-frame" in _codes(rtl_do) or not any(it.command == 178 for it in items)
     assert "px4-landing-required" in _codes(items[:-1] + [MissionItem.do(20)], vehicle="fixed_wing")
-    copter_land_start = items[:-1] + [MissionItem.do(189), items[-1]]
-    assert "ardupilot-command" in _codes(copter_land_start, "ardupilot")
+    # ArduCopter keeps DO_LAND_START / DO_RETURN_PATH_START as markers (mode_auto.cpp
+    # start_command: "case MAV_CMD_DO_RETURN_PATH_START: case MAV_CMD_DO_LAND_START: break;")
+    # but has no NAV_LOITER_TO_ALT
+    copter_markers = items[:-1] + [MissionItem.do(188), MissionItem.do(189), items[-1]]
+    assert "ardupilot-command" not in _codes(copter_markers, "ardupilot")
+    loiter_alt = [replace(it, command=31) if it.command == 16 else it for it in items]
+    assert "ardupilot-command" in _codes(loiter_alt, "ardupilot")
+    assert "px4-command" in _codes(copter_markers)  # PX4 has no DO_RETURN_PATH_START
     ardu, _ = export_mission(hill_tff(), ["plan"], _opts(firmware="ardupilot"))
     bad_takeoff = [replace(ardu.items[0], frame=10, params=(*ardu.items[0].params[:6], 60.0))]
     assert "ardupilot-terrain-takeoff" in _codes(bad_takeoff + ardu.items[1:], "ardupilot")

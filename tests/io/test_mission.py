@@ -272,7 +272,8 @@ def test_plan_command_report_and_exports(tmp_path):
                               "--anchor", "2.35,48.85,35", "--thin", "10", "--json"])
     assert res.exit_code == 0, res.output
     data = json.loads(res.output)
-    assert len(data["files"]) == 9 and data["waypoints"] < 60  # + path.kmz
+    # + path.kmz, and the safe returns: returns.geojson, mission.param
+    assert len(data["files"]) == 11 and data["waypoints"] < 60
     plan = read_plan(out / "mission.plan")
     assert plan["home"][:2] == pytest.approx((48.85, 2.35), abs=0.05)
     assert (out / "report.html").stat().st_size > 1_000_000
@@ -407,6 +408,30 @@ def test_outputs_dir_is_relative_to_the_mission_file(tmp_path, monkeypatch):
                          base_dir=proj).output_dir() == tmp_path / "abs"
     assert parse_mission({"world": {"scenario": "open-field"},
                           "outputs": {"dir": "rel"}}).output_dir() == Path("rel")
+
+
+def test_rally_and_returns_keys(tmp_path):
+    from fm2uav.io.mission import parse_mission
+    from fm2uav.scenarios import get_scenario
+
+    base = {"world": {"scenario": "open-field"}}
+    m = parse_mission({**base, "rally": "auto:2", "returns": {"strict": True, "min_agl": 25}})
+    w = get_scenario("open-field").world
+    ro = m.return_options(w)
+    assert ro.auto_rally == 2 and ro.strict and ro.min_agl == 25 and ro.rally == ()
+    m = parse_mission({**base, "rally": [{"x": 300, "y": 400, "agl": 50},
+                                         {"lon": -3.76, "lat": 40.336}]})
+    ro = m.return_options(w)
+    assert ro.rally[0] == (300.0, 400.0, 50.0) and ro.rally[1][2] is None
+    (tmp_path / "r.csv").write_text("-3.76,40.336\n")
+    m = parse_mission({**base, "rally": "r.csv"}, base_dir=tmp_path)
+    assert len(m.return_options(w).rally) == 1
+    assert parse_mission({**base, "returns": {"enabled": False}}).returns.enabled is False
+    for bad, part in (({"rally": "auto:11"}, "auto:K"), ({"rally": "missing.csv"},
+                      "file not found"), ({"rally": [{"x": 1}]}, "lon and lat"),
+                      ({"returns": {"min_agl": -1}}, "returns.min_agl")):
+        with pytest.raises(InputError, match=part):
+            parse_mission({**base, **bad}, base_dir=tmp_path)
 
 
 def test_parse_world_checks_the_world_section_alone_in_the_mission_words(tmp_path):

@@ -41,3 +41,22 @@ def test_complex_items_without_stored_items_are_refused_by_name(tmp_path):
     doc["mission"]["items"].pop(1)
     (tmp_path / "t.plan").write_text(json.dumps(doc))
     assert read_plan(tmp_path / "t.plan")["command"].tolist() == [22, 20]
+
+
+def test_rally_points_are_written_as_qgc_writes_them(returns_mission, tmp_path):
+    import json
+
+    from fm2uav.io.qgc import plan_document, read_plan, validate_plan
+    from fm2uav.io.rally import rally_rows
+
+    doc = plan_document(returns_mission)
+    rp = doc["rallyPoints"]
+    # QGroundControl's RallyPointController: {"points": [[lat, lon, alt], ...], "version": 2}
+    assert set(rp) == {"points", "version"} and rp["version"] == 2
+    assert rp["points"] == [list(r) for r in rally_rows(returns_mission)]
+    assert validate_plan(doc) == []
+    f = tmp_path / "m.plan"
+    f.write_text(json.dumps(doc))
+    assert read_plan(f)["rally"] == [tuple(p) for p in rp["points"]]
+    bad = {**doc, "rallyPoints": {"points": [[95.0, 0.0, 10.0]], "version": 2}}
+    assert any("rallyPoints.points[0]" in p for p in validate_plan(bad))

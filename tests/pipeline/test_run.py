@@ -28,7 +28,9 @@ def test_run_mission_writes_the_set_reports_progress_and_equals_fm2uav_run(missi
     with OutputDir(tmp_path / "lib") as outdir, reporting(events.append):
         run = run_mission(m, outdir, mission_file=mission_file)
     names = sorted(p.name for p in (tmp_path / "lib").iterdir())
-    assert names == ["mission.plan", "mission.waypoints", "path.geojson", "summary.json"]
+    # the mission files and, with the safe returns, mission.param and returns.geojson
+    assert names == ["mission.param", "mission.plan", "mission.waypoints", "path.geojson",
+                     "returns.geojson", "summary.json"]
     assert run.info["safety"]["height_above_ground"]["cruise"]["median_m"] == \
         pytest.approx(60, abs=1)
     assert run.built.waypoints.frame == 0 and run.world_name == "dem.tif"
@@ -44,7 +46,8 @@ def test_run_mission_writes_the_set_reports_progress_and_equals_fm2uav_run(missi
     res = CliRunner().invoke(app, ["run", str(mission_file), "--out", str(tmp_path / "cli"),
                                    "--quiet"])
     assert res.exit_code == 0, res.output
-    for name in ("mission.plan", "mission.waypoints", "path.geojson"):
+    for name in ("mission.plan", "mission.waypoints", "path.geojson", "mission.param",
+                 "returns.geojson"):
         assert (tmp_path / "cli" / name).read_bytes() == (tmp_path / "lib" / name).read_bytes()
 
 

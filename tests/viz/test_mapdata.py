@@ -82,3 +82,37 @@ def test_items_zones_fences_and_summary(planned):
     assert s["items"] == len(built.items) and s["flight_time_s"] > 0
     assert s["length_m"] == pytest.approx(route.plan.length, abs=0.1)
     assert doc["rows"] == {"length [m]": "1.0"}
+
+
+def test_the_safe_returns_are_on_the_map_as_in_returns_geojson(returns_mission):
+    """Ways back, the point of no return and its way back, rally points: the features of
+    ``returns.geojson`` (home left out), rounded as the map shows them."""
+    from fm2uav.io.returns import returns_document
+    from fm2uav.viz.mapdata import return_features
+    from tests.autopilot.return_cases import ridge_plan
+
+    feats = return_features(returns_mission)
+    ref = [f for f in returns_document(returns_mission)["features"]
+           if f["properties"]["kind"] != "home"]
+    assert [f["properties"] for f in feats] == [f["properties"] for f in ref]
+    for f, g in zip(feats, ref):
+        a = np.asarray(f["geometry"]["coordinates"], dtype=float)
+        b = np.asarray(g["geometry"]["coordinates"], dtype=float)
+        assert a.shape == b.shape and np.max(np.abs(a - b)[..., :2]) <= 5e-8
+    kinds = [f["properties"]["kind"] for f in feats]
+    wps = {int(w) for w in returns_mission.returns.samples.waypoint if w >= 0}
+    assert kinds.count("return") == len(wps) > 3 and kinds.count("rally") == 1
+    assert kinds.count("pnr") == kinds.count("pnr-return") == int(
+        bool(returns_mission.returns.pnr.get("reached")))
+    doc = mission_map(ridge_plan(), returns_mission)
+    assert [f for f in doc["features"] if f["properties"]["kind"] in
+            ("return", "pnr", "pnr-return", "rally")] == feats
+    pnr = doc["summary"]["point_of_no_return"]
+    assert pnr["computed"] and "point_m" not in pnr
+    # a mission without returns (--no-returns) draws none
+    from fm2uav.autopilot.safe_return import ReturnOptions
+    from tests.autopilot.return_cases import build
+
+    off = build(ridge_plan(), ReturnOptions(enabled=False), end="rtl")
+    assert off.returns is None and return_features(off) == []
+    assert mission_map(ridge_plan(), off)["summary"]["point_of_no_return"] is None

@@ -44,7 +44,8 @@ def file_refs(doc: dict[str, Any]) -> list[tuple[list[Any], str]]:
     """``(key path, file)`` of every data file a mission document names.
 
     world.dem (one or a list), world.buildings, no_fly_zones entries (text or
-    ``file:``) and operating_area.
+    ``file:``), the rally points file (``rally: FILE`` or ``rally: {file: ...}``) and
+    operating_area.
     """
     out: list[tuple[list[Any], str]] = []
     world = doc.get("world") or {}
@@ -60,6 +61,11 @@ def file_refs(doc: dict[str, Any]) -> list[tuple[list[Any], str]]:
             out.append((["no_fly_zones", k], z))
         elif isinstance(z, dict) and isinstance(z.get("file"), str):
             out.append((["no_fly_zones", k, "file"], z["file"]))
+    rally = doc.get("rally")
+    if isinstance(rally, str) and not rally.strip().lower().startswith("auto"):
+        out.append((["rally"], rally))
+    elif isinstance(rally, dict) and isinstance(rally.get("file"), str):
+        out.append((["rally", "file"], rally["file"]))
     area = doc.get("operating_area")
     if isinstance(area, str):
         out.append((["operating_area"], area))

@@ -82,7 +82,7 @@ def _plan_job(payload: dict[str, Any]) -> dict[str, Any]:
     from ..io.mission import load_mission
     from ..io.outdir import OutputDir
     from ..pipeline.outputs import output_names
-    from ..pipeline.rows import mission_rows, plan_rows, safety_rows, world_rows
+    from ..pipeline.rows import mission_rows, plan_rows, returns_rows, safety_rows, world_rows
     from ..pipeline.run import run_mission
     from ..viz.mapdata import mission_map
 
@@ -96,7 +96,8 @@ def _plan_job(payload: dict[str, Any]) -> dict[str, Any]:
     np.save(out.parent / "path_m.npy", np.asarray(p.path, dtype=float))  # for a later check
     rows = {"mission": m.name, "world": run.world_name, **plan_rows(p),
             "legs": len(run.route.legs), **safety_rows(run.info["safety"]),
-            **mission_rows(run.built), "time [s]": f"{p.timings['total']:.2f}",
+            **mission_rows(run.built), **returns_rows(run.info),
+            "time [s]": f"{p.timings['total']:.2f}",
             **world_rows(rm.world)}
     points = {"start": rm.start, **{f"via {k + 1}": v for k, v in enumerate(rm.via)},
               "goal": rm.goal}

@@ -60,6 +60,7 @@ from .items import (
     MissionItem,
 )
 from .firmware import FIRMWARES, PROFILES, VEHICLES
+from .returns import rtl_end_notes
 from .validate import check_mission
 from .waypoints import FRAMES, Waypoints, ground_at, mission_waypoints, resolve_frame
 
@@ -242,6 +243,9 @@ class MissionExport:
         Summary numbers (speed changes, camera, landing, flight time, endurance).
     fences : list
         Geofences for the ``.plan`` (:mod:`fm2uav.autopilot.geofence`).
+    returns : ReturnsReport or None
+        The safe returns (:mod:`fm2uav.autopilot.safe_return`): ways back, point of no
+        return, rally points, firmware return settings; None when not computed.
     """
 
     items: list[MissionItem]
@@ -254,6 +258,7 @@ class MissionExport:
     warnings: list[str]
     info: dict[str, Any]
     fences: list[Any] = field(default_factory=list)
+    returns: Any = None
 
     @property
     def home(self) -> tuple[float, float, float]:
@@ -598,24 +603,10 @@ def _end(geo: _Geo, wps: Waypoints, opt: ExportOptions
             items.append(geo.item(CMD_NAV_VTOL_LAND, FRAME_RELATIVE if f_route == FRAME_TERRAIN
                                   else f_route, start_xy, float(geo.ground(start_xy)[0]),
                                   label="home landing"))
-        if len(items) > 1:
-            landing["note"] = ("PX4 needs a landing in fixed-wing and VTOL missions "
-                               "(MIS_TKO_LAND_REQ = 2): the RTL item is followed by a landing at "
-                               "home, which PX4's return mode uses through DO_LAND_START")
-        line = start_xy[None, :] + np.linspace(0, 1, 50)[:, None] * (end_xy - start_xy)[None, :]
-        inside = _inside_xy(geo.world, line)
-        rise = (float((geo.ground(line[inside]) - geo.ground(start_xy)[0]).max())
-                if inside.any() else float("nan"))
-        back = float(np.hypot(*(end_xy - start_xy)))
-        landing["rtl_straight_line_m"] = round(back, 1)
-        landing["rtl_max_ground_above_home_m"] = None if not np.isfinite(rise) else round(rise, 1)
-        if back > max(10.0, opt.tolerance):  # the route did not come back home itself
-            rises = (f" — the ground under it rises {rise:.0f} m above home"
-                     if np.isfinite(rise) and rise > 0 else "")
-            warnings.append("RTL flies a straight line home at the firmware's return altitude "
-                            "(PX4 RTL_RETURN_ALT, ArduPilot RTL_ALT / ALT_HOLD_RTL); fm2uav "
-                            f"neither plans nor checks it{rises}; use return: true (--return) "
-                            "for a planned way back")
+        notes, more = rtl_end_notes(geo.world, start_xy, end_xy, opt.firmware, opt.tolerance,
+                                    items)
+        landing.update(notes)
+        warnings += more
     elif end == "land" and opt.vehicle == "fixed_wing":
         heading = _unit_xy(wps.points_m, from_end=True)
         items, landing, warnings = _landing_pattern(geo, end_xy, heading, f_route, opt, "landing")

@@ -17,6 +17,8 @@ command                     id    params used (p1..p4; p5..p7 = lat, lon, alt)
 ``NAV_VTOL_LAND``           85    p4 yaw (NaN)
 ``DO_CHANGE_SPEED``         178   p1 speed type (0 air, 1 ground), p2 speed [m/s],
                                   p3 throttle (-1: no change) (frame 2)
+``DO_RETURN_PATH_START``   188   none (frame 2): marks the start of a return path
+                                  (ArduPilot: a return rejoins the mission there)
 ``DO_LAND_START``           189   none (frame 2): marks the start of a landing
 ``DO_SET_CAM_TRIGG_DIST``   206   p1 distance [m] (0: stop), p3 trigger once now
 ==========================  ====  ===============================================
@@ -51,8 +53,10 @@ __all__ = [
     "CMD_NAV_VTOL_LAND",
     "CMD_DO_JUMP",
     "CMD_DO_CHANGE_SPEED",
+    "CMD_DO_RETURN_PATH_START",
     "CMD_DO_LAND_START",
     "CMD_DO_SET_CAM_TRIGG_DIST",
+    "CMD_NAV_RALLY_POINT",
     "COMMAND_NAMES",
     "POSITION_COMMANDS",
     "TAKEOFF_COMMANDS",
@@ -94,8 +98,11 @@ CMD_NAV_VTOL_TAKEOFF = 84
 CMD_NAV_VTOL_LAND = 85
 CMD_DO_JUMP = 177
 CMD_DO_CHANGE_SPEED = 178
+CMD_DO_RETURN_PATH_START = 188
 CMD_DO_LAND_START = 189
 CMD_DO_SET_CAM_TRIGG_DIST = 206
+#: MAV_CMD_NAV_RALLY_POINT: a rally point, in a rally-type mission (MAV_MISSION_TYPE_RALLY).
+CMD_NAV_RALLY_POINT = 5100
 
 COMMAND_NAMES = {
     16: "NAV_WAYPOINT",
@@ -116,6 +123,7 @@ COMMAND_NAMES = {
     178: "DO_CHANGE_SPEED",
     179: "DO_SET_HOME",
     183: "DO_SET_SERVO",
+    188: "DO_RETURN_PATH_START",
     189: "DO_LAND_START",
     201: "DO_SET_ROI",
     203: "DO_DIGICAM_CONTROL",
@@ -126,6 +134,7 @@ COMMAND_NAMES = {
     2000: "IMAGE_START_CAPTURE",
     2001: "IMAGE_STOP_CAPTURE",
     3000: "DO_VTOL_TRANSITION",
+    5100: "NAV_RALLY_POINT",
 }
 
 #: Commands whose params 5..7 are a position (latitude, longitude, altitude).

@@ -21,6 +21,7 @@ from .options import (
     world_rows,
 )
 from ._mission_options import parse_anchor
+from ._return_options import ReturnFlags, return_options
 from .cmd_run import mission_rows, output_names, plan_outputs, safety_rows
 
 PLAN_FILES = ("path.csv", "plan.png", "summary.json")
@@ -48,6 +49,7 @@ PLAN_HELP = (
 @output_options("out/plan", report_help="Also write report.html (interactive, self-contained).")
 @world_options
 @mission_options()
+@return_options
 def plan_cmd(
     scenario: ScenarioOpt = None,
     start: str | None = typer.Option(
@@ -104,6 +106,7 @@ def plan_cmd(
                                "Douglas–Peucker)."),
     world: WorldFlags = None,
     mission: MissionFlags = None,
+    returns: ReturnFlags = None,
 ) -> None:
     """``fm2uav plan``: parse, :func:`~fm2uav.missions.route.plan_route`, write, print."""
     from ._first_use import announce_compile, fmm_group
@@ -114,6 +117,7 @@ def plan_cmd(
     from ..missions.route import plan_route
     from ..world.load import world_summary
 
+    returns.check()
     w, sc, scenario = world.build(scenario, start, goal, seed=seed, lonlat=lonlat, agl=agl)
     description = sc.description if sc is not None else f"real data: {scenario}"
     extra = _extra_formats(export, output.report)
@@ -132,6 +136,16 @@ def plan_cmd(
                        return_to_start=bool(mission.return_to_start), shaping=shaping,
                        level=level, options=options)
     p = route.plan
+    built = None
+    info: dict = {}
+    if extra:
+        from ..pipeline.outputs import flown
+
+        ret = returns.options(w, anchor=getattr(export_options, "anchor", None), crs=world.crs)
+        info, built = plan_outputs(outdir, p, extra, export_options,
+                                   title=f"FM² plan — {scenario}", subtitle=description,
+                                   via=route.junctions[1:-1], returns=ret)
+        p = flown(p, built)  # with the planned safe return when the mission carries one
     summary = {"scenario": scenario, "world": world_summary(w), **p.summary(),
                "route": route.summary()}
     if p.path.shape[1] == 3:  # measured on the continuous ground (legs: with the exports)
@@ -144,16 +158,15 @@ def plan_cmd(
             check_ground(w, summary["safety"])
     _write_plan(outdir, p, w, title=f"FM² plan — {scenario}",
                 ground=summary.get("safety", {}).get("ground"))
-    built = None
-    if extra:
-        info, built = plan_outputs(outdir, p, extra, export_options,
-                                   title=f"FM² plan — {scenario}", subtitle=description,
-                                   via=route.junctions[1:-1])
+    if built is not None:
         summary.update(waypoints=info["waypoints"], mavlink_frame=info["mavlink_frame"],
                        home_lat_lon_alt=info["home_lat_lon_alt"], autopilot=info["autopilot"],
                        safety=info["safety"])
+        for key in ("returns", "point_of_no_return"):
+            if key in info:
+                summary[key] = info[key]
     write_json(outdir, "summary.json", summary)
-    output.summary("FM² plan", _rows(scenario, route, w, summary, built), summary)
+    output.summary("FM² plan", _rows(scenario, route, w, summary, built, p), summary)
 
 
 def _planner(shaping: dict, level: dict) -> tuple:
@@ -220,9 +233,10 @@ def _write_plan(outdir, p, world, *, title: str, ground: dict | None = None) -> 
     outdir.commit(tmp_png, "plan.png")
 
 
-def _rows(scenario: str, route, world, summary: dict, built) -> dict:
-    """The printed summary of ``fm2uav plan``."""
-    p = route.plan
+def _rows(scenario: str, route, world, summary: dict, built, p) -> dict:
+    """The printed summary of ``fm2uav plan`` (``p``: the plan as flown)."""
+    from ..pipeline.rows import returns_rows
+
     rows = {
         "scenario": scenario,
         **plan_rows(p),
@@ -236,6 +250,7 @@ def _rows(scenario: str, route, world, summary: dict, built) -> dict:
         rows.update(safety_rows(summary["safety"]))
     if "waypoints" in summary:
         rows["waypoints"] = f"{summary['waypoints']} (MAVLink frame {summary['mavlink_frame']})"
+        rows.update(returns_rows(summary))
         rows.update(mission_rows(built))
     return rows
 

@@ -24,6 +24,7 @@ from ._common import (
     plan_rows,
 )
 from ._mission_options import via_points
+from ._return_options import ReturnFlags, return_options
 from .options import (
     MISSION_FLAGS,
     MissionFlags,
@@ -59,6 +60,7 @@ RUN_HELP = (
                 "when outputs.formats leaves it out (the default formats include it).")
 @world_options
 @mission_options(*MISSION_FLAGS, "thin", "anchor")
+@return_options
 def run_cmd(
     mission_file: Path = typer.Argument(..., help="Mission YAML file.", show_default=False),
     output: Output = None,
@@ -86,6 +88,7 @@ def run_cmd(
         None, "--saturation-distance", help="Override planner.saturation_distance: the "
         "distance (m) from obstacles beyond which W = 1 (a margin that means the same on "
         "any map)."),
+    returns: ReturnFlags = None,
 ) -> None:
     """``fm2uav run``: load the mission file (with the flags' overrides),
     :func:`~fm2uav.pipeline.run.run_mission`, print."""
@@ -93,9 +96,12 @@ def run_cmd(
 
     input_file(mission_file, "")  # a missing mission file is refused before the heavy imports
     from ..io.mission import load_mission
+    from ..pipeline.outputs import flown
+    from ..pipeline.rows import returns_rows
     from ..pipeline.run import run_mission
     from ..progress import reporting
 
+    returns.check()
     points = point_overrides(start=start, goal=goal, lonlat=lonlat) or {}
     if mission.via:
         points["via"] = via_points(mission.via, lonlat=lonlat)
@@ -119,14 +125,18 @@ def run_cmd(
                                  ("saturation_distance", saturation_distance)) if v is not None}
     with output.progress() as step, reporting(lambda e: step(e.message)):
         run = run_mission(m, outdir, mission_file=mission_file, options=options,
-                          planner=planner, no_fly=no_fly or (), formats=formats)
-    p = run.plan
+                          planner=planner, no_fly=no_fly or (), formats=formats,
+                          returns=lambda mi, w: returns.options(
+                              w, base=mi.return_options(w), anchor=mi.anchor(),
+                              crs=mi.world.crs))
+    p = flown(run.plan, run.built)
     rows = {
         "mission": m.name,
         "world": run.world_name,
         **plan_rows(p),
         "legs": len(run.route.legs),
         **safety_rows(run.info["safety"]),
+        **returns_rows(run.info),
         **mission_rows(run.built),
         "time [s]": f"{p.timings['total']:.2f}",
         **world_rows(run.resolved.world),

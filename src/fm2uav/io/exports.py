@@ -17,6 +17,13 @@ wpl        ``mission.waypoints``  MAVLink ``QGC WPL 110`` (tab-separated)
 =========  =====================  ===========================================
 
 ``waypoints`` is accepted as another name of ``wpl``.
+
+With ``returns`` (:class:`~fm2uav.autopilot.safe_return.ReturnOptions`) the mission is
+built with its safe returns (:func:`fm2uav.autopilot.safe_return.build_with_returns`)
+and every export comes with the return files (:data:`RETURN_FILES`):
+``mission.param`` (the firmware's return settings, :mod:`fm2uav.io.params`),
+``returns.geojson`` (the ways back, the point of no return, :mod:`fm2uav.io.returns`)
+and, with rally points, ``rally.waypoints`` and ``rally.txt`` (:mod:`fm2uav.io.rally`).
 """
 
 from __future__ import annotations
@@ -39,6 +46,7 @@ from .wpl import write_wpl
 
 __all__ = [
     "EXPORT_FILES",
+    "RETURN_FILES",
     "FORMAT_ALIASES",
     "ExportOptions",
     "ExportFile",
@@ -57,6 +65,14 @@ EXPORT_FILES = {
     "kmz": "path.kmz",
     "plan": "mission.plan",
     "wpl": "mission.waypoints",
+}
+#: Files written with the exports when the returns are computed (rally files only with
+#: rally points).
+RETURN_FILES = {
+    "param": "mission.param",
+    "returns": "returns.geojson",
+    "rally": "rally.waypoints",
+    "rally_txt": "rally.txt",
 }
 #: Other names of formats.
 FORMAT_ALIASES = {"waypoints": "wpl", "qgc": "plan"}
@@ -101,7 +117,8 @@ def _description(m: MissionExport) -> str:
              f"home {s['home']['lat']:.7f}, {s['home']['lon']:.7f}, "
              f"{s['home']['alt_amsl_m']:.1f} m AMSL ({s['home']['source']})",
              f"CRS {s['crs']}; altitudes: {s['vertical_reference']}"]
-    return "\n".join(lines + [f"warning: {w}" for w in m.warnings])
+    return "\n".join(lines + [f"warning: {w}" for w in m.warnings]
+                     + [f"note: {n}" for n in m.info.get("notes", [])])
 
 
 def export_mission(
@@ -116,6 +133,7 @@ def export_mission(
     times: Any = None,
     start_hold: float = 0.0,
     prefix: str = "",
+    returns: Any = None,
 ) -> tuple[MissionExport, dict[str, ExportFile]]:
     """Build the mission of a plan and the writers of the requested files.
 
@@ -135,6 +153,9 @@ def export_mission(
         See :func:`fm2uav.autopilot.build_mission`.
     prefix : str, optional
         Put before every file name (e.g. ``"leader_"``).
+    returns : ReturnOptions, optional
+        Build the mission with its safe returns and add the return files (module
+        docstring).
 
     Returns
     -------
@@ -161,9 +182,17 @@ def export_mission(
     speed = getattr(plan, "w", None)
     if speed is None:
         speed = getattr(plan, "speed", None)
-    mission = build_mission(path, world, opt, w=speed, agl=agl, times=times, via=via,
-                            camera=camera, fences=fences, start_hold=start_hold,
-                            profile=getattr(plan, "profile", None))
+    inputs = dict(w=speed, agl=agl, times=times, via=via, camera=camera, fences=fences,
+                  start_hold=start_hold, profile=getattr(plan, "profile", None))
+    if returns is not None:
+        from ..autopilot.safe_return import build_with_returns
+
+        mission = build_with_returns(path, world, opt, returns, plan=plan, **inputs)
+        path = np.asarray(mission.path_m, dtype=float)  # with a planned safe return appended
+        if speed is not None and np.shape(speed) != (len(path),):
+            speed = None
+    else:
+        mission = build_mission(path, world, opt, **inputs)
     s = mission.summary()
     props = {"mission": opt.name, "length_m": round(float(getattr(plan, "length", 0.0)), 3),
              "firmware": opt.firmware, "vehicle": opt.vehicle, "frame": mission.waypoints.frame,
@@ -171,6 +200,7 @@ def export_mission(
              "crs": s["crs"], "vertical_reference": s["vertical_reference"],
              "home": [s["home"]["lat"], s["home"]["lon"], s["home"]["alt_amsl_m"]],
              "home_source": s["home"]["source"], "warnings": list(mission.warnings),
+             "notes": list(mission.info.get("notes", [])),
              **{k: v for k, v in params.items() if isinstance(v, (int, float, str, bool))}}
     wpm = mission.waypoints.points_m
     floor = getattr(getattr(plan, "profile", None), "required", None)
@@ -196,7 +226,27 @@ def export_mission(
     for k in keys:
         name = prefix + EXPORT_FILES[k]
         files[name] = ExportFile(name, k in _BINARY, writers[k])
+    if keys and getattr(mission, "returns", None) is not None:
+        files.update(_return_files(mission, prefix))
     return mission, files
+
+
+def _return_files(mission: MissionExport, prefix: str) -> dict[str, ExportFile]:
+    """The return files of a mission built with its returns (module docstring)."""
+    from .params import write_params
+    from .rally import write_rally_txt, write_rally_waypoints
+    from .returns import write_returns
+
+    rep = mission.returns
+    writers: dict[str, Callable[[IO[Any]], Any]] = {
+        "returns": lambda fh: write_returns(fh, mission)}
+    if rep.params is not None:
+        writers["param"] = lambda fh: write_params(fh, rep.params)
+    if rep.rally:
+        writers["rally"] = lambda fh: write_rally_waypoints(fh, mission)
+        writers["rally_txt"] = lambda fh: write_rally_txt(fh, mission)
+    return {prefix + RETURN_FILES[k]: ExportFile(prefix + RETURN_FILES[k], False, w)
+            for k, w in writers.items()}
 
 
 def file_prefix(name: str) -> str:

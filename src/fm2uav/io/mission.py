@@ -40,6 +40,8 @@ Schema (pydantic v2, strict types, unknown keys rejected)::
                                     # auto: ArduPilot terrain, PX4 amsl (DEM ground + AGL)
       end: auto                     # auto | rtl | land | loiter (auto: airframe-aware)
       speed_changes: false          # DO_CHANGE_SPEED from the planned speed W
+    rally: [{lon: -3.76, lat: 40.34, agl: 60}]   # rally points (or a file, or auto / auto:3)
+    returns: {enabled: true, min_agl: 30, strict: false}   # safe returns (docs/returns.md)
 
 **Relative paths** in a mission file (``world.dem``, ``world.buildings``, zone
 files, ``outputs.dir``) are relative to the folder of the mission file, whatever
@@ -86,6 +88,8 @@ __all__ = [
     "PlannerSpec",
     "AirframeSpec",
     "OutputSpec",
+    "RallySpec",
+    "ReturnsSpec",
     "OUTPUT_FORMATS",
     "ResolvedMission",
     "resolve_point",
@@ -355,6 +359,80 @@ class OutputSpec(BaseModel):
     speed_step: float = _num(1.0, unit="m/s", gt=0, le=20, desc="speed quantum")
 
 
+class RallySiteSpec(BaseModel):
+    """One rally site: lon/lat or x/y, and optionally the approach height above the ground."""
+
+    model_config = _STRICT
+    x: float | None = _num(None, unit="m", desc="world x")
+    y: float | None = _num(None, unit="m", desc="world y")
+    lon: float | None = _num(None, unit="deg", ge=-180, le=180, desc="longitude")
+    lat: float | None = _num(None, unit="deg", ge=-90, le=90, desc="latitude")
+    agl: float | None = _num(None, unit="m", gt=0, le=10000,
+                             desc="approach height above the ground (default: the start's)")
+
+    @model_validator(mode="after")
+    def _one(self) -> RallySiteSpec:
+        xy = self.x is not None and self.y is not None
+        ll = self.lon is not None and self.lat is not None
+        if xy == ll or (not xy and (self.x is not None or self.y is not None)):
+            raise ValueError("give lon and lat [deg], or x and y [m]")
+        return self
+
+
+class RallySpec(BaseModel):
+    """Rally points: ``auto`` / ``auto:K`` (the planner chooses K), a file, or a list of sites."""
+
+    model_config = _STRICT
+    auto: int | None = _num(None, ge=1, le=10, desc="rally points for the planner to choose")
+    file: str | None = Field(None, description="points file (relative to the mission file)")
+    points: list[RallySiteSpec] = Field(default_factory=list, max_length=10,
+                                        description="rally sites")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _forms(cls, data: Any) -> Any:
+        if isinstance(data, list):
+            return {"points": data}
+        if isinstance(data, str):
+            t = data.strip()
+            if t.lower() == "auto" or t.lower().startswith("auto:"):
+                from .rally import parse_rally_text
+
+                try:
+                    return {"auto": parse_rally_text(t)[1]}
+                except InputError as exc:
+                    raise ValueError(str(exc).replace("--rally", "rally")) from None
+            return {"file": t}
+        return data
+
+    @field_validator("file")
+    @classmethod
+    def _file(cls, v: str | None, info: Any) -> str | None:
+        if v is None:
+            return v
+        p = Path(v).expanduser()
+        base = (info.context or {}).get("base_dir") if info is not None else None
+        if not p.is_absolute() and base is not None:
+            p = Path(base) / p
+        if not p.is_file():
+            raise ValueError(f"file not found ({p}); allowed: a GeoJSON/KML/GPKG/SHP file of "
+                             "points or a CSV lon,lat[,agl]")
+        return str(p)
+
+
+class ReturnsSpec(BaseModel):
+    """The safe returns (docs/returns.md)."""
+
+    model_config = _STRICT
+    enabled: bool = Field(True, description="compute the ways back, the point of no return, "
+                                            "the firmware return settings")
+    min_agl: float | None = _num(None, unit="m", ge=0, le=5000,
+                                 desc="floor of the straight firmware return lines above the "
+                                      "surface (default planner.min_agl, else the cruise floor)")
+    strict: bool = Field(False, description="refuse a mission that passes its point of no "
+                                            "return before its end")
+
+
 class Mission(BaseModel):
     """A whole mission file."""
 
@@ -376,6 +454,8 @@ class Mission(BaseModel):
     airframe: AirframeSpec = Field(default_factory=AirframeSpec)
     outputs: OutputSpec = Field(default_factory=OutputSpec)
     _base_dir: Path | None = PrivateAttr(None)
+    rally: RallySpec | None = Field(None, description="rally points: sites, a file or auto")
+    returns: ReturnsSpec = Field(default_factory=ReturnsSpec)
 
     @model_validator(mode="after")
     def _points_needed(self) -> Mission:
@@ -434,6 +514,35 @@ class Mission(BaseModel):
             endurance_s=None if a.endurance is None else 60.0 * a.endurance,
             reserve=a.reserve, name=self.name,
         )
+
+    def return_options(self, world: Any) -> Any:
+        """The :class:`~fm2uav.autopilot.safe_return.ReturnOptions` of ``rally:`` and
+        ``returns:``, the rally sites placed on ``world`` (metres).
+
+        Raises
+        ------
+        InputError
+            A rally file that cannot be read (named).
+        """
+        from ..autopilot.safe_return import ReturnOptions
+        from .rally import read_rally_sites
+
+        r, anchor = self.rally, self.anchor()
+        sites: list[tuple[float, float, float | None]] = []
+        auto = 0
+        if r is not None:
+            auto = int(r.auto or 0)
+            if r.file is not None:
+                sites += read_rally_sites(r.file, world, anchor=anchor, crs=self.world.crs)
+            for p in r.points:
+                if p.lon is not None:
+                    xy = from_lonlat(world, [[p.lon, p.lat]], anchor=anchor)[0]
+                else:
+                    xy = (p.x, p.y)
+                sites.append((float(xy[0]), float(xy[1]), p.agl))
+        ret = self.returns
+        return ReturnOptions(enabled=ret.enabled, rally=tuple(sites), auto_rally=auto,
+                             min_agl=ret.min_agl, strict=ret.strict)
 
     def plan_kwargs(self) -> dict[str, Any]:
         """The ``planner:`` section as one flat dict of the given keys (defaults filled

@@ -6,7 +6,9 @@ Format" developer documentation and ``PlanMasterController`` /
 
 * top level: ``fileType`` = "Plan", ``version`` = 1, ``groundStation``,
   ``mission``, and the optional ``geoFence`` (``circles``, ``polygons``,
-  ``version`` 2) and ``rallyPoints`` (``points``, ``version`` 2); fm2uav adds an
+  ``version`` 2) and ``rallyPoints`` (``points``: ``[lat, lon, alt]`` with the
+  altitude relative to home, as QGC's ``RallyPointController`` saves them, ``version``
+  2; :mod:`fm2uav.io.rally`); fm2uav adds an
   ``fm2uav`` object (frame, home and its source, CRS and vertical reference,
   warnings), which QGroundControl ignores;
 * ``mission``: ``version`` 2, ``firmwareType`` (MAV_AUTOPILOT), ``vehicleType``
@@ -51,6 +53,7 @@ from ..errors import InputError
 from ..autopilot.firmware import FIRMWARE_TYPES, VEHICLE_TYPES  # MAV_AUTOPILOT, MAV_TYPE
 from ..autopilot.geofence import Fence, FenceCircle, FencePolygon, as_fences
 from ..autopilot.items import FRAME_GLOBAL, FRAME_RELATIVE, FRAME_TERRAIN, MissionItem
+from .rally import rally_rows
 
 __all__ = [
     "FIRMWARE_TYPES",
@@ -117,7 +120,8 @@ def plan_document(mission: Any) -> dict[str, Any]:
         "fm2uav": {"frame": info["frame"], "home": info["home"], "crs": info["crs"],
                    "georef": _portable(info["georef"]),
                    "vertical_reference": info["vertical_reference"],
-                   "end": info["end"], "warnings": info["warnings"]},
+                   "end": info["end"], "warnings": info["warnings"],
+                   "notes": info.get("notes", [])},
         "geoFence": geofence_document(mission.fences),
         "groundStation": "fm2uav",
         "mission": {
@@ -130,7 +134,8 @@ def plan_document(mission: Any) -> dict[str, Any]:
             "vehicleType": VEHICLE_TYPES[opt.vehicle],
             "version": 2,
         },
-        "rallyPoints": {"points": [], "version": 2},
+        "rallyPoints": {"points": [[la, lo, alt] for la, lo, alt in rally_rows(mission)],
+                        "version": 2},
         "version": 1,
     }
 
@@ -241,7 +246,10 @@ def validate_plan(doc: Any) -> list[str]:
     rally = c.need(doc, "rallyPoints", "dict", "top", optional=True)
     if rally is not None:
         c.need(rally, "version", "num", "rallyPoints")
-        c.need(rally, "points", "list", "rallyPoints")
+        for i, pt in enumerate(c.need(rally, "points", "list", "rallyPoints") or []):
+            if not (isinstance(pt, list) and len(pt) == 3 and all(_is_num(v) for v in pt)
+                    and -90 <= pt[0] <= 90 and -180 <= pt[1] <= 180):
+                c.out.append(f"rallyPoints.points[{i}] must be [lat, lon, alt] numbers")
     m = c.need(doc, "mission", "dict", "top")
     if m is None:
         return c.out

@@ -15,10 +15,10 @@ from typing import Any
 
 from .. import progress
 from ..errors import InputError
-from .rows import safety_rows
+from .rows import returns_rows, safety_rows
 
 __all__ = ["OUTPUT_FILES", "EXPORT_FILES", "output_names", "write_exports", "plan_outputs",
-           "to_jsonable", "write_json", "write_text", "write_figure", "export_options",
+           "flown", "to_jsonable", "write_json", "write_text", "write_figure", "export_options",
            "parse_anchor"]
 
 #: Export format → file name (:data:`fm2uav.io.exports.EXPORT_FILES`, repeated here so that
@@ -101,6 +101,7 @@ def plan_outputs(
     title: str,
     subtitle: str = "",
     summary: dict[str, Any] | None = None,
+    returns: Any = None,
     **mission_inputs: Any,
 ) -> tuple[dict[str, Any], Any]:
     """Write the requested outputs of a plan into ``outdir`` (atomically each).
@@ -117,6 +118,10 @@ def plan_outputs(
         Of the HTML report and PNG figure.
     summary : dict, optional
         Extra entries of ``summary.json``.
+    returns : ReturnOptions, optional
+        Compute the safe returns (:mod:`fm2uav.autopilot.safe_return`): ``returns`` and
+        ``point_of_no_return`` in the summary, the return files, the report's ways back;
+        the figures then describe the plan as flown (:func:`flown`).
     **mission_inputs
         ``via``, ``camera``, ``fences``, ``agl`` of :func:`fm2uav.io.export_mission`.
 
@@ -138,9 +143,11 @@ def plan_outputs(
     if zones and "fences" not in mission_inputs:  # no-fly zones -> the .plan geoFence
         mission_inputs["fences"], fence_warnings = zone_fences(
             zones, plan.world, getattr(options, "anchor", None))
-    progress.step("building the mission (altitudes, waypoints, takeoff, end, firmware checks)",
-                  0.2)
-    mission, files = export_mission(plan, exports, options, **mission_inputs)
+    progress.step("building the mission (altitudes, waypoints, takeoff, end, firmware checks)"
+                  + ("; the ways back, rally points, firmware return settings"
+                     if returns is not None and returns.enabled else ""), 0.2)
+    mission, files = export_mission(plan, exports, options, returns=returns, **mission_inputs)
+    plan = flown(plan, mission)
     wps = mission.waypoints
     progress.step("measuring the flight against the ground, the zones and the limits", 0.2)
     level = getattr(plan, "level", None)
@@ -163,13 +170,16 @@ def plan_outputs(
         "thin_tolerance_m": options.tolerance,
         "safety": safety,
     }
+    if getattr(mission, "returns", None) is not None:
+        info["returns"] = mission.returns.summary(plan.world, options.anchor)
+        info["point_of_no_return"] = mission.returns.pnr
     progress.step("writing the exports", 0.3)
     write_exports(outdir, files)
     if "html" in formats:
         progress.step("writing report.html", 0.2)
         write_text(outdir, "report.html", _plan_report(
             plan, info, wps, options, formats, title=title, subtitle=subtitle, zones=zones,
-            fence_warnings=fence_warnings))
+            fence_warnings=fence_warnings, returns=mission.returns))
     if "png" in formats:
         from ..viz import plan_figure
 
@@ -182,9 +192,51 @@ def plan_outputs(
     return info, mission
 
 
+def flown(plan: Any, mission: Any) -> Any:
+    """The plan as the mission flies it: with the planned safe return appended when the
+    mission carries one (:func:`fm2uav.autopilot.safe_return.flown_plan`), else ``plan``."""
+    if getattr(mission, "returns", None) is None:
+        return plan
+    from ..autopilot.safe_return import flown_plan
+
+    return flown_plan(plan, mission)
+
+
+def _return_overlays(returns: Any) -> dict[str, Any]:
+    """Report overlays: the way back from every waypoint, the point of no return's, rally
+    points (crosses)."""
+    if returns is None:
+        return {}
+    out: dict[str, Any] = {}
+    lines = [p for p in returns.waypoint_paths().values() if len(p) >= 2]
+    if lines:
+        gap = np.full((1, 3), np.nan)
+        pts = np.concatenate([np.vstack([p[:, :3], gap]) for p in lines])[:-1]
+        out["ways back (from each waypoint)"] = {"points": pts, "color": "#9467bd",
+                                                 "width": 2, "dash": "dot"}
+    if returns.pnr_path is not None and len(returns.pnr_path) >= 2:
+        out["point of no return: way back"] = {"points": returns.pnr_path[:, :3],
+                                               "color": "#d62728", "width": 5}
+        x, y, z = (float(v) for v in returns.pnr_path[0, :3])
+        d = 40.0
+        out["point of no return"] = {"points": np.array([
+            [x - d, y, z], [x + d, y, z], [np.nan] * 3, [x, y - d, z], [x, y + d, z],
+            [np.nan] * 3, [x, y, z - d], [x, y, z + d]]), "color": "#d62728", "width": 8}
+    marks = []
+    for r in returns.rally:
+        x, y = float(r.point[0]), float(r.point[1])
+        d = 25.0
+        marks += [np.array([[x - d, y], [x + d, y]]), np.full((1, 2), np.nan),
+                  np.array([[x, y - d], [x, y + d]]), np.full((1, 2), np.nan)]
+    if marks:
+        out["rally points"] = {"points": np.concatenate(marks[:-1]), "color": "#ff7f0e",
+                               "width": 5}
+    return out
+
+
 def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
                  formats: Sequence[str], *, title: str, subtitle: str, zones: Any,
-                 fence_warnings: list[str]) -> str:
+                 fence_warnings: list[str], returns: Any = None) -> str:
     """report.html of a plan and its autopilot mission's waypoints ``wps`` (see
     :func:`plan_outputs`)."""
     import numpy as np
@@ -211,6 +263,7 @@ def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
         "flight time [min]": round(ms["flight"]["flight_time_s"] / 60, 2),
         "planning time [s]": round(float(plan.timings.get("total", 0.0)), 3),
         **safety_rows(info["safety"]),
+        **returns_rows(info),
         **{f"warning {k + 1}": w for k, w in enumerate(ms["warnings"] + fence_warnings)},
     }
     return report_html(
@@ -219,7 +272,7 @@ def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
         params=params, metrics=metrics, files=output_names(formats),
         agl=None if level is None else level.agl,
         overlays={**filled_overlay(plan.world), **filled_path_overlay(plan.world, plan.path),
-                  **zone_overlays(zones)},
+                  **zone_overlays(zones), **_return_overlays(returns)},
         notes=list(ground_notes(plan.world, info["safety"]).values()))
 
 

@@ -152,3 +152,42 @@ def ground_rows(safety: dict[str, Any]) -> dict[str, str]:
             + ("" if r["ok"] or not r.get("needed_pixel_m") else
                f"; needs pixels of <= {r['needed_pixel_m']:.0f} m") + ")")
     return rows
+
+
+def returns_rows(info: dict[str, Any]) -> dict[str, str]:
+    """Printed / report rows of the safe returns (``returns`` of the summary)."""
+    r = info.get("returns")
+    if not r:
+        return {}
+    rows: dict[str, str] = {}
+    w = r["worst"]
+    if w.get("time_s") is not None:
+        rows["longest way back"] = (f"{w['time_s'] / 60:.1f} min to {w['to']} from "
+                                    f"{w['distance_m'] / 1000:.2f} km along the route")
+    rally = [d for d in r["destinations"] if d.get("name") != "home"]
+    if rally:
+        rows["rally points"] = ", ".join(
+            f"{d['name']} ({d.get('chosen_by', 'user')}) {d.get('lon', 0):.5f}, "
+            f"{d.get('lat', 0):.5f}" for d in rally)
+    p = r["point_of_no_return"]
+    if not p.get("computed"):
+        rows["point of no return"] = "not computed: " + p.get("why", "")
+    elif p.get("reached"):
+        rows["point of no return"] = (f"{p['distance_m'] / 1000:.2f} km along the route "
+                                      f"(after waypoint {p['after_waypoint']}, "
+                                      f"{p['t_mission_s'] / 60:.1f} min)"
+                                      + (" — BEFORE the route's end" if p["passed_before_end"]
+                                         else ""))
+    else:
+        rows["point of no return"] = (f"none on the route (smallest margin "
+                                      f"{p['smallest_margin_s'] / 60:.1f} min)")
+    fw = r.get("firmware")
+    if fw:
+        alts = "; ".join(
+            f"{m['firmware']} {m['return_altitude_m']:g} m" if m["feasible"] else
+            f"{m['firmware']}: no safe altitude" for m in fw["models"])
+        rows["firmware return"] = (alts + f" (>= {fw['min_agl_m']:g} m above the surface on "
+                                   f"{fw['start_points']['count']} straight lines)")
+    if r.get("mission_carries_safe_return"):
+        rows["safe return in the mission"] = str(r["mission_carries_safe_return"])
+    return rows

@@ -80,6 +80,7 @@ def run_mission(
     planner: dict[str, Any] | None = None,
     no_fly: Sequence[str | Path] = (),
     formats: Sequence[str] | None = None,
+    returns: Any = None,
 ) -> MissionRun:
     """Plan ``mission`` and write its output set (``outputs.formats``) into ``outdir``.
 
@@ -100,6 +101,10 @@ def run_mission(
     formats : sequence of str, optional
         The output formats (default ``outputs.formats``; ``fm2uav run --report`` adds
         ``html``).
+    returns : callable, optional
+        ``returns(mission, world) -> ReturnOptions``: the safe returns asked for (the
+        CLI's ``--rally``, ``--strict``, ... on the mission file's ``rally:`` /
+        ``returns:``); default ``mission.return_options(world)``.
 
     Returns
     -------
@@ -129,6 +134,8 @@ def run_mission(
                        options=popts)
     world_name = mission.world.scenario or mission.world.describe()
     progress.step("writing the mission files", 0.3)
+    ret = (returns(mission, rm.world) if returns is not None
+           else mission.return_options(rm.world))
     info, built = plan_outputs(
         outdir, route.plan, formats, options, title=f"{mission.name}",
         subtitle=f"{world_name} — {mission.description}" if mission.description
@@ -138,6 +145,6 @@ def run_mission(
                     else {}),
                  "world": {**world_summary(rm.world), "name": world_name},
                  "route": route.summary()},
-        via=route.junctions[1:-1])
+        via=route.junctions[1:-1], returns=ret)
     return MissionRun(mission=mission, resolved=rm, route=route, info=info, built=built,
                       world_name=world_name)

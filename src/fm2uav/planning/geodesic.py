@@ -76,7 +76,7 @@ from ..eikonal.fmm import as_spacing
 from ..errors import InputError, PlanningError, PointError, UnreachableError
 from . import _geodesic_kernels as _k
 
-__all__ = ["descend", "nearest_node", "default_max_steps"]
+__all__ = ["descend", "descend_batch", "nearest_node", "default_max_steps"]
 
 
 def nearest_node(points: Any) -> np.ndarray:
@@ -189,12 +189,9 @@ def _refuse_blocked(mask: np.ndarray | None, node: tuple[int, ...], p: np.ndarra
         )
 
 
-def _check_endpoints(field: np.ndarray, mask: np.ndarray | None, s: np.ndarray, g: np.ndarray
-                     ) -> tuple[int, ...]:
-    """Refuse a goal that is blocked or not the source of ``field``, or a blocked / unreached
-    start; the goal's nearest node."""
+def _check_goal(field: np.ndarray, mask: np.ndarray | None, g: np.ndarray) -> tuple[int, ...]:
+    """Refuse a goal that is blocked or not the source of ``field``; its nearest node."""
     shape = field.shape
-    sn = tuple(nearest_node(s).tolist())
     gn = tuple(nearest_node(g).tolist())
     _refuse_blocked(mask, gn, g, "goal")
     if not np.isfinite(field[gn]):
@@ -210,6 +207,13 @@ def _check_endpoints(field: np.ndarray, mask: np.ndarray | None, s: np.ndarray, 
             f"lower ({t_min:g}) at node {[int(i) for i in where]}, so T was not computed from "
             "this goal; compute T with the goal's nearest node as the source"
         )
+    return gn
+
+
+def _check_start(field: np.ndarray, mask: np.ndarray | None, s: np.ndarray, g: np.ndarray
+                 ) -> None:
+    """Refuse a blocked or unreached start."""
+    sn = tuple(nearest_node(s).tolist())
     _refuse_blocked(mask, sn, s, "start")
     if not np.isfinite(field[sn]):
         raise UnreachableError(
@@ -218,7 +222,44 @@ def _check_endpoints(field: np.ndarray, mask: np.ndarray | None, s: np.ndarray, 
             "joins them; move the start or the goal into the same free region, or clear "
             "(lower the obstacles / raise the speed of) the cells that separate them"
         )
+
+
+def _check_endpoints(field: np.ndarray, mask: np.ndarray | None, s: np.ndarray, g: np.ndarray
+                     ) -> tuple[int, ...]:
+    """Refuse a goal that is blocked or not the source of ``field``, or a blocked / unreached
+    start; the goal's nearest node."""
+    gn = _check_goal(field, mask, g)
+    _check_start(field, mask, s, g)
     return gn
+
+
+def _run(field: np.ndarray, field3: np.ndarray, h3: tuple[float, ...], s: np.ndarray,
+         g: np.ndarray, gn: tuple[int, ...], step: float, max_steps: int) -> np.ndarray:
+    """The kernel's descent from ``s`` to ``g`` on the prepared (3D-padded) field; the path in
+    index coordinates of ``field``'s dimension, ends exact."""
+    ndim = field.ndim
+    pad = 3 - ndim
+    s3 = np.concatenate([s, np.zeros(pad)])
+    g3 = np.concatenate([g, np.zeros(pad)])
+    path, status, info, _ = _k.descend_kernel(field3, s3, g3, *h3, step, int(max_steps))
+    if status != _k.OK:
+        node = info[:ndim].tolist()
+        raise PlanningError(
+            f"descent from start {s.tolist()} stuck at node {node} (T = {field[tuple(node)]:g}), "
+            f"which has no free neighbour with smaller T and is not next to the goal "
+            f"{g.tolist()}; T must be the arrival times of a wave started at the goal's "
+            f"nearest node {list(gn)} (e.g. fast_marching(speed, [goal_node]))"
+        )
+    path = np.ascontiguousarray(path[:, :ndim])
+    path[0] = s
+    path[-1] = g
+    return path
+
+
+def _padded(field: np.ndarray, h: Sequence[float]) -> tuple[np.ndarray, tuple[float, ...]]:
+    pad = 3 - field.ndim
+    field3 = np.ascontiguousarray(field.reshape(field.shape + (1,) * pad))
+    return field3, tuple(h) + (min(h),) * pad  # keeps min(spacing) of the real axes
 
 
 def descend(
@@ -301,22 +342,45 @@ def descend(
     g = _as_point(goal, shape, "goal")
     field, mask = _with_blocked(field, blocked)
     gn = _check_endpoints(field, mask, s, g)
+    field3, h3 = _padded(field, h)
+    return _run(field, field3, h3, s, g, gn, step, max_steps)
 
-    pad = 3 - ndim
-    field3 = np.ascontiguousarray(field.reshape(shape + (1,) * pad))
-    h3 = tuple(h) + (min(h),) * pad  # keeps min(spacing) of the real axes
-    s3 = np.concatenate([s, np.zeros(pad)])
-    g3 = np.concatenate([g, np.zeros(pad)])
-    path, status, info, _ = _k.descend_kernel(field3, s3, g3, *h3, step, int(max_steps))
-    if status != _k.OK:
-        node = info[:ndim].tolist()
-        raise PlanningError(
-            f"descent from start {s.tolist()} stuck at node {node} (T = {field[tuple(node)]:g}), "
-            f"which has no free neighbour with smaller T and is not next to the goal "
-            f"{g.tolist()}; T must be the arrival times of a wave started at the goal's "
-            f"nearest node {list(gn)} (e.g. fast_marching(speed, [goal_node]))"
-        )
-    path = np.ascontiguousarray(path[:, :ndim])
-    path[0] = s
-    path[-1] = g
-    return path
+
+def descend_batch(
+    T: Any,
+    starts: Sequence[Any],
+    goal: Any,
+    *,
+    spacing: float | Sequence[float] = 1.0,
+    blocked: Any = None,
+    step: float = 0.5,
+    max_steps: int | None = None,
+) -> list[np.ndarray]:
+    """:func:`descend` from each of ``starts`` to one ``goal``, the field checked once.
+
+    The same paths as one :func:`descend` per start; ``T`` and ``blocked`` are checked
+    and prepared once (a per-call check scans the whole field), each start on its own.
+
+    Returns
+    -------
+    list of ndarray
+        One path (N, ndim) per start, in index coordinates.
+
+    Raises
+    ------
+    As :func:`descend`, for the first start that fails.
+    """
+    field = _as_field(T)
+    shape = field.shape
+    h = as_spacing(spacing, field.ndim)
+    step, max_steps = _check_step(step, max_steps, shape, h)
+    g = _as_point(goal, shape, "goal")
+    field, mask = _with_blocked(field, blocked)
+    gn = _check_goal(field, mask, g)
+    field3, h3 = _padded(field, h)
+    out = []
+    for start in starts:
+        s = _as_point(start, shape, "start")
+        _check_start(field, mask, s, g)
+        out.append(_run(field, field3, h3, s, g, gn, step, max_steps))
+    return out

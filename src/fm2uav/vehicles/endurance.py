@@ -15,6 +15,11 @@ line home at cruise speed and the descent there.
 :func:`check_endurance` compares the total with the usable endurance,
 ``endurance × (1 − reserve)``, and, when it does not last, says how far along
 the route the vehicle gets before it eats into the reserve.
+
+The way back from a point of the route (:func:`return_time`) is timed the same
+way, leg by leg of the return path at the forward speed, plus the final descent at
+the destination; :func:`first_shortfall` finds where the time flown plus the time
+back first exceeds the usable endurance: the point of no return.
 """
 
 from __future__ import annotations
@@ -27,7 +32,8 @@ import numpy as np
 from .._validate import positive
 from ..errors import InputError
 
-__all__ = ["FlightTime", "EnduranceReport", "flight_time", "check_endurance"]
+__all__ = ["FlightTime", "EnduranceReport", "flight_time", "check_endurance", "return_time",
+           "first_shortfall"]
 
 
 @dataclass(frozen=True)
@@ -222,3 +228,71 @@ def check_endurance(ft: FlightTime, *, endurance_s: float | None, reserve: float
         reach += ft.leg_length[k] * min((usable - t_wp[k]) / ft.leg_time[k], 1.0)
     return EnduranceReport(ft.time_s, ft.distance_m, float(endurance_s), r, usable, False,
                            float(reach), k, n)
+
+
+def return_time(path: Any, *, speed: float, climb_rate: float, descent_rate: float,
+                landing_height: float = 0.0) -> tuple[float, float]:
+    """``(time [s], 3D length [m])`` of flying ``path`` home and landing.
+
+    Each segment takes ``max(L / speed, dz / climb, -dz / descent)`` (as the
+    mission's legs, :func:`flight_time`); the final descent of ``landing_height``
+    [m] at ``descent_rate`` is added (the vehicle is on the ground at the end).
+
+    Parameters
+    ----------
+    path : array_like, shape (n, 3)
+        The way back [m], from the point to over the destination.
+    speed : float
+        Forward speed [m/s] (the airframe's: RTL flies at its cruise speed).
+    climb_rate, descent_rate : float
+        Vertical speed limits [m/s].
+    landing_height : float
+        Height of the destination point above its ground [m].
+    """
+    p = np.asarray(path, dtype=float)
+    if p.ndim != 2 or len(p) < 1:
+        raise InputError(f"path must be an (n, 2|3) array, got shape {p.shape}")
+    if p.shape[1] == 2:
+        p = np.column_stack([p, np.zeros(len(p))])
+    ft = flight_time(p, speed, climb_rate=climb_rate, descent_rate=descent_rate,
+                     final_descent=max(float(landing_height), 0.0))
+    return ft.time_s, float(ft.leg_length.sum())
+
+
+def first_shortfall(t_out: Any, t_back: Any, usable: float) -> tuple[int, float] | None:
+    """Where ``t_out + t_back`` first exceeds ``usable``, between samples ``k - 1`` and ``k``.
+
+    Parameters
+    ----------
+    t_out : array_like, shape (m,)
+        Time flown to each sample of the route [s] (increasing).
+    t_back : array_like, shape (m,)
+        Time back home from each sample [s] (``inf``: no way back).
+    usable : float
+        Usable endurance [s].
+
+    Returns
+    -------
+    (k, f) or None
+        The first sample ``k`` over the budget and the fraction ``f`` in [0, 1] of the
+        interval ``k - 1 → k`` where the margin ``usable - t_out - t_back`` crosses 0
+        (linear between the samples); ``k = 0`` when the first sample is already over;
+        None when every sample is within the budget.
+
+    Examples
+    --------
+    >>> first_shortfall([0, 10, 20], [5, 15, 25], 30.0)
+    (2, 0.25)
+    """
+    out = np.asarray(t_out, dtype=float)
+    back = np.asarray(t_back, dtype=float)
+    margin = float(usable) - out - back
+    bad = np.flatnonzero(~(margin >= 0))
+    if not len(bad):
+        return None
+    k = int(bad[0])
+    if k == 0:
+        return 0, 0.0
+    a, b = margin[k - 1], margin[k]
+    f = 1.0 if not np.isfinite(b) else float(a / (a - b)) if a != b else 1.0
+    return k, min(max(f, 0.0), 1.0)

@@ -18,6 +18,10 @@ Features (``properties.kind``):
 * ``zone``: no-fly zones and the operating area (``inclusion``), with floor,
   ceiling, reference and buffer; circles keep ``center`` and ``radius``;
 * ``fence``: the geofence written to the ``.plan`` (polygons and circles);
+* the safe returns, when the mission has them (:func:`return_features`, the same
+  features as ``returns.geojson``): ``return`` (the FM² way back from each waypoint,
+  with ``to``, ``time_s``, ``length_m``), ``pnr`` (the point of no return) and
+  ``pnr-return`` (its way back), ``rally`` (the rally points, on the ground);
 * coverage missions (:func:`coverage_features`): ``area`` (the surveyed polygon),
   ``band`` (the zigzag's bands as planned) and ``photo`` (the ground footprint of
   each photo the camera takes, numbered).
@@ -33,7 +37,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["mission_map", "zone_features", "coverage_features", "AGL_COLOURS"]
+__all__ = ["mission_map", "zone_features", "coverage_features", "return_features",
+           "AGL_COLOURS"]
 
 #: Colour scale of the route by height above ground, as a share of the requested
 #: height (shared with the page's legend): below the floor red, at the level green.
@@ -121,6 +126,34 @@ def _fence_features(mission: Any) -> list[dict[str, Any]]:
     return feats
 
 
+#: The features of ``returns.geojson`` the map draws.
+RETURN_KINDS = ("return", "pnr", "pnr-return", "rally")
+
+
+def return_features(mission: Any) -> list[dict[str, Any]]:
+    """The safe returns of a built mission as map features (module docstring).
+
+    The features of :func:`fm2uav.io.returns.returns_document` (home is left out: it is
+    the mission's home) with coordinates rounded as the map shows them; none when the
+    mission has no returns (``--no-returns``).
+    """
+    if getattr(mission, "returns", None) is None:
+        return []
+    from ..io.returns import returns_document
+
+    def rnd(c: Any) -> Any:
+        if c and isinstance(c[0], list):
+            return [rnd(v) for v in c]
+        return [round(float(c[0]), 7), round(float(c[1]), 7), round(float(c[2]), 1)]
+
+    out = []
+    for f in returns_document(mission)["features"]:
+        if f["properties"].get("kind") in RETURN_KINDS:
+            out.append({**f, "geometry": {"type": f["geometry"]["type"],
+                                          "coordinates": rnd(f["geometry"]["coordinates"])}})
+    return out
+
+
 def mission_map(plan: Any, mission: Any, safety: dict[str, Any] | None = None, *,
                 points: dict[str, Any] | None = None, anchor: Any = None,
                 rows: dict[str, str] | None = None, junctions: Any = None) -> dict[str, Any]:
@@ -179,6 +212,7 @@ def mission_map(plan: Any, mission: Any, safety: dict[str, Any] | None = None, *
     feats += _item_features(mission)
     feats += zone_features(world, getattr(world, "zones", ()), anchor)
     feats += _fence_features(mission)
+    feats += return_features(mission)
     s = mission.summary()
     hag = (safety or {}).get("height_above_ground", {}).get("path", {})
     zones = (safety or {}).get("zones") or {}
@@ -197,12 +231,21 @@ def mission_map(plan: Any, mission: Any, safety: dict[str, Any] | None = None, *
         "zone_entries": len(zones.get("path_entries", ())) if zones else 0,
         "warnings": list(s["warnings"]),
         "crs": s["crs"], "vertical_reference": s["vertical_reference"],
+        "point_of_no_return": _pnr_summary(mission),
     }
     lon, lat = ll[:, 0], ll[:, 1]
     return {"type": "FeatureCollection", "features": feats,
             "bbox": [round(float(lon.min()), 7), round(float(lat.min()), 7),
                      round(float(lon.max()), 7), round(float(lat.max()), 7)],
             "summary": summary, "rows": dict(rows or {})}
+
+
+def _pnr_summary(mission: Any) -> dict[str, Any] | None:
+    """The point of no return's figures for the page (None without returns)."""
+    rep = getattr(mission, "returns", None)
+    if rep is None:
+        return None
+    return {k: v for k, v in rep.pnr.items() if k not in ("point_m", "return")}
 
 
 def coverage_features(coverage: Any, shots: Any, camera: Any = None, anchor: Any = None

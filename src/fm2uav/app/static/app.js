@@ -452,6 +452,9 @@
                                     ["thin_tolerance", "o-thin_tolerance"],
                                     ["speed_changes", "o-speed_changes", "check"]]);
     for (const k of ["airframe", "outputs"]) if (!Object.keys(d[k]).length) delete d[k];
+    // the safe returns' keys of the mission file the page started from, kept as they are
+    if (b.rally !== undefined && b.rally !== null) d.rally = b.rally;
+    if (b.returns) d.returns = b.returns;
     return d;
   }
   S.missionDoc = missionDoc;
@@ -500,7 +503,8 @@
     ].join("");
     const order = ["mission.plan", "mission.waypoints", "path.kml", "path.kmz", "path.geojson",
                    "report.html", "plan.png", "coverage.html", "coverage.png", "bands.png",
-                   "path.csv", "zigzag.csv", "summary.json"];
+                   "path.csv", "zigzag.csv", "mission.param", "returns.geojson",
+                   "rally.waypoints", "rally.txt", "summary.json"];
     const names = order.filter(n => r.files.includes(n));
     $("downloads").innerHTML = names.map(n =>
       `<a href="/api/jobs/${job.id}/files/${n}" download="${n}" id="dl-${n.replace(".", "-")}">${n}</a>`)

@@ -8,6 +8,41 @@ items; VTOL items need a QuadPlane); position items in frame 0, 3 or 10 (and
 (``TERRAIN_ENABLE``), so a terrain-following plan is written in that frame; no
 ``NAV_TAKEOFF`` in the terrain frame (ArduPilot issue #20142: the altitude
 target jumps when the terrain under the vehicle differs from the takeoff point's).
+Copter and Plane both keep ``DO_LAND_START`` (189) and ``DO_RETURN_PATH_START``
+(188) as markers of a mission's landing and return path (ArduPilot wiki "Using
+DO_RETURN_PATH_START Mission Command", copied to the Plane and Copter wikis).
+
+**Returns** (:data:`COPTER_RETURN`, :data:`PLANE_RETURN`, used by
+:mod:`fm2uav.autopilot.returns`):
+
+* Copter RTL (``ArduCopter/mode_rtl.cpp`` ``compute_return_target``; wiki
+  "RTL Mode"): the return target is the closest of home and the rally points
+  (``AP_Rally::calc_best_rally_or_home_location``; home competes only with
+  ``RALLY_INCL_HOME`` = 1, a far rally point only within ``RALLY_LIMIT_KM``, 0 =
+  no limit); the target altitude above home is ``max(rally altitude, RTL_ALT,
+  current altitude + RTL_CLIMB_MIN)``, reduced near the target by the cone
+  ``RTL_CONE_SLOPE`` (0 disables it) and never below the current altitude; the
+  vehicle climbs over its position first, flies straight to the target at that
+  altitude, then descends (``RTL_ALT_FINAL`` = 0: lands). ``RTL_ALT`` is in
+  centimetres up to Copter 4.6; Copter 4.7 renamed it ``RTL_ALT_M`` in metres
+  (ArduPilot PR #31970, "SI param conversion for RTL and LAND parameters").
+  ``RTL_ALT_TYPE`` = 1 (terrain) follows the terrain database, and falls back to
+  above home when the data are missing ("RTL: no terrain data, using
+  alt-above-home"), so it is not what fm2uav sets.
+* Plane RTL (wiki "RTL Mode", Plane parameter ``RTL_ALTITUDE``): "When initiated
+  below RTL_ALTITUDE, Plane will immediately climb at maximum allowable rate to
+  reach that altitude, if above, it will descend in a linear manner versus
+  distance to home, reaching that altitude at the home loiter point";
+  ``RTL_ALTITUDE`` (m, relative to home) since Plane 4.5, ``ALT_HOLD_RTL`` (cm)
+  before; "if not returning home, the rally point altitude is used".
+* Mission-based returns: ``DO_RETURN_PATH_START`` marks a return path; "the
+  vehicle would return to the mission path, proceed to the waypoint after the
+  DO_LAND_START tag and LAND"; "In Plane, set RTL_AUTOLAND to 4 to use this. In
+  Copter, set any failsafe action to DO_LAND_START" (``FS_THR_ENABLE`` /
+  ``BATT_FS_LOW_ACT`` = 6, "Auto DO_LAND_START or RTL"; the AUTO RTL flight mode,
+  27, does the same on a switch). Copter's SmartRTL (``FS_*`` 4/5) retraces the
+  flown path instead, but falls back to RTL (or a landing in place) when its path
+  memory (``SRTL_POINTS``) is full.
 """
 
 from __future__ import annotations
@@ -15,17 +50,18 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from ..items import FRAME_TERRAIN, TAKEOFF_COMMANDS, VTOL_COMMANDS, MissionItem
-from .profile import FirmwareProfile, Problem
+from .profile import AltitudeParam, FirmwareProfile, Param, Problem, ReturnModel
 
 __all__ = ["ARDUPILOT", "COPTER_COMMANDS", "PLANE_COMMANDS", "POSITION_FRAMES", "VEHICLE_NAMES",
-           "check"]
+           "COPTER_RETURN", "PLANE_RETURN", "check"]
 
 #: ArduCopter mode_auto.cpp and ArduPlane commands_logic.cpp (ArduPilot wiki lists).
 COPTER_COMMANDS = frozenset({
-    16, 17, 18, 19, 20, 21, 22, 93, 112, 114, 115, 177, 178, 179, 183, 201, 203, 205, 206,
+    16, 17, 18, 19, 20, 21, 22, 93, 112, 114, 115, 177, 178, 179, 183, 188, 189, 201, 203,
+    205, 206,
 })
 PLANE_COMMANDS = frozenset({
-    16, 17, 18, 19, 20, 21, 22, 31, 84, 85, 93, 112, 114, 177, 178, 179, 183, 189, 201,
+    16, 17, 18, 19, 20, 21, 22, 31, 84, 85, 93, 112, 114, 177, 178, 179, 183, 188, 189, 201,
     203, 205, 206, 3000,
 })
 #: MAV_FRAMEs of position items.
@@ -55,6 +91,60 @@ def check(items: Sequence[MissionItem], vehicle: str, **_: object) -> list[Probl
     return out
 
 
+_SOURCES = (
+    "ArduCopter/mode_rtl.cpp (compute_return_target)",
+    "https://ardupilot.org/copter/docs/rtl-mode.html",
+    "https://ardupilot.org/plane/docs/rtl-mode.html",
+    "https://ardupilot.org/copter/docs/common-rally-points.html",
+    "https://ardupilot.org/plane/docs/common-do-return-path-start.html",
+    "ArduPilot PR #31970 (Copter 4.7: RTL_ALT -> RTL_ALT_M)",
+)
+_RALLY = (
+    Param("RALLY_INCL_HOME", 1, "home competes with the rally points: the closest one is the "
+          "return target, as checked"),
+    Param("RALLY_LIMIT_KM", 0, "no distance limit: the closest rally point is always a "
+          "candidate, as checked"),
+)
+#: ArduCopter's RTL (module docstring).
+COPTER_RETURN = ReturnModel(
+    label="ArduCopter", climb="vertical", above="keep", reference="home",
+    destinations="home_rally", rally_altitude="transit",
+    altitude=(AltitudeParam("RTL_ALT", 100.0, "cm", "Copter 4.6 and older"),
+              AltitudeParam("RTL_ALT_M", 1.0, "m", "Copter 4.7 and newer")),
+    min_m=2.0, max_m=3000.0,
+    settings=(Param("RTL_ALT_TYPE", 0, "return altitude above home (terrain following "
+                    "falls back to above home without terrain data)"),
+              Param("RTL_CONE_SLOPE", 0, "no cone: the checked return altitude holds from "
+                    "everywhere, also close to home")),
+    rally_settings=_RALLY,
+    mission_return=(Param("FS_THR_ENABLE", 6, "radio failsafe: Auto DO_LAND_START or RTL "
+                          "(joins the mission's planned return)"),
+                    Param("BATT_FS_LOW_ACT", 6, "low battery: Auto DO_LAND_START or RTL "
+                          "(joins the mission's planned return)")),
+    return_path_start=True,
+    mission_note="ArduCopter: a failsafe with action 6 (Auto DO_LAND_START) rejoins the "
+                 "mission at its closest point after DO_RETURN_PATH_START and flies it to the "
+                 "landing; use the AUTO RTL flight mode (27) instead of RTL on the RTL switch — "
+                 "RTL mode itself still flies the straight line",
+    sources=_SOURCES,
+)
+#: ArduPlane's (and QuadPlane's) RTL (module docstring).
+PLANE_RETURN = ReturnModel(
+    label="ArduPlane", climb="along", above="glide", reference="home",
+    destinations="home_rally", rally_altitude="transit",
+    altitude=(AltitudeParam("ALT_HOLD_RTL", 100.0, "cm", "Plane 4.4 and older"),
+              AltitudeParam("RTL_ALTITUDE", 1.0, "m", "Plane 4.5 and newer")),
+    min_m=0.0, max_m=None,
+    rally_settings=_RALLY,
+    mission_return=(Param("RTL_AUTOLAND", 4, "RTL goes directly to the landing sequence via "
+                          "DO_RETURN_PATH_START: it rejoins the mission's planned return"),),
+    return_path_start=True,
+    mission_note="ArduPlane: RTL_AUTOLAND = 4 makes RTL (and every failsafe that triggers "
+                 "it) rejoin the mission at its closest point after DO_RETURN_PATH_START and "
+                 "fly it to the DO_LAND_START landing",
+    sources=_SOURCES,
+)
+
 ARDUPILOT = FirmwareProfile(
     name="ardupilot",
     mav_autopilot=3,  # MAV_AUTOPILOT_ARDUPILOTMEGA
@@ -64,4 +154,6 @@ ARDUPILOT = FirmwareProfile(
     terrain_frame=True,
     landing_required=frozenset(),
     rules=(check,),
+    returns={"multirotor": (COPTER_RETURN,), "fixed_wing": (PLANE_RETURN,),
+             "vtol": (PLANE_RETURN,)},
 )

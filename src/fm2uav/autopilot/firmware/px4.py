@@ -13,6 +13,22 @@ defaults to 2 for both); at most one ``DO_LAND_START``, never before an RTL
 item, and before the landing approach; a fixed-wing ``NAV_LAND`` approached
 from a ``NAV_WAYPOINT`` or ``NAV_LOITER_TO_ALT`` above it, outside that
 loiter's radius, with a glide slope no steeper than ``FW_LND_ANG`` (default 5 deg).
+
+**Returns** (:data:`MC_RETURN`, :data:`FW_RETURN`; PX4 user guide "Return Mode
+(Generic Vehicle)", ``src/modules/navigator/rtl.cpp`` ``computeReturnAltitude`` and
+``rtl_direct.cpp``): the vehicle climbs over its position to the return altitude
+(a fixed-wing in a loiter there: ``setLoiterToAltMissionItem`` at the current
+position), flies straight to the destination at that altitude and descends there
+to ``RTL_DESCEND_ALT``. Without the cone (``RTL_CONE_ANG`` = 0) the return
+altitude is ``max(current altitude, destination altitude + RTL_RETURN_ALT)``:
+``RTL_RETURN_ALT`` (m) is "above destination (e.g. home, safe point, landing
+pattern)". The destination: ``RTL_TYPE`` 0 (multicopter default) "the closest
+rally point or home"; 1 (fixed-wing and VTOL default) "a rally point or the start
+of a mission landing pattern (whichever is closest)", home when there is neither.
+Mission-based: ``RTL_TYPE`` 2 "uses the mission path": in mission mode the mission
+is continued fast-forward to its landing (``DO_LAND_START`` ... ``NAV_LAND``),
+skipping non-position items; outside mission mode the vehicle first flies
+straight to the closest mission waypoint.
 """
 
 from __future__ import annotations
@@ -36,9 +52,9 @@ from ..items import (
     MissionItem,
     distance_m,
 )
-from .profile import VEHICLES, FirmwareProfile, Problem
+from .profile import VEHICLES, AltitudeParam, FirmwareProfile, Param, Problem, ReturnModel
 
-__all__ = ["PX4", "COMMANDS", "POSITION_FRAMES", "FW_LND_ANG", "check"]
+__all__ = ["PX4", "COMMANDS", "POSITION_FRAMES", "FW_LND_ANG", "MC_RETURN", "FW_RETURN", "check"]
 
 #: PX4 FeasibilityChecker::checkMissionItemValidity (the commands fm2uav may meet).
 COMMANDS = frozenset({
@@ -135,6 +151,36 @@ def _fw_landing(items: Sequence[MissionItem], i: int, home_alt: float | None,
     return []
 
 
+_SOURCES = (
+    "https://docs.px4.io/main/en/flight_modes/return.html",
+    "src/modules/navigator/rtl.cpp (computeReturnAltitude)",
+    "src/modules/navigator/rtl_direct.cpp (CLIMBING: loiter to altitude at the position)",
+)
+_ALT = (AltitudeParam("RTL_RETURN_ALT", 1.0, "m", "every version"),)
+_NO_CONE = Param("RTL_CONE_ANG", 0, "no cone: the checked return altitude holds from "
+                 "everywhere, also close to the destination")
+_MISSION = (Param("RTL_TYPE", 2, "mission path: in a mission the vehicle continues it "
+                  "fast-forward to its landing, which carries the planned safe return"),)
+_NOTE = ("PX4: RTL_TYPE = 2 makes Return follow the mission to its landing (in mission mode; "
+         "from another mode it first flies straight to the closest mission waypoint)")
+#: PX4's return of a multicopter (module docstring).
+MC_RETURN = ReturnModel(
+    label="PX4 multicopter", climb="vertical", above="keep", reference="destination",
+    destinations="home_rally", rally_altitude="ground", altitude=_ALT, min_m=0.0,
+    settings=(Param("RTL_TYPE", 0, "home/rally point return: straight to the closest of home "
+                    "and the rally points, as checked"), _NO_CONE),
+    mission_return=_MISSION, mission_note=_NOTE, sources=_SOURCES,
+)
+#: PX4's return of a fixed-wing or VTOL (module docstring).
+FW_RETURN = ReturnModel(
+    label="PX4 fixed-wing", climb="vertical", above="keep", reference="destination",
+    destinations="landing_rally", rally_altitude="ground", altitude=_ALT, min_m=0.0,
+    settings=(Param("RTL_TYPE", 1, "mission landing / rally point return: straight to the "
+                    "closest of the rally points and the mission landing, as checked"),
+              _NO_CONE),
+    mission_return=_MISSION, mission_note=_NOTE, sources=_SOURCES,
+)
+
 PX4 = FirmwareProfile(
     name="px4",
     mav_autopilot=12,  # MAV_AUTOPILOT_PX4
@@ -143,4 +189,5 @@ PX4 = FirmwareProfile(
     terrain_frame=False,
     landing_required=frozenset({"fixed_wing", "vtol"}),  # MIS_TKO_LAND_REQ = 2
     rules=(check,),
+    returns={"multirotor": (MC_RETURN,), "fixed_wing": (FW_RETURN,), "vtol": (FW_RETURN,)},
 )

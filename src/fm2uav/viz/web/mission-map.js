@@ -82,6 +82,25 @@
       L.geoJSON(f, { style: () => style })
         .bindTooltip(zoneText(p), { sticky: true }).addTo(group);
     }
+    // the safe returns (fm2uav.viz.mapdata.return_features): the ways back under the route
+    for (const f of feature(doc, "return")) {
+      const p = f.properties;
+      L.geoJSON(f, { renderer, style: () => ({ color: "#5b6b8c", weight: 1.5, opacity: 0.7,
+                                                 dashArray: "3 4", className: "fm2-return" }) })
+        .bindTooltip(`way back from waypoint ${p.waypoint} to ${p.to}: ` +
+                     `${fmt(p.length_m / 1000, "km", 2)}, ${fmt(p.time_s / 60, "min", 1)}` +
+                     (p.battery_share !== undefined
+                       ? ` (${(100 * p.battery_share).toFixed(0)} % of the endurance)` : ""),
+                     { sticky: true })
+        .addTo(group);
+    }
+    for (const f of feature(doc, "pnr-return")) {
+      L.geoJSON(f, { style: () => ({ color: "#8e44ad", weight: 3, dashArray: "8 5",
+                                     className: "fm2-pnr-return" }) })
+        .bindTooltip(`way back from the point of no return: ${fmt(f.properties.time_s / 60, "min", 1)}`,
+                     { sticky: true })
+        .addTo(group);
+    }
     const route = feature(doc, "route")[0];
     if (route) {
       const c = route.geometry.coordinates, agl = route.properties.agl;
@@ -111,6 +130,22 @@
         .bindTooltip(`${p.seq} ${p.command}${p.label ? " (" + p.label + ")" : ""}<br>` +
                      `alt ${fmt(p.alt, "m", 1)} (frame ${p.frame}) · ${fmt(p.alt_amsl, "m", 1)} ` +
                      `AMSL · ${fmt(p.agl, "m", 1)} above ground`)
+        .addTo(group);
+    }
+    for (const f of feature(doc, "rally")) {
+      const p = f.properties, [lon, lat] = f.geometry.coordinates;
+      L.marker([lat, lon], { icon: L.divIcon({ className: "fm2-rally", iconSize: [22, 22],
+                                               html: "<span>R</span>" }) })
+        .bindTooltip(`${p.name}${p.chosen_by ? " (chosen by the " + p.chosen_by + ")" : ""}`)
+        .addTo(group);
+    }
+    for (const f of feature(doc, "pnr")) {
+      const p = f.properties, [lon, lat] = f.geometry.coordinates;
+      L.marker([lat, lon], { icon: L.divIcon({ className: "fm2-pnr", iconSize: [26, 26],
+                                               html: "<span>PNR</span>" }) })
+        .bindTooltip(`point of no return: ${fmt(p.distance_m / 1000, "km", 2)} along the route, ` +
+                     `${fmt(p.t_mission_s / 60, "min", 1)} into the mission` +
+                     (p.passed_before_end ? " — the mission passes it before its end" : ""))
         .addTo(group);
     }
     if (opts.points !== false) {
