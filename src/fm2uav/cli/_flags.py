@@ -58,6 +58,10 @@ FLAG_KEYS = {
     "--cruise-speed": "airframe.cruise_speed", "--hover-speed": "airframe.hover_speed",
     "--min-speed": "airframe.min_speed", "--endurance": "airframe.endurance",
     "--reserve": "airframe.reserve",
+    # safe returns
+    "--rally": "rally", "--rally-file": "rally", "--return-min-agl": "returns.min_agl",
+    "--strict": "returns.strict", "--returns": "returns.enabled",
+    "--no-returns": "returns.enabled",
     # outputs
     "--out": "outputs.dir", "--frame": "outputs.frame", "--end": "outputs.end",
     "--speed-changes": "outputs.speed_changes", "--thin": "outputs.thin_tolerance",
