@@ -207,6 +207,8 @@ def _return_overlays(returns: Any) -> dict[str, Any]:
     points (crosses)."""
     if returns is None:
         return {}
+    import numpy as np
+
     out: dict[str, Any] = {}
     lines = [p for p in returns.waypoint_paths().values() if len(p) >= 2]
     if lines:
