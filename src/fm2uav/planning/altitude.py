@@ -491,12 +491,11 @@ def final_profile(world: Any, path: Any, level: FlightLevel, *, ds: float | None
     if level.max_agl is not None:  # the take-off / landing points must be legal too
         _check_ends_below_ceiling(world, p, level)
     xy, s = resample_route(p, ds)
-    mids = 0.5 * (xy[:-1] + xy[1:])
     s_at, smax, gmin = _surface_envelope(world, xy)
     # the FM² route's own height at each sample (chooses over/under a zone)
     cum = arc_length(p[:, :2])  # horizontal distance along the route
     z_route = np.interp(s, cum, p[:, 2]) if cum[-1] > 0 else np.full(len(s), p[0, 2])
-    lo_x, up_x = zone_bounds_along(world, xy, z_route, mids)
+    lo_x, up_x = zone_bounds_along(world, xy, z_route)
     top = float(world.bounds[2, 1])
     out = solve_profile(s, smax, gmin, level, z_start=float(p[0, 2]), z_goal=float(p[-1, 2]),
                         ground_start=float(s_at[0]), ground_goal=float(s_at[-1]),

@@ -274,7 +274,8 @@ def from_buildings(
     world_crs = data.crs
     org, nx, ny, ground = _horizontal_grid(terrain, polys, heights, box, world_crs, cs, shape,
                                            origin, height_cells, margin, agl, top)
-    roof, outside, off_grid = _roofs(polys, heights, ground, org, cs, all_touched)
+    roof, outside, off_grid, model = _roofs(polys, heights, ground, org, cs, all_touched,
+                                            terrain)
     _report_left_out(data, outside, off_grid)
     surface = np.maximum(roof, ground)
     nz = _vertical_nodes(terrain, shape, height_cells, org, cs, float(surface.max()), agl, top)
@@ -287,6 +288,7 @@ def from_buildings(
         occupancy=occ, spacing=tuple(float(c) for c in cs), origin=tuple(float(v) for v in org),
         terrain=ground, crs=world_crs, name=name or (terrain.name if terrain is not None else ""),
         filled=None if terrain is None else terrain.filled, georef=georef,
+        ground=None if terrain is None else terrain.ground, buildings=model,
     )
 
 
@@ -491,11 +493,21 @@ def _report_left_out(data: Any, outside: int, off_grid: int) -> None:
 
 
 def _roofs(polys: Sequence[Any], heights: Sequence[float], ground: np.ndarray, org: np.ndarray,
-           cs: np.ndarray, all_touched: bool) -> tuple[np.ndarray, int, int]:
-    """Roof altitude per column (-inf where no building), and counts outside / off-grid."""
+           cs: np.ndarray, all_touched: bool, terrain: World | None = None
+           ) -> tuple[np.ndarray, int, int, Any]:
+    """Roof altitude per column (-inf where no building), counts outside / off-grid, and the
+    :class:`~fm2uav.world.building_model.BuildingModel` of the footprints on the grid.
+
+    A footprint's roof is the highest ground under it plus its height: the highest
+    node it covers, and on a DEM world also the source DEM at its vertices.
+    """
+    from .building_model import BuildingModel
+
     nx, ny = ground.shape
     roof = np.full((nx, ny), -np.inf)
     outside = off_grid = 0
+    kept, tops = [], []
+    dem = None if terrain is None else getattr(terrain, "ground", None)
     for g, h in zip(polys, heights):
         minx, miny, maxx, maxy = g.bounds
         i0 = max(int(np.floor((minx - org[0]) / cs[0])) - 1, 0)
@@ -521,6 +533,14 @@ def _roofs(polys: Sequence[Any], heights: Sequence[float], ground: np.ndarray, o
             off_grid += 1
             continue
         win = (slice(i0, i1 + 1), slice(j0, j1 + 1))
-        top = float(ground[win][inside].max()) + float(h)
+        base = float(ground[win][inside].max())
+        if dem is not None:  # the DEM itself at the footprint's corners
+            xy = shapely.get_coordinates(g)
+            base = max(base, float(np.max(dem.height(xy[:, 0], xy[:, 1]))))
+        top = base + float(h)
         roof[win] = np.where(inside, np.maximum(roof[win], top), roof[win])
-    return roof, outside, off_grid
+        kept.append(g)
+        tops.append(top)
+    model = BuildingModel(tuple(kept), np.asarray(tops, dtype=float),
+                          description=f"{len(kept)} building footprints with their roofs")
+    return roof, outside, off_grid, model
