@@ -247,13 +247,18 @@ def export_formation(
     t0 = float(climb_s.max())
     missions: dict[str, MissionExport] = {}
     files: dict[str, ExportFile] = {}
+    tracks = tuple(getattr(result, "tracks", ()) or ())
     for i, name in enumerate(result.names):
-        path = np.asarray(result.positions[:, i], dtype=float)
+        # the UAV's track: its final heights with times (one truth for all its files)
+        tr = tracks[i] if i < len(tracks) else None
+        path = np.asarray(result.positions[:, i] if tr is None else tr.path, dtype=float)
+        times = result.times if tr is None else tr.times
         track = SimpleNamespace(path=path, world=world, w=None, level=None, params={},
-                                length=path_length(path))
+                                length=path_length(path),
+                                profile=None if tr is None else tr.profile)
         agl = result.agl[i] if i < len(result.agl) else None
         m, f = export_mission(track, formats, replace(opt, name=f"{opt.name} — {name}"),
-                              agl=agl, times=result.times, start_hold=t0 - float(climb_s[i]),
+                              agl=agl, times=times, start_hold=t0 - float(climb_s[i]),
                               prefix=file_prefix(name), fences=fences)
         missions[name] = m
         files.update(f)

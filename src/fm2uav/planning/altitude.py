@@ -424,7 +424,8 @@ def _check_ends_below_ceiling(world: Any, p: np.ndarray, level: FlightLevel) -> 
 def _surface_envelope(world: Any, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Surface at the route samples ``xy`` [m]; its upper and the ground's lower envelope.
 
-    The chord between two samples is flown straight: it is read at 1/4, 1/2, 3/4.
+    The chord between two samples is flown straight: it is read at 1/4, 1/2, 3/4, and
+    the roof of every building footprint it meets counts (``World.buildings``).
     Returns the surface height at the samples, the highest surface and the lowest
     ground over each sample's two chords [m].
     """
@@ -450,6 +451,10 @@ def _surface_envelope(world: Any, xy: np.ndarray) -> tuple[np.ndarray, np.ndarra
     else:
         bump = dip = np.zeros(0)
     smax = s_at + _window(np.zeros(len(xy)), bump, np.maximum)
+    model = getattr(world, "buildings", None)
+    if model is not None and n_ch:  # a roof a chord meets between its read points
+        smax = np.maximum(smax, _window(np.full(len(xy), -np.inf),
+                                        model.roof_along(xy[:-1], xy[1:]), np.maximum))
     gmin = g_at - _window(np.zeros(len(xy)), dip, np.maximum)
     return s_at, smax, gmin
 
