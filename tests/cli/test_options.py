@@ -12,7 +12,8 @@ from fm2uav.cli import app
 from fm2uav.cli.options import WorldFlags, option_group, world_options
 
 WORLD = ["--dem", "--buildings", "--bbox", "--sea-level", "--cell-size", "--dz", "--ceiling",
-         "--nodata", "--nodata-value", "--crs", "--default-height", "--allow-filled"]
+         "--nodata", "--nodata-value", "--crs", "--default-height", "--allow-filled",
+         "--ground-elevation", "--margin"]
 
 
 def _flags(*path: str) -> list[str]:

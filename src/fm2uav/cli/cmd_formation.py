@@ -259,6 +259,7 @@ def _safety_rows(safety: dict[str, Any]) -> dict[str, str]:
         bad = [k for k, c in s.get("checks", {}).items() if not c.get("ok", True)]
         if bad:
             parts.append("limits NOT met: " + ", ".join(bad))
+        parts += [f"warning: {w}" for w in s.get("warnings", ())]
         if parts:
             rows[f"safety {name}"] = "; ".join(parts)
     return rows

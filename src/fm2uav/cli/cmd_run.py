@@ -102,6 +102,8 @@ def safety_rows(safety: dict[str, Any]) -> dict[str, str]:
     bad = [k for k, c in safety.get("checks", {}).items() if not c.get("ok", True)]
     if bad:
         rows["limits NOT met"] = ", ".join(bad)
+    for k, w in enumerate(safety.get("warnings", ())):
+        rows[f"safety warning {k + 1}"] = w
     return rows
 
 

@@ -8,7 +8,8 @@ mission file's ``world:`` section becomes), :func:`build_world` and
 
 * ``--dem FILE`` (repeatable: tiles), ``--buildings FILE``, ``--bbox W,S,E,N``,
   ``--sea-level M``, ``--cell-size``, ``--dz``, ``--ceiling``, ``--nodata``,
-  ``--nodata-value``, ``--crs``, ``--default-height``, ``--allow-filled``;
+  ``--nodata-value``, ``--crs``, ``--default-height``, ``--allow-filled``,
+  ``--ground-elevation``, ``--margin``;
 * ``--lonlat``: read ``--start``/``--goal`` as ``LON,LAT[,AGL]`` (degrees,
   degrees, metres above the ground; without AGL the command's ``--agl``).
 """
@@ -30,6 +31,7 @@ from ..errors import InputError
 __all__ = [
     "DemOpt", "BuildingsOpt", "BboxOpt", "SeaLevelOpt", "CellSizeOpt", "DzOpt", "CeilingOpt",
     "NodataOpt", "NodataValueOpt", "CrsOpt", "DefaultHeightOpt", "AllowFilledOpt", "LonLatOpt",
+    "GroundElevationOpt", "MarginOpt",
     "ScenarioOpt", "WORLD_FLAGS", "world_spec", "build_world", "cli_point", "world_rows",
     "requested_heights", "world_overrides", "point_overrides", "option_group", "WorldFlags",
     "world_options", "MissionFlags", "mission_options", "output_options", "NoFlyOpt",
@@ -85,6 +87,15 @@ DefaultHeightOpt = _option(float | None, "--default-height",
                            panel=_P)
 AllowFilledOpt = _option(bool, "--allow-filled", panel=_P, show_default=True,
                          help="Only warn when the start/goal lies over filled DEM nodata.")
+GroundElevationOpt = _option(
+    float | None, "--ground-elevation", panel=_P,
+    help="Altitude (m above sea level) of the flat ground of --buildings without --dem. "
+         "Without it the mission is written relative to home (the ground's altitude is "
+         "unknown).")
+MarginOpt = _option(
+    float | None, "--margin", panel=_P,
+    help="Free border (m) around the footprints of --buildings without --dem. Default: "
+         "50 m, at least 10 cells.")
 LonLatOpt = Annotated[bool, typer.Option(
     "--lonlat", help="Read --start/--goal as LON,LAT[,AGL] (degrees, degrees, metres above "
                      "the ground; default AGL: --agl).")]
@@ -97,7 +108,8 @@ WORLD_FLAGS = {
     "dem": "--dem", "buildings": "--buildings", "bbox": "--bbox", "sea_level": "--sea-level",
     "cell_size": "--cell-size", "dz": "--dz", "ceiling": "--ceiling", "nodata": "--nodata",
     "nodata_value": "--nodata-value", "crs": "--crs", "default_height": "--default-height",
-    "allow_filled": "--allow-filled",
+    "allow_filled": "--allow-filled", "ground_elevation": "--ground-elevation",
+    "margin": "--margin",
 }
 
 
@@ -127,6 +139,8 @@ def world_spec(
     crs: str | None = None,
     default_height: float | None = None,
     allow_filled: bool = False,
+    ground_elevation: float | None = None,
+    margin: float | None = None,
 ) -> Any:
     """The :class:`~fm2uav.world.load.WorldSpec` of the world options, or None without data.
 
@@ -145,7 +159,8 @@ def world_spec(
               "bbox": None if bbox is None else _bbox(bbox), "sea_level": sea_level,
               "cell_size": cell_size, "dz": dz, "ceiling": ceiling, "nodata": nodata,
               "nodata_value": nodata_value, "crs": crs, "default_height": default_height,
-              "allow_filled": allow_filled}
+              "allow_filled": allow_filled, "ground_elevation": ground_elevation,
+              "margin": margin}
     if values["dem"] is not None and len(values["dem"]) == 1:
         values["dem"] = values["dem"][0]
     if values["dem"] is None and values["buildings"] is None:
@@ -184,7 +199,7 @@ def world_overrides(**options: Any) -> dict[str, Any] | None:
     if values.get("bbox") is not None:
         out["bbox"] = _bbox(values["bbox"])
     for k in ("sea_level", "cell_size", "dz", "ceiling", "nodata_value", "crs",
-              "default_height"):
+              "default_height", "ground_elevation", "margin"):
         if values.get(k) is not None:
             out[k] = values[k]
     if values.get("nodata", "error") != "error":
@@ -403,6 +418,8 @@ class WorldFlags:
     crs: str | None = None
     default_height: float | None = None
     allow_filled: bool = False
+    ground_elevation: float | None = None
+    margin: float | None = None
 
     def values(self) -> dict[str, Any]:
         """The flags as keywords of :func:`world_spec` / :func:`world_overrides`."""
@@ -425,13 +442,14 @@ class WorldFlags:
                            top=need_top, default=default)
 
 
-#: ``@world_options``: the 12 world flags in place of the command's ``world`` parameter.
+#: ``@world_options``: the 14 world flags in place of the command's ``world`` parameter.
 world_options = option_group("world", [
     ("dem", DemOpt, None), ("buildings", BuildingsOpt, None), ("bbox", BboxOpt, None),
     ("sea_level", SeaLevelOpt, None), ("cell_size", CellSizeOpt, None), ("dz", DzOpt, None),
     ("ceiling", CeilingOpt, None), ("nodata", NodataOpt, "error"),
     ("nodata_value", NodataValueOpt, None), ("crs", CrsOpt, None),
     ("default_height", DefaultHeightOpt, None), ("allow_filled", AllowFilledOpt, False),
+    ("ground_elevation", GroundElevationOpt, None), ("margin", MarginOpt, None),
 ], WorldFlags)
 
 
