@@ -259,7 +259,7 @@ def cover_cmd(
     with output.progress() as step:
         step("building the map")
         w, _, scenario = build_world(world.spec(), scenario=scenario, seed=seed, agl=agl,
-                                     default="coverage")
+                                     default="coverage", max_cell=_band_cell(d, safety))
         poly, area_source = _load_area(area, w, world.crs)
         w = safety.apply(w, crs=world.crs)  # --no-fly zones become obstacles
         step("searching the steering angle and planning FM² along the bands")
@@ -281,6 +281,18 @@ def cover_cmd(
     write_json(outdir, "summary.json", summary)
     output.summary("coverage plan", {**_cover_rows(area, d, cp, built, w),
                                      **_safety_rows(safety_figures)}, summary)
+
+
+def _band_cell(d: float, safety: SafetyFlags) -> tuple[float, str] | None:
+    """The largest automatic cell [m] (and why) of a survey around --no-fly zones: the route
+    around them resolves bands only :data:`~fm2uav.missions.coverage.zones.ROUTE_BAND_CELLS`
+    cells apart (the corridor grid of a survey without zones resolves any spacing)."""
+    from ..missions.coverage.zones import ROUTE_BAND_CELLS, route_cell
+
+    if not safety.no_fly:
+        return None
+    return route_cell(d), (f"at most D / {ROUTE_BAND_CELLS:g} = {route_cell(d):.3g} m so that "
+                           "the route around the no-fly zones resolves the bands")
 
 
 def _cover_rows(area: str, d: float, cp, mission, world) -> dict:

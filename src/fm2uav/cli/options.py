@@ -237,10 +237,12 @@ def point_overrides(*, start: str | None, goal: str | None, lonlat: bool
 
 
 def build_world(spec: Any, *, scenario: str | None, seed: int = 0, agl: float | None = None,
-                top: float | None = None, default: str = "open-field") -> tuple[Any, Any, str]:
+                top: float | None = None, default: str = "open-field",
+                max_cell: tuple[float, str] | None = None) -> tuple[Any, Any, str]:
     """``(world, scenario or None, description)`` from a spec, else a built-in scenario.
 
-    ``agl`` / ``top`` size a data world (see :func:`fm2uav.world.load.load_world`).
+    ``agl`` / ``top`` / ``max_cell`` size a data world (see
+    :func:`fm2uav.world.load.load_world`).
     Warnings of the data (below sea level, distortion) are shown by
     :func:`~fm2uav.cli._common.handle_errors` as one-line ``warning:`` lines.
 
@@ -258,7 +260,7 @@ def build_world(spec: Any, *, scenario: str | None, seed: int = 0, agl: float | 
         return sc.world, sc, scenario or default
     if scenario is not None:
         raise InputError("give either --scenario or --dem/--buildings, not both")
-    world = load_world(spec, agl=agl, top=top)
+    world = load_world(spec, agl=agl, top=top, max_cell=max_cell)
     return world, None, spec.describe()
 
 

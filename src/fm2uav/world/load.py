@@ -392,7 +392,7 @@ def _requested(v: float | None, what: str) -> float | None:
 
 
 def load_world(spec: WorldSpec, *, agl: float | None = None, top: float | None = None,
-               name: str = "") -> World:
+               name: str = "", max_cell: tuple[float, str] | None = None) -> World:
     """Build the world a :class:`WorldSpec` describes, sized for the request.
 
     Parameters
@@ -406,6 +406,10 @@ def load_world(spec: WorldSpec, *, agl: float | None = None, top: float | None =
         Highest requested altitude [m] (points given with ``alt`` / ``z``).
     name : str
         World name (default: the source file's stem).
+    max_cell : (float, str), optional
+        Largest automatic cell size [m] and why (e.g. a survey whose bands must be
+        resolved): the default ``cell_size`` is rounded down to it. Ignored when
+        ``spec.cell_size`` is given.
 
     Returns
     -------
@@ -432,6 +436,8 @@ def load_world(spec: WorldSpec, *, agl: float | None = None, top: float | None =
         dx, why_dx = float(spec.cell_size), "given (world.cell_size)"
     else:
         dx, why_dx = _auto_cell(spec, agl)
+        if max_cell is not None and float(max_cell[0]) < dx:
+            dx, why_dx = round_down(float(max_cell[0])), f"auto: {max_cell[1]}"
     if spec.dz is not None:
         dz, why_dz = float(spec.dz), "given (world.dz)"
     elif spec.height_cells is not None:

@@ -33,10 +33,22 @@ import numpy as np
 import shapely
 from shapely.geometry import LineString, box
 
-from ...errors import PlanningError
+from ...errors import InputError, PlanningError
 from ...planning import FlightLevel, PlanOptions, Shaping
 
-__all__ = ["allowed_region", "meets_zones", "zone_route_points", "plan_zone_route"]
+__all__ = ["allowed_region", "meets_zones", "zone_route_points", "plan_zone_route",
+           "ROUTE_BAND_CELLS", "route_cell"]
+
+#: Fewest map cells between two bands the route around zones resolves: its points are kept
+#: more than two cells apart (so that consecutive FM² legs are not shorter than the grid),
+#: so band ends closer than that merge and the bands are not flown.
+ROUTE_BAND_CELLS = 2.5
+
+
+def route_cell(spacing: float) -> float:
+    """Largest horizontal cell [m] on which the route around zones flies bands ``spacing``
+    [m] apart (:data:`ROUTE_BAND_CELLS` cells between two bands)."""
+    return float(spacing) / ROUTE_BAND_CELLS
 
 
 def _margin(world: Any) -> float:
@@ -72,6 +84,13 @@ def meets_zones(world: Any, track: np.ndarray, half_width: float,
     return not allowed_region(world, margin).contains(grown)
 
 
+def _round_cell(v: float) -> str:
+    """A cell size [m] no larger than ``v``, as a short number for a message."""
+    from ...world.load import round_down
+
+    return f"{round_down(v):g}"
+
+
 def zone_route_points(world: Any, track: np.ndarray, spacing: float, agl: float,
                       margin: float | None = None) -> np.ndarray:
     """Points (k, 3) [m] of the zigzag ``track`` outside the zones, in order, at ``agl``
@@ -79,9 +98,18 @@ def zone_route_points(world: Any, track: np.ndarray, spacing: float, agl: float,
 
     Raises
     ------
+    InputError
+        The bands are closer than :data:`ROUTE_BAND_CELLS` cells (names the flags).
     PlanningError
         Nothing of the zigzag lies outside the zones.
     """
+    cell = float(min(world.spacing[0], world.spacing[1]))
+    if float(spacing) < ROUTE_BAND_CELLS * cell * (1 - 1e-9):
+        raise InputError(
+            f"the bands are {float(spacing):g} m apart (--spacing D), less than "
+            f"{ROUTE_BAND_CELLS:g} cells of the map ({cell:g} m): the route around the no-fly "
+            f"zones cannot fly them apart; use --cell-size {_round_cell(route_cell(spacing))} "
+            f"(world.cell_size) or --spacing >= {ROUTE_BAND_CELLS * cell:g}")
     line = LineString(np.asarray(track, dtype=float)[:, :2])
     inside = line.intersection(allowed_region(world, margin))
     pieces = [g for g in getattr(inside, "geoms", [inside])
@@ -90,7 +118,6 @@ def zone_route_points(world: Any, track: np.ndarray, spacing: float, agl: float,
         raise PlanningError("the whole zigzag lies in no-fly zones (or outside the operating "
                             "area); check --no-fly / no_fly_zones against --area")
     pieces.sort(key=lambda g: line.project(shapely.Point(g.coords[0])))
-    cell = float(min(world.spacing[0], world.spacing[1]))
     pts: list[np.ndarray] = []
     for g in pieces:
         for p in np.asarray(g.simplify(0.25 * float(spacing)).coords)[:, :2]:
