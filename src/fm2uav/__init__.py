@@ -8,7 +8,7 @@ unreached arrival time = ``inf``.
 Layers, bottom to top (each imports only from those below; see
 docs/architecture.md): ``errors``, ``geometry`` → ``eikonal`` → ``world`` →
 ``planning`` → ``missions`` → ``vehicles`` → ``analysis`` → ``baselines`` →
-``scenarios`` → ``experiments`` → ``io`` → ``viz`` → ``cli``.
+``scenarios`` → ``experiments`` → ``autopilot`` → ``io`` → ``viz`` → ``cli``.
 """
 
 import importlib
@@ -18,7 +18,7 @@ from . import errors
 from .errors import *  # noqa: F403 -- the error hierarchy (pure Python), listed once in errors.__all__
 
 if TYPE_CHECKING:  # loaded on first attribute access (PEP 562), see __getattr__
-    from . import baselines, experiments, io, viz
+    from . import autopilot, baselines, experiments, io, viz
     from .analysis import flight_level_deviation, path_profiles
     from .analysis.tune import tune
     from .eikonal import distance_map, fast_marching, velocity_map
@@ -74,7 +74,7 @@ _LAZY_NAMES = {
 #: Subpackages, also imported on first use (``fm2uav.scenarios.open_field()``
 #: works after a bare ``import fm2uav``).
 _LAZY_SUBMODULES = (
-    "analysis", "baselines", "eikonal", "errors", "experiments", "geometry", "io",
+    "analysis", "autopilot", "baselines", "eikonal", "errors", "experiments", "geometry", "io",
     "missions", "planning", "scenarios", "vehicles", "viz", "world",
 )
 
@@ -128,6 +128,7 @@ __all__ = [
     "path_profiles",
     # subpackages
     "analysis",
+    "autopilot",
     "baselines",
     "experiments",
     "geometry",

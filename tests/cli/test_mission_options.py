@@ -11,7 +11,8 @@ from pymavlink import mavwp
 from typer.testing import CliRunner
 
 from fm2uav.cli import app
-from fm2uav.io import read_plan, read_wpl, validate_mission
+from fm2uav.autopilot import validate_mission
+from fm2uav.io import read_plan, read_wpl
 
 runner = CliRunner()
 MISSION_FILES = ("mission.plan", "mission.waypoints", "path.kml", "path.kmz", "path.geojson",

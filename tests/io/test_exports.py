@@ -1,5 +1,6 @@
-"""Mission exports: waypoint thinning, QGC .plan structure and checker, WPL 110 (loaded by
-pymavlink), GeoJSON/KML round trips (the mission content itself: test_build.py)."""
+"""Mission exports: the files of a built mission, QGC .plan structure and checker, WPL 110
+(loaded by pymavlink), GeoJSON/KML round trips (the mission content itself:
+tests/autopilot/test_build.py; its waypoints: tests/autopilot/test_waypoints.py)."""
 
 import io
 import json
@@ -8,13 +9,12 @@ import numpy as np
 import pytest
 from pymavlink import mavwp
 
+from fm2uav.autopilot import ExportOptions
 from fm2uav.io import (
     EXPORT_FILES,
-    ExportOptions,
     export_mission,
     export_writers,
     from_lonlat,
-    mission_waypoints,
     read_geojson_path,
     read_kml_path,
     read_plan,
@@ -22,10 +22,8 @@ from fm2uav.io import (
     to_lonlat,
     validate_plan,
 )
-from fm2uav.io.thin import segment_distances
-from fm2uav.io.waypoints import thin_with_keep
 
-from .mission_cases import ANCHOR, hill_free, hill_tff
+from ..autopilot.mission_cases import ANCHOR, hill_free, hill_tff
 
 
 def _write_all(plan, tmp_path, **opts):
@@ -34,50 +32,6 @@ def _write_all(plan, tmp_path, **opts):
         with open(tmp_path / name, "wb" if f.binary else "w") as fh:
             f.write(fh)
     return mission
-
-
-def test_waypoints_are_few_and_within_tolerance():
-    p = hill_tff()
-    wps = mission_waypoints(p.path, p.world, tolerance=2.0, anchor=ANCHOR, frame="amsl", agl=60)
-    assert 3 <= len(wps) <= 40 < len(p.path)
-    flown, k = wps.points_m, wps.indices
-    # the thinned legs stay within the tolerance of the flown (ground + AGL) profile
-    from fm2uav.io.waypoints import altitude_profile
-
-    dense = altitude_profile(p.path, p.world, agl=60.0)[0]
-    for a, b in zip(k[:-1], k[1:]):
-        if b - a > 1:
-            assert segment_distances(dense[a + 1:b], dense[a], dense[b]).max() <= 2.0 + 1e-9
-    np.testing.assert_array_equal(flown, dense[k])
-
-
-def test_forced_points_are_kept_and_pieces_thinned_alone():
-    line = np.column_stack([np.linspace(0, 100, 101), np.zeros(101), np.zeros(101)])
-    assert thin_with_keep(line, 0.5).tolist() == [0, 100]
-    assert thin_with_keep(line, 0.5, keep=[37, 80]).tolist() == [0, 37, 80, 100]
-    with pytest.raises(ValueError, match="keep indices"):
-        thin_with_keep(line, 0.5, keep=[101])
-
-
-def test_frames_write_the_same_flown_altitude():
-    p = hill_tff()
-    got = {f: mission_waypoints(p.path, p.world, anchor=ANCHOR, frame=f, agl=60.0)
-           for f in ("terrain", "amsl", "relative")}
-    assert {f: w.frame for f, w in got.items()} == {"terrain": 10, "amsl": 0, "relative": 3}
-    np.testing.assert_allclose(got["terrain"].alt, got["terrain"].agl)
-    np.testing.assert_allclose(got["amsl"].alt, got["amsl"].alt_amsl)
-    np.testing.assert_allclose(got["relative"].alt, got["relative"].alt_amsl - got["relative"].home[2])
-    for f in ("amsl", "relative"):
-        np.testing.assert_allclose(got[f].alt_amsl, got[f].ground_amsl + got[f].agl, atol=1e-9)
-
-
-def test_relative_frame_altitudes_are_above_home():
-    p = hill_free()
-    wps = mission_waypoints(p.path, p.world, anchor=ANCHOR)
-    assert wps.frame == 3
-    home_ground = p.world.ground_height(*p.path[0, :2])
-    np.testing.assert_allclose(wps.alt, wps.points_m[:, 2] - home_ground, atol=1e-9)
-    np.testing.assert_allclose(wps.points_m[:, 2], p.path[wps.indices, 2])  # no level: own z
 
 
 def test_export_writers_pick_the_frame_from_the_plan_and_firmware():

@@ -13,7 +13,8 @@ from typer.testing import CliRunner
 
 from fm2uav.cli import app
 from fm2uav.errors import InputError
-from fm2uav.io import read_plan, read_wpl, to_lonlat, validate_mission, validate_plan
+from fm2uav.autopilot import validate_mission
+from fm2uav.io import read_plan, read_wpl, to_lonlat, validate_plan
 from fm2uav.io.mission import load_mission, parse_mission
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"

@@ -2,10 +2,10 @@
 
 from pathlib import Path
 
-from fm2uav.io import ExportOptions
-from fm2uav.io.build import DEFAULT_CLIMB, DEFAULT_DESCENT, DEFAULT_MIN_SPEED
+from fm2uav.autopilot import ExportOptions
+from fm2uav.autopilot.build import DEFAULT_CLIMB, DEFAULT_DESCENT, DEFAULT_MIN_SPEED
 from fm2uav.io.mission import AirframeSpec, OutputSpec
-from fm2uav.io.validate import PX4_FW_LND_ANG
+from fm2uav.autopilot.validate import PX4_FW_LND_ANG
 
 DOC = (Path(__file__).resolve().parents[2] / "docs" / "operator.md").read_text()
 

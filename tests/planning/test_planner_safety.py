@@ -18,7 +18,8 @@ from pyproj import Transformer
 from scipy import ndimage
 
 from fm2uav.errors import InputError
-from fm2uav.io.thin import refine_legs, thin_indices
+from fm2uav.autopilot.legs import refine_legs
+from fm2uav.autopilot.thin import thin_indices
 from fm2uav.planning import FlightLevel, plan
 from fm2uav.scenarios import get_scenario
 from fm2uav.world import World

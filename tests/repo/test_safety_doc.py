@@ -43,7 +43,8 @@ def _ground(name, world):
 
 
 def table_rows():
-    from fm2uav.io.thin import refine_legs, thin_indices
+    from fm2uav.autopilot.legs import refine_legs
+    from fm2uav.autopilot.thin import thin_indices
     from fm2uav.planning import FlightLevel, plan
     from fm2uav.scenarios import get_scenario
 

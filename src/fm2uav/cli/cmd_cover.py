@@ -107,7 +107,7 @@ def _write_cover_outputs(outdir: OutputDir, cp, area: str, *, report: bool, titl
     comment = georef.comment() if georef is not None else None
     from ..analysis.safety import safety_summary
     from ..io import export_mission
-    from ..io.fence import zone_fences
+    from ..autopilot.geofence import zone_fences
 
     zones = tuple(getattr(world, "zones", ()))
     fences, fence_warnings = (zone_fences(zones, world, getattr(options, "anchor", None))

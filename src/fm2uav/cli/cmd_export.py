@@ -87,7 +87,7 @@ def export_cmd(
     level = (FlightLevel(agl=agl) if agl is not None and mission_level is None else
              mission_level if agl is None else replace(mission_level, agl=agl))
     # a path with a final altitude profile (its floor column): heights as they are, legs
-    # checked against the floor (see fm2uav.io.build_mission)
+    # checked against the floor (see fm2uav.autopilot.build_mission)
     profile = None if floor is None else SimpleNamespace(
         required=floor, level=level if level is not None else FlightLevel(agl=1.0))
     track = SimpleNamespace(

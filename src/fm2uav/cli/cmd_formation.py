@@ -168,7 +168,7 @@ def formation_cmd(
     from ..experiments.formation import fly_and_summarise, summary_rows
     from ..io.exports import EXPORT_FILES, export_formation, file_prefix
     from ..missions.formation import FormationConfig
-    from ..io.fence import zone_fences
+    from ..autopilot.geofence import zone_fences
     from ..scenarios.scenario import Scenario
     from ..world.load import check_points, world_summary
     from .cmd_run import write_exports

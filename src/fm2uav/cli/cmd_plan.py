@@ -239,7 +239,7 @@ def _extra_formats(export: str, report: bool) -> list[str]:
 
 
 def _export_options(anchor: str | None, thin: float):
-    from ..io import ExportOptions
+    from ..autopilot import ExportOptions
 
     if not np.isfinite(thin) or thin < 0:
         raise InputError(f"--thin must be a tolerance >= 0 m, got {thin}")

@@ -163,7 +163,7 @@ def plan_outputs(
     """
     from ..analysis.safety import safety_summary
     from ..io import export_mission
-    from ..io.fence import zone_fences
+    from ..autopilot.geofence import zone_fences
 
     exports = [f for f in formats if f in EXPORT_FILES]
     zones = tuple(getattr(plan.world, "zones", ()))

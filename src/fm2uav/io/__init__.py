@@ -1,15 +1,17 @@
-"""Reading and writing: path files, geo-referencing, mission exports, mission files.
+"""File formats: path files, geo-referencing, mission exports, mission files.
 
 Exports (all in WGS84 lon/lat; see :func:`fm2uav.world.geo.to_lonlat` for how worlds
 without a CRS are placed on the Earth): CSV, GeoJSON, KML/KMZ, QGroundControl
 ``.plan`` and MAVLink ``QGC WPL 110``, all written by :func:`export_mission`
-from one list of MAVLink items (:mod:`fm2uav.io.build`: takeoff, waypoints
-thinned with 3D Douglas–Peucker, speeds, camera triggers, RTL/land/loiter),
-checked per firmware (:mod:`fm2uav.io.validate`). Mission files:
-:mod:`fm2uav.io.mission`.
+from one mission built by :mod:`fm2uav.autopilot` (MAVLink items, firmware
+checks, leg checks, geofences). Mission files: :mod:`fm2uav.io.mission`.
+Readers and writers only: they take items and points and compute nothing.
+
+The mission names of :mod:`fm2uav.autopilot` (``build_mission``,
+``ExportOptions``, ``MissionItem``, ``validate_mission``, ...) live there; they
+are re-exported here so that code written before the autopilot layer keeps working.
 """
 
-from .build import CameraPlan, MissionExport, build_mission, speed_commands
 from .exports import (
     EXPORT_FILES,
     ExportFile,
@@ -20,22 +22,37 @@ from .exports import (
     parse_formats,
 )
 from ..world.geo import DEFAULT_ANCHOR, Anchor, from_lonlat, to_lonlat  # the one conversion
-from .geofence import FenceCircle, FencePolygon, fences_from_world, geofence_document
-from .items import MissionItem
-from .validate import Problem, check_mission, validate_mission
 from .geojson import geojson_document, read_geojson_path, write_geojson
 from .kml import kml_document, read_kml_path, write_kml, write_kmz
 from .paths import read_path_csv, write_path_csv
-from .qgc import plan_document, read_plan, validate_plan, write_plan
-from .thin import thin_indices, thin_path
+from .qgc import geofence_document, plan_document, read_plan, validate_plan, write_plan
 from .trajectories import (
     read_trajectories_csv,
     write_cycles_csv,
     write_formation_metrics_csv,
     write_trajectories_csv,
 )
-from .waypoints import Waypoints, mission_waypoints, resolve_frame
 from .wpl import read_wpl, write_wpl
+
+# the mission itself lives in fm2uav.autopilot (re-exported for existing code)
+from ..autopilot import (
+    CameraPlan,
+    FenceCircle,
+    FencePolygon,
+    MissionExport,
+    MissionItem,
+    Problem,
+    Waypoints,
+    build_mission,
+    check_mission,
+    fences_from_world,
+    mission_waypoints,
+    resolve_frame,
+    speed_commands,
+    thin_indices,
+    thin_path,
+    validate_mission,
+)
 
 __all__ = [
     "read_path_csv",

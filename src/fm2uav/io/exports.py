@@ -1,6 +1,6 @@
 """Every mission file of a plan, from one function.
 
-:func:`export_mission` builds the mission once (:func:`fm2uav.io.build_mission`:
+:func:`export_mission` builds the mission once (:func:`fm2uav.autopilot.build_mission`:
 altitudes, takeoff, speeds, camera, end, firmware check) and returns a writer per
 requested format, so that the CLI decides where and how files are written
 (atomically, without overwriting) and all formats describe the same mission:
@@ -30,7 +30,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..geometry import path_length
-from .build import CameraPlan, ExportOptions, MissionExport, build_mission
+from ..autopilot.build import CameraPlan, ExportOptions, MissionExport, build_mission, start_holds
 from .geojson import write_geojson
 from .kml import write_kml, write_kmz
 from .paths import write_path_csv
@@ -132,7 +132,7 @@ def export_mission(
     agl : float, optional
         Requested height above ground (default ``plan.params.get("agl")``).
     via, camera, fences, times, start_hold
-        See :func:`fm2uav.io.build_mission`.
+        See :func:`fm2uav.autopilot.build_mission`.
     prefix : str, optional
         Put before every file name (e.g. ``"leader_"``).
 
@@ -233,18 +233,12 @@ def export_formation(
     fences : optional
         Geofences written into every vehicle's ``.plan`` and checked against its
         waypoints (as :func:`export_mission` ``fences``), e.g. the no-fly zones of
-        :func:`fm2uav.io.fence.zone_fences`.
+        :func:`fm2uav.autopilot.geofence.zone_fences`.
     """
     opt = options or ExportOptions()
     opt = replace(opt, speed_step=min(opt.speed_step, 0.1))
-    from .build import DEFAULT_CLIMB
-
-    climb = opt.climb_rate or DEFAULT_CLIMB[opt.vehicle]
     world = result.world
-    starts = np.asarray(result.positions[0], dtype=float)
-    ground = np.asarray([world.ground_height(x, y) for x, y in starts[:, :2]], dtype=float)
-    climb_s = (starts[:, 2] - ground) / climb
-    t0 = float(climb_s.max())
+    holds = start_holds(result.positions[0], world, opt)
     missions: dict[str, MissionExport] = {}
     files: dict[str, ExportFile] = {}
     tracks = tuple(getattr(result, "tracks", ()) or ())
@@ -258,7 +252,7 @@ def export_formation(
                                 profile=None if tr is None else tr.profile)
         agl = result.agl[i] if i < len(result.agl) else None
         m, f = export_mission(track, formats, replace(opt, name=f"{opt.name} — {name}"),
-                              agl=agl, times=times, start_hold=t0 - float(climb_s[i]),
+                              agl=agl, times=times, start_hold=float(holds[i]),
                               prefix=file_prefix(name), fences=fences)
         missions[name] = m
         files.update(f)

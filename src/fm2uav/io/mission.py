@@ -58,7 +58,9 @@ from pydantic import field_validator, model_validator
 from ..errors import InputError
 from ..world.load import WorldSpec as DataWorldSpec
 from ..world.load import check_points, load_world
-from .exports import EXPORT_FILES, ExportOptions
+from ..autopilot.build import ExportOptions
+from ..autopilot.firmware import FIRMWARES, VEHICLES
+from .exports import EXPORT_FILES
 from ..world.geo import DEFAULT_ANCHOR, Anchor, from_lonlat, to_lonlat
 from .zone_spec import ZoneSpec, resolve_zones
 
@@ -281,8 +283,8 @@ class AirframeSpec(BaseModel):
     """The aircraft, as far as the exports need it."""
 
     model_config = _STRICT
-    type: Literal["multirotor", "fixed_wing", "vtol"] = Field("multirotor")
-    firmware: Literal["px4", "ardupilot", "generic"] = Field("px4")
+    type: Literal[VEHICLES] = Field("multirotor")  # type: ignore[valid-type]
+    firmware: Literal[FIRMWARES] = Field("px4")  # type: ignore[valid-type]
     cruise_speed: float = _num(15.0, unit="m/s", gt=0, le=100, desc="cruise speed")
     hover_speed: float = _num(5.0, unit="m/s", gt=0, le=50, desc="multirotor speed")
     min_speed: float | None = _num(None, unit="m/s", gt=0, le=100,

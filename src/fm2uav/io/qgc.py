@@ -30,6 +30,12 @@ fm2uav computed (DEM ground + AGL).
 
 :func:`validate_plan` checks a document against these rules (used on every
 file written); :func:`read_plan` reads any plan QGC writes.
+
+The ``geoFence`` object (:func:`geofence_document`, :func:`read_geofence`) holds
+``polygons`` (``{"inclusion": bool, "polygon": [[lat, lon], ...], "version": 1}``,
+clockwise) and ``circles`` (``{"circle": {"center": [lat, lon], "radius": m},
+"inclusion": bool, "version": 1}``), written from the fences of
+:mod:`fm2uav.autopilot.geofence`.
 """
 
 from __future__ import annotations
@@ -42,8 +48,9 @@ from typing import IO, Any
 import numpy as np
 
 from ..errors import InputError
-from .geofence import geofence_document, read_geofence
-from .items import FRAME_GLOBAL, FRAME_RELATIVE, FRAME_TERRAIN, MissionItem
+from ..autopilot.firmware import FIRMWARE_TYPES, VEHICLE_TYPES  # MAV_AUTOPILOT, MAV_TYPE
+from ..autopilot.geofence import Fence, FenceCircle, FencePolygon, as_fences
+from ..autopilot.items import FRAME_GLOBAL, FRAME_RELATIVE, FRAME_TERRAIN, MissionItem
 
 __all__ = [
     "FIRMWARE_TYPES",
@@ -53,12 +60,10 @@ __all__ = [
     "write_plan",
     "read_plan",
     "validate_plan",
+    "geofence_document",
+    "read_geofence",
 ]
 
-#: Autopilot firmware name → MAV_AUTOPILOT.
-FIRMWARE_TYPES = {"generic": 0, "ardupilot": 3, "px4": 12}
-#: Airframe kind → MAV_TYPE.
-VEHICLE_TYPES = {"fixed_wing": 1, "multirotor": 2, "vtol": 22}
 #: MAV_FRAME of a position item → QGroundControl AltitudeFrame ("AltitudeMode").
 ALTITUDE_MODES = {FRAME_RELATIVE: 1, FRAME_GLOBAL: 2, FRAME_TERRAIN: 4}
 #: Complex items QGC writes and whether they carry their mission items.
@@ -91,7 +96,7 @@ def plan_document(mission: Any) -> dict[str, Any]:
     Parameters
     ----------
     mission : MissionExport
-        From :func:`fm2uav.io.build_mission` (items, home, airframe, fences).
+        From :func:`fm2uav.autopilot.build_mission` (items, home, airframe, fences).
     """
     opt = mission.options
     items = [_item_json(it, k + 1) for k, it in enumerate(mission.items)]
@@ -344,3 +349,37 @@ def read_plan(file: str | Path) -> dict[str, Any]:
         "lon": np.array([it.lon for it in items], dtype=float),
         "alt": np.array([it.alt for it in items], dtype=float),
     }
+
+
+# ---------------------------------------------------------------- geofences
+def _fence_json(f: Fence) -> dict[str, Any]:
+    """The QGC ``geoFence.polygons[]`` / ``geoFence.circles[]`` entry of a fence."""
+    if isinstance(f, FencePolygon):
+        return {"inclusion": bool(f.inclusion),
+                "polygon": [[lat, lon] for lat, lon in f.points], "version": 1}
+    return {"circle": {"center": [f.center[0], f.center[1]], "radius": f.radius},
+            "inclusion": bool(f.inclusion), "version": 1}
+
+
+def geofence_document(fences: Any = ()) -> dict[str, Any]:
+    """The ``geoFence`` object of a ``.plan`` (version 2) from
+    :func:`~fm2uav.autopilot.geofence.as_fences` input."""
+    fences = as_fences(fences)
+    polys = [_fence_json(f) for f in fences if isinstance(f, FencePolygon)]
+    circles = [_fence_json(f) for f in fences if isinstance(f, FenceCircle)]
+    return {"circles": circles, "polygons": polys, "version": 2}
+
+
+def read_geofence(doc: dict[str, Any]) -> list[Fence]:
+    """Fences of a ``.plan``'s ``geoFence`` object (QGC version 2; [] without one)."""
+    if not doc:
+        return []
+    out: list[Fence] = []
+    for i, p in enumerate(doc.get("polygons", [])):
+        out.append(FencePolygon(tuple((a, b) for a, b in p["polygon"]),
+                                bool(p.get("inclusion", True)), f"polygon {i + 1}"))
+    for i, c in enumerate(doc.get("circles", [])):
+        circ = c["circle"]
+        out.append(FenceCircle(tuple(circ["center"]), circ["radius"],
+                               bool(c.get("inclusion", True)), f"circle {i + 1}"))
+    return out

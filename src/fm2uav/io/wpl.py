@@ -23,7 +23,7 @@ from typing import IO, Any
 import numpy as np
 
 from ..errors import InputError
-from .items import CMD_NAV_WAYPOINT, FRAME_GLOBAL, MissionItem
+from ..autopilot.items import CMD_NAV_WAYPOINT, FRAME_GLOBAL, MissionItem
 
 __all__ = ["HEADER", "wpl_text", "write_wpl", "read_wpl"]
 

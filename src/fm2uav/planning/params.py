@@ -22,7 +22,7 @@ agl must be a finite number > 0 m, got -5 (mission file: planner.agl; CLI: --agl
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, fields
+from dataclasses import asdict, dataclass, fields
 from typing import Any, Literal
 
 import numpy as np
@@ -39,6 +39,7 @@ __all__ = [
     "STORAGE_MODES",
     "planner_objects",
     "planner_keys",
+    "plan_params",
 ]
 
 #: Accepted values of :attr:`FlightLevel.mode`.
@@ -315,3 +316,18 @@ def planner_objects(
             f"planner.agl; CLI: --agl) or drop {first} ({key} / {flag_})")
     return Shaping(**shaping_kw), level, PlanOptions(**options_kw)
 
+
+def plan_params(shaping: Shaping, level: FlightLevel | None, options: PlanOptions) -> dict[str, Any]:
+    """Flat JSON-friendly record of the planner's parameters (``Plan.params``).
+
+    The field names of the objects (one spelling): ``saturation``, ...,
+    ``order``, ``step``, ``custom_speed_map`` and, with a level, ``agl``, ``p1``,
+    ``p2``, ``band``, ... ``max_descent``. With a custom speed map the level
+    was not applied and is left out.
+    """
+    custom = options.speed_map is not None
+    out: dict[str, Any] = asdict(shaping)
+    out.update(order=int(options.order), step=float(options.step), custom_speed_map=custom)
+    if level is not None and not custom:
+        out.update(asdict(level))
+    return out

@@ -10,7 +10,7 @@ the start gives the path.
 from __future__ import annotations
 
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -27,7 +27,7 @@ from ..world.zones import check_points_allowed, zone_violations
 from .altitude import AltitudeProfile, final_profile, height_figures
 from .flight_level import flight_level_speed
 from .geodesic import descend
-from .params import FlightLevel, PlanOptions, Shaping
+from .params import FlightLevel, PlanOptions, Shaping, plan_params
 from .regional import check_full_grid, plan_regional, use_regional
 
 __all__ = ["Plan", "plan", "base_velocity", "shaped_velocity", "max_distance", "plan_params"]
@@ -201,22 +201,6 @@ def shaped_velocity(world: World, shaping: Shaping = Shaping()) -> np.ndarray:
                           saturation_distance=shaping.saturation_distance, max_distance=top)
 
 
-def plan_params(shaping: Shaping, level: FlightLevel | None, options: PlanOptions) -> dict[str, Any]:
-    """Flat JSON-friendly record of the planner's parameters (``Plan.params``).
-
-    The field names of the objects (one spelling): ``saturation``, ...,
-    ``order``, ``step``, ``custom_speed_map`` and, with a level, ``agl``, ``p1``,
-    ``p2``, ``band``, ... ``max_descent``. With a custom speed map the level
-    was not applied and is left out.
-    """
-    custom = options.speed_map is not None
-    out: dict[str, Any] = asdict(shaping)
-    out.update(order=int(options.order), step=float(options.step), custom_speed_map=custom)
-    if level is not None and not custom:
-        out.update(asdict(level))
-    return out
-
-
 def _check_free(world: World, point: np.ndarray, what: str) -> tuple[int, ...]:
     # World.to_cell validates "inside the map" with a clear message and uses the
     # same nearest-node rule as the geodesic
@@ -304,7 +288,7 @@ def plan(
     _check_work(world, start_m, goal_m, start_cell, goal_cell, options)
     if use_regional(world, shaping, level, options):  # too big for one full grid
         return plan_regional(world, start_m, goal_m, shaping=shaping, level=level,
-                             options=options, t_all=t_all)
+                             options=options, t_all=t_all, full_plan=plan)
 
     t0 = time.perf_counter()
     W = plan_velocity(world, shaping, level, options)

@@ -40,7 +40,9 @@ from __future__ import annotations
 import math
 import os
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
@@ -56,7 +58,7 @@ from ..world.geo import BYTES_PER_NODE
 from .altitude import final_profile
 from .flight_level import flight_layer, flight_level_speed
 from .geodesic import descend
-from .params import FlightLevel, PlanOptions, Shaping
+from .params import FlightLevel, PlanOptions, Shaping, plan_params
 
 __all__ = [
     "plan_regional",
@@ -206,10 +208,8 @@ def _coarse_world(world: World, level: FlightLevel) -> World:
 
 
 def _coarse_route(world: World, start: np.ndarray, goal: np.ndarray, shaping: Shaping,
-                  level: FlightLevel, options: PlanOptions):
-    """The coarse stage's plan (module docstring, stage 1)."""
-    from .planner import plan
-
+                  level: FlightLevel, options: PlanOptions, plan: Callable[..., Any]):
+    """The coarse stage's plan by the full-grid planner ``plan`` (module docstring, stage 1)."""
     cw = _coarse_world(world, level)
 
     def lift(p: np.ndarray) -> np.ndarray:
@@ -333,22 +333,23 @@ def _windows(world: World, top: np.ndarray, layer: np.ndarray, points: list[np.n
 
 
 def plan_regional(world: World, start: np.ndarray, goal: np.ndarray, *, shaping: Shaping,
-                  level: FlightLevel, options: PlanOptions, t_all: float | None = None):
+                  level: FlightLevel, options: PlanOptions, t_all: float | None = None,
+                  full_plan: Callable[..., Any]):
     """FM² from ``start`` to ``goal`` [m] by coarse-to-fine windows (module docstring).
 
     Called by :func:`fm2uav.plan` (``PlanOptions.storage``), which has checked the
-    points; returns the same :class:`~fm2uav.planning.planner.Plan`, with
+    points and gives itself as ``full_plan``, the planner of the coarse stage (run
+    with ``storage="full"``); returns the coarse stage's
+    :class:`~fm2uav.planning.planner.Plan` carrying the fine route, with
     ``params["storage"] = "regional"`` and ``params["regional"]`` (coarse factor and
     grid, number of windows, largest window's and all windows' nodes), ``timings`` with a ``coarse`` stage, and ``W`` / ``T``
     the *coarse* stage's maps (their shape is not the world's).
     """
-    from .planner import Plan, plan_params
-
     t_all = time.perf_counter() if t_all is None else t_all
     layer = flight_layer(world, level.agl)  # also: the level must fit under the ceiling
     top = column_surface(world)
     t0 = time.perf_counter()
-    coarse = _coarse_route(world, start, goal, shaping, level, options)
+    coarse = _coarse_route(world, start, goal, shaping, level, options, full_plan)
     t_coarse = time.perf_counter() - t0
     top_distance = world_max_distance(world)
     points, stretches = _waypoints(world, layer, coarse.path[:, :2], start, goal)
@@ -384,6 +385,6 @@ def plan_regional(world: World, start: np.ndarray, goal: np.ndarray, *, shaping:
         "coarse_factor": round(coarse.world.spacing[0] / world.spacing[0], 3),
         "coarse_shape": list(coarse.world.shape), "windows": len(legs),
         "largest_window_nodes": int(max(nodes)), "window_nodes": int(sum(nodes))})
-    return Plan(path=path, w=w, length=length, clearance=clearance, timings=timings,
-                W=coarse.W, T=coarse.T, world=world, params=params, shaping=shaping,
-                level=level, profile=profile)
+    return replace(coarse, path=path, w=w, length=length, clearance=clearance, timings=timings,
+                   W=coarse.W, T=coarse.T, world=world, params=params, shaping=shaping,
+                   level=level, profile=profile)

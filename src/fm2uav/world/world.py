@@ -12,7 +12,7 @@ Conventions (see the project architecture):
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -20,13 +20,25 @@ import numpy as np
 
 from ..errors import InputError, PointError, WorldError
 
-__all__ = ["World"]
+__all__ = ["World", "register_builders"]
 
 
 #: ids of occupancy arrays made by World's own builders, which World may keep without the
 #: defensive copy (a 3000 x 3000 x 78 DEM world's grid is 0.7 GB: the copy doubled the
 #: peak and took seconds of page faults).
 _BUILT: set[int] = set()
+
+#: The functions behind World's ``from_dem``, ``from_lonlat_grid``, ``from_buildings``,
+#: ``from_image`` and ``from_ros_map``, by name. They live in their own modules (dem.py,
+#: buildings.py, images.py), which import World; ``fm2uav/world/__init__.py`` registers
+#: them, so this module never imports its builders (imports go one way: the acyclic
+#: contract in pyproject.toml).
+_BUILDERS: dict[str, Callable[..., Any]] = {}
+
+
+def register_builders(**builders: Callable[..., Any]) -> None:
+    """Register the functions behind World's ``from_*`` classmethods, by classmethod name."""
+    _BUILDERS.update(builders)
 
 
 def _readonly(arr: np.ndarray) -> np.ndarray:
@@ -481,9 +493,7 @@ class World:
         See :func:`fm2uav.world.dem.from_dem` for the parameters (CRS handling,
         masks, ``bbox`` crop, ``sea_level``, nodata rule, ``ceiling`` altitude [m]).
         """
-        from .dem import from_dem
-
-        return from_dem(source, cell_size, ceiling, **kwargs)
+        return _BUILDERS["from_dem"](source, cell_size, ceiling, **kwargs)
 
     @classmethod
     def from_lonlat_grid(
@@ -496,9 +506,7 @@ class World:
         longitudes 0..360 or -180..180, latitudes in either order. See
         :func:`fm2uav.world.dem.from_lonlat_grid`.
         """
-        from .dem import from_lonlat_grid
-
-        return from_lonlat_grid(z, lon, lat, cell_size, ceiling, **kwargs)
+        return _BUILDERS["from_lonlat_grid"](z, lon, lat, cell_size, ceiling, **kwargs)
 
     @classmethod
     def from_buildings(cls, footprints: Any, cell_size: float | Sequence[float], **kwargs: Any) -> World:
@@ -509,9 +517,7 @@ class World:
         See :func:`fm2uav.world.buildings.from_buildings` for the parameters
         (``height`` [m], else ``building:levels`` x 3 m, else ``default_height``).
         """
-        from .buildings import from_buildings
-
-        return from_buildings(footprints, cell_size, **kwargs)
+        return _BUILDERS["from_buildings"](footprints, cell_size, **kwargs)
 
     @classmethod
     def from_image(cls, path: Any, resolution: float, **kwargs: Any) -> World:
@@ -520,9 +526,7 @@ class World:
         See :func:`fm2uav.world.images.world_from_image` (``threshold``, ``negate``,
         ``origin``).
         """
-        from .images import world_from_image
-
-        return world_from_image(path, resolution, **kwargs)
+        return _BUILDERS["from_image"](path, resolution, **kwargs)
 
     @classmethod
     def from_ros_map(cls, yaml_path: Any, **kwargs: Any) -> World:
@@ -531,6 +535,4 @@ class World:
         See :func:`fm2uav.world.images.world_from_ros_map` (thresholds, negate,
         unknown cells = obstacles by default).
         """
-        from .images import world_from_ros_map
-
-        return world_from_ros_map(yaml_path, **kwargs)
+        return _BUILDERS["from_ros_map"](yaml_path, **kwargs)

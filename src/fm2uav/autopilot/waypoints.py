@@ -37,6 +37,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..world.geo import Anchor, to_lonlat
+from .firmware import PROFILES
 from .items import FRAME_GLOBAL, FRAME_RELATIVE, FRAME_TERRAIN, CMD_NAV_TAKEOFF, CMD_NAV_WAYPOINT
 from .thin import thin_indices
 
@@ -67,9 +68,10 @@ def resolve_frame(frame: str, firmware: str, *, terrain_following: bool,
     """The frame ``"auto"`` stands for, per firmware (other names pass through).
 
     ``auto``: a terrain-following plan over a world with terrain is written in
-    the **terrain** frame for ArduPilot (it follows its terrain database) and
-    in **amsl** for PX4 and generic autopilots (PX4 has no terrain frame for
-    mission items); any other plan in **relative** (above home).
+    the **terrain** frame for a firmware that flies it (its profile's
+    ``terrain_frame``, :mod:`fm2uav.autopilot.firmware`: ArduPilot follows its
+    terrain database) and in **amsl** for the others (PX4 has no terrain frame
+    for mission items; generic); any other plan in **relative** (above home).
 
     Raises
     ------
@@ -82,7 +84,8 @@ def resolve_frame(frame: str, firmware: str, *, terrain_following: bool,
     if frame != "auto":
         return frame
     if terrain_following and has_terrain:
-        return "terrain" if firmware == "ardupilot" else "amsl"
+        profile = PROFILES.get(firmware)
+        return "terrain" if profile is not None and profile.terrain_frame else "amsl"
     return "relative"
 
 
@@ -126,7 +129,7 @@ class Waypoints:
     requested_agl : float or None
         The plan's requested height above ground [m].
     legs : dict or None
-        What the leg check (:func:`fm2uav.io.thin.refine_legs`) did: waypoints
+        What the leg check (:func:`fm2uav.autopilot.legs.refine_legs`) did: waypoints
         ``added`` where a straight leg dipped below its floor or entered a zone,
         ``lowest_margin_m`` above the floor along the legs, ...
     """
@@ -271,7 +274,7 @@ def mission_waypoints(
     required : array_like, shape (N,), optional
         Lowest admissible height above the surface at each dense point [m]
         (``Plan.profile.required``); legs that would dip below it, or enter a
-        no-fly zone, get more waypoints (:func:`fm2uav.io.thin.refine_legs`).
+        no-fly zone, get more waypoints (:func:`fm2uav.autopilot.legs.refine_legs`).
         Default: no floor (zones are still checked).
     """
     if frame not in FRAME_CODES:
@@ -285,7 +288,7 @@ def mission_waypoints(
     idx = thin_with_keep(space, tolerance, keep=keep, max_points=max_points)
     legs = None
     if p.shape[1] == 3 and getattr(world, "ndim", 3) == 3:
-        from .thin import refine_legs
+        from .legs import refine_legs
 
         req = np.full(len(p), -np.inf) if required is None else np.asarray(required, dtype=float)
         if req.shape != (len(p),):

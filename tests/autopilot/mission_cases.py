@@ -8,7 +8,7 @@ import numpy as np
 from scipy import ndimage
 
 from fm2uav import FlightLevel, World, plan
-from fm2uav.io import Anchor, from_lonlat
+from fm2uav.world.geo import Anchor, from_lonlat
 
 #: PX4 SITL's home (QGC docs example), used to place the synthetic worlds.
 ANCHOR = Anchor(lon=8.545594, lat=47.3977419, alt=488.0)
@@ -50,7 +50,7 @@ def hill_free():
 
 def bilinear_ground(world: World, lonlat: np.ndarray, anchor: Anchor | None = ANCHOR) -> np.ndarray:
     """Ground under lon/lat points, interpolated bilinearly on the terrain map (independent of
-    fm2uav.io: back to world metres, then scipy's linear interpolation)."""
+    fm2uav.autopilot.waypoints: back to world metres, then scipy's linear interpolation)."""
     xy = from_lonlat(world, np.asarray(lonlat)[:, :2], anchor=anchor)
     idx = (xy - np.asarray(world.origin[:2])) / np.asarray(world.spacing[:2])
     g = ndimage.map_coordinates(world.terrain, idx.T, order=1, mode="nearest")

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from fm2uav.io.fence import zone_fences
-from fm2uav.io.geofence import FenceCircle, FencePolygon, geofence_document
+from fm2uav.autopilot.geofence import FenceCircle, FencePolygon, zone_fences
+from fm2uav.io.qgc import geofence_document
 from fm2uav.world.geo import from_lonlat
 from fm2uav.scenarios import get_scenario
 from fm2uav.world.zones import zone_from_mapping

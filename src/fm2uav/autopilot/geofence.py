@@ -1,16 +1,23 @@
-"""Geofences for the QGroundControl ``.plan``: exclusion / inclusion polygons and circles.
+"""Geofences: the zones of a world as exclusion / inclusion polygons and circles in WGS84.
 
-The ``geoFence`` object of a plan (QGC "Plan File Format", version 2) holds
-``polygons`` (``{"inclusion": bool, "polygon": [[lat, lon], ...], "version": 1}``,
-clockwise) and ``circles`` (``{"circle": {"center": [lat, lon], "radius": m},
-"inclusion": bool, "version": 1}``). An *inclusion* fence is an area the vehicle
-must stay inside (an operating area), an *exclusion* fence one it must not
-enter (a no-fly zone). PX4 and ArduPilot take both from the plan (QGC uploads
-them as the fence mission type).
+An *inclusion* fence is an area the vehicle must stay inside (an operating
+area), an *exclusion* fence one it must not enter (a no-fly zone). PX4 and
+ArduPilot take both from a QGroundControl plan (QGC uploads them as the fence
+mission type); the plan's ``geoFence`` object is written and read by
+:mod:`fm2uav.io.qgc`.
+
+:func:`zone_fences` turns ``World.zones`` (:mod:`fm2uav.world.zones`) into
+fences: each no-fly zone an *exclusion* polygon (or circle, when it is one),
+the operating area an *inclusion* polygon. Fences are written as the zones are,
+without the planning buffer (the buffer is the planner's margin, the fence the
+boundary the autopilot enforces). QGC / PX4 / ArduPilot fences are
+two-dimensional: a zone with a floor or a ceiling (airspace above or below which
+the plan may fly) cannot be a fence without the autopilot breaching it when the
+plan passes over or under it, so such zones are left out and named in the
+returned warnings.
 
 :func:`fences_from_world` turns shapely polygons or circles in world metres into
-fences in WGS84; :func:`geofence_document` writes the ``geoFence`` object.
-QGC fences have no holes: an inclusion polygon's holes become exclusion
+fences. QGC fences have no holes: an inclusion polygon's holes become exclusion
 polygons; an exclusion polygon with holes is written without them (a larger
 no-fly area, on the safe side) and listed in the returned warnings.
 """
@@ -32,8 +39,7 @@ __all__ = [
     "Fence",
     "fences_from_world",
     "as_fences",
-    "geofence_document",
-    "read_geofence",
+    "zone_fences",
 ]
 
 
@@ -77,11 +83,6 @@ class FencePolygon:
             pts = pts[::-1]
         object.__setattr__(self, "points", tuple(pts))
 
-    def to_json(self) -> dict[str, Any]:
-        """The QGC ``geoFence.polygons[]`` entry."""
-        return {"inclusion": bool(self.inclusion),
-                "polygon": [[lat, lon] for lat, lon in self.points], "version": 1}
-
 
 @dataclass(frozen=True)
 class FenceCircle:
@@ -98,11 +99,6 @@ class FenceCircle:
         if not (math.isfinite(r) and r > 0):
             raise InputError(f"fence circle {self.name!r} radius must be > 0 m, got {self.radius!r}")
         object.__setattr__(self, "radius", r)
-
-    def to_json(self) -> dict[str, Any]:
-        """The QGC ``geoFence.circles[]`` entry."""
-        return {"circle": {"center": [self.center[0], self.center[1]], "radius": self.radius},
-                "inclusion": bool(self.inclusion), "version": 1}
 
 
 Fence = FencePolygon | FenceCircle
@@ -189,25 +185,38 @@ def as_fences(fences: Any) -> list[Fence]:
     return out
 
 
-def geofence_document(fences: Any = ()) -> dict[str, Any]:
-    """The ``geoFence`` object of a ``.plan`` (version 2) from :func:`as_fences` input."""
-    fences = as_fences(fences)
-    polys = [f.to_json() for f in fences if isinstance(f, FencePolygon)]
-    circles = [f.to_json() for f in fences if isinstance(f, FenceCircle)]
-    return {"circles": circles, "polygons": polys, "version": 2}
+def zone_fences(zones: Any, world: Any, anchor: Anchor | None = None
+                ) -> tuple[list[Any], list[str]]:
+    """Geofences (WGS84) of the zones, and warnings for zones that cannot be fences.
 
+    Parameters
+    ----------
+    zones : sequence of Zone
+        Usually ``world.zones``.
+    world : World
+        Gives the CRS (or ``anchor`` for a world without one).
+    anchor : Anchor, optional
 
-def read_geofence(doc: dict[str, Any]) -> list[Fence]:
-    """Fences of a ``.plan``'s ``geoFence`` object (QGC version 2; [] without one)."""
-    if not doc:
-        return []
-    out: list[Fence] = []
-    for i, p in enumerate(doc.get("polygons", [])):
-        out.append(FencePolygon(tuple((a, b) for a, b in p["polygon"]),
-                                bool(p.get("inclusion", True)), f"polygon {i + 1}"))
-    for i, c in enumerate(doc.get("circles", [])):
-        circ = c["circle"]
-        out.append(FenceCircle(tuple(circ["center"]), circ["radius"],
-                               bool(c.get("inclusion", True)), f"circle {i + 1}"))
-    return out
-
+    Returns
+    -------
+    fences : list of FencePolygon / FenceCircle
+    warnings : list of str
+    """
+    fences: list[Any] = []
+    warnings: list[str] = []
+    for k, z in enumerate(zones or ()):
+        name = z.name or f"{z.kind} {k + 1}"
+        vertical = z.floor is not None or z.ceiling is not None
+        if vertical and not z.inclusion:
+            warnings.append(f"{z.kind} {name!r} has a floor/ceiling; QGC geofences are 2D, so it "
+                            "is not written into the .plan geoFence (the plan keeps out of it)")
+            continue
+        geom = ("circle", z.circle[0], z.circle[1]) if z.circle is not None else z.geometry
+        out, warn = fences_from_world(geom, world, anchor=anchor, inclusion=z.inclusion,
+                                      name=name)
+        fences.extend(out)
+        warnings.extend(warn)
+        if vertical:
+            warnings.append(f"operating area {name!r}: its floor/ceiling are not part of the "
+                            "geofence (QGC fences are 2D)")
+    return fences, warnings

@@ -6,8 +6,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from fm2uav.errors import InputError
-from fm2uav.io import thin_indices, thin_path
-from fm2uav.io.thin import segment_distances
+from fm2uav.autopilot.thin import segment_distances, thin_indices, thin_path
 
 
 def test_straight_line_keeps_the_ends():

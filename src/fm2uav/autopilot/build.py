@@ -3,7 +3,7 @@
 :func:`build_mission` turns a dense path (a :class:`~fm2uav.Plan`, a route, a
 coverage path, one UAV of a formation) into the list of MAVLink items every
 mission file is written from, checks it with the firmware's validator
-(:func:`fm2uav.io.validate.check_mission`) and computes flight time and
+(:func:`fm2uav.autopilot.validate.check_mission`) and computes flight time and
 endurance. The items, in order:
 
 1. **Takeoff** to the start's altitude: ``NAV_VTOL_TAKEOFF`` for VTOL airframes,
@@ -59,7 +59,8 @@ from .items import (
     FRAME_TERRAIN,
     MissionItem,
 )
-from .validate import FIRMWARES, VEHICLES, check_mission
+from .firmware import FIRMWARES, PROFILES, VEHICLES
+from .validate import check_mission
 from .waypoints import FRAMES, Waypoints, ground_at, mission_waypoints, resolve_frame
 
 __all__ = [
@@ -68,6 +69,7 @@ __all__ = [
     "CameraPlan",
     "MissionExport",
     "speed_commands",
+    "start_holds",
     "build_mission",
 ]
 
@@ -96,7 +98,7 @@ class ExportOptions:
     max_points : int or None
         Cap on the number of waypoints.
     frame : {"auto", "terrain", "amsl", "relative"}
-        Altitude frame (:func:`fm2uav.io.waypoints.resolve_frame`).
+        Altitude frame (:func:`fm2uav.autopilot.waypoints.resolve_frame`).
     anchor : Anchor or None
         Placement of a world without CRS (default
         :data:`~fm2uav.world.geo.DEFAULT_ANCHOR`).
@@ -231,7 +233,7 @@ class MissionExport:
     info : dict
         Summary numbers (speed changes, camera, landing, flight time, endurance).
     fences : list
-        Geofences for the ``.plan`` (:mod:`fm2uav.io.geofence`).
+        Geofences for the ``.plan`` (:mod:`fm2uav.autopilot.geofence`).
     """
 
     items: list[MissionItem]
@@ -577,12 +579,13 @@ def _end(geo: _Geo, wps: Waypoints, opt: ExportOptions
     warnings: list[str] = []
     if end == "rtl":
         items.append(MissionItem.do(CMD_NAV_RETURN_TO_LAUNCH, label="return to launch"))
-        if opt.firmware in ("px4", "generic") and opt.vehicle == "fixed_wing":
+        must_land = opt.vehicle in PROFILES[opt.firmware].landing_required
+        if must_land and opt.vehicle == "fixed_wing":
             heading = -_unit_xy(wps.points_m, from_end=False)
             pattern, landing, warnings = _landing_pattern(geo, start_xy, heading, f_route, opt,
                                                           "home landing")
             items += pattern
-        elif opt.firmware in ("px4", "generic") and opt.vehicle == "vtol":
+        elif must_land and opt.vehicle == "vtol":
             items.append(MissionItem.do(CMD_DO_LAND_START, label="home landing start"))
             items.append(geo.item(CMD_NAV_VTOL_LAND, FRAME_RELATIVE if f_route == FRAME_TERRAIN
                                   else f_route, start_xy, float(geo.ground(start_xy)[0]),
@@ -617,6 +620,21 @@ def _end(geo: _Geo, wps: Waypoints, opt: ExportOptions
         items.append(geo.item(CMD_NAV_LOITER_UNLIM, f_route, end_xy, end_z,
                               label="loiter at the end", p3=radius))
     return end, items, landing, warnings
+
+
+def start_holds(starts: Any, world: Any, options: ExportOptions) -> np.ndarray:
+    """Wait at each vehicle's start [s] so that vehicles armed together leave together.
+
+    Each vehicle climbs from the ground (:meth:`World.ground_height`) to its
+    start ``starts[i]`` [m] at ``options.climb_rate`` (default
+    :data:`DEFAULT_CLIMB` of the airframe); the ones with less to climb wait for
+    the one with most.
+    """
+    climb = options.climb_rate or DEFAULT_CLIMB[options.vehicle]
+    starts = np.asarray(starts, dtype=float)
+    ground = np.asarray([world.ground_height(x, y) for x, y in starts[:, :2]], dtype=float)
+    climb_s = (starts[:, 2] - ground) / climb
+    return float(climb_s.max()) - climb_s
 
 
 def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: _Speeds, start_hold: float

@@ -57,8 +57,10 @@ __all__ = [
     "POSITION_COMMANDS",
     "TAKEOFF_COMMANDS",
     "END_COMMANDS",
+    "VTOL_COMMANDS",
     "MissionItem",
     "command_name",
+    "distance_m",
 ]
 
 #: MAV_FRAME_GLOBAL: altitude above mean sea level.
@@ -132,12 +134,23 @@ POSITION_COMMANDS = frozenset({16, 17, 18, 19, 21, 22, 31, 84, 85})
 TAKEOFF_COMMANDS = frozenset({22, 84})
 #: A mission's last navigation item: RTL, land, VTOL land or loiter for ever.
 END_COMMANDS = frozenset({20, 21, 85, 17})
+#: Commands only a VTOL airframe flies (VTOL takeoff / land, transition).
+VTOL_COMMANDS = frozenset({84, 85, 3000})
 
 
 def command_name(command: int) -> str:
     """``"NAV_WAYPOINT (16)"`` for 16; ``"MAV_CMD 1234"`` for unknown ids."""
     name = COMMAND_NAMES.get(int(command))
     return f"{name} ({int(command)})" if name else f"MAV_CMD {int(command)}"
+
+
+def distance_m(lat1: float, lon1: float, lat2: float, lon2: float) -> float:
+    """Great-circle distance [m] (haversine, mean Earth radius)."""
+    r = 6371008.8
+    p1, p2 = math.radians(lat1), math.radians(lat2)
+    dp, dl = p2 - p1, math.radians(lon2 - lon1)
+    a = math.sin(dp / 2) ** 2 + math.cos(p1) * math.cos(p2) * math.sin(dl / 2) ** 2
+    return 2 * r * math.asin(min(1.0, math.sqrt(a)))
 
 
 def _num(v: Any) -> float:

@@ -13,24 +13,27 @@ import pytest
 from pymavlink import mavwp
 
 from fm2uav.errors import InputError, MissionError
-from fm2uav.io import (
+from fm2uav.autopilot import (
     CameraPlan,
     ExportOptions,
     FenceCircle,
     FencePolygon,
     build_mission,
-    export_mission,
     fences_from_world,
+    speed_commands,
+    start_holds,
+)
+from fm2uav.autopilot.items import END_COMMANDS, TAKEOFF_COMMANDS
+from fm2uav.autopilot.validate import validate_mission
+from fm2uav.io import (
+    export_mission,
     from_lonlat,
     read_kml_path,
     read_plan,
     read_wpl,
-    speed_commands,
     to_lonlat,
     validate_plan,
 )
-from fm2uav.io.items import END_COMMANDS, TAKEOFF_COMMANDS
-from fm2uav.io.validate import validate_mission
 from fm2uav.missions.route import plan_route
 
 from .mission_cases import ANCHOR, UTM, bilinear_ground, hill, hill_free, hill_tff
@@ -437,7 +440,7 @@ def _codes(items, firmware="px4", vehicle="multirotor", home=None):
 def test_validators_accept_our_missions_and_name_each_defect():
     from dataclasses import replace
 
-    from fm2uav.io import MissionItem
+    from fm2uav.autopilot import MissionItem
 
     items, home = _good()
     assert _codes(items, home=home) == set()
@@ -485,7 +488,7 @@ def test_px4_fixed_wing_landing_rules():
     assert "px4-fw-glide-slope" in _codes(steep, vehicle="fixed_wing", home=m.home[2])
     twice = items[:-3] + [items[-3]] + items[-3:]
     assert "px4-land-start" in _codes(twice, vehicle="fixed_wing", home=m.home[2])
-    from fm2uav.io import MissionItem
+    from fm2uav.autopilot import MissionItem
 
     before_rtl = items[:-3] + [items[-3], MissionItem.do(20)] + items[-2:]
     assert "px4-land-before-rtl" in _codes(before_rtl, vehicle="fixed_wing", home=m.home[2])
@@ -497,41 +500,6 @@ def test_export_refuses_a_start_on_the_ground():
     path = np.array([[20.0, 20.0, g + 0.1], [200.0, 20.0, g + 60.0], [380.0, 280.0, 200.0]])
     with pytest.raises(MissionError, match="start is 0.10 m above the ground"):
         build_mission(path, world, _opts())
-
-
-# ---------------------------------------------------------------- QGC plans
-def test_a_qgc_survey_plan_is_read_with_its_transect_items():
-    from pathlib import Path
-
-    data = Path(__file__).parent / "data"
-    r = read_plan(data / "qgc_survey.plan")
-    cmds = r["command"].tolist()
-    assert cmds[0] == 22 and cmds[-1] == 20
-    assert cmds.count(206) == 8 and cmds.count(16) == 16  # 4 transects x (2 + 2 turnarounds)
-    assert r["sources"][1] == "items[1] survey" and r["sources"][-1] == "items[2]"
-    assert [it.params[0] for it in r["items"] if it.command == 206] == [25, 0] * 4
-    assert r["home"] == pytest.approx((47.3977419, 8.545594, 487.989))
-    assert isinstance(r["fences"][0], FenceCircle) and r["fences"][0].inclusion
-    assert len(r["rally"]) == 2
-    assert validate_mission(r["items"], "px4", home_alt=r["home"][2]) == []
-
-
-def test_complex_items_without_stored_items_are_refused_by_name(tmp_path):
-    from pathlib import Path
-
-    data = Path(__file__).parent / "data"
-    with pytest.raises(InputError, match=r"mission item 2 is a QGroundControl 'StructureScan'"):
-        read_plan(data / "qgc_structure_scan.plan")
-    doc = json.loads((data / "qgc_survey.plan").read_text())
-    del doc["mission"]["items"][1]["TransectStyleComplexItem"]["Items"]
-    del doc["geoFence"], doc["rallyPoints"]  # optional in QGC plans
-    (tmp_path / "s.plan").write_text(json.dumps(doc))
-    assert validate_plan(doc) == []
-    with pytest.raises(InputError, match=r"'survey' complex item.*saved without"):
-        read_plan(tmp_path / "s.plan")
-    doc["mission"]["items"].pop(1)
-    (tmp_path / "t.plan").write_text(json.dumps(doc))
-    assert read_plan(tmp_path / "t.plan")["command"].tolist() == [22, 20]
 
 
 def test_written_plans_read_back_item_for_item(tmp_path):
@@ -610,3 +578,11 @@ def test_formation_missions_one_per_vehicle_leave_together_and_keep_their_timing
         assert sum(it.command == 178 for it in m.items) >= 1
     _write(files, tmp_path)
     assert read_plan(tmp_path / "follower2_mission.plan")["command"][0] == 22
+
+
+def test_start_holds_let_vehicles_armed_together_leave_together():
+    from fm2uav import World
+
+    flat = World.from_heightmap(np.zeros((5, 5)), 10.0, 10)  # ground at z = 0
+    holds = start_holds([[0.0, 0.0, 25.0], [10.0, 10.0, 10.0]], flat, ExportOptions())
+    np.testing.assert_allclose(holds, [0.0, 6.0])  # 2.5 m/s up: 10 s and 4 s of climb
