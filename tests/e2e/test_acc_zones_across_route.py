@@ -140,5 +140,10 @@ def test_zone_across_the_only_route_is_flown_over_or_under(data, case):
     _check_outside(_dense(wps), zfile, tif)
     s = json.loads((out / "summary.json").read_text())
     assert s["safety"]["zones"]["path_entries"] == []
-    # a 2D geofence cannot carry a floor or ceiling: the zone is not in the .plan's fence
+    # a 2D geofence cannot carry a floor or ceiling: the zone is not in the .plan's fence,
+    # and the .plan's fm2uav metadata and the summary say so
     assert plan["geoFence"]["polygons"] == [] and plan["geoFence"]["circles"] == []
+    st = plan["fm2uav"]["geofence"]
+    assert [e["zone"] for e in st["not_carried"]] == ["strip"] and "2D" in st["limits"]
+    assert st == s["autopilot"]["geofence"]
+    assert any("geofence" in w and "strip" in w for w in s["autopilot"]["warnings"])

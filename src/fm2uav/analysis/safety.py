@@ -247,9 +247,15 @@ def ceiling_warning(world: Any, path: Any, agl: Any, level: Any = None) -> str |
 
         lon, lat, _ = to_lonlat(world, p[k])
         where = f"lon {lon:.5f}, lat {lat:.5f}"
-    fix = ("plan with a height above the ground and a ceiling: --agl H --max-agl 120 "
-           "(planner.agl, planner.max_agl)" if level is None else
-           "set the ceiling the profile keeps: --max-agl 120 (planner.max_agl)")
+    if level is None:
+        fix = ("plan with a height above the ground and a ceiling: --agl H --max-agl 120 "
+               "(planner.agl, planner.max_agl)")
+    elif float(level.agl) > ADVISORY_MAX_AGL:
+        fix = (f"lower --agl (planner.agl, now {float(level.agl):g} m) to 120 m or less and set "
+               "--max-agl 120 (planner.max_agl); where a higher flight is allowed, give that "
+               "ceiling as --max-agl")
+    else:
+        fix = "set the ceiling the profile keeps: --max-agl 120 (planner.max_agl)"
     return (f"the path flies up to {h[k]:.1f} m above the ground ({where}; {seg[high].sum():.0f} "
             f"m of it above {ADVISORY_MAX_AGL:g} m), higher than {ADVISORY_MAX_AGL:g} m — the "
             "limit of the EU open category and about that of US Part 107 (400 ft); if that is "

@@ -57,8 +57,9 @@ def mission_rows(mission: Any) -> dict[str, str]:
         "autopilot mission": f"{s['firmware']} {s['vehicle']}, {s['items']} items, "
                              f"{s['waypoints']} waypoints, ends with {s['end']}",
         "altitude frame": f"{s['frame']['name']} (MAVLink frame {s['frame']['mav_frame']})",
-        "home lat, lon, alt": f"{h['lat']:.7f}, {h['lon']:.7f}, {h['alt_amsl_m']:.1f} m AMSL "
-                              f"({h['source']})",
+        "home lat, lon, alt": f"{h['lat']:.7f}, {h['lon']:.7f}, "
+                              + ("altitude above sea level unknown" if h["alt_amsl_m"] is None
+                                 else f"{h['alt_amsl_m']:.1f} m AMSL") + f" ({h['source']})",
         "flight": f"{s['flight']['flight_distance_m'] / 1000:.2f} km, "
                   f"{s['flight']['flight_time_s'] / 60:.1f} min",
     }
@@ -190,7 +191,8 @@ def plan_outputs(
         "autopilot": mission.summary(),
         "waypoints": len(wps),
         "mavlink_frame": wps.frame,
-        "home_lat_lon_alt": [round(v, 9) for v in wps.home],
+        "home_lat_lon_alt": [round(v, 9) for v in wps.home[:2]]
+        + [round(wps.home[2], 9) if wps.amsl else None],
         "thin_tolerance_m": options.tolerance,
         "safety": safety,
     }
@@ -233,7 +235,8 @@ def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
         "path points": len(plan.path),
         "waypoints": len(wps),
         "mission items": ms["items"],
-        "home (lat, lon, alt AMSL)": [round(v, 7) for v in wps.home],
+        "home (lat, lon, alt AMSL)": [round(v, 7) for v in wps.home[:2]]
+        + [round(wps.home[2], 7) if wps.amsl else "unknown"],
         "flight time [min]": round(ms["flight"]["flight_time_s"] / 60, 2),
         "planning time [s]": round(float(plan.timings.get("total", 0.0)), 3),
         **safety_rows(info["safety"]),

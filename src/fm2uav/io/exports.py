@@ -99,7 +99,8 @@ def _description(m: MissionExport) -> str:
     lines = [f"firmware {s['firmware']}, {s['vehicle']}, frame {s['frame']['name']} "
              f"(MAV_FRAME {s['frame']['mav_frame']}), end {s['end']}",
              f"home {s['home']['lat']:.7f}, {s['home']['lon']:.7f}, "
-             f"{s['home']['alt_amsl_m']:.1f} m AMSL ({s['home']['source']})",
+             + ("altitude above sea level unknown" if s["home"]["alt_amsl_m"] is None
+                else f"{s['home']['alt_amsl_m']:.1f} m AMSL") + f" ({s['home']['source']})",
              f"CRS {s['crs']}; altitudes: {s['vertical_reference']}"]
     return "\n".join(lines + [f"warning: {w}" for w in m.warnings])
 

@@ -8,7 +8,9 @@ Format" developer documentation and ``PlanMasterController`` /
   ``mission``, and the optional ``geoFence`` (``circles``, ``polygons``,
   ``version`` 2) and ``rallyPoints`` (``points``, ``version`` 2); fm2uav adds an
   ``fm2uav`` object (frame, home and its source, CRS and vertical reference,
-  warnings), which QGroundControl ignores;
+  warnings, and with zones ``geofence``: what the 2D fence carries of them and
+  what it cannot — floors, ceilings, buffers,
+  :func:`fm2uav.autopilot.geofence.fence_statement`), which QGroundControl ignores;
 * ``mission``: ``version`` 2, ``firmwareType`` (MAV_AUTOPILOT), ``vehicleType``
   (MAV_TYPE), ``cruiseSpeed``, ``hoverSpeed``, ``globalPlanAltitudeMode``,
   ``plannedHomePosition`` ``[lat, lon, alt AMSL]`` and ``items``;
@@ -106,7 +108,8 @@ def plan_document(mission: Any) -> dict[str, Any]:
         "fileType": "Plan",
         "fm2uav": {"frame": info["frame"], "home": info["home"], "crs": info["crs"],
                    "georef": info["georef"], "vertical_reference": info["vertical_reference"],
-                   "end": info["end"], "warnings": info["warnings"]},
+                   "end": info["end"], "warnings": info["warnings"],
+                   **({"geofence": info["geofence"]} if "geofence" in info else {})},
         "geoFence": geofence_document(mission.fences),
         "groundStation": "fm2uav",
         "mission": {
