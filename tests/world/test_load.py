@@ -188,6 +188,9 @@ def test_buildings_alone_ground_elevation_and_default_margin(tmp_path):
     with pytest.raises(InputError, match=r"ground_elevation.*--ground-elevation.*DEM"):
         load_world(_spec(buildings=str(f), default_height=12.0, ground_elevation=400.0,
                          dem=str(gd.dem_4326(tmp_path / "d.tif"))), agl=30.0)
+    with pytest.raises(InputError, match=r"world.margin \(--margin\).*DEM"):
+        load_world(_spec(buildings=str(f), default_height=12.0, margin=10.0,
+                         dem=str(gd.dem_4326(tmp_path / "d.tif"))), agl=30.0)
     with pytest.raises(ValidationError):
         _spec(buildings=str(f), ground_elevation=20000.0)
 

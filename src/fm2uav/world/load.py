@@ -431,6 +431,10 @@ def load_world(spec: WorldSpec, *, agl: float | None = None, top: float | None =
     if spec.ground_elevation is not None and spec.dem is not None:
         raise InputError("world.ground_elevation (--ground-elevation) is for buildings without "
                          "a DEM; with world.dem (--dem) the ground is the DEM's: leave it out")
+    if spec.margin is not None and spec.dem is not None:
+        raise InputError("world.margin (--margin) is for buildings without a DEM; with "
+                         "world.dem (--dem) the map is the DEM's (crop it with world.bbox / "
+                         "--bbox): leave it out")
     agl = _requested(agl, "planner.agl (--agl)")
     if spec.cell_size is not None:
         dx, why_dx = float(spec.cell_size), "given (world.cell_size)"
