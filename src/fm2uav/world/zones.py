@@ -452,27 +452,6 @@ def terrain_surface_index(world: World) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------- along a route
-def _chords_touching(foot: BaseGeometry, xy: np.ndarray) -> np.ndarray:
-    """Bool per sample of the polyline ``xy``: the sample, or a chord to a neighbour, meets
-    ``foot`` (its interior or boundary)."""
-    m = len(xy)
-    touched = shapely.intersects_xy(foot, xy[:, 0], xy[:, 1])
-    if m < 2:
-        return touched
-    x0, y0, x1, y1 = foot.bounds
-    a, b = xy[:-1], xy[1:]
-    near = ~((np.maximum(a[:, 0], b[:, 0]) < x0) | (np.minimum(a[:, 0], b[:, 0]) > x1)
-             | (np.maximum(a[:, 1], b[:, 1]) < y0) | (np.minimum(a[:, 1], b[:, 1]) > y1))
-    hit = np.zeros(m - 1, dtype=bool)
-    k = np.flatnonzero(near)
-    if len(k):
-        lines = shapely.linestrings(np.stack([a[k], b[k]], axis=1))
-        hit[k] = shapely.intersects(foot, lines)
-    touched[:-1] |= hit
-    touched[1:] |= hit
-    return touched
-
-
 #: Points read on each chord between two route samples to bound the ground under a zone
 #: whose floor/ceiling is measured above the ground (the bilinear ground bulges between
 #: samples at pixel edges: centimetres that three points per chord missed).
