@@ -12,6 +12,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import shapely
+import shapely.affinity
+from hypothesis import HealthCheck, given, settings, strategies as st
 
 from fm2uav.planning import FlightLevel, plan
 from fm2uav.world import World
@@ -159,3 +161,45 @@ def test_operating_area_floor_and_ceiling_shrink_by_the_buffer(hills):
 def w_box(w):
     b = w.bounds
     return shapely.box(b[0, 0] - 100, b[1, 0] - 100, b[0, 1] + 100, b[1, 1] + 100)
+
+
+@settings(max_examples=8, derandomize=True, deadline=None,
+          suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 10_000), reference=st.sampled_from(["amsl", "agl"]),
+       buffer=st.sampled_from([0.0, 3.0, 25.0]), width=st.floats(0.05, 0.3),
+       angle=st.floats(-0.6, 0.6), over=st.booleans())
+def test_random_strips_with_a_ceiling_or_floor_are_never_refused(seed, reference, buffer,
+                                                                  width, angle, over):
+    """Seeded terrains, a slanted strip across the whole map with a ceiling (or a floor) at
+    a random height: the plan succeeds and the flown path, sampled every 0.5 m, stays out of
+    the buffered zone (shapely and the world's ground here)."""
+    z = rough_dem(seed, rows=50, cols=80, relief=150.0)
+    west, north = 8.50, 47.40
+    bounds = (west, north - z.shape[0] * PIXEL, west + z.shape[1] * PIXEL, north)
+    w = World.from_dem(z, (100.0, 100.0, 10.0), crs="EPSG:4326", bounds=bounds, agl=50.0,
+                       ceiling=900.0)
+    b = w.bounds
+    cx, cy = b[:2].mean(axis=1)
+    half = 0.5 * width * (b[0, 1] - b[0, 0])
+    tall = 2.0 * (b[1, 1] - b[1, 0])
+    strip = shapely.affinity.rotate(shapely.box(cx - half, cy - tall, cx + half, cy + tall),
+                                    angle, origin=(cx, cy), use_radians=True)
+    g = np.asarray(w.ground_height(*np.meshgrid(np.linspace(*b[0], 60),
+                                                np.linspace(*b[1], 40))))
+    if reference == "agl":
+        spec = {"ceiling": 30.0} if over else {"floor": 120.0}
+    else:
+        spec = {"ceiling": float(g.max()) + 10.0} if over else {"floor": float(g.max()) + 90.0}
+    zone = Zone(strip, name="strip", reference=reference, buffer=buffer, **spec)
+    wz = with_zones(w, [zone])
+    start, goal = _ends(w, agl=50.0)
+    p = plan(wz, start, goal, level=FlightLevel(agl=50.0))
+    d = _dense(p.path)
+    keep = strip.buffer(buffer) if buffer else strip
+    inside = shapely.contains_xy(keep, d[:, 0], d[:, 1])
+    base = np.asarray(w.ground_height(d[:, 0], d[:, 1])) if reference == "agl" else 0.0
+    if zone.ceiling is not None:
+        ok = d[:, 2] >= base + zone.ceiling + buffer - 2e-3
+    else:
+        ok = d[:, 2] <= base + zone.floor - buffer + 2e-3
+    assert np.all(ok[inside])

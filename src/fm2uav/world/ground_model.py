@@ -92,8 +92,9 @@ class GroundModel:
         """``(rows, cols)`` of the raster."""
         return tuple(int(v) for v in self.z.shape)  # type: ignore[return-value]
 
-    def height(self, x: Any, y: Any) -> np.ndarray:
-        """Bilinear DEM height [m] at world ``(x, y)`` [m] (edge pixels outside)."""
+    def pixel_index(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
+        """Continuous ``(row, col)`` of world ``(x, y)`` [m] in the raster, pixel centres at
+        whole numbers: the bilinear surface is smooth between whole rows and columns."""
         xa, ya = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         xs, ys = xa.ravel(), ya.ravel()
         if self._to_src is not None:
@@ -102,8 +103,14 @@ class GroundModel:
         ia, ib, ic, id_, ie, if_ = self._inv
         col = ia * xs + ib * ys + ic - 0.5
         row = id_ * xs + ie * ys + if_ - 0.5
-        out = ndimage.map_coordinates(self.z, np.stack([row, col]), order=1, mode="nearest")
-        return out.reshape(xa.shape)
+        return row.reshape(xa.shape), col.reshape(xa.shape)
+
+    def height(self, x: Any, y: Any) -> np.ndarray:
+        """Bilinear DEM height [m] at world ``(x, y)`` [m] (edge pixels outside)."""
+        row, col = self.pixel_index(x, y)
+        out = ndimage.map_coordinates(self.z, np.stack([row.ravel(), col.ravel()]), order=1,
+                                      mode="nearest")
+        return out.reshape(row.shape)
 
 
 def sampling_step(world: Any) -> float:

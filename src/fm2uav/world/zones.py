@@ -452,27 +452,18 @@ def terrain_surface_index(world: World) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------- along a route
-#: Points read on each chord between two route samples to bound the ground under a zone
-#: whose floor/ceiling is measured above the ground (the bilinear ground bulges between
-#: samples at pixel edges: centimetres that three points per chord missed).
-_CHORD_READS = 16
-
-
 def _chord_ground(world: World, xy: np.ndarray, ground: np.ndarray, chords: np.ndarray
                   ) -> tuple[np.ndarray, np.ndarray]:
     """Highest and lowest ground [m] over each sample and the chosen chords next to it,
-    relative to the chord's straight line (z is flown linearly between samples)."""
+    relative to the chord's straight line (z is flown linearly between samples; the
+    ground's exact rise and drop along a chord: :func:`fm2uav.world.ground.ground_bulge`)."""
+    from .ground import ground_bulge
+
     g_hi, g_lo = ground.copy(), ground.copy()
     k = np.flatnonzero(chords)
     if not len(k):
         return g_hi, g_lo
-    fr = np.arange(1, _CHORD_READS) / _CHORD_READS
-    a, b = xy[k], xy[k + 1]
-    q = (a[:, None, :] + fr[None, :, None] * (b - a)[:, None, :]).reshape(-1, 2)
-    g = np.asarray(world.ground_height(q[:, 0], q[:, 1]), dtype=float).reshape(len(k), -1)
-    lin = ground[k, None] + fr[None, :] * (ground[k + 1] - ground[k])[:, None]
-    bump = np.maximum((g - lin).max(axis=1), 0.0)
-    dip = np.maximum((lin - g).max(axis=1), 0.0)
+    bump, dip = ground_bulge(world, xy[k], xy[k + 1])
     for side in (k, k + 1):
         np.maximum.at(g_hi, side, ground[side] + bump)
         np.minimum.at(g_lo, side, ground[side] - dip)
@@ -509,8 +500,8 @@ def zone_bounds_along(world: World, xy: np.ndarray, z_route: np.ndarray
     chords, the sample must pass over the zone (``z >= ceiling + buffer``) or under it
     (``z <= floor - buffer``) — on the side of the FM² route's own height ``z_route``
     there — so that the whole chord does: an AGL ceiling is raised by the ground's
-    bulge above the chord (read at :data:`_CHORD_READS` points), an AGL floor lowered
-    by its dip. An operating area's floor/ceiling (shrunk by its buffer) bound every
+    exact rise above the chord (:func:`fm2uav.world.ground.ground_bulge`), an AGL floor
+    lowered by its drop. An operating area's floor/ceiling (shrunk by its buffer) bound every
     sample. Zones without vertical limits give no bound (the route must not enter them
     at all; see :func:`zone_violations`).
 
