@@ -31,7 +31,7 @@ from scipy import ndimage
 if TYPE_CHECKING:
     from .world import World
 
-__all__ = ["ground_height", "surface_height", "roof_heights", "terrain_along", "ground_bulge"]
+__all__ = ["ground_height", "surface_height", "roof_heights", "terrain_along"]
 
 
 def _xy(world: World, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray, bool]:
@@ -126,72 +126,3 @@ def terrain_along(world: World, path: np.ndarray) -> np.ndarray | None:
     p = np.asarray(path, dtype=float)
     return np.asarray(ground_height(world, p[:, 0], p[:, 1]), dtype=float)
 
-
-def _grid_index(world: World, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Continuous index of world points in the grid the ground is bilinear on (the source
-    DEM's pixel centres, or the world's terrain nodes): smooth between whole numbers."""
-    model = getattr(world, "ground", None)
-    if model is not None:
-        return model.pixel_index(x, y)
-    return ((np.asarray(x, dtype=float) - world.origin[0]) / world.spacing[0],
-            (np.asarray(y, dtype=float) - world.origin[1]) / world.spacing[1])
-
-
-def ground_bulge(world: World, a: Any, b: Any) -> tuple[np.ndarray, np.ndarray]:
-    """How far the ground rises above, and drops below, the straight line between its
-    heights at the ends of each chord ``a[i]`` → ``b[i]`` (x, y [m]): ``(rise, drop)`` [m],
-    both >= 0.
-
-    Exact for the bilinear ground (:func:`ground_height`): along a straight chord it is a
-    quadratic between the chord's crossings of the grid's whole rows and columns (the
-    source DEM's pixel centres, or the terrain nodes), so the extremes lie at those
-    crossings or at a piece's vertex; each piece is read at its ends and middle and its
-    quadratic solved (a DEM in another CRS than the world bends the chord by far less
-    than a millimetre over a pixel). Reading a few points per chord missed centimetres
-    at pixel edges — enough to put a path exactly at a zone's ceiling inside it.
-    """
-    pa = np.atleast_2d(np.asarray(a, dtype=float))[:, :2]
-    pb = np.atleast_2d(np.asarray(b, dtype=float))[:, :2]
-    k = len(pa)
-    if k == 0 or (getattr(world, "ground", None) is None and world.terrain is None):
-        return np.zeros(k), np.zeros(k)
-    r0, c0 = _grid_index(world, pa[:, 0], pa[:, 1])
-    r1, c1 = _grid_index(world, pb[:, 0], pb[:, 1])
-    # breakpoints: t where the row or the column index crosses a whole number
-    ts = [np.zeros(k), np.ones(k)]
-    for u0, u1 in ((r0, r1), (c0, c1)):
-        lo, hi = np.minimum(u0, u1), np.maximum(u0, u1)
-        first = np.floor(lo) + 1.0
-        n = np.maximum(np.ceil(hi) - first, 0).astype(int)
-        du = np.where(np.abs(u1 - u0) > 1e-12, u1 - u0, np.nan)
-        for j in range(int(n.max()) if n.size else 0):
-            v = first + j
-            t = np.where(j < n, (v - u0) / du, np.nan)
-            ts.append(np.where((t > 0) & (t < 1), t, np.nan))
-    t = np.sort(np.column_stack(ts), axis=1)  # NaNs last
-    ta, tb = t[:, :-1], t[:, 1:]
-    ok = np.isfinite(ta) & np.isfinite(tb) & (tb > ta)
-    tm = 0.5 * (ta + tb)
-    fr = np.stack([ta, tm, tb], axis=-1)  # (k, pieces, 3)
-    fr = np.where(ok[..., None], fr, 0.0)
-    d = pb - pa
-    q = pa[:, None, None, :] + fr[..., None] * d[:, None, None, :]
-    g = np.asarray(ground_height(world, q[..., 0].ravel(), q[..., 1].ravel()),
-                   dtype=float).reshape(fr.shape)
-    g_end = np.asarray(ground_height(world, np.r_[pa[:, 0], pb[:, 0]],
-                                     np.r_[pa[:, 1], pb[:, 1]]), dtype=float)
-    lin = g_end[:k, None, None] + fr * (g_end[k:] - g_end[:k])[:, None, None]
-    h = g - lin  # the ground above the chord's straight line, per piece at ends and middle
-    # the quadratic through the three values: h(s) = h0 + B s + C s^2, s in [0, 1]
-    h0, hm, h1 = h[..., 0], h[..., 1], h[..., 2]
-    C = 2.0 * (h0 + h1) - 4.0 * hm
-    B = h1 - h0 - C
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s = np.where(np.abs(C) > 1e-12, -B / (2.0 * C), np.nan)
-    inside = np.isfinite(s) & (s > 0) & (s < 1)
-    hv = np.where(inside, h0 + B * s + C * s * s, np.nan)
-    vals = np.concatenate([h0, h1, hv], axis=1)
-    vals = np.where(np.concatenate([ok, ok, ok & inside], axis=1), vals, np.nan)
-    rise = np.nanmax(np.concatenate([vals, np.zeros((k, 1))], axis=1), axis=1)
-    drop = np.nanmax(np.concatenate([-vals, np.zeros((k, 1))], axis=1), axis=1)
-    return np.maximum(rise, 0.0), np.maximum(drop, 0.0)

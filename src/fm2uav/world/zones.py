@@ -456,8 +456,8 @@ def _chord_ground(world: World, xy: np.ndarray, ground: np.ndarray, chords: np.n
                   ) -> tuple[np.ndarray, np.ndarray]:
     """Highest and lowest ground [m] over each sample and the chosen chords next to it,
     relative to the chord's straight line (z is flown linearly between samples; the
-    ground's exact rise and drop along a chord: :func:`fm2uav.world.ground.ground_bulge`)."""
-    from .ground import ground_bulge
+    ground's exact rise and drop along a chord: :func:`fm2uav.world.ground_model.ground_bulge`)."""
+    from .ground_model import ground_bulge
 
     g_hi, g_lo = ground.copy(), ground.copy()
     k = np.flatnonzero(chords)
@@ -500,7 +500,7 @@ def zone_bounds_along(world: World, xy: np.ndarray, z_route: np.ndarray
     chords, the sample must pass over the zone (``z >= ceiling + buffer``) or under it
     (``z <= floor - buffer``) — on the side of the FM² route's own height ``z_route``
     there — so that the whole chord does: an AGL ceiling is raised by the ground's
-    exact rise above the chord (:func:`fm2uav.world.ground.ground_bulge`), an AGL floor
+    exact rise above the chord (:func:`fm2uav.world.ground_model.ground_bulge`), an AGL floor
     lowered by its drop. An operating area's floor/ceiling (shrunk by its buffer) bound every
     sample. Zones without vertical limits give no bound (the route must not enter them
     at all; see :func:`zone_violations`).
