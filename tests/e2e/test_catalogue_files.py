@@ -66,16 +66,16 @@ _pit[5:9, 5:9] = -9999.0
 _spike = relief()
 _spike[20, 20] = 4000.0
 _hole = relief()
-_hole[12, 12] = -600.0  # one pixel below -500 m
+_hole[12, 12] = -2000.0  # a one-pixel pit 2100 m deep on 30 m pixels: no terrain does that
 _feet = relief() + 9500.0
 _nan = np.full((40, 40), np.nan)
 _nodata_all = np.full((40, 40), -32768.0)
 
 DEM_CASES = [
-    ("dem-undeclared-nodata", _dem(_pit), WorldError, "undeclared nodata"),
-    ("dem-undeclared-nodata-value", _dem(_pit), WorldError, "--nodata-value -9999"),
-    ("dem-spike", _dem(_spike), WorldError, "isolated spike"),
-    ("dem-pit-below-500", _dem(_hole), WorldError, "below -500 m"),
+    ("dem-undeclared-nodata", _dem(_pit), WorldError, "nodata the file does not declare"),
+    ("dem-undeclared-nodata-value", _dem(_pit), WorldError, "16 pixel(s) of -9999"),
+    ("dem-spike", _dem(_spike), WorldError, "no terrain on Earth steps like that"),
+    ("dem-pit-2100m", _dem(_hole), WorldError, "a step of 2102 m (89°)"),
     ("dem-above-9000", _dem(_feet), WorldError, "above 9000 m"),
     ("dem-all-nan", _dem(_nan), WorldError, "no valid elevation"),
     ("dem-all-nodata", _dem(_nodata_all, nodata=-32768.0), WorldError, "no valid elevation"),
@@ -89,7 +89,20 @@ DEM_CASES = [
     ("dem-fifo", _fifo("dem.tif"), InputError, "named pipe"),
     ("dem-directory", _dir("dem.tif"), InputError, "is a directory"),
     ("dem-missing", lambda tmp: tmp / "nowhere.tif", InputError, "does not exist"),
+    # rasters that are not elevation (issue 25)
+    ("dem-rgb", lambda tmp: _dc().rgb(tmp / "map.tif"), InputError, "RGB colour image"),
+    ("dem-palette", lambda tmp: _dc().palette(tmp / "lc.tif"), InputError, "colour-indexed"),
+    ("dem-complex", lambda tmp: _dc().complex_raster(tmp / "ifg.tif"), InputError,
+     "complex complex64"),
+    ("dem-celsius", lambda tmp: _dc().temperature(tmp / "t.tif"), InputError,
+     "unit 'degC', which is not a length"),
 ]
+
+
+def _dc():
+    from tests.world import dem_cases
+
+    return dem_cases
 
 
 @pytest.mark.parametrize("make, exc, fragment", [c[1:] for c in DEM_CASES],

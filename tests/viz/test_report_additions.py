@@ -79,3 +79,24 @@ def test_paths_without_a_world():
     assert "none given (paths only)" in html
     with pytest.raises(ValueError, match="one dimension"):
         report_html(None, {"a": p, "b": p[:, :2]})
+
+
+def test_notes_come_first_and_the_path_over_filled_ground_is_drawn(slope):
+    from fm2uav.viz.overlays import FILLED_PATH_NAME, filled_path_overlay
+
+    h = np.zeros((30, 20))
+    filled = np.zeros((30, 20), bool)
+    filled[10:20, :] = True
+    w = World.from_heightmap(h, 10.0, 6).with_fields(filled=filled)
+    path = np.column_stack([np.linspace(0, 290, 59), np.full(59, 95.0), np.full(59, 30.0)])
+    ov = filled_path_overlay(w, path)
+    pts = ov[FILLED_PATH_NAME]["points"]
+    on = pts[np.isfinite(pts[:, 0])]
+    assert on[:, 0].min() >= 90.0 - 5.0 - 1e-9 and on[:, 0].max() <= 200.0 + 1e-9
+    html = report_html(w, {"FM² path": path}, overlays=ov,
+                       notes=["the path flies 0.10 km of 0.29 km over <filled> ground"])
+    assert html.index('id="fm2uav-warnings"') < html.index("fm2uav-scene")
+    assert "over &lt;filled&gt; ground" in html  # escaped
+    assert FILLED_PATH_NAME in _traces(html, "fm2uav-scene")
+    assert 'id="fm2uav-warnings"' not in report_html(w, {"FM² path": path})
+    assert filled_path_overlay(World.from_heightmap(h, 10.0, 6), path) == {}

@@ -217,17 +217,36 @@ def test_masks_alpha_scale_offset_and_vertical_crs(tmp_path):
 
 
 @pytest.mark.parametrize("value", [-9999.0, -32768.0, 32767.0])
-def test_undeclared_nodata_is_named(tmp_path, value):
+def test_undeclared_nodata_is_found_said_and_left_to_the_nodata_rule(tmp_path, value):
+    """Sentinels the file does not declare are nodata (issue 25): said once in a warning that
+    names the value and how to declare it; world.nodata then decides (error names them too)."""
     z = gd.terrain(*np.meshgrid(10.0 + np.arange(120) / 1200, 45.6 - np.arange(100) / 1200))
     z[40:45, 50:60] = value
     p = gd._write(tmp_path / "undeclared.tif", z, "EPSG:4326", from_origin(10, 45.6, 1 / 1200,
                                                                            1 / 1200))
-    with pytest.raises(WorldError, match=rf"exactly {value:g}, which looks like an undeclared "
-                                         rf"nodata value; declare it with world.nodata_value: "
-                                         rf"{value:g} \(CLI --nodata-value {value:g}\)"):
-        World.from_dem(p, 100.0)
-    w = World.from_dem(p, 100.0, nodata_value=value, nodata="fill")
+    with pytest.warns(GeodataWarning, match=rf"50 pixel\(s\) of {value:g} .*nodata the file does "
+                                            rf"not declare.*world.nodata_value: {value:g}, CLI "
+                                            rf"--nodata-value {value:g}"):
+        with pytest.raises(WorldError, match=rf"nodata/NaN under \d+ .*among the gaps: 50 "
+                                             rf"pixel\(s\) of {value:g}"):
+            World.from_dem(p, 100.0)
+    with pytest.warns(GeodataWarning, match="nodata the file does not declare"):
+        w = World.from_dem(p, 100.0, nodata="fill")
     assert w.filled.any() and w.terrain.max() < 2000
+    assert w.georef.sources[0].details["undeclared_nodata"] == [{"value": value, "pixels": 50}]
+    # declared by the user: no warning, the same world
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", GeodataWarning)
+        w2 = World.from_dem(p, 100.0, nodata_value=value, nodata="fill")
+    np.testing.assert_array_equal(w2.terrain, w.terrain)
+    # the heights written into the filled columns come from the measured ground around them
+    # (GDAL's bilinear value from the valid pixels, else the nearest measured node): never
+    # outside the range of the measured nodes within four cells
+    f = w.filled
+    for i, j in np.argwhere(f):
+        nb = (slice(max(i - 4, 0), i + 5), slice(max(j - 4, 0), j + 5))
+        around = w.terrain[nb][~f[nb]]
+        assert around.size and around.min() - 1e-6 <= w.terrain[i, j] <= around.max() + 1e-6
 
 
 def test_sea_level_and_the_below_zero_warning(tmp_path):

@@ -62,3 +62,23 @@ def test_surface_height_counts_roofs_not_the_terrain_nodes():
     assert wb.surface_height(15.0, 15.0) == 12.0        # top node z = 12 <= roof 12
     assert wb.surface_height(30.0, 30.0) == 0.0
 
+
+def test_unknown_ground_follows_the_bilinear_stencil_of_the_grid():
+    """Without a ground model, a point is over filled ground when a node of its bilinear
+    cell (with a non-zero weight) is filled; on a node, only that node counts."""
+    import numpy as np
+
+    from fm2uav import World
+
+    h = np.full((6, 5), 10.0)
+    filled = np.zeros((6, 5), bool)
+    filled[3, 2] = True
+    w = World.from_heightmap(h, 10.0, 4).with_fields(filled=filled)
+    assert w.ground is None
+    x = np.array([30.0, 25.0, 35.0, 29.999, 20.0, 40.0, 30.0, 30.0, 15.0, 45.0])
+    y = np.array([20.0, 15.0, 25.0, 20.0, 20.0, 20.0, 10.0, 30.0, 20.0, 20.0])
+    want = [True, True, True, True, False, False, False, False, False, False]
+    assert w.ground_filled(x, y).tolist() == want
+    assert w.ground_source(x, y).tolist() == [-1 if v else 0 for v in want]
+    # a world without filled nodes is known everywhere (synthetic terrain)
+    assert not World.from_heightmap(h, 10.0, 4).ground_filled(x, y).any()

@@ -16,6 +16,11 @@ bilinearly — and :meth:`World.surface_height` with roofs), never on grid nodes
   path): lowest AGL along them and where, and the zones they enter;
 * **zones**: horizontal distance to every no-fly zone / the operating area and
   any point inside (:mod:`fm2uav.world.zones`);
+* **known and unknown ground** (:mod:`fm2uav.analysis.known_ground`): every
+  figure above split into over measured ground and over filled (unknown)
+  ground, length and share, the lowest AGL along the legs over each, which
+  DEM measured how much; and whether the DEM's pixels resolve the relief for
+  the requested flight level;
 * **warnings**: a path that flies higher above the ground than
   :data:`ADVISORY_MAX_AGL` (120 m: the EU open category's limit, and about US
   Part 107's 400 ft) without a ``max_agl`` of its own is named, with where and how
@@ -37,8 +42,10 @@ from ..errors import InputError
 from ..geometry import densify
 from ..planning.altitude import height_figures
 from ..world.clearance import surface_clearance
+from ..world.ground import has_unknown_ground
 from ..world.ground_model import sampling_step
 from ..world.zones import zone_distances, zone_violations
+from .known_ground import dem_resolution, filled_mask, ground_split
 
 __all__ = ["ADVISORY_MAX_AGL", "height_above_ground", "leg_figures", "safety_summary",
            "ceiling_warning"]
@@ -131,6 +138,12 @@ def leg_figures(world: Any, waypoints: Any, *, requested: float | None = None,
         sel = cl[leg] & inner
         if sel.any():
             out["cruise"] = height_figures(h[sel], requested, points=dense[sel])
+    if has_unknown_ground(world):
+        unknown = filled_mask(world, dense)
+        out["ground"] = {
+            "measured_min_m": round(float(h[~unknown].min()), 3) if (~unknown).any() else None,
+            "filled_min_m": round(float(h[unknown].min()), 3) if unknown.any() else None,
+            "filled_samples": int(unknown.sum()), "samples": int(len(h))}
     hits = zone_violations(world, dense if terrain_frame else p, step=step)
     out["zone_entries"] = [{"zone": v.zone, "leg": int(leg[min(v.segment, len(leg) - 1)])
                             if terrain_frame else v.segment,
@@ -169,7 +182,9 @@ def safety_summary(world: Any, path: Any, *, requested: float | None = None,
     dict
         ``height_above_ground`` {``path``, ``cruise``}, ``cruise_points``
         (first and last index of the cruise in ``path``), ``clearance_m``,
-        ``legs``, ``zones``, ``checks`` (each limit with pass/fail).
+        ``ground`` (:func:`~fm2uav.analysis.known_ground.ground_split`, DEM
+        worlds), ``dem_resolution`` (with a flight level), ``legs``, ``zones``,
+        ``checks`` (each limit with pass/fail).
     """
     p = np.asarray(path, dtype=float)
     if p.ndim != 2 or p.shape[1] != 3:
@@ -206,6 +221,13 @@ def safety_summary(world: Any, path: Any, *, requested: float | None = None,
     k = int(np.argmin(clr))
     out["clearance_m"] = round(float(clr[k]), 3)
     out["clearance_point_m"] = [round(float(v), 3) for v in p[k]]
+    split = ground_split(world, p, agl, clr, requested=requested, s=s)
+    if split is not None:
+        out["ground"] = split
+    res = dem_resolution(world, p, getattr(level, "agl", None) if level is not None
+                         else requested, cruise=cruise)
+    if res is not None:
+        out["dem_resolution"] = res
     if getattr(world, "zones", ()):
         out["zones"] = {
             "count": len(world.zones),

@@ -111,10 +111,12 @@ def _read_path(path_file: Path, header: dict, world, where: str):
     from ..io import read_path_csv
     from ..io.path_header import read_path_floor, read_path_w
 
+    from ..world.geo import crs_label, crs_token
+
     crs = getattr(world, "crs", None)
-    if header["crs"] and crs and header["crs"] != crs:
+    if header["crs"] and crs and header["crs"] not in (crs, crs_token(crs)):
         raise InputError(f"{path_file} says crs={header['crs']} but the {where} world is in "
-                         f"{crs}: give the mission or scenario the path was planned on")
+                         f"{crs_label(crs)}: give the mission or scenario the path was planned on")
     if header["crs"] and not crs:
         raise InputError(f"{path_file} says crs={header['crs']} but the {where} world has "
                          "no CRS: give the mission file of that DEM (--mission)")

@@ -226,6 +226,7 @@ def formation_cmd(
 def _safety(result, missions: dict[str, Any], level, fences, fence_warnings) -> dict[str, Any]:
     """summary.json 'safety': :func:`~fm2uav.analysis.safety.safety_summary` of every UAV's
     flown trajectory and its mission's legs (and the geofence count with zones)."""
+    from ..analysis.known_ground import check_ground
     from ..analysis.safety import safety_summary
 
     out: dict[str, Any] = {}
@@ -240,6 +241,7 @@ def _safety(result, missions: dict[str, Any], level, fences, fence_warnings) -> 
             phase=None if tr is None or tr.profile is None else tr.profile.phase,
             waypoints=wps.points_m, waypoint_indices=wps.indices,
             terrain_frame=wps.frame == 10, waypoint_agl=wps.agl, level=level)
+        check_ground(result.world, out[name], what=f"the {name}'s path")
     if getattr(result.world, "zones", ()):
         out["geofence"] = {"fences": len(fences), "warnings": list(fence_warnings)}
     return out

@@ -130,11 +130,15 @@ def plan_cmd(
     summary = {"scenario": scenario, "world": world_summary(w), **p.summary(),
                "route": route.summary()}
     if p.path.shape[1] == 3:  # measured on the continuous ground (legs: with the exports)
+        from ..analysis.known_ground import check_ground
         from ..analysis.safety import safety_summary
 
         summary["safety"] = safety_summary(w, p.path, requested=agl, phase=p.phase,
                                            level=p.level)
-    _write_plan(outdir, p, w, title=f"FM² plan — {scenario}")
+        if not extra:  # else plan_outputs measures the legs too, and says it there
+            check_ground(w, summary["safety"])
+    _write_plan(outdir, p, w, title=f"FM² plan — {scenario}",
+                ground=summary.get("safety", {}).get("ground"))
     built = None
     if extra:
         info, built = plan_outputs(outdir, p, extra, export_options,
@@ -182,13 +186,14 @@ def _points(w, sc, start: str | None, goal: str | None, via: list[str] | None, *
     return w, start_m, goal_m, via_m
 
 
-def _write_plan(outdir, p, world, *, title: str) -> None:
-    """plan.png and path.csv (with the final profile's floor) of a plan on ``world``."""
+def _write_plan(outdir, p, world, *, title: str, ground: dict | None = None) -> None:
+    """plan.png (with the known/unknown ground split ``ground``) and path.csv (with the final
+    profile's floor) of a plan on ``world``."""
     from ..io import write_path_csv
     from ..viz import plan_figure
 
     georef = getattr(world, "georef", None)
-    fig = plan_figure(p, title=title)
+    fig = plan_figure(p, title=title, ground=ground)
     tmp_png = outdir.target("plan.png")
     fig.savefig(tmp_png, dpi=110)
     with outdir.open("path.csv") as fh:

@@ -6,7 +6,8 @@ Each planning command (``plan``, ``cover``, ``check``, ``tune``, ``formation``,
 mission file's ``world:`` section becomes), :func:`build_world` and
 :func:`cli_point`:
 
-* ``--dem FILE`` (repeatable: tiles), ``--buildings FILE``, ``--bbox W,S,E,N``,
+* ``--dem FILE`` (repeatable: tiles), ``--dem-fill FILE`` (repeatable: more DEMs in
+  priority order that fill its gaps), ``--buildings FILE``, ``--bbox W,S,E,N``,
   ``--sea-level M``, ``--cell-size``, ``--dz``, ``--ceiling``, ``--nodata``,
   ``--nodata-value``, ``--crs``, ``--default-height``, ``--allow-filled``,
   ``--ground-elevation``, ``--margin``;
@@ -27,9 +28,10 @@ import numpy as np
 import typer
 
 from ..errors import InputError
+from ..pipeline.rows import world_rows  # noqa: F401  (re-exported: was defined here)
 
 __all__ = [
-    "DemOpt", "BuildingsOpt", "BboxOpt", "SeaLevelOpt", "CellSizeOpt", "DzOpt", "CeilingOpt",
+    "DemOpt", "DemFillOpt", "BuildingsOpt", "BboxOpt", "SeaLevelOpt", "CellSizeOpt", "DzOpt", "CeilingOpt",
     "NodataOpt", "NodataValueOpt", "CrsOpt", "DefaultHeightOpt", "AllowFilledOpt", "LonLatOpt",
     "GroundElevationOpt", "MarginOpt",
     "ScenarioOpt", "WORLD_FLAGS", "world_spec", "build_world", "cli_point", "world_rows",
@@ -52,6 +54,11 @@ DemOpt = _option(
     list[Path] | None, "--dem", panel=_P, metavar="FILE",
     help="DEM raster, any GDAL format (GeoTIFF, VRT, SRTM .hgt); repeat for tiles. "
          "Geographic/Web Mercator DEMs are reprojected to the local UTM zone.")
+DemFillOpt = _option(
+    list[Path] | None, "--dem-fill", panel=_P, metavar="FILE",
+    help="Another DEM (any CRS and resolution) that fills the gaps of --dem: the ground it "
+         "measures is measured ground, not filled. Repeat in priority order (e.g. a 30 m "
+         "national model under a 1 m survey).")
 BuildingsOpt = _option(
     Path | None, "--buildings", panel=_P, metavar="FILE",
     help="Building footprints: GeoJSON (lon/lat, RFC 7946), GeoPackage, Shapefile, KML/KMZ; "
@@ -72,8 +79,9 @@ CeilingOpt = _option(
     help="Altitude (m) of the top of the grid. Default: highest ground + agl + margin.")
 NodataOpt = _option(
     str, "--nodata", panel=_P, show_default=True,
-    help="DEM gaps under the map: 'error' or 'fill' (nearest valid elevation, marked as "
-         "filled).")
+    help="Ground no DEM measures: 'error' (refuse the DEM), 'fill' (nearest valid elevation, "
+         "reported as unknown ground, with a warning of the length flown over it) or "
+         "'error_on_route' (fill, but refuse a plan that flies over it).")
 NodataValueOpt = _option(
     float | None, "--nodata-value", panel=_P,
     help="An elevation value meaning 'no data' that the DEM file does not declare "
@@ -105,7 +113,8 @@ ScenarioOpt = Annotated[str | None, typer.Option(
 
 #: WorldSpec field -> CLI flag (for one-line errors that name the flag).
 WORLD_FLAGS = {
-    "dem": "--dem", "buildings": "--buildings", "bbox": "--bbox", "sea_level": "--sea-level",
+    "dem": "--dem", "dem_fill": "--dem-fill", "buildings": "--buildings", "bbox": "--bbox",
+    "sea_level": "--sea-level",
     "cell_size": "--cell-size", "dz": "--dz", "ceiling": "--ceiling", "nodata": "--nodata",
     "nodata_value": "--nodata-value", "crs": "--crs", "default_height": "--default-height",
     "allow_filled": "--allow-filled", "ground_elevation": "--ground-elevation",
@@ -128,6 +137,7 @@ def _bbox(text: str) -> list[float]:
 def world_spec(
     *,
     dem: list[Path] | None = None,
+    dem_fill: list[Path] | None = None,
     buildings: Path | None = None,
     bbox: str | None = None,
     sea_level: float | None = None,
@@ -155,6 +165,7 @@ def world_spec(
     from ..world.load import WorldSpec
 
     values = {"dem": [str(p) for p in dem] if dem else None,
+              "dem_fill": [str(p) for p in dem_fill] if dem_fill else None,
               "buildings": None if buildings is None else str(buildings),
               "bbox": None if bbox is None else _bbox(bbox), "sea_level": sea_level,
               "cell_size": cell_size, "dz": dz, "ceiling": ceiling, "nodata": nodata,
@@ -194,6 +205,8 @@ def world_overrides(**options: Any) -> dict[str, Any] | None:
     if values.get("dem"):
         dems = [str(p) for p in values["dem"]]
         out["dem"] = dems[0] if len(dems) == 1 else dems
+    if values.get("dem_fill"):
+        out["dem_fill"] = [str(p) for p in values["dem_fill"]]
     if values.get("buildings") is not None:
         out["buildings"] = str(values["buildings"])
     if values.get("bbox") is not None:
@@ -334,37 +347,6 @@ def requested_heights(*texts: str | None, lonlat: bool, agl: float | None
     return (max(agls) if agls else None), (max(tops) if tops else None)
 
 
-def world_rows(world: Any) -> dict[str, str]:
-    """Printed summary rows about a data world (nothing for a built-in scenario)."""
-    g = getattr(world, "georef", None)
-    if g is None:
-        return {}
-    rows = {"CRS": f"{g.crs}" + (f" — {g.reprojection}" if g.reprojection else ""),
-            "vertical": g.vertical}
-    for s in g.sources:
-        d = s.details
-        if s.role == "dem":
-            rows["grid"] = (f"{' x '.join(str(n) for n in world.shape)} nodes, cells "
-                            f"{d.get('cell_size', world.spacing[0]):g} m ({d.get('cell_size_rule', '')}), "
-                            f"dz {d.get('dz', world.spacing[2]):g} m ({d.get('dz_rule', '')})")
-            if d.get("filled_nodes"):
-                rows["filled nodata"] = f"{d['filled_nodes']} columns"
-        if s.role == "buildings":
-            hr = d.get("height_rule", {})
-            rows["buildings"] = (
-                f"{d.get('buildings', 0)}: {hr.get('height', 0)} from height, "
-                f"{hr.get('building:levels', 0)} from building:levels x "
-                f"{d.get('metres_per_level', 3.0):g} m, {hr.get('default_height', 0)} from "
-                f"--default-height" + (f"; left out: {d['skipped']}" if d.get("skipped") else "")
-                + (f"; {d['outside_map']} outside the map" if d.get("outside_map") else ""))
-            if "grid" not in rows:
-                rows["grid"] = (f"{' x '.join(str(n) for n in world.shape)} nodes, cells "
-                                f"{world.spacing[0]:g} m, dz {world.spacing[2]:g} m")
-    rows["sources"] = ", ".join(f"{Path(s.path).name} (sha256 {s.sha256[:12]})"
-                                for s in g.sources if s.sha256)
-    return rows
-
-
 # -- option groups: one decorator adds a group's flags to a command --------------------------
 
 def option_group(name: str, params: Sequence[tuple[str, Any, Any]],
@@ -409,6 +391,7 @@ class WorldFlags:
     """The world options as given (``--dem`` ... ``--allow-filled``)."""
 
     dem: list[Path] | None = None
+    dem_fill: list[Path] | None = None
     buildings: Path | None = None
     bbox: str | None = None
     sea_level: float | None = None
@@ -444,9 +427,10 @@ class WorldFlags:
                            top=need_top, default=default)
 
 
-#: ``@world_options``: the 14 world flags in place of the command's ``world`` parameter.
+#: ``@world_options``: the 15 world flags in place of the command's ``world`` parameter.
 world_options = option_group("world", [
-    ("dem", DemOpt, None), ("buildings", BuildingsOpt, None), ("bbox", BboxOpt, None),
+    ("dem", DemOpt, None), ("dem_fill", DemFillOpt, None), ("buildings", BuildingsOpt, None),
+    ("bbox", BboxOpt, None),
     ("sea_level", SeaLevelOpt, None), ("cell_size", CellSizeOpt, None), ("dz", DzOpt, None),
     ("ceiling", CeilingOpt, None), ("nodata", NodataOpt, "error"),
     ("nodata_value", NodataValueOpt, None), ("crs", CrsOpt, None),

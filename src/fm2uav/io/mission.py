@@ -14,7 +14,9 @@ Schema (pydantic v2, strict types, unknown keys rejected)::
       cell_size: 15                 # [m] horizontal grid cell (default: from the data)
       dz: 15                        # [m] vertical cell (default cell_size, <= planner.agl / 6)
       ceiling: 1500                 # [m] top node (default: highest ground + agl + margin)
-      nodata: error                 # DEM gaps: error | fill; nodata_value: -9999 if undeclared
+      dem_fill: [national_30m.tif]  # DEMs in priority order filling the gaps of dem
+      nodata: error                 # unknown ground: error | fill | error_on_route;
+                                    # nodata_value: -9999 if undeclared
       default_height: 10            # buildings without height/building:levels; crs, margin,
                                     # height_cells, metres_per_level, ground_elevation,
                                     # allow_filled
@@ -76,6 +78,7 @@ __all__ = [
     "resolve_point",
     "load_mission",
     "parse_mission",
+    "parse_world",
 ]
 
 #: Output formats a mission can ask for (exports + report + figure + summary).
@@ -100,7 +103,7 @@ class AnchorSpec(BaseModel):
 class WorldSpec(DataWorldSpec):
     """The map: a built-in scenario, or real data (DEM and/or buildings).
 
-    The real-data keys (``dem``, ``buildings``, ``bbox``, ``sea_level``,
+    The real-data keys (``dem``, ``dem_fill``, ``buildings``, ``bbox``, ``sea_level``,
     ``cell_size``, ``dz``, ``ceiling``, ``nodata``, ``nodata_value``, ``crs``,
     ``default_height``, ``metres_per_level``, ``height_cells``, ``margin``,
     ``ground_elevation``, ``allow_filled``) are :class:`fm2uav.world.load.WorldSpec`'s, shared with
@@ -141,7 +144,8 @@ class WorldSpec(DataWorldSpec):
                     raise ValueError(f"{k} does not apply to a built-in scenario (its grid is "
                                      "fixed); remove it")
             return self
-        only = {"dem": ("ceiling", "nodata", "nodata_value", "sea_level", "allow_filled"),
+        only = {"dem": ("ceiling", "nodata", "nodata_value", "sea_level", "allow_filled",
+                        "dem_fill"),
                 "buildings": ("height_cells", "default_height", "metres_per_level", "margin",
                               "ground_elevation")}
         for source, keys in only.items():
@@ -565,7 +569,8 @@ _TYPE_WORDS = {
 
 def _show(v: Any) -> str:
     text = repr(v)
-    return text if len(text) <= 60 else text[:57] + "..."
+    # a long value keeps its end too: a path's file name says which file is wrong
+    return text if len(text) <= 60 else text[:22] + "..." + text[-35:]
 
 
 def _format_error(err: dict[str, Any]) -> str:
@@ -636,6 +641,30 @@ def parse_mission(data: Any, *, source: str = "mission", base_dir: str | Path | 
         raise InputError(f"{source}: {_format_error(errs[0])}{more}") from None
 
 
+def parse_world(data: Any, *, source: str = "mission", base_dir: str | Path | None = None
+                ) -> WorldSpec:
+    """Validate a mission's ``world:`` section alone (e.g. to show a map before planning).
+
+    The same checks and the same one-line messages as :func:`parse_mission`
+    gives for that section (``<source>: world.dem = ... cannot be read as a
+    raster ...``), with paths relative to ``base_dir``.
+
+    Raises
+    ------
+    InputError
+    """
+    if not isinstance(data, dict):
+        raise InputError(f"{source}: world must be a mapping (scenario:, dem:, buildings:, ...), "
+                         f"got {type(data).__name__}")
+    try:
+        return WorldSpec.model_validate(data, context={"base_dir": base_dir})
+    except ValidationError as exc:
+        errs = exc.errors()
+        more = f" (+{len(errs) - 1} more)" if len(errs) > 1 else ""
+        first = {**errs[0], "loc": ("world", *errs[0]["loc"])}
+        raise InputError(f"{source}: {_format_error(first)}{more}") from None
+
+
 def load_mission(file: str | Path, *, world_overrides: dict[str, Any] | None = None,
                  point_overrides: dict[str, Any] | None = None) -> Mission:
     """Read and validate a YAML mission file (paths inside are relative to it).
@@ -662,7 +691,7 @@ def load_mission(file: str | Path, *, world_overrides: dict[str, Any] | None = N
         raise InputError(f"{file}: the mission file is empty; see examples/ for a template")
     if world_overrides and isinstance(data, dict):
         over = {k: v for k, v in world_overrides.items() if v is not None}
-        for k in ("dem", "buildings"):
+        for k in ("dem", "dem_fill", "buildings"):
             if k in over:
                 over[k] = ([str(Path(v).resolve()) for v in over[k]] if isinstance(over[k], list)
                            else str(Path(over[k]).resolve()))

@@ -14,10 +14,38 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["FILLED_NAME", "filled_overlay", "zone_overlays"]
+__all__ = ["FILLED_NAME", "FILLED_PATH_NAME", "filled_overlay", "filled_path_overlay",
+           "zone_overlays"]
 
 #: Legend name of the hatch.
 FILLED_NAME = "filled DEM nodata (invented ground)"
+#: Legend name of the path stretches over it.
+FILLED_PATH_NAME = "path over FILLED ground (unknown)"
+
+
+def filled_path_overlay(world: Any, paths: Any) -> dict[str, Any]:
+    """``{FILLED_PATH_NAME: overlay}``: the stretches of the 3D ``paths`` (one (N, 3) array or
+    a list) over filled (unknown) ground, as 3D polylines with NaN rows between them; empty
+    when no path crosses filled ground."""
+    from ..world.ground import has_unknown_ground
+
+    if getattr(world, "filled", None) is None or not has_unknown_ground(world):
+        return {}
+    parts: list[np.ndarray] = []
+    for p in ([paths] if isinstance(paths, np.ndarray) else list(paths)):
+        p = np.asarray(p, dtype=float)
+        if p.ndim != 2 or p.shape[1] != 3:
+            continue
+        on = np.asarray(world.ground_filled(p[:, 0], p[:, 1]), dtype=bool)
+        on[1:] |= on[:-1].copy()
+        if not on.any():
+            continue
+        pts = np.where(on[:, None], p, np.nan)
+        parts += [pts, np.full((1, 3), np.nan)]
+    if not parts:
+        return {}
+    return {FILLED_PATH_NAME: {"points": np.concatenate(parts[:-1]), "color": "#ff7f0e",
+                               "width": 10}}
 
 
 def filled_overlay(world: Any, *, lines: int = 60) -> dict[str, Any]:

@@ -324,7 +324,8 @@ section{background:#fff;border:1px solid #ddd;border-radius:6px;margin:0 0 16px;
 h2{font-size:17px;margin:6px 0}.cols{display:flex;gap:16px;flex-wrap:wrap}.cols>div{flex:1;min-width:300px}
 table{border-collapse:collapse;font-size:13px;width:100%}th,td{border-bottom:1px solid #eee;padding:3px 8px;text-align:left;vertical-align:top}
 th{width:38%;color:#444;font-weight:600}
-table.results th{width:auto;white-space:nowrap}footer{font-size:12px;color:#666;padding:8px 24px 24px}
+table.results th{width:auto;white-space:nowrap}
+section.warn{border-color:#ff7f0e;background:#fff4e5}section.warn h2{color:#b35900}footer{font-size:12px;color:#666;padding:8px 24px 24px}
 """
 
 
@@ -345,6 +346,7 @@ def report_html(
     ideal_agl: Mapping[str, float | None] | None = None,
     overlays: Mapping[str, Any] | None = None,
     tables: Mapping[str, Sequence[Mapping[str, Any]]] | None = None,
+    notes: Sequence[str] = (),
 ) -> str:
     """A self-contained interactive HTML report of paths on a world.
 
@@ -381,6 +383,9 @@ def report_html(
         with ``points`` and optional ``color``, ``dash``, ``width``.
     tables : mapping of str to sequence of dict, optional
         Titled result tables, one dict per row (e.g. a reproduced paper table).
+    notes : sequence of str, optional
+        Warnings shown first, highlighted (e.g. the length flown over filled DEM
+        nodata, a DEM too coarse for the flight level).
 
     Returns
     -------
@@ -413,7 +418,7 @@ def report_html(
 <title>{html.escape(title)}</title><style>{_CSS}</style></head>
 <body><header><h1>{html.escape(title)}</h1><p>{html.escape(subtitle)}</p></header>
 <main>
-<section><h2>Mission</h2>{div_scene}</section>
+{_notes(notes)}<section><h2>Mission</h2>{div_scene}</section>
 <section><h2>Profiles</h2>{div_prof}</section>
 <section class="cols"><div><h2>Parameters</h2>{_table(params or {})}</div>
 <div><h2>Metrics</h2>{_table(metrics or {})}</div>
@@ -426,6 +431,14 @@ def report_html(
 """
 
 
+def _notes(notes: Sequence[str]) -> str:
+    """The highlighted warnings section (empty without notes)."""
+    if not notes:
+        return ""
+    items = "".join(f"<li>{html.escape(str(n))}</li>" for n in notes)
+    return f'<section class="warn" id="fm2uav-warnings"><h2>Warnings</h2><ul>{items}</ul></section>\n'
+
+
 def _world_rows(world: Any) -> dict[str, Any]:
     """Rows of the report's World table (name, grid, spacing [m], origin [m], terrain, CRS)."""
     if world is None:
@@ -436,8 +449,17 @@ def _world_rows(world: Any) -> dict[str, Any]:
         "spacing [m]": world.spacing,
         "origin [m]": world.origin,
         "terrain": "yes" if world.terrain is not None else "no",
-        "CRS": world.crs or "none (local anchor)",
+        "CRS": _crs_name(world.crs) if world.crs else "none (local anchor)",
     }
+
+
+def _crs_name(crs: str) -> str:
+    from ..world.geo import crs_label
+
+    try:
+        return crs_label(crs)
+    except Exception:  # a world with a CRS pyproj no longer reads: as it is
+        return str(crs)
 
 
 def plan_report(

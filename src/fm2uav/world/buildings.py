@@ -374,7 +374,7 @@ def _flat_grid(polys: list[Any], heights: Sequence[float], box: Any, world_crs: 
     """
     if shape is None:
         if box is not None and world_crs is not None:
-            from .dem import _bbox_in
+            from .dem_read import _bbox_in
 
             minx, miny, maxx, maxy = _bbox_in(world_crs, box)
             mg = 0.0

@@ -44,6 +44,9 @@ __all__ = [
     "scale_error",
     "local_metric_crs",
     "crs_label",
+    "crs_token",
+    "crs_epsg",
+    "crs_string",
     "check_lonlat_bbox",
     "bounds_lonlat",
     "check_fit",
@@ -62,8 +65,16 @@ __all__ = [
 WGS84 = "EPSG:4326"
 
 
+@lru_cache(maxsize=256)
+def _crs_from_text(text: str) -> Any:
+    from pyproj import CRS
+
+    return CRS.from_user_input(text)
+
+
 def parse_crs(crs: Any) -> Any:
-    """A :class:`pyproj.CRS` from a string/EPSG code/CRS object, with a clear error."""
+    """A :class:`pyproj.CRS` from a string/EPSG code/CRS object, with a clear error
+    (strings are parsed once: a custom WKT takes tens of milliseconds)."""
     from pyproj import CRS
     from pyproj.exceptions import CRSError
 
@@ -73,9 +84,57 @@ def parse_crs(crs: Any) -> Any:
             "for longitude/latitude degrees or the EPSG code of its projection)"
         )
     try:
+        if isinstance(crs, CRS):
+            return crs
+        if isinstance(crs, str):
+            return _crs_from_text(crs)
         return CRS.from_user_input(crs)
     except CRSError as exc:
         raise WorldError(f"unknown coordinate reference system {crs!r}: {exc}") from None
+
+
+@lru_cache(maxsize=256)
+def _wkt_of_text(text: str) -> str:
+    return _crs_from_text(text).to_wkt()
+
+
+def _key(crs: Any) -> str:
+    """One string per CRS, however it was written (EPSG code, PROJ string, WKT1 of a file,
+    pyproj's WKT2): its WKT, so that caches keyed on it find it again."""
+    return _wkt_of_text(crs) if isinstance(crs, str) else parse_crs(crs).to_wkt()
+
+
+@lru_cache(maxsize=256)
+def _identity_of(wkt: str) -> tuple[int | None, int | None, tuple[str, str] | None, str]:
+    c = parse_crs(wkt)
+    matches = c.list_authority(min_confidence=70)
+    epsg70 = next((int(m.code) for m in matches if m.auth_name == "EPSG"), None)
+    epsg90 = next((int(m.code) for m in matches if m.auth_name == "EPSG"
+                   and m.confidence >= 90), None)
+    auth90 = next(((m.auth_name, m.code) for m in matches if m.confidence >= 90), None)
+    full = next((f"{m.auth_name}:{m.code}" for m in matches if m.confidence >= 100), None)
+    return epsg70, epsg90, auth90, full or c.srs
+
+
+def _identity(key: str) -> tuple[int | None, int | None, tuple[str, str] | None, str]:
+    """(EPSG code at 70 % confidence, at 90 %, authority at 90 %, ``to_string()``) of a CRS.
+
+    pyproj searches its whole database for a CRS without an authority code (about half a
+    second for a custom WKT), so each CRS is identified once, in one search.
+    """
+    ident = _identity_of(_key(key))
+    return ident[:3] + ((key if isinstance(key, str) and ident[3] == _key(key) else ident[3]),)
+
+
+def crs_epsg(crs: Any, min_confidence: int = 70) -> int | None:
+    """EPSG code of a CRS (None without one), identified once per CRS."""
+    ident = _identity(crs if isinstance(crs, str) else _key(crs))
+    return ident[1] if min_confidence >= 90 else ident[0]
+
+
+def crs_string(crs: Any) -> str:
+    """``pyproj.CRS.to_string()`` of a CRS (authority string, else its definition), cached."""
+    return _identity(crs if isinstance(crs, str) else _key(crs))[3]
 
 
 def utm_crs(lon: float, lat: float) -> str:
@@ -125,7 +184,7 @@ def _transformer(src: str, dst: str) -> Any:
 
 def transformer(src: Any, dst: Any) -> Any:
     """Cached ``pyproj.Transformer`` (x/lon first) from ``src`` to ``dst``."""
-    return _transformer(parse_crs(src).to_string(), parse_crs(dst).to_string())
+    return _transformer(_key(src), _key(dst))
 
 
 @dataclass(frozen=True)
@@ -306,15 +365,41 @@ MAX_SCALE_ERROR = 0.005
 
 
 def crs_label(crs: Any) -> str:
-    """Short name of a CRS: ``"EPSG:32630"`` when it has an EPSG code, else its PROJ string."""
-    c = parse_crs(crs)
-    code = c.to_epsg(min_confidence=90)
+    """Short name of a CRS: ``"EPSG:32630"`` when it has an authority code, a PROJ string
+    when it was given as one (the world's own transverse Mercator), else its name and
+    projection, e.g. ``'"Custom TM South" (Transverse Mercator; WKT without an EPSG code)'``
+    — never a whole WKT, and never through ``to_proj4`` (which warns and loses datum
+    shifts)."""
+    _, code, auth, text = _identity(crs if isinstance(crs, str) else _key(crs))
     if code is not None:
         return f"EPSG:{code}"
-    auth = c.to_authority(min_confidence=90)
     if auth is not None:
         return f"{auth[0]}:{auth[1]}"
-    return c.to_proj4() or c.to_wkt()
+    if text.startswith("+proj"):
+        return text
+    c = parse_crs(crs)
+    base = c.source_crs if c.is_bound and c.source_crs is not None else c
+    name = base.name if base.name and base.name.lower() not in ("unknown", "unnamed") else ""
+    op = getattr(base, "coordinate_operation", None)
+    method = getattr(op, "method_name", "") if op is not None else ""
+    kind = method or ("geographic" if base.is_geographic else base.type_name)
+    shown = f'"{name}"' if name else "unnamed CRS"
+    return f"{shown} ({kind}; WKT without an EPSG code)"
+
+
+def crs_token(crs: Any) -> str:
+    """One word naming a CRS exactly, for file headers (``# crs=...``): its authority code
+    (``"EPSG:32630"``), else ``"wkt-sha256:"`` and 16 hex digits of its WKT.
+
+    Two files on the same world carry the same token, so ``fm2uav export`` can tell a
+    path planned on another world even when the CRS has no EPSG code.
+    """
+    _, code, auth, _ = _identity(crs if isinstance(crs, str) else _key(crs))
+    if code is not None:
+        return f"EPSG:{code}"
+    if auth is not None:
+        return f"{auth[0]}:{auth[1]}"
+    return "wkt-sha256:" + hashlib.sha256(parse_crs(crs).to_wkt().encode()).hexdigest()[:16]
 
 
 def _lonlat_samples(bbox: tuple[float, float, float, float], n: int = 7) -> tuple[np.ndarray, np.ndarray]:
@@ -378,7 +463,7 @@ def local_metric_crs(crs: Any, bbox_lonlat: tuple[float, float, float, float]
     own = scale_error(c, bbox_lonlat)
     name = crs_label(c)
     if own <= MAX_SCALE_ERROR:
-        return c.to_string(), own, f"{name} kept (length distortion {100 * own:.2f} % here)"
+        return crs_string(c), own, f"{name} kept (length distortion {100 * own:.2f} % here)"
     units = {a.unit_name for a in c.axis_info[:2]}
     if c.is_geographic:
         why = f"{name} is geographic (degrees)"
@@ -603,9 +688,15 @@ class Georef:
     sources: tuple[SourceFile, ...] = ()
     amsl: bool = True
 
+    @property
+    def name(self) -> str:
+        """Short name of :attr:`crs` (:func:`crs_label`), for summaries."""
+        return crs_label(self.crs)
+
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready dict (``summary.json`` ``"georef"``; exports' metadata)."""
-        return {"crs": self.crs, "epsg": self.epsg, "vertical": self.vertical,
+        return {"crs": self.crs, "crs_name": self.name, "crs_token": crs_token(self.crs),
+                "epsg": self.epsg, "vertical": self.vertical,
                 "vertical_crs": self.vertical_crs, "vertical_assumed": self.vertical_assumed,
                 "amsl": self.amsl,
                 "reprojection": self.reprojection,
@@ -616,8 +707,10 @@ class Georef:
         """One line for file headers, e.g. ``"crs=EPSG:32630; z=DEM heights, ..."``."""
         srcs = ", ".join(f"{s.role} {Path(s.path).name} sha256={s.sha256[:12] if s.sha256 else '-'}"
                          for s in self.sources)
-        return (f"crs={self.epsg and f'EPSG:{self.epsg}' or self.crs}; z={self.vertical}"
-                + (f"; sources: {srcs}" if srcs else ""))
+        token = crs_token(self.crs)
+        name = self.name
+        return (f"crs={token}" + (f" ({name})" if name != token else "")
+                + f"; z={self.vertical}" + (f"; sources: {srcs}" if srcs else ""))
 
     def with_sources(self, *more: SourceFile) -> Georef:
         """A copy with more sources appended."""
@@ -631,8 +724,8 @@ def make_georef(crs: Any, *, vertical: str, vertical_crs: str | None = None,
                 scale_error: float = 0.0, sources: tuple[SourceFile, ...] = (),
                 amsl: bool = True) -> Georef:
     """A :class:`Georef` for a world in ``crs`` (EPSG code looked up)."""
-    c = parse_crs(crs)
-    return Georef(crs=c.to_string() if c.to_epsg() else str(crs), epsg=c.to_epsg(),
+    epsg = crs_epsg(crs)
+    return Georef(crs=crs_string(crs) if epsg else str(crs), epsg=epsg,
                   vertical=vertical, vertical_crs=vertical_crs,
                   vertical_assumed=vertical_assumed, reprojection=reprojection,
                   scale_error=float(scale_error), sources=tuple(sources), amsl=bool(amsl))

@@ -31,7 +31,8 @@ from scipy import ndimage
 if TYPE_CHECKING:
     from .world import World
 
-__all__ = ["ground_height", "surface_height", "roof_heights", "terrain_along"]
+__all__ = ["ground_height", "ground_filled", "ground_source", "has_unknown_ground",
+           "surface_height", "roof_heights", "terrain_along"]
 
 
 def _xy(world: World, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray, bool]:
@@ -68,6 +69,56 @@ def ground_height(world: World, x: Any, y: Any) -> np.ndarray | float:
         world.terrain, np.stack([ix.ravel(), iy.ravel()]), order=1, mode="nearest"
     )
     return _out(z.reshape(xa.shape), scalar)
+
+
+def ground_source(world: World, x: Any, y: Any) -> np.ndarray:
+    """Which DEM measures the ground at ``(x, y)`` [m]: 0 for ``world.dem``, k for the k-th
+    ``world.dem_fill``, -1 where the ground is unknown (filled nodata).
+
+    The rule of :meth:`ground_height`'s bilinear stencil: the ground is measured where
+    every sample with a non-zero weight is (the source DEM's four pixels, or the
+    planning grid's four nodes against ``World.filled`` when the world keeps no ground
+    model). A world without ``filled`` nodes and without a ground model is measured
+    everywhere (synthetic terrain is known by construction).
+    """
+    xa, ya, _ = _xy(world, x, y)
+    model = getattr(world, "ground", None)
+    if model is not None:
+        return np.asarray(model.source(xa, ya), dtype=np.int8)
+    filled = getattr(world, "filled", None)
+    out = np.zeros(xa.shape, dtype=np.int8)
+    if filled is None or not filled.any():
+        return out
+    nx, ny = filled.shape
+    ix = np.clip((xa - world.origin[0]) / world.spacing[0], 0, nx - 1)
+    iy = np.clip((ya - world.origin[1]) / world.spacing[1], 0, ny - 1)
+    i0 = np.minimum(np.floor(ix).astype(np.int64), max(nx - 2, 0))
+    j0 = np.minimum(np.floor(iy).astype(np.int64), max(ny - 2, 0))
+    fx, fy = ix - i0, iy - j0
+    bad = np.zeros(xa.shape, dtype=bool)
+    for di, dj, w in ((0, 0, (1 - fx) * (1 - fy)), (1, 0, fx * (1 - fy)),
+                      (0, 1, (1 - fx) * fy), (1, 1, fx * fy)):
+        ii, jj = np.minimum(i0 + di, nx - 1), np.minimum(j0 + dj, ny - 1)
+        bad |= (w > 1e-12) & filled[ii, jj]
+    out[bad] = -1
+    return out
+
+
+def has_unknown_ground(world: World) -> bool:
+    """Whether some ground of the map is unknown (filled): a filled node, or nodata pixels
+    of the DEM between the nodes (counted when the world was built)."""
+    filled = getattr(world, "filled", None)
+    if filled is not None and bool(np.asarray(filled).any()):
+        return True
+    g = getattr(world, "georef", None)
+    return any(s.role == "dem" and s.details.get("filled_pixels_between_nodes", 0) > 0
+               for s in (getattr(g, "sources", ()) or ()))
+
+
+def ground_filled(world: World, x: Any, y: Any) -> np.ndarray:
+    """Whether the ground at ``(x, y)`` [m] is unknown: filled nodata that no DEM measures
+    (see :func:`ground_source`)."""
+    return ground_source(world, x, y) < 0
 
 
 def roof_heights(world: World) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""The ground as the source DEM itself, beside the (coarser) planning grid.
+"""The ground as the source DEM(s) themselves, beside the (coarser) planning grid.
 
 A world built from a DEM resamples it to its cell size (``World.terrain``, one
 height per column node), which is what FM² plans on. Between those nodes the
@@ -9,77 +9,108 @@ DEM on ridges. Every height-above-ground question (``World.ground_height``,
 the final altitude profile, the safety figures, the exports' AMSL altitudes)
 therefore reads the DEM itself.
 
-:class:`GroundModel` keeps the source raster (elevations, affine transform,
-CRS) and answers ``height(x, y)`` for world coordinates by transforming them
-into the raster's CRS (pyproj, exact) and interpolating the raster bilinearly
-between pixel centres — the DEM "interpolated bilinearly", with no second
-resampling in between. Nodata pixels are filled with the nearest valid one
-(as the world's terrain is) and ``sea_level`` clamps the ground as in the
-world. It is kept whenever the raster holds at most :data:`MAX_SAMPLES`
-pixels, also when the DEM is coarser than the planning grid: the nodes of a
+:class:`GroundModel` keeps the source rasters (elevations, affine transform,
+CRS; one :class:`GroundLayer` per DEM, in priority order: ``world.dem`` first,
+then each ``world.dem_fill``) and answers ``height(x, y)`` for world
+coordinates by transforming them into each raster's CRS (pyproj, exact) and
+interpolating the raster bilinearly between pixel centres — the DEM
+"interpolated bilinearly", with no second resampling in between.
+
+**Known and unknown ground.** A point's height is *measured* by a layer when
+the four pixels of its bilinear stencil (those with a non-zero weight) are all
+valid in that layer; it takes the first such layer (:meth:`GroundModel.source`
+says which). Where no layer measures it, the ground is *unknown* (filled): the
+height is the first covering layer's value with its nodata filled by the
+nearest valid pixel, and :meth:`GroundModel.filled` says so — every safety
+figure over such points is reported apart (:mod:`fm2uav.analysis.known_ground`).
+``sea_level`` is already applied to the rasters (:func:`fm2uav.world.dem.read_dem`).
+
+The model is kept whenever its rasters hold at most :data:`MAX_SAMPLES` pixels
+together, also when the DEM is coarser than the planning grid: the nodes of a
 reprojected grid are bilinear samples of the DEM, but the bilinear surface
 between them is not the DEM's (a 0.01° DEM on its default 600 m UTM grid is
-off by up to 7 m on rough relief). A larger raster is not kept; the world's
-terrain answers then, and ``World.georef``'s sources still name the file.
+off by up to 7 m on rough relief). Larger rasters are not kept; the world's
+terrain (and ``World.filled``) answer then, and ``World.georef``'s sources still
+name the files.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 from scipy import ndimage
 
-__all__ = ["GroundModel", "MAX_SAMPLES", "ground_model_from_dem", "sampling_step", "ground_bulge"]
+__all__ = ["GroundModel", "GroundLayer", "MAX_SAMPLES", "ground_model_from_dem",
+           "sampling_step", "ground_bulge"]
 
-#: Largest raster (pixels) kept as a ground model (about 200 MB of float64).
+#: Largest raster (pixels, all layers together) kept as a ground model (about 200 MB of
+#: float64).
 MAX_SAMPLES = 25_000_000
+#: Points evaluated at a time by a model of several DEMs (bounds the temporaries).
+_CHUNK = 1_000_000
 
 
 @dataclass(frozen=True, eq=False)
-class GroundModel:
-    """The source DEM, interpolated bilinearly at world coordinates.
+class GroundLayer:
+    """One source DEM of a :class:`GroundModel`.
 
     Attributes
     ----------
     z : ndarray, shape (rows, cols)
         Elevations [m, world z], nodata filled with the nearest valid pixel.
+    valid : ndarray of bool, shape (rows, cols)
+        Which pixels were measured (not nodata).
     transform : 6 floats
         Affine ``(a, b, c, d, e, f)`` from (col, row) pixel-corner coordinates
         to the raster's CRS.
     crs : str
         The raster's horizontal CRS (WKT or authority string).
     world_crs : str
-        The world's CRS (the coordinates ``height`` is asked in).
+        The world's CRS (the coordinates questions are asked in).
     pixel_m : float
         Smaller side of a pixel in the world's metres.
-    description : str
-        One line for summaries.
+    name : str
+        The file (or "array"), for summaries.
+    spacing_m : float
+        Larger side of a pixel in the world's metres (the distance over which relief
+        between pixel centres goes unseen); default ``pixel_m``.
     """
 
     z: np.ndarray = field(repr=False)
+    valid: np.ndarray = field(repr=False)
     transform: tuple[float, ...]
     crs: str = field(repr=False)
     world_crs: str = field(repr=False)
     pixel_m: float = 0.0
-    description: str = ""
+    name: str = ""
+    spacing_m: float = 0.0
     _to_src: Any = field(default=None, init=False, repr=False, compare=False)
     _inv: tuple[float, ...] = field(default=(), init=False, repr=False, compare=False)
+    _all_valid: bool = field(default=True, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         from .geo import parse_crs, transformer
 
         z = np.array(self.z, dtype=float, copy=True)
-        if z.ndim != 2 or min(z.shape) < 2 or not np.all(np.isfinite(z)):
-            raise ValueError(f"GroundModel z must be a finite (rows >= 2, cols >= 2) array, "
-                             f"got shape {z.shape}")
+        valid = np.array(self.valid, dtype=bool, copy=True)
+        if z.ndim != 2 or min(z.shape) < 2 or not np.all(np.isfinite(z)) or \
+                valid.shape != z.shape:
+            raise ValueError(f"GroundLayer z must be a finite (rows >= 2, cols >= 2) array with "
+                             f"a valid mask of its shape, got {z.shape} and {valid.shape}")
         z.setflags(write=False)
+        valid.setflags(write=False)
         object.__setattr__(self, "z", z)
+        object.__setattr__(self, "valid", valid)
+        object.__setattr__(self, "_all_valid", bool(valid.all()))
+        if not self.spacing_m:
+            object.__setattr__(self, "spacing_m", float(self.pixel_m))
         a, b, c, d, e, f = (float(v) for v in self.transform)
         det = a * e - b * d
         if det == 0:
-            raise ValueError("GroundModel transform is singular")
+            raise ValueError("GroundLayer transform is singular")
         # inverse affine: (x, y) -> (col, row)
         inv = (e / det, -b / det, (b * f - c * e) / det, -d / det, a / det, (c * d - a * f) / det)
         object.__setattr__(self, "_inv", inv)
@@ -87,30 +118,126 @@ class GroundModel:
         object.__setattr__(self, "_to_src", None if same else
                            transformer(self.world_crs, self.crs))
 
-    @property
-    def shape(self) -> tuple[int, int]:
-        """``(rows, cols)`` of the raster."""
-        return tuple(int(v) for v in self.z.shape)  # type: ignore[return-value]
-
-    def pixel_index(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
-        """Continuous ``(row, col)`` of world ``(x, y)`` [m] in the raster, pixel centres at
-        whole numbers: the bilinear surface is smooth between whole rows and columns."""
-        xa, ya = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
-        xs, ys = xa.ravel(), ya.ravel()
+    def pixel_coords(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Continuous (row, col) of world points in this raster (pixel centres at integers)."""
+        xs, ys = x, y
         if self._to_src is not None:
             xs, ys = self._to_src.transform(xs, ys)
             xs, ys = np.asarray(xs, dtype=float), np.asarray(ys, dtype=float)
         ia, ib, ic, id_, ie, if_ = self._inv
         col = ia * xs + ib * ys + ic - 0.5
         row = id_ * xs + ie * ys + if_ - 0.5
-        return row.reshape(xa.shape), col.reshape(xa.shape)
+        return row, col
+
+    def height_at(self, row: np.ndarray, col: np.ndarray) -> np.ndarray:
+        """Bilinear height at continuous pixel coordinates (edge pixels outside)."""
+        return ndimage.map_coordinates(self.z, np.stack([row, col]), order=1, mode="nearest")
+
+    def measured_at(self, row: np.ndarray, col: np.ndarray) -> np.ndarray:
+        """Whether every pixel with a non-zero bilinear weight is measured (and the point
+        lies within the pixel-centre footprint)."""
+        rows, cols = self.z.shape
+        tol = 1e-6  # pixels: world edges sit on the footprint up to round-off
+        ok = (row >= -tol) & (row <= rows - 1 + tol) & (col >= -tol) & (col <= cols - 1 + tol)
+        ok &= np.isfinite(row) & np.isfinite(col)
+        if self._all_valid:
+            return ok
+        r = np.clip(np.where(ok, row, 0.0), 0, rows - 1)
+        c = np.clip(np.where(ok, col, 0.0), 0, cols - 1)
+        r0 = np.minimum(np.floor(r).astype(np.int64), rows - 2)
+        c0 = np.minimum(np.floor(c).astype(np.int64), cols - 2)
+        fr, fc = r - r0, c - c0
+        v = self.valid
+        out = ok.copy()
+        for dr, dc, w in ((0, 0, (1 - fr) * (1 - fc)), (0, 1, (1 - fr) * fc),
+                          (1, 0, fr * (1 - fc)), (1, 1, fr * fc)):
+            out &= (w <= 1e-12) | v[r0 + dr, c0 + dc]
+        return out
+
+    def covers(self, row: np.ndarray, col: np.ndarray) -> np.ndarray:
+        """Whether points lie within the pixel-centre footprint."""
+        rows, cols = self.z.shape
+        return (row >= -0.5) & (row <= rows - 0.5) & (col >= -0.5) & (col <= cols - 0.5)
+
+
+@dataclass(frozen=True, eq=False)
+class GroundModel:
+    """The source DEMs (priority order), interpolated bilinearly at world coordinates.
+
+    Attributes
+    ----------
+    layers : tuple of GroundLayer
+        ``world.dem`` first, then each ``world.dem_fill``.
+    description : str
+        One line for summaries.
+    """
+
+    layers: tuple[GroundLayer, ...]
+    description: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.layers:
+            raise ValueError("GroundModel needs at least one layer")
+        object.__setattr__(self, "layers", tuple(self.layers))
+
+    @property
+    def pixel_m(self) -> float:
+        """The smallest pixel of the layers [m]."""
+        return float(min(layer.pixel_m for layer in self.layers))
+
+    def _evaluate(self, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray, tuple[int, ...]]:
+        """(heights, measuring layer or -1, shape) of world points, in chunks of
+        :data:`_CHUNK` points (a clearance grid asks for millions)."""
+        xa, ya = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+        xs, ys = xa.ravel(), ya.ravel()
+        h = np.empty(xs.shape)
+        src = np.empty(xs.shape, dtype=np.int8)
+        for a in range(0, len(xs), _CHUNK):
+            h[a:a + _CHUNK], src[a:a + _CHUNK] = self._evaluate_flat(xs[a:a + _CHUNK],
+                                                                     ys[a:a + _CHUNK])
+        return h, src, xa.shape
+
+    def _evaluate_flat(self, xs: np.ndarray, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        h = np.full(xs.shape, np.nan)
+        src = np.full(xs.shape, -1, dtype=np.int8)
+        fallback = np.full(xs.shape, np.nan)
+        for k, layer in enumerate(self.layers):
+            todo = src < 0
+            if not todo.any():
+                break
+            row, col = layer.pixel_coords(xs[todo], ys[todo])
+            m = layer.measured_at(row, col)
+            hk = layer.height_at(row, col)
+            idx = np.flatnonzero(todo)
+            h[idx[m]] = hk[m]
+            src[idx[m]] = k
+            cover = ~m & layer.covers(row, col) & np.isnan(fallback[idx])
+            fallback[idx[cover]] = hk[cover]
+            if k == len(self.layers) - 1:  # beyond every footprint: the last layer's edge
+                rest = ~m & np.isnan(fallback[idx])
+                fallback[idx[rest]] = hk[rest]
+        unknown = src < 0
+        h[unknown] = fallback[unknown]
+        return h, src
 
     def height(self, x: Any, y: Any) -> np.ndarray:
-        """Bilinear DEM height [m] at world ``(x, y)`` [m] (edge pixels outside)."""
-        row, col = self.pixel_index(x, y)
-        out = ndimage.map_coordinates(self.z, np.stack([row.ravel(), col.ravel()]), order=1,
-                                      mode="nearest")
-        return out.reshape(row.shape)
+        """Bilinear DEM height [m] at world ``(x, y)`` [m] (see the module docstring)."""
+        if len(self.layers) == 1:  # one DEM: its (nodata-filled) raster everywhere
+            xa, ya = np.broadcast_arrays(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+            layer = self.layers[0]
+            row, col = layer.pixel_coords(xa.ravel(), ya.ravel())
+            return layer.height_at(row, col).reshape(xa.shape)
+        h, _, shape = self._evaluate(x, y)
+        return h.reshape(shape)
+
+    def source(self, x: Any, y: Any) -> np.ndarray:
+        """Index of the layer measuring the ground at ``(x, y)``; -1 where none does."""
+        _, src, shape = self._evaluate(x, y)
+        return src.reshape(shape)
+
+    def filled(self, x: Any, y: Any) -> np.ndarray:
+        """Whether the ground at ``(x, y)`` is unknown (no layer measures it)."""
+        return self.source(x, y) < 0
 
 
 def sampling_step(world: Any) -> float:
@@ -123,14 +250,16 @@ def sampling_step(world: Any) -> float:
     return step
 
 
-def _grid_index(world: Any, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Continuous index of world points in the grid the ground is bilinear on (the source
-    DEM's pixel centres, or the world's terrain nodes): smooth between whole numbers."""
+def _grid_indices(world: Any, x: np.ndarray, y: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Continuous indices of world points in each grid the ground is bilinear on (every
+    source DEM's pixel centres — a model of several DEMs switches layer only on the
+    higher-priority layer's whole rows and columns — or the world's terrain nodes): the
+    ground is smooth between whole numbers of all of them."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     model = getattr(world, "ground", None)
     if model is not None:
-        return model.pixel_index(x, y)
-    return ((np.asarray(x, dtype=float) - world.origin[0]) / world.spacing[0],
-            (np.asarray(y, dtype=float) - world.origin[1]) / world.spacing[1])
+        return [layer.pixel_coords(x, y) for layer in model.layers]
+    return [((x - world.origin[0]) / world.spacing[0], (y - world.origin[1]) / world.spacing[1])]
 
 
 def ground_bulge(world: Any, a: Any, b: Any) -> tuple[np.ndarray, np.ndarray]:
@@ -151,11 +280,10 @@ def ground_bulge(world: Any, a: Any, b: Any) -> tuple[np.ndarray, np.ndarray]:
     k = len(pa)
     if k == 0 or (getattr(world, "ground", None) is None and world.terrain is None):
         return np.zeros(k), np.zeros(k)
-    r0, c0 = _grid_index(world, pa[:, 0], pa[:, 1])
-    r1, c1 = _grid_index(world, pb[:, 0], pb[:, 1])
-    # breakpoints: t where the row or the column index crosses a whole number
+    ends = zip(_grid_indices(world, pa[:, 0], pa[:, 1]), _grid_indices(world, pb[:, 0], pb[:, 1]))
+    # breakpoints: t where a row or a column index crosses a whole number
     ts = [np.zeros(k), np.ones(k)]
-    for u0, u1 in ((r0, r1), (c0, c1)):
+    for u0, u1 in (pair for (r0, c0), (r1, c1) in ends for pair in ((r0, r1), (c0, c1))):
         lo, hi = np.minimum(u0, u1), np.maximum(u0, u1)
         first = np.floor(lo) + 1.0
         n = np.maximum(np.ceil(hi) - first, 0).astype(int)
@@ -193,8 +321,9 @@ def ground_bulge(world: Any, a: Any, b: Any) -> tuple[np.ndarray, np.ndarray]:
     return np.maximum(rise, 0.0), np.maximum(drop, 0.0)
 
 
-def _pixel_metres(dem: Any, src: Any, dst: Any) -> float:
-    """Smaller side of the DEM's centre pixel, measured in the destination CRS [m]."""
+def _pixel_metres(dem: Any, src: Any, dst: Any, larger: bool = False) -> float:
+    """Smaller (``larger``: larger) side of the DEM's centre pixel, measured in the
+    destination CRS [m]."""
     from .geo import transformer
 
     rows, cols = dem.z.shape
@@ -208,47 +337,49 @@ def _pixel_metres(dem: Any, src: Any, dst: Any) -> float:
     tx, ty = np.asarray(tx), np.asarray(ty)
     side_c = float(np.hypot(tx[1] - tx[0], ty[1] - ty[0]))
     side_r = float(np.hypot(tx[2] - tx[0], ty[2] - ty[0]))
-    return min(side_c, side_r)
+    return max(side_c, side_r) if larger else min(side_c, side_r)
 
 
-def ground_model_from_dem(dem: Any, src: Any, dst: Any, cell: float, *,
-                          sea_level: float | None = None,
+def ground_model_from_dem(dems: Any, srcs: Any, dst: Any, cell: float, *,
                           max_samples: int = MAX_SAMPLES) -> GroundModel | None:
-    """The ground model of a DEM, or None if it is too large or has no valid pixel.
+    """The ground model of DEMs in priority order, or None if too large or without data.
 
     Parameters
     ----------
-    dem : fm2uav.world.dem.DemRaster
-        The raster as read (north-up, NaN where masked).
-    src, dst : CRS
-        The DEM's CRS and the world's.
+    dems : DemRaster or list of them
+        The rasters as read (NaN where masked, ``sea_level`` applied), priority order.
+    srcs : CRS or list of them
+        Their CRSs; ``dst`` the world's.
     cell : float
         The world's smallest horizontal cell [m] (the model is kept at any cell
         size; the argument stays for callers).
-    sea_level : float, optional
-        ``ground = max(DEM, sea_level)`` as in the world.
     max_samples : int
-        Largest raster kept [pixels].
+        Largest number of pixels kept, all layers together.
     """
     from .geo import crs_label, parse_crs
 
-    z = np.asarray(dem.z, dtype=float)
-    if z.ndim != 2 or min(z.shape) < 2 or z.size > max_samples:
+    if not isinstance(dems, (list, tuple)):
+        dems, srcs = [dems], [srcs]
+    if sum(int(np.asarray(d.z).size) for d in dems) > max_samples:
         return None
-    pixel = _pixel_metres(dem, src, dst)
-    if not (np.isfinite(pixel) and pixel > 0):
-        return None
-    bad = ~np.isfinite(z)
-    if bad.all():
-        return None
-    if bad.any():
-        _, (ii, jj) = ndimage.distance_transform_edt(bad, return_indices=True)
-        z = z[ii, jj]
-    if sea_level is not None:
-        z = np.maximum(z, float(sea_level))
-    src_s = parse_crs(src).to_wkt()
+    layers = []
     dst_s = parse_crs(dst).to_wkt()
-    desc = (f"source DEM ({z.shape[0]} x {z.shape[1]} pixels of {pixel:.1f} m, "
-            f"{crs_label(src)}), bilinear between pixel centres")
-    return GroundModel(z, tuple(float(v) for v in dem.transform), src_s, dst_s, float(pixel),
-                       desc)
+    for dem, src in zip(dems, srcs):
+        z = np.asarray(dem.z, dtype=float)
+        if z.ndim != 2 or min(z.shape) < 2:
+            return None
+        pixel = _pixel_metres(dem, src, dst)
+        bad = ~np.isfinite(z)
+        if not (np.isfinite(pixel) and pixel > 0) or bad.all():
+            return None
+        if bad.any():
+            _, (ii, jj) = ndimage.distance_transform_edt(bad, return_indices=True)
+            z = z[ii, jj]
+        name = Path(dem.sources[0].path).name if getattr(dem, "sources", ()) else "array"
+        layers.append(GroundLayer(z, ~bad, tuple(float(v) for v in dem.transform),
+                                  parse_crs(src).to_wkt(), dst_s, float(pixel), name,
+                                  _pixel_metres(dem, src, dst, larger=True)))
+    desc = "; ".join(f"{'fill: ' if k else ''}{layer.name} ({layer.z.shape[0]} x "
+                     f"{layer.z.shape[1]} pixels of {layer.pixel_m:.1f} m, "
+                     f"{crs_label(layer.crs)})" for k, layer in enumerate(layers))
+    return GroundModel(tuple(layers), f"source DEM {desc}, bilinear between pixel centres")

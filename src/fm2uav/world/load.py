@@ -50,7 +50,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator
 
 from ..errors import InputError, PointError, WorldError
-from .dem import GeodataWarning
+from .quiet import GeodataWarning, library_warnings
 from .world import World
 
 __all__ = [
@@ -130,6 +130,35 @@ def _regular_file(path: Path) -> None:
         raise ValueError(str(exc).removeprefix("file ")) from None
 
 
+def _raster_file(item: str, info: ValidationInfo | None) -> str:
+    """A DEM path resolved against the mission file's folder, checked to be an elevation
+    raster GDAL reads (as a ValueError for pydantic)."""
+    path = _resolve(item, info)
+    if not path.exists():
+        raise ValueError(f"file not found ({path}); allowed: an existing raster file "
+                         "(GeoTIFF, VRT, .hgt, ...)")
+    _regular_file(path)
+    import rasterio
+
+    from .dem_values import raster_problem
+
+    try:
+        with library_warnings(f"the DEM {path.name}"), rasterio.open(path) as ds:
+            problem = raster_problem(ds, path.name)
+            crs = ds.crs
+    except Exception as exc:  # rasterio raises its own error types
+        raise ValueError(f"cannot be read as a raster ({type(exc).__name__}); "
+                         "allowed: a raster file GDAL reads (GeoTIFF, VRT, .hgt)") from None
+    if problem is not None:
+        raise ValueError(problem.removeprefix(f"the DEM {path.name} "))
+    if crs is None and (info is None or (info.data or {}).get("crs") is None):
+        raise ValueError(
+            f"{path.name} has no coordinate reference system (CRS); give it with world.crs "
+            "(CLI --crs), e.g. EPSG:32630, or assign one in the file (gdal_edit.py -a_srs "
+            "EPSG:32630 FILE)")
+    return str(path)
+
+
 class WorldSpec(BaseModel):
     """The real-data part of a world: DEM, buildings, crop, sea, grid (see the module docstring).
 
@@ -138,8 +167,14 @@ class WorldSpec(BaseModel):
     """
 
     model_config = _STRICT
+    # first: the DEM and buildings validators below read it (fields validate in this order)
+    crs: str | None = Field(None, description="CRS of input files that declare none")
     dem: str | list[str] | None = Field(
-        None, description="DEM raster file(s) GDAL reads (GeoTIFF, VRT, .hgt); several = tiles")
+        None, description="DEM raster file(s) GDAL reads (GeoTIFF, VRT, .hgt); several = tiles "
+        "of one DEM (merged, one CRS)")
+    dem_fill: str | list[str | list[str]] | None = Field(
+        None, description="more DEMs in priority order that fill the gaps of dem (any CRS and "
+        "resolution; an entry may be a list of tiles)")
     buildings: str | None = Field(
         None, description="building footprints: GeoJSON (lon/lat), GeoPackage, Shapefile, KML/KMZ")
     bbox: list[float] | None = Field(
@@ -152,9 +187,10 @@ class WorldSpec(BaseModel):
                             desc="vertical cell (default: cell_size, at most agl/6)")
     ceiling: float | None = _num(None, unit="m", ge=-500, le=12000,
                                  desc="altitude of the top node (default: follows agl)")
-    nodata: Literal["error", "fill"] = Field("error", description="DEM gaps: refuse or fill")
+    nodata: Literal["error", "fill", "error_on_route"] = Field(
+        "error", description="ground no DEM measures: refuse the DEM, fill it (reported as "
+        "unknown ground), or fill it and refuse plans that fly over it")
     nodata_value: float | None = _num(None, unit="m", desc="an undeclared DEM nodata value")
-    crs: str | None = Field(None, description="CRS of input files that declare none")
     default_height: float | None = _num(None, unit="m", gt=0, le=1000,
                                         desc="height of buildings without one")
     metres_per_level: float = _num(3.0, unit="m", gt=0, le=20,
@@ -177,28 +213,50 @@ class WorldSpec(BaseModel):
         items = [v] if isinstance(v, str) else list(v)
         if not items:
             raise ValueError("is empty; allowed: a raster file or a list of tiles")
-        out = []
-        for item in items:
-            path = _resolve(item, info)
-            if not path.exists():
-                raise ValueError(f"file not found ({path}); allowed: an existing raster file "
-                                 "(GeoTIFF, VRT, .hgt, ...)")
-            _regular_file(path)
-            try:
-                import rasterio
-
-                with rasterio.open(path) as ds:
-                    crs = ds.crs
-            except Exception as exc:  # rasterio raises its own error types
-                raise ValueError(f"cannot be read as a raster ({type(exc).__name__}); "
-                                 "allowed: a raster file GDAL reads (GeoTIFF, VRT, .hgt)") from None
-            if crs is None and (info.data or {}).get("crs") is None:
-                raise ValueError(
-                    f"{path.name} has no coordinate reference system (CRS); allowed: a raster "
-                    "with a CRS (assign one: gdal_edit.py -a_srs EPSG:32616 FILE), or give it "
-                    "with world.crs")
-            out.append(str(path))
+        out = [_raster_file(item, info) for item in items]
         return out[0] if isinstance(v, str) else out
+
+    @field_validator("dem_fill")
+    @classmethod
+    def _fill_files(cls, v: Any, info: ValidationInfo) -> Any:
+        if v is None:
+            return v
+        items = [v] if isinstance(v, str) else list(v)
+        if not items:
+            raise ValueError("is empty; allowed: a raster file or a list of them (priority "
+                             "order)")
+        out: list[Any] = []
+        for item in items:
+            if isinstance(item, list):
+                if not item:
+                    raise ValueError("has an empty list of tiles; allowed: raster files")
+                out.append([_raster_file(t, info) for t in item])
+            else:
+                out.append(_raster_file(item, info))
+        return out
+
+    @field_validator("dem_fill")
+    @classmethod
+    def _fill_needs_dem(cls, v: Any, info: ValidationInfo) -> Any:
+        if v is not None and (info.data or {}).get("dem") is None:
+            raise ValueError("fills the gaps of world.dem (CLI --dem), which is not given; "
+                             "give the DEM first, or make this DEM world.dem")
+        return v
+
+    def fill_sources(self) -> list[Any]:
+        """``dem_fill`` as a list (each entry a file or a list of tiles), priority order."""
+        if self.dem_fill is None:
+            return []
+        return [self.dem_fill] if isinstance(self.dem_fill, str) else list(self.dem_fill)
+
+    def dem_files(self) -> list[str]:
+        """Every DEM file of the spec (``dem`` tiles, then each ``dem_fill`` entry's files)."""
+        out = [] if self.dem is None else ([self.dem] if isinstance(self.dem, str)
+                                           else list(self.dem))
+        for item in ([self.dem_fill] if isinstance(self.dem_fill, str) else
+                     list(self.dem_fill or ())):
+            out += item if isinstance(item, list) else [item]
+        return out
 
     @field_validator("buildings")
     @classmethod
@@ -251,6 +309,10 @@ class WorldSpec(BaseModel):
             dems = [self.dem] if isinstance(self.dem, str) else self.dem
             parts.append(Path(dems[0]).name + (f" (+{len(dems) - 1} tiles)" if len(dems) > 1
                                                else ""))
+            fills = self.fill_sources()
+            if fills:
+                names = [Path(f if isinstance(f, str) else f[0]).name for f in fills]
+                parts[-1] += f" (gaps from {', '.join(names)})"
         if self.buildings is not None:
             parts.append(Path(self.buildings).name)
         return " + ".join(parts)
@@ -260,15 +322,18 @@ def _pixel_ground_size(path: str) -> tuple[float, float]:
     """(pixel size on the ground [m], footprint area [m²]) of a raster from its metadata."""
     import rasterio
 
+    from .dem_values import pixel_sizes
     from .geo import bounds_lonlat, parse_crs
 
-    with rasterio.open(path) as ds:
+    with library_warnings(f"the DEM {Path(path).name}"), rasterio.open(path) as ds:
         crs = parse_crs(ds.crs.to_wkt()) if ds.crs is not None else None
-        res = max(abs(ds.transform.a), abs(ds.transform.e))
+        t = ds.transform
+        shape = (ds.height, ds.width)
         b = ds.bounds
-        if crs is None:
-            return res, (b.right - b.left) * (b.top - b.bottom)
-        ll = bounds_lonlat((b.left, b.bottom, b.right, b.top), crs)
+    if crs is None:
+        res = max(float(np.hypot(t.a, t.d)), float(np.hypot(t.b, t.e)))
+        return res, (b.right - b.left) * (b.top - b.bottom)
+    ll = bounds_lonlat((b.left, b.bottom, b.right, b.top), crs)
     from pyproj import Geod
 
     lat_c = 0.5 * (ll[1] + ll[3])
@@ -276,20 +341,13 @@ def _pixel_ground_size(path: str) -> tuple[float, float]:
     width = geod.inv(ll[0], lat_c, ll[2], lat_c)[2]
     height = geod.inv(ll[0], ll[1], ll[0], ll[3])[2]
     if crs.is_geographic:
-        pix = res * 111320.0 * max(math.cos(math.radians(lat_c)), 0.05)
-    else:
-        # projected units -> ground metres: the unit, and the scale factor at the centre
-        # (Web Mercator at 45 deg stores 1.41 projected metres per ground metre)
-        from pyproj import Proj
-
-        unit = crs.axis_info[0].unit_conversion_factor if crs.axis_info else 1.0
-        try:
-            f = Proj(crs).get_factors(0.5 * (ll[0] + ll[2]), lat_c)
-            k = math.sqrt(float(f.tissot_semimajor) * float(f.tissot_semiminor))
-        except Exception:  # projections without factors: take the units as they are
-            k = 1.0
-        pix = res * unit / (k if np.isfinite(k) and k > 0 else 1.0)
-    return float(pix), float(width * height)
+        # the larger step in degrees, as metres east-west at the centre (the pixel's short
+        # side towards the poles: the finer of the two ground spacings of a square-degree grid)
+        res = max(float(np.hypot(t.a, t.d)), float(np.hypot(t.b, t.e)))
+        return float(res * 111320.0 * max(math.cos(math.radians(lat_c)), 0.05)), \
+            float(width * height)
+    ex, ey = pixel_sizes(tuple(t)[:6], crs, shape)
+    return float(max(ex[0], ey[0])), float(width * height)
 
 
 def _bbox_area(bbox: Any) -> float:
@@ -299,38 +357,64 @@ def _bbox_area(bbox: Any) -> float:
     return abs(Geod(ellps="WGS84").polygon_area_perimeter([w, e, e, w], [s, s, n, n])[0])
 
 
-def _relief(spec: WorldSpec) -> tuple[float, float] | None:
-    """(lowest, highest) elevation [m] of the DEM's area, from a decimated read (<= 256²)."""
+def _relief_of(path: str, spec: WorldSpec) -> tuple[float, float] | None:
+    """(lowest, highest) elevation [m] of one DEM file over the area, from a decimated read
+    (<= 256²) taken through the same nodata, sentinel and sea-level rules as the real read."""
     import rasterio
     from rasterio.windows import from_bounds
 
-    first = spec.dem if isinstance(spec.dem, str) else spec.dem[0]
+    from .dem_values import find_sentinels, length_unit_factor, pixel_sizes
+
     try:
-        with rasterio.open(first) as ds:
+        with library_warnings(f"the DEM {Path(path).name}"), rasterio.open(path) as ds:
             win = None
             if spec.bbox is not None and ds.crs is not None:
-                from .dem import _bbox_in
+                from .dem_read import _bbox_in
                 from .geo import parse_crs
 
                 b = _bbox_in(parse_crs(ds.crs.to_wkt()), tuple(spec.bbox))
                 win = from_bounds(*b, transform=ds.transform)
-            h = int(min(256, ds.height if win is None else max(win.height, 1)))
-            w = int(min(256, ds.width if win is None else max(win.width, 1)))
+            full_h = ds.height if win is None else max(win.height, 1)
+            full_w = ds.width if win is None else max(win.width, 1)
+            h, w = int(min(256, full_h)), int(min(256, full_w))
             z = ds.read(1, masked=True, window=win, out_shape=(max(h, 1), max(w, 1)),
-                        boundless=win is not None)
+                        boundless=win is not None, out_dtype="float64")
             scale, offset = float(ds.scales[0] or 1.0), float(ds.offsets[0] or 0.0)
+            unit = length_unit_factor(ds.units[0] if ds.units else None) or 1.0
+            crs = ds.crs.to_wkt() if ds.crs is not None else spec.crs
+            t = tuple(ds.transform)[:6]
+            dtype = ds.dtypes[0]
     except Exception:  # any read problem is reported by the real read
         return None
-    v = np.ma.compressed(z).astype(float) * scale + offset
+    raw = np.ma.filled(z, np.nan)
     if spec.nodata_value is not None:
-        v = v[v != spec.nodata_value * scale + offset]
-    v = v[np.isfinite(v)]
+        raw[raw == spec.nodata_value] = np.nan
+    if crs is not None and np.isfinite(raw).any():
+        try:
+            ex, ey = pixel_sizes(t, crs, raw.shape)
+            k = max(full_h / raw.shape[0], full_w / raw.shape[1])  # the decimation
+            mask, _ = find_sentinels(raw, dtype, lambda a: (a * scale + offset) * unit,
+                                     ex[:1] * k, ey[:1] * k)
+            raw[mask] = np.nan
+        except Exception:  # the real read reports it
+            pass
+    v = (raw[np.isfinite(raw)] * scale + offset) * unit
     if v.size == 0:
         return None
     lo, hi = float(v.min()), float(v.max())
     if spec.sea_level is not None:
         lo = max(lo, float(spec.sea_level))
     return lo, max(hi, lo)
+
+
+def _relief(spec: WorldSpec) -> tuple[float, float] | None:
+    """(lowest, highest) elevation [m] of the DEMs' area (``dem`` and every ``dem_fill``)."""
+    firsts = [spec.dem if isinstance(spec.dem, str) else spec.dem[0]]
+    firsts += [f if isinstance(f, str) else f[0] for f in spec.fill_sources()]
+    reliefs = [r for r in (_relief_of(f, spec) for f in firsts) if r is not None]
+    if not reliefs:
+        return None
+    return min(r[0] for r in reliefs), max(r[1] for r in reliefs)
 
 
 def _auto_cell(spec: WorldSpec, agl: float | None = None) -> tuple[float, str]:
@@ -468,7 +552,8 @@ def load_world(spec: WorldSpec, *, agl: float | None = None, top: float | None =
     grid = {"cell_size": dx, "cell_size_rule": why_dx, "dz": dz, "dz_rule": why_dz}
     world = None
     if spec.dem is not None:
-        world = from_dem(spec.dem, (dx, dx, dz), spec.ceiling, crs=spec.crs, nodata=spec.nodata,
+        world = from_dem(spec.dem, (dx, dx, dz), spec.ceiling, fill=spec.fill_sources(),
+                         crs=spec.crs, nodata=spec.nodata,
                          nodata_value=spec.nodata_value, bbox=spec.bbox,
                          sea_level=spec.sea_level, agl=agl, top=top, name=stem)
     if spec.buildings is not None:
@@ -497,7 +582,8 @@ def load_world(spec: WorldSpec, *, agl: float | None = None, top: float | None =
 
 
 def check_points(world: World, points: dict[str, Any], *, allow_filled: bool = False) -> None:
-    """Refuse named points (``{"start": p, "goal": q}``) over filled DEM cells.
+    """Refuse named points (``{"start": p, "goal": q}``) over filled DEM nodata (ground no DEM
+    measures, :func:`fm2uav.world.ground.ground_source`).
 
     Parameters
     ----------
@@ -510,16 +596,18 @@ def check_points(world: World, points: dict[str, Any], *, allow_filled: bool = F
     Raises
     ------
     PointError
-        A point whose nearest column has a filled (invented) ground height;
-        the message names ``--allow-filled`` / ``world.allow_filled``.
+        A point whose ground height is filled (invented); the message names
+        ``--allow-filled`` / ``world.allow_filled``.
     """
-    filled = getattr(world, "filled", None)
-    if filled is None or not filled.any():
+    from .ground import has_unknown_ground
+
+    if not has_unknown_ground(world):
         return
     for what, p in points.items():
         q = np.asarray(p, dtype=float)
-        cell = world.to_cell(q, what=what)
-        if filled[cell[0], cell[1]]:
+        world.to_cell(q, what=what)  # outside the map: named as such
+        # the rule of every safety figure: the ground under the point is measured by no DEM
+        if bool(np.asarray(world.ground_filled(q[0], q[1]))):
             lonlat = ""
             if world.crs is not None:
                 from .geo import to_lonlat

@@ -380,6 +380,21 @@ class World:
 
         return ground_height(self, x, y)
 
+    def ground_source(self, x: Any, y: Any) -> np.ndarray:
+        """Which DEM measures the ground at ``(x, y)`` [m]: 0 = ``world.dem``, k = the k-th
+        ``world.dem_fill``, -1 = unknown (filled nodata); see
+        :func:`fm2uav.world.ground.ground_source`."""
+        from .ground import ground_source
+
+        return ground_source(self, x, y)
+
+    def ground_filled(self, x: Any, y: Any) -> np.ndarray:
+        """Whether the ground at ``(x, y)`` [m] is unknown (filled DEM nodata), as a bool
+        array of the broadcast shape; see :func:`fm2uav.world.ground.ground_source`."""
+        from .ground import ground_filled
+
+        return ground_filled(self, x, y)
+
     def surface_height(self, x: Any, y: Any) -> np.ndarray | float:
         """Height (world z [m]) of the ground or a roof at ``(x, y)``, whichever is higher.
 
