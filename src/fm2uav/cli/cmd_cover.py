@@ -153,7 +153,7 @@ def cover_cmd(
 ) -> None:
     """``fm2uav cover``: parse, :func:`~fm2uav.pipeline.cover.run_cover`, print."""
     from ..missions.coverage import FULL_BOUNDS_DEG
-    from ..pipeline.cover import cover_rows, run_cover
+    from ..pipeline.cover import band_cell, cover_rows, run_cover
     from ..pipeline.rows import safety_rows
     from ..progress import reporting
     from ..world.load import world_summary
@@ -169,7 +169,8 @@ def cover_cmd(
     with output.progress() as step, reporting(lambda e: step(e.message)):
         step("building the map")
         w, _, scenario = build_world(world.spec(), scenario=scenario, seed=seed, agl=agl,
-                                     default="coverage", max_cell=_band_cell(d, safety))
+                                     default="coverage",
+                                     max_cell=band_cell(d, bool(safety.no_fly)))
         poly, area_source = _load_area(area, w, world.crs)
         w = safety.apply(w, crs=world.crs)  # --no-fly zones become obstacles
         run = run_cover(outdir, w, poly, area_label=area, spacing=d, level=level,
@@ -182,18 +183,6 @@ def cover_cmd(
                                else {})})
     output.summary("coverage plan", {**cover_rows(area, d, run.coverage, run.built, w),
                                      **safety_rows(run.safety)}, run.summary)
-
-
-def _band_cell(d: float, safety: SafetyFlags) -> tuple[float, str] | None:
-    """The largest automatic cell [m] (and why) of a survey around --no-fly zones: the route
-    around them resolves bands only :data:`~fm2uav.missions.coverage.zones.ROUTE_BAND_CELLS`
-    cells apart (the corridor grid of a survey without zones resolves any spacing)."""
-    from ..missions.coverage.zones import ROUTE_BAND_CELLS, route_cell
-
-    if not safety.no_fly:
-        return None
-    return route_cell(d), (f"at most D / {ROUTE_BAND_CELLS:g} = {route_cell(d):.3g} m so that "
-                           "the route around the no-fly zones resolves the bands")
 
 
 @handle_errors
