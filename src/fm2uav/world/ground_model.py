@@ -51,6 +51,8 @@ __all__ = ["GroundModel", "GroundLayer", "MAX_SAMPLES", "ground_model_from_dem",
 MAX_SAMPLES = 25_000_000
 #: Points evaluated at a time by a model of several DEMs (bounds the temporaries).
 _CHUNK = 1_000_000
+#: How far inside each piece's ends :func:`ground_bulge` reads the ground [m].
+_BULGE_INSET_M = 1e-3
 
 
 @dataclass(frozen=True, eq=False)
@@ -269,11 +271,14 @@ def ground_bulge(world: Any, a: Any, b: Any) -> tuple[np.ndarray, np.ndarray]:
 
     Exact for the bilinear ground (:meth:`World.ground_height`): along a straight chord it is a
     quadratic between the chord's crossings of the grid's whole rows and columns (the
-    source DEM's pixel centres, or the terrain nodes), so the extremes lie at those
-    crossings or at a piece's vertex; each piece is read at its ends and middle and its
-    quadratic solved (a DEM in another CRS than the world bends the chord by far less
-    than a millimetre over a pixel). Reading a few points per chord missed centimetres
-    at pixel edges — enough to put a path exactly at a zone's ceiling inside it.
+    source DEMs' pixel centres — of every layer: ``world.dem_fill`` takes over from
+    ``world.dem`` only on its whole rows and columns, where the ground may step — or the
+    terrain nodes), so the extremes lie at those crossings, on either side of a step, or
+    at a piece's vertex; each piece is read 1 mm inside its ends and at its middle and its
+    quadratic solved and extended to the ends (a DEM in another CRS than the world bends
+    the chord by far less than a millimetre over a pixel). Reading a few points per chord
+    missed centimetres at pixel edges — enough to put a path exactly at a zone's ceiling
+    inside it.
     """
     pa = np.atleast_2d(np.asarray(a, dtype=float))[:, :2]
     pb = np.atleast_2d(np.asarray(b, dtype=float))[:, :2]
@@ -296,7 +301,13 @@ def ground_bulge(world: Any, a: Any, b: Any) -> tuple[np.ndarray, np.ndarray]:
     ta, tb = t[:, :-1], t[:, 1:]
     ok = np.isfinite(ta) & np.isfinite(tb) & (tb > ta)
     tm = 0.5 * (ta + tb)
-    fr = np.stack([ta, tm, tb], axis=-1)  # (k, pieces, 3)
+    # each piece is read 1 mm inside its ends (a quarter of it if shorter) and its quadratic
+    # extended to them: where several DEMs meet, the ground switches layer (and may step)
+    # on a grid line, and the chord's slight bend in another CRS must not put a read on the
+    # far side of that line
+    length = np.maximum(np.hypot(*(pb - pa).T), 1e-12)[:, None]
+    eps = np.where(ok, np.minimum(_BULGE_INSET_M / length, 0.25 * (tb - ta)), 0.0)
+    fr = np.stack([ta + eps, tm, tb - eps], axis=-1)  # (k, pieces, 3)
     fr = np.where(ok[..., None], fr, 0.0)
     d = pb - pa
     q = pa[:, None, None, :] + fr[..., None] * d[:, None, None, :]
@@ -306,14 +317,17 @@ def ground_bulge(world: Any, a: Any, b: Any) -> tuple[np.ndarray, np.ndarray]:
                                            np.r_[pa[:, 1], pb[:, 1]]), dtype=float)
     lin = g_end[:k, None, None] + fr * (g_end[k:] - g_end[:k])[:, None, None]
     h = g - lin  # the ground above the chord's straight line, per piece at ends and middle
-    # the quadratic through the three values: h(s) = h0 + B s + C s^2, s in [0, 1]
+    # the quadratic through the three values: h(u) = h0 + B u + C u^2, u in [0, 1] between
+    # the reads; the piece's true ends are at u = -e and 1 + e
     h0, hm, h1 = h[..., 0], h[..., 1], h[..., 2]
     C = 2.0 * (h0 + h1) - 4.0 * hm
     B = h1 - h0 - C
     with np.errstate(divide="ignore", invalid="ignore"):
+        e = np.where(ok, eps / np.maximum(tb - ta - 2.0 * eps, 1e-300), 0.0)
         s = np.where(np.abs(C) > 1e-12, -B / (2.0 * C), np.nan)
-    inside = np.isfinite(s) & (s > 0) & (s < 1)
+    inside = np.isfinite(s) & (s > -e) & (s < 1.0 + e)
     hv = np.where(inside, h0 + B * s + C * s * s, np.nan)
+    h0, h1 = h0 - B * e + C * e * e, h0 + B * (1.0 + e) + C * (1.0 + e) ** 2
     vals = np.concatenate([h0, h1, hv], axis=1)
     vals = np.where(np.concatenate([ok, ok, ok & inside], axis=1), vals, np.nan)
     rise = np.nanmax(np.concatenate([vals, np.zeros((k, 1))], axis=1), axis=1)
