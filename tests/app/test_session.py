@@ -91,3 +91,24 @@ def test_rally_and_returns_keys_round_trip_through_a_saved_mission(tmp_path):
         target = s.save({**base, "rally": rally_key}, tmp_path / "again.yaml")
         assert yaml.safe_load(target.read_text())["rally"] == rally_key
         assert check(load_mission(target).rally)
+
+
+def test_the_cover_command_passes_every_world_key_as_its_flag(tmp_path):
+    """Issue 25's world keys (ground_elevation, margin; dem_fill lists) reach fm2uav cover as
+    the flags the CLI knows, and the mission-file world they come from is valid."""
+    from fm2uav.app.session import cover_command
+    from fm2uav.cli.options import WORLD_FLAGS
+    from fm2uav.io.mission import parse_world
+
+    (tmp_path / "town.geojson").write_text('{"type": "FeatureCollection", "features": []}')
+    world = {"buildings": "town.geojson", "crs": "EPSG:32630", "ground_elevation": 650.0,
+             "margin": 40.0, "cell_size": 5.0}
+    parse_world(world, source="world", base_dir=tmp_path)  # the keys of a mission file
+    argv = cover_command(world, {"agl": 20.0, "spacing": 30.0}, {}, [], None)
+    for key, v in world.items():
+        k = argv.index(WORLD_FLAGS[key])
+        assert argv[k + 1] == (v if isinstance(v, str) else repr(v))
+    argv = cover_command({"dem": ["a.tif", "b.tif"], "dem_fill": ["c.tif", "d.tif"]},
+                         {"agl": 20.0, "spacing": 30.0}, {}, [], None)
+    assert argv[2:10] == ["--dem", "a.tif", "--dem", "b.tif", "--dem-fill", "c.tif",
+                          "--dem-fill", "d.tif"]

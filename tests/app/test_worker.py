@@ -68,3 +68,39 @@ def test_an_internal_error_says_it_is_a_bug(tmp_path):
     state, (message, code) = run_job("plan", {"mission_file": None, "out": str(tmp_path)})
     assert (state, code) == ("error", 70)
     assert message.startswith("internal error: TypeError") and "this is a bug" in message
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("ground", [None, 650.0])
+def test_a_plan_job_on_buildings_alone_says_what_its_altitudes_are(tmp_path, ground):
+    """Issue 25 in the app: a mission file with world.ground_elevation / world.margin plans,
+    and its map is AMSL on that ground — or, without it, says that its altitudes are above
+    the flat ground (the mission is relative to home, home's altitude unknown)."""
+    import json
+    import shutil
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    shutil.copy(root / "examples" / "data" / "town.geojson", tmp_path / "town.geojson")
+    world = {"buildings": "town.geojson", "crs": "EPSG:32630", "cell_size": 5,
+             "height_cells": 24, "margin": 40, **({} if ground is None else
+                                                   {"ground_elevation": ground})}
+    (tmp_path / "m.yaml").write_text(json.dumps({
+        "version": 1, "name": "town", "world": world,
+        "start": {"x": 440070, "y": 4470070, "agl": 20},
+        "goal": {"x": 440460, "y": 4470330, "agl": 20}, "planner": {"agl": 20},
+        "outputs": {"formats": ["geojson", "plan", "json"]}}))
+    state, res = run_job("plan", {"mission_file": str(tmp_path / "m.yaml"),
+                                  "out": str(tmp_path / "out")})
+    assert state == "done", res
+    s = res["map"]["summary"]
+    route = next(f for f in res["map"]["features"] if f["properties"]["kind"] == "route")
+    items = [f["properties"] for f in res["map"]["features"] if f["properties"]["kind"] == "item"]
+    assert s["amsl"] is route["properties"]["amsl"] is (ground is not None)
+    assert s["home"]["alt_amsl_m"] == ground
+    assert s["frame"] == ("relative" if ground is None else "amsl")
+    base = 0.0 if ground is None else ground
+    assert min(route["properties"]["ground"]) == max(route["properties"]["ground"]) == base
+    cruise = [it for it in items if it["command"].startswith("NAV_WAYPOINT")]
+    assert len(cruise) >= 2, items
+    assert all(abs(it["alt_amsl"] - (base + it["agl"])) < 0.05 for it in cruise)

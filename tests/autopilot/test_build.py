@@ -358,6 +358,42 @@ def test_endurance_warning_says_how_far_the_vehicle_gets():
     assert any("endurance" in w and "km along" in w for w in short.warnings)
 
 
+@pytest.mark.parametrize("vehicle, minutes", [("multirotor", 20.0), ("fixed_wing", 45.0),
+                                              ("vtol", 45.0)])
+def test_the_endurance_check_runs_by_default_and_says_where_the_reserve_is_reached(
+        vehicle, minutes):
+    """Issue 25: a 177-minute multirotor transit passed without a word. Without an
+    endurance the airframe type's default is checked, the summary says so, and the warning
+    names the point where the reserve is reached (checked here on the waypoint legs)."""
+    slow = 0.2 if vehicle == "multirotor" else 1.0  # the hill is short: fly it slowly
+    m, _ = export_mission(hill_tff(), ["plan"], _opts(vehicle=vehicle, hover_speed=slow,
+                                                      cruise_speed=slow, end="land"))
+    f = m.summary()["flight"]
+    assert f["endurance_s"] == pytest.approx(60.0 * minutes)
+    assert "default" in f["endurance_source"] and "--endurance" in f["endurance_source"]
+    if f["flight_time_s"] <= 0.8 * 60.0 * minutes:
+        assert f["ok"] and f["warning"] is None
+        return
+    assert not f["ok"]
+    w = next(x for x in m.warnings if x.startswith("endurance"))
+    assert "lon" in w and "--endurance" in w
+    # the point is on the legs, as far along as the usable endurance lasts
+    q = np.asarray(f["reserve_reached_at_m"])
+    p = m.waypoints.points_m
+    k = f["reach_waypoint"]
+    seg = p[k + 1] - p[k]
+    t = float(np.dot(q - p[k], seg) / np.dot(seg, seg))
+    assert 0.0 <= t <= 1.0 and np.allclose(p[k] + t * seg, q, atol=0.01)
+    lon, lat, _ = to_lonlat(m.world, q, anchor=ANCHOR)
+    assert f["reserve_reached_at_lonlat"] == pytest.approx([lon, lat], abs=1e-6)
+    # --endurance overrides the default
+    given, _ = export_mission(hill_tff(), ["plan"], _opts(vehicle=vehicle, hover_speed=slow,
+                                                          cruise_speed=slow, end="land",
+                                                          endurance_s=1e6))
+    assert given.summary()["flight"]["ok"]
+    assert given.summary()["flight"]["endurance_source"].startswith("given")
+
+
 def test_flight_time_is_the_slowest_of_horizontal_and_vertical_motion():
     from fm2uav.vehicles.endurance import check_endurance, flight_time
 

@@ -11,8 +11,9 @@ from typer.testing import CliRunner
 from fm2uav.cli import app
 from fm2uav.cli.options import WorldFlags, option_group, world_options
 
-WORLD = ["--dem", "--dem-fill", "--buildings", "--bbox", "--sea-level", "--cell-size", "--dz", "--ceiling",
-         "--nodata", "--nodata-value", "--crs", "--default-height", "--allow-filled"]
+WORLD = ["--dem", "--dem-fill", "--buildings", "--bbox", "--sea-level", "--cell-size", "--dz",
+         "--ceiling", "--nodata", "--nodata-value", "--crs", "--default-height", "--allow-filled",
+         "--ground-elevation", "--margin"]
 
 
 def _flags(*path: str) -> list[str]:

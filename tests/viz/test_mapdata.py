@@ -51,6 +51,7 @@ def test_route_in_lonlat_with_height_above_ground_and_distance(planned):
     assert d[0] == 0 and d[-1] == pytest.approx(
         np.sum(np.linalg.norm(np.diff(path[:, :2], axis=0), axis=1)), abs=0.1)
     assert r["properties"]["requested_agl"] == 60.0
+    assert r["properties"]["amsl"] is doc["summary"]["amsl"] is True  # a DEM's altitudes
     assert r["properties"]["junctions"] == [int(v) for v in route.junctions]
     w, s, e, n = doc["bbox"]
     assert w == pytest.approx(coords[:, 0].min()) and n == pytest.approx(coords[:, 1].max())

@@ -146,10 +146,53 @@ def test_buildings_on_the_dem_and_alone(dem, tmp_path):
     alone = load_world(_spec(buildings=str(f), default_height=12.0), agl=120.0)
     assert alone.spacing == (2.0, 2.0, 2.0)  # auto: 2 m cells for buildings
     assert alone.bounds[2, 1] >= 35.0 + 120.0
-    assert "not to sea level" in alone.georef.vertical
+    assert "altitude above sea level is unknown" in alone.georef.vertical
+    assert alone.georef.amsl is False
     with pytest.raises(WorldError, match=r"world.height_cells = 20 leaves no room to fly 120 m"):
         load_world(_spec(buildings=str(f), default_height=12.0, cell_size=5.0,
                          height_cells=20), agl=120.0)
+
+
+def test_buildings_alone_ground_elevation_and_default_margin(tmp_path):
+    """Issue 25: an AMSL frame needs a ground elevation, and a take-off 13 m beside the
+    outermost building is on the map without world.margin."""
+    polys, props = _town_lonlat()
+    f = tmp_path / "town.geojson"
+    f.write_text(json.dumps({"type": "FeatureCollection", "features": [
+        {"type": "Feature", "properties": p, "geometry": shapely.geometry.mapping(g)}
+        for g, p in zip(polys, props)]}))
+    w = load_world(_spec(buildings=str(f), default_height=12.0), agl=30.0)
+    tr = Transformer.from_crs("EPSG:4326", w.crs, always_xy=True)
+    foot = shapely.union_all([shapely.transform(
+        g, lambda xy: np.column_stack(tr.transform(xy[:, 0], xy[:, 1]))) for g in polys])
+    x0, y0, x1, y1 = foot.bounds
+    b = w.bounds
+    # 50 m of free ground around the footprints (2 m cells: more than 10 cells)
+    assert b[0, 0] <= x0 - 50.0 + 1e-6 and b[0, 1] >= x1 + 50.0 - 2.0
+    assert b[1, 0] <= y0 - 50.0 + 1e-6 and b[1, 1] >= y1 + 50.0 - 2.0
+    assert w.contains([x0 - 13.0, 0.5 * (y0 + y1), 30.0])
+    assert w.origin[2] == 0.0 and not w.georef.amsl
+    assert not w.georef.as_dict()["amsl"]
+    # on coarse cells the margin is at least 10 cells
+    coarse = load_world(_spec(buildings=str(f), default_height=12.0, cell_size=10.0), agl=60.0)
+    assert coarse.bounds[0, 0] <= x0 - 100.0 + 1e-6
+    # a given ground elevation is the grid's floor: z is an altitude above sea level
+    e = load_world(_spec(buildings=str(f), default_height=12.0, ground_elevation=408.0),
+                   agl=30.0)
+    assert e.origin[2] == 408.0 and e.georef.amsl and "408" in e.georef.vertical
+    assert e.ground_height(x0 - 13.0, y0) == 408.0
+    assert e.surface_height(*foot.representative_point().coords[0]) >= 408.0 + 12.0 - 1e-9
+    assert e.bounds[2, 1] >= 408.0 + 35.0 + 30.0
+    assert load_world(_spec(buildings=str(f), default_height=12.0, margin=0.0),
+                      agl=30.0).bounds[0, 0] >= x0 - 2.0
+    with pytest.raises(InputError, match=r"ground_elevation.*--ground-elevation.*DEM"):
+        load_world(_spec(buildings=str(f), default_height=12.0, ground_elevation=400.0,
+                         dem=str(gd.dem_4326(tmp_path / "d.tif"))), agl=30.0)
+    with pytest.raises(InputError, match=r"world.margin \(--margin\).*DEM"):
+        load_world(_spec(buildings=str(f), default_height=12.0, margin=10.0,
+                         dem=str(gd.dem_4326(tmp_path / "d.tif"))), agl=30.0)
+    with pytest.raises(ValidationError):
+        _spec(buildings=str(f), ground_elevation=20000.0)
 
 
 def test_sea_level_from_the_spec(tmp_path):

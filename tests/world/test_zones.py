@@ -59,8 +59,12 @@ def test_zone_with_a_ceiling_blocks_only_below_it(field):
     xy = np.column_stack([np.linspace(500, 1100, 61), np.full(61, 600.0)])
     ground = field.ground_height(xy[:, 0], xy[:, 1])
     lo, hi = zone_bounds_along(w, xy, ground + 200.0)
-    inside = np.abs(xy[:, 0] - 800) < 150 + 10 - 1e-9
-    assert np.allclose(lo[inside], ground[inside] + 110.0) and np.isinf(lo[~inside]).all()
+    # samples 10 m apart: a sample whose chord to a neighbour meets the buffered circle is
+    # bounded too (the whole chord is flown over it), raised by the ground's bulge
+    inside = np.abs(xy[:, 0] - 800) < 150 + 10 + 10 - 1e-9
+    assert np.isinf(lo[~inside]).all()
+    assert np.all(lo[inside] >= ground[inside] + 110.0)
+    assert np.all(lo[inside] <= ground[inside] + 110.0 + 0.5)
     assert np.isinf(hi).all()
 
 

@@ -20,7 +20,12 @@ bilinearly — and :meth:`World.surface_height` with roofs), never on grid nodes
   figure above split into over measured ground and over filled (unknown)
   ground, length and share, the lowest AGL along the legs over each, which
   DEM measured how much; and whether the DEM's pixels resolve the relief for
-  the requested flight level.
+  the requested flight level;
+* **warnings**: a path that flies higher above the ground than
+  :data:`ADVISORY_MAX_AGL` (120 m: the EU open category's limit, and about US
+  Part 107's 400 ft) without a ``max_agl`` of its own is named, with where and how
+  much of it — ``planner.max_agl`` (``--max-agl``) turns the advice into a limit the
+  profile keeps (docs/safety.md).
 
 :func:`safety_summary` gathers them in one JSON-friendly dict; the CLI puts it
 into ``summary.json`` and the report, and the tests recompute the same numbers
@@ -42,7 +47,13 @@ from ..world.ground_model import sampling_step
 from ..world.zones import zone_distances, zone_violations
 from .known_ground import dem_resolution, filled_mask, ground_split
 
-__all__ = ["height_above_ground", "leg_figures", "safety_summary"]
+__all__ = ["ADVISORY_MAX_AGL", "height_above_ground", "leg_figures", "safety_summary",
+           "ceiling_warning"]
+
+#: Height above the ground [m] above which a plan without its own ``max_agl`` is warned
+#: about: the EU open category's 120 m (Regulation (EU) 2019/947, UAS.OPEN.010) and about
+#: the US Part 107 limit (400 ft = 121.9 m, 14 CFR 107.51).
+ADVISORY_MAX_AGL = 120.0
 
 
 def height_above_ground(world: Any, points: Any, *, surface: bool = False) -> np.ndarray:
@@ -234,7 +245,43 @@ def safety_summary(world: Any, path: Any, *, requested: float | None = None,
                                   cruise=wcruise)
     if level is not None:
         out["checks"] = _checks(agl, cruise, level, out)
+    warning = ceiling_warning(world, p, agl, level)
+    out["warnings"] = [warning] if warning else []
     return out
+
+
+def ceiling_warning(world: Any, path: Any, agl: Any, level: Any = None) -> str | None:
+    """A warning when ``path`` flies higher than :data:`ADVISORY_MAX_AGL` above the ground
+    and its ``level`` sets no ``max_agl`` (None otherwise): how high, where, over how much
+    of the path, and the flag that makes it a limit."""
+    if level is not None and getattr(level, "max_agl", None) is not None:
+        return None
+    h = np.asarray(agl, dtype=float)
+    p = np.asarray(path, dtype=float)
+    k = int(np.argmax(h))
+    if not h[k] > ADVISORY_MAX_AGL + 1e-6:
+        return None
+    seg = np.linalg.norm(np.diff(p[:, :2], axis=0), axis=1)
+    high = (h[1:] > ADVISORY_MAX_AGL) | (h[:-1] > ADVISORY_MAX_AGL)
+    where = f"x {p[k, 0]:.0f}, y {p[k, 1]:.0f} m"
+    if getattr(world, "crs", None):
+        from ..world.geo import to_lonlat
+
+        lon, lat, _ = to_lonlat(world, p[k])
+        where = f"lon {lon:.5f}, lat {lat:.5f}"
+    if level is None:
+        fix = ("plan with a height above the ground and a ceiling: --agl H --max-agl 120 "
+               "(planner.agl, planner.max_agl)")
+    elif float(level.agl) > ADVISORY_MAX_AGL:
+        fix = (f"lower --agl (planner.agl, now {float(level.agl):g} m) to 120 m or less and set "
+               "--max-agl 120 (planner.max_agl); where a higher flight is allowed, give that "
+               "ceiling as --max-agl")
+    else:
+        fix = "set the ceiling the profile keeps: --max-agl 120 (planner.max_agl)"
+    return (f"the path flies up to {h[k]:.1f} m above the ground ({where}; {seg[high].sum():.0f} "
+            f"m of it above {ADVISORY_MAX_AGL:g} m), higher than {ADVISORY_MAX_AGL:g} m — the "
+            "limit of the EU open category and about that of US Part 107 (400 ft); if that is "
+            f"not allowed where you fly, {fix}")
 
 
 def _checks(agl: np.ndarray, cruise: np.ndarray | None, level: Any,

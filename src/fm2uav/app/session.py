@@ -111,9 +111,9 @@ def cover_command(world: dict[str, Any], cover: dict[str, Any], export: dict[str
     for key, v in world.items():
         if v is None or v is False:
             continue
-        if key == "dem":
+        if key in ("dem", "dem_fill"):  # one file or a list: the flag repeated
             for d in ([v] if isinstance(v, str) else v):
-                argv += ["--dem", d]
+                argv += [_flag(key), d]
         elif key == "bbox":
             argv += ["--bbox", ",".join(_text(float(x)) for x in v)]
         elif v is True:

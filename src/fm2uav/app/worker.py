@@ -115,7 +115,7 @@ def _cover_job(payload: dict[str, Any]) -> dict[str, Any]:
     from ..io.zone_spec import zones_from_cli
     from ..missions.coverage import Camera
     from ..missions.coverage.area import load_area
-    from ..pipeline.cover import COVER_FILES, REPORT, cover_rows, run_cover
+    from ..pipeline.cover import COVER_FILES, REPORT, band_cell, cover_rows, run_cover
     from ..pipeline.outputs import export_options
     from ..pipeline.rows import safety_rows
     from ..planning import FlightLevel
@@ -141,7 +141,7 @@ def _cover_job(payload: dict[str, Any]) -> dict[str, Any]:
     options = export_options(name=f"coverage of {area_name}", **payload.get("export", {}))
     step("building the map", 0.1)
     spec = parse_world(payload["world"], source="world")
-    world = load_world(spec, agl=agl)
+    world = load_world(spec, agl=agl, max_cell=band_cell(d, bool(payload.get("zones"))))
     poly, area_source = load_area(payload["area"], world, crs=spec.crs)
     if payload.get("zones"):
         world = with_zones(world, zones_from_cli(payload["zones"], world, crs=spec.crs))

@@ -40,8 +40,8 @@ import numpy as np
 from ..errors import InputError, MissionError
 from ..geometry import runs
 from ..missions.coverage.triggers import CameraPlan
-from .geofence import as_fences
-from ..world.geo import DEFAULT_ANCHOR, Anchor, to_lonlat
+from .geofence import as_fences, fence_statement, statement_warning
+from ..world.geo import DEFAULT_ANCHOR, Anchor, amsl_known, to_lonlat
 from .items import (
     CMD_DO_CHANGE_SPEED,
     CMD_DO_LAND_START,
@@ -141,7 +141,8 @@ class ExportOptions:
     climb_rate, descent_rate : float or None
         Vertical speeds for the flight time [m/s] (None: airframe defaults).
     endurance_s : float or None
-        Airframe endurance [s]; None: not checked.
+        Airframe endurance [s]; None: the airframe type's default
+        (:func:`fm2uav.vehicles.airframes.default_endurance`), and the summary says so.
     reserve : float
         Share of the endurance kept in reserve. Default 0.2.
     name : str
@@ -278,7 +279,8 @@ class MissionExport:
             "frame": {"name": self.frame, "mav_frame": w.frame,
                       "requested": self.options.frame},
             "home": {"lat": round(w.home[0], 9), "lon": round(w.home[1], 9),
-                     "alt_amsl_m": round(w.home[2], 3), "source": w.home_source},
+                     "alt_amsl_m": round(w.home[2], 3) if w.amsl else None,
+                     "source": w.home_source},
             "crs": crs,
             "georef": None if georef is None else georef.as_dict(),
             "vertical_reference": vref or ("metres above the DEM's vertical datum (normally "
@@ -636,9 +638,12 @@ def start_holds(starts: Any, world: Any, options: ExportOptions) -> np.ndarray:
     return float(climb_s.max()) - climb_s
 
 
-def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: _Speeds, start_hold: float
-            ) -> tuple[dict[str, Any], str | None]:
-    """Flight time / endurance figures (and the endurance warning)."""
+def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: _Speeds, start_hold: float,
+            world: Any = None) -> tuple[dict[str, Any], str | None]:
+    """Flight time / endurance figures (and the endurance warning, with the point where the
+    reserve is reached). Without ``opt.endurance_s`` the airframe type's default endurance
+    is checked (:func:`fm2uav.vehicles.airframes.default_endurance`)."""
+    from ..vehicles.airframes import default_endurance
     from ..vehicles.endurance import check_endurance, flight_time
 
     climb = opt.climb_rate or DEFAULT_CLIMB[opt.vehicle]
@@ -649,9 +654,26 @@ def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: _Speeds, start_hol
                      final_descent=0.0 if end == "loiter" else float(wps.agl[-1]),
                      return_distance=float(np.hypot(*(end_xy - start_xy))) if end == "rtl"
                      else 0.0, return_speed=opt.forward_speed, holds=sp.holds)
-    rep = check_endurance(ft, endurance_s=opt.endurance_s, reserve=opt.reserve)
+    endurance_s, source = opt.endurance_s, "given (airframe.endurance / --endurance)"
+    if endurance_s is None:  # the check runs by default (issue 25)
+        endurance_s, source = default_endurance(opt.vehicle)
+    rep = check_endurance(ft, endurance_s=endurance_s, reserve=opt.reserve)
+    warning = rep.warning
+    where: dict[str, Any] = {}
+    if warning is not None:
+        k = int(rep.reach_waypoint)
+        p = wps.points_m
+        q = p[k] if k + 1 >= len(p) else p[k] + rep.reach_fraction * (p[k + 1] - p[k])
+        where = {"reserve_reached_at_m": [round(float(v), 2) for v in q]}
+        lon, lat, _ = to_lonlat(world, q, anchor=opt.anchor)
+        where["reserve_reached_at_lonlat"] = [round(float(lon), 7), round(float(lat), 7)]
+        warning += f", at lon {lon:.5f}, lat {lat:.5f}"
+        if opt.endurance_s is None:
+            warning += (f" (endurance: {source.split('; give')[0]}; give your vehicle's with "
+                        "airframe.endurance / --endurance)")
     info: dict[str, Any] = {"flight": {
-        **rep.summary(), "climb_rate_mps": climb, "descent_rate_mps": descent,
+        **rep.summary(), "warning": warning, "endurance_source": source, **where,
+        "climb_rate_mps": climb, "descent_rate_mps": descent,
         "forward_speed_mps": opt.forward_speed,
         "note": {"loiter": "loiter end: the time until the loiter starts",
                  "rtl": "rtl: the straight line home at the forward speed, then the descent"
@@ -666,7 +688,7 @@ def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: _Speeds, start_hol
                 f"timing: the mission's route takes {route_t:.0f} s, {late:.0f} s more than the "
                 f"planned {sp.timing['planned_s']:.0f} s: the trajectory climbs or descends "
                 f"faster than {climb:g} / {descent:g} m/s (airframe climb_rate / descent_rate)")
-    return info, rep.warning
+    return info, warning
 
 
 def _snap(profile: Any, frame: str) -> bool | float:
@@ -681,6 +703,12 @@ def _snap(profile: Any, frame: str) -> bool | float:
     return False
 
 
+def _flat(world: Any) -> bool:
+    """True when the world's ground is one flat level (buildings without a DEM)."""
+    t = getattr(world, "terrain", None)
+    return t is None or float(np.ptp(t)) == 0.0
+
+
 def _world_warnings(world: Any, opt: ExportOptions, frame: str, has_terrain: bool) -> list[str]:
     """Warnings about the world the mission is built on (no CRS: made-up relief; no terrain map)."""
     warnings: list[str] = []
@@ -693,6 +721,14 @@ def _world_warnings(world: Any, opt: ExportOptions, frame: str, has_terrain: boo
     if frame == "terrain" and not has_terrain:
         warnings.append("frame terrain on a world without a terrain map: altitudes are above "
                         "the world's flat ground")
+    if getattr(world, "crs", None) and not amsl_known(world):
+        warnings.append(
+            "buildings without a DEM or a ground elevation: the ground's altitude above sea "
+            f"level is unknown, so the mission is written in frame {frame} "
+            f"({'MAVLink 3, altitudes above home' if frame == 'relative' else 'MAVLink 10'}) "
+            "and assumes the ground is flat at the take-off's height everywhere; give "
+            "world.ground_elevation (--ground-elevation) or world.dem (--dem) for altitudes "
+            "above sea level")
     return warnings
 
 
@@ -751,7 +787,7 @@ def build_mission(
     p = np.asarray(path_m, dtype=float)
     has_terrain = getattr(world, "terrain", None) is not None
     frame = resolve_frame(opt.frame, opt.firmware, terrain_following=agl is not None,
-                          has_terrain=has_terrain)
+                          has_terrain=has_terrain, amsl=amsl_known(world))
     warnings = _world_warnings(world, opt, frame, has_terrain)
     keep, via_idx = _events(p, via, camera, times)
     required = getattr(profile, "required", None)
@@ -769,7 +805,7 @@ def build_mission(
     fence_list = as_fences(fences)
     check_mission(items, opt.firmware, vehicle=opt.vehicle, home_alt=wps.home[2],
                   max_land_slope_deg=opt.max_land_slope_deg, fences=fence_list)
-    info, endurance_warning = _flight(wps, opt, end, sp, start_hold)
+    info, endurance_warning = _flight(wps, opt, end, sp, start_hold, world)
     if endurance_warning:
         warnings.append(endurance_warning)
     if "warning" in info.get("timing", {}):
@@ -789,6 +825,15 @@ def build_mission(
         info["legs"] = wps.legs
     if via_idx:
         info["via_waypoints"] = [int(np.searchsorted(wps.indices, i)) for i in via_idx]
+    statement = fence_statement(
+        getattr(world, "zones", ()), fence_list, firmware=opt.firmware,
+        home_amsl=wps.home[2] if wps.amsl else None,
+        flat_ground=getattr(world, "ground", None) is None and _flat(world))
+    if statement is not None:
+        info["geofence"] = statement
+        line = statement_warning(statement)
+        if line:
+            warnings.append(line)
     return MissionExport(items=items, waypoints=wps, options=opt, frame=frame, end=end,
                          path_m=p, world=world, warnings=warnings, info=info,
                          fences=fence_list)

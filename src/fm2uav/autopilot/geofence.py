@@ -40,6 +40,8 @@ __all__ = [
     "fences_from_world",
     "as_fences",
     "zone_fences",
+    "fence_statement",
+    "statement_warning",
 ]
 
 
@@ -187,7 +189,11 @@ def as_fences(fences: Any) -> list[Fence]:
 
 def zone_fences(zones: Any, world: Any, anchor: Anchor | None = None
                 ) -> tuple[list[Any], list[str]]:
-    """Geofences (WGS84) of the zones, and warnings for zones that cannot be fences.
+    """Geofences (WGS84) of the zones, and warnings about the fences (holes left out).
+
+    Zones with a floor or a ceiling are not written as no-fly fences; what the fence
+    cannot carry is stated by :func:`fence_statement` (the mission's summary, warnings
+    and ``.plan`` metadata).
 
     Parameters
     ----------
@@ -207,16 +213,142 @@ def zone_fences(zones: Any, world: Any, anchor: Anchor | None = None
     for k, z in enumerate(zones or ()):
         name = z.name or f"{z.kind} {k + 1}"
         vertical = z.floor is not None or z.ceiling is not None
-        if vertical and not z.inclusion:
-            warnings.append(f"{z.kind} {name!r} has a floor/ceiling; QGC geofences are 2D, so it "
-                            "is not written into the .plan geoFence (the plan keeps out of it)")
+        if vertical and not z.inclusion:  # stated by fence_statement (the mission's warnings)
             continue
         geom = ("circle", z.circle[0], z.circle[1]) if z.circle is not None else z.geometry
         out, warn = fences_from_world(geom, world, anchor=anchor, inclusion=z.inclusion,
                                       name=name)
         fences.extend(out)
         warnings.extend(warn)
-        if vertical:
-            warnings.append(f"operating area {name!r}: its floor/ceiling are not part of the "
-                            "geofence (QGC fences are 2D)")
     return fences, warnings
+
+
+#: What a QGroundControl geoFence (PX4's and ArduPilot's fence mission items) cannot hold.
+FENCE_LIMITS = (
+    "QGroundControl geofences (uploaded as PX4's and ArduPilot's fence items) are 2D polygons "
+    "and circles: no floor, no ceiling, no height reference and no planning buffer. A no-fly "
+    "zone with a floor or a ceiling is left out of geoFence (a 2D exclusion fence would trip "
+    "where the plan flies over or under it) and the plan keeps out of its air by itself; an "
+    "operating area's fence is its footprint only.")
+
+
+def _zone_label(z: Any, k: int) -> str:
+    return z.name or f"{z.kind} {k + 1}"
+
+
+def _ardupilot_altitude(z: Any, *, home_amsl: float | None, flat_ground: bool
+                        ) -> dict[str, Any] | None:
+    """ArduPilot's FENCE_ALT_MAX / FENCE_ALT_MIN (metres above home, one value for the whole
+    flight) for an operating area's ceiling / floor, where they truly represent it: an AMSL
+    limit (known home altitude) or an AGL limit over flat ground (home on that ground).
+    The limits are shrunk by the area's buffer, as the plan keeps them."""
+    if not z.inclusion or (z.ceiling is None and z.floor is None):
+        return None
+    if z.reference == "amsl" and home_amsl is not None:
+        base, how = float(home_amsl), "an AMSL limit minus home's altitude"
+    elif z.reference == "agl" and flat_ground:
+        base, how = 0.0, "an AGL limit over flat ground, home on that ground"
+    else:
+        return None
+    out: dict[str, Any] = {"note": f"metres above home: {how}", "FENCE_TYPE_bits": 0}
+    if z.ceiling is not None:
+        out["FENCE_ALT_MAX"] = round(float(z.ceiling) - z.buffer - base, 1)
+        out["FENCE_TYPE_bits"] |= 1
+    if z.floor is not None:
+        out["FENCE_ALT_MIN"] = round(float(z.floor) + z.buffer - base, 1)
+        out["FENCE_TYPE_bits"] |= 8
+    return out
+
+
+def fence_statement(zones: Any, fences: Any, *, firmware: str = "generic",
+                    home_amsl: float | None = None, flat_ground: bool = False
+                    ) -> dict[str, Any] | None:
+    """What the mission's geofence carries of the zones, and what it cannot (JSON-ready).
+
+    For ``summary.json`` and the ``.plan``'s ``fm2uav`` object: each zone written as a fence
+    (its kind), each zone or part of one that is not (a floor, a ceiling, the buffer) and
+    why, :data:`FENCE_LIMITS`, and — on ArduPilot — the FENCE_ALT_MAX / FENCE_ALT_MIN
+    parameters (metres above home, FENCE_TYPE bits 1 / 8) that represent an operating
+    area's ceiling / floor exactly (an AMSL limit with a known home altitude, or an AGL
+    limit over flat ground); no such parameter ever represents a no-fly zone's floor or
+    ceiling, which is local while the parameters hold everywhere.
+
+    Parameters
+    ----------
+    zones : sequence of Zone
+        ``World.zones``.
+    fences : sequence of FencePolygon / FenceCircle
+        The fences written (their names are the zones').
+    firmware : str
+        ``ardupilot`` gives the altitude parameters.
+    home_amsl : float, optional
+        Home's altitude above sea level [m] (None when unknown).
+    flat_ground : bool
+        The world's ground is flat (buildings without a DEM).
+
+    Returns
+    -------
+    dict or None
+        None without zones.
+    """
+    zones = tuple(zones or ())
+    if not zones:
+        return None
+    written: dict[str, list[str]] = {}
+    for f in as_fences(fences):
+        kind = ("inclusion " if f.inclusion else "exclusion ") + (
+            "circle" if isinstance(f, FenceCircle) else "polygon")
+        written.setdefault(f.name, []).append(kind)
+    carried, not_carried, params = [], [], {}
+    for k, z in enumerate(zones):
+        name = _zone_label(z, k)
+        vertical = {key: v for key, v in (("floor_m", z.floor), ("ceiling_m", z.ceiling))
+                    if v is not None}
+        if name in written:
+            carried.append({"zone": name, "fence": written[name],
+                            "carries": "the 2D footprint, without the planning buffer "
+                                       f"({z.buffer:g} m)"})
+        if vertical:
+            why = ("a 2D fence cannot hold a floor or a ceiling: the zone is left out of "
+                   "geoFence, the plan keeps out of its air" if not z.inclusion else
+                   "a 2D fence cannot hold a floor or a ceiling: the fence is the area's "
+                   "footprint only")
+            entry = {"zone": name, "kind": z.kind, **vertical, "reference": z.reference,
+                     "buffer_m": z.buffer, "why": why}
+            if firmware == "ardupilot":
+                alt = _ardupilot_altitude(z, home_amsl=home_amsl, flat_ground=flat_ground)
+                if alt is not None:
+                    params[name] = alt
+                else:
+                    entry["ardupilot"] = (
+                        "FENCE_ALT_MAX / FENCE_ALT_MIN hold over the whole flight, above "
+                        "home: they cannot represent "
+                        + ("a no-fly zone's local floor/ceiling" if not z.inclusion else
+                           "this limit (AGL over uneven ground, or home's altitude unknown)"))
+            not_carried.append(entry)
+    out: dict[str, Any] = {"fences": sum(len(v) for v in written.values()),
+                           "carried": carried, "not_carried": not_carried,
+                           "limits": FENCE_LIMITS}
+    if params:
+        out["ardupilot_parameters"] = params
+    return out
+
+
+def statement_warning(statement: dict[str, Any] | None) -> str | None:
+    """One warning line of :func:`fence_statement`'s zones the fence cannot carry (None if
+    every zone is carried whole)."""
+    if not statement or not statement["not_carried"]:
+        return None
+    parts = []
+    for e in statement["not_carried"]:
+        lim = ", ".join(f"{k[:-2]} {e[k]:g} m" for k in ("floor_m", "ceiling_m") if k in e)
+        parts.append(f"{e['kind']} {e['zone']!r} ({lim} {e['reference'].upper()}, buffer "
+                     f"{e['buffer_m']:g} m)" + (": left out of geoFence" if e["kind"] ==
+                                                "no-fly zone" else ": fence = footprint only"))
+    extra = ""
+    if statement.get("ardupilot_parameters"):
+        extra = "; ArduPilot parameters that hold it: " + "; ".join(
+            f"{n}: " + ", ".join(f"{k} {v:g}" for k, v in p.items() if k.startswith("FENCE_A"))
+            for n, p in statement["ardupilot_parameters"].items())
+    return ("geofence: QGC fences are 2D and cannot carry a floor or a ceiling — "
+            + "; ".join(parts) + extra + " (the plan keeps out of the zones' air itself)")

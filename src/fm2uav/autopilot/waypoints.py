@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from ..world.geo import Anchor, to_lonlat
+from ..world.geo import Anchor, amsl_known, to_lonlat
 from .firmware import PROFILES
 from .items import FRAME_GLOBAL, FRAME_RELATIVE, FRAME_TERRAIN, CMD_NAV_TAKEOFF, CMD_NAV_WAYPOINT
 from .thin import thin_indices
@@ -64,7 +64,7 @@ FRAME_CODES = {"terrain": FRAME_TERRAIN, "amsl": FRAME_GLOBAL, "relative": FRAME
 
 
 def resolve_frame(frame: str, firmware: str, *, terrain_following: bool,
-                  has_terrain: bool) -> str:
+                  has_terrain: bool, amsl: bool = True) -> str:
     """The frame ``"auto"`` stands for, per firmware (other names pass through).
 
     ``auto``: a terrain-following plan over a world with terrain is written in
@@ -72,17 +72,29 @@ def resolve_frame(frame: str, firmware: str, *, terrain_following: bool,
     ``terrain_frame``, :mod:`fm2uav.autopilot.firmware`: ArduPilot follows its
     terrain database) and in **amsl** for the others (PX4 has no terrain frame
     for mission items; generic); any other plan in **relative** (above home).
+    A world whose altitude above sea level is unknown (``amsl=False``: buildings
+    without a DEM or ``world.ground_elevation``, :func:`fm2uav.world.geo.amsl_known`)
+    is always written **relative** to home: an AMSL altitude would be one above an
+    implicit 0 m.
 
     Raises
     ------
     InputError
-        Unknown frame name.
+        Unknown frame name; ``amsl`` asked for on a world without an altitude datum.
     """
     if frame not in FRAMES:
         raise InputError(f"frame must be one of {', '.join(FRAMES)}, got {frame!r} "
                          "(mission file outputs.frame, CLI --frame)")
+    if not amsl and frame == "amsl":
+        raise InputError(
+            "outputs.frame = amsl (--frame amsl) needs the ground's altitude above sea level, "
+            "which buildings without a DEM do not give: set world.ground_elevation "
+            "(--ground-elevation) or add world.dem (--dem), or write the mission relative to "
+            "home (frame relative)")
     if frame != "auto":
         return frame
+    if not amsl:
+        return "relative"
     if terrain_following and has_terrain:
         profile = PROFILES.get(firmware)
         return "terrain" if profile is not None and profile.terrain_frame else "amsl"
@@ -132,6 +144,11 @@ class Waypoints:
         What the leg check (:func:`fm2uav.autopilot.legs.refine_legs`) did: waypoints
         ``added`` where a straight leg dipped below its floor or entered a zone,
         ``lowest_margin_m`` above the floor along the legs, ...
+    amsl : bool
+        Whether the world's altitudes are above mean sea level
+        (:func:`fm2uav.world.geo.amsl_known`); False: ``alt_amsl``, ``ground_amsl``
+        and ``home[2]`` are heights above the world's flat ground, the mission is
+        relative to home.
     """
 
     lat: np.ndarray
@@ -148,6 +165,7 @@ class Waypoints:
     indices: np.ndarray
     requested_agl: float | None = None
     legs: dict[str, Any] | None = None
+    amsl: bool = True
 
     def __len__(self) -> int:
         return int(len(self.lat))
@@ -220,6 +238,14 @@ def thin_with_keep(points: np.ndarray, tolerance: float, *, keep: Any = (),
 def _home_source(world: Any, anchor: Anchor | None) -> str:
     has_terrain = getattr(world, "terrain", None) is not None
     if getattr(world, "crs", None):
+        georef = getattr(world, "georef", None)
+        roles = {s.role for s in getattr(georef, "sources", ())}
+        if not amsl_known(world):
+            return ("the flat ground under the start (buildings without a DEM or "
+                    "world.ground_elevation / --ground-elevation)")
+        if roles == {"buildings"} and getattr(world, "ground", None) is None:
+            return (f"flat ground under the start at {float(world.origin[2]):g} m above sea "
+                    "level (world.ground_elevation / --ground-elevation)")
         what = "DEM ground (bilinear) under the start" if has_terrain else \
             "flat ground of the world (its bottom) under the start"
         vref = getattr(world, "vertical_reference", None)
@@ -279,6 +305,8 @@ def mission_waypoints(
     """
     if frame not in FRAME_CODES:
         raise InputError(f"frame must be one of {', '.join(FRAME_CODES)} here, got {frame!r}")
+    resolve_frame(frame, "generic", terrain_following=False, has_terrain=False,
+                  amsl=amsl_known(world))  # no AMSL altitudes without a datum
     flown, height, ground = altitude_profile(path_m, world, agl=agl, flight_alt=flight_alt,
                                              snap=snap)
     p = np.asarray(path_m, dtype=float)
@@ -311,5 +339,5 @@ def mission_waypoints(
         agl=height[idx], ground_amsl=gnd, frame=FRAME_CODES[frame], frame_name=frame,
         home=(float(home_geo[1]), float(home_geo[0]), float(home_geo[2])),
         home_source=_home_source(world, anchor), points_m=kept, indices=idx,
-        requested_agl=None if agl is None else float(agl), legs=legs,
+        requested_agl=None if agl is None else float(agl), legs=legs, amsl=amsl_known(world),
     )

@@ -156,7 +156,7 @@ def cover_cmd(
 ) -> None:
     """``fm2uav cover``: parse, :func:`~fm2uav.pipeline.cover.run_cover`, print."""
     from ..missions.coverage import FULL_BOUNDS_DEG
-    from ..pipeline.cover import COVER_FILES, REPORT, cover_rows, run_cover
+    from ..pipeline.cover import COVER_FILES, REPORT, band_cell, cover_rows, run_cover
     from ..pipeline.rows import safety_rows
     from ..progress import reporting
     from ..world.load import world_summary
@@ -183,7 +183,8 @@ def cover_cmd(
     with output.progress() as step, reporting(lambda e: step(e.message)):
         step("building the map")
         w, _, scenario = build_world(world.spec(), scenario=scenario, seed=seed, agl=agl,
-                                     default="coverage")
+                                     default="coverage",
+                                     max_cell=band_cell(d, bool(safety.no_fly)))
         poly, area_source = _load_area(area, w, world.crs)
         w = safety.apply(w, crs=world.crs)  # --no-fly zones become obstacles
         run = run_cover(outdir, w, poly, area_label=area, spacing=d, level=level,

@@ -240,13 +240,17 @@ def _safety(result, missions: dict[str, Any], level, fences, fence_warnings) -> 
     from ..analysis.safety import safety_summary
 
     out: dict[str, Any] = {}
+    tracks = result.tracks or ()
     for i, name in enumerate(result.names):
         wps = missions[name].waypoints
+        tr = tracks[i] if i < len(tracks) else None  # what {name}_path.* hold
         out[name] = safety_summary(
-            result.world, np.asarray(result.positions[:, i], dtype=float),
-            requested=None if level is None else level.agl, waypoints=wps.points_m,
-            waypoint_indices=wps.indices, terrain_frame=wps.frame == 10,
-            waypoint_agl=wps.agl, level=level)
+            result.world, np.asarray(result.positions[:, i] if tr is None else tr.path,
+                                     dtype=float),
+            requested=None if level is None else level.agl,
+            phase=None if tr is None or tr.profile is None else tr.profile.phase,
+            waypoints=wps.points_m, waypoint_indices=wps.indices,
+            terrain_frame=wps.frame == 10, waypoint_agl=wps.agl, level=level)
         check_ground(result.world, out[name], what=f"the {name}'s path")
     if getattr(result.world, "zones", ()):
         out["geofence"] = {"fences": len(fences), "warnings": list(fence_warnings)}
@@ -267,6 +271,7 @@ def _safety_rows(safety: dict[str, Any]) -> dict[str, str]:
         bad = [k for k, c in s.get("checks", {}).items() if not c.get("ok", True)]
         if bad:
             parts.append("limits NOT met: " + ", ".join(bad))
+        parts += [f"warning: {w}" for w in s.get("warnings", ())]
         if parts:
             rows[f"safety {name}"] = "; ".join(parts)
     return rows

@@ -9,7 +9,8 @@ mission file's ``world:`` section becomes), :func:`build_world` and
 * ``--dem FILE`` (repeatable: tiles), ``--dem-fill FILE`` (repeatable: more DEMs in
   priority order that fill its gaps), ``--buildings FILE``, ``--bbox W,S,E,N``,
   ``--sea-level M``, ``--cell-size``, ``--dz``, ``--ceiling``, ``--nodata``,
-  ``--nodata-value``, ``--crs``, ``--default-height``, ``--allow-filled``;
+  ``--nodata-value``, ``--crs``, ``--default-height``, ``--allow-filled``,
+  ``--ground-elevation``, ``--margin``;
 * ``--lonlat``: read ``--start``/``--goal`` as ``LON,LAT[,AGL]`` (degrees,
   degrees, metres above the ground; without AGL the command's ``--agl``).
 """
@@ -34,6 +35,7 @@ if TYPE_CHECKING:
 __all__ = [
     "DemOpt", "DemFillOpt", "BuildingsOpt", "BboxOpt", "SeaLevelOpt", "CellSizeOpt", "DzOpt", "CeilingOpt",
     "NodataOpt", "NodataValueOpt", "CrsOpt", "DefaultHeightOpt", "AllowFilledOpt", "LonLatOpt",
+    "GroundElevationOpt", "MarginOpt",
     "ScenarioOpt", "SCENARIO_NAMES", "AIRFRAME_NAMES", "WORLD_FLAGS", "world_spec",
     "build_world", "cli_point", "world_rows", "requested_heights", "world_overrides",
     "point_overrides", "option_group", "WorldFlags", "world_options", "MissionFlags",
@@ -96,6 +98,15 @@ DefaultHeightOpt = _option(float | None, "--default-height",
                            panel=_P)
 AllowFilledOpt = _option(bool, "--allow-filled", panel=_P, show_default=True,
                          help="Only warn when the start/goal lies over filled DEM nodata.")
+GroundElevationOpt = _option(
+    float | None, "--ground-elevation", panel=_P,
+    help="Altitude (m above sea level) of the flat ground of --buildings without --dem. "
+         "Without it the mission is written relative to home (the ground's altitude is "
+         "unknown).")
+MarginOpt = _option(
+    float | None, "--margin", panel=_P,
+    help="Free border (m) around the footprints of --buildings without --dem. Default: "
+         "50 m, at least 10 cells.")
 LonLatOpt = Annotated[bool, typer.Option(
     "--lonlat", help="Read --start/--goal as LON,LAT[,AGL] (degrees, degrees, metres above "
                      "the ground; default AGL: --agl).")]
@@ -117,7 +128,8 @@ WORLD_FLAGS = {
     "sea_level": "--sea-level",
     "cell_size": "--cell-size", "dz": "--dz", "ceiling": "--ceiling", "nodata": "--nodata",
     "nodata_value": "--nodata-value", "crs": "--crs", "default_height": "--default-height",
-    "allow_filled": "--allow-filled",
+    "allow_filled": "--allow-filled", "ground_elevation": "--ground-elevation",
+    "margin": "--margin",
 }
 
 
@@ -148,6 +160,8 @@ def world_spec(
     crs: str | None = None,
     default_height: float | None = None,
     allow_filled: bool = False,
+    ground_elevation: float | None = None,
+    margin: float | None = None,
 ) -> Any:
     """The :class:`~fm2uav.world.load.WorldSpec` of the world options, or None without data.
 
@@ -167,7 +181,8 @@ def world_spec(
               "bbox": None if bbox is None else _bbox(bbox), "sea_level": sea_level,
               "cell_size": cell_size, "dz": dz, "ceiling": ceiling, "nodata": nodata,
               "nodata_value": nodata_value, "crs": crs, "default_height": default_height,
-              "allow_filled": allow_filled}
+              "allow_filled": allow_filled, "ground_elevation": ground_elevation,
+              "margin": margin}
     if values["dem"] is not None and len(values["dem"]) == 1:
         values["dem"] = values["dem"][0]
     if values["dem"] is None and values["buildings"] is None:
@@ -208,7 +223,7 @@ def world_overrides(**options: Any) -> dict[str, Any] | None:
     if values.get("bbox") is not None:
         out["bbox"] = _bbox(values["bbox"])
     for k in ("sea_level", "cell_size", "dz", "ceiling", "nodata_value", "crs",
-              "default_height"):
+              "default_height", "ground_elevation", "margin"):
         if values.get(k) is not None:
             out[k] = values[k]
     if values.get("nodata", "error") != "error":
@@ -246,10 +261,12 @@ def point_overrides(*, start: str | None, goal: str | None, lonlat: bool
 
 
 def build_world(spec: Any, *, scenario: str | None, seed: int = 0, agl: float | None = None,
-                top: float | None = None, default: str = "open-field") -> tuple[Any, Any, str]:
+                top: float | None = None, default: str = "open-field",
+                max_cell: tuple[float, str] | None = None) -> tuple[Any, Any, str]:
     """``(world, scenario or None, description)`` from a spec, else a built-in scenario.
 
-    ``agl`` / ``top`` size a data world (see :func:`fm2uav.world.load.load_world`).
+    ``agl`` / ``top`` / ``max_cell`` size a data world (see
+    :func:`fm2uav.world.load.load_world`).
     Warnings of the data (below sea level, distortion) are shown by
     :func:`~fm2uav.cli._common.handle_errors` as one-line ``warning:`` lines.
 
@@ -267,7 +284,7 @@ def build_world(spec: Any, *, scenario: str | None, seed: int = 0, agl: float | 
         return sc.world, sc, scenario or default
     if scenario is not None:
         raise InputError("give either --scenario or --dem/--buildings, not both")
-    world = load_world(spec, agl=agl, top=top)
+    world = load_world(spec, agl=agl, top=top, max_cell=max_cell)
     return world, None, spec.describe()
 
 
@@ -399,6 +416,8 @@ class WorldFlags:
     crs: str | None = None
     default_height: float | None = None
     allow_filled: bool = False
+    ground_elevation: float | None = None
+    margin: float | None = None
 
     def values(self) -> dict[str, Any]:
         """The flags as keywords of :func:`world_spec` / :func:`world_overrides`."""
@@ -421,7 +440,7 @@ class WorldFlags:
                            top=need_top, default=default)
 
 
-#: ``@world_options``: the 13 world flags in place of the command's ``world`` parameter.
+#: ``@world_options``: the 15 world flags in place of the command's ``world`` parameter.
 world_options = option_group("world", [
     ("dem", DemOpt, None), ("dem_fill", DemFillOpt, None), ("buildings", BuildingsOpt, None),
     ("bbox", BboxOpt, None),
@@ -429,6 +448,7 @@ world_options = option_group("world", [
     ("ceiling", CeilingOpt, None), ("nodata", NodataOpt, "error"),
     ("nodata_value", NodataValueOpt, None), ("crs", CrsOpt, None),
     ("default_height", DefaultHeightOpt, None), ("allow_filled", AllowFilledOpt, False),
+    ("ground_elevation", GroundElevationOpt, None), ("margin", MarginOpt, None),
 ], WorldFlags)
 
 

@@ -66,8 +66,9 @@ class FormationCase:
     def options(self, dz: float) -> dict[str, Any]:
         """The ``fly_formation`` keyword arguments of this case on vertical cells of ``dz`` m."""
         out: dict[str, Any] = {}
-        if self.level is not None:
-            out["level"] = FlightLevel(agl=self.level * dz, p1=self.p1, p2=self.p2)
+        if self.level is not None:  # the seeds' Algorithm 2 itself: FM²'s own heights
+            out["level"] = FlightLevel(agl=self.level * dz, p1=self.p1, p2=self.p2,
+                                       heights="fm2")
         if self.walls:
             out["shaping"] = Shaping(walls=True)
         if self.dist is not None:

@@ -115,7 +115,8 @@ def _description(m: MissionExport) -> str:
     lines = [f"firmware {s['firmware']}, {s['vehicle']}, frame {s['frame']['name']} "
              f"(MAV_FRAME {s['frame']['mav_frame']}), end {s['end']}",
              f"home {s['home']['lat']:.7f}, {s['home']['lon']:.7f}, "
-             f"{s['home']['alt_amsl_m']:.1f} m AMSL ({s['home']['source']})",
+             + ("altitude above sea level unknown" if s["home"]["alt_amsl_m"] is None
+                else f"{s['home']['alt_amsl_m']:.1f} m AMSL") + f" ({s['home']['source']})",
              f"CRS {s['crs']}; altitudes: {s['vertical_reference']}"]
     return "\n".join(lines + [f"warning: {w}" for w in m.warnings]
                      + [f"note: {n}" for n in m.info.get("notes", [])])
@@ -291,13 +292,18 @@ def export_formation(
     holds = start_holds(result.positions[0], world, opt)
     missions: dict[str, MissionExport] = {}
     files: dict[str, ExportFile] = {}
+    tracks = tuple(getattr(result, "tracks", ()) or ())
     for i, name in enumerate(result.names):
-        path = np.asarray(result.positions[:, i], dtype=float)
+        # the UAV's track: its final heights with times (one truth for all its files)
+        tr = tracks[i] if i < len(tracks) else None
+        path = np.asarray(result.positions[:, i] if tr is None else tr.path, dtype=float)
+        times = result.times if tr is None else tr.times
         track = SimpleNamespace(path=path, world=world, w=None, level=None, params={},
-                                length=path_length(path))
+                                length=path_length(path),
+                                profile=None if tr is None else tr.profile)
         agl = result.agl[i] if i < len(result.agl) else None
         m, f = export_mission(track, formats, replace(opt, name=f"{opt.name} — {name}"),
-                              agl=agl, times=result.times, start_hold=float(holds[i]),
+                              agl=agl, times=times, start_hold=float(holds[i]),
                               prefix=file_prefix(name), fences=fences)
         missions[name] = m
         files.update(f)

@@ -3,8 +3,11 @@
 A Document with the path as an absolute-altitude LineString (extruded to the
 ground, so the flight height is visible as a curtain), the thinned waypoints
 as a second line, and start/goal Placemarks. KML coordinates are
-``lon,lat,alt`` with alt in metres above mean sea level. A KMZ is the same
-document zipped as ``doc.kml`` (the KML 2.2 convention for the main file).
+``lon,lat,alt`` with alt in metres above mean sea level. A world whose altitude
+above sea level is unknown (buildings without a DEM or a ground elevation,
+:func:`fm2uav.world.geo.amsl_known`) is written ``relativeToGround`` instead,
+alt the height above the ground. A KMZ is the same document zipped as
+``doc.kml`` (the KML 2.2 convention for the main file).
 """
 
 from __future__ import annotations
@@ -19,7 +22,7 @@ from xml.sax.saxutils import escape
 import numpy as np
 
 from ..errors import InputError
-from ..world.geo import Anchor, to_lonlat
+from ..world.geo import Anchor, amsl_known, to_lonlat
 
 __all__ = ["kml_document", "write_kml", "write_kmz", "read_kml_path"]
 
@@ -30,20 +33,31 @@ def _coord_text(geo: np.ndarray) -> str:
     return " ".join(f"{lo:.9f},{la:.9f},{al:.3f}" for lo, la, al in geo)
 
 
-def _line(name: str, style: str, geo: np.ndarray, extrude: bool) -> str:
+def _line(name: str, style: str, geo: np.ndarray, extrude: bool, mode: str = "absolute"
+          ) -> str:
     return (
         f"<Placemark><name>{escape(name)}</name><styleUrl>#{style}</styleUrl>"
         f"<LineString><extrude>{int(extrude)}</extrude><tessellate>0</tessellate>"
-        f"<altitudeMode>absolute</altitudeMode><coordinates>{_coord_text(geo)}</coordinates>"
+        f"<altitudeMode>{mode}</altitudeMode><coordinates>{_coord_text(geo)}</coordinates>"
         "</LineString></Placemark>"
     )
 
 
-def _point(name: str, geo: np.ndarray) -> str:
+def _point(name: str, geo: np.ndarray, mode: str = "absolute") -> str:
     return (
-        f"<Placemark><name>{escape(name)}</name><Point><altitudeMode>absolute</altitudeMode>"
+        f"<Placemark><name>{escape(name)}</name><Point><altitudeMode>{mode}</altitudeMode>"
         f"<coordinates>{_coord_text(geo[None])}</coordinates></Point></Placemark>"
     )
+
+
+def _geo(world: Any, points: np.ndarray, anchor: Anchor | None) -> tuple[np.ndarray, str]:
+    """lon, lat, alt of world points and the KML altitude mode: absolute (AMSL), or
+    relativeToGround with the height above the ground where the datum is unknown."""
+    geo = to_lonlat(world, points, anchor=anchor)
+    if points.shape[1] == 3 and not amsl_known(world):
+        g = np.asarray(world.ground_height(points[:, 0], points[:, 1]), dtype=float)
+        return np.column_stack([geo[:, :2], points[:, 2] - g]), "relativeToGround"
+    return geo, "absolute"
 
 
 def kml_document(
@@ -60,7 +74,7 @@ def kml_document(
     p = np.asarray(path_m, dtype=float)
     if p.ndim != 2 or len(p) < 2:
         raise InputError(f"path must be an (N, 2|3) array with N >= 2, got shape {p.shape}")
-    geo = to_lonlat(world, p, anchor=anchor)
+    geo, mode = _geo(world, p, anchor)
     parts = [
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<kml xmlns="{_NS}"><Document><name>{escape(name)}</name>'
@@ -69,12 +83,12 @@ def kml_document(
         "<PolyStyle><color>401e1ee6</color></PolyStyle></Style>",
         '<Style id="waypoints"><LineStyle><color>ff00d7ff</color><width>2</width></LineStyle>'
         "</Style>",
-        _line("path", "path", geo, extrude=True),
+        _line("path", "path", geo, extrude=True, mode=mode),
     ]
     if waypoints_m is not None:
-        wgeo = to_lonlat(world, np.asarray(waypoints_m, dtype=float), anchor=anchor)
-        parts.append(_line("waypoints", "waypoints", wgeo, extrude=False))
-    parts += [_point("start", geo[0]), _point("goal", geo[-1]), "</Document></kml>"]
+        wgeo, _ = _geo(world, np.asarray(waypoints_m, dtype=float), anchor)
+        parts.append(_line("waypoints", "waypoints", wgeo, extrude=False, mode=mode))
+    parts += [_point("start", geo[0], mode), _point("goal", geo[-1], mode), "</Document></kml>"]
     return "\n".join(parts) + "\n"
 
 

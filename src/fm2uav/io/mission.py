@@ -18,7 +18,8 @@ Schema (pydantic v2, strict types, unknown keys rejected)::
       nodata: error                 # unknown ground: error | fill | error_on_route;
                                     # nodata_value: -9999 if undeclared
       default_height: 10            # buildings without height/building:levels; crs, margin,
-                                    # height_cells, metres_per_level, allow_filled
+                                    # height_cells, metres_per_level, ground_elevation,
+                                    # allow_filled
       anchor: {lon: -3.7649, lat: 40.3326, alt: 0}   # where a world without CRS sits
     start: [300, 300, 300]          # x, y, z [m]; or {x, y, agl}, {lon, lat, alt},
     goal: {lon: -3.747, lat: 40.343, agl: 60}        # {lon, lat, agl} or {cell: [i, j, k]}
@@ -142,7 +143,7 @@ class WorldSpec(DataWorldSpec):
     The real-data keys (``dem``, ``dem_fill``, ``buildings``, ``bbox``, ``sea_level``,
     ``cell_size``, ``dz``, ``ceiling``, ``nodata``, ``nodata_value``, ``crs``,
     ``default_height``, ``metres_per_level``, ``height_cells``, ``margin``,
-    ``allow_filled``) are :class:`fm2uav.world.load.WorldSpec`'s, shared with
+    ``ground_elevation``, ``allow_filled``) are :class:`fm2uav.world.load.WorldSpec`'s, shared with
     the CLI's world options; this adds the built-in ``scenario`` with its
     ``seed``, and the ``anchor`` of worlds without a CRS.
     """
@@ -182,16 +183,19 @@ class WorldSpec(DataWorldSpec):
             return self
         only = {"dem": ("ceiling", "nodata", "nodata_value", "sea_level", "allow_filled",
                         "dem_fill"),
-                "buildings": ("height_cells", "default_height", "metres_per_level", "margin")}
+                "buildings": ("height_cells", "default_height", "metres_per_level", "margin",
+                              "ground_elevation")}
         for source, keys in only.items():
             if getattr(self, source) is None:
                 for k in keys:
                     if getattr(self, k) != getattr(defaults, k):
                         raise ValueError(f"{k} only applies to a world with {source}, not a "
                                          f"{' and '.join(data)} world; remove it")
-        if self.dem is not None and (self.height_cells is not None or self.margin):
-            raise ValueError("height_cells and margin apply to buildings on flat ground; on a "
-                             "DEM the grid follows the DEM (use ceiling, bbox); remove them")
+        if self.dem is not None and (self.height_cells is not None or self.margin is not None
+                                     or self.ground_elevation is not None):
+            raise ValueError("height_cells, margin and ground_elevation apply to buildings on "
+                             "flat ground; on a DEM the grid and the ground follow the DEM (use "
+                             "ceiling, bbox); remove them")
         return self
 
     def data_spec(self) -> DataWorldSpec:

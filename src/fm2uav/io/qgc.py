@@ -10,7 +10,9 @@ Format" developer documentation and ``PlanMasterController`` /
   altitude relative to home, as QGC's ``RallyPointController`` saves them, ``version``
   2; :mod:`fm2uav.io.rally`); fm2uav adds an
   ``fm2uav`` object (frame, home and its source, CRS and vertical reference,
-  warnings), which QGroundControl ignores;
+  warnings, and with zones ``geofence``: what the 2D fence carries of them and
+  what it cannot — floors, ceilings, buffers,
+  :func:`fm2uav.autopilot.geofence.fence_statement`), which QGroundControl ignores;
 * ``mission``: ``version`` 2, ``firmwareType`` (MAV_AUTOPILOT), ``vehicleType``
   (MAV_TYPE), ``cruiseSpeed``, ``hoverSpeed``, ``globalPlanAltitudeMode``,
   ``plannedHomePosition`` ``[lat, lon, alt AMSL]`` and ``items``;
@@ -121,7 +123,8 @@ def plan_document(mission: Any) -> dict[str, Any]:
                    "georef": _portable(info["georef"]),
                    "vertical_reference": info["vertical_reference"],
                    "end": info["end"], "warnings": info["warnings"],
-                   "notes": info.get("notes", [])},
+                   "notes": info.get("notes", []),
+                   **({"geofence": info["geofence"]} if "geofence" in info else {})},
         "geoFence": geofence_document(mission.fences),
         "groundStation": "fm2uav",
         "mission": {

@@ -18,7 +18,7 @@ from .outputs import write_exports, write_figure, write_json
 from .rows import mission_rows, safety_rows, world_rows
 
 __all__ = ["COVER_EXPORTS", "COVER_FILES", "REPORT", "CoverRun", "run_cover", "cover_outputs",
-           "cover_rows"]
+           "cover_rows", "band_cell"]
 
 #: Mission files of a coverage flight (written by fm2uav.io.export_mission).
 COVER_EXPORTS = ("csv", "plan", "wpl", "kml", "kmz", "geojson")
@@ -27,6 +27,20 @@ COVER_FILES = ("path.csv", "zigzag.csv", "bands.png", "coverage.png", "coverage.
                "path.geojson")
 REPORT = "report.html"
 
+
+def band_cell(spacing: float, zones: bool) -> tuple[float, str] | None:
+    """The largest automatic cell [m] (and why) of a survey with band spacing ``spacing``
+    [m] around no-fly zones (``zones``), for :func:`fm2uav.world.load.load_world`'s
+    ``max_cell``: the route around them resolves bands only
+    :data:`~fm2uav.missions.coverage.zones.ROUTE_BAND_CELLS` cells apart (the corridor
+    grid of a survey without zones resolves any spacing: None)."""
+    from ..missions.coverage.zones import ROUTE_BAND_CELLS, route_cell
+
+    if not zones:
+        return None
+    cell = route_cell(spacing)
+    return cell, (f"at most D / {ROUTE_BAND_CELLS:g} = {cell:.3g} m so that the route around "
+                  "the no-fly zones resolves the bands")
 
 
 @dataclass(frozen=True)

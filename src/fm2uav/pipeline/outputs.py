@@ -166,7 +166,8 @@ def plan_outputs(
         "autopilot": mission.summary(),
         "waypoints": len(wps),
         "mavlink_frame": wps.frame,
-        "home_lat_lon_alt": [round(v, 9) for v in wps.home],
+        "home_lat_lon_alt": [round(v, 9) for v in wps.home[:2]]
+        + [round(wps.home[2], 9) if wps.amsl else None],
         "thin_tolerance_m": options.tolerance,
         "safety": safety,
     }
@@ -261,7 +262,8 @@ def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
         "path points": len(plan.path),
         "waypoints": len(wps),
         "mission items": ms["items"],
-        "home (lat, lon, alt AMSL)": [round(v, 7) for v in wps.home],
+        "home (lat, lon, alt AMSL)": [round(v, 7) for v in wps.home[:2]]
+        + [round(wps.home[2], 7) if wps.amsl else "unknown"],
         "flight time [min]": round(ms["flight"]["flight_time_s"] / 60, 2),
         "planning time [s]": round(float(plan.timings.get("total", 0.0)), 3),
         **safety_rows(info["safety"]),

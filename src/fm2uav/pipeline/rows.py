@@ -17,8 +17,9 @@ def mission_rows(mission: Any) -> dict[str, str]:
         "autopilot mission": f"{s['firmware']} {s['vehicle']}, {s['items']} items, "
                              f"{s['waypoints']} waypoints, ends with {s['end']}",
         "altitude frame": f"{s['frame']['name']} (MAVLink frame {s['frame']['mav_frame']})",
-        "home lat, lon, alt": f"{h['lat']:.7f}, {h['lon']:.7f}, {h['alt_amsl_m']:.1f} m AMSL "
-                              f"({h['source']})",
+        "home lat, lon, alt": f"{h['lat']:.7f}, {h['lon']:.7f}, "
+                              + ("altitude above sea level unknown" if h["alt_amsl_m"] is None
+                                 else f"{h['alt_amsl_m']:.1f} m AMSL") + f" ({h['source']})",
         "flight": f"{s['flight']['flight_distance_m'] / 1000:.2f} km, "
                   f"{s['flight']['flight_time_s'] / 60:.1f} min",
     }
@@ -63,6 +64,8 @@ def safety_rows(safety: dict[str, Any]) -> dict[str, str]:
     bad = [k for k, c in safety.get("checks", {}).items() if not c.get("ok", True)]
     if bad:
         rows["limits NOT met"] = ", ".join(bad)
+    for k, w in enumerate(safety.get("warnings", ())):
+        rows[f"safety warning {k + 1}"] = w
     return rows
 
 

@@ -424,7 +424,8 @@ def _check_ends_below_ceiling(world: Any, p: np.ndarray, level: FlightLevel) -> 
 def _surface_envelope(world: Any, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Surface at the route samples ``xy`` [m]; its upper and the ground's lower envelope.
 
-    The chord between two samples is flown straight: it is read at 1/4, 1/2, 3/4.
+    The chord between two samples is flown straight: it is read at 1/4, 1/2, 3/4, and
+    the roof of every building footprint it meets counts (``World.buildings``).
     Returns the surface height at the samples, the highest surface and the lowest
     ground over each sample's two chords [m].
     """
@@ -450,6 +451,10 @@ def _surface_envelope(world: Any, xy: np.ndarray) -> tuple[np.ndarray, np.ndarra
     else:
         bump = dip = np.zeros(0)
     smax = s_at + _window(np.zeros(len(xy)), bump, np.maximum)
+    model = getattr(world, "buildings", None)
+    if model is not None and n_ch:  # a roof a chord meets between its read points
+        smax = np.maximum(smax, _window(np.full(len(xy), -np.inf),
+                                        model.roof_along(xy[:-1], xy[1:]), np.maximum))
     gmin = g_at - _window(np.zeros(len(xy)), dip, np.maximum)
     return s_at, smax, gmin
 
@@ -491,12 +496,11 @@ def final_profile(world: Any, path: Any, level: FlightLevel, *, ds: float | None
     if level.max_agl is not None:  # the take-off / landing points must be legal too
         _check_ends_below_ceiling(world, p, level)
     xy, s = resample_route(p, ds)
-    mids = 0.5 * (xy[:-1] + xy[1:])
     s_at, smax, gmin = _surface_envelope(world, xy)
     # the FM² route's own height at each sample (chooses over/under a zone)
     cum = arc_length(p[:, :2])  # horizontal distance along the route
     z_route = np.interp(s, cum, p[:, 2]) if cum[-1] > 0 else np.full(len(s), p[0, 2])
-    lo_x, up_x = zone_bounds_along(world, xy, z_route, mids)
+    lo_x, up_x = zone_bounds_along(world, xy, z_route)
     top = float(world.bounds[2, 1])
     out = solve_profile(s, smax, gmin, level, z_start=float(p[0, 2]), z_goal=float(p[-1, 2]),
                         ground_start=float(s_at[0]), ground_goal=float(s_at[-1]),

@@ -29,6 +29,31 @@ multirotor          vmax   amax   vclimb   vdesc    source
 =================  =====  =====  =======  =======  ==========================
 ``arducopter``      10     2.5    2.5      1.5      ArduCopter AC_WPNav defaults
 =================  =====  =====  =======  =======  ==========================
+
+Endurance
+---------
+Every mission's flight time is checked against an endurance (``airframe.endurance``
+/ ``--endurance`` in minutes, with ``airframe.reserve`` kept back). When none is
+given, the airframe type's default below is used and the summary says so
+(:func:`default_endurance`): the check runs by default and warns where the reserve is
+reached; it is a conservative class figure, not your vehicle's — give its own.
+
+==============  =========  =====================================================
+type / preset   endurance  rationale
+==============  =========  =====================================================
+multirotor      20 min     lower end of common survey multirotors: DJI Phantom 4
+                           RTK is rated about 30 min, typical ArduPilot quads on a
+                           4S 5000 mAh pack fly 15–25 min; rated times are flown
+                           without payload or wind
+fixed_wing      45 min     Parrot Disco, the smallest fixed-wing preset: rated
+                           45 min by its maker
+vtol            45 min     lower end of survey VTOLs (WingtraOne GEN II rated
+                           59 min); hover phases cost several times cruise power
+``disco``       45 min     Parrot's rated flight time
+``crosswind``   45 min     the VTOL default (no rated figure in the parameter file)
+``plane-jet``   15 min     model turbine jets carry fuel for about 10–15 min
+``arducopter``  20 min     the multirotor default
+==============  =========  =====================================================
 """
 
 from __future__ import annotations
@@ -41,6 +66,8 @@ from ..errors import InputError
 
 __all__ = [
     "G",
+    "DEFAULT_ENDURANCE_MIN",
+    "default_endurance",
     "AirframeLimits",
     "FixedWing",
     "Multirotor",
@@ -51,6 +78,42 @@ __all__ = [
 
 #: Standard gravity [m/s²].
 G = 9.80665
+
+#: Default endurance of each airframe type [min] (module docstring, "Endurance").
+DEFAULT_ENDURANCE_MIN = {"multirotor": 20.0, "fixed_wing": 45.0, "vtol": 45.0}
+_ENDURANCE_WHY = {
+    "multirotor": "lower end of common survey multirotors (DJI Phantom 4 RTK rated about "
+                  "30 min, ArduPilot quads 15-25 min)",
+    "fixed_wing": "Parrot Disco's rated 45 min (the smallest fixed-wing preset)",
+    "vtol": "lower end of survey VTOLs (WingtraOne GEN II rated 59 min)",
+}
+
+
+def default_endurance(vehicle: str) -> tuple[float, str]:
+    """``(endurance [s], where it comes from)`` of an airframe type without its own.
+
+    Parameters
+    ----------
+    vehicle : {"multirotor", "fixed_wing", "vtol"}
+        The mission's airframe type (``airframe.type``), or a preset name of
+        :data:`AIRFRAMES` (its own ``endurance_s``).
+
+    Examples
+    --------
+    >>> default_endurance("multirotor")[0] / 60
+    20.0
+    """
+    key = str(vehicle).strip().lower()
+    preset = AIRFRAMES.get(key.replace("_", "-"))
+    if preset is not None and key not in DEFAULT_ENDURANCE_MIN:
+        return float(preset.endurance_s), f"preset {preset.name}: {preset.endurance_source}"
+    if key not in DEFAULT_ENDURANCE_MIN:
+        raise InputError(f"unknown airframe type {vehicle!r}; allowed: "
+                         f"{', '.join(DEFAULT_ENDURANCE_MIN)}")
+    minutes = DEFAULT_ENDURANCE_MIN[key]
+    return 60.0 * minutes, (f"default for a {key.replace('_', '-')}: {minutes:g} min, "
+                            f"{_ENDURANCE_WHY[key]}; give your vehicle's with "
+                            "airframe.endurance (--endurance)")
 
 
 def _positive(name: str, value: Any, *, allow_zero: bool = False) -> float:
@@ -136,6 +199,10 @@ class FixedWing:
         Maximum flight-path angle when descending (positive number) [rad].
     source : str
         Where the numbers come from.
+    endurance_s : float
+        Flight time the mission is checked against [s] (module docstring, "Endurance").
+    endurance_source : str
+        Where that endurance comes from.
     """
 
     name: str
@@ -146,12 +213,15 @@ class FixedWing:
     max_climb: float
     max_descent: float
     source: str = ""
+    endurance_s: float = 60.0 * DEFAULT_ENDURANCE_MIN["fixed_wing"]
+    endurance_source: str = "the fixed-wing default"
 
     kind = "fixed-wing"
 
     def __post_init__(self) -> None:
         for attr in ("cruise_speed", "min_speed", "max_speed"):
             object.__setattr__(self, attr, _positive(attr + " [m/s]", getattr(self, attr)))
+        object.__setattr__(self, "endurance_s", _positive("endurance_s [s]", self.endurance_s))
         for attr in ("max_bank", "max_climb", "max_descent"):
             v = _positive(attr + " [rad]", getattr(self, attr))
             if v >= math.pi / 2:
@@ -212,6 +282,8 @@ class FixedWing:
             "max_descent_deg": round(math.degrees(self.max_descent), 3),
             "min_turn_radius_m": round(self.turn_radius(), 3),
             "max_turn_rate_dps": round(math.degrees(self.max_turn_rate()), 3),
+            "endurance_min": round(self.endurance_s / 60.0, 3),
+            "endurance_source": self.endurance_source,
             "source": self.source,
         }
 
@@ -234,6 +306,10 @@ class Multirotor:
         Maximum vertical speed down (positive number) [m/s].
     source : str
         Where the numbers come from.
+    endurance_s : float
+        Flight time the mission is checked against [s] (module docstring, "Endurance").
+    endurance_source : str
+        Where that endurance comes from.
     """
 
     name: str
@@ -242,6 +318,8 @@ class Multirotor:
     max_climb_rate: float
     max_descent_rate: float
     source: str = ""
+    endurance_s: float = 60.0 * DEFAULT_ENDURANCE_MIN["multirotor"]
+    endurance_source: str = "the multirotor default"
 
     kind = "multirotor"
 
@@ -251,6 +329,7 @@ class Multirotor:
             ("max_accel", "m/s²"),
             ("max_climb_rate", "m/s"),
             ("max_descent_rate", "m/s"),
+            ("endurance_s", "s"),
         ):
             object.__setattr__(self, attr, _positive(f"{attr} [{unit}]", getattr(self, attr)))
 
@@ -278,6 +357,8 @@ class Multirotor:
             "max_climb_rate_mps": self.max_climb_rate,
             "max_descent_rate_mps": self.max_descent_rate,
             "turn_radius_at_max_speed_m": round(self.turn_radius(), 3),
+            "endurance_min": round(self.endurance_s / 60.0, 3),
+            "endurance_source": self.endurance_source,
             "source": self.source,
         }
 
@@ -291,22 +372,28 @@ AIRFRAMES: dict[str, Airframe] = {
         "disco", 14.0, 12.0, 17.0, math.radians(55.0), math.radians(30.0), math.radians(25.0),
         source=f"Parrot Disco, {_ARDU}/Parrot_Disco/Parrot_Disco.param (AIRSPEED_CRUISE/MIN/MAX, "
         "ROLL_LIMIT_DEG, PTCH_LIM_MAX_DEG/PTCH_LIM_MIN_DEG)",
+        endurance_s=45 * 60.0, endurance_source="Parrot's rated flight time of the Disco, 45 min",
     ),
     "crosswind": FixedWing(
         "crosswind", 20.0, 16.0, 29.0, math.radians(35.0), math.radians(22.0), math.radians(25.0),
         source=f"MFD Crosswind VTOL in plane mode, {_ARDU}/QuadPlanes/MFD_Crosswind_VTOL.param "
         "(AIRSPEED_*, ROLL_LIMIT_DEG, PTCH_LIM_MAX_DEG); descent 25 deg as the other ArduPilot "
         "plane files (the file leaves PTCH_LIM_MIN_DEG unset)",
+        endurance_s=45 * 60.0,
+        endurance_source="the VTOL default, 45 min (the parameter file rates no flight time)",
     ),
     "plane-jet": FixedWing(
         "plane-jet", 40.0, 25.0, 80.0, math.radians(70.0), math.radians(20.0), math.radians(25.0),
         source="ArduPilot Tools/autotest/default_params/plane-jet.parm (AIRSPEED_*, ROLL_LIMIT_DEG, "
         "PTCH_LIM_MAX_DEG/PTCH_LIM_MIN_DEG)",
+        endurance_s=15 * 60.0,
+        endurance_source="model turbine jets carry fuel for about 10-15 min",
     ),
     "arducopter": Multirotor(
         "arducopter", 10.0, 2.5, 2.5, 1.5,
         source="ArduCopter waypoint navigation defaults, libraries/AC_WPNav (WPNAV_SPEED 1000 cm/s, "
         "WPNAV_ACCELERATION 2.5 m/s², WPNAV_SPEED_UP 250 cm/s, WPNAV_SPEED_DN 150 cm/s)",
+        endurance_source="the multirotor default, 20 min",
     ),
 }
 

@@ -158,6 +158,12 @@ class EnduranceReport:
         (the whole distance when it lasts).
     reach_waypoint : int
         Last waypoint reached within the usable endurance (index).
+    waypoints : int
+        Number of waypoints.
+    reach_fraction : float
+        Share of the leg after ``reach_waypoint`` flown when the usable endurance runs
+        out (0 when it runs out during the take-off climb or lasts), so that the point
+        is ``p[k] + reach_fraction (p[k + 1] - p[k])``.
     """
 
     time_s: float
@@ -169,6 +175,7 @@ class EnduranceReport:
     reach_m: float
     reach_waypoint: int
     waypoints: int
+    reach_fraction: float = 0.0
 
     @property
     def warning(self) -> str | None:
@@ -224,10 +231,12 @@ def check_endurance(ft: FlightTime, *, endurance_s: float | None, reserve: float
                                frac * ft.takeoff_m, 0, n)
     k = min(int(np.searchsorted(t_wp, usable, side="right") - 1), n - 1)
     reach = ft.takeoff_m + float(np.sum(ft.leg_length[:k]))
+    frac = 0.0
     if k < n - 1 and ft.leg_time[k] > 0:
-        reach += ft.leg_length[k] * min((usable - t_wp[k]) / ft.leg_time[k], 1.0)
+        frac = min((usable - t_wp[k]) / ft.leg_time[k], 1.0)
+        reach += ft.leg_length[k] * frac
     return EnduranceReport(ft.time_s, ft.distance_m, float(endurance_s), r, usable, False,
-                           float(reach), k, n)
+                           float(reach), k, n, float(frac))
 
 
 def return_time(path: Any, *, speed: float, climb_rate: float, descent_rate: float,

@@ -29,6 +29,11 @@ Features (``properties.kind``):
 ``summary`` holds the operator's figures (length, flight time, waypoints, lowest
 height above ground, nearest zone) and ``rows`` the same summary rows the
 command line prints.
+
+``summary.amsl`` (and the route's ``amsl``) is False when the world's altitude
+above sea level is unknown (buildings without a DEM or ``world.ground_elevation``):
+the "AMSL" altitudes and ``ground`` are then heights above the flat ground, as the
+mission (relative to home) is, and the page labels them so.
 """
 
 from __future__ import annotations
@@ -187,6 +192,7 @@ def mission_map(plan: Any, mission: Any, safety: dict[str, Any] | None = None, *
     world = plan.world
     path = np.asarray(plan.path, dtype=float)
     ll = _lonlat(world, path, anchor)
+    amsl = bool(getattr(mission.waypoints, "amsl", True))
     ground = np.asarray(world.ground_height(path[:, 0], path[:, 1]), dtype=float)
     agl = path[:, 2] - ground
     amsl_offset = ll[:, 2] - path[:, 2]     # world z -> altitude AMSL (0 on a DEM world)
@@ -197,7 +203,7 @@ def mission_map(plan: Any, mission: Any, safety: dict[str, Any] | None = None, *
         "type": "Feature",
         "geometry": {"type": "LineString", "coordinates": [
             [round(float(a), 7), round(float(b), 7), round(float(c), 1)] for a, b, c in ll]},
-        "properties": {"kind": "route", "requested_agl": requested,
+        "properties": {"kind": "route", "requested_agl": requested, "amsl": amsl,
                        "agl": [round(float(v), 1) for v in agl],
                        "ground": [round(float(v), 1) for v in ground + amsl_offset],
                        "distance": [round(float(v), 1) for v in dist],
@@ -224,7 +230,7 @@ def mission_map(plan: Any, mission: Any, safety: dict[str, Any] | None = None, *
         "items": s["items"], "waypoints": s["waypoints"],
         "firmware": s["firmware"], "vehicle": s["vehicle"], "frame": s["frame"]["name"],
         "mav_frame": s["frame"]["mav_frame"], "end": s["end"],
-        "home": s["home"], "requested_agl_m": requested,
+        "home": s["home"], "amsl": amsl, "requested_agl_m": requested,
         "min_agl_m": _r(hag["min_m"]) if "min_m" in hag else _r(np.min(agl)),
         "max_agl_m": _r(hag["max_m"]) if "max_m" in hag else _r(np.max(agl)),
         "nearest_zone_m": None if near is None else _r(near),

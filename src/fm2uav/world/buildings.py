@@ -206,6 +206,7 @@ def from_buildings(
     agl: float | None = None,
     top: float | None = None,
     layer: str | None = None,
+    ground_elevation: float | None = None,
 ) -> World:
     """Build a 3D world from building footprints with heights (see the module docstring).
 
@@ -253,6 +254,12 @@ def from_buildings(
         Highest requested altitude [m] (start/goal): the default grid reaches it.
     layer : str, optional
         Read only this layer of the file.
+    ground_elevation : float, optional
+        Altitude of the flat ground above mean sea level [m] (without ``terrain``):
+        the grid's floor ``z0`` (unless ``origin`` gives one) and the datum of every
+        altitude. Without it (and without ``terrain``) z is the height above the
+        ground, whose altitude is unknown (``World.georef.amsl`` is False): missions
+        are then written relative to home.
 
     Returns
     -------
@@ -267,14 +274,16 @@ def from_buildings(
     """
     cs = _cell_size(cell_size) if terrain is None else np.asarray(terrain.spacing, dtype=float)
     _check_level_and_terrain(metres_per_level, terrain)
+    z0 = _ground_elevation(ground_elevation, terrain)
     box = None if bbox is None else check_lonlat_bbox(bbox, "world.bbox (--bbox)")
     data, polys = _read_footprints(footprints, terrain, crs, layer)
     ids = [_feature_id(p) for p in data.properties]
     heights, counts = _heights(data.properties, metres_per_level, default_height, ids)
     world_crs = data.crs
     org, nx, ny, ground = _horizontal_grid(terrain, polys, heights, box, world_crs, cs, shape,
-                                           origin, height_cells, margin, agl, top)
-    roof, outside, off_grid = _roofs(polys, heights, ground, org, cs, all_touched)
+                                           origin, height_cells, margin, agl, top, z0)
+    roof, outside, off_grid, model = _roofs(polys, heights, ground, org, cs, all_touched,
+                                            terrain)
     _report_left_out(data, outside, off_grid)
     surface = np.maximum(roof, ground)
     nz = _vertical_nodes(terrain, shape, height_cells, org, cs, float(surface.max()), agl, top)
@@ -282,11 +291,13 @@ def from_buildings(
     occ = _occupancy(surface, org, cs, nz, heights, ids, agl,
                      height_cells is not None and terrain is None and shape is None)
     georef = _buildings_georef(data, polys, counts, metres_per_level, default_height, outside,
-                               off_grid, all_touched, terrain, world_crs, org)
+                               off_grid, all_touched, terrain, world_crs, org,
+                               ground_elevation is not None)
     return World(
         occupancy=occ, spacing=tuple(float(c) for c in cs), origin=tuple(float(v) for v in org),
         terrain=ground, crs=world_crs, name=name or (terrain.name if terrain is not None else ""),
         filled=None if terrain is None else terrain.filled, georef=georef,
+        ground=None if terrain is None else terrain.ground, buildings=model,
     )
 
 
@@ -309,16 +320,34 @@ def _check_level_and_terrain(metres_per_level: float, terrain: World | None) -> 
         raise WorldError("terrain= must be a 3D world with a terrain height map (a DEM world)")
 
 
+def _ground_elevation(value: Any, terrain: World | None) -> float:
+    """The flat ground's altitude z0 [m]: ``ground_elevation`` or 0 (refused on a DEM)."""
+    if value is None:
+        return 0.0
+    if terrain is not None:
+        raise WorldError("world.ground_elevation (--ground-elevation) is for buildings without "
+                         "a DEM; on a DEM the ground is the DEM's: leave it out")
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        v = float("nan")
+    if not (np.isfinite(v) and -500.0 <= v <= 9000.0):
+        raise WorldError(f"world.ground_elevation (--ground-elevation) must be the ground's "
+                         f"altitude above sea level in metres, -500..9000, got {value!r}")
+    return v
+
+
 def _horizontal_grid(terrain: World | None, polys: list[Any], heights: Sequence[float], box: Any,
                      world_crs: Any, cs: np.ndarray, shape: Any, origin: Any, height_cells: Any,
-                     margin: float, agl: Any, top: Any) -> tuple[np.ndarray, int, int, np.ndarray]:
+                     margin: float, agl: Any, top: Any, z0: float = 0.0
+                     ) -> tuple[np.ndarray, int, int, np.ndarray]:
     """Origin [m], horizontal node counts and ground heights [m]: the terrain's, or flat at z0."""
     if terrain is not None:
         org = np.asarray(terrain.origin, dtype=float)
         nx, ny = terrain.shape[:2]
         return org, nx, ny, np.asarray(terrain.terrain, dtype=float)
     org, nx, ny = _flat_grid(polys, heights, box, world_crs, cs, shape, origin, height_cells,
-                             margin, agl, top)
+                             margin, agl, top, z0)
     return org, nx, ny, np.full((nx, ny), org[2])
 
 
@@ -337,7 +366,7 @@ def _read_footprints(footprints: Any, terrain: World | None, crs: Any, layer: st
 
 def _flat_grid(polys: list[Any], heights: Sequence[float], box: Any, world_crs: Any,
                cs: np.ndarray, shape: Any, origin: Any, height_cells: Any, margin: float,
-               agl: Any, top: Any) -> tuple[np.ndarray, int, int]:
+               agl: Any, top: Any, z0: float = 0.0) -> tuple[np.ndarray, int, int]:
     """Origin [m] and horizontal node counts of a world on flat ground (no terrain).
 
     Default extent: ``box`` (lon/lat) or the footprints' bounds plus ``margin`` [m]; the
@@ -356,7 +385,7 @@ def _flat_grid(polys: list[Any], heights: Sequence[float], box: Any, world_crs: 
             raise WorldError("no buildings given and no shape=; give the grid size "
                              "(nx, ny, nz)")
         if origin is None:
-            origin = (minx - mg, miny - mg, 0.0)
+            origin = (minx - mg, miny - mg, z0)
         nx = int(np.ceil((maxx + mg - origin[0]) / cs[0] - 1e-9)) + 1
         ny = int(np.ceil((maxy + mg - origin[1]) / cs[1] - 1e-9)) + 1
     else:
@@ -364,13 +393,14 @@ def _flat_grid(polys: list[Any], heights: Sequence[float], box: Any, world_crs: 
             raise WorldError(f"shape must be three positive node counts (nx, ny, nz), "
                              f"got {shape!r}")
         nx, ny = int(shape[0]), int(shape[1])
-    org = np.zeros(3) if origin is None else np.asarray(origin, dtype=float)
+    org = np.array([0.0, 0.0, z0]) if origin is None else np.asarray(origin, dtype=float)
     if org.shape != (3,) or not np.all(np.isfinite(org)):
         raise WorldError(f"origin must be three finite numbers (x0, y0, z0) in metres, got "
                          f"{origin!r}")
     check_size((nx, ny), cs[:2])
     # refuse a 3D grid beyond memory before the (nx, ny) roof pass (seconds on 1e8 columns)
-    check_size((nx, ny, _nz_estimate(heights, shape, height_cells, agl, top, cs[2])), cs)
+    check_size((nx, ny, _nz_estimate(heights, shape, height_cells, agl,
+                                      None if top is None else float(top) - org[2], cs[2])), cs)
     return org, nx, ny
 
 
@@ -424,8 +454,9 @@ def _check_headroom(smax: float, zs: np.ndarray, heights: Sequence[float], ids: 
 def _buildings_georef(data: Any, polys: list[Any], counts: Any, metres_per_level: float,
                       default_height: float | None, outside: Any, off_grid: Any,
                       all_touched: bool, terrain: World | None, world_crs: Any,
-                      org: np.ndarray) -> Any:
-    """The georeference of a buildings world, its source file noting the height rules used."""
+                      org: np.ndarray, ground_given: bool = False) -> Any:
+    """The georeference of a buildings world, its source file noting the height rules used;
+    on flat ground, whether z is an altitude (``ground_given``) or a height above the ground."""
     details = {
         "buildings": len(polys),
         "height_rule": counts,
@@ -442,11 +473,18 @@ def _buildings_georef(data: Any, polys: list[Any], counts: Any, metres_per_level
     if terrain is not None and getattr(terrain, "georef", None) is not None:
         georef = terrain.georef.with_sources(src)
     elif world_crs is not None:
+        if ground_given:
+            vertical = (f"metres above mean sea level: flat ground at {org[2]:g} m (given: "
+                        "world.ground_elevation / --ground-elevation), roofs at its height "
+                        "plus the buildings'")
+        else:
+            vertical = ("height above the flat ground (no DEM and no world.ground_elevation / "
+                        "--ground-elevation: its altitude above sea level is unknown, so "
+                        "missions are relative to home)")
         georef = make_georef(
-            world_crs, vertical=f"height above flat ground at z = {org[2]:g} m (no terrain "
-            "model: altitudes are relative to the ground, not to sea level)",
-            vertical_assumed=True, reprojection=data.source.details.get("reprojection", ""),
-            sources=(src,))
+            world_crs, vertical=vertical, vertical_assumed=True,
+            reprojection=data.source.details.get("reprojection", ""), sources=(src,),
+            amsl=ground_given)
     return georef
 
 
@@ -491,11 +529,21 @@ def _report_left_out(data: Any, outside: int, off_grid: int) -> None:
 
 
 def _roofs(polys: Sequence[Any], heights: Sequence[float], ground: np.ndarray, org: np.ndarray,
-           cs: np.ndarray, all_touched: bool) -> tuple[np.ndarray, int, int]:
-    """Roof altitude per column (-inf where no building), and counts outside / off-grid."""
+           cs: np.ndarray, all_touched: bool, terrain: World | None = None
+           ) -> tuple[np.ndarray, int, int, Any]:
+    """Roof altitude per column (-inf where no building), counts outside / off-grid, and the
+    :class:`~fm2uav.world.building_model.BuildingModel` of the footprints on the grid.
+
+    A footprint's roof is the highest ground under it plus its height: the highest
+    node it covers, and on a DEM world also the source DEM at its vertices.
+    """
+    from .building_model import BuildingModel
+
     nx, ny = ground.shape
     roof = np.full((nx, ny), -np.inf)
     outside = off_grid = 0
+    kept, tops = [], []
+    dem = None if terrain is None else getattr(terrain, "ground", None)
     for g, h in zip(polys, heights):
         minx, miny, maxx, maxy = g.bounds
         i0 = max(int(np.floor((minx - org[0]) / cs[0])) - 1, 0)
@@ -521,6 +569,14 @@ def _roofs(polys: Sequence[Any], heights: Sequence[float], ground: np.ndarray, o
             off_grid += 1
             continue
         win = (slice(i0, i1 + 1), slice(j0, j1 + 1))
-        top = float(ground[win][inside].max()) + float(h)
+        base = float(ground[win][inside].max())
+        if dem is not None:  # the DEM itself at the footprint's corners
+            xy = shapely.get_coordinates(g)
+            base = max(base, float(np.max(dem.height(xy[:, 0], xy[:, 1]))))
+        top = base + float(h)
         roof[win] = np.where(inside, np.maximum(roof[win], top), roof[win])
-    return roof, outside, off_grid
+        kept.append(g)
+        tops.append(top)
+    model = BuildingModel(tuple(kept), np.asarray(tops, dtype=float),
+                          description=f"{len(kept)} building footprints with their roofs")
+    return roof, outside, off_grid, model

@@ -6,8 +6,11 @@ Two questions:
   to the continuous terrain/building surface (terrain = the bilinear ground of
   :meth:`World.ground_height`, triangulated four triangles per cell around the
   cell centre — for a world with a source-DEM ground model, that DEM sampled a
-  quarter pixel apart; buildings = their columns as boxes up to the roof of
-  :meth:`World.surface_height`). Never more than the exact vertical height
+  quarter pixel apart; buildings = their true footprints extruded up to their
+  roofs when the world keeps them (``World.buildings``,
+  :class:`~fm2uav.world.building_model.BuildingModel`), else their grid
+  columns as boxes up to the roof of :meth:`World.surface_height`). Never more
+  than the exact vertical height
   above the surface. No-fly zones are not surfaces and do not
   count (see :mod:`fm2uav.world.zones`). Worlds that are not made of solid
   columns (and 2D worlds) measure to their obstacle *cells* as boxes.
@@ -128,10 +131,18 @@ def surface_clearance(world: World, points: np.ndarray) -> np.ndarray:
     pts = np.atleast_2d(np.asarray(points, dtype=float))
     if world.ndim == 2 or not _is_columns(world):
         return _cell_box_clearance(world, pts)
-    above = pts[:, 2] - np.asarray(world.surface_height(pts[:, 0], pts[:, 1]), dtype=float)
     from .ground import roof_heights
 
     heights, ox, oy, hx, hy = _ground_grid(world)
+    model = getattr(world, "buildings", None)
+    if model is not None:  # terrain from the grid search, buildings from their footprints
+        above = pts[:, 2] - np.asarray(world.ground_height(pts[:, 0], pts[:, 1]), dtype=float)
+        no_roofs = np.full((2, 2), -np.inf)
+        terrain = surface_distance(np.ascontiguousarray(pts), np.ascontiguousarray(above),
+                                   heights, ox, oy, hx, hy, no_roofs, world.origin[0],
+                                   world.origin[1], world.spacing[0], world.spacing[1])
+        return np.minimum(terrain, model.distance(pts))
+    above = pts[:, 2] - np.asarray(world.surface_height(pts[:, 0], pts[:, 1]), dtype=float)
     roofs = np.ascontiguousarray(roof_heights(world), dtype=float)
     return surface_distance(np.ascontiguousarray(pts), np.ascontiguousarray(above), heights,
                             ox, oy, hx, hy, roofs, world.origin[0], world.origin[1],

@@ -51,6 +51,7 @@ __all__ = [
     "bounds_lonlat",
     "check_fit",
     "make_georef",
+    "amsl_known",
     "parse_crs",
     "utm_crs",
     "metric_crs",
@@ -669,6 +670,12 @@ class Georef:
     scale_error : float
         Largest length distortion of :attr:`crs` over the world (``|k - 1|``).
     sources : tuple of SourceFile
+    amsl : bool
+        World z is an altitude above mean sea level (a DEM's heights, or the flat
+        ground of a buildings world at a given ``world.ground_elevation``). False: z
+        is the height above a flat ground whose altitude is unknown (buildings
+        without a DEM or a ground elevation): missions are then written relative to
+        home, never as AMSL altitudes.
     """
 
     crs: str
@@ -679,6 +686,7 @@ class Georef:
     reprojection: str = ""
     scale_error: float = 0.0
     sources: tuple[SourceFile, ...] = ()
+    amsl: bool = True
 
     @property
     def name(self) -> str:
@@ -690,6 +698,7 @@ class Georef:
         return {"crs": self.crs, "crs_name": self.name, "crs_token": crs_token(self.crs),
                 "epsg": self.epsg, "vertical": self.vertical,
                 "vertical_crs": self.vertical_crs, "vertical_assumed": self.vertical_assumed,
+                "amsl": self.amsl,
                 "reprojection": self.reprojection,
                 "scale_error_pct": round(100.0 * float(self.scale_error), 4),
                 "sources": [s.as_dict() for s in self.sources]}
@@ -712,10 +721,22 @@ class Georef:
 
 def make_georef(crs: Any, *, vertical: str, vertical_crs: str | None = None,
                 vertical_assumed: bool = True, reprojection: str = "",
-                scale_error: float = 0.0, sources: tuple[SourceFile, ...] = ()) -> Georef:
+                scale_error: float = 0.0, sources: tuple[SourceFile, ...] = (),
+                amsl: bool = True) -> Georef:
     """A :class:`Georef` for a world in ``crs`` (EPSG code looked up)."""
     epsg = crs_epsg(crs)
     return Georef(crs=crs_string(crs) if epsg else str(crs), epsg=epsg,
                   vertical=vertical, vertical_crs=vertical_crs,
                   vertical_assumed=vertical_assumed, reprojection=reprojection,
-                  scale_error=float(scale_error), sources=tuple(sources))
+                  scale_error=float(scale_error), sources=tuple(sources), amsl=bool(amsl))
+
+
+def amsl_known(world: Any) -> bool:
+    """Whether world z is an altitude above mean sea level (:attr:`Georef.amsl`).
+
+    True for DEM worlds, buildings on a given ground elevation and worlds without a
+    CRS (placed at their anchor's altitude); False for buildings without a DEM or a
+    ground elevation (z = height above their flat ground).
+    """
+    g = getattr(world, "georef", None)
+    return True if g is None else bool(getattr(g, "amsl", True))

@@ -11,7 +11,10 @@ The one home of "how high is the ground here": :meth:`World.ground_height` and
   without terrain has its ground at the **floor of the grid**: ``origin[2]``,
   the z of the lowest node layer (``0`` for a 2D world, which has no z).
 * **Surface** (:func:`surface_height`): the ground or a roof, whichever is
-  higher. Roofs are what the occupancy grid holds above the ground: in each
+  higher. A world built from building footprints keeps them
+  (``World.buildings``, :mod:`fm2uav.world.building_model`): the roof is then
+  that of the footprint under the point (edge included). Otherwise roofs are
+  what the occupancy grid holds above the ground: in each
   column, the z of the topmost obstacle node when it is above the column's
   ground; read from the nearest column (roofs have sharp edges, so they are
   not interpolated). The grid resolves a roof to one vertical cell (the true
@@ -147,11 +150,15 @@ def roof_heights(world: World) -> np.ndarray:
 def surface_height(world: World, x: Any, y: Any) -> np.ndarray | float:
     """Height (world z [m]) of the ground or a roof at ``(x, y)``, whichever is higher.
 
-    Ground as :func:`ground_height` (bilinear); roofs from the nearest column
+    Ground as :func:`ground_height` (bilinear); roofs from the world's building
+    footprints when it keeps them, else from the nearest column
     (:func:`roof_heights`). ``x`` and ``y`` broadcast together.
     """
     xa, ya, scalar = _xy(world, x, y)
     ground = np.asarray(ground_height(world, xa, ya), dtype=float)
+    model = getattr(world, "buildings", None)
+    if model is not None:  # the footprints themselves (world/building_model.py)
+        return _out(np.maximum(ground, model.roof_at(xa, ya)), scalar)
     roofs = roof_heights(world)
     if world.ndim != 3 or not np.isfinite(roofs).any():
         return _out(ground, scalar)
@@ -169,3 +176,4 @@ def terrain_along(world: World, path: np.ndarray) -> np.ndarray | None:
         return None
     p = np.asarray(path, dtype=float)
     return np.asarray(ground_height(world, p[:, 0], p[:, 1]), dtype=float)
+

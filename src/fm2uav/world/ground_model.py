@@ -44,13 +44,15 @@ import numpy as np
 from scipy import ndimage
 
 __all__ = ["GroundModel", "GroundLayer", "MAX_SAMPLES", "ground_model_from_dem",
-           "sampling_step"]
+           "sampling_step", "ground_bulge"]
 
 #: Largest raster (pixels, all layers together) kept as a ground model (about 200 MB of
 #: float64).
 MAX_SAMPLES = 25_000_000
 #: Points evaluated at a time by a model of several DEMs (bounds the temporaries).
 _CHUNK = 1_000_000
+#: How far inside each piece's ends :func:`ground_bulge` reads the ground [m].
+_BULGE_INSET_M = 1e-3
 
 
 @dataclass(frozen=True, eq=False)
@@ -248,6 +250,89 @@ def sampling_step(world: Any) -> float:
     if model is not None and model.pixel_m > 0:
         step = min(step, 0.25 * float(model.pixel_m))
     return step
+
+
+def _grid_indices(world: Any, x: np.ndarray, y: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Continuous indices of world points in each grid the ground is bilinear on (every
+    source DEM's pixel centres — a model of several DEMs switches layer only on the
+    higher-priority layer's whole rows and columns — or the world's terrain nodes): the
+    ground is smooth between whole numbers of all of them."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    model = getattr(world, "ground", None)
+    if model is not None:
+        return [layer.pixel_coords(x, y) for layer in model.layers]
+    return [((x - world.origin[0]) / world.spacing[0], (y - world.origin[1]) / world.spacing[1])]
+
+
+def ground_bulge(world: Any, a: Any, b: Any) -> tuple[np.ndarray, np.ndarray]:
+    """How far the ground rises above, and drops below, the straight line between its
+    heights at the ends of each chord ``a[i]`` → ``b[i]`` (x, y [m]): ``(rise, drop)`` [m],
+    both >= 0.
+
+    Exact for the bilinear ground (:meth:`World.ground_height`): along a straight chord it is a
+    quadratic between the chord's crossings of the grid's whole rows and columns (the
+    source DEMs' pixel centres — of every layer: ``world.dem_fill`` takes over from
+    ``world.dem`` only on its whole rows and columns, where the ground may step — or the
+    terrain nodes), so the extremes lie at those crossings, on either side of a step, or
+    at a piece's vertex; each piece is read 1 mm inside its ends and at its middle and its
+    quadratic solved and extended to the ends (a DEM in another CRS than the world bends
+    the chord by far less than a millimetre over a pixel). Reading a few points per chord
+    missed centimetres at pixel edges — enough to put a path exactly at a zone's ceiling
+    inside it.
+    """
+    pa = np.atleast_2d(np.asarray(a, dtype=float))[:, :2]
+    pb = np.atleast_2d(np.asarray(b, dtype=float))[:, :2]
+    k = len(pa)
+    if k == 0 or (getattr(world, "ground", None) is None and world.terrain is None):
+        return np.zeros(k), np.zeros(k)
+    ends = zip(_grid_indices(world, pa[:, 0], pa[:, 1]), _grid_indices(world, pb[:, 0], pb[:, 1]))
+    # breakpoints: t where a row or a column index crosses a whole number
+    ts = [np.zeros(k), np.ones(k)]
+    for u0, u1 in (pair for (r0, c0), (r1, c1) in ends for pair in ((r0, r1), (c0, c1))):
+        lo, hi = np.minimum(u0, u1), np.maximum(u0, u1)
+        first = np.floor(lo) + 1.0
+        n = np.maximum(np.ceil(hi) - first, 0).astype(int)
+        du = np.where(np.abs(u1 - u0) > 1e-12, u1 - u0, np.nan)
+        for j in range(int(n.max()) if n.size else 0):
+            v = first + j
+            t = np.where(j < n, (v - u0) / du, np.nan)
+            ts.append(np.where((t > 0) & (t < 1), t, np.nan))
+    t = np.sort(np.column_stack(ts), axis=1)  # NaNs last
+    ta, tb = t[:, :-1], t[:, 1:]
+    ok = np.isfinite(ta) & np.isfinite(tb) & (tb > ta)
+    tm = 0.5 * (ta + tb)
+    # each piece is read 1 mm inside its ends (a quarter of it if shorter) and its quadratic
+    # extended to them: where several DEMs meet, the ground switches layer (and may step)
+    # on a grid line, and the chord's slight bend in another CRS must not put a read on the
+    # far side of that line
+    length = np.maximum(np.hypot(*(pb - pa).T), 1e-12)[:, None]
+    eps = np.where(ok, np.minimum(_BULGE_INSET_M / length, 0.25 * (tb - ta)), 0.0)
+    fr = np.stack([ta + eps, tm, tb - eps], axis=-1)  # (k, pieces, 3)
+    fr = np.where(ok[..., None], fr, 0.0)
+    d = pb - pa
+    q = pa[:, None, None, :] + fr[..., None] * d[:, None, None, :]
+    g = np.asarray(world.ground_height(q[..., 0].ravel(), q[..., 1].ravel()),
+                   dtype=float).reshape(fr.shape)
+    g_end = np.asarray(world.ground_height(np.r_[pa[:, 0], pb[:, 0]],
+                                           np.r_[pa[:, 1], pb[:, 1]]), dtype=float)
+    lin = g_end[:k, None, None] + fr * (g_end[k:] - g_end[:k])[:, None, None]
+    h = g - lin  # the ground above the chord's straight line, per piece at ends and middle
+    # the quadratic through the three values: h(u) = h0 + B u + C u^2, u in [0, 1] between
+    # the reads; the piece's true ends are at u = -e and 1 + e
+    h0, hm, h1 = h[..., 0], h[..., 1], h[..., 2]
+    C = 2.0 * (h0 + h1) - 4.0 * hm
+    B = h1 - h0 - C
+    with np.errstate(divide="ignore", invalid="ignore"):
+        e = np.where(ok, eps / np.maximum(tb - ta - 2.0 * eps, 1e-300), 0.0)
+        s = np.where(np.abs(C) > 1e-12, -B / (2.0 * C), np.nan)
+    inside = np.isfinite(s) & (s > -e) & (s < 1.0 + e)
+    hv = np.where(inside, h0 + B * s + C * s * s, np.nan)
+    h0, h1 = h0 - B * e + C * e * e, h0 + B * (1.0 + e) + C * (1.0 + e) ** 2
+    vals = np.concatenate([h0, h1, hv], axis=1)
+    vals = np.where(np.concatenate([ok, ok, ok & inside], axis=1), vals, np.nan)
+    rise = np.nanmax(np.concatenate([vals, np.zeros((k, 1))], axis=1), axis=1)
+    drop = np.nanmax(np.concatenate([-vals, np.zeros((k, 1))], axis=1), axis=1)
+    return np.maximum(rise, 0.0), np.maximum(drop, 0.0)
 
 
 def _pixel_metres(dem: Any, src: Any, dst: Any, larger: bool = False) -> float:

@@ -23,7 +23,14 @@ points' ``agl``) and the highest requested altitude:
   (rounded down to a round number), so the flight level is >= 6 cells above
   the ground — unless ``height_cells`` fixes the node count (then ``cell_size``);
 * ``ceiling`` default: the highest ground (or roof) + ``max(20 dz, agl + 10 dz)``
-  (``agl`` given) and at least ``top + 5 dz``, so a 120 m request always has sky.
+  (``agl`` given) and at least ``top + 5 dz``, so a 120 m request always has sky;
+* ``margin`` default (buildings without a DEM or ``bbox``): :data:`DEFAULT_MARGIN`
+  (50 m), at least :data:`MARGIN_CELLS` cells, of free ground around the footprints.
+
+**Ground of buildings without a DEM.** ``ground_elevation`` (m above sea level)
+puts the flat ground at that altitude, so z is an AMSL altitude; without it z is
+the height above the ground and ``World.georef.amsl`` is False: missions are then
+written relative to home and say so, never as altitudes above an implicit 0 m.
 
 Every error names the mission-file key (``world.<key>``) and the CLI flag.
 
@@ -55,8 +62,14 @@ __all__ = [
     "round_up",
     "AUTO_COLUMNS",
     "AUTO_NODES",
+    "DEFAULT_MARGIN",
 ]
 
+#: Default free border around buildings without a DEM [m] (at least :data:`MARGIN_CELLS`
+#: cells): room to take off next to the outermost building and for FM² to go around it
+#: (a start 13 m beside a building was outside a map cut at the footprints).
+DEFAULT_MARGIN = 50.0
+MARGIN_CELLS = 10
 #: Largest number of map columns (nx * ny) of an automatic cell size.
 AUTO_COLUMNS = 250_000
 #: Largest number of grid nodes (columns x layers) of an automatic DEM cell size.
@@ -201,8 +214,12 @@ class WorldSpec(BaseModel):
                                    desc="storey height for building:levels")
     height_cells: int | None = _num(None, ge=2, le=2000,
                                     desc="number of vertical nodes (buildings on flat ground)")
-    margin: float = _num(0.0, unit="m", ge=0, le=100000,
-                         desc="free border around the buildings (no DEM, no bbox)")
+    margin: float | None = _num(None, unit="m", ge=0, le=100000,
+                                desc="free border around the buildings (no DEM, no bbox); "
+                                "default max(50 m, 10 cells)")
+    ground_elevation: float | None = _num(
+        None, unit="m", ge=-500, le=9000,
+        desc="altitude of the flat ground of buildings without a DEM (m above sea level)")
     allow_filled: bool = Field(False, description="start/goal on filled nodata: warn only")
 
     @field_validator("dem")
@@ -456,7 +473,8 @@ def _auto_cell(spec: WorldSpec, agl: float | None = None) -> tuple[float, str]:
         import shapely
 
         x0, y0, x1, y1 = shapely.total_bounds(np.asarray(data.geometries, dtype=object))
-        area = (x1 - x0 + 2 * spec.margin) * (y1 - y0 + 2 * spec.margin)
+        mg = DEFAULT_MARGIN if spec.margin is None else spec.margin
+        area = (x1 - x0 + 2 * mg) * (y1 - y0 + 2 * mg)
     else:
         area = 0.0
     cap = math.sqrt(max(area, 1.0) / AUTO_COLUMNS)
@@ -475,7 +493,7 @@ def _requested(v: float | None, what: str) -> float | None:
 
 
 def load_world(spec: WorldSpec, *, agl: float | None = None, top: float | None = None,
-               name: str = "") -> World:
+               name: str = "", max_cell: tuple[float, str] | None = None) -> World:
     """Build the world a :class:`WorldSpec` describes, sized for the request.
 
     Parameters
@@ -489,6 +507,10 @@ def load_world(spec: WorldSpec, *, agl: float | None = None, top: float | None =
         Highest requested altitude [m] (points given with ``alt`` / ``z``).
     name : str
         World name (default: the source file's stem).
+    max_cell : (float, str), optional
+        Largest automatic cell size [m] and why (e.g. a survey whose bands must be
+        resolved): the default ``cell_size`` is rounded down to it. Ignored when
+        ``spec.cell_size`` is given.
 
     Returns
     -------
@@ -507,11 +529,20 @@ def load_world(spec: WorldSpec, *, agl: float | None = None, top: float | None =
     if not spec.has_data:
         raise InputError("the world needs world.dem (CLI --dem) and/or world.buildings "
                          "(CLI --buildings)")
+    if spec.ground_elevation is not None and spec.dem is not None:
+        raise InputError("world.ground_elevation (--ground-elevation) is for buildings without "
+                         "a DEM; with world.dem (--dem) the ground is the DEM's: leave it out")
+    if spec.margin is not None and spec.dem is not None:
+        raise InputError("world.margin (--margin) is for buildings without a DEM; with "
+                         "world.dem (--dem) the map is the DEM's (crop it with world.bbox / "
+                         "--bbox): leave it out")
     agl = _requested(agl, "planner.agl (--agl)")
     if spec.cell_size is not None:
         dx, why_dx = float(spec.cell_size), "given (world.cell_size)"
     else:
         dx, why_dx = _auto_cell(spec, agl)
+        if max_cell is not None and float(max_cell[0]) < dx:
+            dx, why_dx = round_down(float(max_cell[0])), f"auto: {max_cell[1]}"
     if spec.dz is not None:
         dz, why_dz = float(spec.dz), "given (world.dz)"
     elif spec.height_cells is not None:
@@ -543,11 +574,14 @@ def load_world(spec: WorldSpec, *, agl: float | None = None, top: float | None =
                          nodata_value=spec.nodata_value, bbox=spec.bbox,
                          sea_level=spec.sea_level, agl=agl, top=top, name=stem)
     if spec.buildings is not None:
+        margin = (max(DEFAULT_MARGIN, MARGIN_CELLS * dx) if spec.margin is None
+                  else float(spec.margin))
         world = from_buildings(
             spec.buildings, (dx, dx, dz), height_cells=spec.height_cells,
             metres_per_level=spec.metres_per_level, default_height=spec.default_height,
-            margin=spec.margin, name=stem, crs=spec.crs, terrain=world, all_touched=True,
-            bbox=spec.bbox if world is None else None, agl=agl, top=top)
+            margin=margin, name=stem, crs=spec.crs, terrain=world, all_touched=True,
+            bbox=spec.bbox if world is None else None, agl=agl, top=top,
+            ground_elevation=spec.ground_elevation)
         if spec.ceiling is not None and world.bounds[2, 1] > spec.ceiling + 1e-6 and \
                 spec.dem is not None:
             raise WorldError(

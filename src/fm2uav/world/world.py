@@ -124,6 +124,11 @@ class World:
         Optional :class:`~fm2uav.world.ground_model.GroundModel`: the DEM at
         its own (finer) resolution; :meth:`ground_height` reads it instead of
         ``terrain`` when present (FM² keeps planning on ``terrain``).
+    buildings:
+        Optional :class:`~fm2uav.world.building_model.BuildingModel`: the building
+        footprints themselves with their roofs; :meth:`surface_height` and the
+        clearance read them instead of the (dilated, one-vertical-cell) grid columns
+        when present (FM² keeps planning on the grid).
     zones:
         No-fly zones and operating areas (:class:`fm2uav.world.zones.Zone`)
         whose nodes are part of ``occupancy``; build with
@@ -145,6 +150,7 @@ class World:
     georef: Any = None
     ground: Any = None
     zones: tuple = ()
+    buildings: Any = None
     _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     # ------------------------------------------------------------------ validation

@@ -158,6 +158,11 @@ class Zone:
         if self.floor is not None and self.ceiling is not None and self.floor >= self.ceiling:
             raise InputError(f"{where}: floor {self.floor:g} m must be below ceiling "
                              f"{self.ceiling:g} m")
+        if (self.inclusion and self.floor is not None and self.ceiling is not None
+                and self.floor + 2 * self.buffer >= self.ceiling):
+            raise InputError(f"{where}: the operating area has no air left between its floor "
+                             f"{self.floor:g} m and ceiling {self.ceiling:g} m inside a buffer "
+                             f"of {self.buffer:g} m; lower operating_area buffer")
         if self.inclusion and self.buffer > 0:
             inner = g.buffer(-self.buffer)
             if inner.is_empty:
@@ -192,13 +197,19 @@ class Zone:
         return self.geometry.buffer(grow, quad_segs=_QUAD_SEGS) if grow else self.geometry
 
     def vertical_range(self, ground: Any, margin: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-        """``(low, high)`` world z [m] of the kept-out air over ground heights ``ground``.
+        """``(low, high)`` world z [m] of the zone's air over ground heights ``ground``.
 
-        Includes the buffer and ``margin``; ``-inf`` / ``+inf`` where unlimited.
+        For a no-fly zone the *kept-out* air: floor lowered and ceiling raised by
+        ``buffer + margin``. For an operating area the *allowed* air: floor raised and
+        ceiling lowered by ``buffer + margin`` (the area shrunk, as horizontally).
+        ``-inf`` / ``+inf`` where unlimited. The range is open: a point exactly at
+        ``low`` or ``high`` is on the boundary, which the plan may fly along.
         """
         g = np.asarray(ground, dtype=float)
         base = g if self.reference == "agl" else np.zeros_like(g)
         grow = self.buffer + margin
+        if self.inclusion:
+            grow = -grow
         lo = np.full(g.shape, -np.inf) if self.floor is None else base + self.floor - grow
         hi = np.full(g.shape, np.inf) if self.ceiling is None else base + self.ceiling + grow
         return lo, hi
@@ -467,16 +478,66 @@ def terrain_surface_index(world: World) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------- along a route
-def zone_bounds_along(world: World, xy: np.ndarray, z_route: np.ndarray,
-                      mids: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def _chord_ground(world: World, xy: np.ndarray, ground: np.ndarray, chords: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """Highest and lowest ground [m] over each sample and the chosen chords next to it,
+    relative to the chord's straight line (z is flown linearly between samples; the
+    ground's exact rise and drop along a chord: :func:`fm2uav.world.ground_model.ground_bulge`)."""
+    from .ground_model import ground_bulge
+
+    g_hi, g_lo = ground.copy(), ground.copy()
+    k = np.flatnonzero(chords)
+    if not len(k):
+        return g_hi, g_lo
+    bump, dip = ground_bulge(world, xy[k], xy[k + 1])
+    for side in (k, k + 1):
+        np.maximum.at(g_hi, side, ground[side] + bump)
+        np.minimum.at(g_lo, side, ground[side] - dip)
+    return g_hi, g_lo
+
+
+def _chords_touching(foot: BaseGeometry, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Which samples of the polyline ``xy`` meet ``foot`` (interior or boundary) themselves
+    or through a chord to a neighbour, and which chords meet it."""
+    m = len(xy)
+    touched = shapely.intersects_xy(foot, xy[:, 0], xy[:, 1])
+    hit = np.zeros(max(m - 1, 0), dtype=bool)
+    if m < 2:
+        return touched, hit
+    x0, y0, x1, y1 = foot.bounds
+    a, b = xy[:-1], xy[1:]
+    near = ~((np.maximum(a[:, 0], b[:, 0]) < x0) | (np.minimum(a[:, 0], b[:, 0]) > x1)
+             | (np.maximum(a[:, 1], b[:, 1]) < y0) | (np.minimum(a[:, 1], b[:, 1]) > y1))
+    k = np.flatnonzero(near)
+    if len(k):
+        lines = shapely.linestrings(np.stack([a[k], b[k]], axis=1))
+        hit[k] = shapely.intersects(foot, lines)
+    touched[:-1] |= hit
+    touched[1:] |= hit
+    return touched, hit
+
+
+def zone_bounds_along(world: World, xy: np.ndarray, z_route: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray]:
     """Lower/upper altitude bounds [m] the zones put on route samples.
 
-    For each zone with a floor or ceiling whose kept-out footprint holds a
-    sample (or a chord midpoint next to it), the sample must pass over the
-    zone (``z >= ceiling + buffer``) or under it (``z <= floor - buffer``) —
-    on the side of the FM² route's own height ``z_route`` there. An operating
-    area's ceiling/floor bound every sample. Zones without vertical limits give
-    no bound (the route must not enter them at all; see :func:`zone_violations`).
+    The flown height is linear between consecutive samples (a chord). For each zone
+    with a floor or ceiling whose kept-out footprint meets a sample or one of its
+    chords, the sample must pass over the zone (``z >= ceiling + buffer``) or under it
+    (``z <= floor - buffer``) — on the side of the FM² route's own height ``z_route``
+    there — so that the whole chord does: an AGL ceiling is raised by the ground's
+    exact rise above the chord (:func:`fm2uav.world.ground_model.ground_bulge`), an AGL floor
+    lowered by its drop. An operating area's floor/ceiling (shrunk by its buffer) bound every
+    sample. Zones without vertical limits give no bound (the route must not enter them
+    at all; see :func:`zone_violations`).
+
+    Parameters
+    ----------
+    world : World
+    xy : ndarray, shape (M, 2)
+        Route samples [m].
+    z_route : ndarray, shape (M,)
+        The FM² route's height at each sample [m] (chooses over / under).
 
     Returns
     -------
@@ -491,27 +552,31 @@ def zone_bounds_along(world: World, xy: np.ndarray, z_route: np.ndarray,
         return lower, upper
     ground = np.asarray(world.ground_height(xy[:, 0], xy[:, 1]), dtype=float)
     for zone in zones:
-        lo, hi = zone.vertical_range(ground)
         if zone.inclusion:
-            lower = np.maximum(lower, np.where(np.isfinite(lo), lo, -np.inf))
-            upper = np.minimum(upper, np.where(np.isfinite(hi), hi, np.inf))
+            chords = np.ones(max(m - 1, 0), dtype=bool)
+            inside = np.ones(m, dtype=bool)
+        elif zone.full_height:
             continue
-        if zone.full_height:
+        else:
+            inside, chords = _chords_touching(zone.keep_out(), xy)
+            if not inside.any():
+                continue
+        g_hi, g_lo = (_chord_ground(world, xy, ground, chords) if zone.reference == "agl"
+                      else (ground, ground))
+        if zone.inclusion:
+            lower = np.maximum(lower, zone.vertical_range(g_hi)[0])
+            upper = np.minimum(upper, zone.vertical_range(g_lo)[1])
             continue
-        foot = zone.keep_out()
-        inside = shapely.contains_xy(foot, xy[:, 0], xy[:, 1])
-        if mids is not None and len(mids):
-            im = shapely.contains_xy(foot, mids[:, 0], mids[:, 1])
-            inside[:-1] |= im
-            inside[1:] |= im
-        if not inside.any():
-            continue
-        over = np.isfinite(hi) & (~np.isfinite(lo) | (z_route >= 0.5 * (np.where(
-            np.isfinite(lo), lo, 0) + np.where(np.isfinite(hi), hi, 0))))
-        over &= np.isfinite(hi)
-        under = ~over
+        lo = zone.vertical_range(g_lo)[0]
+        hi = zone.vertical_range(g_hi)[1]
+        if zone.ceiling is None:
+            over = np.zeros(m, dtype=bool)
+        elif zone.floor is None:
+            over = np.ones(m, dtype=bool)
+        else:
+            over = np.asarray(z_route, dtype=float) >= 0.5 * (lo + hi)
         lower = np.where(inside & over, np.maximum(lower, hi), lower)
-        upper = np.where(inside & under, np.minimum(upper, lo), upper)
+        upper = np.where(inside & ~over, np.minimum(upper, lo), upper)
     return lower, upper
 
 
@@ -571,17 +636,27 @@ def zone_violations(world: World, points: Any, *, step: float | None = None,
     return out
 
 
+#: Points within this distance [m] of a zone's (buffered) floor or ceiling are on its
+#: boundary, which a plan may fly along: the profile puts the path exactly there.
+BOUNDARY_TOL = 1e-3
+
+
 def _inside(zone: Zone, dense: np.ndarray, ground: np.ndarray | None) -> np.ndarray:
-    """Which points are in the zone's kept-out air (outside an operating area)."""
-    inside = shapely.contains_xy(zone.keep_out(), dense[:, 0], dense[:, 1])
+    """Which points are in the zone's kept-out air (outside an operating area).
+
+    The kept-out air is open: its boundary (the buffered footprint's edge, the buffered
+    floor and ceiling, to :data:`BOUNDARY_TOL`) belongs to the air the plan may use.
+    """
     if zone.inclusion:
-        inside = ~inside
+        inside = ~shapely.intersects_xy(zone.keep_out(), dense[:, 0], dense[:, 1])
         if ground is not None:
             lo, hi = zone.vertical_range(ground)
-            inside |= (dense[:, 2] < lo) | (dense[:, 2] > hi)
-    elif ground is not None:
+            inside |= (dense[:, 2] < lo - BOUNDARY_TOL) | (dense[:, 2] > hi + BOUNDARY_TOL)
+        return inside
+    inside = shapely.contains_xy(zone.keep_out(), dense[:, 0], dense[:, 1])
+    if ground is not None:
         lo, hi = zone.vertical_range(ground)
-        inside &= (dense[:, 2] >= lo) & (dense[:, 2] <= hi)
+        inside &= (dense[:, 2] > lo + BOUNDARY_TOL) & (dense[:, 2] < hi - BOUNDARY_TOL)
     return inside
 
 
@@ -606,7 +681,7 @@ def zone_distances(world: World, points: Any) -> dict[str, float]:
         signed = np.where(inside != zone.inclusion, -d, d)
         if ground is not None and not zone.inclusion:
             lo, hi = zone.vertical_range(ground)
-            within = (p[:, 2] >= lo) & (p[:, 2] <= hi)
+            within = (p[:, 2] > lo + BOUNDARY_TOL) & (p[:, 2] < hi - BOUNDARY_TOL)
             signed = np.where(within, signed, np.inf)
         out[name] = float(np.min(signed)) if len(signed) else math.inf
     return out

@@ -572,13 +572,27 @@ def _on_map(cg: CorridorGrid, fm: Plan) -> Plan:
 
 
 def _check_free(world: World, path: np.ndarray) -> None:
-    """Raise PlanningError if a path point's nearest map node is an obstacle."""
+    """Raise PlanningError if a path point's nearest map node is terrain or a building, or a
+    point enters a no-fly zone's true (buffered) air.
+
+    Zone nodes are not tested: they are the zones grown by half a cell, and a path whose
+    heights are set over the continuous ground may pass within that margin of a zone
+    without entering it (:func:`fm2uav.world.zones.zone_violations` checks the zone itself).
+    """
+    from ...world.clearance import base_occupancy
+    from ...world.zones import zone_violations
+
     idx = np.clip(np.floor(world.to_index(path) + 0.5).astype(np.int64), 0,
                   np.asarray(world.shape) - 1)
-    hit = world.occupancy[tuple(idx.T)]
+    hit = base_occupancy(world)[tuple(idx.T)]
     if hit.any():
         p = path[np.argmax(hit)]
         raise PlanningError(
             f"the coverage path enters an obstacle node of the map at "
             f"({p[0]:.1f}, {p[1]:.1f}, {p[2]:.1f}) m; raise agl or plan with grid='map'"
         )
+    bad = zone_violations(world, path)
+    if bad:
+        raise PlanningError(
+            f"the coverage path enters {bad[0].zone!r} at "
+            f"{np.round(bad[0].point, 1).tolist()} m; widen the zone's buffer or report this")

@@ -93,8 +93,11 @@ def band_indices(zigzag: Any, path: Any) -> tuple[list[tuple[int, int]], float]:
             elif idx[0] + 1 < len(p):
                 idx[1] = idx[0] + 1
             else:
-                raise InputError(f"band {k + 1}: the path does not fly it forward (start index "
-                                 f"{idx[0]}, end {idx[1]}); is it this zigzag's path?")
+                raise InputError(
+                    f"band {k + 1}: the flown path does not pass its ends in order (start "
+                    f"index {idx[0]}, end {idx[1]}): the bands, {float(zigzag.spacing):g} m "
+                    "apart, are not resolved by the path; use a smaller --cell-size "
+                    "(world.cell_size) or a wider --spacing")
             lo = min(idx[1] + 1, len(p) - 1)
         out.append((idx[0], idx[1]))
     return out, worst

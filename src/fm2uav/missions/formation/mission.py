@@ -50,6 +50,7 @@ from .checks import min_separation, pair_distances
 from .config import FormationConfig
 from .cycles import CycleSettings, FlightLog, check_point, check_separation, fly_cycles, place_starts
 from .guide import LeaderGuide
+from .heights import Track, profile_tracks
 from .local import StaticMaps
 from .metrics import formation_error
 from .shapes import FormationShape, formation_shape
@@ -110,6 +111,11 @@ class FormationResult:
     world : World
     config : FormationConfig
         The settings flown, defaults resolved.
+    tracks : tuple of Track
+        Each UAV's flown trajectory (:mod:`.heights`): for a UAV with a flight
+        level, its route at the final altitude profile's heights with times; every
+        file written for that UAV comes from it. ``positions`` holds the same heights
+        at the common sample times.
     """
 
     times: np.ndarray
@@ -134,6 +140,7 @@ class FormationResult:
     params: dict[str, Any]
     world: World = field(repr=False)
     config: FormationConfig = field(default_factory=FormationConfig)
+    tracks: tuple[Track, ...] = field(default=(), repr=False)
 
     @property
     def n_uav(self) -> int:
@@ -387,7 +394,9 @@ def _result(world: World, log: FlightLog, names: tuple[str, ...], guide: LeaderG
     """Metrics of the flight and the :class:`FormationResult`; ``timings["total"]``
     holds the start time and is turned into the total."""
     t3 = time.perf_counter()
-    positions = np.asarray(log.samples)
+    # one truth per vehicle: the final altitude profile's heights (heights.py)
+    positions, tracks = profile_tracks(world, np.asarray(log.times), np.asarray(log.samples),
+                                       names, levels)
     min_d = pair_distances(positions)
     sep, _, _ = min_separation(positions)
     err = formation_error(guide.path, positions, fshape, cfg.dist)
@@ -409,5 +418,5 @@ def _result(world: World, log: FlightLog, names: tuple[str, ...], guide: LeaderG
         settled=log.settled,
         timings={**{k: v for k, v in timings.items() if k != "total"}, "metrics": t4 - t3,
                  "total": t4 - timings["total"]},
-        params=params, world=world, config=cfg,
+        params=params, world=world, config=cfg, tracks=tracks,
     )

@@ -122,6 +122,7 @@
       L.polyline(run, { color: colour, weight: 4, renderer, className: "fm2-route" })
         .addTo(group);
     }
+    const amsl = !(doc.summary && doc.summary.amsl === false);
     for (const f of feature(doc, "item")) {
       const p = f.properties, [lon, lat] = f.geometry.coordinates;
       const icon = L.divIcon({ className: "fm2-item", iconSize: [22, 22],
@@ -129,7 +130,7 @@
       L.marker([lat, lon], { icon, keyboard: false, interactive: true, zIndexOffset: -500 })
         .bindTooltip(`${p.seq} ${p.command}${p.label ? " (" + p.label + ")" : ""}<br>` +
                      `alt ${fmt(p.alt, "m", 1)} (frame ${p.frame}) · ${fmt(p.alt_amsl, "m", 1)} ` +
-                     `AMSL · ${fmt(p.agl, "m", 1)} above ground`)
+                     `${amsl ? "AMSL" : "above the flat ground"} · ${fmt(p.agl, "m", 1)} above ground`)
         .addTo(group);
     }
     for (const f of feature(doc, "rally")) {
@@ -237,7 +238,8 @@
       width, height: opts.height || 190,
       scales: { x: { time: false } },
       axes: [{ label: "distance along the route [km]", size: 40 },
-             { label: "altitude AMSL [m]", size: 60 }],
+             { label: p.amsl === false ? "height above the flat ground [m] (altitude AMSL unknown)"
+                                       : "altitude AMSL [m]", size: 60 }],
       cursor: { drag: { x: false, y: false } },
       legend: { live: true },
       series: [
