@@ -65,6 +65,8 @@ def test_every_warning_fm2uav_issues_has_a_category_of_its_own():
                 continue
             cat = node.args[1] if len(node.args) > 1 else next(
                 (k.value for k in node.keywords if k.arg == "category"), None)
+            if cat is None and node.args and isinstance(node.args[0], ast.Call):
+                cat = node.args[0].func  # warnings.warn(ZoneWarning("...")): its class
             name = ast.unparse(cat).split(".")[-1] if cat is not None else "UserWarning"
             if name not in ours:
                 wrong.append(f"{path.relative_to(SRC)}:{node.lineno} warns with {name}")

@@ -71,4 +71,4 @@ def test_a_given_cell_that_cannot_resolve_the_bands_names_the_flags(files):
     res, _ = _cover(files, "--cell-size", "10")
     assert res.exit_code == 2
     msg = res.output.strip().splitlines()[-1]
-    assert "--cell-size 3" in msg and "--spacing >= 25" in msg
+    assert "--cell-size 3" in msg and "bands at least 25 m apart (--spacing)" in msg

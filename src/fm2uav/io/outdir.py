@@ -51,7 +51,6 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from .. import _validate
 from ..errors import InputError
 
 __all__ = ["OutputDir", "Interrupted", "active_sets", "finish_all", "abort_all",
@@ -360,6 +359,8 @@ class OutputDir:
             raise InputError("--out is empty; give the folder to write into (e.g. --out "
                              "out/mission)")
         path = os.path.expanduser(path)  # "~/out" in quotes, or a mission's outputs.dir
+        from .. import _validate  # numpy: not on the light path of an output set
+
         gone = _validate.cwd_gone(path)
         if gone:
             raise InputError(f"--out {path}: {gone}")

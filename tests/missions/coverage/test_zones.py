@@ -36,7 +36,7 @@ def test_bands_closer_than_the_route_resolves_name_the_flags():
     with pytest.raises(InputError) as e:
         plan_coverage(wz, AREA, 20.0, level=FlightLevel(agl=60.0), angle=0.0)
     msg = str(e.value)
-    assert "--cell-size 8" in msg and "--spacing >= 25" in msg and "\n" not in msg
+    assert "--cell-size 8" in msg and "bands at least 25 m apart (--spacing)" in msg and "\n" not in msg
     assert route_cell(20.0) == 20.0 / ROUTE_BAND_CELLS
 
 

@@ -113,7 +113,8 @@ def zone_route_points(world: Any, track: np.ndarray, spacing: float, agl: float,
             f"the bands are {float(spacing):g} m apart (--spacing D), less than "
             f"{ROUTE_BAND_CELLS:g} cells of the map ({cell:g} m): the route around the no-fly "
             f"zones cannot fly them apart; use --cell-size {_round_cell(route_cell(spacing))} "
-            f"(world.cell_size) or --spacing >= {ROUTE_BAND_CELLS * cell:g}")
+            f"(world.cell_size) or bands at least {ROUTE_BAND_CELLS * cell:g} m apart "
+            "(--spacing)")
     line = LineString(np.asarray(track, dtype=float)[:, :2])
     inside = line.intersection(allowed_region(world, margin))
     pieces = [g for g in getattr(inside, "geoms", [inside])
