@@ -117,7 +117,8 @@ def test_terrain_plan_uses_terrain_altitude_mode():
         (lambda d: d["mission"].update(items=[]), "at least one item"),
         (lambda d: d["mission"]["items"][0].update(autoContinue=1), "autoContinue: expected bool"),
         (lambda d: d["mission"]["items"][0]["params"].pop(), "7 values"),
-        (lambda d: d["mission"]["items"][1]["params"].__setitem__(4, 123.0), "valid latitude"),
+        (lambda d: next(it for it in d["mission"]["items"] if it["command"] == 16)["params"]
+         .__setitem__(4, 123.0), "valid latitude"),
         (lambda d: d["mission"]["items"][1].update(type="Mystery"), "'SimpleItem' or 'ComplexItem'"),
         (lambda d: d["mission"]["items"][1].update(type="ComplexItem"), "complexItemType"),
         (lambda d: d["mission"].update(plannedHomePosition=[1, 2]), "[lat, lon, alt]"),

@@ -161,7 +161,10 @@ def export_mission(
     speed = getattr(plan, "w", None)
     if speed is None:
         speed = getattr(plan, "speed", None)
-    mission = build_mission(path, world, opt, w=speed, agl=agl, times=times, via=via,
+    share = speed
+    if opt.speed_changes and hasattr(plan, "speed_share"):
+        share = plan.speed_share()  # the obstacle-distance W, not a flight level's shaping
+    mission = build_mission(path, world, opt, w=share, agl=agl, times=times, via=via,
                             camera=camera, fences=fences, start_hold=start_hold,
                             profile=getattr(plan, "profile", None))
     s = mission.summary()

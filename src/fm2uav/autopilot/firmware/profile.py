@@ -10,7 +10,9 @@ branches. The mission builder and the validator ask the profile.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+
+from .navigation import FixedWingNav, SpeedCommand, merge_nav, merge_speed
 
 __all__ = ["VEHICLES", "VEHICLE_TYPES", "Problem", "Rule", "FirmwareProfile", "both"]
 
@@ -32,11 +34,21 @@ class Problem:
         Short identifier, e.g. ``"px4-terrain-frame"``.
     message : str
         What is wrong and how to fix it.
+    severity : {"error", "warning"}
+        ``error``: the firmware rejects or misflies the mission (the export stops);
+        ``warning``: it flies it with a deviation the message quantifies.
     """
 
     index: int | None
     code: str
     message: str
+    severity: str = "error"
+
+    @property
+    def is_error(self) -> bool:
+        """Whether the firmware rejects or misflies the mission (else: a warning that the
+        mission flies, with the deviation the message says)."""
+        return self.severity == "error"
 
     def __str__(self) -> str:
         return self.message if self.index is None else f"item {self.index}: {self.message}"
@@ -72,6 +84,11 @@ class FirmwareProfile:
     rules : tuple of Rule
         The firmware's own mission rules, run after the rules of every firmware
         (:func:`fm2uav.autopilot.validate.validate_mission`).
+    fixed_wing_nav : FixedWingNav or None
+        How it navigates a fixed-wing mission (acceptance, guidance, turn radius,
+        climb, airspeeds; :mod:`fm2uav.autopilot.firmware.navigation`).
+    change_speed : mapping of str to SpeedCommand
+        Airframe kind → what its ``DO_CHANGE_SPEED`` means (speed type, range).
     """
 
     name: str
@@ -81,6 +98,8 @@ class FirmwareProfile:
     terrain_frame: bool
     landing_required: frozenset[str]
     rules: tuple[Rule, ...]
+    fixed_wing_nav: FixedWingNav | None = None
+    change_speed: Mapping[str, SpeedCommand] = field(default_factory=dict)
 
 
 def both(name: str, profiles: Sequence[FirmwareProfile], *, mav_autopilot: int) -> FirmwareProfile:
@@ -95,4 +114,9 @@ def both(name: str, profiles: Sequence[FirmwareProfile], *, mav_autopilot: int) 
         terrain_frame=all(p.terrain_frame for p in profiles),
         landing_required=frozenset.union(*(p.landing_required for p in profiles)),
         rules=tuple(r for p in profiles for r in p.rules),
+        fixed_wing_nav=merge_nav(tuple(p.fixed_wing_nav for p in profiles
+                                       if p.fixed_wing_nav is not None)),
+        change_speed={v: merge_speed(tuple(p.change_speed[v] for p in profiles
+                                           if v in p.change_speed))
+                      for v in VEHICLES if any(v in p.change_speed for p in profiles)},
     )
