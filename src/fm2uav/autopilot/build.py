@@ -136,6 +136,12 @@ class ExportOptions:
     max_bank : float or None
         A fixed-wing's bank limit [deg] (``ROLL_LIMIT_DEG``; None: the firmware's
         default): sets the turn radius the waypoints and loiters are fitted to.
+    terrain : bool or None
+        Write ArduPilot's terrain files (``terrain/*.DAT``) beside the mission;
+        None: with every terrain-frame mission (``outputs.terrain`` / ``--terrain``).
+    terrain_spacing : int or None
+        Their grid spacing [m] (``TERRAIN_SPACING``; None: the planner's DEM
+        resolution within [30, 100] m, :func:`fm2uav.autopilot.terrain_grid.default_spacing`).
     loiter_radius : float
         Radius of fixed-wing loiters and of the landing pattern's loiter [m]
         (PX4 NAV_LOITER_RAD default 80 m).
@@ -173,6 +179,8 @@ class ExportOptions:
     min_speed: float | None = None
     max_speed: float | None = None
     max_bank: float | None = None
+    terrain: bool | None = None
+    terrain_spacing: int | None = None
     loiter_radius: float = 80.0
     land_approach_agl: float = 40.0
     land_slope_deg: float = 4.0
@@ -213,6 +221,12 @@ class ExportOptions:
                 raise InputError(f"export option {name} must be a number > 0, got {v!r}")
         if self.speed_step <= 0:
             raise InputError(f"speed_step must be > 0 m/s, got {self.speed_step!r}")
+        if self.terrain_spacing is not None and not (
+                float(self.terrain_spacing) == int(self.terrain_spacing)
+                and 5 <= self.terrain_spacing <= 1000):
+            raise InputError(f"terrain_spacing must be a whole number of metres in [5, 1000], "
+                             f"got {self.terrain_spacing!r} (outputs.terrain_spacing / "
+                             "--terrain-spacing)")
         if self.max_bank is not None and not 5.0 <= self.max_bank <= 85.0:
             raise InputError(f"max_bank must be in [5, 85] degrees, got {self.max_bank!r} "
                              "(airframe.max_bank)")
