@@ -179,17 +179,14 @@ def _straight(geo: ItemPlacer, wps: Waypoints, nav: FixedWingNav, h_route: float
     dist = float(np.hypot(*u))
     u = u / dist
     # the straight line replaces the route up to waypoint j: it must stay near it
-    s = np.linspace(0.0, dist, 200)
-    line = home + s[:, None] * u
-    z = g_home + np.minimum(h_to, s * nav.climb_rate / nav.airspeed_cruise)
+    line, z = _climb_line(home, u, g_home, h_to, nav, dist)
     dev = 0.0
     if j > 1:
         seg = p[1:j, :2] - home
         dev = float(np.abs(seg[:, 0] * u[1] - seg[:, 1] * u[0]).max())
     if dev > max(tolerance, nav.turn_radius()):
         return None
-    climbing = s * nav.climb_rate / nav.airspeed_cruise >= 1.0  # past the first metre
-    clear = _clearance(geo, line[climbing], z[climbing])
+    clear = _line_clearance(geo, line, z, g_home)
     pts3 = np.column_stack([line, z])
     if clear < CLIMB_CLEARANCE or _zone_hits(geo.world, pts3):
         return None
@@ -205,20 +202,30 @@ def _straight(geo: ItemPlacer, wps: Waypoints, nav: FixedWingNav, h_route: float
     return ClimbOut([takeoff], j, info, t)
 
 
-def _line_clearance(geo: ItemPlacer, home: np.ndarray, u: np.ndarray, g_home: float,
-                    h_to: float, nav: FixedWingNav) -> float:
-    """Lowest margin of the straight take-off climb along ``u`` over the ground [m]: the
-    climb line minus the ground, counted against ``min(CLIMB_CLEARANCE, height above the
-    runway)`` so that the runway itself passes (inf off the map)."""
-    d_climb = nav.climb_distance(h_to)
-    s = np.linspace(0.0, max(d_climb, 1.0), 80)
-    line = home + s[:, None] * u
-    z = g_home + np.minimum(h_to, s * nav.climb_rate / nav.airspeed_cruise)
+def _line_clearance(geo: ItemPlacer, line: np.ndarray, z: np.ndarray, g_home: float) -> float:
+    """Lowest height of a take-off climb above the ground once it is ``CLIMB_CLEARANCE``
+    above the runway [m] (inf off the map; -inf when the ground rises above the climb
+    before that: the runway ends in a slope)."""
     inside = inside_xy(geo.world, line)
     if not inside.any():
         return math.inf
-    need = np.minimum(CLIMB_CLEARANCE, z - g_home)
-    return float((z - geo.ground(line) - need)[inside].min()) + CLIMB_CLEARANCE
+    g = geo.ground(line[inside])
+    zi = z[inside]
+    early = (zi - g_home) < CLIMB_CLEARANCE
+    if np.any(g[early] > zi[early] + 1e-6):
+        return -math.inf
+    late = ~early
+    return float((zi - g)[late].min()) if late.any() else math.inf
+
+
+def _climb_line(home: np.ndarray, u: np.ndarray, g_home: float, h_to: float,
+                nav: FixedWingNav, length: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Points and altitudes of a straight take-off climb along ``u`` [m] (level at the
+    take-off altitude beyond the climb distance, up to ``length``)."""
+    d = max(nav.climb_distance(h_to) if length is None else length, 1.0)
+    s = np.linspace(0.0, d, 120)
+    z = g_home + np.minimum(h_to, s * nav.climb_rate / nav.airspeed_cruise)
+    return home + s[:, None] * u, z
 
 
 def _circle(centre: np.ndarray, r: float) -> np.ndarray:
@@ -256,12 +263,12 @@ def _loiter(geo: ItemPlacer, wps: Waypoints, nav: FixedWingNav, h_route: float,
                 h_to = min(h_route, max(h_to, h_need))
             ring = _circle(centre, r)
             c_ring = _clearance(geo, ring, np.full(len(ring), g_home + h_to))
-            c_line = _line_clearance(geo, home, u, g_home, h_to, nav)
+            line, z_line = _climb_line(home, u, g_home, h_to, nav)
+            c_line = _line_clearance(geo, line, z_line, g_home)
             clear = min(c_ring, c_line)
             hits = _zone_hits(geo.world, np.vstack([
                 np.column_stack([ring, np.full(len(ring), g_home + h_to)]),
-                np.column_stack([home + np.linspace(0, nav.climb_distance(h_to), 40)[:, None]
-                                 * u, np.linspace(g_home, g_home + h_to, 40)])]))
+                np.column_stack([line, z_line])]))
             ok = clear >= CLIMB_CLEARANCE and not hits
             score = (ok, k == 0, clear)
             if best is None or score > best[0]:

@@ -301,13 +301,15 @@ def _legs(items: Sequence[MissionItem], nav_idx: Sequence[int], xy: np.ndarray,
                                f"one ({n.param('acceptance_radius')} / L1 at {v:g} m/s), so it "
                                "never flies to it"))
             continue
-        need = n.turn_on_distance(ang[k], v) + acc_b
+        turn_on = n.turn_on_distance(ang[k], v)
+        need = turn_on + acc_b
         if L < need - 1e-6:
             out.append(Problem(j, "fw-short-leg", f"the {L:.0f} m leg to {b.name} is shorter than "
-                               f"the {n.turn_on_distance(ang[k], v):.0f} m {label} needs to "
-                               f"turn {ang[k]:.0f}° onto it (turn radius "
-                               f"{n.turn_radius(v):.0f} m at {v:g} m/s) plus its "
-                               f"{acc_b:.0f} m acceptance: it overshoots", "warning"))
+                               f"the {need:.0f} m {label} flies on it ({turn_on:.0f} m to turn "
+                               f"{ang[k]:.0f}° onto it at a {n.turn_radius(v):.0f} m radius, "
+                               f"{v:g} m/s, and {acc_b:.0f} m of turn distance before the "
+                               "waypoint): it reaches the waypoint before it is on the leg, "
+                               "off its line by up to about a turn radius", "warning"))
     return out
 
 
