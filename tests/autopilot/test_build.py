@@ -50,6 +50,7 @@ def _opts(**kw) -> ExportOptions:
 
 def _write(files, tmp_path):
     for name, f in files.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)  # terrain/*.DAT
         with open(tmp_path / name, "wb" if f.binary else "w") as fh:
             f.write(fh)
 

@@ -29,6 +29,7 @@ from ..autopilot.mission_cases import ANCHOR, hill_free, hill_tff
 def _write_all(plan, tmp_path, **opts):
     mission, files = export_mission(plan, list(EXPORT_FILES), ExportOptions(anchor=ANCHOR, **opts))
     for name, f in files.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)  # terrain/*.DAT
         with open(tmp_path / name, "wb" if f.binary else "w") as fh:
             f.write(fh)
     return mission

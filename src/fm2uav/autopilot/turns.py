@@ -148,8 +148,9 @@ def fit_turns(
     if len(idx) > 2:
         L, need, gap = leg_needs(xy, nav)
         for k in range(1, len(idx) - 1):
-            if gap[k] <= 1e-6 and k + 1 < len(idx) - 1:
-                # the aircraft reaches k+1 by radius before it turns onto it: shrink both
+            if (gap[k] <= 1e-6 or L[k] < need[k] - 1e-6) and k + 1 < len(idx) - 1:
+                # a leg between waypoints that must stay is too short to turn onto (or
+                # the aircraft reaches k+1 by radius before it turns onto it): shrink both
                 r = max(MIN_ACCEPTANCE, min(255.0, np.floor(L[k] / 3.0)))
                 acc[k] = acc[k] or r
                 acc[k + 1] = acc[k + 1] or r

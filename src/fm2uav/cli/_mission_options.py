@@ -19,7 +19,8 @@ from ..errors import InputError
 
 __all__ = [
     "Firmware", "Vehicle", "Frame", "End", "Thin", "AnchorText", "SpeedChanges", "MinSpeed",
-    "CruiseSpeed", "HoverSpeed", "Endurance", "Reserve", "Via", "Return", "parse_anchor",
+    "CruiseSpeed", "HoverSpeed", "Endurance", "Reserve", "Terrain", "TerrainSpacing", "Via",
+    "Return", "parse_anchor",
     "via_points", "export_options",
 ]
 
@@ -53,6 +54,14 @@ Endurance = Annotated[float | None, typer.Option(
     help="Airframe endurance (min): the flight time is checked against it (airframe.endurance).")]
 Reserve = Annotated[float | None, typer.Option(
     help="Share of the endurance kept in reserve (airframe.reserve). Default 0.2.")]
+Terrain = Annotated[bool | None, typer.Option(
+    "--terrain/--no-terrain",
+    help="Write ArduPilot's terrain files (terrain/NxxEyyy.DAT for the SD card's "
+    "APM/terrain/) from the world's ground (outputs.terrain). Default: with every "
+    "terrain-frame mission.")]
+TerrainSpacing = Annotated[int | None, typer.Option(
+    help="Grid spacing (m) of the terrain files = the vehicle's TERRAIN_SPACING "
+    "(outputs.terrain_spacing). Default: half the DEM's resolution, 30 to 100 m.")]
 
 
 Via = Annotated[list[str] | None, typer.Option(
@@ -101,7 +110,8 @@ def export_options(base: Any = None, *, firmware: str | None = None, vehicle: st
                    anchor: str | None = None, speed_changes: bool | None = None,
                    min_speed: float | None = None, cruise_speed: float | None = None,
                    hover_speed: float | None = None, endurance: float | None = None,
-                   reserve: float | None = None, **more: Any) -> Any:
+                   reserve: float | None = None, terrain: bool | None = None,
+                   terrain_spacing: int | None = None, **more: Any) -> Any:
     """``base`` (default ``ExportOptions()``) with the flags that were given."""
     from ..io import ExportOptions
 
@@ -109,7 +119,7 @@ def export_options(base: Any = None, *, firmware: str | None = None, vehicle: st
              "tolerance": thin, "anchor": parse_anchor(anchor), "speed_changes": speed_changes,
              "min_speed": min_speed, "cruise_speed": cruise_speed, "hover_speed": hover_speed,
              "endurance_s": None if endurance is None else 60.0 * float(endurance),
-             "reserve": reserve, **more}
+             "reserve": reserve, "terrain": terrain, "terrain_spacing": terrain_spacing, **more}
     if thin is not None and not thin >= 0:
         raise InputError(f"--thin must be a tolerance >= 0 m, got {thin}")
     if endurance is not None and not endurance > 0:

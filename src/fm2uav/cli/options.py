@@ -471,7 +471,8 @@ def _mission_params() -> dict[str, Any]:
             "vehicle": m.Vehicle, "frame": m.Frame, "end": m.End, "thin": m.Thin,
             "anchor": m.AnchorText, "speed_changes": m.SpeedChanges, "min_speed": m.MinSpeed,
             "cruise_speed": m.CruiseSpeed, "hover_speed": m.HoverSpeed,
-            "endurance": m.Endurance, "reserve": m.Reserve}
+            "endurance": m.Endurance, "reserve": m.Reserve, "terrain": m.Terrain,
+            "terrain_spacing": m.TerrainSpacing}
 
 
 #: The mission flags of ``plan``/``formation`` (in their ``--help`` order).
