@@ -349,3 +349,24 @@ def test_run_flags_override_the_mission_export_and_route(examples, tmp_path):
     res = runner.invoke(app, ["run", str(examples / "open_field_tff.yaml"), "--out",
                               str(tmp_path / "q"), "--via", "1,2"])
     assert res.exit_code == 2 and "--via 1 must be x,y,z" in res.output
+
+
+def test_parse_world_checks_the_world_section_alone_in_the_mission_words(tmp_path):
+    from fm2uav.io.mission import parse_world
+
+    bad = tmp_path / ("a-long-folder-name-" * 4) / "not-a-raster.tif"
+    bad.parent.mkdir()
+    bad.write_text("text")
+    with pytest.raises(InputError) as e:
+        parse_world({"dem": str(bad)}, source="m.yaml")
+    msg = str(e.value)
+    assert msg.startswith("m.yaml: world.dem = '/") and "...'" not in msg
+    assert "/not-a-raster.tif' cannot be read as a raster" in msg   # the file's name kept
+    data = Path(__file__).resolve().parents[2] / "examples" / "data"
+    with pytest.raises(InputError, match=r"^m.yaml: world.cell_size = -1 is out of range"):
+        parse_world({"buildings": "town.geojson", "cell_size": -1}, source="m.yaml",
+                    base_dir=data)
+    with pytest.raises(InputError, match="world must be a mapping"):
+        parse_world(["x"])
+    spec = parse_world({"buildings": "town.geojson"}, base_dir=data)
+    assert spec.buildings.endswith("examples/data/town.geojson")

@@ -39,7 +39,22 @@ from rich.markup import escape
 from rich.table import Table
 from rich.text import Text
 
-from ..errors import Fm2uavError, InputError, PlanningError, PointError
+from ..errors import (  # noqa: F401  (exit codes and describe_error: re-exported)
+    EXIT_INPUT,
+    EXIT_INTERNAL,
+    EXIT_INTERRUPTED,
+    EXIT_OK,
+    EXIT_PLANNING,
+    InputError,
+    describe_error,
+)
+from ..pipeline.rows import plan_rows  # noqa: F401  (re-exported: was defined here)
+from ..pipeline.outputs import (  # noqa: F401  (re-exported: were defined here)
+    to_jsonable,
+    write_figure,
+    write_json,
+    write_text,
+)
 from ..io.outdir import Interrupted, OutputDir, abort_all, finish_all, interrupt_signals
 
 __all__ = [
@@ -65,33 +80,10 @@ __all__ = [
     "to_jsonable",
 ]
 
-EXIT_OK = 0
-EXIT_PLANNING = 1
-EXIT_INPUT = 2
-EXIT_INTERNAL = 70  # EX_SOFTWARE (sysexits.h): a bug in fm2uav
-EXIT_INTERRUPTED = 130  # 128 + SIGINT, also for SIGTERM (the output set is left as it was)
-
 console = Console()
 err_console = Console(stderr=True)
 
 F = TypeVar("F", bound=Callable[..., Any])
-
-
-def to_jsonable(obj: Any) -> Any:
-    """Convert numpy scalars/arrays and paths into plain JSON types."""
-    if isinstance(obj, dict):
-        return {str(k): to_jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [to_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return to_jsonable(obj.tolist())
-    if isinstance(obj, np.generic):
-        return obj.item()
-    if isinstance(obj, Path):
-        return str(obj)
-    if isinstance(obj, float) and not np.isfinite(obj):
-        return None
-    return obj
 
 
 def _fail(message: str, code: int) -> None:
@@ -99,70 +91,6 @@ def _fail(message: str, code: int) -> None:
     err_console.print(Text.assemble(("error: ", "bold red"), str(message)), highlight=False,
                       soft_wrap=True)
     raise typer.Exit(code)
-
-
-def _os_message(exc: OSError) -> str:
-    import errno
-
-    name = exc.filename if exc.filename is not None else ""
-    where = f" {name}" if name != "" else ""
-    if isinstance(exc, FileNotFoundError):
-        return f"file not found:{where}; check the path"
-    if isinstance(exc, IsADirectoryError):
-        return f"{name or 'the path'} is a directory, not a file; give the file inside it"
-    if isinstance(exc, NotADirectoryError):
-        return f"{name or 'the path'}: a part of the path is a file, not a folder; check it"
-    if isinstance(exc, PermissionError):
-        return f"permission denied:{where}; fix its permissions or choose another path"
-    if exc.errno == errno.ENOSPC:
-        return f"the disk is full{' writing' + where if where else ''}; free space or choose " \
-               "another --out"
-    if exc.errno == errno.EROFS:
-        return f"read-only file system:{where}; choose another --out"
-    return f"cannot read or write{where}: {exc.strerror or exc}; check the path"
-
-
-def describe_error(exc: BaseException) -> tuple[str, int] | None:
-    """``(one-line message, exit code)`` for an error caused by the input or the
-    environment, or None for a genuine internal error (a bug).
-
-    Fm2uavError subclasses keep their message (PlanningError → exit 1, others
-    → 2); OS errors, undecodable text, malformed YAML/JSON/zip files, invalid
-    geometries, inputs nested too deeply and memory exhaustion are named with
-    exit 2, so no bad input ends in a traceback.
-    """
-    import json
-    import zipfile
-
-    if isinstance(exc, PointError):
-        return str(exc), EXIT_INPUT
-    if isinstance(exc, PlanningError):
-        return str(exc), EXIT_PLANNING
-    if isinstance(exc, Fm2uavError):
-        return str(exc), EXIT_INPUT
-    if isinstance(exc, OSError):
-        return _os_message(exc), EXIT_INPUT
-    if isinstance(exc, UnicodeDecodeError):
-        return (f"an input file is not UTF-8 text (byte {exc.start}: {exc.reason}); give a "
-                "text file (YAML, GeoJSON, CSV) or the right format"), EXIT_INPUT
-    if isinstance(exc, json.JSONDecodeError):
-        return (f"an input file is not valid JSON ({exc.msg} at line {exc.lineno}, column "
-                f"{exc.colno}); check the file"), EXIT_INPUT
-    if isinstance(exc, zipfile.BadZipFile):
-        return f"an input file is not a valid zip archive (KMZ/NPZ): {exc}", EXIT_INPUT
-    if isinstance(exc, RecursionError):
-        return ("an input is nested too deeply to read (YAML/JSON with hundreds of levels); "
-                "flatten it"), EXIT_INPUT
-    if isinstance(exc, MemoryError):
-        return ("out of memory: the grid or the input is too large for this machine; use a "
-                "coarser --cell-size/--spacing or a smaller area (--bbox)"), EXIT_INPUT
-    mod = type(exc).__module__ or ""
-    if mod.startswith("yaml"):
-        return f"an input file is not valid YAML: {str(exc).splitlines()[0]}", EXIT_INPUT
-    if type(exc).__name__ == "GEOSException" or mod.startswith("shapely"):
-        return (f"an input geometry is invalid ({exc}); check the polygons (closed rings, "
-                "no self-intersections, finite coordinates)"), EXIT_INPUT
-    return None
 
 
 def _internal(exc: BaseException) -> None:
@@ -305,39 +233,6 @@ def progress(enabled: bool = True) -> Iterator[Callable[[str], None]]:
         return
     with err_console.status("starting", spinner="dots") as status:
         yield lambda message: status.update(f"[bold]{message}[/]")
-
-
-def write_json(outdir: OutputDir, name: str, payload: Any) -> None:
-    """Write ``payload`` (numpy values allowed) as indented JSON into the output set."""
-    with outdir.open(name) as fh:
-        json.dump(to_jsonable(payload), fh, indent=2)
-
-
-def write_text(outdir: OutputDir, name: str, text: str) -> None:
-    """Write a text file (Markdown, CSV, HTML) into the output set."""
-    with outdir.open(name) as fh:
-        fh.write(text)
-
-
-def write_figure(outdir: OutputDir, fig: Any, name: str, dpi: int = 110) -> None:
-    """Save a matplotlib figure as ``name`` (PNG) into the output set."""
-    tmp = outdir.target(name)
-    try:
-        fig.savefig(tmp, dpi=dpi)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-    outdir.commit(tmp, name)
-
-
-def plan_rows(p: Any) -> dict[str, Any]:
-    """The printed summary rows every planning command shows of a plan."""
-    return {
-        "start [m]": np.round(p.start, 1).tolist(),
-        "goal [m]": np.round(p.goal, 1).tolist(),
-        "length [m]": f"{p.length:.1f}",
-        "clearance [m]": f"{p.clearance:.1f}",
-    }
 
 
 @dataclass

@@ -10,12 +10,12 @@ applies; :func:`export_options` builds the :class:`~fm2uav.io.ExportOptions`.
 
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import Annotated, Any
 
 import typer
 
 from ..errors import InputError
+from ..pipeline.outputs import export_options, parse_anchor  # noqa: F401  (re-exported)
 
 __all__ = [
     "Firmware", "Vehicle", "Frame", "End", "Thin", "AnchorText", "SpeedChanges", "MinSpeed",
@@ -87,41 +87,3 @@ def via_points(via: list[str] | None, *, lonlat: bool) -> list[Any] | None:
             raise InputError(f"--via {k + 1} must be {form}, got {text!r}")
         out.append({"lon": v[0], "lat": v[1], "agl": v[2]} if lonlat else v)
     return out
-
-
-def parse_anchor(text: str | None) -> Any:
-    """``"lon,lat[,alt]"`` → :class:`~fm2uav.io.Anchor` (None → None)."""
-    if text is None:
-        return None
-    from ..io import Anchor
-
-    try:
-        v = [float(x) for x in text.replace(",", " ").split()]
-    except ValueError:
-        v = []
-    if len(v) not in (2, 3):
-        raise InputError(f"--anchor must be lon,lat or lon,lat,alt (degrees, degrees, metres), "
-                         f"got {text!r}")
-    return Anchor(lon=v[0], lat=v[1], alt=v[2] if len(v) == 3 else 0.0)
-
-
-def export_options(base: Any = None, *, firmware: str | None = None, vehicle: str | None = None,
-                   frame: str | None = None, end: str | None = None, thin: float | None = None,
-                   anchor: str | None = None, speed_changes: bool | None = None,
-                   min_speed: float | None = None, cruise_speed: float | None = None,
-                   hover_speed: float | None = None, endurance: float | None = None,
-                   reserve: float | None = None, terrain: bool | None = None,
-                   terrain_spacing: int | None = None, **more: Any) -> Any:
-    """``base`` (default ``ExportOptions()``) with the flags that were given."""
-    from ..io import ExportOptions
-
-    given = {"firmware": firmware, "vehicle": vehicle, "frame": frame, "end": end,
-             "tolerance": thin, "anchor": parse_anchor(anchor), "speed_changes": speed_changes,
-             "min_speed": min_speed, "cruise_speed": cruise_speed, "hover_speed": hover_speed,
-             "endurance_s": None if endurance is None else 60.0 * float(endurance),
-             "reserve": reserve, "terrain": terrain, "terrain_spacing": terrain_spacing, **more}
-    if thin is not None and not thin >= 0:
-        raise InputError(f"--thin must be a tolerance >= 0 m, got {thin}")
-    if endurance is not None and not endurance > 0:
-        raise InputError(f"--endurance must be > 0 minutes, got {endurance}")
-    return replace(base or ExportOptions(), **{k: v for k, v in given.items() if v is not None})

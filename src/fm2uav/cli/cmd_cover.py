@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 import typer
 
 from ..errors import InputError
@@ -16,6 +15,7 @@ from ._common import (
     write_json,
     write_text,
 )
+from ..pipeline.cover import COVER_EXPORTS, COVER_FILES, REPORT  # noqa: F401  (re-exported)
 from .options import (
     MissionFlags,
     SafetyFlags,
@@ -26,15 +26,7 @@ from .options import (
     output_options,
     safety_options,
     world_options,
-    world_rows,
 )
-
-#: Mission files of a coverage flight (written by fm2uav.io.export_mission).
-COVER_EXPORTS = ("csv", "plan", "wpl", "kml", "kmz", "geojson")
-COVER_FILES = ("path.csv", "zigzag.csv", "bands.png", "coverage.png", "coverage.html",
-               "summary.json", "mission.plan", "mission.waypoints", "path.kml", "path.kmz",
-               "path.geojson")
-REPORT = "report.html"
 
 def _camera(camera: str):
     """``--camera`` text → :class:`~fm2uav.missions.coverage.Camera`."""
@@ -73,94 +65,6 @@ def _load_area(area: str, world=None, crs=None):
         )
     return load_area(area, world, crs=crs)
 
-
-def _write_report(outdir: OutputDir, cp, *, title: str, subtitle: str, metrics: dict,
-                  waypoints=None, files=(), notes=()) -> None:
-    from ..viz.coverage import coverage_overlays
-    from ..viz.overlays import filled_overlay, filled_path_overlay, zone_overlays
-    from ..viz.report import report_html
-
-    name = "FM² path"
-    world = cp.plan.world
-    overlays = {**filled_overlay(world), **filled_path_overlay(world, cp.path),
-                **coverage_overlays(cp), **zone_overlays(getattr(world, "zones", ()))}
-    html = report_html(
-        world, {name: cp.path}, title=title, subtitle=subtitle,
-        speeds={name: cp.plan.w}, ideal_agl={name: cp.level.agl},
-        waypoints=None if waypoints is None else {name: waypoints},
-        overlays=overlays, params=cp.params, metrics=metrics, files=files, notes=notes)
-    with outdir.open(REPORT) as fh:
-        fh.write(html)
-
-
-def _write_cover_outputs(outdir: OutputDir, cp, area: str, *, report: bool, title: str,
-                         options=None, camera=None):
-    """The mission files (path.csv, mission.plan, .waypoints, KML/KMZ, GeoJSON), zigzag.csv,
-    PNGs, coverage.html and report.html; returns ``(built mission, safety figures)`` (the
-    no-fly zones of the world go into the .plan geoFence)."""
-    from ..io import write_path_csv
-    from ..viz.coverage import bands_figure, coverage_figure, coverage_html
-    from .cmd_run import write_exports
-
-    world = cp.plan.world
-    georef = getattr(world, "georef", None)
-    comment = georef.comment() if georef is not None else None
-    from ..analysis.safety import safety_summary
-    from ..io import export_mission
-    from ..autopilot.geofence import zone_fences
-
-    zones = tuple(getattr(world, "zones", ()))
-    fences, fence_warnings = (zone_fences(zones, world, getattr(options, "anchor", None))
-                              if zones else ([], []))
-    mission, files = export_mission(cp.plan, COVER_EXPORTS, options, agl=cp.level.agl,
-                                    camera=camera, fences=fences)
-    wps = mission.waypoints
-    safety = safety_summary(
-        world, cp.path, requested=cp.level.agl, phase=getattr(cp.plan, "phase", None),
-        waypoints=wps.points_m, waypoint_indices=wps.indices, terrain_frame=wps.frame == 10,
-        waypoint_agl=wps.agl, level=cp.level)
-    if zones:
-        safety["geofence"] = {"fences": len(fences), "warnings": fence_warnings}
-    from ..analysis.known_ground import check_ground, ground_notes
-
-    check_ground(world, safety, what="the survey path")
-    write_exports(outdir, files)
-    with outdir.open("zigzag.csv") as fh:
-        write_path_csv(fh, cp.zigzag.path(), comment=comment)
-    write_figure(outdir, bands_figure(cp.zigzag, title=f"zigzag over {area}"), "bands.png")
-    write_figure(outdir, coverage_figure(cp, title=title), "coverage.png")
-    with outdir.open("coverage.html") as fh:
-        fh.write(coverage_html(cp, title=title))
-    if report:
-        e = np.abs(cp.agl_error)
-        metrics = {
-            "steering angle [deg]": round(cp.zigzag.angle_deg, 3),
-            "band spacing D [m]": cp.zigzag.spacing,
-            "bands": cp.zigzag.n_bands,
-            "zigzag cost [m]": round(cp.zigzag.cost, 1),
-            "FM² path length [m]": round(float(cp.plan.length), 1),
-            "coverage (FM² path) [%]": round(100 * cp.coverage, 2),
-            "|AGL error| mean / max [m]": f"{e.mean():.1f} / {e.max():.1f}",
-            "mission": f"{mission.options.firmware} {mission.options.vehicle}, "
-                       f"{len(mission.items)} items, frame {mission.frame}, end {mission.end}",
-            "camera trigger [m]": mission.info["camera"]["trigger_distance_m"],
-            **({"GSD [cm/px]": mission.info["camera"]["gsd_cm_per_px"]}
-               if "gsd_cm_per_px" in mission.info["camera"] else {}),
-            "planning time [s]": round(cp.timings.get("total", 0.0), 3),
-            **_safety_rows(safety),
-        }
-        _write_report(outdir, cp, title=title,
-                      subtitle=f"zigzag bands over {area}, FM² at "
-                               f"{cp.level.agl:g} m above the terrain",
-                      metrics=metrics, waypoints=wps.points_m, files=list(COVER_FILES),
-                      notes=list(ground_notes(world, safety, what="the survey path").values()))
-    return mission, safety
-
-
-def _safety_rows(safety: dict) -> dict:
-    from .cmd_run import safety_rows
-
-    return safety_rows(safety)
 
 def _write_coverage_figures(outdir: OutputDir, run) -> None:
     """bands_<area>.png, coverage_<area>.png and bands_S1_D<d>.png of a coverage run."""
@@ -247,9 +151,11 @@ def cover_cmd(
     world: WorldFlags = None,
     safety: SafetyFlags = None,
 ) -> None:
-    """``fm2uav cover``: parse, :func:`~fm2uav.missions.coverage.plan_coverage`, write, print."""
-    from ..missions.coverage import FULL_BOUNDS_DEG, plan_coverage
-    from ..missions.coverage.triggers import camera_plan
+    """``fm2uav cover``: parse, :func:`~fm2uav.pipeline.cover.run_cover`, print."""
+    from ..missions.coverage import FULL_BOUNDS_DEG
+    from ..pipeline.cover import cover_rows, run_cover
+    from ..pipeline.rows import safety_rows
+    from ..progress import reporting
     from ..world.load import world_summary
 
     level = safety.level(agl, p1=p1, p2=p2)  # refuses agl outside --min-agl/--max-agl
@@ -260,55 +166,22 @@ def cover_cmd(
     mission_options = mission.export_options(name=f"coverage of {area}")
     outdir = output.dir(COVER_FILES + ((REPORT,) if output.report else ()))
     opts = {"bounds_deg": FULL_BOUNDS_DEG} if full_range else {}
-    with output.progress() as step:
+    with output.progress() as step, reporting(lambda e: step(e.message)):
         step("building the map")
         w, _, scenario = build_world(world.spec(), scenario=scenario, seed=seed, agl=agl,
                                      default="coverage")
         poly, area_source = _load_area(area, w, world.crs)
         w = safety.apply(w, crs=world.crs)  # --no-fly zones become obstacles
-        step("searching the steering angle and planning FM² along the bands")
-        cp = plan_coverage(w, poly, d, level=level,
-                           angle=None if angle is None else np.radians(angle),
-                           search=search, search_options=opts, seed=seed,
-                           shaping=safety.shaping())
-        step("writing the outputs")
-        shots = camera_plan(cp, camera=cam, front_overlap=front_overlap,
-                            trigger_distance=trigger_distance)
-        built, safety_figures = _write_cover_outputs(outdir, cp, area, report=output.report,
-                                     title=f"coverage of {area}", options=mission_options,
-                                     camera=shots)
-    summary = {"area": area, "scenario": scenario, "world": world_summary(w),
-               **({"area_source": area_source.as_dict()} if area_source else {}),
-               **cp.summary()}
-    summary["autopilot"] = built.summary()
-    summary["safety"] = safety_figures
-    write_json(outdir, "summary.json", summary)
-    output.summary("coverage plan", {**_cover_rows(area, d, cp, built, w),
-                                     **_safety_rows(safety_figures)}, summary)
-
-
-def _cover_rows(area: str, d: float, cp, mission, world) -> dict:
-    """The printed summary of ``fm2uav cover``."""
-    from .cmd_run import mission_rows
-
-    return {
-        "area": area,
-        "band spacing D [m]": f"{d:.1f}",
-        "steering angle [deg]": f"{cp.zigzag.angle_deg:.3f}",
-        "bands": cp.zigzag.n_bands,
-        "zigzag cost [m]": f"{cp.zigzag.cost:.1f}",
-        "FM² path length [m]": f"{cp.plan.length:.1f}",
-        "coverage (FM² path) [%]": f"{100 * cp.coverage:.2f}",
-        "|AGL error| mean/max [m]": f"{np.abs(cp.agl_error).mean():.1f} / "
-                                    f"{np.abs(cp.agl_error).max():.1f}",
-        "camera": ", ".join(
-            f"{k} {v}" for k, v in mission.info["camera"].items()
-            if k in ("gsd_cm_per_px", "side_overlap", "front_overlap", "trigger_distance_m",
-                     "trigger_items")),
-        **mission_rows(mission),
-        "timings [ms]": ", ".join(f"{k} {v * 1e3:.0f}" for k, v in cp.timings.items()),
-        **world_rows(world),
-    }
+        run = run_cover(outdir, w, poly, area_label=area, spacing=d, level=level,
+                        options=mission_options, camera=cam, front_overlap=front_overlap,
+                        trigger_distance=trigger_distance, angle_deg=angle, search=search,
+                        search_options=opts, seed=seed, shaping=safety.shaping(),
+                        report=output.report, summary={
+                            "area": area, "scenario": scenario, "world": world_summary(w),
+                            **({"area_source": area_source.as_dict()} if area_source
+                               else {})})
+    output.summary("coverage plan", {**cover_rows(area, d, run.coverage, run.built, w),
+                                     **safety_rows(run.safety)}, run.summary)
 
 
 @handle_errors

@@ -27,6 +27,7 @@ import numpy as np
 import typer
 
 from ..errors import InputError
+from ..pipeline.rows import world_rows  # noqa: F401  (re-exported: was defined here)
 
 __all__ = [
     "DemOpt", "DemFillOpt", "BuildingsOpt", "BboxOpt", "SeaLevelOpt", "CellSizeOpt", "DzOpt", "CeilingOpt",
@@ -327,37 +328,6 @@ def requested_heights(*texts: str | None, lonlat: bool, agl: float | None
         if len(v) == 3:
             (agls if lonlat else tops).append(v[2])
     return (max(agls) if agls else None), (max(tops) if tops else None)
-
-
-def world_rows(world: Any) -> dict[str, str]:
-    """Printed summary rows about a data world (nothing for a built-in scenario)."""
-    g = getattr(world, "georef", None)
-    if g is None:
-        return {}
-    rows = {"CRS": f"{g.name}" + (f" — {g.reprojection}" if g.reprojection else ""),
-            "vertical": g.vertical}
-    for s in g.sources:
-        d = s.details
-        if s.role == "dem":
-            rows["grid"] = (f"{' x '.join(str(n) for n in world.shape)} nodes, cells "
-                            f"{d.get('cell_size', world.spacing[0]):g} m ({d.get('cell_size_rule', '')}), "
-                            f"dz {d.get('dz', world.spacing[2]):g} m ({d.get('dz_rule', '')})")
-            if d.get("filled_nodes"):
-                rows["filled nodata"] = f"{d['filled_nodes']} columns"
-        if s.role == "buildings":
-            hr = d.get("height_rule", {})
-            rows["buildings"] = (
-                f"{d.get('buildings', 0)}: {hr.get('height', 0)} from height, "
-                f"{hr.get('building:levels', 0)} from building:levels x "
-                f"{d.get('metres_per_level', 3.0):g} m, {hr.get('default_height', 0)} from "
-                f"--default-height" + (f"; left out: {d['skipped']}" if d.get("skipped") else "")
-                + (f"; {d['outside_map']} outside the map" if d.get("outside_map") else ""))
-            if "grid" not in rows:
-                rows["grid"] = (f"{' x '.join(str(n) for n in world.shape)} nodes, cells "
-                                f"{world.spacing[0]:g} m, dz {world.spacing[2]:g} m")
-    rows["sources"] = ", ".join(f"{Path(s.path).name} (sha256 {s.sha256[:12]})"
-                                for s in g.sources if s.sha256)
-    return rows
 
 
 # -- option groups: one decorator adds a group's flags to a command --------------------------

@@ -77,6 +77,7 @@ __all__ = [
     "resolve_point",
     "load_mission",
     "parse_mission",
+    "parse_world",
 ]
 
 #: Output formats a mission can ask for (exports + report + figure + summary).
@@ -574,7 +575,8 @@ _TYPE_WORDS = {
 
 def _show(v: Any) -> str:
     text = repr(v)
-    return text if len(text) <= 60 else text[:57] + "..."
+    # a long value keeps its end too: a path's file name says which file is wrong
+    return text if len(text) <= 60 else text[:22] + "..." + text[-35:]
 
 
 def _format_error(err: dict[str, Any]) -> str:
@@ -643,6 +645,30 @@ def parse_mission(data: Any, *, source: str = "mission", base_dir: str | Path | 
         errs = exc.errors()
         more = f" (+{len(errs) - 1} more)" if len(errs) > 1 else ""
         raise InputError(f"{source}: {_format_error(errs[0])}{more}") from None
+
+
+def parse_world(data: Any, *, source: str = "mission", base_dir: str | Path | None = None
+                ) -> WorldSpec:
+    """Validate a mission's ``world:`` section alone (e.g. to show a map before planning).
+
+    The same checks and the same one-line messages as :func:`parse_mission`
+    gives for that section (``<source>: world.dem = ... cannot be read as a
+    raster ...``), with paths relative to ``base_dir``.
+
+    Raises
+    ------
+    InputError
+    """
+    if not isinstance(data, dict):
+        raise InputError(f"{source}: world must be a mapping (scenario:, dem:, buildings:, ...), "
+                         f"got {type(data).__name__}")
+    try:
+        return WorldSpec.model_validate(data, context={"base_dir": base_dir})
+    except ValidationError as exc:
+        errs = exc.errors()
+        more = f" (+{len(errs) - 1} more)" if len(errs) > 1 else ""
+        first = {**errs[0], "loc": ("world", *errs[0]["loc"])}
+        raise InputError(f"{source}: {_format_error(first)}{more}") from None
 
 
 def load_mission(file: str | Path, *, world_overrides: dict[str, Any] | None = None,

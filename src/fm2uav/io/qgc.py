@@ -90,6 +90,16 @@ def _item_json(it: MissionItem, jump_id: int) -> dict[str, Any]:
     return out
 
 
+def _portable(georef: dict[str, Any] | None) -> dict[str, Any] | None:
+    """The georeference with each source named by its file name (and sha256), not by the
+    folder it was read from: a plan file tells the same flight wherever its mission was run
+    from (the same mission file gives the same bytes on any machine, from any folder)."""
+    if georef is None:
+        return None
+    return {**georef, "sources": [{**s, "path": Path(str(s["path"])).name}
+                                  for s in georef.get("sources", ())]}
+
+
 def plan_document(mission: Any) -> dict[str, Any]:
     """The ``.plan`` JSON document of a built mission (a plain dict).
 
@@ -105,7 +115,8 @@ def plan_document(mission: Any) -> dict[str, Any]:
     return {
         "fileType": "Plan",
         "fm2uav": {"frame": info["frame"], "home": info["home"], "crs": info["crs"],
-                   "georef": info["georef"], "vertical_reference": info["vertical_reference"],
+                   "georef": _portable(info["georef"]),
+                   "vertical_reference": info["vertical_reference"],
                    "end": info["end"], "warnings": info["warnings"]},
         "geoFence": geofence_document(mission.fences),
         "groundStation": "fm2uav",

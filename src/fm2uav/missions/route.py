@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import progress
 from ..errors import InputError, PlanningError, PointError
 from ..planning import Plan, plan
 from ..planning.params import FlightLevel, PlanOptions, Shaping
@@ -126,8 +127,10 @@ def plan_route(
         reuse = legs and legs[0].params.get("storage") != "regional"
         opts = replace(options, speed_map=legs[0].W) if reuse else options
         try:
-            legs.append(plan(world, pts[k], pts[k + 1], shaping=shaping, level=level,
-                             options=opts))
+            with progress.span(f"leg {k + 1} of {len(pts) - 1}" if len(pts) > 2 else "",
+                               1.0 / (len(pts) - 1)):
+                legs.append(plan(world, pts[k], pts[k + 1], shaping=shaping, level=level,
+                                 options=opts))
         except PlanningError as exc:
             raise type(exc)(f"route leg {k + 1} of {len(pts) - 1} "
                             f"({np.round(pts[k], 1).tolist()} → {np.round(pts[k + 1], 1).tolist()}"

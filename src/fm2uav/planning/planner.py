@@ -17,6 +17,7 @@ import numpy as np
 from scipy import ndimage
 
 from .. import _validate
+from .. import progress
 from ..eikonal.fmm import fast_marching
 from ..eikonal.velocity import distance_map, distance_scale, normalise_distance, shape_velocity
 from ..errors import InputError, PlanningError, PointError, UnreachableError
@@ -242,6 +243,7 @@ def _check_free(world: World, point: np.ndarray, what: str) -> tuple[int, ...]:
     return cell
 
 
+@progress.stage()
 def plan(
     world: World,
     start: Any,
@@ -316,6 +318,7 @@ def plan(
                              options=options, t_all=t_all, full_plan=plan)
 
     t0 = time.perf_counter()
+    progress.step("velocity map W", 0.3)
     W = plan_velocity(world, shaping, level, options)
     t1 = time.perf_counter()
     if W[start_cell] <= 0 or W[goal_cell] <= 0:
@@ -323,6 +326,7 @@ def plan(
         raise PointError(
             f"the velocity map is 0 at the {which} node; move the {which} away from obstacles"
         )
+    progress.step("arrival times T (Fast Marching)", 0.45)
     T = fast_marching(W, [goal_cell], spacing=world.spacing, order=options.order,
                       stop_at=[start_cell])
     t2 = time.perf_counter()
@@ -401,6 +405,7 @@ def trace_plan(world: World, W: np.ndarray, T: np.ndarray, start_m: np.ndarray,
     # T = inf, unless a custom speed map gave them a speed: only then pass the
     # mask (it costs a copy of T, ~1 s on a 40M-node map).
     blocked = world.occupancy if np.isfinite(T[world.occupancy]).any() else None
+    progress.step("path (geodesic descent)", 0.6)
     try:
         path_idx = descend(
             T,
@@ -422,6 +427,7 @@ def trace_plan(world: World, W: np.ndarray, T: np.ndarray, start_m: np.ndarray,
     if level is not None and level.heights == "ground" and world.ndim == 3:
         # heights from the continuous ground along the FM² route (issue 13); with a
         # custom speed map (route legs re-use the first leg's W) the level still sets them
+        progress.step("heights above the ground", 1.0)
         profile = final_profile(world, path, level)
         path = profile.path
         path_idx = world.to_index(path)

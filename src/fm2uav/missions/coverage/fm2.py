@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ... import progress
 from ...errors import InputError, PlanningError
 from ...geometry import path_length
 from ...planning import FlightLevel, Plan, PlanOptions, Shaping, base_velocity, shaped_velocity
@@ -358,6 +359,7 @@ def _zigzag_in_map(world: World, poly: Any, d: float, angle: float) -> tuple[Zig
     return zz, ideal
 
 
+@progress.stage()
 def plan_coverage(
     world: World,
     area,
@@ -433,18 +435,22 @@ def plan_coverage(
     poly = as_area(area)
     d = check_spacing(poly, spacing)
     check_inside_world(poly, world)
+    progress.step("steering angle of the bands" + (f" ({search})" if angle is None else ""), 0.3)
     angle, found = _steering(poly, d, angle, search, search_options, seed)
     t1 = time.perf_counter()
+    progress.step("zigzag bands", 0.05)
     zz, ideal = _zigzag_in_map(world, poly, d, angle)
     t2 = time.perf_counter()
     if not (0 < corridor < 0.5):
         raise InputError(f"corridor must be a share of D in (0, 0.5), got {corridor!r}")
+    progress.step("FM² along the bands", 0.5)
     fm, grid, cg, grid_plan, t3 = _fly_zigzag(
         world, zz, ideal, d, level, grid, corridor, options,
         dict(level_contrast=level_contrast, level_base=level_base, shaping=shaping))
     _check_free(world, fm.path)
     fm = with_flown_heights(world, fm, level)
     t4 = time.perf_counter()
+    progress.step("coverage and heights above the ground", 0.15)
     cov, zcov, err = _report(world, poly, fm.path, ideal, d, level)
     t5 = time.perf_counter()
     return CoveragePlan(

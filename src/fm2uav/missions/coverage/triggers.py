@@ -25,7 +25,7 @@ import numpy as np
 from ...errors import InputError
 from .camera import Camera
 
-__all__ = ["CameraPlan", "band_indices", "camera_plan"]
+__all__ = ["CameraPlan", "band_indices", "camera_plan", "photo_positions"]
 
 
 @dataclass(frozen=True)
@@ -148,3 +148,53 @@ def camera_plan(
     bands, worst = band_indices(coverage.zigzag, coverage.path)
     info["band_end_mismatch_m"] = round(worst, 3)
     return CameraPlan(trigger_distance=float(trig), bands=tuple(bands), info=info)
+
+
+def photo_positions(path: Any, shots: CameraPlan) -> tuple[np.ndarray, np.ndarray]:
+    """Where the camera fires along the flown path, and the heading there.
+
+    The mission switches distance triggering on at each band's start with
+    "trigger once now" (``DO_SET_CAM_TRIGG_DIST`` param3 = 1) and off at its end,
+    so a photo is taken at the band's start and then every ``trigger_distance``
+    metres of ground track until the band's end.
+
+    Parameters
+    ----------
+    path : ndarray, shape (N, 3)
+        The flown path [m].
+    shots : CameraPlan
+
+    Returns
+    -------
+    points : ndarray, shape (k, 3)
+        Photo positions [m].
+    headings : ndarray, shape (k,)
+        Direction of flight there [rad, counter-clockwise from +x].
+
+    Examples
+    --------
+    >>> path = np.array([[0.0, 0, 50], [100, 0, 50], [100, 30, 50], [0, 30, 50]])
+    >>> pts, hdg = photo_positions(path, CameraPlan(40.0, ((0, 1), (2, 3))))
+    >>> pts[:, :2].tolist()
+    [[0.0, 0.0], [40.0, 0.0], [80.0, 0.0], [100.0, 30.0], [60.0, 30.0], [20.0, 30.0]]
+    >>> np.degrees(hdg).round().tolist()
+    [0.0, 0.0, 0.0, 180.0, 180.0, 180.0]
+    """
+    p = np.asarray(path, dtype=float)
+    pts: list[np.ndarray] = []
+    hdg: list[np.ndarray] = []
+    for a, b in shots.bands:
+        seg = p[a:b + 1]
+        if len(seg) < 2:
+            continue
+        step = np.linalg.norm(np.diff(seg[:, :2], axis=0), axis=1)
+        s = np.concatenate([[0.0], np.cumsum(step)])
+        at = np.arange(0.0, s[-1] + 1e-9, shots.trigger_distance)
+        k = np.clip(np.searchsorted(s, at, side="right") - 1, 0, len(step) - 1)
+        u = np.where(step[k] > 0, (at - s[k]) / np.where(step[k] > 0, step[k], 1.0), 0.0)
+        pts.append(seg[k] + u[:, None] * (seg[k + 1] - seg[k]))
+        d = seg[k + 1] - seg[k]
+        hdg.append(np.arctan2(d[:, 1], d[:, 0]))
+    if not pts:
+        return np.zeros((0, 3)), np.zeros(0)
+    return np.vstack(pts), np.concatenate(hdg)

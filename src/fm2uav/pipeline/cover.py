@@ -1,0 +1,203 @@
+"""A coverage mission from an area to its output set (shared by ``fm2uav cover`` and the app).
+
+:func:`run_cover` plans the zigzag bands and FM² along them
+(:func:`fm2uav.missions.coverage.plan_coverage`), the camera triggering, the
+autopilot mission, and writes the mission files, the figures, ``coverage.html``,
+``report.html`` (optional) and ``summary.json`` into an output set.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .. import progress
+from .outputs import write_exports, write_figure, write_json
+from .rows import mission_rows, safety_rows, world_rows
+
+__all__ = ["COVER_EXPORTS", "COVER_FILES", "REPORT", "CoverRun", "run_cover", "cover_outputs",
+           "cover_rows"]
+
+#: Mission files of a coverage flight (written by fm2uav.io.export_mission).
+COVER_EXPORTS = ("csv", "plan", "wpl", "kml", "kmz", "geojson")
+COVER_FILES = ("path.csv", "zigzag.csv", "bands.png", "coverage.png", "coverage.html",
+               "summary.json", "mission.plan", "mission.waypoints", "path.kml", "path.kmz",
+               "path.geojson")
+REPORT = "report.html"
+
+
+
+@dataclass(frozen=True)
+class CoverRun:
+    """What :func:`run_cover` planned and wrote: the coverage plan, the camera plan, the
+    autopilot mission, its safety figures and the ``summary.json`` document."""
+
+    coverage: Any
+    shots: Any
+    built: Any
+    safety: dict[str, Any]
+    summary: dict[str, Any]
+
+
+@progress.stage()
+def run_cover(outdir: Any, world: Any, area: Any, *, area_label: str, spacing: float,
+              level: Any, options: Any, camera: Any = None, front_overlap: float = 0.0,
+              trigger_distance: float | None = None, angle_deg: float | None = None,
+              search: str = "de", search_options: dict[str, Any] | None = None, seed: int = 0,
+              shaping: Any = None, report: bool = False,
+              summary: dict[str, Any] | None = None) -> CoverRun:
+    """Plan the coverage of ``area`` and write its output set (see the module docstring).
+
+    Parameters
+    ----------
+    outdir : fm2uav.io.outdir.OutputDir
+    world : World
+        With the no-fly zones as obstacles (their geofences go into the ``.plan``).
+    area : shapely Polygon
+        In world metres (:func:`fm2uav.missions.coverage.area.load_area`).
+    area_label : str
+        How the area is named in titles (``--area``).
+    spacing : float
+        Band spacing D [m].
+    level : FlightLevel
+    options : fm2uav.io.ExportOptions
+    camera : Camera, optional
+    front_overlap, trigger_distance
+        Photos along the bands (:func:`fm2uav.missions.coverage.triggers.camera_plan`).
+    angle_deg : float, optional
+        Steering angle [deg]; default: searched with ``search``.
+    search, search_options, seed, shaping
+        As :func:`fm2uav.missions.coverage.plan_coverage`.
+    report : bool
+        Also write ``report.html``.
+    summary : dict, optional
+        First entries of ``summary.json`` (the area, the world).
+    """
+    from ..missions.coverage import plan_coverage
+    from ..missions.coverage.triggers import camera_plan
+
+    progress.step("planning the bands and FM² along them", 0.75)
+    cp = plan_coverage(world, area, spacing, level=level,
+                       angle=None if angle_deg is None else np.radians(angle_deg),
+                       search=search, search_options=search_options or {}, seed=seed,
+                       shaping=shaping)
+    progress.step("writing the mission files and figures", 0.25)
+    shots = camera_plan(cp, camera=camera, front_overlap=front_overlap,
+                        trigger_distance=trigger_distance)
+    built, safety = cover_outputs(outdir, cp, area_label, report=report,
+                                  title=f"coverage of {area_label}", options=options,
+                                  camera=shots)
+    doc = {**(summary or {}), **cp.summary(), "autopilot": built.summary(), "safety": safety}
+    write_json(outdir, "summary.json", doc)
+    return CoverRun(coverage=cp, shots=shots, built=built, safety=safety, summary=doc)
+
+
+def _cover_report(outdir: Any, cp, *, title: str, subtitle: str, metrics: dict,
+                  waypoints=None, files=(), notes=()) -> None:
+    from ..viz.coverage import coverage_overlays
+    from ..viz.overlays import filled_overlay, filled_path_overlay, zone_overlays
+    from ..viz.report import report_html
+
+    name = "FM² path"
+    world = cp.plan.world
+    overlays = {**filled_overlay(world), **filled_path_overlay(world, cp.path),
+                **coverage_overlays(cp),
+                **zone_overlays(getattr(world, "zones", ()))}
+    html = report_html(
+        world, {name: cp.path}, title=title, subtitle=subtitle,
+        speeds={name: cp.plan.w}, ideal_agl={name: cp.level.agl},
+        waypoints=None if waypoints is None else {name: waypoints},
+        overlays=overlays, params=cp.params, metrics=metrics, files=files, notes=notes)
+    with outdir.open(REPORT) as fh:
+        fh.write(html)
+
+
+@progress.stage()
+def cover_outputs(outdir: Any, cp, area: str, *, report: bool, title: str,
+                         options=None, camera=None):
+    """The mission files (path.csv, mission.plan, .waypoints, KML/KMZ, GeoJSON), zigzag.csv,
+    PNGs, coverage.html and report.html; returns ``(built mission, safety figures)`` (the
+    no-fly zones of the world go into the .plan geoFence)."""
+    from ..io import write_path_csv
+    from ..viz.coverage import bands_figure, coverage_figure, coverage_html
+    world = cp.plan.world
+    georef = getattr(world, "georef", None)
+    comment = georef.comment() if georef is not None else None
+    from ..analysis.safety import safety_summary
+    from ..io import export_mission
+    from ..autopilot.geofence import zone_fences
+
+    zones = tuple(getattr(world, "zones", ()))
+    fences, fence_warnings = (zone_fences(zones, world, getattr(options, "anchor", None))
+                              if zones else ([], []))
+    mission, files = export_mission(cp.plan, COVER_EXPORTS, options, agl=cp.level.agl,
+                                    camera=camera, fences=fences)
+    wps = mission.waypoints
+    safety = safety_summary(
+        world, cp.path, requested=cp.level.agl, phase=getattr(cp.plan, "phase", None),
+        waypoints=wps.points_m, waypoint_indices=wps.indices, terrain_frame=wps.frame == 10,
+        waypoint_agl=wps.agl, level=cp.level)
+    if zones:
+        safety["geofence"] = {"fences": len(fences), "warnings": fence_warnings}
+    from ..analysis.known_ground import check_ground, ground_notes
+
+    check_ground(world, safety, what="the survey path")
+    progress.step("writing the mission files", 0.3)
+    write_exports(outdir, files)
+    progress.step("writing the figures", 0.7)
+    with outdir.open("zigzag.csv") as fh:
+        write_path_csv(fh, cp.zigzag.path(), comment=comment)
+    write_figure(outdir, bands_figure(cp.zigzag, title=f"zigzag over {area}"), "bands.png")
+    write_figure(outdir, coverage_figure(cp, title=title), "coverage.png")
+    with outdir.open("coverage.html") as fh:
+        fh.write(coverage_html(cp, title=title))
+    if report:
+        e = np.abs(cp.agl_error)
+        metrics = {
+            "steering angle [deg]": round(cp.zigzag.angle_deg, 3),
+            "band spacing D [m]": cp.zigzag.spacing,
+            "bands": cp.zigzag.n_bands,
+            "zigzag cost [m]": round(cp.zigzag.cost, 1),
+            "FM² path length [m]": round(float(cp.plan.length), 1),
+            "coverage (FM² path) [%]": round(100 * cp.coverage, 2),
+            "|AGL error| mean / max [m]": f"{e.mean():.1f} / {e.max():.1f}",
+            "mission": f"{mission.options.firmware} {mission.options.vehicle}, "
+                       f"{len(mission.items)} items, frame {mission.frame}, end {mission.end}",
+            "camera trigger [m]": mission.info["camera"]["trigger_distance_m"],
+            **({"GSD [cm/px]": mission.info["camera"]["gsd_cm_per_px"]}
+               if "gsd_cm_per_px" in mission.info["camera"] else {}),
+            "planning time [s]": round(cp.timings.get("total", 0.0), 3),
+            **safety_rows(safety),
+        }
+        _cover_report(outdir, cp, title=title,
+                      subtitle=f"zigzag bands over {area}, FM² at "
+                               f"{cp.level.agl:g} m above the terrain",
+                      metrics=metrics, waypoints=wps.points_m, files=list(COVER_FILES),
+                      notes=list(ground_notes(world, safety, what="the survey path").values()))
+    return mission, safety
+
+
+def cover_rows(area: str, d: float, cp, mission, world) -> dict:
+    """The printed summary of ``fm2uav cover`` (and the app's coverage rows)."""
+    return {
+        "area": area,
+        "band spacing D [m]": f"{d:.1f}",
+        "steering angle [deg]": f"{cp.zigzag.angle_deg:.3f}",
+        "bands": cp.zigzag.n_bands,
+        "zigzag cost [m]": f"{cp.zigzag.cost:.1f}",
+        "FM² path length [m]": f"{cp.plan.length:.1f}",
+        "coverage (FM² path) [%]": f"{100 * cp.coverage:.2f}",
+        "|AGL error| mean/max [m]": f"{np.abs(cp.agl_error).mean():.1f} / "
+                                    f"{np.abs(cp.agl_error).max():.1f}",
+        "camera": ", ".join(
+            f"{k} {v}" for k, v in mission.info["camera"].items()
+            if k in ("gsd_cm_per_px", "side_overlap", "front_overlap", "trigger_distance_m",
+                     "trigger_items")),
+        **mission_rows(mission),
+        "timings [ms]": ", ".join(f"{k} {v * 1e3:.0f}" for k, v in cp.timings.items()),
+        **world_rows(world),
+    }
+
+

@@ -1,0 +1,271 @@
+"""The output set of a plan: exports, report, figure and summary, written atomically.
+
+Shared by ``fm2uav plan``, ``fm2uav run``, ``fm2uav cover`` and the web app, so
+that every front end writes the same files from the same plan. Each file goes
+into an :class:`fm2uav.io.outdir.OutputDir` (renamed into place when the whole
+set is complete). Stages are reported through :mod:`fm2uav.progress`.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .. import progress
+from ..errors import InputError
+from .rows import safety_rows
+
+__all__ = ["OUTPUT_FILES", "EXPORT_FILES", "output_names", "write_exports", "plan_outputs",
+           "to_jsonable", "write_json", "write_text", "write_figure", "export_options",
+           "parse_anchor"]
+
+#: Export format → file name (:data:`fm2uav.io.exports.EXPORT_FILES`, repeated here so that
+#: importing this module loads no exporter; a test keeps both equal).
+EXPORT_FILES = {"csv": "path.csv", "geojson": "path.geojson", "kml": "path.kml",
+                "kmz": "path.kmz", "plan": "mission.plan", "wpl": "mission.waypoints"}
+#: Output format → file name, for every format a command can write.
+OUTPUT_FILES = {**EXPORT_FILES, "html": "report.html", "png": "plan.png", "json": "summary.json"}
+
+
+def to_jsonable(obj: Any) -> Any:
+    """Convert numpy scalars/arrays and paths into plain JSON types."""
+    if isinstance(obj, dict):
+        return {str(k): to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return to_jsonable(obj.tolist())
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, Path):
+        return str(obj)
+    if isinstance(obj, float) and not np.isfinite(obj):
+        return None
+    return obj
+
+
+def write_json(outdir: Any, name: str, payload: Any) -> None:
+    """Write ``payload`` (numpy values allowed) as indented JSON into the output set."""
+    with outdir.open(name) as fh:
+        json.dump(to_jsonable(payload), fh, indent=2)
+
+
+def write_text(outdir: Any, name: str, text: str) -> None:
+    """Write a text file (Markdown, CSV, HTML) into the output set."""
+    with outdir.open(name) as fh:
+        fh.write(text)
+
+
+def write_figure(outdir: Any, fig: Any, name: str, dpi: int = 110) -> None:
+    """Save a matplotlib figure as ``name`` (PNG) into the output set."""
+    tmp = outdir.target(name)
+    try:
+        fig.savefig(tmp, dpi=dpi)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    outdir.commit(tmp, name)
+
+
+def output_names(formats: Sequence[str]) -> list[str]:
+    """File names of the given output formats (for ``OutputDir.check``)."""
+    return [OUTPUT_FILES[f] for f in formats]
+
+
+@progress.stage()
+def write_exports(outdir: Any, files: dict[str, Any],
+                  step: Callable[[str], None] | None = None) -> None:
+    """Write :func:`fm2uav.io.export_mission` files into ``outdir`` (atomically each).
+
+    Each file is a :mod:`fm2uav.progress` step; ``step(message)`` is also told, if given.
+    """
+    for name, f in files.items():
+        progress.step(f"writing {name}", 1.0 / max(1, len(files)))
+        if step is not None:
+            step(f"writing {name}")
+        with outdir.open(name, mode="wb" if f.binary else "w") as fh:
+            f.write(fh)
+
+
+@progress.stage()
+def plan_outputs(
+    outdir: Any,
+    plan: Any,
+    formats: Sequence[str],
+    options: Any,
+    *,
+    title: str,
+    subtitle: str = "",
+    summary: dict[str, Any] | None = None,
+    **mission_inputs: Any,
+) -> tuple[dict[str, Any], Any]:
+    """Write the requested outputs of a plan into ``outdir`` (atomically each).
+
+    Parameters
+    ----------
+    outdir : OutputDir
+    plan : fm2uav.Plan
+    formats : sequence of str
+        Keys of :data:`OUTPUT_FILES`.
+    options : fm2uav.io.ExportOptions
+        Waypoint thinning, frame, anchor, airframe.
+    title, subtitle : str
+        Of the HTML report and PNG figure.
+    summary : dict, optional
+        Extra entries of ``summary.json``.
+    **mission_inputs
+        ``via``, ``camera``, ``fences``, ``agl`` of :func:`fm2uav.io.export_mission`.
+
+    Returns
+    -------
+    info : dict
+        The summary (plan numbers, the autopilot mission, waypoints, home, files).
+    mission : fm2uav.io.MissionExport
+        The built mission.
+    """
+    from ..analysis.known_ground import check_ground
+    from ..analysis.safety import safety_summary
+    from ..autopilot.geofence import zone_fences
+    from ..io import export_mission
+
+    exports = [f for f in formats if f in EXPORT_FILES]
+    zones = tuple(getattr(plan.world, "zones", ()))
+    fence_warnings: list[str] = []
+    if zones and "fences" not in mission_inputs:  # no-fly zones -> the .plan geoFence
+        mission_inputs["fences"], fence_warnings = zone_fences(
+            zones, plan.world, getattr(options, "anchor", None))
+    progress.step("building the mission (altitudes, waypoints, takeoff, end, firmware checks)",
+                  0.2)
+    mission, files = export_mission(plan, exports, options, **mission_inputs)
+    wps = mission.waypoints
+    progress.step("measuring the flight against the ground, the zones and the limits", 0.2)
+    level = getattr(plan, "level", None)
+    safety = safety_summary(
+        plan.world, plan.path, requested=None if level is None else level.agl,
+        phase=getattr(plan, "phase", None), waypoints=wps.points_m,
+        waypoint_indices=wps.indices, terrain_frame=wps.frame == 10, waypoint_agl=wps.agl,
+        level=level)
+    if zones:
+        safety["geofence"] = {"fences": len(mission_inputs.get("fences") or ()),
+                              "warnings": fence_warnings}
+    check_ground(plan.world, safety)  # filled ground: warned, or refused (error_on_route)
+    info = {
+        **(summary or {}),
+        **plan.summary(),
+        "autopilot": mission.summary(),
+        "waypoints": len(wps),
+        "mavlink_frame": wps.frame,
+        "home_lat_lon_alt": [round(v, 9) for v in wps.home],
+        "thin_tolerance_m": options.tolerance,
+        "safety": safety,
+    }
+    progress.step("writing the exports", 0.3)
+    write_exports(outdir, files)
+    if "html" in formats:
+        progress.step("writing report.html", 0.2)
+        write_text(outdir, "report.html", _plan_report(
+            plan, info, wps, options, formats, title=title, subtitle=subtitle, zones=zones,
+            fence_warnings=fence_warnings))
+    if "png" in formats:
+        from ..viz import plan_figure
+
+        progress.step("writing plan.png", 0.1)
+        write_figure(outdir, plan_figure(plan, title=title, ground=safety.get("ground")),
+                     "plan.png")
+    if "json" in formats:
+        write_json(outdir, "summary.json", {**info, "files": [str(p.name) for p in outdir.written]
+                                            + ["summary.json"]})
+    return info, mission
+
+
+def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
+                 formats: Sequence[str], *, title: str, subtitle: str, zones: Any,
+                 fence_warnings: list[str]) -> str:
+    """report.html of a plan and its autopilot mission's waypoints ``wps`` (see
+    :func:`plan_outputs`)."""
+    from ..analysis.known_ground import ground_notes
+    from ..viz.overlays import filled_overlay, filled_path_overlay, zone_overlays
+    from ..viz.report import report_html
+
+    ms, level = info["autopilot"], getattr(plan, "level", None)
+    params = {**plan.params, "waypoint tolerance [m]": options.tolerance,
+              "firmware / airframe": f"{ms['firmware']} / {ms['vehicle']}",
+              "MAVLink frame": {0: "0 (AMSL: DEM ground + AGL)", 3: "3 (relative to home)",
+                                10: "10 (above terrain)"}.get(wps.frame, wps.frame),
+              "mission end": ms["end"]}
+    metrics = {
+        "length [m]": round(float(plan.length), 1),
+        "clearance [m]": (round(float(plan.clearance), 2) if np.isfinite(plan.clearance)
+                          else "inf"),
+        "min W on path": round(float(np.min(plan.w)), 4),
+        "path points": len(plan.path),
+        "waypoints": len(wps),
+        "mission items": ms["items"],
+        "home (lat, lon, alt AMSL)": [round(v, 7) for v in wps.home],
+        "flight time [min]": round(ms["flight"]["flight_time_s"] / 60, 2),
+        "planning time [s]": round(float(plan.timings.get("total", 0.0)), 3),
+        **safety_rows(info["safety"]),
+        **{f"warning {k + 1}": w for k, w in enumerate(ms["warnings"] + fence_warnings)},
+    }
+    return report_html(
+        plan.world, {"FM² path": plan.path}, title=title, subtitle=subtitle,
+        speeds={"FM² path": plan.w}, waypoints={"FM² path": wps.points_m},
+        params=params, metrics=metrics, files=output_names(formats),
+        agl=None if level is None else level.agl,
+        overlays={**filled_overlay(plan.world), **filled_path_overlay(plan.world, plan.path),
+                  **zone_overlays(zones)},
+        notes=list(ground_notes(plan.world, info["safety"]).values()))
+
+
+def export_options(base: Any = None, *, firmware: str | None = None, vehicle: str | None = None,
+                   frame: str | None = None, end: str | None = None, thin: float | None = None,
+                   anchor: str | None = None, speed_changes: bool | None = None,
+                   min_speed: float | None = None, cruise_speed: float | None = None,
+                   hover_speed: float | None = None, endurance: float | None = None,
+                   reserve: float | None = None, terrain: bool | None = None,
+                   terrain_spacing: int | None = None, **more: Any) -> Any:
+    """``base`` (default ``ExportOptions()``) with the settings that were given (None =
+    not given): the command line's mission flags, the app's aircraft and mission fields.
+
+    ``thin`` is the waypoint tolerance [m], ``endurance`` in minutes, ``anchor`` the
+    ``lon,lat[,alt]`` text of ``--anchor``.
+
+    Raises
+    ------
+    InputError
+        A negative tolerance, a non-positive endurance (naming the flag).
+    """
+    from dataclasses import replace
+
+    from ..autopilot import ExportOptions
+
+    given = {"firmware": firmware, "vehicle": vehicle, "frame": frame, "end": end,
+             "tolerance": thin, "anchor": parse_anchor(anchor), "speed_changes": speed_changes,
+             "min_speed": min_speed, "cruise_speed": cruise_speed, "hover_speed": hover_speed,
+             "endurance_s": None if endurance is None else 60.0 * float(endurance),
+             "reserve": reserve, "terrain": terrain, "terrain_spacing": terrain_spacing, **more}
+    if thin is not None and not thin >= 0:
+        raise InputError(f"--thin must be a tolerance >= 0 m, got {thin}")
+    if endurance is not None and not endurance > 0:
+        raise InputError(f"--endurance must be > 0 minutes, got {endurance}")
+    return replace(base or ExportOptions(), **{k: v for k, v in given.items() if v is not None})
+
+
+def parse_anchor(text: str | None) -> Any:
+    """``"lon,lat[,alt]"`` (``--anchor``) → :class:`~fm2uav.io.Anchor` (None → None)."""
+    if text is None:
+        return None
+    from ..io import Anchor
+
+    try:
+        v = [float(x) for x in text.replace(",", " ").split()]
+    except ValueError:
+        v = []
+    if len(v) not in (2, 3):
+        raise InputError(f"--anchor must be lon,lat or lon,lat,alt (degrees, degrees, "
+                         f"metres), got {text!r}")
+    return Anchor(lon=v[0], lat=v[1], alt=v[2] if len(v) == 3 else 0.0)
