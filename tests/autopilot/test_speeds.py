@@ -79,3 +79,27 @@ def test_the_speed_type_is_the_firmwares_for_the_airframe(firmware, vehicle, kin
     assert speeds and {it.params[0] for it in speeds} == {kind}
     assert m.items.index(speeds[0]) < first_wp
     assert m.info["speed_changes"]["speed_type"] == kind
+
+
+def test_the_flight_time_is_flown_at_the_commanded_speeds():
+    """The route time of the summary is the waypoint legs at the speed each DO_CHANGE_SPEED
+    puts in force (issue 24: the estimate assumed the hover speed while 1 m/s was commanded)."""
+    m, _ = export_mission(hill_tff(), ["plan"], ExportOptions(anchor=ANCHOR, speed_changes=True,
+                                                              hover_speed=8.0))
+    fl = m.info["flight"]
+    v, legs, prev = None, [], None
+    for it in m.items:
+        if it.command == 178:
+            v = it.params[1]
+        elif it.command == 16:
+            if prev is not None:
+                legs.append((prev, it, v))
+            prev = it
+    pts = m.waypoints.points_m[1:]  # the first point is the take-off's
+    t = 0.0
+    for k, (_, _, speed) in enumerate(legs):
+        d = pts[k + 1] - pts[k]
+        t += max(float(np.hypot(d[0], d[1])) / speed,
+                 d[2] / fl["climb_rate_mps"] if d[2] > 0 else -d[2] / fl["descent_rate_mps"])
+    assert len(legs) == len(pts) - 1 and v < 8.0  # the obstacles slow it below the hover speed
+    assert fl["route_s"] == pytest.approx(t, rel=0.05)

@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from .firmware.flight_rules import turn_angles
+from .firmware.flight_rules import END_TURN_DEG, turn_angles
 from .firmware.navigation import FixedWingNav
 from .legs import LegCheck
 
@@ -40,11 +40,15 @@ def leg_needs(xy: np.ndarray, nav: FixedWingNav, speed: float | None = None,
     ``needed`` is the turn onto the leg plus the next waypoint's turn distance;
     ``gap`` is how far the aircraft still is from the leg's end waypoint when it
     reaches its start (the next waypoint is skipped if ``gap`` <= its turn distance).
-    The first leg starts straight (no turn), the last ends without one.
+    The first leg starts straight (no turn). The last waypoint is reached with the
+    turn distance of a 90° turn: ArduPlane assumes 90° where the mission has no next
+    leg to turn onto (``Plane::setup_turn_angle``: the end of the mission, an RTL).
     """
     n = len(xy)
     acc_r = np.zeros(n) if acceptance is None else np.asarray(acceptance, dtype=float)
     ang = turn_angles(xy)
+    if n >= 2:
+        ang[-1] = END_TURN_DEG
     d = np.diff(xy, axis=0)
     L = np.hypot(d[:, 0], d[:, 1])
     acc = np.array([nav.turn_distance(ang[k], speed, acc_r[k]) for k in range(n)])
@@ -148,7 +152,7 @@ def fit_turns(
     if len(idx) > 2:
         L, need, gap = leg_needs(xy, nav)
         for k in range(1, len(idx) - 1):
-            if (gap[k] <= 1e-6 or L[k] < need[k] - 1e-6) and k + 1 < len(idx) - 1:
+            if gap[k] <= 1e-6 or L[k] < need[k] - 1e-6:
                 # a leg between waypoints that must stay is too short to turn onto (or
                 # the aircraft reaches k+1 by radius before it turns onto it): shrink both
                 r = max(MIN_ACCEPTANCE, min(255.0, np.floor(L[k] / 3.0)))

@@ -70,7 +70,7 @@ from .navigation import AirframeNav, FixedWingNav, SpeedCommand
 from .profile import Problem
 
 __all__ = ["speed_rules", "fixed_wing_rules", "local_xy", "item_amsl", "turn_angles",
-           "leg_speeds"]
+           "END_TURN_DEG", "leg_speeds"]
 
 _EARTH = 6371008.8
 #: A waypoint ahead of the take-off course: within this angle of it [deg].
@@ -96,6 +96,12 @@ def local_xy(items: Sequence[MissionItem], lat0: float, lon0: float) -> np.ndarr
     x = (lon - math.radians(lon0)) * math.cos(math.radians(lat0)) * _EARTH
     y = (lat - math.radians(lat0)) * _EARTH
     return np.column_stack([x, y])
+
+
+#: The turn ArduPlane assumes at a waypoint with no next leg (the mission's last position
+#: item, or one followed by an RTL): ``Plane::setup_turn_angle`` ("the mission library
+#: can't determine a turn angle, assume 90 degrees") [deg].
+END_TURN_DEG = 90.0
 
 
 def turn_angles(xy: np.ndarray) -> np.ndarray:
@@ -280,6 +286,7 @@ def _legs(items: Sequence[MissionItem], nav_idx: Sequence[int], xy: np.ndarray,
     """Waypoint after waypoint: skipped waypoints (error) and overshoots (warning)."""
     out: list[Problem] = []
     ang = turn_angles(xy)
+    ang[-1] = END_TURN_DEG  # no next leg: the firmware assumes a 90° turn
     for k in range(1, len(nav_idx) - 1):
         i, j = nav_idx[k], nav_idx[k + 1]
         a, b = items[i], items[j]
