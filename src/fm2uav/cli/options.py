@@ -448,7 +448,7 @@ def _mission_params() -> dict[str, Any]:
 #: The mission flags of ``plan``/``formation`` (in their ``--help`` order).
 MISSION_FLAGS = ("via", "return_to_start", "firmware", "vehicle", "frame", "end",
                  "speed_changes", "min_speed", "cruise_speed", "hover_speed", "endurance",
-                 "reserve")
+                 "reserve", "terrain", "terrain_spacing")
 
 
 def _mission_flags(via: list[str] | None = None, return_to_start: bool | None = None,
