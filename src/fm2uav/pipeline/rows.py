@@ -40,9 +40,15 @@ def mission_rows(mission: Any) -> dict[str, str]:
             f"m, then {how}")
     t = s.get("terrain")
     if t:
+        beyond = t.get("nodes_beyond_dem", 0)
+        edge = (f"; {100 * beyond / t['nodes']:.0f} % of the nodes lie beyond the DEM (its "
+                "edge heights, not measured)" if beyond and t.get("nodes") else "")
+        if t.get("nodes_over_filled_ground"):
+            edge += (f"; {t['nodes_over_filled_ground']} nodes over FILLED ground (heights "
+                     "invented)")
         rows["terrain files"] = (f"{', '.join('terrain/' + f for f in t['files'])} "
                                  f"({t['blocks']} blocks, {t['spacing_m']} m): {t['load']}; "
-                                 f"{t['without']}")
+                                 f"{t['without']}{edge}")
     for k, w in enumerate(s["warnings"]):
         rows[f"warning {k + 1}"] = w
     return rows
