@@ -64,7 +64,23 @@ def test_a_terrain_following_plan_is_slowed_by_its_obstacles_not_its_flight_leve
     idx = m.waypoints.indices
     legs = 1.0 + np.array([share[a:b + 1].min() for a, b in zip(idx[:-1], idx[1:])]) * 7.0
     first = next(it for it in m.items if it.command == 178)
-    assert first.params[1] == np.floor(legs[0])  # quantised down to the 1 m/s step
+    assert first.params[1] == np.floor(legs[0] + 1e-9)  # quantised down to the 1 m/s step
+
+
+def test_the_flight_level_a_plan_keeps_is_open_sky_full_speed():
+    """The speed share of a terrain-following plan: the distance to the nearest obstacle
+    over the flight level's AGL (saturated at 1), computed here with scipy's exact
+    distance transform on the occupancy grid."""
+    from scipy import ndimage
+
+    p = hill_tff()
+    occ = p.world.occupancy
+    d = ndimage.distance_transform_edt(~occ, sampling=p.world.spacing)
+    at = ndimage.map_coordinates(d, p.world.to_index(p.path).T, order=1, mode="nearest")
+    expect = np.minimum(at / p.level.agl, 1.0)
+    # (the map is saturated on the grid, then interpolated: up to a few % apart near d = agl)
+    np.testing.assert_allclose(p.speed_share(), expect, atol=0.05)
+    assert np.mean(p.speed_share() >= 0.99) > 0.3  # most of the cruise is at full speed
 
 
 @pytest.mark.parametrize("firmware, vehicle, kind", [

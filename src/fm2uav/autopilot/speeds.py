@@ -15,7 +15,9 @@ flight-time estimate assumed. The speeds:
   speed the user chose. W is the **obstacle-distance** map along the path
   (:meth:`fm2uav.planning.Plan.speed_share`): the flight-level shaping of a
   terrain-following plan (p1/p2) keeps the path on its level and says nothing about
-  speed (taking it for a speed commanded 1 m/s for a whole route, issue 24). Speeds
+  speed (taking it for a speed commanded 1 m/s for a whole route, issue 24), and the
+  obstacle distances saturate at the flight level's AGL (the height the plan keeps is
+  open sky: the forward speed). Speeds
   are quantised down to ``speed_step`` with a hysteresis (:func:`speed_commands`);
 * **timed** trajectories (formations): the mean speed of each leg keeps the
   timing, holds where the vehicle waits;
