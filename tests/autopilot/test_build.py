@@ -50,6 +50,7 @@ def _opts(**kw) -> ExportOptions:
 
 def _write(files, tmp_path):
     for name, f in files.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)  # terrain/*.DAT
         with open(tmp_path / name, "wb" if f.binary else "w") as fh:
             f.write(fh)
 
@@ -237,6 +238,8 @@ def test_speed_commands_quantise_down_slow_at_once_and_speed_up_with_hysteresis(
 
 
 def test_speed_items_follow_w_and_never_exceed_it():
+    """The speeds map the obstacle-distance W onto the airframe's range, floor + W (cap -
+    floor), quantised down: never above what a leg allows, never below the floor."""
     p = hill_tff()
     opts = _opts(speed_changes=True, hover_speed=12.0)
     m, _ = export_mission(p, ["plan"], opts)
@@ -245,14 +248,15 @@ def test_speed_items_follow_w_and_never_exceed_it():
     changes = [it for it in m.items if it.command == 178]
     assert 1 <= len(changes) <= legs
     assert {it.params[0] for it in changes} == {1.0}  # ground speed (multirotor)
+    share = p.speed_share()
     current, k = None, 0
     for it in m.items:  # the speed in force when a waypoint is reached is its leg's
         if it.command == 178:
             current = it.params[1]
         elif it.command == 16:
             k += 1
-            admissible = max(float(p.w[idx[k - 1]:idx[k] + 1].min()) * 12.0, 1.0)
-            assert current <= admissible + 1e-9
+            admissible = 1.0 + float(share[idx[k - 1]:idx[k] + 1].min()) * (12.0 - 1.0)
+            assert 1.0 <= current <= admissible + 1e-9
 
 
 def test_fixed_wing_speed_changes_need_a_minimum_speed():
@@ -545,7 +549,8 @@ def test_export_refuses_a_start_on_the_ground():
 
 
 def test_written_plans_read_back_item_for_item(tmp_path):
-    m, files = export_mission(hill_tff(), ["plan"], _opts(vehicle="vtol", speed_changes=True))
+    m, files = export_mission(hill_tff(), ["plan"], _opts(vehicle="vtol", speed_changes=True,
+                                                          min_speed=9.0))
     _write(files, tmp_path)
     back = read_plan(tmp_path / "mission.plan")
     assert [it.command for it in back["items"]] == [it.command for it in m.items]

@@ -29,6 +29,7 @@ from ..autopilot.mission_cases import ANCHOR, hill_free, hill_tff
 def _write_all(plan, tmp_path, **opts):
     mission, files = export_mission(plan, list(EXPORT_FILES), ExportOptions(anchor=ANCHOR, **opts))
     for name, f in files.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)  # terrain/*.DAT
         with open(tmp_path / name, "wb" if f.binary else "w") as fh:
             f.write(fh)
     return mission
@@ -117,7 +118,8 @@ def test_terrain_plan_uses_terrain_altitude_mode():
         (lambda d: d["mission"].update(items=[]), "at least one item"),
         (lambda d: d["mission"]["items"][0].update(autoContinue=1), "autoContinue: expected bool"),
         (lambda d: d["mission"]["items"][0]["params"].pop(), "7 values"),
-        (lambda d: d["mission"]["items"][1]["params"].__setitem__(4, 123.0), "valid latitude"),
+        (lambda d: next(it for it in d["mission"]["items"] if it["command"] == 16)["params"]
+         .__setitem__(4, 123.0), "valid latitude"),
         (lambda d: d["mission"]["items"][1].update(type="Mystery"), "'SimpleItem' or 'ComplexItem'"),
         (lambda d: d["mission"]["items"][1].update(type="ComplexItem"), "complexItemType"),
         (lambda d: d["mission"].update(plannedHomePosition=[1, 2]), "[lat, lon, alt]"),

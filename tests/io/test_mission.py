@@ -328,7 +328,10 @@ def test_export_converts_an_existing_path_for_another_firmware(examples, tmp_pat
     s = json.loads(res.output)["autopilot"]
     assert (s["firmware"], s["frame"]["name"], s["end"]) == ("ardupilot", "terrain", "rtl")
     assert {p.name for p in conv.iterdir()} == {"mission.plan", "mission.waypoints", "path.kmz",
-                                                "summary.json"}
+                                                "summary.json", "terrain"}
+    # a terrain-frame ArduPilot mission comes with the vehicle's terrain (issue 24)
+    assert {p.suffix for p in (conv / "terrain").iterdir()} == {".DAT", ".param"}
+    assert s["terrain"]["files"] and "TERRAIN_SPACING" in s["terrain"]["load"]
     a, b = read_plan(out / "mission.plan"), read_plan(conv / "mission.plan")
     wa, wb = a["command"] == 16, b["command"] == 16
     assert set(a["frame"][wa]) == {0} and set(b["frame"][wb]) == {10}

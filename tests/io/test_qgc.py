@@ -25,7 +25,9 @@ def test_a_qgc_survey_plan_is_read_with_its_transect_items():
     assert r["home"] == pytest.approx((47.3977419, 8.545594, 487.989))
     assert isinstance(r["fences"][0], FenceCircle) and r["fences"][0].inclusion
     assert len(r["rally"]) == 2
-    assert validate_mission(r["items"], "px4", home_alt=r["home"][2]) == []
+    problems = validate_mission(r["items"], "px4", home_alt=r["home"][2])
+    # QGC's survey commands no speed: PX4 flies MPC_XY_CRUISE (a warning, not a rejection)
+    assert [(p.code, p.severity) for p in problems] == [("no-cruise-speed", "warning")]
 
 
 def test_complex_items_without_stored_items_are_refused_by_name(tmp_path):

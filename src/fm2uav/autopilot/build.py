@@ -47,22 +47,25 @@ from .items import (
     CMD_DO_LAND_START,
     CMD_DO_SET_CAM_TRIGG_DIST,
     CMD_NAV_LAND,
-    CMD_NAV_LOITER_TO_ALT,
     CMD_NAV_LOITER_UNLIM,
     CMD_NAV_RETURN_TO_LAUNCH,
     CMD_NAV_TAKEOFF,
     CMD_NAV_VTOL_LAND,
     CMD_NAV_VTOL_TAKEOFF,
     CMD_NAV_WAYPOINT,
-    FRAME_GLOBAL,
     FRAME_RELATIVE,
     FRAME_TERRAIN,
     MissionItem,
 )
+from .climbout import ClimbOut, plan_climb_out
 from .firmware import FIRMWARES, PROFILES, VEHICLES
 from .returns import rtl_end_notes
+from .firmware.navigation import AirframeNav, FixedWingNav
+from .landing import landing_pattern, loiter_radius
+from .placing import ItemPlacer, unit_xy
+from .speeds import Speeds, plan_speeds, speed_commands
 from .validate import check_mission
-from .waypoints import FRAMES, Waypoints, ground_at, mission_waypoints, resolve_frame
+from .waypoints import FRAMES, Waypoints, mission_waypoints, resolve_frame
 
 __all__ = [
     "ENDS",
@@ -82,9 +85,6 @@ ENDS = ("auto", "rtl", "land", "loiter")
 #: and VTOL = TECS_CLMB_MAX / TECS_SINK_MAX (ArduPlane) and FW_T_CLMB_MAX /
 #: FW_T_SINK_MAX (PX4), both 5 m/s by default.
 DEFAULT_CLIMB = {"multirotor": 2.5, "fixed_wing": 5.0, "vtol": 2.5}
-#: Lowest commanded speed of multirotors and VTOL without ``min_speed`` [m/s] (never 0:
-#: a 0 m/s DO_CHANGE_SPEED would stop the vehicle on its leg).
-DEFAULT_MIN_SPEED = 1.0
 DEFAULT_DESCENT = {"multirotor": 1.5, "fixed_wing": 5.0, "vtol": 1.5}
 
 
@@ -126,8 +126,21 @@ class ExportOptions:
         Speed up only when the leg allows this many steps more (slowing down is
         immediate). Default 2.
     min_speed : float or None
-        Lowest commanded speed [m/s]: multirotors default to 1 m/s, fixed-wing
-        speed changes need it (a margin above the stall speed).
+        Lowest commanded speed [m/s]: multirotors default to 1 m/s, fixed-wing and
+        VTOL speed changes need it (a margin above the stall speed); a fixed-wing's
+        ``AIRSPEED_MIN`` (ArduPlane ignores a ``DO_CHANGE_SPEED`` below it).
+    max_speed : float or None
+        A fixed-wing's highest airspeed [m/s] (``AIRSPEED_MAX``; None: the firmware's
+        default, raised to the cruise speed).
+    max_bank : float or None
+        A fixed-wing's bank limit [deg] (``ROLL_LIMIT_DEG``; None: the firmware's
+        default): sets the turn radius the waypoints and loiters are fitted to.
+    terrain : bool or None
+        Write ArduPilot's terrain files (``terrain/*.DAT``) beside the mission;
+        None: with every terrain-frame mission (``outputs.terrain`` / ``--terrain``).
+    terrain_spacing : int or None
+        Their grid spacing [m] (``TERRAIN_SPACING``; None: the planner's DEM
+        resolution within [30, 100] m, :func:`fm2uav.autopilot.terrain_grid.default_spacing`).
     loiter_radius : float
         Radius of fixed-wing loiters and of the landing pattern's loiter [m]
         (PX4 NAV_LOITER_RAD default 80 m).
@@ -164,6 +177,10 @@ class ExportOptions:
     speed_step: float = 1.0
     speed_hysteresis: int = 2
     min_speed: float | None = None
+    max_speed: float | None = None
+    max_bank: float | None = None
+    terrain: bool | None = None
+    terrain_spacing: int | None = None
     loiter_radius: float = 80.0
     land_approach_agl: float = 40.0
     land_slope_deg: float = 4.0
@@ -197,7 +214,8 @@ class ExportOptions:
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
                 raise InputError(f"export option {name} must be a number >= 0, got {v!r}")
-        for name in ("min_speed", "climb_rate", "descent_rate", "endurance_s"):
+        for name in ("min_speed", "max_speed", "max_bank", "climb_rate", "descent_rate",
+                     "endurance_s"):
             v = getattr(self, name)
             if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
                 raise InputError(f"export option {name} must be a number > 0, got {v!r}")
@@ -211,6 +229,22 @@ class ExportOptions:
                 f"airframe.{key} = {self.forward_speed:g} m/s ({flag}), the speed this "
                 f"{self.vehicle.replace('_', '-')} flies the mission at: no commanded speed "
                 f"may be below the one or above the other; allowed: min_speed <= {key}")
+        if self.terrain_spacing is not None and not (
+                float(self.terrain_spacing) == int(self.terrain_spacing)
+                and 5 <= self.terrain_spacing <= 1000):
+            raise InputError(f"terrain_spacing must be a whole number of metres in [5, 1000], "
+                             f"got {self.terrain_spacing!r} (outputs.terrain_spacing / "
+                             "--terrain-spacing)")
+        if self.max_bank is not None and not 5.0 <= self.max_bank <= 85.0:
+            raise InputError(f"max_bank must be in [5, 85] degrees, got {self.max_bank!r} "
+                             "(airframe.max_bank)")
+        lo, hi = self.min_speed, self.max_speed
+        if lo is not None and hi is not None and lo > hi:
+            raise InputError(f"min_speed {lo:g} m/s is above max_speed {hi:g} m/s "
+                             "(airframe.min_speed / max_speed)")
+        if self.vehicle != "multirotor" and hi is not None and self.cruise_speed > hi:
+            raise InputError(f"cruise_speed {self.cruise_speed:g} m/s is above max_speed "
+                             f"{hi:g} m/s (airframe.cruise_speed / max_speed)")
         if not 0 < self.land_slope_deg <= self.max_land_slope_deg:
             raise InputError(f"land_slope_deg must be in (0, {self.max_land_slope_deg:g}] "
                              f"(FW_LND_ANG), got {self.land_slope_deg!r}")
@@ -219,6 +253,12 @@ class ExportOptions:
     def forward_speed(self) -> float:
         """The airframe's mission speed [m/s]: hover speed (multirotor) or cruise speed."""
         return self.hover_speed if self.vehicle == "multirotor" else self.cruise_speed
+
+    def airframe_nav(self) -> AirframeNav:
+        """The airframe's numbers a fixed-wing firmware's defaults are overlaid with."""
+        return AirframeNav(cruise=self.cruise_speed, minimum=self.min_speed,
+                           maximum=self.max_speed, bank_deg=self.max_bank,
+                           climb_rate=self.climb_rate, sink_rate=self.descent_rate)
 
 
 @dataclass(frozen=True, eq=False)
@@ -298,145 +338,6 @@ class MissionExport:
         }
 
 
-# ---------------------------------------------------------------- speeds
-def speed_commands(leg_speeds: Any, *, current: float | None, step: float, hysteresis: int,
-                   floor: float, cap: float, rounding: str = "down") -> list[tuple[int, float]]:
-    """Where to change speed and to what: ``[(leg index, speed m/s), ...]``.
-
-    Each leg's admissible speed is quantised down to a multiple of ``step``
-    (never above what the leg allows), clipped to ``[floor, cap]``. The first
-    leg always gets a command; later legs get one when the quantised speed is
-    below the current command (slow down at once) or at least ``hysteresis``
-    steps above it (speed up only for a clear gain), so noise in W does not
-    produce a stream of items. ``rounding="nearest"`` (timed trajectories)
-    rounds to the nearest step instead of down.
-    """
-    v = np.asarray(leg_speeds, dtype=float)
-    out: list[tuple[int, float]] = []
-    c = current
-    for k, s in enumerate(v):
-        n = math.floor(s / step + 1e-9) if rounding == "down" else round(s / step)
-        q = min(max(n * step, floor), cap)
-        if c is None or q < c - 1e-9 or q >= c + hysteresis * step - 1e-9:
-            out.append((k, round(q, 6)))
-            c = q
-    return out
-
-
-def _leg_speeds(w_dense: np.ndarray, idx: np.ndarray, vmax: float, floor: float) -> np.ndarray:
-    """Slowest admissible speed W x vmax over the dense points of each leg [m/s]."""
-    v = np.maximum(np.clip(w_dense, 0.0, 1.0) * vmax, floor)
-    return np.array([v[a:b + 1].min() for a, b in zip(idx[:-1], idx[1:])])
-
-
-def _timed_legs(times: np.ndarray, points: np.ndarray, idx: np.ndarray, floor: float
-                ) -> tuple[np.ndarray, np.ndarray]:
-    """Speed on each straight leg between waypoints that keeps a timed trajectory's
-    timing, and the hold time at each waypoint where it waits [m/s], [s]."""
-    d = np.diff(points, axis=0)
-    lengths = np.hypot(d[:, 0], d[:, 1])
-    dt = times[idx[1:]] - times[idx[:-1]]
-    if np.any(dt <= 0):
-        raise InputError("the trajectory's times must increase from waypoint to waypoint")
-    holds = np.zeros(len(idx))
-    speeds = lengths / dt
-    slow = speeds < floor  # fly at the floor speed and wait the rest at the leg's start
-    holds[:-1][slow] = dt[slow] - lengths[slow] / floor
-    speeds[slow] = floor
-    return speeds, holds
-
-
-# ---------------------------------------------------------------- geometry
-def _unit_xy(points: np.ndarray, from_end: bool) -> np.ndarray:
-    """Unit horizontal direction of arrival at the end (or of departure from the start),
-    measured to the nearest waypoint more than 1 m away."""
-    ref = points[-1] if from_end else points[0]
-    seq = points[-2::-1] if from_end else points[1:]
-    for q in seq:
-        d = (ref - q)[:2] if from_end else (q - ref)[:2]
-        n = float(np.hypot(d[0], d[1]))
-        if n > 1.0:
-            return d / n
-    return np.array([1.0, 0.0])
-
-
-def _inside_xy(world: Any, xy: np.ndarray) -> np.ndarray:
-    b = world.bounds
-    return ((xy[:, 0] >= b[0, 0]) & (xy[:, 0] <= b[0, 1]) & (xy[:, 1] >= b[1, 0])
-            & (xy[:, 1] <= b[1, 1]))
-
-
-class _Geo:
-    """World metres → items, in the mission's altitude frame."""
-
-    def __init__(self, world: Any, anchor: Anchor | None, wps: Waypoints) -> None:
-        self.world, self.anchor, self.wps = world, anchor, wps
-        self.home_amsl = wps.home[2]
-
-    def ground(self, xy: np.ndarray) -> np.ndarray:
-        return ground_at(self.world, xy)
-
-    def item(self, command: int, frame: int, xy: np.ndarray, z_world: float, *,
-             label: str, **params: float) -> MissionItem:
-        """A position item at world ``xy`` and flown altitude ``z_world`` [m]."""
-        lo, la, amsl = to_lonlat(self.world, [[xy[0], xy[1], z_world]], anchor=self.anchor)[0]
-        g = float(self.ground(xy)[0])
-        agl = z_world - g
-        alt = {FRAME_GLOBAL: amsl, FRAME_RELATIVE: amsl - self.home_amsl,
-               FRAME_TERRAIN: agl}[frame]
-        return MissionItem.at(command, frame, float(la), float(lo), float(alt), agl=float(agl),
-                              alt_amsl=float(amsl), label=label, **params)
-
-
-def _landing_pattern(geo: _Geo, touchdown: np.ndarray, heading: np.ndarray, frame: int,
-                     opt: ExportOptions, label: str) -> tuple[list[MissionItem], dict, list[str]]:
-    """DO_LAND_START + NAV_LOITER_TO_ALT + NAV_LAND, approach along ``heading``.
-
-    The loiter centre sits behind the touchdown along ``heading`` so that the
-    tangent from its circle to the touchdown is ``approach_agl / tan(slope)``
-    long; its altitude is ``approach_agl`` above the touchdown's ground.
-    """
-    r = float(opt.loiter_radius)
-    h = float(opt.land_approach_agl)
-    run = h / math.tan(math.radians(opt.land_slope_deg))
-    d = math.hypot(run, r)
-    centre = touchdown - heading * d
-    g_td = float(geo.ground(touchdown)[0])
-    f = FRAME_RELATIVE if frame == FRAME_TERRAIN else frame  # altitudes above the touchdown
-    items = [
-        MissionItem.do(CMD_DO_LAND_START, label=f"{label}: landing start"),
-        geo.item(CMD_NAV_LOITER_TO_ALT, f, centre, g_td + h, label=f"{label}: approach loiter",
-                 p1=1.0, p2=r, p4=0.0),
-        geo.item(CMD_NAV_LAND, f, touchdown, g_td, label=f"{label}: touchdown"),
-    ]
-    warnings: list[str] = []
-    s = np.linspace(0.0, run, 64)
-    line = touchdown[None, :] - heading[None, :] * s[:, None]
-    phi = np.linspace(0.0, 2 * math.pi, 72, endpoint=False)
-    circle = centre[None, :] + r * np.column_stack([np.cos(phi), np.sin(phi)])
-    pts = np.vstack([line, circle])
-    info: dict[str, Any] = {"touchdown_alt_amsl_m": round(items[2].alt_amsl or 0.0, 2),
-                            "approach_agl_m": h, "glide_slope_deg": opt.land_slope_deg,
-                            "approach_run_m": round(run, 1), "loiter_radius_m": r}
-    inside = _inside_xy(geo.world, pts)
-    if not inside.all():
-        warnings.append(f"{label}: the landing approach ({d:.0f} m back from the touchdown, "
-                        f"{r:.0f} m loiter) leaves the map: its terrain is not checked")
-    if inside.any():
-        glide = np.concatenate([g_td + s * math.tan(math.radians(opt.land_slope_deg)),
-                                np.full(len(circle), g_td + h)])
-        clear = glide - geo.ground(pts)
-        check = inside & (glide - g_td >= 10.0)
-        if check.any():
-            worst = float(clear[check].min())
-            info["approach_min_clearance_m"] = round(worst, 1)
-            if worst < 10.0:
-                warnings.append(f"{label}: the landing approach passes only {worst:.1f} m above "
-                                "the ground (DEM): check the landing site, or change "
-                                "land_approach_agl / land_slope_deg")
-    return items, info, warnings
-
-
 # ---------------------------------------------------------------- building
 _Event = tuple[str, float, str]  # (kind, value, label) at a dense-path index
 
@@ -475,68 +376,23 @@ def _events(p: np.ndarray, via: Any, camera: CameraPlan | None, times: Any
     return keep, via_idx
 
 
-@dataclass(frozen=True)
-class _Speeds:
-    commanded: np.ndarray  # speed in force on each leg [m/s]
-    changes: list[tuple[int, float]]  # DO_CHANGE_SPEED (leg index, m/s)
-    holds: np.ndarray  # hold time at each waypoint [s]
-    timing: dict[str, Any] | None
-
-
-def _speeds(opt: ExportOptions, wps: Waypoints, w: Any, times: Any,
-            start_hold: float) -> _Speeds:
-    """Commanded speed of each leg (W-based or timed) and the speed items."""
-    idx = wps.indices
-    vmax = opt.forward_speed
-    floor = opt.min_speed if opt.min_speed is not None else (
-        min(DEFAULT_MIN_SPEED, vmax) if opt.vehicle != "fixed_wing" else None)
-    holds = np.zeros(len(idx))
-    changes: list[tuple[int, float]] = []
-    timing = None
-    if times is not None:
-        t = np.asarray(times, dtype=float)
-        lo = floor or 0.5
-        leg_v, holds = _timed_legs(t, wps.points_m, idx, lo)
-        holds[0] += float(start_hold)
-        changes = speed_commands(leg_v, current=None, step=opt.speed_step, hysteresis=0,
-                                 floor=lo, cap=float(max(leg_v.max(), lo)), rounding="nearest")
-        timing = {"planned_s": round(float(t[-1] - t[0]), 2),
-                  "start_hold_s": round(float(start_hold), 2)}
-    elif opt.speed_changes:
-        if floor is None:
-            raise MissionError("fixed-wing speed changes need airframe.min_speed (a margin "
-                               "above the stall speed; CLI --min-speed) so that no commanded "
-                               "airspeed falls below it")
-        if w is None:
-            raise MissionError("speed changes need W along the path (the plan's speed profile)")
-        wd = np.asarray(w, dtype=float)
-        if wd.shape != (idx[-1] + 1,):
-            raise InputError(f"W along the path must have {idx[-1] + 1} values, got {wd.shape}")
-        leg_v = _leg_speeds(wd, idx, vmax, floor)
-        changes = speed_commands(leg_v, current=None, step=opt.speed_step,
-                                 hysteresis=opt.speed_hysteresis, floor=floor, cap=vmax)
-    commanded = np.full(len(idx) - 1, vmax)
-    for k, v in changes:
-        commanded[k:] = v
-    return _Speeds(commanded, changes, holds, timing)
-
-
-def _takeoff(geo: _Geo, wps: Waypoints, opt: ExportOptions) -> MissionItem:
-    """The takeoff item to the start's altitude (frame 3 instead of 10, issue #20142)."""
+def _takeoff(geo: ItemPlacer, wps: Waypoints, opt: ExportOptions, nav: FixedWingNav | None,
+             first_forced: int) -> ClimbOut:
+    """The items up to the route: a takeoff to the start's altitude at the start (frame 3
+    instead of 10, ArduPilot issue #20142), a fixed-wing's climb-out
+    (:func:`fm2uav.autopilot.climbout.plan_climb_out`)."""
     frame = FRAME_RELATIVE if wps.frame == FRAME_TERRAIN else wps.frame
     start_xy, start_z = wps.points_m[0, :2], float(wps.points_m[0, 2])
     if wps.agl[0] < 0.5:
         raise MissionError(f"the start is {wps.agl[0]:.2f} m above the ground: a takeoff needs "
                            "a start above it (give start with agl, e.g. {x, y, agl: 30})")
-    if opt.vehicle == "vtol":
-        return geo.item(CMD_NAV_VTOL_TAKEOFF, frame, start_xy, start_z, label="takeoff")
-    if opt.vehicle == "fixed_wing":  # the item's position gives the climb-out course
-        leg = wps.points_m[1, :2] - start_xy
-        n = max(float(np.hypot(*leg)), 1e-9)
-        target = start_xy + leg / n * min(200.0, 0.5 * n)
-        return geo.item(CMD_NAV_TAKEOFF, frame, target, start_z,
-                        label="takeoff (climb-out course)", p1=15.0)
-    return geo.item(CMD_NAV_TAKEOFF, frame, start_xy, start_z, label="takeoff")
+    if opt.vehicle == "fixed_wing" and nav is not None:
+        return plan_climb_out(geo, wps, nav, first_forced=first_forced, tolerance=opt.tolerance)
+    cmd = CMD_NAV_VTOL_TAKEOFF if opt.vehicle == "vtol" else CMD_NAV_TAKEOFF
+    climb = opt.climb_rate or DEFAULT_CLIMB[opt.vehicle]
+    item = geo.item(cmd, frame, start_xy, start_z, label="takeoff")
+    return ClimbOut([item], 1, {"mode": "vertical", "takeoff_alt_m": round(float(wps.agl[0]), 1)},
+                    float(wps.agl[0]) / climb)
 
 
 def _do_items(events: list[_Event], change: float | None, speed_type: float
@@ -556,23 +412,27 @@ def _do_items(events: list[_Event], change: float | None, speed_type: float
     return out
 
 
-def _route(wps: Waypoints, keep: dict[int, list[_Event]], sp: _Speeds,
-           opt: ExportOptions) -> list[MissionItem]:
-    """The waypoints after the takeoff, with their hold times and DO items."""
+def _route(wps: Waypoints, keep: dict[int, list[_Event]], sp: Speeds, first: int,
+           speed_type: int) -> list[MissionItem]:
+    """The waypoints from ``first`` on (the climb-out replaced the ones before), with their
+    hold times, acceptance radii and DO items; the speed of the first flown leg before them."""
     idx = wps.indices
     change_at = dict(sp.changes)
-    speed_type = 1.0 if opt.vehicle == "multirotor" else 0.0
+    acc = wps.acceptance if wps.acceptance is not None else np.zeros(len(wps))
 
     def waypoint(k: int, label: str) -> MissionItem:
         return MissionItem(CMD_NAV_WAYPOINT, wps.frame,
-                           (float(sp.holds[k]), 0.0, 0.0, math.nan, float(wps.lat[k]),
+                           (float(sp.holds[k]), float(acc[k]), 0.0, math.nan, float(wps.lat[k]),
                             float(wps.lon[k]), float(wps.alt[k])),
                            agl=float(wps.agl[k]), alt_amsl=float(wps.alt_amsl[k]), label=label)
 
-    items = [waypoint(0, "start (hold)")] if sp.holds[0] > 0 else []
-    items += _do_items(keep.get(int(idx[0]), []), change_at.get(0), speed_type)
+    items = [waypoint(0, "start (hold)")] if sp.holds[0] > 0 and first == 1 else []
+    # the speed in force on the first leg flown, commanded before its waypoint
+    initial = float(sp.commanded[first - 1]) if len(sp.commanded) else None
+    events = [e for j in range(first) for e in keep.get(int(idx[j]), [])]
+    items += _do_items(events, initial, speed_type)
     last = len(wps) - 1
-    for k in range(1, last + 1):
+    for k in range(first, last + 1):
         vias = [lab for kind, _, lab in keep.get(int(idx[k]), []) if kind == "via"]
         items.append(waypoint(k, ", ".join(vias) or f"waypoint {k}"))
         events = keep.get(int(idx[k]), [])
@@ -582,7 +442,7 @@ def _route(wps: Waypoints, keep: dict[int, list[_Event]], sp: _Speeds,
     return items
 
 
-def _end(geo: _Geo, wps: Waypoints, opt: ExportOptions
+def _end(geo: ItemPlacer, wps: Waypoints, opt: ExportOptions, nav: FixedWingNav | None = None
          ) -> tuple[str, list[MissionItem], dict[str, Any], list[str]]:
     """(resolved end, items, landing figures, warnings)."""
     end = opt.end if opt.end != "auto" else ("rtl" if opt.vehicle == "fixed_wing" else "land")
@@ -596,9 +456,11 @@ def _end(geo: _Geo, wps: Waypoints, opt: ExportOptions
         items.append(MissionItem.do(CMD_NAV_RETURN_TO_LAUNCH, label="return to launch"))
         must_land = opt.vehicle in PROFILES[opt.firmware].landing_required
         if must_land and opt.vehicle == "fixed_wing":
-            heading = -_unit_xy(wps.points_m, from_end=False)
-            pattern, landing, warnings = _landing_pattern(geo, start_xy, heading, f_route, opt,
-                                                          "home landing")
+            heading = -unit_xy(wps.points_m, from_end=False)
+            pattern, landing, warnings = landing_pattern(
+                geo, start_xy, heading, f_route, radius=opt.loiter_radius,
+                approach_agl=opt.land_approach_agl, slope_deg=opt.land_slope_deg, nav=nav,
+                label="home landing")
             items += pattern
         elif must_land and opt.vehicle == "vtol":
             items.append(MissionItem.do(CMD_DO_LAND_START, label="home landing start"))
@@ -610,14 +472,17 @@ def _end(geo: _Geo, wps: Waypoints, opt: ExportOptions
         landing.update(notes)
         warnings += more
     elif end == "land" and opt.vehicle == "fixed_wing":
-        heading = _unit_xy(wps.points_m, from_end=True)
-        items, landing, warnings = _landing_pattern(geo, end_xy, heading, f_route, opt, "landing")
+        heading = unit_xy(wps.points_m, from_end=True)
+        items, landing, warnings = landing_pattern(
+            geo, end_xy, heading, f_route, radius=opt.loiter_radius,
+            approach_agl=opt.land_approach_agl, slope_deg=opt.land_slope_deg, nav=nav,
+            label="landing")
     elif end == "land":
         cmd = CMD_NAV_VTOL_LAND if opt.vehicle == "vtol" else CMD_NAV_LAND
         items.append(geo.item(cmd, f_route, end_xy, float(geo.ground(end_xy)[0]),
                               label="landing"))
     else:  # loiter
-        radius = 0.0 if opt.vehicle == "multirotor" else float(opt.loiter_radius)
+        radius = 0.0 if opt.vehicle == "multirotor" else loiter_radius(opt.loiter_radius, nav)
         items.append(geo.item(CMD_NAV_LOITER_UNLIM, f_route, end_xy, end_z,
                               label="loiter at the end", p3=radius))
     return end, items, landing, warnings
@@ -638,22 +503,53 @@ def start_holds(starts: Any, world: Any, options: ExportOptions) -> np.ndarray:
     return float(climb_s.max()) - climb_s
 
 
-def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: _Speeds, start_hold: float,
+def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: Speeds, start_hold: float,
+            climb_out: ClimbOut, items: list[MissionItem], nav: FixedWingNav | None,
             world: Any = None) -> tuple[dict[str, Any], str | None]:
     """Flight time / endurance figures (and the endurance warning, with the point where the
-    reserve is reached). Without ``opt.endurance_s`` the airframe type's default endurance
-    is checked (:func:`fm2uav.vehicles.airframes.default_endurance`)."""
+    reserve is reached).
+
+    Multirotors and VTOL: the take-off climb at the vertical speed, the legs at the
+    commanded speeds (a multirotor waits for its altitude: climbs and descents at the
+    vertical speed limits), the final descent
+    (:func:`fm2uav.vehicles.endurance.flight_time`). Fixed-wing: the climb-out's own
+    time (take-off climb, loiter climb; :mod:`fm2uav.autopilot.climbout`), then every
+    leg at its commanded airspeed (a plane does not wait for its altitude), and the
+    landing pattern (to the loiter, the descent in it at the sink limit or half a
+    circle to line up, the approach run) or the straight line home of an RTL
+    (ArduPlane then circles home at its RTL altitude). Without ``opt.endurance_s`` the
+    airframe type's default endurance is checked
+    (:func:`fm2uav.vehicles.airframes.default_endurance`).
+    """
     from ..vehicles.airframes import default_endurance
-    from ..vehicles.endurance import check_endurance, flight_time
+    from ..vehicles.endurance import FlightTime, check_endurance, flight_time
 
     climb = opt.climb_rate or DEFAULT_CLIMB[opt.vehicle]
     descent = opt.descent_rate or DEFAULT_DESCENT[opt.vehicle]
-    start_xy, end_xy = wps.points_m[0, :2], wps.points_m[-1, :2]
-    ft = flight_time(wps.points_m, sp.commanded, climb_rate=climb, descent_rate=descent,
-                     takeoff_climb=float(wps.agl[0]),
-                     final_descent=0.0 if end == "loiter" else float(wps.agl[-1]),
+    first = climb_out.first
+    p = wps.points_m
+    start_xy, end_xy = p[0, :2], p[-1, :2]
+    fixed = opt.vehicle == "fixed_wing"
+    hover = opt.vehicle == "multirotor"
+    final = 0.0 if end == "loiter" or (fixed and end in ("rtl", "land")) else float(wps.agl[-1])
+    holds = sp.holds[first - 1:].copy()
+    ft = flight_time(p[first - 1:], sp.commanded[first - 1:], climb_rate=climb,
+                     descent_rate=descent, takeoff_climb=0.0 if fixed else float(wps.agl[0]),
+                     final_descent=final,
                      return_distance=float(np.hypot(*(end_xy - start_xy))) if end == "rtl"
-                     else 0.0, return_speed=opt.forward_speed, holds=sp.holds)
+                     else 0.0, return_speed=opt.forward_speed, holds=holds, hover=hover)
+    leg_time = ft.leg_time.copy()
+    takeoff_s = ft.takeoff_s
+    if fixed:
+        # the climb-out's time runs to where it leaves for waypoint `first`
+        leg_time[0] = (_entry_length(climb_out, p, first)
+                       / max(float(sp.commanded[first - 1]), 1e-6) + float(holds[1]))
+        takeoff_s = climb_out.time_s
+    landing_s = ft.landing_s + (_pattern_time(items, nav, opt) if fixed and end == "land"
+                                else 0.0)
+    ft = FlightTime(leg_time=leg_time, leg_length=ft.leg_length, takeoff_s=takeoff_s,
+                    takeoff_m=ft.takeoff_m if not fixed else float(wps.agl[0]),
+                    landing_s=landing_s, landing_m=ft.landing_m)
     endurance_s, source = opt.endurance_s, "given (airframe.endurance / --endurance)"
     if endurance_s is None:  # the check runs by default (issue 25)
         endurance_s, source = default_endurance(opt.vehicle)
@@ -661,9 +557,9 @@ def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: _Speeds, start_hol
     warning = rep.warning
     where: dict[str, Any] = {}
     if warning is not None:
+        q_ = p[first - 1:]  # the legs timed (from where the climb-out leaves)
         k = int(rep.reach_waypoint)
-        p = wps.points_m
-        q = p[k] if k + 1 >= len(p) else p[k] + rep.reach_fraction * (p[k + 1] - p[k])
+        q = q_[k] if k + 1 >= len(q_) else q_[k] + rep.reach_fraction * (q_[k + 1] - q_[k])
         where = {"reserve_reached_at_m": [round(float(v), 2) for v in q]}
         lon, lat, _ = to_lonlat(world, q, anchor=opt.anchor)
         where["reserve_reached_at_lonlat"] = [round(float(lon), 7), round(float(lat), 7)]
@@ -675,11 +571,15 @@ def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: _Speeds, start_hol
         **rep.summary(), "warning": warning, "endurance_source": source, **where,
         "climb_rate_mps": climb, "descent_rate_mps": descent,
         "forward_speed_mps": opt.forward_speed,
+        "takeoff_s": round(float(takeoff_s), 1), "route_s": round(float(leg_time.sum()), 1),
+        "end_s": round(float(landing_s), 1),
         "note": {"loiter": "loiter end: the time until the loiter starts",
-                 "rtl": "rtl: the straight line home at the forward speed, then the descent"
+                 "rtl": "rtl: the straight line home at the forward speed"
+                        + (", then the descent" if not fixed else
+                           " (the aircraft then circles home at its RTL altitude)"),
                  }.get(end, "")}}
     if sp.timing is not None:  # the route from leaving the start (after any start hold)
-        route_t = float(ft.leg_time.sum() + sp.holds[0] - float(start_hold))
+        route_t = float(leg_time.sum() + sp.holds[0] - float(start_hold))
         info["timing"] = {**sp.timing, "mission_route_s": round(route_t, 2),
                           "error_s": round(route_t - sp.timing["planned_s"], 2)}
         late = route_t - sp.timing["planned_s"]
@@ -689,6 +589,41 @@ def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: _Speeds, start_hol
                 f"planned {sp.timing['planned_s']:.0f} s: the trajectory climbs or descends "
                 f"faster than {climb:g} / {descent:g} m/s (airframe climb_rate / descent_rate)")
     return info, warning
+
+
+def _entry_length(climb_out: ClimbOut, p: np.ndarray, first: int) -> float:
+    """Horizontal length from where the climb-out ends to the first flown waypoint [m]."""
+    info = climb_out.info
+    d = float(np.hypot(*(p[first, :2] - p[0, :2])))
+    if info.get("mode") == "loiter":
+        r = float(info["loiter_radius_m"])
+        return math.sqrt(max(d * d - r * r, 0.0))
+    if info.get("mode") == "straight":
+        return 0.0  # the climb-out's time runs to the waypoint
+    return float(np.hypot(*(p[first, :2] - p[first - 1, :2])))
+
+
+def _pattern_time(items: list[MissionItem], nav: FixedWingNav | None,
+                  opt: ExportOptions) -> float:
+    """Time of a fixed-wing landing pattern after the route [s]: to the loiter, the
+    descent in it at the sink limit (at least half a circle to line up), the approach run."""
+    from .firmware.flight_rules import local_xy
+
+    k = next((i for i, it in enumerate(items) if it.command == CMD_DO_LAND_START), None)
+    if k is None or nav is None:
+        return 0.0
+    seq = [it for it in items[k:] if it.has_position]
+    before = next((it for it in reversed(items[:k]) if it.has_position), None)
+    if len(seq) < 2 or before is None:
+        return 0.0
+    loiter, land = seq[0], seq[-1]
+    xy = local_xy([before, loiter, land], loiter.lat, loiter.lon)
+    v = opt.forward_speed
+    r = abs(loiter.params[1]) or nav.loiter_radius
+    d_in = max(float(np.hypot(*(xy[1] - xy[0]))) - r, 0.0)
+    drop = max((before.alt_amsl or 0.0) - (loiter.alt_amsl or 0.0), 0.0)
+    run = math.sqrt(max(float(np.hypot(*(xy[2] - xy[1]))) ** 2 - r * r, 0.0))
+    return d_in / v + max(drop / nav.sink_rate, math.pi * r / v) + run / v
 
 
 def _snap(profile: Any, frame: str) -> bool | float:
@@ -793,27 +728,41 @@ def build_mission(
     required = getattr(profile, "required", None)
     if required is not None and np.shape(required) != (len(p),):
         required = None  # a profile of another sampling than the path: no floor to compare
+    fw = PROFILES[opt.firmware]
+    nav = (fw.fixed_wing_nav.for_airframe(opt.airframe_nav())
+           if opt.vehicle != "multirotor" and fw.fixed_wing_nav is not None else None)
     wps = mission_waypoints(p, world, frame=frame, agl=agl, tolerance=opt.tolerance,
                             anchor=opt.anchor, flight_alt=opt.flight_alt,
                             max_points=opt.max_points, keep=sorted(keep),
-                            snap=_snap(profile, frame), required=required)
-    geo = _Geo(world, opt.anchor, wps)
-    sp = _speeds(opt, wps, w, times, start_hold)
-    end, end_items, landing, end_warnings = _end(geo, wps, opt)
-    items = [_takeoff(geo, wps, opt), *_route(wps, keep, sp, opt), *end_items]
-    warnings += end_warnings
+                            snap=_snap(profile, frame), required=required, turns=nav)
+    geo = ItemPlacer(world, opt.anchor, wps)
+    forced = [k for k in range(1, len(wps)) if int(wps.indices[k]) in keep]
+    climb_out = _takeoff(geo, wps, opt, nav, forced[0] if forced else len(wps) - 1)
+    sp = plan_speeds(indices=wps.indices, points=wps.points_m, forward=opt.forward_speed,
+                     floor=opt.min_speed, fixed_wing=opt.vehicle != "multirotor",
+                     changes=opt.speed_changes, step=opt.speed_step,
+                     hysteresis=opt.speed_hysteresis, w=w, times=times, start_hold=start_hold)
+    speed_type = fw.change_speed[opt.vehicle].speed_type
+    end, end_items, landing, end_warnings = _end(geo, wps, opt, nav)
+    items = [*climb_out.items, *_route(wps, keep, sp, climb_out.first, speed_type), *end_items]
+    warnings += climb_out.warnings + end_warnings
     fence_list = as_fences(fences)
-    check_mission(items, opt.firmware, vehicle=opt.vehicle, home_alt=wps.home[2],
-                  max_land_slope_deg=opt.max_land_slope_deg, fences=fence_list)
-    info, endurance_warning = _flight(wps, opt, end, sp, start_hold, world)
+    flight_warnings = check_mission(
+        items, opt.firmware, vehicle=opt.vehicle, home_alt=wps.home[2],
+        home_latlon=wps.home[:2], max_land_slope_deg=opt.max_land_slope_deg,
+        fences=fence_list, airframe=opt.airframe_nav())
+    warnings += [str(w_) for w_ in flight_warnings]
+    info, endurance_warning = _flight(wps, opt, end, sp, start_hold, climb_out, items, nav,
+                                     world)
     if endurance_warning:
         warnings.append(endurance_warning)
     if "warning" in info.get("timing", {}):
         warnings.append(info["timing"]["warning"])
-    info["speed_changes"] = {"items": len(sp.changes),
-                             "speeds_mps": sorted({round(v, 3) for _, v in sp.changes}),
-                             "step_mps": opt.speed_step,
-                             "enabled": bool(opt.speed_changes or times is not None)}
+    info["speed_changes"] = sp.summary(opt.speed_step, speed_type)
+    if opt.vehicle != "multirotor":
+        info["climb_out"] = climb_out.info
+    if nav is not None:
+        info["navigation"] = {**nav.summary(), **({"turns": wps.turns} if wps.turns else {})}
     if camera is not None:
         info["camera"] = {**camera.info, "trigger_distance_m": round(camera.trigger_distance, 3),
                           "bands": len(camera.bands),

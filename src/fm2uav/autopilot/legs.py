@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import InputError
 from ..geometry import arc_length
 
-__all__ = ["refine_legs"]
+__all__ = ["LegCheck", "refine_legs"]
 
 
 def _leg_heights(world: Any, a: np.ndarray, b: np.ndarray, step: float,
@@ -35,6 +35,59 @@ def _leg_heights(world: Any, a: np.ndarray, b: np.ndarray, step: float,
         pts[:, 2] = np.asarray(world.ground_height(pts[:, 0], pts[:, 1]), dtype=float) + h
         return pts, t, pts[:, 2] - surf
     return pts, t, pts[:, 2] - surf
+
+
+class LegCheck:
+    """Straight legs between points of a dense flown path, checked against its floor and
+    the world's zones (:func:`refine_legs`; the fixed-wing turn fitting re-checks the
+    legs it merges, :mod:`fm2uav.autopilot.turns`).
+
+    Parameters
+    ----------
+    world : World
+    flown : ndarray, shape (N, 3)
+        The dense path at its flown altitude (world z) [m].
+    required : ndarray, shape (N,)
+        Lowest admissible height above the surface at each dense point [m].
+    step : float, optional
+        Leg sampling [m] (default a quarter of
+        :func:`~fm2uav.world.ground_model.sampling_step`).
+    terrain_frame : bool
+        The autopilot follows the terrain between waypoints (frame 10).
+    """
+
+    def __init__(self, world: Any, flown: np.ndarray, required: np.ndarray, *,
+                 step: float | None = None, terrain_frame: bool = False) -> None:
+        from ..world.ground_model import sampling_step
+
+        self.world, self.p, self.req = world, flown, required
+        self.step = 0.25 * sampling_step(world) if step is None else float(step)
+        self.terrain_frame = terrain_frame
+        ground = np.asarray(world.ground_height(flown[:, 0], flown[:, 1]), dtype=float)
+        self.own_agl = flown[:, 2] - ground
+        self.cum = arc_length(flown[:, :2])  # horizontal distance along the path
+
+    def check(self, a: int, b: int) -> tuple[float, int, list[Any]]:
+        """``(lowest margin above the floor [m], dense index where it is lowest, zone hits)``
+        of the straight leg from dense point ``a`` to ``b``."""
+        from ..world.zones import zone_violations
+
+        p, req = self.p, self.req
+        pts, t, h = _leg_heights(self.world, p[a], p[b], self.step, self.terrain_frame,
+                                 self.own_agl[a], self.own_agl[b])
+        # dense point under each sample, by horizontal arc length
+        span = self.cum[b] - self.cum[a]
+        k = a + np.searchsorted(self.cum[a:b + 1], self.cum[a] + t * span, side="left")
+        k = np.clip(k, a, b)
+        floor = np.minimum(req[k], req[np.clip(k - 1, a, b)])
+        margin = h - floor
+        inner = (k > 0) & (k < len(p) - 1)
+        margin = np.where(inner, margin, np.inf)
+        low = float(margin.min()) if len(margin) else np.inf
+        worst = int(k[int(np.argmin(margin))]) if len(margin) else a
+        hits = (zone_violations(self.world, pts if self.terrain_frame else np.array([p[a], p[b]]),
+                                step=self.step) if getattr(self.world, "zones", ()) else [])
+        return low, worst, hits
 
 
 def refine_legs(
@@ -84,37 +137,19 @@ def refine_legs(
         floor), ``zone_splits``, ``unresolved`` (legs of neighbouring points that
         still fail; 0 normally).
     """
-    from ..world.ground_model import sampling_step
-    from ..world.zones import zone_violations
-
     p = np.asarray(flown, dtype=float)
     req = np.asarray(required, dtype=float)
     if p.ndim != 2 or p.shape[1] != 3 or req.shape != (len(p),):
         raise InputError(f"flown must be (N, 3) and required (N,), got {p.shape} and {req.shape}")
-    if step is None:
-        step = 0.25 * sampling_step(world)  # legs are long: read them finely
+    legs = LegCheck(world, p, req, step=step, terrain_frame=terrain_frame)
     keep = set(int(i) for i in np.asarray(indices, dtype=int))
     keep |= {0, len(p) - 1}
-    ground = np.asarray(world.ground_height(p[:, 0], p[:, 1]), dtype=float)
-    own_agl = p[:, 2] - ground
-    cum = arc_length(p[:, :2])  # horizontal distance along the path
     stack = [(a, b) for a, b in zip(sorted(keep)[:-1], sorted(keep)[1:])]
     added = zone_splits = unresolved = 0
     worst_margin = np.inf
     while stack:
         a, b = stack.pop()
-        pts, t, h = _leg_heights(world, p[a], p[b], step, terrain_frame, own_agl[a], own_agl[b])
-        # dense point under each sample, by horizontal arc length
-        span = cum[b] - cum[a]
-        k = a + np.searchsorted(cum[a:b + 1], cum[a] + t * span, side="left")
-        k = np.clip(k, a, b)
-        floor = np.minimum(req[k], req[np.clip(k - 1, a, b)])
-        margin = h - floor
-        inner = (k > 0) & (k < len(p) - 1)
-        margin = np.where(inner, margin, np.inf)
-        low = float(margin.min()) if len(margin) else np.inf
-        hits = (zone_violations(world, pts if terrain_frame else np.array([p[a], p[b]]),
-                                step=step) if getattr(world, "zones", ()) else [])
+        low, worst, hits = legs.check(a, b)
         if low >= -1e-6 and not hits:
             worst_margin = min(worst_margin, low)
             continue
@@ -123,7 +158,7 @@ def refine_legs(
             worst_margin = min(worst_margin, low)
             continue
         if low < -1e-6:
-            split = int(k[int(np.argmin(margin))])
+            split = worst
         else:
             zone_splits += 1
             hx, hy = hits[0].point[:2]
@@ -133,6 +168,7 @@ def refine_legs(
         keep.add(split)
         added += 1
         stack.extend([(a, split), (split, b)])
+    step = legs.step
     report = {"added": added, "zone_splits": zone_splits, "unresolved": unresolved,
               "lowest_margin_m": None if not np.isfinite(worst_margin)
               else round(float(worst_margin), 3), "step_m": round(float(step), 3)}

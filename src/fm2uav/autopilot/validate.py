@@ -24,6 +24,15 @@ What is checked, and where each rule comes from:
 * **Geofences** (``fences``, both firmwares; PX4's feasibility checker rejects a
   mission item that conflicts with a plan geofence): no position item inside an
   exclusion polygon or circle, none outside an inclusion one.
+* **How the firmware flies it** (:mod:`fm2uav.autopilot.firmware.flight_rules`, in
+  each profile's ``rules``): the speed commands (type, range, a cruise speed
+  before the first waypoint) and a fixed-wing's climb-out, loiters, waypoint
+  spacing and landing approach, from the firmware's navigation numbers with the
+  airframe's own laid over them (``airframe``).
+
+A problem is an ``error`` (the firmware rejects or misflies the mission: the export
+stops) or a ``warning`` (it flies it with the deviation the message says:
+:func:`check_mission` returns them for the summary).
 """
 
 from __future__ import annotations
@@ -41,6 +50,7 @@ from .firmware import (
     firmware_profile,
     supported_commands,
 )
+from .firmware.navigation import AirframeNav
 from .firmware.px4 import FW_LND_ANG as PX4_FW_LND_ANG
 from .items import (
     CMD_DO_CHANGE_SPEED,
@@ -164,6 +174,8 @@ def validate_mission(
     home_alt: float | None = None,
     max_land_slope_deg: float = PX4_FW_LND_ANG,
     fences: Sequence[Any] = (),
+    home_latlon: tuple[float, float] | None = None,
+    airframe: AirframeNav | None = None,
 ) -> list[Problem]:
     """Problems that would make ``firmware`` reject or misfly the mission ([] = none).
 
@@ -180,6 +192,10 @@ def validate_mission(
         PX4 ``FW_LND_ANG`` [deg] (default 5, PX4's default).
     fences : sequence of FencePolygon / FenceCircle, optional
         The plan's geofences.
+    home_latlon : (float, float), optional
+        Home latitude, longitude [deg]: where a fixed-wing take-off starts.
+    airframe : AirframeNav, optional
+        The airframe's speeds, bank, climb and sink, laid over the firmware's defaults.
 
     Returns
     -------
@@ -190,17 +206,21 @@ def validate_mission(
     items = list(items)
     out = _common(items, home_alt)
     for rule in profile.rules:
-        out += rule(items, vehicle, home_alt=home_alt, max_land_slope_deg=max_land_slope_deg)
+        out += rule(items, vehicle, home_alt=home_alt, max_land_slope_deg=max_land_slope_deg,
+                    home_latlon=home_latlon, airframe=airframe)
     if fences:
         out += _fence_problems(items, list(fences))
     return out
 
 
-def check_mission(items: Sequence[MissionItem], firmware: str, **options: object) -> None:
-    """Raise :class:`~fm2uav.errors.MissionError` naming the first problem (see
-    :func:`validate_mission` for ``options``)."""
+def check_mission(items: Sequence[MissionItem], firmware: str, **options: object
+                  ) -> list[Problem]:
+    """Raise :class:`~fm2uav.errors.MissionError` naming the first error (see
+    :func:`validate_mission` for ``options``); return the warnings."""
     problems = validate_mission(items, firmware, **options)  # type: ignore[arg-type]
-    if problems:
-        more = f" (+{len(problems) - 1} more)" if len(problems) > 1 else ""
-        raise MissionError(f"{firmware} would reject this mission: {problems[0]}{more}")
+    errors = [p for p in problems if p.is_error]
+    if errors:
+        more = f" (+{len(errors) - 1} more)" if len(errors) > 1 else ""
+        raise MissionError(f"{firmware} would reject or misfly this mission: {errors[0]}{more}")
+    return [p for p in problems if not p.is_error]
 

@@ -149,6 +149,11 @@ class Waypoints:
         (:func:`fm2uav.world.geo.amsl_known`); False: ``alt_amsl``, ``ground_amsl``
         and ``home[2]`` are heights above the world's flat ground, the mission is
         relative to home.
+    acceptance : ndarray or None
+        Fixed-wing: the acceptance radius of each waypoint [m] (``NAV_WAYPOINT``
+        param2; 0 = the firmware's), set where a waypoint must stay on a short leg.
+    turns : dict or None
+        Fixed-wing: what :func:`fm2uav.autopilot.turns.fit_turns` did.
     """
 
     lat: np.ndarray
@@ -166,6 +171,8 @@ class Waypoints:
     requested_agl: float | None = None
     legs: dict[str, Any] | None = None
     amsl: bool = True
+    acceptance: np.ndarray | None = None
+    turns: dict[str, Any] | None = None
 
     def __len__(self) -> int:
         return int(len(self.lat))
@@ -270,6 +277,7 @@ def mission_waypoints(
     keep: Any = (),
     snap: bool | float = True,
     required: Any = None,
+    turns: Any = None,
 ) -> Waypoints:
     """Thin a dense path and express it as MAVLink waypoints.
 
@@ -302,6 +310,9 @@ def mission_waypoints(
         (``Plan.profile.required``); legs that would dip below it, or enter a
         no-fly zone, get more waypoints (:func:`fm2uav.autopilot.legs.refine_legs`).
         Default: no floor (zones are still checked).
+    turns : FixedWingNav, optional
+        A fixed-wing's navigation: waypoints that make legs too short to turn onto
+        are removed where that stays safe (:func:`fm2uav.autopilot.turns.fit_turns`).
     """
     if frame not in FRAME_CODES:
         raise InputError(f"frame must be one of {', '.join(FRAME_CODES)} here, got {frame!r}")
@@ -315,14 +326,21 @@ def mission_waypoints(
         space = space[:, :2]
     idx = thin_with_keep(space, tolerance, keep=keep, max_points=max_points)
     legs = None
+    req = np.full(len(p), -np.inf) if required is None else np.asarray(required, dtype=float)
+    if req.shape != (len(p),):
+        raise InputError(f"required must hold one floor per path point ({len(p)}), got "
+                         f"shape {req.shape}")
     if p.shape[1] == 3 and getattr(world, "ndim", 3) == 3:
         from .legs import refine_legs
 
-        req = np.full(len(p), -np.inf) if required is None else np.asarray(required, dtype=float)
-        if req.shape != (len(p),):
-            raise InputError(f"required must hold one floor per path point ({len(p)}), got "
-                             f"shape {req.shape}")
         idx, legs = refine_legs(idx, flown, world, required=req, terrain_frame=frame == "terrain")
+    acceptance = turned = None
+    if turns is not None and len(idx) > 2:
+        from .turns import fit_turns
+
+        idx, acceptance, turned = fit_turns(idx, flown, world, required=req, keep=keep, nav=turns,
+                                            tolerance=tolerance,
+                                            terrain_frame=frame == "terrain")
     kept = flown[idx]
     geo = to_lonlat(world, kept, anchor=anchor)
     gnd = to_lonlat(world, np.column_stack([kept[:, :2], ground[idx]]), anchor=anchor)[:, 2]
@@ -340,4 +358,5 @@ def mission_waypoints(
         home=(float(home_geo[1]), float(home_geo[0]), float(home_geo[2])),
         home_source=_home_source(world, anchor), points_m=kept, indices=idx,
         requested_agl=None if agl is None else float(agl), legs=legs, amsl=amsl_known(world),
+        acceptance=acceptance, turns=turned,
     )

@@ -19,7 +19,8 @@ from ..pipeline.outputs import export_options, parse_anchor  # noqa: F401  (re-e
 
 __all__ = [
     "Firmware", "Vehicle", "Frame", "End", "Thin", "AnchorText", "SpeedChanges", "MinSpeed",
-    "CruiseSpeed", "HoverSpeed", "Endurance", "Reserve", "Via", "Return", "parse_anchor",
+    "CruiseSpeed", "HoverSpeed", "Endurance", "Reserve", "Terrain", "TerrainSpacing", "Via",
+    "Return", "parse_anchor",
     "via_points", "export_options",
 ]
 
@@ -53,6 +54,14 @@ Endurance = Annotated[float | None, typer.Option(
     help="Airframe endurance (min): the flight time is checked against it (airframe.endurance).")]
 Reserve = Annotated[float | None, typer.Option(
     help="Share of the endurance kept in reserve (airframe.reserve). Default 0.2.")]
+Terrain = Annotated[bool | None, typer.Option(
+    "--terrain/--no-terrain",
+    help="Write ArduPilot's terrain files (terrain/NxxEyyy.DAT for the SD card's "
+    "APM/terrain/) from the world's ground (outputs.terrain). Default: with every "
+    "terrain-frame mission.")]
+TerrainSpacing = Annotated[int | None, typer.Option(
+    help="Grid spacing (m) of the terrain files = the vehicle's TERRAIN_SPACING "
+    "(outputs.terrain_spacing). Default: half the DEM's resolution, 30 to 100 m.")]
 
 
 Via = Annotated[list[str] | None, typer.Option(

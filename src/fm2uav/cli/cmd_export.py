@@ -37,20 +37,24 @@ EXPORT_HELP = (
     "Turn an existing path (path.csv, x_m,y_m,z_m[,speed]) into mission files: "
     "mission.plan (QGroundControl), mission.waypoints (QGC WPL 110), path.kml, "
     "path.kmz, path.geojson — with takeoff, end, altitude frame and firmware checks as "
-    "every command writes them. The world comes from the mission file the path was "
+    "every command writes them, and ArduPilot's terrain files (terrain/*.DAT) with a "
+    "terrain-frame mission (--terrain). The world comes from the mission file the path was "
     "planned with (--mission) or a built-in scenario; a path whose '# crs=' header "
     "names another CRS than the world's is refused.\n\n"
     "Examples:\n\n"
     "  fm2uav export out/open_field_tff/path.csv --mission examples/open_field_tff.yaml "
     "--format plan,waypoints --firmware ardupilot --out out/ardu\n\n"
     "  fm2uav export out/plan/path.csv --scenario open-field --agl 150 --format kmz "
-    "--out out/kmz"
+    "--out out/kmz\n\n"
+    "  fm2uav export out/jacksboro/path.csv --mission examples/jacksboro_tff.yaml "
+    "--terrain --terrain-spacing 50 --out out/jacksboro_terrain"
 )
 
 
 @handle_errors
 @mission_options("firmware", "vehicle", "frame", "end", "thin", "anchor", "speed_changes",
-                 "min_speed", "cruise_speed", "hover_speed", "endurance", "reserve")
+                 "min_speed", "cruise_speed", "hover_speed", "endurance", "reserve", "terrain",
+                 "terrain_spacing")
 @output_options("out/export", report_help="Also write report.html (interactive, "
                 "self-contained: the path, its waypoints and the mission's numbers on the world).")
 def export_cmd(
@@ -76,7 +80,7 @@ def export_cmd(
     from ..planning import FlightLevel
 
     formats = parse_formats(",".join(fmt))
-    outdir = output.dir([EXPORT_FILES[f] for f in formats] + ["summary.json"]
+    outdir = output.dir([EXPORT_FILES[f] for f in formats] + ["summary.json", "terrain"]
                         + (["report.html"] if output.report else []))
     world, base, mission_level, where = _world(mission_file, scenario, seed)
     header = read_path_header(path_file)

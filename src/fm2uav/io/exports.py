@@ -8,7 +8,8 @@ requested format, so that the CLI decides where and how files are written
 =========  =====================  ===========================================
 format     file                   content
 =========  =====================  ===========================================
-csv        ``path.csv``           dense path x, y, z [m] and W
+csv        ``path.csv``           dense path x, y, z [m] and the speed share W
+                                 (obstacle distances, :meth:`fm2uav.Plan.speed_share`)
 geojson    ``path.geojson``       3D LineString lon/lat/alt + waypoints (RFC 7946)
 kml        ``path.kml``           3D path and waypoints for Google Earth
 kmz        ``path.kmz``           the same KML, zipped (``doc.kml``)
@@ -42,6 +43,7 @@ from .geojson import write_geojson
 from .kml import write_kml, write_kmz
 from .paths import write_path_csv
 from .qgc import write_plan
+from .terrain_dat import terrain_files
 from .wpl import write_wpl
 
 __all__ = [
@@ -55,6 +57,9 @@ __all__ = [
     "export_formation",
     "file_prefix",
     "export_writers",
+    "terrain_export",
+    "TERRAIN_LOAD",
+    "TERRAIN_WITHOUT",
 ]
 
 #: Export format → file name.
@@ -183,6 +188,12 @@ def export_mission(
     speed = getattr(plan, "w", None)
     if speed is None:
         speed = getattr(plan, "speed", None)
+    if hasattr(plan, "speed_share"):  # the obstacle-distance W, not a flight level's shaping
+        try:
+            speed = plan.speed_share()
+        except InputError:  # a regional plan: no world-sized map to read it from
+            if opt.speed_changes:
+                raise
     inputs = dict(w=speed, agl=agl, times=times, via=via, camera=camera, fences=fences,
                   start_hold=start_hold, profile=getattr(plan, "profile", None))
     if returns is not None:
@@ -229,6 +240,8 @@ def export_mission(
         files[name] = ExportFile(name, k in _BINARY, writers[k])
     if keys and getattr(mission, "returns", None) is not None:
         files.update(_return_files(mission, prefix))
+    if opt.terrain if opt.terrain is not None else mission.frame == "terrain":
+        files.update(terrain_export(world, [mission], [path], opt))
     return mission, files
 
 
@@ -248,6 +261,41 @@ def _return_files(mission: MissionExport, prefix: str) -> dict[str, ExportFile]:
         writers["rally_txt"] = lambda fh: write_rally_txt(fh, mission)
     return {prefix + RETURN_FILES[k]: ExportFile(prefix + RETURN_FILES[k], False, w)
             for k, w in writers.items()}
+
+
+#: What a terrain folder is for (summary line): how to load it, what happens without it.
+TERRAIN_LOAD = ("copy terrain/*.DAT to the SD card's APM/terrain/ folder (SITL: the terrain/ "
+                "folder of its working directory) and set TERRAIN_ENABLE=1, TERRAIN_SPACING="
+                "{spacing} (terrain/terrain.param)")
+TERRAIN_WITHOUT = ("without them ArduPilot does not arm a terrain-frame mission (\"PreArm: "
+                   "waiting for terrain data\") unless a ground station serves the terrain, and "
+                   "with TERRAIN_ENABLE=0 not at all (\"PreArm: terrain disabled\")")
+
+
+def terrain_export(world: Any, missions: Sequence[MissionExport], paths: Sequence[Any],
+                   options: ExportOptions) -> dict[str, ExportFile]:
+    """ArduPilot's terrain files of missions flown on one world: the blocks around their
+    homes, items and paths (:func:`fm2uav.autopilot.terrain_grid.mission_terrain`), one
+    ``terrain/NxxEyyy.DAT`` per degree and ``terrain/terrain.param``; each mission's
+    ``info["terrain"]`` says what they hold and how to load them."""
+    from ..autopilot.terrain_grid import mission_terrain
+
+    items = [it for m in missions for it in m.items]
+    path = np.vstack([np.asarray(p, dtype=float)[:, :3] if np.shape(p)[1] >= 3 else
+                      np.column_stack([p, np.zeros(len(p))]) for p in paths])
+    grid = mission_terrain(world, home_latlon=missions[0].home[:2], items=items, path_m=path,
+                           anchor=options.anchor, spacing=options.terrain_spacing)
+    info = {**grid.info, "folder": "terrain/",
+            "load": TERRAIN_LOAD.format(spacing=grid.spacing), "without": TERRAIN_WITHOUT}
+    for m in missions:
+        m.info["terrain"] = info
+    files = {f"terrain/{name}": ExportFile(f"terrain/{name}", True, write)
+             for name, write in terrain_files(grid).items()}
+    params = ("# ArduPilot parameters for the terrain files of this folder (fm2uav)\n"
+              f"TERRAIN_ENABLE 1\nTERRAIN_SPACING {grid.spacing}\n")
+    files["terrain/terrain.param"] = ExportFile("terrain/terrain.param", False,
+                                                lambda fh: fh.write(params))
+    return files
 
 
 def file_prefix(name: str) -> str:
@@ -302,11 +350,17 @@ def export_formation(
                                 length=path_length(path),
                                 profile=None if tr is None else tr.profile)
         agl = result.agl[i] if i < len(result.agl) else None
-        m, f = export_mission(track, formats, replace(opt, name=f"{opt.name} — {name}"),
+        m, f = export_mission(track, formats, replace(opt, name=f"{opt.name} — {name}",
+                                                      terrain=False),
                               agl=agl, times=times, start_hold=float(holds[i]),
                               prefix=file_prefix(name), fences=fences)
         missions[name] = m
         files.update(f)
+    ms = list(missions.values())
+    if opt.terrain if opt.terrain is not None else any(m.frame == "terrain" for m in ms):
+        # one terrain folder for every vehicle: the blocks around all their paths
+        files.update(terrain_export(world, ms, [np.asarray(m.path_m, dtype=float) for m in ms],
+                                    opt))
     return missions, files
 
 

@@ -330,6 +330,10 @@ class AirframeSpec(BaseModel):
     hover_speed: float = _num(5.0, unit="m/s", gt=0, le=50, desc="multirotor speed")
     min_speed: float | None = _num(None, unit="m/s", gt=0, le=100,
                                    desc="lowest commanded speed (fixed-wing: above stall)")
+    max_speed: float | None = _num(None, unit="m/s", gt=0, le=200,
+                                   desc="highest airspeed (fixed-wing AIRSPEED_MAX)")
+    max_bank: float | None = _num(None, unit="deg", ge=5, le=85,
+                                  desc="bank limit (fixed-wing ROLL_LIMIT_DEG)")
     climb_rate: float | None = _num(None, unit="m/s", gt=0, le=50, desc="climb speed")
     descent_rate: float | None = _num(None, unit="m/s", gt=0, le=50, desc="descent speed")
     endurance: float | None = _num(None, unit="min", gt=0, le=10000,
@@ -361,6 +365,10 @@ class OutputSpec(BaseModel):
     end: Literal["auto", "rtl", "land", "loiter"] = Field("auto")
     speed_changes: bool = Field(False, description="DO_CHANGE_SPEED from the planned speed")
     speed_step: float = _num(1.0, unit="m/s", gt=0, le=20, desc="speed quantum")
+    terrain: bool | None = Field(None, description="ArduPilot terrain files (terrain/*.DAT); "
+                                 "default: with terrain-frame missions")
+    terrain_spacing: int | None = _num(None, unit="m", ge=5, le=1000,
+                                       desc="terrain files grid spacing (TERRAIN_SPACING)")
 
 
 class RallySiteSpec(BaseModel):
@@ -514,6 +522,8 @@ class Mission(BaseModel):
             anchor=self.anchor(), takeoff=o.takeoff, cruise_speed=a.cruise_speed,
             hover_speed=a.hover_speed, vehicle=a.type, firmware=a.firmware, end=o.end,
             speed_changes=o.speed_changes, speed_step=o.speed_step, min_speed=a.min_speed,
+            max_speed=a.max_speed, max_bank=a.max_bank, terrain=o.terrain,
+            terrain_spacing=o.terrain_spacing,
             climb_rate=a.climb_rate, descent_rate=a.descent_rate,
             endurance_s=None if a.endurance is None else 60.0 * a.endurance,
             reserve=a.reserve, name=self.name,

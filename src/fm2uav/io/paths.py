@@ -1,5 +1,9 @@
 """Path files as CSV: one point a row, columns ``x_m,y_m[,z_m][,speed][,floor_agl_m]``.
 
+``speed`` is the admissible speed share W in [0, 1] of the obstacle distances
+(:meth:`fm2uav.Plan.speed_share`: without a flight level's shaping), which
+``fm2uav export --speed-changes`` maps onto the airframe's speed range.
+
 ``floor_agl_m`` (paths with a final altitude profile, ``Plan.profile.required``)
 is the lowest height above the surface each point must keep [m] (``-inf`` at
 the take-off and landing points): ``fm2uav export`` checks the legs against it.

@@ -285,7 +285,8 @@ def export_options(base: Any = None, *, firmware: str | None = None, vehicle: st
                    anchor: str | None = None, speed_changes: bool | None = None,
                    min_speed: float | None = None, cruise_speed: float | None = None,
                    hover_speed: float | None = None, endurance: float | None = None,
-                   reserve: float | None = None, **more: Any) -> Any:
+                   reserve: float | None = None, terrain: bool | None = None,
+                   terrain_spacing: int | None = None, **more: Any) -> Any:
     """``base`` (default ``ExportOptions()``) with the settings that were given (None =
     not given): the command line's mission flags, the app's aircraft and mission fields.
 
@@ -306,7 +307,7 @@ def export_options(base: Any = None, *, firmware: str | None = None, vehicle: st
              "tolerance": thin, "anchor": parse_anchor(anchor), "speed_changes": speed_changes,
              "min_speed": min_speed, "cruise_speed": cruise_speed, "hover_speed": hover_speed,
              "endurance_s": None if endurance is None else 60.0 * float(endurance),
-             "reserve": reserve, **more}
+             "reserve": reserve, "terrain": terrain, "terrain_spacing": terrain_spacing, **more}
     if thin is not None and not 0 <= thin <= 1000:
         raise InputError(f"--thin must be a tolerance in [0, 1000] m (mission file: "
                          f"outputs.thin_tolerance), got {thin}")

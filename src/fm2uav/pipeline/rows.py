@@ -23,10 +23,31 @@ def mission_rows(mission: Any) -> dict[str, str]:
         "flight": f"{s['flight']['flight_distance_m'] / 1000:.2f} km, "
                   f"{s['flight']['flight_time_s'] / 60:.1f} min",
     }
-    if s["speed_changes"]["items"]:
-        rows["speed changes"] = (f"{s['speed_changes']['items']} "
-                                 f"({', '.join(f'{v:g}' for v in s['speed_changes']['speeds_mps'])}"
-                                 " m/s)")
+    sc = s["speed_changes"]
+    kind = "airspeed" if sc.get("speed_type") == 0 else "ground speed"
+    rows["speeds"] = (f"DO_CHANGE_SPEED {kind} {', '.join(f'{v:g}' for v in sc['speeds_mps'])} "
+                      f"m/s ({sc['items']} item{'s' if sc['items'] != 1 else ''}, from "
+                      f"{sc.get('from', 'the forward speed')})")
+    co = s.get("climb_out")
+    if co and co.get("mode") in ("straight", "loiter"):
+        how = (f"climb in a {co['loiter_radius_m']:g} m loiter to {co['loiter_alt_m']:g} m"
+               if co["mode"] == "loiter" else
+               f"first waypoint {co['first_waypoint_m']:g} m ahead")
+        rows["fixed-wing climb-out"] = (
+            f"launch on course {co['course_deg']:g}° (the take-off item's direction), climb "
+            f"straight to {co['takeoff_alt_m']:g} m above home in {co['climb_distance_m']:g} "
+            f"m, then {how}")
+    t = s.get("terrain")
+    if t:
+        beyond = t.get("nodes_beyond_dem", 0)
+        edge = (f"; {100 * beyond / t['nodes']:.0f} % of the nodes lie beyond the DEM (its "
+                "edge heights, not measured)" if beyond and t.get("nodes") else "")
+        if t.get("nodes_over_filled_ground"):
+            edge += (f"; {t['nodes_over_filled_ground']} nodes over FILLED ground (heights "
+                     "invented)")
+        rows["terrain files"] = (f"{', '.join('terrain/' + f for f in t['files'])} "
+                                 f"({t['blocks']} blocks, {t['spacing_m']} m): {t['load']}; "
+                                 f"{t['without']}{edge}")
     for k, w in enumerate(s["warnings"]):
         rows[f"warning {k + 1}"] = w
     return rows

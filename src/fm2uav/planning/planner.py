@@ -98,6 +98,41 @@ class Plan:
         """``"climb-out"`` / ``"cruise"`` / ``"descent"`` per path point (None without a profile)."""
         return None if self.profile is None else self.profile.phase
 
+    def speed_share(self) -> np.ndarray:
+        """The admissible speed share along the path from the obstacle distances alone [0, 1].
+
+        ``w`` is the map the plan marched on, which for a terrain-following plan
+        includes the flight-level shaping (p1/p2 keep the path on its level; they say
+        nothing about speed). The speed share of a terrain-following plan is
+        ``min(d / d_sat, 1) ** β`` of the distance ``d`` to the nearest obstacle,
+        interpolated at the path's final points, with ``d_sat`` the flight level's
+        ``agl`` (or the shaping's saturation distance, α · max d, when nearer): the
+        height above ground the plan was asked to keep is open sky, full speed;
+        closer to the terrain or the buildings (slopes, ridges, roofs) the vehicle
+        slows down. Plans without a flight level, and plans on a custom speed map,
+        return ``w``.
+
+        Raises
+        ------
+        InputError
+            A regional plan (no world-sized map to read it from).
+        """
+        if self.level is None or self.params.get("custom_speed_map"):
+            return self.w
+        if self.params.get("storage") == "regional":
+            raise InputError("a regional plan keeps no world-sized velocity map to read the "
+                             "speeds from: export it without speed changes "
+                             "(outputs.speed_changes: false, --no-speed-changes)")
+        sh = self.shaping
+        top = max_distance(self.world, sh)
+        d_sat = sh.saturation_distance if sh.saturation_distance is not None else \
+            sh.saturation * top
+        d_sat = min(float(d_sat), float(self.level.agl))
+        W = shape_velocity(base_velocity(self.world, method=sh.method, walls=sh.walls),
+                           exponent=sh.exponent, saturation_distance=d_sat, max_distance=top)
+        idx = self.world.to_index(self.path)
+        return ndimage.map_coordinates(W, idx.T, order=1, mode="nearest")
+
     def height_above_ground(self) -> np.ndarray | None:
         """``z - World.ground_height(x, y)`` [m] at every path point (None for 2D)."""
         if self.path.shape[1] != 3:

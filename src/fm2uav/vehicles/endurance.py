@@ -1,13 +1,15 @@
 """Flight time, distance and endurance of a mission: does the battery last?
 
 The mission is flown leg by leg between its waypoints. A leg of horizontal
-length ``L`` and height change ``dz`` at commanded speed ``v`` takes
+length ``L`` and height change ``dz`` at commanded speed ``v`` takes, for a
+vehicle that can hover (``hover=True``),
 
 ``t = max(L / v, dz / v_climb, -dz / v_descent)``
 
 (the horizontal and vertical motions run at the same time, each limited by its
 own speed: a multirotor's ``WPNAV_SPEED`` / ``WPNAV_SPEED_UP`` /
-``WPNAV_SPEED_DN``, a fixed-wing's cruise speed and TECS climb / sink limits).
+``WPNAV_SPEED_DN``), and for a fixed-wing (``hover=False``), which flies on at its
+airspeed whether or not it has reached the leg's altitude, ``t = sqrt(L² + dz²) / v``.
 Hold times add to the leg they end. The take-off climb (home → first waypoint)
 and the final descent are vertical legs; a return to launch adds the straight
 line home at cruise speed and the descent there.
@@ -85,6 +87,7 @@ def flight_time(
     return_distance: float = 0.0,
     return_speed: float | None = None,
     holds: Any = None,
+    hover: bool = True,
 ) -> FlightTime:
     """Leg-by-leg flight time of waypoints flown at the given speeds.
 
@@ -105,6 +108,9 @@ def flight_time(
         ``return_speed`` (default: the last leg's speed).
     holds : array_like, shape (n,), optional
         Hold time at each waypoint [s].
+    hover : bool, optional
+        The vehicle waits for its altitude (multirotor); False: a fixed-wing flying
+        each leg at its airspeed.
     """
     p = np.asarray(points, dtype=float)
     if p.ndim != 2 or p.shape[1] != 3 or len(p) < 1 or not np.all(np.isfinite(p)):
@@ -116,8 +122,13 @@ def flight_time(
     v = np.broadcast_to(np.asarray(speeds, dtype=float), horiz.shape)
     if v.size and not (np.all(np.isfinite(v)) and np.all(v > 0)):
         raise InputError("leg speeds must be finite and > 0 m/s")
-    t = np.maximum.reduce([horiz / np.where(v > 0, v, 1.0), np.maximum(d[:, 2], 0) / up,
-                           np.maximum(-d[:, 2], 0) / down]) if len(d) else np.zeros(0)
+    if not len(d):
+        t = np.zeros(0)
+    elif hover:
+        t = np.maximum.reduce([horiz / np.where(v > 0, v, 1.0), np.maximum(d[:, 2], 0) / up,
+                               np.maximum(-d[:, 2], 0) / down])
+    else:
+        t = np.hypot(horiz, d[:, 2]) / np.where(v > 0, v, 1.0)
     if holds is not None:
         h = np.asarray(holds, dtype=float)
         if h.shape != (len(p),) or np.any(h < 0) or not np.all(np.isfinite(h)):

@@ -50,10 +50,13 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from ..items import FRAME_TERRAIN, TAKEOFF_COMMANDS, VTOL_COMMANDS, MissionItem
+from .flight_rules import fixed_wing_rules, speed_rules
+from .navigation import FixedWingNav, SpeedCommand
 from .profile import AltitudeParam, FirmwareProfile, Param, Problem, ReturnModel
 
-__all__ = ["ARDUPILOT", "COPTER_COMMANDS", "PLANE_COMMANDS", "POSITION_FRAMES", "VEHICLE_NAMES",
-           "COPTER_RETURN", "PLANE_RETURN", "check"]
+__all__ = ["ARDUPILOT", "COPTER_COMMANDS", "PLANE_COMMANDS", "POSITION_FRAMES",
+           "VEHICLE_NAMES", "COPTER_RETURN", "PLANE_RETURN", "PLANE_NAV", "PLANE_SPEED",
+           "COPTER_SPEED", "check"]
 
 #: ArduCopter mode_auto.cpp and ArduPlane commands_logic.cpp (ArduPilot wiki lists).
 COPTER_COMMANDS = frozenset({
@@ -144,6 +147,46 @@ PLANE_RETURN = ReturnModel(
                  "fly it to the DO_LAND_START landing",
     sources=_SOURCES,
 )
+#: ArduPlane's navigation defaults (ArduPlane/config.h, Parameters.cpp, AP_L1_Control,
+#: AP_TECS): WP_RADIUS 90 m, WP_LOITER_RAD 60 m, ROLL_LIMIT_DEG 45, NAVL1_PERIOD 17 s,
+#: NAVL1_DAMPING 0.75, TECS_CLMB_MAX / TECS_SINK_MAX 5 m/s, AIRSPEED_MIN 9,
+#: AIRSPEED_CRUISE 12, AIRSPEED_MAX 22 m/s, TKOFF_ALT 50 m.
+PLANE_NAV = FixedWingNav(
+    label="ArduPlane", acceptance_radius=90.0, loiter_radius=60.0, bank_limit_deg=45.0,
+    guidance_period=17.0, guidance_damping=0.75, climb_rate=5.0, sink_rate=5.0,
+    airspeed_min=9.0, airspeed_cruise=12.0, airspeed_max=22.0, takeoff_pitch_deg=15.0,
+    takeoff_alt=50.0, turn_distance_rule="l1", landing_slope_max_deg=None,
+    names={"acceptance_radius": "WP_RADIUS", "loiter_radius": "WP_LOITER_RAD",
+           "bank_limit_deg": "ROLL_LIMIT_DEG", "guidance_period": "NAVL1_PERIOD",
+           "guidance_damping": "NAVL1_DAMPING", "climb_rate": "TECS_CLMB_MAX",
+           "sink_rate": "TECS_SINK_MAX", "airspeed_min": "AIRSPEED_MIN",
+           "airspeed_cruise": "AIRSPEED_CRUISE", "airspeed_max": "AIRSPEED_MAX",
+           "takeoff_alt": "TKOFF_ALT"},
+    sources=("https://ardupilot.org/plane/docs/parameters.html#wp-radius",
+             "https://ardupilot.org/plane/docs/navigation-tuning.html (L1 controller)",
+             "https://ardupilot.org/plane/docs/common-mavlink-mission-command-messages-mav_cmd"
+             ".html",
+             "https://ardupilot.org/plane/docs/automatic-landing.html",
+             "libraries/AP_L1_Control/AP_L1_Control.cpp (turn_distance, L1 distance)",
+             "ArduPlane/commands_logic.cpp (do_takeoff, verify_nav_wp, verify_loiter_to_alt, "
+             "do_change_speed)"),
+)
+#: ArduPlane's DO_CHANGE_SPEED (Plane::do_change_speed): type 0 sets the target airspeed,
+#: and only between AIRSPEED_MIN and AIRSPEED_MAX (else it is ignored); type 1 sets
+#: MIN_GROUNDSPEED, not the speed flown.
+PLANE_SPEED = SpeedCommand(
+    speed_type=0, accepted=(0,), ignored_outside=True,
+    other_type="speed type 1 (ground speed) sets MIN_GROUNDSPEED on ArduPlane, not the speed "
+               "flown",
+    default="AIRSPEED_CRUISE",
+    source="ArduPlane/commands_logic.cpp Plane::do_change_speed")
+#: ArduCopter's DO_CHANGE_SPEED (ModeAuto::do_change_speed): types 0 and 1 set the
+#: horizontal speed (WPNAV_SPEED), 2 the climb and 3 the descent speed.
+COPTER_SPEED = SpeedCommand(
+    speed_type=1, accepted=(0, 1), ignored_outside=False,
+    other_type="speed types 2/3 set ArduCopter's climb/descent speed, not the horizontal speed",
+    default="WPNAV_SPEED",
+    source="ArduCopter/mode_auto.cpp ModeAuto::do_change_speed")
 
 ARDUPILOT = FirmwareProfile(
     name="ardupilot",
@@ -153,7 +196,11 @@ ARDUPILOT = FirmwareProfile(
     position_frames=POSITION_FRAMES,
     terrain_frame=True,
     landing_required=frozenset(),
-    rules=(check,),
+    rules=(check, speed_rules({"multirotor": COPTER_SPEED, "fixed_wing": PLANE_SPEED,
+                               "vtol": PLANE_SPEED}, PLANE_NAV, "ArduPilot"),
+           fixed_wing_rules(PLANE_NAV, "ArduPlane")),
+    fixed_wing_nav=PLANE_NAV,
+    change_speed={"multirotor": COPTER_SPEED, "fixed_wing": PLANE_SPEED, "vtol": PLANE_SPEED},
     returns={"multirotor": (COPTER_RETURN,), "fixed_wing": (PLANE_RETURN,),
              "vtol": (PLANE_RETURN,)},
 )

@@ -13,6 +13,8 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
+from .navigation import FixedWingNav, SpeedCommand, merge_nav, merge_speed
+
 __all__ = ["VEHICLES", "VEHICLE_TYPES", "Problem", "Rule", "Param", "AltitudeParam",
            "ReturnModel", "FirmwareProfile", "both"]
 
@@ -34,11 +36,21 @@ class Problem:
         Short identifier, e.g. ``"px4-terrain-frame"``.
     message : str
         What is wrong and how to fix it.
+    severity : {"error", "warning"}
+        ``error``: the firmware rejects or misflies the mission (the export stops);
+        ``warning``: it flies it with a deviation the message quantifies.
     """
 
     index: int | None
     code: str
     message: str
+    severity: str = "error"
+
+    @property
+    def is_error(self) -> bool:
+        """Whether the firmware rejects or misflies the mission (else: a warning that the
+        mission flies, with the deviation the message says)."""
+        return self.severity == "error"
 
     def __str__(self) -> str:
         return self.message if self.index is None else f"item {self.index}: {self.message}"
@@ -189,6 +201,11 @@ class FirmwareProfile:
     returns : mapping of str to tuple of ReturnModel
         Airframe kind → how the firmware's return mode flies it (one model per
         firmware; the generic profile holds both, every one must be safe).
+    fixed_wing_nav : FixedWingNav or None
+        How it navigates a fixed-wing mission (acceptance, guidance, turn radius,
+        climb, airspeeds; :mod:`fm2uav.autopilot.firmware.navigation`).
+    change_speed : mapping of str to SpeedCommand
+        Airframe kind → what its ``DO_CHANGE_SPEED`` means (speed type, range).
     """
 
     name: str
@@ -199,6 +216,8 @@ class FirmwareProfile:
     landing_required: frozenset[str]
     rules: tuple[Rule, ...]
     returns: Mapping[str, tuple[ReturnModel, ...]] = field(default_factory=dict)
+    fixed_wing_nav: FixedWingNav | None = None
+    change_speed: Mapping[str, SpeedCommand] = field(default_factory=dict)
 
 
 def both(name: str, profiles: Sequence[FirmwareProfile], *, mav_autopilot: int) -> FirmwareProfile:
@@ -214,4 +233,9 @@ def both(name: str, profiles: Sequence[FirmwareProfile], *, mav_autopilot: int) 
         landing_required=frozenset.union(*(p.landing_required for p in profiles)),
         rules=tuple(r for p in profiles for r in p.rules),
         returns={v: tuple(m for p in profiles for m in p.returns.get(v, ())) for v in VEHICLES},
+        fixed_wing_nav=merge_nav(tuple(p.fixed_wing_nav for p in profiles
+                                       if p.fixed_wing_nav is not None)),
+        change_speed={v: merge_speed(tuple(p.change_speed[v] for p in profiles
+                                           if v in p.change_speed))
+                      for v in VEHICLES if any(v in p.change_speed for p in profiles)},
     )

@@ -52,9 +52,12 @@ from ..items import (
     MissionItem,
     distance_m,
 )
+from .flight_rules import fixed_wing_rules, speed_rules
+from .navigation import FixedWingNav, SpeedCommand
 from .profile import VEHICLES, AltitudeParam, FirmwareProfile, Param, Problem, ReturnModel
 
-__all__ = ["PX4", "COMMANDS", "POSITION_FRAMES", "FW_LND_ANG", "MC_RETURN", "FW_RETURN", "check"]
+__all__ = ["PX4", "COMMANDS", "POSITION_FRAMES", "FW_LND_ANG", "MC_RETURN", "FW_RETURN",
+           "FW_NAV", "FW_SPEED", "MC_SPEED", "check"]
 
 #: PX4 FeasibilityChecker::checkMissionItemValidity (the commands fm2uav may meet).
 COMMANDS = frozenset({
@@ -78,7 +81,7 @@ def _amsl(item: MissionItem, home_alt: float | None) -> float | None:
 
 
 def check(items: Sequence[MissionItem], vehicle: str, *, home_alt: float | None,
-          max_land_slope_deg: float = FW_LND_ANG) -> list[Problem]:
+          max_land_slope_deg: float = FW_LND_ANG, **_: object) -> list[Problem]:
     """The problems PX4 would reject or misfly in ``items`` on a ``vehicle`` (module docstring)."""
     out: list[Problem] = []
     allowed = PX4.commands[vehicle]
@@ -180,6 +183,35 @@ FW_RETURN = ReturnModel(
               _NO_CONE),
     mission_return=_MISSION, mission_note=_NOTE, sources=_SOURCES,
 )
+#: PX4's fixed-wing navigation defaults (parameter reference): NAV_ACC_RAD 10 m,
+#: NAV_LOITER_RAD 80 m, FW_R_LIM 50 deg, NPFG_PERIOD 10 s, NPFG_DAMPING 0.7,
+#: FW_T_CLMB_MAX / FW_T_SINK_MAX 5 m/s, FW_AIRSPD_MIN 10, FW_AIRSPD_TRIM 15,
+#: FW_AIRSPD_MAX 20 m/s, FW_LND_ANG 5 deg. A waypoint counts as reached within the larger
+#: of NAV_ACC_RAD and the guidance's switch distance (Navigator::get_acceptance_radius).
+FW_NAV = FixedWingNav(
+    label="PX4 fixed-wing", acceptance_radius=10.0, loiter_radius=80.0, bank_limit_deg=50.0,
+    guidance_period=10.0, guidance_damping=0.7, climb_rate=5.0, sink_rate=5.0,
+    airspeed_min=10.0, airspeed_cruise=15.0, airspeed_max=20.0, takeoff_pitch_deg=15.0,
+    takeoff_alt=50.0, turn_distance_rule="switch", landing_slope_max_deg=FW_LND_ANG,
+    names={"acceptance_radius": "NAV_ACC_RAD", "loiter_radius": "NAV_LOITER_RAD",
+           "bank_limit_deg": "FW_R_LIM", "guidance_period": "NPFG_PERIOD",
+           "guidance_damping": "NPFG_DAMPING", "climb_rate": "FW_T_CLMB_MAX",
+           "sink_rate": "FW_T_SINK_MAX", "airspeed_min": "FW_AIRSPD_MIN",
+           "airspeed_cruise": "FW_AIRSPD_TRIM", "airspeed_max": "FW_AIRSPD_MAX",
+           "takeoff_alt": "MIS_TAKEOFF_ALT"},
+    sources=("https://docs.px4.io/main/en/advanced_config/parameter_reference.html",
+             "https://docs.px4.io/main/en/flight_modes_fw/mission.html",
+             "https://docs.px4.io/main/en/flight_modes_fw/takeoff.html",
+             "src/modules/navigator/navigator_main.cpp (get_acceptance_radius)"),
+)
+#: PX4's DO_CHANGE_SPEED: the navigator sets the cruising speed from param2 (airspeed on a
+#: fixed-wing, ground speed on a multicopter, as MAVLink's speed type names them).
+FW_SPEED = SpeedCommand(speed_type=0, accepted=(0,), ignored_outside=False,
+                        default="FW_AIRSPD_TRIM",
+                        source="PX4 navigator (VEHICLE_CMD_DO_CHANGE_SPEED)")
+MC_SPEED = SpeedCommand(speed_type=1, accepted=(1,), ignored_outside=False,
+                        default="MPC_XY_CRUISE",
+                        source="PX4 navigator (VEHICLE_CMD_DO_CHANGE_SPEED)")
 
 PX4 = FirmwareProfile(
     name="px4",
@@ -188,6 +220,10 @@ PX4 = FirmwareProfile(
     position_frames=POSITION_FRAMES,
     terrain_frame=False,
     landing_required=frozenset({"fixed_wing", "vtol"}),  # MIS_TKO_LAND_REQ = 2
-    rules=(check,),
+    rules=(check, speed_rules({"multirotor": MC_SPEED, "fixed_wing": FW_SPEED, "vtol": FW_SPEED},
+                              FW_NAV, "PX4"),
+           fixed_wing_rules(FW_NAV, "PX4")),
+    fixed_wing_nav=FW_NAV,
+    change_speed={"multirotor": MC_SPEED, "fixed_wing": FW_SPEED, "vtol": FW_SPEED},
     returns={"multirotor": (MC_RETURN,), "fixed_wing": (FW_RETURN,), "vtol": (FW_RETURN,)},
 )
