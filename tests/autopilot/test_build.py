@@ -371,7 +371,8 @@ def test_the_endurance_check_runs_by_default_and_says_where_the_reserve_is_reach
     names the point where the reserve is reached (checked here on the waypoint legs)."""
     slow = 0.2 if vehicle == "multirotor" else 1.0  # the hill is short: fly it slowly
     m, _ = export_mission(hill_tff(), ["plan"], _opts(vehicle=vehicle, hover_speed=slow,
-                                                      cruise_speed=slow, end="land"))
+                                                      cruise_speed=slow, min_speed=slow / 2,
+                                                      end="land"))
     f = m.summary()["flight"]
     assert f["endurance_s"] == pytest.approx(60.0 * minutes)
     assert "default" in f["endurance_source"] and "--endurance" in f["endurance_source"]
@@ -392,7 +393,8 @@ def test_the_endurance_check_runs_by_default_and_says_where_the_reserve_is_reach
     assert f["reserve_reached_at_lonlat"] == pytest.approx([lon, lat], abs=1e-6)
     # --endurance overrides the default
     given, _ = export_mission(hill_tff(), ["plan"], _opts(vehicle=vehicle, hover_speed=slow,
-                                                          cruise_speed=slow, end="land",
+                                                          cruise_speed=slow, min_speed=slow / 2,
+                                                          end="land",
                                                           endurance_s=1e6))
     assert given.summary()["flight"]["ok"]
     assert given.summary()["flight"]["endurance_source"].startswith("given")

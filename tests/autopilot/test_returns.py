@@ -90,7 +90,7 @@ def test_a_plane_too_close_below_the_wall_cannot_climb_over_it_copter_can(world)
 def test_a_plane_taking_off_below_the_floor_keeps_its_own_height_not_min_agl(world):
     # the route starts 10 m above home and climbs out east of the wall: from there a plane
     # cannot be 30 m up at once, and need not be; it must not come closer to the ground
-    climb = [[700.0, 200.0, 10.0], [650.0, 200.0, 20.0], [560.0, 200.0, 150.0],
+    climb = [[790.0, 200.0, 10.0], [640.0, 200.0, 20.0], [560.0, 200.0, 150.0],
              [200.0, 200.0, 150.0], [200.0, 50.0, 150.0]]
     plane = firmware_returns(mission(world, climb, firmware="ardupilot", vehicle="fixed_wing",
                                      end="loiter"), min_agl=30.0).results[0]

@@ -63,7 +63,7 @@ from .returns import rtl_end_notes
 from .firmware.navigation import AirframeNav, FixedWingNav
 from .landing import landing_pattern, loiter_radius
 from .placing import ItemPlacer, unit_xy
-from .speeds import Speeds, plan_speeds, speed_commands
+from .speeds import DEFAULT_MIN_SPEED, Speeds, plan_speeds, speed_commands  # noqa: F401 (re-exported)
 from .validate import check_mission
 from .waypoints import FRAMES, Waypoints, mission_waypoints, resolve_frame
 
@@ -557,10 +557,9 @@ def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: Speeds, start_hold
     warning = rep.warning
     where: dict[str, Any] = {}
     if warning is not None:
-        q_ = p[first - 1:]  # the legs timed (from where the climb-out leaves)
-        k = int(rep.reach_waypoint)
-        q = q_[k] if k + 1 >= len(q_) else q_[k] + rep.reach_fraction * (q_[k + 1] - q_[k])
-        where = {"reserve_reached_at_m": [round(float(v), 2) for v in q]}
+        k = int(rep.reach_waypoint) + first - 1  # the legs timed start where the climb-out leaves
+        q = p[k] if k + 1 >= len(p) else p[k] + rep.reach_fraction * (p[k + 1] - p[k])
+        where = {"reserve_reached_at_m": [round(float(v), 2) for v in q], "reach_waypoint": k}
         lon, lat, _ = to_lonlat(world, q, anchor=opt.anchor)
         where["reserve_reached_at_lonlat"] = [round(float(lon), 7), round(float(lat), 7)]
         warning += f", at lon {lon:.5f}, lat {lat:.5f}"

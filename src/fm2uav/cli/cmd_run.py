@@ -59,8 +59,7 @@ RUN_HELP = (
                 "folder.", report_help="Also write report.html (interactive, self-contained) "
                 "when outputs.formats leaves it out (the default formats include it).")
 @world_options
-@mission_options(*MISSION_FLAGS, "thin", "anchor", "terrain",
-                 "terrain_spacing")
+@mission_options(*MISSION_FLAGS, "thin", "anchor")
 @return_options
 def run_cmd(
     mission_file: Path = typer.Argument(..., help="Mission YAML file.", show_default=False),
