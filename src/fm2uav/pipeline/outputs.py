@@ -168,8 +168,8 @@ def plan_outputs(
     if "html" in formats:
         progress.step("writing report.html", 0.2)
         write_text(outdir, "report.html", _plan_report(
-            plan, info, wps, options, formats, title=title, subtitle=subtitle, zones=zones,
-            fence_warnings=fence_warnings))
+            plan, info, mission, options, formats, title=title, subtitle=subtitle, zones=zones,
+            fence_warnings=fence_warnings, via=mission_inputs.get("via")))
     if "png" in formats:
         from ..viz import plan_figure
 
@@ -182,16 +182,20 @@ def plan_outputs(
     return info, mission
 
 
-def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
+def _plan_report(plan: Any, info: dict[str, Any], mission: Any, options: Any,
                  formats: Sequence[str], *, title: str, subtitle: str, zones: Any,
-                 fence_warnings: list[str]) -> str:
-    """report.html of a plan and its autopilot mission's waypoints ``wps`` (see
-    :func:`plan_outputs`)."""
+                 fence_warnings: list[str], via: Any = None) -> str:
+    """report.html of a plan and its autopilot mission (see :func:`plan_outputs`): the
+    mission's map and the operator's figures first, the planner's details folded away."""
     from ..analysis.known_ground import ground_notes
+    from ..viz.mapdata import mission_map
     from ..viz.overlays import filled_overlay, filled_path_overlay, zone_overlays
     from ..viz.report import report_html
+    from .rows import mission_figures
 
+    wps = mission.waypoints
     ms, level = info["autopilot"], getattr(plan, "level", None)
+    anchor = getattr(options, "anchor", None)
     params = {**plan.params, "waypoint tolerance [m]": options.tolerance,
               "firmware / airframe": f"{ms['firmware']} / {ms['vehicle']}",
               "MAVLink frame": {0: "0 (AMSL: DEM ground + AGL)", 3: "3 (relative to home)",
@@ -209,16 +213,32 @@ def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
         "flight time [min]": round(ms["flight"]["flight_time_s"] / 60, 2),
         "planning time [s]": round(float(plan.timings.get("total", 0.0)), 3),
         **safety_rows(info["safety"]),
-        **{f"warning {k + 1}": w for k, w in enumerate(ms["warnings"] + fence_warnings)},
     }
+    path = np.asarray(plan.path, dtype=float)
+    junctions = None if via is None else [0, *[int(v) for v in via], len(path) - 1]
+    points = {"start": path[0], **{f"via {k + 1}": path[int(v)] for k, v in
+                                   enumerate(via if via is not None else [])},
+              "goal": path[-1]}
+    doc = mission_map(plan, mission, info["safety"], points=points, anchor=anchor,
+                      junctions=junctions)
+    warnings = list(ground_notes(plan.world, info["safety"]).values())
+    warnings += [w for w in ms["warnings"] + fence_warnings if w not in warnings]
     return report_html(
         plan.world, {"FM² path": plan.path}, title=title, subtitle=subtitle,
         speeds={"FM² path": plan.w}, waypoints={"FM² path": wps.points_m},
         params=params, metrics=metrics, files=output_names(formats),
         agl=None if level is None else level.agl,
-        overlays={**filled_overlay(plan.world), **filled_path_overlay(plan.world, plan.path),
-                  **zone_overlays(zones)},
-        notes=list(ground_notes(plan.world, info["safety"]).values()))
+        overlays={**_not_on_map(filled_overlay(plan.world)),
+                  **_not_on_map(filled_path_overlay(plan.world, plan.path)),
+                  **_not_on_map(zone_overlays(zones))},
+        notes=warnings, map_doc=doc, anchor=anchor,
+        figures=mission_figures(plan.length, mission, info["safety"], plan.world,
+                                anchor=anchor))
+
+
+def _not_on_map(overlays: dict[str, Any]) -> dict[str, Any]:
+    """Report overlays for the 3D view only (the map draws zones and filled ground itself)."""
+    return {k: {**v, "map": False} for k, v in overlays.items()}
 
 
 def export_options(base: Any = None, *, firmware: str | None = None, vehicle: str | None = None,
