@@ -199,20 +199,23 @@ def formation_cmd(
     sc = Scenario(world=w, start=s, goal=g,
                   description=sc.description if sc else f"real data: {scenario}")
     title = f"formation — {scenario}" + (f", flight level {agl:g} m" if agl else "")
+    from .. import progress
+
     with output.progress() as step:
-        step(f"{title}: flying the formation (FM² re-planning every cycle)")
+        progress.step("the formation flight", 0.8)
         config = FormationConfig(n_followers=followers, shape=shape, dist=dist,
                                  leader_speed=speed, follower_speed=follower_speed,
                                  cycle=cycle, grey=grey)
         result, summary = fly_and_summarise(
             sc, config=config, level=flight_level,
             **({} if shaping is None else {"shaping": shaping}))
-        step("building one mission per UAV")
+        progress.step("building one mission per UAV", 0.05)
         missions, files = export_formation(result, MISSION_FORMATS, mission_options,
                                            fences=fences)
         summary = {"scenario": scenario, "world": world_summary(w), **summary,
                    "missions": {n: m.summary() for n, m in missions.items()},
                    "safety": _safety(result, missions, flight_level, fences, fence_warnings)}
+        progress.step("writing the files", 0.15)
         write_exports(outdir, files, step)
         _write_case(outdir, result, summary, title=title, gif=gif, frames=frames,
                     report=output.report, subtitle=sc.description, step=step)
@@ -296,7 +299,7 @@ def reproduce_formation_cmd(
                         title=case.title, gif=gif, frames=60, report=report,
                         subtitle=subtitle, step=step)
 
-        run = reproduce_formation(seed, on_case=write, on_step=step)
+        run = reproduce_formation(seed, on_case=write)
     lines = thesis_markdown(run)
     write_text(root, "table.md", lines)
     write_json(root, "summary.json", run.summaries)

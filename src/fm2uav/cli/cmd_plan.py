@@ -106,48 +106,56 @@ def plan_cmd(
     mission: MissionFlags = None,
 ) -> None:
     """``fm2uav plan``: parse, :func:`~fm2uav.missions.route.plan_route`, write, print."""
+    from .. import progress
     from ..missions.route import plan_route
     from ..world.load import world_summary
 
-    w, sc, scenario = world.build(scenario, start, goal, seed=seed, lonlat=lonlat, agl=agl)
-    description = sc.description if sc is not None else f"real data: {scenario}"
-    extra = _extra_formats(export, output.report)
-    export_options = mission.export_options(_export_options(anchor, thin))
-    outdir = output.dir(PLAN_FILES + tuple(output_names(extra)))
+    with output.progress():
+        progress.step("building the world", 0.1)
+        w, sc, scenario = world.build(scenario, start, goal, seed=seed, lonlat=lonlat, agl=agl)
+        description = sc.description if sc is not None else f"real data: {scenario}"
+        extra = _extra_formats(export, output.report)
+        export_options = mission.export_options(_export_options(anchor, thin))
+        outdir = output.dir(PLAN_FILES + tuple(output_names(extra)))
 
-    w, start_m, goal_m, via_m = _points(
-        w, sc, start, goal, mission.via, world=world, no_fly=no_fly, lonlat=lonlat,
-        cells=cells, agl=agl, anchor=getattr(export_options, "anchor", None))
-    shaping, level, options = _planner(
-        dict(saturation=saturation, saturation_distance=saturation_distance, exponent=exponent,
-             order=order, storage=storage),
-        dict(agl=agl, p1=p1, p2=p2, band=band, graded=graded, mode=mode, min_agl=min_agl,
-             max_agl=max_agl))
-    route = plan_route(w, start_m, goal_m, via=via_m,
-                       return_to_start=bool(mission.return_to_start), shaping=shaping,
-                       level=level, options=options)
-    p = route.plan
-    summary = {"scenario": scenario, "world": world_summary(w), **p.summary(),
-               "route": route.summary()}
-    if p.path.shape[1] == 3:  # measured on the continuous ground (legs: with the exports)
-        from ..analysis.known_ground import check_ground
-        from ..analysis.safety import safety_summary
+        w, start_m, goal_m, via_m = _points(
+            w, sc, start, goal, mission.via, world=world, no_fly=no_fly, lonlat=lonlat,
+            cells=cells, agl=agl, anchor=getattr(export_options, "anchor", None))
+        shaping, level, options = _planner(
+            dict(saturation=saturation, saturation_distance=saturation_distance,
+                 exponent=exponent, order=order, storage=storage),
+            dict(agl=agl, p1=p1, p2=p2, band=band, graded=graded, mode=mode, min_agl=min_agl,
+                 max_agl=max_agl))
+        progress.step("planning (FM²)", 0.6)
+        route = plan_route(w, start_m, goal_m, via=via_m,
+                           return_to_start=bool(mission.return_to_start), shaping=shaping,
+                           level=level, options=options)
+        p = route.plan
+        progress.step("measuring the flight against the ground", 0.05)
+        summary = {"scenario": scenario, "world": world_summary(w), **p.summary(),
+                   "route": route.summary()}
+        if p.path.shape[1] == 3:  # measured on the continuous ground (legs: with the exports)
+            from ..analysis.known_ground import check_ground
+            from ..analysis.safety import safety_summary
 
-        summary["safety"] = safety_summary(w, p.path, requested=agl, phase=p.phase,
-                                           level=p.level)
-        if not extra:  # else plan_outputs measures the legs too, and says it there
-            check_ground(w, summary["safety"])
-    _write_plan(outdir, p, w, title=f"FM² plan — {scenario}",
-                ground=summary.get("safety", {}).get("ground"))
-    built = None
-    if extra:
-        info, built = plan_outputs(outdir, p, extra, export_options,
-                                   title=f"FM² plan — {scenario}", subtitle=description,
-                                   via=route.junctions[1:-1])
-        summary.update(waypoints=info["waypoints"], mavlink_frame=info["mavlink_frame"],
-                       home_lat_lon_alt=info["home_lat_lon_alt"], autopilot=info["autopilot"],
-                       safety=info["safety"])
-    write_json(outdir, "summary.json", summary)
+            summary["safety"] = safety_summary(w, p.path, requested=agl, phase=p.phase,
+                                               level=p.level)
+            if not extra:  # else plan_outputs measures the legs too, and says it there
+                check_ground(w, summary["safety"])
+        progress.step("drawing plan.png, writing path.csv", 0.1 if extra else 0.25)
+        _write_plan(outdir, p, w, title=f"FM² plan — {scenario}",
+                    ground=summary.get("safety", {}).get("ground"),
+                    anchor=getattr(export_options, "anchor", None))
+        built = None
+        if extra:
+            progress.step("the mission and the report", 0.15)
+            info, built = plan_outputs(outdir, p, extra, export_options,
+                                       title=f"FM² plan — {scenario}", subtitle=description,
+                                       via=route.junctions[1:-1])
+            summary.update(waypoints=info["waypoints"], mavlink_frame=info["mavlink_frame"],
+                           home_lat_lon_alt=info["home_lat_lon_alt"],
+                           autopilot=info["autopilot"], safety=info["safety"])
+        write_json(outdir, "summary.json", summary)
     output.summary("FM² plan", _rows(scenario, route, w, summary, built), summary)
 
 
@@ -186,14 +194,15 @@ def _points(w, sc, start: str | None, goal: str | None, via: list[str] | None, *
     return w, start_m, goal_m, via_m
 
 
-def _write_plan(outdir, p, world, *, title: str, ground: dict | None = None) -> None:
+def _write_plan(outdir, p, world, *, title: str, ground: dict | None = None,
+                anchor=None) -> None:
     """plan.png (with the known/unknown ground split ``ground``) and path.csv (with the final
     profile's floor) of a plan on ``world``."""
     from ..io import write_path_csv
     from ..viz import plan_figure
 
     georef = getattr(world, "georef", None)
-    fig = plan_figure(p, title=title, ground=ground)
+    fig = plan_figure(p, title=title, ground=ground, anchor=anchor)
     tmp_png = outdir.target("plan.png")
     fig.savefig(tmp_png, dpi=110)
     with outdir.open("path.csv") as fh:

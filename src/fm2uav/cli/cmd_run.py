@@ -88,7 +88,6 @@ def run_cmd(
     :func:`~fm2uav.pipeline.run.run_mission`, print."""
     from ..io.mission import load_mission
     from ..pipeline.run import run_mission
-    from ..progress import reporting
 
     points = point_overrides(start=start, goal=goal, lonlat=lonlat) or {}
     if mission.via:
@@ -103,7 +102,7 @@ def run_cmd(
     outdir = output.dir(output_names(formats), path=target)
     planner = {k: v for k, v in (("min_agl", min_agl), ("max_agl", max_agl),
                                  ("saturation_distance", saturation_distance)) if v is not None}
-    with output.progress() as step, reporting(lambda e: step(e.message)):
+    with output.progress():
         run = run_mission(m, outdir, mission_file=mission_file, options=options,
                           planner=planner, no_fly=no_fly or ())
     p = run.plan

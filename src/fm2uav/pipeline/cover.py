@@ -169,7 +169,9 @@ def cover_outputs(outdir: Any, cp, area: str, *, report: bool, title: str,
     with outdir.open("zigzag.csv") as fh:
         write_path_csv(fh, cp.zigzag.path(), comment=comment)
     write_figure(outdir, bands_figure(cp.zigzag, title=f"zigzag over {area}"), "bands.png")
-    write_figure(outdir, coverage_figure(cp, title=title), "coverage.png")
+    write_figure(outdir, coverage_figure(cp, title=title,
+                                         anchor=getattr(options, "anchor", None)),
+                 "coverage.png")
     with outdir.open("coverage.html") as fh:
         fh.write(coverage_html(cp, title=title))
     if report:

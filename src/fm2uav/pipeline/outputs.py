@@ -174,8 +174,8 @@ def plan_outputs(
         from ..viz import plan_figure
 
         progress.step("writing plan.png", 0.1)
-        write_figure(outdir, plan_figure(plan, title=title, ground=safety.get("ground")),
-                     "plan.png")
+        write_figure(outdir, plan_figure(plan, title=title, ground=safety.get("ground"),
+                                         anchor=getattr(options, "anchor", None)), "plan.png")
     if "json" in formats:
         write_json(outdir, "summary.json", {**info, "files": [str(p.name) for p in outdir.written]
                                             + ["summary.json"]})

@@ -259,6 +259,8 @@ def coverage_figures(cp: Any, shots: Any, mission: Any, *, photos: int,
            "covered": f"{100 * cp.coverage:.1f} % of the area"}
     if cam.get("gsd_cm_per_px") is not None:
         out["ground sample distance"] = f"{cam['gsd_cm_per_px']:.2f} cm/px"
+    else:
+        out["ground sample distance"] = "not known: no camera given (--camera)"
     if camera is not None:
         across, along = camera.footprint(float(cp.level.agl))
         out["photo footprint"] = f"{across:.0f} m × {along:.0f} m on the ground"

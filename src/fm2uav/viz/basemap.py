@@ -101,7 +101,7 @@ class LonLatImage:
         from PIL import Image
 
         buf = io.BytesIO()
-        Image.fromarray(self.rgba, "RGBA").save(buf, format="PNG", optimize=True)
+        Image.fromarray(self.rgba, "RGBA").save(buf, format="PNG", compress_level=6)
         return buf.getvalue()
 
     def data_uri(self) -> str:

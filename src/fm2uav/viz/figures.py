@@ -76,7 +76,7 @@ def plan_figure(plan: Plan, *, title: str | None = None,
     m.points(path[0], path[-1])
     m.scale_bar()
     ax.set_title("map")
-    ax.legend(loc="upper left", fontsize=7, framealpha=0.85)
+    m.legend()
     if three_d:
         ax2 = axes[0, 1]
         s = arc_length(path)

@@ -320,8 +320,19 @@ def formation_report_html(result: FormationResult, summary: dict[str, Any], *, t
                 "flown [m]": round(float(lengths[i]), 1),
                 **summary["level_keeping"].get(name, {})}
                for i, (name, agl) in enumerate(zip(r.names, r.agl))]
+    from .report import path_figures
+
+    figures = {
+        "UAVs": f"{len(r.names)} ({', '.join(r.names)}), shape {summary['shape']}, "
+                f"{summary['dist_m']:g} m apart",
+        "mission time (simulated)": f"{summary['mission_time_s']:.0f} s",
+        "closest two UAVs": f"{summary['min_separation_m']:.1f} m (bound "
+                            f"{summary['separation_bound_m']:g} m)",
+        "completed / settled": f"{summary['completed']} / {summary['settled']}",
+        **path_figures(r.world, paths),
+    }
     return report_html(
-        r.world, paths, title=title, subtitle=subtitle,
+        r.world, paths, title=title, subtitle=subtitle, figures=figures,
         ideal_agl={name: agl for name, agl in zip(r.names, r.agl) if agl is not None},
         overlays={"leader FM² plan": {"points": r.leader_plan.path, "color": "#333333",
                                       "dash": "dot", "width": 2}},

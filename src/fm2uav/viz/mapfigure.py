@@ -155,8 +155,6 @@ class LonLatMap:
         ax.yaxis.set_major_formatter(LonLatFormatter("lat"))
         ax.tick_params(labelsize=8)
         ax.grid(color="#334", alpha=0.25, lw=0.5, ls=":")
-        ax.set_xlabel("longitude")
-        ax.set_ylabel("latitude")
 
     def _plain(self) -> np.ndarray:
         img = self.image.rgba.copy()
@@ -282,6 +280,11 @@ class LonLatMap:
         if goal is not None:
             q = self.lonlat(np.asarray(goal, dtype=float)[None])[0]
             self.ax.plot(*q, "*", color="gold", mec="k", ms=13, label="goal", zorder=7)
+
+    def legend(self, ncol: int = 3) -> Any:
+        """The legend under the map (never over the route)."""
+        return self.ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.07), ncol=ncol,
+                              fontsize=7, frameon=False)
 
     def scale_bar(self) -> None:
         """A scale bar of a round length (about a fifth of the width), bottom right."""

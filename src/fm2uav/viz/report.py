@@ -45,8 +45,11 @@ from ..geometry import arc_length
 __all__ = ["report_html", "plan_report", "write_report", "join_polylines", "path_figures",
            "latlon_text"]
 
-_COLOURS = ["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#e377c2",
-            "#8c564b", "#bcbd22", "#7f7f7f"]
+#: Path colours: the first (the main route, coloured by height above ground on the map)
+#: red; the others avoid the map's height-above-ground scale (red-orange-green-blue), so a
+#: second path never reads as a height.
+_COLOURS = ["#d62728", "#9467bd", "#e377c2", "#8c564b", "#17becf", "#7f7f7f", "#bcbd22",
+            "#1f77b4", "#ff7f0e", "#2ca02c"]
 _CONFIG = {"displaylogo": False, "responsive": True}
 
 

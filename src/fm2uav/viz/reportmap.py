@@ -31,9 +31,9 @@ import numpy as np
 
 __all__ = ["report_map_document", "map_head", "map_body", "figures_table", "MAP_COLOURS"]
 
-#: Colours of the routes drawn in a fixed colour (as the 3D view's).
-MAP_COLOURS = ["#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf", "#e377c2",
-               "#8c564b", "#bcbd22", "#7f7f7f"]
+#: Colours of the routes drawn in a fixed colour (the 3D view's and the profiles').
+MAP_COLOURS = ["#d62728", "#9467bd", "#e377c2", "#8c564b", "#17becf", "#7f7f7f", "#bcbd22",
+               "#1f77b4", "#ff7f0e", "#2ca02c"]
 #: Secondary routes longer than this are thinned for the map (every k-th point).
 _MAX_SECONDARY = 5000
 

@@ -71,7 +71,8 @@
                        interactive: false }).addTo(layer);
     }
     if (p.color || !agl) {
-      L.polyline(ll, { color: p.color || "#c0392b", weight, renderer, dashArray: p.dash || null,
+      L.polyline(ll, { color: p.color || "#c0392b", weight: p.color ? weight - 1 : weight,
+                       renderer, dashArray: p.dash || null,
                        className: "fm2-route" }).bindTooltip(tip, { sticky: true }).addTo(layer);
       return;
     }
@@ -166,9 +167,10 @@
       if (p.label) layer.bindTooltip(escapeHtml(p.label), { sticky: true });
       layer.addTo(grp(p.layer || "more"));
     }
-    // routes: the ones in fixed colours first, the one coloured by height above ground on top
+    // routes: the one coloured by height above ground first, the others (flown tracks,
+    // followers, thinner) over it
     const routes = feature(doc, "route");
-    routes.sort((a, b) => (a.properties.color ? 0 : 1) - (b.properties.color ? 0 : 1));
+    routes.sort((a, b) => (a.properties.color ? 1 : 0) - (b.properties.color ? 1 : 0));
     for (const f of routes) drawRoute(grp(f.properties.name || "route"), f, renderer);
     const items = feature(doc, "item");
     const small = items.length > 60;
