@@ -104,7 +104,10 @@ class LonLatLocator(MaxNLocator):
             span = abs(vmax - vmin) or 1.0
             digits = len(f"{max(abs(vmin), abs(vmax)):.0f}") + _decimals(span / 5) + 1
             need = ((digits + 3) * 0.62 * size if self.kind == "lon" else 1.3 * size)
-            self.set_params(nbins=max(1, int(length_pt // (need + self.gap_pt))))
+            # one tick is allowed: MaxNLocator otherwise shrinks the step below the room
+            # a label needs to show two (a narrow map would get colliding labels)
+            self.set_params(nbins=max(1, int(length_pt // (need + self.gap_pt))),
+                            min_n_ticks=1)
         return super().tick_values(vmin, vmax)
 
 
@@ -235,8 +238,11 @@ class LonLatMap:
                     self.ax.fill([], [], facecolor=colour, alpha=0.3, edgecolor=colour,
                                  label=kind)
             c = self.lonlat(np.asarray(z.geometry.representative_point().coords)[:, :2])[0]
+            w, s, e, n = self.image.bounds
+            if not (w <= c[0] <= e and s <= c[1] <= n):
+                continue      # a zone beyond the map: its outline is cut, no label outside
             self.ax.text(c[0], c[1], _zone_label(z), fontsize=7, color="#8e1b10",
-                         ha="center", va="center", zorder=6,
+                         ha="center", va="center", zorder=6, clip_on=True,
                          bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none",
                                "alpha": 0.7})
 
@@ -293,7 +299,7 @@ class LonLatMap:
 
         w, e = self.ax.get_xlim()
         m_per_deg = 111_320.0 * math.cos(math.radians(self.lat0))
-        target = 0.2 * (e - w) * m_per_deg
+        target = 0.2 * (e - w) * m_per_deg * (1.0 + 1e-9)   # a fifth of 500 m: 100 m, not 50
         e10 = 10 ** math.floor(math.log10(max(target, 1e-3)))
         length = max(m for m in (e10, 2 * e10, 5 * e10) if m <= target) if target >= e10 \
             else e10
