@@ -262,6 +262,11 @@
     const layer = L.layerGroup().addTo(map);
     const steps = [10, 5, 2, 1, 0.5, 0.2, 0.1, 0.05, 0.02, 0.01, 0.005, 0.002, 0.001,
                    0.0005, 0.0002, 0.0001];
+    // "3.765° W", as the figures and plan.png write them (no sign to misread)
+    const hemi = (v, nd, pos, neg) => {
+      const t = Math.abs(v).toFixed(nd);
+      return `${t}° ${v < 0 && Number(t) !== 0 ? neg : pos}`;
+    };
     function redraw() {
       layer.clearLayers();
       const b = map.getBounds(), span = Math.max(b.getEast() - b.getWest(),
@@ -273,13 +278,13 @@
       for (let lon = Math.ceil(b.getWest() / step) * step; lon <= b.getEast(); lon += step) {
         L.polyline([[b.getSouth(), lon], [b.getNorth(), lon]], style).addTo(layer);
         L.marker([b.getNorth(), lon], { interactive: false, icon: L.divIcon({
-          className: "fm2-grat fm2-grat-lon", html: `${lon.toFixed(nd)}°`, iconSize: null }) })
+          className: "fm2-grat fm2-grat-lon", html: hemi(lon, nd, "E", "W"), iconSize: null }) })
           .addTo(layer);
       }
       for (let lat = Math.ceil(b.getSouth() / step) * step; lat <= b.getNorth(); lat += step) {
         L.polyline([[lat, b.getWest()], [lat, b.getEast()]], style).addTo(layer);
         L.marker([lat, b.getWest()], { interactive: false, icon: L.divIcon({
-          className: "fm2-grat fm2-grat-lat", html: `${lat.toFixed(nd)}°`, iconSize: null }) })
+          className: "fm2-grat fm2-grat-lat", html: hemi(lat, nd, "N", "S"), iconSize: null }) })
           .addTo(layer);
       }
     }
