@@ -89,10 +89,13 @@ def _thin(p: np.ndarray, limit: int) -> np.ndarray:
     return p[np.unique(np.r_[idx, len(p) - 1])]
 
 
-def _surface(world: Any, limit: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, str] | None:
-    """(x, y, z(ny, nx), label) of the ground surface, subsampled to <= limit nodes/axis."""
+def _surface(world: Any, limit: int) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, str]]:
+    """``[(x, y, z(ny, nx), label), ...]`` of the ground, subsampled to <= limit nodes/axis:
+    the terrain, and what stands on it (buildings, blocks, zones closed to flight) as
+    ``"obstacles"`` with NaN where nothing does — or, without terrain, the height of the
+    obstacles of each column alone. Empty for a 2D world."""
     if world.ndim != 3:
-        return None
+        return []
     nx, ny = world.shape[:2]
     s = max(_stride(nx, limit), _stride(ny, limit))
     x = world.origin[0] + np.arange(0, nx, s) * world.spacing[0]
@@ -102,17 +105,24 @@ def _surface(world: Any, limit: int) -> tuple[np.ndarray, np.ndarray, np.ndarray
     # obstacles standing on the terrain (buildings) rise more than a cell above it
     raised = world.terrain is not None and bool(np.any(h > world.terrain + world.spacing[2]))
     if world.terrain is not None and not raised:
-        z = world.terrain[::s, ::s]
-        label = "terrain"
-    else:
-        if world.terrain is not None:
-            h = np.maximum(h, world.terrain)
-        # block maximum, so thin obstacles (walls, small buildings) stay visible
-        px, py = (-nx) % s, (-ny) % s
-        hp = np.pad(h, ((0, px), (0, py)), mode="edge")
-        z = hp.reshape(hp.shape[0] // s, s, hp.shape[1] // s, s).max(axis=(1, 3))
-        label = "obstacles"
-    return x, y, np.asarray(z).T, label
+        return [(x, y, np.asarray(world.terrain[::s, ::s]).T, "terrain")]
+    if world.terrain is not None:
+        h = np.maximum(h, world.terrain)
+    # block maximum, so thin obstacles (walls, small buildings) stay visible
+    px, py = (-nx) % s, (-ny) % s
+    hp = np.pad(h, ((0, px), (0, py)), mode="edge")
+    z = hp.reshape(hp.shape[0] // s, s, hp.shape[1] // s, s).max(axis=(1, 3))
+    if world.terrain is None:
+        return [(x, y, np.asarray(z).T, "obstacles")]
+    ground = np.asarray(world.terrain[::s, ::s], dtype=float)
+    z = z[:ground.shape[0], :ground.shape[1]]
+    from scipy.ndimage import binary_dilation
+
+    up = z > ground + world.spacing[2]
+    # a ring of ground nodes around each block, so its walls are drawn down to the ground
+    blocks = np.where(up, z, np.where(binary_dilation(up, np.ones((3, 3), bool)), ground,
+                                                   np.nan))
+    return [(x, y, ground.T, "terrain"), (x, y, blocks.T, "obstacles")]
 
 
 def _table(rows: Mapping[str, Any]) -> str:
@@ -231,11 +241,10 @@ def _scene_figure(world: Any, paths: Mapping[str, np.ndarray],
     if world is None:
         pass
     elif three_d:
-        surf = _surface(world, limit)
-        if surf is not None:
-            x, y, z, label = surf
+        for x, y, z, label in _surface(world, limit):
             fig.add_trace(go.Surface(
-                x=x, y=y, z=z, name=label, colorscale="Earth" if label == "terrain" else "Greys",
+                x=x, y=y, z=z, name=label,
+                colorscale="Earth" if label == "terrain" else [[0, "#8a8a92"], [1, "#4a4a52"]],
                 opacity=0.9 if label == "terrain" else 0.75, showscale=False,
                 hovertemplate="x %{x:.0f} m<br>y %{y:.0f} m<br>z %{z:.1f} m<extra>" + label
                 + "</extra>"))
@@ -368,6 +377,8 @@ def _profile_figure(world: Any, paths: Mapping[str, np.ndarray],
         for level in dict.fromkeys(levels):
             fig.add_hline(y=level, line={"color": "black", "dash": "dash", "width": 1},
                           annotation_text=f"flight level {level:g} m", row=2, col=1)
+    if agl_row:   # from 0: a steady height reads as steady, not as centimetre noise
+        fig.update_yaxes(rangemode="tozero", row=2, col=1)
     fig.update_xaxes(title_text="distance along the path [m]", row=len(rows), col=1)
     fig.update_layout(height=240 * len(rows), margin={"l": 60, "r": 20, "t": 30, "b": 40})
     return fig
