@@ -52,8 +52,24 @@ def test_stages_counts_and_units_are_drawn_on_a_terminal():
         progress.step("writing the files", 0.5)
         time.sleep(0.3)
     frames = _frames(buf.getvalue())
-    assert any("planning (FM²): bands (3 of 40 bands)" in f for f in frames), frames
+    assert any("bands — planning (FM²)" in f and "3/40 bands" in f for f in frames), frames
     assert any("writing the files" in f and "50%" in f for f in frames), frames
+
+
+def test_a_narrow_terminal_keeps_the_count_and_the_innermost_stage():
+    console, buf = _terminal(width=80)
+    with progress_display(True, console):
+        progress.step("the formation flight with three UAVs over the fissure", 0.8)
+        with progress.span("flying the 3 UAVs (FM² re-planning every cycle)", 1.0):
+            progress.count(40, 95, "cycles")
+            time.sleep(0.3)
+    frames = _frames(buf.getvalue())
+    last = [f for f in frames if "cycles" in f]
+    assert last and all(len(f) <= 80 for f in last), frames
+    assert "40/95 cycles" in last[-1] and "%" in last[-1], last[-1]
+    # what is done now comes first; what it is part of is cut with "…"
+    assert last[-1][2:].startswith("flying the 3 UAVs") and "…" in last[-1], last[-1]
+    assert "formation" not in last[-1]
 
 
 def test_nothing_is_drawn_or_listened_to_off_a_terminal_or_when_disabled():

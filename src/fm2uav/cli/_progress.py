@@ -3,10 +3,10 @@
 The library marks the stages of long work (``span``/``step``/``count``, no printing);
 :func:`progress_display` listens to them while a command runs and draws, on stderr,
 
-    ⠹ planning (FM²): leg 2 of 3: arrival times T (Fast Marching) ━━━━━━╺━━━  48% 0:00:07 ETA 0:00:08
+    ⠹ flying the 3 UAVs — the formation flight  40/95 cycles ━━━━━╺━━━━  48% 0:00:07 ETA 0:08
 
-— the open stages, a count where the library gives one (bands, UAVs, cases), the
-share done, the time spent and, once the rate is known, the time left. It shows
+— the innermost open stage and the one it is part of, a count where the library gives one (bands, cycles,
+cases), the share done, the time spent and, once the rate is known, the time left. It shows
 nothing when stderr is not a terminal (a pipe, a file, CI) or when the command was
 asked for ``--quiet`` / ``--json``, and clears itself when the command ends, so the
 summary table follows a clean line.
@@ -77,19 +77,37 @@ def progress_display(enabled: bool = True, console: Any = None
 
     from rich.table import Column
 
-    # the stage text takes the room left and is cut with "…"; bar, share and times keep theirs
+    # the stage text takes the room left and is cut with "…"; the count, bar, share and
+    # times keep theirs
     what = TextColumn("{task.fields[what]}", markup=False,
                       table_column=Column(ratio=1, no_wrap=True, overflow="ellipsis"))
-    bar = Progress(SpinnerColumn(), what, BarColumn(bar_width=20), TaskProgressColumn(),
-                   TimeElapsedColumn(), _eta_column(), console=console, transient=True,
-                   refresh_per_second=8, expand=True)
-    task = bar.add_task("", total=_TOTAL, what="starting")
+    count = TextColumn("{task.fields[count]}", markup=False, style="progress.download",
+                       table_column=Column(no_wrap=True))
+    bar = Progress(SpinnerColumn(), what, count, BarColumn(bar_width=20),
+                   TaskProgressColumn(), TimeElapsedColumn(), _eta_column(), console=console,
+                   transient=True, refresh_per_second=8, expand=True)
+    task = bar.add_task("", total=_TOTAL, what="starting", count="")
 
     def on_event(event: Any) -> None:
         if event.fraction >= 1.0 and not event.stages:
             return    # the end: the summary follows
         # cheap (fields set under a lock): the bar draws them at its refresh rate
-        bar.update(task, completed=round(event.fraction * _TOTAL), what=event.message)
+        bar.update(task, completed=round(event.fraction * _TOTAL), what=_what(event),
+                   count=_count(event))
 
     with bar, reporting(on_event):
-        yield lambda message: bar.update(task, what=str(message))
+        yield lambda message: bar.update(task, what=str(message), count="")
+
+
+def _what(event: Any) -> str:
+    """What is being done now, then what it is part of: ``"arrival times T (Fast Marching)
+    — planning (FM²)"`` (the innermost stage first, so a narrow terminal cuts the context,
+    not the news; the outer stages are left out)."""
+    return " — ".join(reversed(event.stages[-2:])) if event.stages else "working"
+
+
+def _count(event: Any) -> str:
+    """``"40/95 cycles"`` when the innermost stage counts, else empty."""
+    if not event.total:
+        return ""
+    return f"{event.done}/{event.total}" + (f" {event.unit}" if event.unit else "")

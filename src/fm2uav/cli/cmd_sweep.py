@@ -102,10 +102,8 @@ def _fail(message: str, code: int, prefix: str = "error: ") -> None:
 def _run_and_report(config, out: Path, outdir: OutputDir, *, fresh: bool, scheduler: str | None,
                     workers: int | None, retry_failed: bool, as_json: bool, quiet: bool,
                     title: str) -> Any:
-    from ..experiments.curvature import summarise_run, sweep_payload, tables_markdown
-    from ..experiments.runner import run_sweep
-
     from .. import progress
+    from ..experiments.runner import run_sweep
     from ._common import progress as progress_display
 
     with progress_display(not (quiet or as_json)):

@@ -9,7 +9,7 @@ set is complete). Stages are reported through :mod:`fm2uav.progress`.
 from __future__ import annotations
 
 import json
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -77,16 +77,13 @@ def output_names(formats: Sequence[str]) -> list[str]:
 
 
 @progress.stage()
-def write_exports(outdir: Any, files: dict[str, Any],
-                  step: Callable[[str], None] | None = None) -> None:
+def write_exports(outdir: Any, files: dict[str, Any]) -> None:
     """Write :func:`fm2uav.io.export_mission` files into ``outdir`` (atomically each).
 
-    Each file is a :mod:`fm2uav.progress` step; ``step(message)`` is also told, if given.
+    Each file is a :mod:`fm2uav.progress` step.
     """
     for name, f in files.items():
         progress.step(f"writing {name}", 1.0 / max(1, len(files)))
-        if step is not None:
-            step(f"writing {name}")
         with outdir.open(name, mode="wb" if f.binary else "w") as fh:
             f.write(fh)
 

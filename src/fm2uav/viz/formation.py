@@ -304,6 +304,12 @@ def formation_animation(
     return path
 
 
+def _duration(seconds: float) -> str:
+    """``"2 min 41 s"`` (``"41 s"`` under a minute)."""
+    m, s = divmod(int(round(seconds)), 60)
+    return f"{m} min {s:02d} s" if m else f"{s} s"
+
+
 def formation_report_html(result: FormationResult, summary: dict[str, Any], *, title: str,
                           subtitle: str, files: list[str]) -> str:
     """report.html of one formation flight: every UAV's track, the leader's FM² plan.
@@ -325,10 +331,12 @@ def formation_report_html(result: FormationResult, summary: dict[str, Any], *, t
     figures = {
         "UAVs": f"{len(r.names)} ({', '.join(r.names)}), shape {summary['shape']}, "
                 f"{summary['dist_m']:g} m apart",
-        "mission time (simulated)": f"{summary['mission_time_s']:.0f} s",
+        "mission time (simulated)": _duration(float(summary["mission_time_s"])),
         "closest two UAVs": f"{summary['min_separation_m']:.1f} m (bound "
                             f"{summary['separation_bound_m']:g} m)",
-        "completed / settled": f"{summary['completed']} / {summary['settled']}",
+        "reached the goal / formation settled": (
+            f"{'yes' if summary['completed'] else 'NO'} / "
+            f"{'yes' if summary['settled'] else 'NO'}"),
         **path_figures(r.world, paths),
     }
     return report_html(
