@@ -40,11 +40,8 @@ CHILD_PRELUDE = textwrap.dedent(
 
     def speed_field(shape):
         # smooth, strictly positive speed field, the same for both solvers
-        axes = np.meshgrid(*[np.linspace(0, 1, n) for n in shape], indexing="ij")
-        v = np.ones(shape)
-        for a in axes:
-            v += 0.4 * np.sin(3.0 * a)
-        return v
+        from benchmarks.fields import smooth
+        return smooth(shape)[0]
     """
 )
 
@@ -125,37 +122,49 @@ def _eikonalfm(shape: tuple[int, ...], order: int, repeats: int, factored: bool)
     )
 
 
-def _fmm_interleaved(shape: tuple[int, ...], order: int, repeats: int) -> dict:
+def _fmm_interleaved(shape: tuple[int, ...], order: int, repeats: int,
+                     field: str = "smooth") -> dict:
     """Median times [s] of every solver, run in turn in one process (ours, then each peer,
     ``repeats`` rounds): on a shared machine a load change hits all of them alike, so the
-    ratios hold where separate processes' times would not. Peers missing: left out."""
+    ratios hold where separate processes' times would not. Peers missing: left out.
+
+    ``field``: ``"smooth"`` or ``"fm2"`` (:mod:`benchmarks.fields`; eikonalfm needs a
+    positive speed everywhere and runs on the smooth field only). Also returns the median
+    CPU time of the calling thread per solver (``"cpu"``: both solvers run on this thread).
+    """
     return _child(
         f"""
         from fm2uav import fast_marching
+        from benchmarks import fields
         import skfmm
         try:
             import eikonalfm
         except ImportError:
             eikonalfm = None
-        shape = {shape!r}; order = {order}; v = speed_field(shape)
-        src = tuple(n // 2 for n in shape); dx = (1.0,) * len(shape)
-        axes = np.meshgrid(*[np.arange(n) - n // 2 for n in shape], indexing="ij")
-        phi = np.sqrt(sum(a.astype(float) ** 2 for a in axes)) - 0.5
-        del axes
+        shape = {shape!r}; order = {order}
+        v, src = fields.smooth(shape) if {field!r} == "smooth" else fields.fm2_shaped(shape)
+        dx = (1.0,) * len(shape)
+        phi, vs = fields.skfmm_point_source(v, src)
         solvers = {{"ours": lambda: fast_marching(v, [src], order=order),
-                   "scikit-fmm": lambda: skfmm.travel_time(phi, v, order=order)}}
-        if eikonalfm is not None:
+                   "scikit-fmm": lambda: skfmm.travel_time(phi, vs, order=order)}}
+        if eikonalfm is not None and {field!r} == "smooth":
             tau0 = eikonalfm.distance(shape, dx, src, indexing="ij")
             solvers["eikonalfm"] = lambda: eikonalfm.fast_marching(v, src, dx, order)
             solvers["eikonalfm factored"] = (
                 lambda: eikonalfm.factored_fast_marching(v, src, dx, order) * tau0)
         small = tuple(slice(0, 9) for _ in shape)
-        fast_marching(v[small], [(4,) * len(shape)], order=order)  # JIT warm-up
+        fast_marching(np.ones(v[small].shape), [(4,) * len(shape)], order=order)  # JIT warm-up
         times = {{name: [] for name in solvers}}
+        cpu = {{name: [] for name in solvers}}
         for _ in range({repeats}):
             for name, fn in solvers.items():
-                t = time.perf_counter(); fn(); times[name].append(time.perf_counter() - t)
-        print(json.dumps({{name: statistics.median(ts) for name, ts in times.items()}}))
+                t, c = time.perf_counter(), time.thread_time()
+                fn()
+                times[name].append(time.perf_counter() - t)
+                cpu[name].append(time.thread_time() - c)
+        out = {{name: statistics.median(ts) for name, ts in times.items()}}
+        out["cpu"] = {{name: statistics.median(ts) for name, ts in cpu.items()}}
+        print(json.dumps(out))
         """
     )
 
@@ -177,7 +186,9 @@ def fmm_rows(quick: bool) -> list[dict]:
     The same smooth speed field and a point source at the grid centre for all. Times:
     all solvers in turn in one child process (:func:`_fmm_interleaved`, medians); peak
     memory: each solver alone in its own child, one run. Bar (issue 15): >= 3x
-    scikit-fmm at the same order (goal 4x); eikonalfm is reported, not barred.
+    scikit-fmm at the same order (goal 4x); eikonalfm is reported, not barred. Then the
+    FM²-shaped field (:func:`benchmarks.fields.fm2_shaped`, issue 27: >= 4x scikit-fmm),
+    against scikit-fmm only, with the ratio of the thread CPU times beside the wall times'.
     """
     cases = [((256, 256), 3), ((32, 32, 32), 3)] if quick else [((2048, 2048), 5), ((160, 160, 160), 3)]
     rows = []
@@ -205,6 +216,19 @@ def fmm_rows(quick: bool) -> list[dict]:
                         "notes": f"peer: {note}",
                     }
                 )
+    for shape, repeats in cases:
+        for order in (1, 2):
+            times = _fmm_interleaved(shape, order, repeats, field="fm2")
+            cpu = times["cpu"]
+            rows.append({
+                "benchmark": "fmm",
+                "case": f"{'x'.join(map(str, shape))} FM²-shaped order {order}",
+                "ours_s": times["ours"], "peer": "scikit-fmm", "peer_s": times["scikit-fmm"],
+                "ratio": times["scikit-fmm"] / times["ours"],
+                "bar": ">= 4x (issue 27)",
+                "notes": (f"obstacles 25 % (speed 0, masked for the peer), W = (d/d_max)^0.5, "
+                          f"source off-centre; thread CPU time ratio "
+                          f"{cpu['scikit-fmm'] / cpu['ours']:.2f}x")})
     return rows
 
 

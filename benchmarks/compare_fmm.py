@@ -9,7 +9,9 @@ change of machine load hits both alike. Three speed fields per grid:
 * ``sinusoidal``: ``1 + 0.4 sum_k sin(3 x_k)`` on the unit cube, as
   ``benchmarks/bench_core.py``'s ``speed_field``;
 * ``smooth random``: ``0.2 + g`` with ``g`` a Gaussian-filtered (sigma 4
-  cells) uniform random field (seed 0) scaled to ``[0, 1]``.
+  cells) uniform random field (seed 0) scaled to ``[0, 1]``;
+* ``fm2-shaped``: obstacles (speed 0, masked for scikit-fmm), ``W = (d/d_max)^0.5``
+  outside, the source off-centre (``benchmarks.fields.fm2_shaped``).
 
 scikit-fmm gets ``phi = |x - centre| - 0.5`` (its zero contour half a cell
 around the centre node) and ``travel_time(phi, speed, order)``; we get
@@ -36,7 +38,16 @@ import time
 
 import numpy as np
 
-FIELDS = ("constant", "sinusoidal", "smooth random")
+FIELDS = ("constant", "sinusoidal", "smooth random", "fm2-shaped")
+
+
+def _fields():
+    """``benchmarks.fields``, also when this file runs as a script (``python benchmarks/...``)."""
+    try:
+        from benchmarks import fields
+    except ImportError:  # run as a script: its folder is on sys.path
+        import fields
+    return fields
 
 
 def speed(shape: tuple[int, ...], field: str) -> np.ndarray:
@@ -54,7 +65,20 @@ def speed(shape: tuple[int, ...], field: str) -> np.ndarray:
 
         g = gaussian_filter(np.random.default_rng(0).random(shape), 4)
         return 0.2 + (g - g.min()) / (g.max() - g.min())
+    if field == "fm2-shaped":
+        fm2_shaped = _fields().fm2_shaped
+
+        return fm2_shaped(shape)[0]
     raise ValueError(f"unknown field {field!r}")
+
+
+def source(shape: tuple[int, ...], field: str) -> tuple[int, ...]:
+    """The source node of a field: the centre, off-centre on the FM²-shaped map."""
+    if field == "fm2-shaped":
+        fm2_shaped = _fields().fm2_shaped
+
+        return fm2_shaped(shape)[1]
+    return tuple(n // 2 for n in shape)
 
 
 def _time(fn) -> tuple[float, float]:
@@ -70,12 +94,13 @@ def compare(shape: tuple[int, ...], field: str, order: int, repeats: int) -> dic
 
     from fm2uav import fast_marching
 
+    skfmm_point_source = _fields().skfmm_point_source
+
     v = speed(shape, field)
-    src = tuple(n // 2 for n in shape)
-    axes = np.meshgrid(*[np.arange(n) - n // 2 for n in shape], indexing="ij")
-    phi = np.sqrt(sum(a.astype(float) ** 2 for a in axes)) - 0.5
+    src = source(shape, field)
+    phi, vs = skfmm_point_source(v, src)
     ours = lambda: fast_marching(v, [src], order=order)  # noqa: E731
-    peer = lambda: skfmm.travel_time(phi, v, order=order)  # noqa: E731
+    peer = lambda: skfmm.travel_time(phi, vs, order=order)  # noqa: E731
     ours()  # warm-up (compilation, page faults)
     peer()
     load0 = os.getloadavg()[0]

@@ -129,7 +129,8 @@ def summary(rows: list[dict], report: dict) -> str:
     parts = [f"`make bench` of {m['date']} on this {m['cpus']}-core machine (load average "
              f"{max(m['load_before'], m['load_after']):.1f}; table and method in "
              "`docs/performance.md`):"]
-    fmm = [r for r in rows if r["benchmark"] == "fmm" and r.get("ratio")]
+    fmm = [r for r in rows if r["benchmark"] == "fmm" and r.get("ratio")
+           and "FM²" not in r["case"]]
     for peer in ("scikit-fmm", "eikonalfm", "eikonalfm factored"):
         ratios = [r["ratio"] for r in fmm if r["peer"] == peer]
         if ratios:
@@ -137,6 +138,9 @@ def summary(rows: list[dict], report: dict) -> str:
     sizes = sorted({r["case"].split(" ")[0] for r in fmm})
     if sizes:
         parts[-1] = parts[-1].rstrip(";") + f" ({', '.join(sizes)}, order 1 and 2);"
+    shaped = [r["ratio"] for r in rows if r["benchmark"] == "fmm" and "FM²" in r["case"]]
+    if shaped:
+        parts.append(f"{_span(shaped)} on FM²-shaped maps (obstacles, W from 0 at the walls);")
     by_case = {r["case"]: r for r in rows}
     warm_plan = next((r for r in rows if r["benchmark"] == "plan"
                       and r["case"].startswith("open field") and "cached" in r["case"]), None)

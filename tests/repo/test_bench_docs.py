@@ -6,6 +6,7 @@ import shutil
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -20,6 +21,8 @@ ROWS = [
      "notes": "a | b"},
     {"benchmark": "fmm", "case": "160x160x160 order 2", "ours_s": 1.0, "peer": "scikit-fmm",
      "peer_s": 3.5, "ratio": 3.5},
+    {"benchmark": "fmm", "case": "2048x2048 FM²-shaped order 1", "ours_s": 0.25,
+     "peer": "scikit-fmm", "peer_s": 0.75, "ratio": 3.0},
     {"benchmark": "coldstart", "case": "first `fm2uav plan`, empty numba cache", "ours_s": 11.0,
      "first_output_s": 0.2},
     {"benchmark": "coldstart", "case": "first `fm2uav plan`, numba cache filled", "ours_s": 1.5,
@@ -47,6 +50,7 @@ def test_write_docs_replaces_the_blocks_only(tmp_path):
     assert "| fmm | 2048x2048 order 1 | 0.2 s | scikit-fmm | 0.8 s | 4.00× | 100 / 140 |" in table
     assert "a \\| b" in table and "machine otherwise idle" in table
     assert "FMM 3.50–4.00× faster than scikit-fmm (160x160x160, 2048x2048, order 1 and 2)" in readme
+    assert "3.00× on FM²-shaped maps" in readme  # apart: not mixed into the smooth field's span
     assert "takes 11 s" in readme and "every later one 1.5 s" in readme
     # the prose around the blocks is kept, and a second run gives the same pages
     for name, page in PAGES.items():
@@ -59,3 +63,18 @@ def test_write_docs_replaces_the_blocks_only(tmp_path):
 def test_fill_needs_the_markers():
     with pytest.raises(ValueError):
         bench.fill("no block here", "table", "x")
+
+
+def test_fm2_shaped_field_is_an_fm2_map():
+    from benchmarks import fields
+
+    W, src = fields.fm2_shaped((120, 90))
+    again, src2 = fields.fm2_shaped((120, 90))
+    np.testing.assert_array_equal(W, again)  # seeded
+    assert src == src2 and W[src] >= 0.5
+    walls = W == 0
+    assert 0.24 < walls.mean() < 0.3  # a quarter of the nodes are obstacles
+    assert W.max() == 1.0 and 0 < W[~walls].min() < 0.3  # sqrt(1 / d_max) next to a wall
+    assert abs(src[0] / 120 - 0.3) < 0.15 and abs(src[1] / 90 - 0.6) < 0.15  # off-centre
+    phi, v = fields.skfmm_point_source(W, src)
+    assert phi.mask.sum() == walls.sum() and (v > 0).all()

@@ -399,6 +399,48 @@ def _combine(ta, aa, tb, ab, tc, ac, rhs):
 
 
 @njit(**_OPT)
+def _side_min(T, c, s):
+    """Order 1: the smaller frozen neighbour time of node ``c`` along one axis (inf if none)."""
+    a = T[c - s]
+    b = T[c + s]
+    a = a if a >= 0.0 else _INF  # band, far, wall or ghost (NaN)
+    b = b if b >= 0.0 else _INF
+    return min(a, b)
+
+
+@njit(**_OPT)
+def _solve_iso(a, b, c, q):
+    """Order-1 update with the same spacing on every axis: ``sum (T - tau)^2 = q``.
+
+    ``q = h^2 / speed^2``; ``a, b, c`` the axes' upwind times (inf: none). The same
+    causal rule as :func:`_combine` (an axis joins while the solution is later than its
+    time), with the equal weights folded in: the one-axis solution ``a + sqrt(q)`` stands
+    when ``(b - a)^2 >= q``, the two-axis one ``(a + b + sqrt(2q - (b - a)^2)) / 2`` when
+    it is not later than ``c``. One square root per update and no division (measured
+    -12 % on 2048^2 order 1 constant speed, -7 % on an FM²-shaped map).
+    """
+    if b < a:
+        a, b = b, a
+    if c < b:
+        b, c = c, b
+        if b < a:
+            a, b = b, a
+    if a == _INF:
+        return _INF
+    d = b - a
+    if d * d >= q:  # also for b = inf
+        return a + math.sqrt(q)
+    t = 0.5 * (a + b + math.sqrt(q + q - d * d))
+    if t <= c:
+        return t
+    s = a + b + c
+    disc = s * s - 3.0 * (a * a + b * b + c * c - q)
+    if disc < 0.0:
+        return t
+    return (s + math.sqrt(disc)) / 3.0
+
+
+@njit(**_OPT)
 def _relax(T, V, c, t, last, pool, nxt, bk, mw, nfree, fh, cur, pf1, pf2, n):
     """Lower the band/far node ``c`` to ``t`` if that is smaller; queue it.
 
@@ -480,6 +522,9 @@ def _march2d_kernel(order):
         """
         n = _U(nx) * _U(ny)
         sx = _U(ny)
+        # order 1 on equal spacings: the cheaper update (_solve_iso)
+        iso = order == 1 and ihx2 == ihy2
+        hh = 1.0 / ihx2
         if st[_PHASE] == 0:
             if not _seed(T, n, pool, nxt, bk, mw, st):
                 return 1
@@ -526,9 +571,13 @@ def _march2d_kernel(order):
             # compile time, 17 s instead of 4.5 s, for no measurable speed)
             for nb in (c - sx, c + sx, c - _ONE, c + _ONE):
                 if T[nb] < 0.0:
-                    ta, aa = _axis_term(T, V, nb, sx, ihx2, order)
-                    tb, ab = _axis_term(T, V, nb, _ONE, ihy2, order)
-                    t = _combine(ta, aa, tb, ab, _INF, 0.0, V[nb])
+                    if iso:
+                        t = _solve_iso(_side_min(T, nb, sx), _side_min(T, nb, _ONE), _INF,
+                                       V[nb] * hh)
+                    else:
+                        ta, aa = _axis_term(T, V, nb, sx, ihx2, order)
+                        tb, ab = _axis_term(T, V, nb, _ONE, ihy2, order)
+                        t = _combine(ta, aa, tb, ab, _INF, 0.0, V[nb])
                     nfree, fh, cur = _relax(T, V, nb, t, last, pool, nxt, bk, mw, nfree, fh, cur,
                                             sx, _ZERO, n)
         st[_PHASE] = phase
@@ -552,6 +601,8 @@ def _march3d_kernel(order):
         n = _U(nx) * _U(ny) * _U(nz)
         sx = _U(ny) * _U(nz)
         sy = _U(nz)
+        iso = order == 1 and ihx2 == ihy2 and ihy2 == ihz2
+        hh = 1.0 / ihx2
         if st[_PHASE] == 0:
             if not _seed(T, n, pool, nxt, bk, mw, st):
                 return 1
@@ -596,10 +647,14 @@ def _march3d_kernel(order):
                         break
             for nb in (c - sx, c + sx, c - sy, c + sy, c - _ONE, c + _ONE):
                 if T[nb] < 0.0:
-                    ta, aa = _axis_term(T, V, nb, sx, ihx2, order)
-                    tb, ab = _axis_term(T, V, nb, sy, ihy2, order)
-                    tc, ac = _axis_term(T, V, nb, _ONE, ihz2, order)
-                    t = _combine(ta, aa, tb, ab, tc, ac, V[nb])
+                    if iso:
+                        t = _solve_iso(_side_min(T, nb, sx), _side_min(T, nb, sy),
+                                       _side_min(T, nb, _ONE), V[nb] * hh)
+                    else:
+                        ta, aa = _axis_term(T, V, nb, sx, ihx2, order)
+                        tb, ab = _axis_term(T, V, nb, sy, ihy2, order)
+                        tc, ac = _axis_term(T, V, nb, _ONE, ihz2, order)
+                        t = _combine(ta, aa, tb, ab, tc, ac, V[nb])
                     nfree, fh, cur = _relax(T, V, nb, t, last, pool, nxt, bk, mw, nfree, fh, cur, sx, sy, n)
         st[_PHASE] = phase
         st[_SCAN] = scan
