@@ -44,9 +44,9 @@ def _eta_column() -> Any:
 
 
 @contextmanager
-def progress_display(enabled: bool = True, console: Any = None
-                     ) -> Iterator[Callable[[str], None]]:
-    """Show the progress of the work inside the ``with`` block on ``console`` (stderr).
+def progress_display(enabled: bool, console: Any) -> Iterator[Callable[[str], None]]:
+    """Show the progress of the work inside the ``with`` block on ``console`` (the
+    command line's stderr console).
 
     Listens to :mod:`fm2uav.progress` (:func:`fm2uav.progress.reporting`) for the
     block and yields ``step(message)``, which names what the command itself does
@@ -56,11 +56,9 @@ def progress_display(enabled: bool = True, console: Any = None
 
     Example
     -------
-    >>> with progress_display(enabled=False) as step:
+    >>> with progress_display(False, None) as step:
     ...     step("planning")
     """
-    if console is None:
-        from ._common import err_console as console
     if not enabled or not console.is_terminal:
         yield lambda message: None
         return
