@@ -86,7 +86,9 @@ def coverage_figure(cp: CoveragePlan, *, title: str | None = None, anchor: Any =
     ax.plot(zz[:, 0], zz[:, 1], color="k", lw=0.6, ls=":", zorder=5, label="zigzag (planned)")
     if world.ndim == 3:
         agl = path[:, 2] - np.asarray(world.ground_height(path[:, 0], path[:, 1]), dtype=float)
-        m.agl_path(path, agl, float(cp.level.agl), lw=1.2 if cp.zigzag.n_bands > 40 else 1.8,
+        # hundreds of bands stay apart: thinner lines the more there are
+        n = cp.zigzag.n_bands
+        m.agl_path(path, agl, float(cp.level.agl), lw=1.8 if n <= 40 else max(0.4, 60.0 / n),
                    label="FM² path")
     else:
         m.path(path, color="crimson", lw=1.4, label="FM² path")

@@ -263,8 +263,9 @@ class LonLatMap:
         top = float(np.nanmax(a)) if np.isfinite(a).any() else 1.0
         scale = requested if requested else max(top, 1.0) / 1.6
         segs = np.stack([ll[:-1], ll[1:]], axis=1)
-        self.ax.plot(ll[:, 0], ll[:, 1], color="black", lw=lw + 2.2, alpha=0.35, zorder=5,
-                     solid_capstyle="round")
+        if lw >= 1.5:     # a dark edge lifts a route off the relief; dense bands go without
+            self.ax.plot(ll[:, 0], ll[:, 1], color="black", lw=lw + 2.2, alpha=0.35, zorder=5,
+                         solid_capstyle="round")
         lc = LineCollection(segs, cmap=AGL_CMAP, norm=Normalize(0.0, 1.6 * scale), lw=lw,
                             zorder=5, capstyle="round")
         lc.set_array(0.5 * (a[:-1] + a[1:]))
