@@ -92,8 +92,21 @@ def _write_tune_report(outdir: OutputDir, res, sc, s, g, *, agl: float, scenario
             "min_turn_radius_m", "length_m", "feasible")
     pareto = [{k: (round(r[k], 3) if isinstance(r[k], float) else r[k]) for k in keys}
               for r in res.pareto]
+    from ..viz.report import path_figures
     from ..viz.tff import tff_report_html
 
+    keeps = res.best_plan is not None
+    figures = {
+        "tuned parameters" if keeps else "closest parameters": (f"p1 {row['p1']:g}, p2 {row['p2']:g}, saturation α "
+                             f"{row['saturation']:g}, exponent β {row['exponent']:g}"),
+        "airframe limits": (
+            f"{'kept' if keeps else 'NOT kept by any candidate: the closest is shown'} "
+            f"(max climb {limits.max_climb_deg:g}°: path {row['climb_max_deg']:.1f}°; "
+            f"min turn radius {limits.min_turn_radius:g} m: path "
+            f"{row['min_turn_radius_m']:.0f} m)"),
+        "on the flight level (±1 cell)": f"{m['within']:.0%} of the path",
+        **path_figures(sc.world, {label: p.path}),
+    }
     html = tff_report_html(
         [p], [m], [label], sc, title=f"Auto-tuning — {scenario}, {agl:g} m above ground",
         params={"scenario": scenario, "agl [m]": agl,
@@ -101,7 +114,8 @@ def _write_tune_report(outdir: OutputDir, res, sc, s, g, *, agl: float, scenario
                 "min turn radius [m]": limits.min_turn_radius,
                 **{f"grid {k}": v for k, v in grid.items()}},
         files=list(TUNE_FILES), table_title="The tuned path",
-        extra_tables={"Pareto front (deviation ↓, max climb ↓, min turn radius ↑)": pareto})
+        extra_tables={"Pareto front (deviation ↓, max climb ↓, min turn radius ↑)": pareto},
+        figures=figures)
     write_text(outdir, REPORT, html)
 
 
