@@ -19,8 +19,9 @@
   const data = document.getElementById("fm2uav-map-data");
   if (!el || !data || typeof L === "undefined") return;
   const doc = JSON.parse(data.textContent);
+  // the zoom buttons go bottom right (added below): top left they hid the lat/lon labels
   const map = L.map(el, { zoomSnap: 0.25, zoomDelta: 0.5, attributionControl: false,
-                          preferCanvas: true, scrollWheelZoom: true });
+                          preferCanvas: true, scrollWheelZoom: true, zoomControl: false });
   const groups = {};
   if (doc.terrain) {
     const [w, s, e, n] = doc.terrain.bounds;
@@ -64,6 +65,7 @@
       ? `height above ground (requested ${p.requested_agl} m)` : "height above ground")
       .addTo(map);
   }
+  L.control.zoom({ position: "bottomright" }).addTo(map);   // stacked above the legend
   // cursor position
   const readout = L.control({ position: "bottomleft" });
   readout.onAdd = () => {
