@@ -30,15 +30,16 @@ listener), and nothing has to be threaded through the planners' signatures.
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
-__all__ = ["ProgressEvent", "reporting", "span", "stage", "step", "count"]
+__all__ = ["ProgressEvent", "reporting", "span", "stage", "step", "count", "each"]
 
 F = TypeVar("F", bound=Callable[..., Any])
+T = TypeVar("T")
 
 
 @dataclass(frozen=True)
@@ -53,20 +54,23 @@ class ProgressEvent:
         Names of the open stages, outermost first (empty at the end).
     done, total : int or None
         A count inside the innermost stage (e.g. leg 2 of 3), when known.
+    unit : str
+        What is counted (``"cycles"``, ``"cases"``), or ``""``.
     """
 
     fraction: float
     stages: tuple[str, ...]
     done: int | None = None
     total: int | None = None
+    unit: str = ""
 
     @property
     def message(self) -> str:
-        """The stages joined by ``": "`` with the count, e.g. ``"planning: leg 2 of 3"``."""
+        """The stages joined by ``": "`` with the count, e.g. ``"flying: (40 of 95 cycles)"``."""
         text = ": ".join(self.stages) if self.stages else (
             "done" if self.fraction >= 1.0 else "working")
         if self.total:
-            text += f" ({self.done} of {self.total})"
+            text += f" ({self.done} of {self.total}{' ' + self.unit if self.unit else ''})"
         return text
 
 
@@ -86,10 +90,11 @@ class _Tracker:
     stack: list[_Frame] = field(default_factory=lambda: [_Frame("", 0.0, 1.0)])
     last: float = 0.0
 
-    def emit(self, fraction: float, done: int | None = None, total: int | None = None) -> None:
+    def emit(self, fraction: float, done: int | None = None, total: int | None = None,
+             unit: str = "") -> None:
         self.last = max(self.last, min(1.0, fraction))
         self.callback(ProgressEvent(self.last, tuple(f.name for f in self.stack[1:] if f.name),
-                                    done, total))
+                                    done, total, unit))
 
     def open(self, name: str, share: float, is_step: bool) -> None:
         parent = self.stack[-1]
@@ -178,10 +183,30 @@ def step(name: str, share: float) -> None:
     tracker.open(name, share, is_step=True)
 
 
-def count(done: int, total: int) -> None:
-    """Report ``done`` of ``total`` items inside the innermost open stage (e.g. legs)."""
+def count(done: int, total: int, unit: str = "") -> None:
+    """Report ``done`` of ``total`` items (``unit``: what they are, e.g. ``"cycles"``) inside
+    the innermost open stage; its share done follows ``done / total``."""
     tracker = _LISTENER.get()
     if tracker is None or total <= 0:
         return
     f = tracker.stack[-1]
-    tracker.emit(f.start + f.width * min(done, total) / total, done, total)
+    done = min(int(done), int(total))
+    tracker.emit(f.start + f.width * done / total, done, int(total), unit)
+
+
+def each(items: Sequence[T], label: Callable[[T], str] | str) -> Iterator[T]:
+    """Iterate over ``items``, each a :func:`step` of an equal share named
+    ``"<label> (k of n)"`` (``label`` a text or a function of the item).
+
+    >>> events = []
+    >>> with reporting(events.append):
+    ...     for case in each(["a", "b"], lambda c: f"case {c}"):
+    ...         pass
+    >>> [(e.fraction, e.message) for e in events]
+    [(0.0, 'case a (1 of 2)'), (0.5, 'case b (2 of 2)'), (1.0, 'done')]
+    """
+    n = len(items)
+    for k, item in enumerate(items):
+        name = label(item) if callable(label) else str(label)
+        step(f"{name} ({k + 1} of {n})", 1.0 / max(n, 1))
+        yield item

@@ -196,9 +196,14 @@ def test_tune_report_shows_the_best_path(runs):
     best = json.loads((out / "tune.json").read_text())["best"]
     html = (out / "report.html").read_text(encoding="utf-8")
     names = {t.get("name") for t in _figure(html, "fm2uav-scene")}
+    # beside the map: the parameters chosen and whether they keep the airframe's limits
+    aside = html[html.index("<aside"):html.index("</aside>")]
     if best is None:
         assert any(n and n.startswith("closest (breaks the limits)") for n in names), names
+        assert "closest parameters" in aside and "NOT kept by any candidate" in aside
     else:
+        assert "tuned parameters" in aside and f"p1 {best['p1']:g}, p2 {best['p2']:g}" in aside
+        assert "<td>kept (max climb" in aside
         label = f"best: p1={best['p1']:g}, p2={best['p2']:g}, α={best['saturation']:g}"
         assert label in names and f"{label} ideal (150 m AGL)" in {
             t.get("name") for t in _figure(html, "fm2uav-profiles")}

@@ -100,3 +100,30 @@ def test_notes_come_first_and_the_path_over_filled_ground_is_drawn(slope):
     assert FILLED_PATH_NAME in _traces(html, "fm2uav-scene")
     assert 'id="fm2uav-warnings"' not in report_html(w, {"FM² path": path})
     assert filled_path_overlay(World.from_heightmap(h, 10.0, 6), path) == {}
+
+
+def test_3d_view_keeps_the_relief_and_draws_buildings_apart():
+    """Terrain with a building: the relief stays coloured as terrain, the building is its own
+    grey surface standing on the ground (walls down to it), nothing elsewhere."""
+    x = np.arange(31)[:, None] * 10.0
+    h = 40.0 + 0.2 * x + np.zeros((31, 21))
+    ground = World.from_heightmap(h, 10.0, 20)
+    occ = np.array(ground.occupancy)
+    occ[12:16, 8:12, :15] = True                   # roof at 140 m
+    w = ground.with_fields(occupancy=occ)
+    p = np.column_stack([np.linspace(0, 300, 11), np.full(11, 30.0), np.full(11, 150.0)])
+    scene = _traces(report_html(w, {"a": p}), "fm2uav-scene")
+    terrain, blocks = scene["terrain"], scene["obstacles"]
+    def grid(v):
+        if isinstance(v, dict):      # plotly's typed array: base64 data and its shape
+            shape = [int(n) for n in str(v["shape"]).split(",")]
+            return _arr(v).astype(float).reshape(shape)
+        return np.array([[np.nan if c is None else c for c in row] for row in v], float)
+
+    tz = grid(terrain["z"])                           # (ny, nx)
+    np.testing.assert_allclose(tz, h.T, atol=1e-9)
+    bz = grid(blocks["z"])
+    assert np.all(bz[8:12, 12:16] == 140.0)          # the roof
+    ring = np.isfinite(bz) & (bz < 140.0)
+    np.testing.assert_allclose(bz[ring], h.T[ring])  # its walls end on the ground
+    assert ring.sum() == 6 * 6 - 4 * 4 and np.isfinite(bz).sum() == 36

@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import progress
 from .flight_level import flight_level_deviation
 from .profiles import path_profiles
 from ..errors import InputError, PlanningError
@@ -215,6 +216,7 @@ def _measure(row: dict[str, Any], world: World, pl: Plan, agl: float, step: floa
     )
 
 
+@progress.stage()
 def tune(
     world: World,
     start: Any,
@@ -284,9 +286,9 @@ def tune(
     if not (np.isfinite(step) and step > 0):
         raise InputError(f"ds must be > 0 metres, got {ds!r}")
     rows, plans = [], []
-    for sat, beta, p1, p2 in itertools.product(sats, exps, p1s, p2s):
-        if p2 <= p1:
-            continue
+    cases = [c for c in itertools.product(sats, exps, p1s, p2s) if c[3] > c[2]]
+    for sat, beta, p1, p2 in progress.each(
+            cases, lambda c: f"p1 = {c[2]:g}, p2 = {c[3]:g}, α = {c[0]:g}, β = {c[1]:g}"):
         row: dict[str, Any] = {"p1": p1, "p2": p2, "saturation": sat, "exponent": beta}
         pl = _plan_row(row, world, start, goal,
                        dataclasses.replace(shaping, saturation=sat, exponent=beta),

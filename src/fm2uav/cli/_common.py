@@ -309,24 +309,23 @@ def print_summary(
             console.print(Text(f"  {f}"), highlight=False)
 
 
-@contextmanager
-def progress(enabled: bool = True) -> Iterator[Callable[[str], None]]:
-    """Show the current stage of a long command as a rich spinner on stderr.
+def progress(enabled: bool = True) -> Any:
+    """The progress display of a long command on stderr (:func:`._progress.progress_display`):
+    the :mod:`fm2uav.progress` stages, counts, share done and time left as a rich bar.
 
-    Yields a function ``step(message)`` that updates the spinner. Nothing is
-    shown when ``enabled`` is False (``--quiet`` / ``--json``) or when stderr
-    is not a terminal (scripts, CI), so output stays clean for pipes.
+    Used as ``with progress(enabled) as step:``; ``step(message)`` names what the
+    command does itself. Nothing is shown when ``enabled`` is False (``--quiet`` /
+    ``--json``) or when stderr is not a terminal (scripts, CI), so output stays clean
+    for pipes.
 
     Example
     -------
     >>> with progress(enabled=False) as step:
     ...     step("planning")
     """
-    if not enabled or not err_console.is_terminal:
-        yield lambda message: None
-        return
-    with err_console.status("starting", spinner="dots") as status:
-        yield lambda message: status.update(f"[bold]{message}[/]")
+    from ._progress import progress_display
+
+    return progress_display(enabled, err_console)
 
 
 @dataclass
@@ -347,7 +346,7 @@ class Output:
 
     @property
     def show_progress(self) -> bool:
-        """Whether a progress spinner may be shown (neither ``--quiet`` nor ``--json``)."""
+        """Whether the progress display may be shown (neither ``--quiet`` nor ``--json``)."""
         return not (self.quiet or self.as_json)
 
     def progress(self) -> Any:

@@ -20,12 +20,17 @@ REPORT = "report.html"
 
 def _report(rep, world, rows: dict, *, title: str, subtitle: str, params: dict) -> str:
     """report.html of a check: the planned path and the flown track, saturation intervals."""
-    from ..viz.report import report_html
+    from ..viz.report import path_figures, report_html
 
     tr = rep.tracking
     flown = f"flown ({rep.airframe.name})"
+    paths = {"planned": tr.planned, flown: tr.trajectory}
+    figures = {"verdict": f"{'FEASIBLE' if rep.feasible else 'INFEASIBLE'} — {rep.reason}",
+               "airframe": f"{rep.airframe.name} ({rep.airframe.kind})",
+               "largest separation from the plan": f"{float(np.max(tr.separation)):.1f} m",
+               **path_figures(world, paths)}
     return report_html(
-        world, {"planned": tr.planned, flown: tr.trajectory}, title=title, subtitle=subtitle,
+        world, paths, title=title, subtitle=subtitle, figures=figures,
         styles={flown: {"dash": "dash", "width": 4}},
         params=params, metrics=rows,
         tables={"Where the limits saturate": tr.saturation_intervals()},
@@ -74,36 +79,40 @@ def check_cmd(
     world: WorldFlags = None,
 ) -> None:
     """``fm2uav check``: parse, :func:`~fm2uav.vehicles.check_feasibility`, write, print."""
+    from .. import progress
     from ..io import read_path_csv
     from ..vehicles import TrackingOptions, check_feasibility, get_airframe
 
     af = get_airframe(airframe)
     path = read_path_csv(path_file)
-    w = _check_world(world.spec(), scenario, seed, path)
-    outdir = output.dir(CHECK_FILES + ((REPORT,) if output.report else ()))
-    with output.progress() as step:
-        step(f"simulating the {af.name} along the path")
+    with output.progress():
+        progress.step("building the world", 0.2)
+        w = _check_world(world.spec(), scenario, seed, path)
+        outdir = output.dir(CHECK_FILES + ((REPORT,) if output.report else ()))
+        progress.step(f"simulating the {af.name} along the path", 0.5)
         rep = check_feasibility(path, af, world=w, tolerance=tolerance, speed=speed,
                                 tracking=TrackingOptions(lookahead=lookahead,
                                                          lookahead_points=lookahead_points,
                                                          dt=dt))
-    summary = {"path_file": str(path_file), "scenario": scenario, **rep.summary()}
-    if w is not None and getattr(w, "georef", None) is not None:
-        from ..world.load import world_summary
+        progress.step("writing the files", 0.3)
+        summary = {"path_file": str(path_file), "scenario": scenario, **rep.summary()}
+        if w is not None and getattr(w, "georef", None) is not None:
+            from ..world.load import world_summary
 
-        summary["world"] = world_summary(w)
-    _write_track(outdir, rep, w, path_file.name)
-    write_json(outdir, "report.json", summary)
-    rows = _rows(rep, af, w)
-    if output.report:
-        params = {"path file": path_file.name, "scenario": scenario or "none",
-                  "tolerance [m]": tolerance, "lookahead [m]": rep.tracking.lookahead,
-                  "time step [s]": dt, **{f"airframe {k}": v
-                                          for k, v in rep.airframe.summary().items()}}
-        write_text(outdir, REPORT, _report(
-            rep, w, rows, title=f"feasibility check — {path_file.name}",
-            subtitle=f"{af.name} ({af.kind}): {'FEASIBLE' if rep.feasible else 'INFEASIBLE'} "
-                     f"— {rep.reason}", params=params))
+            summary["world"] = world_summary(w)
+        _write_track(outdir, rep, w, path_file.name)
+        write_json(outdir, "report.json", summary)
+        rows = _rows(rep, af, w)
+        if output.report:
+            params = {"path file": path_file.name, "scenario": scenario or "none",
+                      "tolerance [m]": tolerance, "lookahead [m]": rep.tracking.lookahead,
+                      "time step [s]": dt, **{f"airframe {k}": v
+                                              for k, v in rep.airframe.summary().items()}}
+            write_text(outdir, REPORT, _report(
+                rep, w, rows, title=f"feasibility check — {path_file.name}",
+                subtitle=f"{af.name} ({af.kind}): "
+                         f"{'FEASIBLE' if rep.feasible else 'INFEASIBLE'} — {rep.reason}",
+                params=params))
     output.summary("feasibility check", rows, summary)
     if fail_infeasible and not rep.feasible:
         raise typer.Exit(EXIT_PLANNING)

@@ -92,10 +92,13 @@ def city_cmd(
 
     af = get_airframe(airframe)  # a bad --airframe fails before anything is checked
     outdir = output.dir(CITY_FILES + ((REPORT,) if output.report else ()))
-    with output.progress() as step:
+    from .. import progress
+
+    with output.progress():
+        progress.step("the experiment", 0.9)
         run = reproduce_city(seed, af, tolerance=tolerance, rrt=rrt, rrt_time=rrt_time,
-                             rrtstar_time=rrtstar_time, on_step=step)
-        step("writing the tables and figures")
+                             rrtstar_time=rrtstar_time)
+        progress.step("writing the tables and figures", 0.1)
         _write_city_outputs(outdir, run, report=output.report)
     summary = city_summary(run)
     write_json(outdir, "summary.json", summary)

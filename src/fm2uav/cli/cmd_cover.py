@@ -156,9 +156,9 @@ def cover_cmd(
 ) -> None:
     """``fm2uav cover``: parse, :func:`~fm2uav.pipeline.cover.run_cover`, print."""
     from ..missions.coverage import FULL_BOUNDS_DEG
+    from .. import progress
     from ..pipeline.cover import COVER_FILES, REPORT, band_cell, cover_rows, run_cover
     from ..pipeline.rows import safety_rows
-    from ..progress import reporting
     from ..world.load import world_summary
 
     level = safety.level(agl, p1=p1, p2=p2)  # refuses agl outside --min-agl/--max-agl
@@ -180,13 +180,14 @@ def cover_cmd(
         _validate.note_input(Path(area), "--area")
     outdir = output.dir(COVER_FILES + ((REPORT,) if output.report else ()))
     opts = {"bounds_deg": FULL_BOUNDS_DEG} if full_range else {}
-    with output.progress() as step, reporting(lambda e: step(e.message)):
-        step("building the map")
+    with output.progress():
+        progress.step("building the map", 0.1)
         w, _, scenario = build_world(world.spec(), scenario=scenario, seed=seed, agl=agl,
                                      default="coverage",
                                      max_cell=band_cell(d, bool(safety.no_fly)))
         poly, area_source = _load_area(area, w, world.crs)
         w = safety.apply(w, crs=world.crs)  # --no-fly zones become obstacles
+        progress.step(f"coverage of {area}", 0.9)
         run = run_cover(outdir, w, poly, area_label=area, spacing=d, level=level,
                         options=mission_options, camera=cam, front_overlap=front_overlap,
                         trigger_distance=trigger_distance, angle_deg=angle, search=search,
@@ -214,6 +215,7 @@ def reproduce_coverage_cmd(
         table_csv,
         tables_markdown,
     )
+    from .. import progress
     from ..pipeline.cover import REPORT
     from ..scenarios.coverage import COVERAGE_AREAS
 
@@ -222,9 +224,10 @@ def reproduce_coverage_cmd(
     files += [f"bands_{n}.png" for n in names] + [f"coverage_{n}.png" for n in names]
     files += [f"bands_S1_D{d}.png" for d in (40, 60, 100)]
     outdir = output.dir(files + ([REPORT] if output.report else []))
-    with output.progress() as step:
-        run = reproduce_coverage(seed, on_step=step)
-        step("drawing the figures")
+    with output.progress():
+        progress.step("Tables 5.1 and 5.2", 0.85)
+        run = reproduce_coverage(seed)
+        progress.step("drawing the figures", 0.15)
         _write_coverage_figures(outdir, run)
     write_text(outdir, "table_5_1.csv", table_csv(run.table_5_1, "surface", SEEDS_T51))
     write_text(outdir, "table_5_2.csv", table_csv(run.table_5_2, "D_m", SEEDS_T52))

@@ -74,15 +74,31 @@ def export_cmd(
     output: Output = None,
 ) -> None:
     """``fm2uav export``: read the path, :func:`~fm2uav.io.export_mission`, write, print."""
-    from ..geometry import path_length
-    from ..io import EXPORT_FILES, export_mission, parse_formats
-    from ..io.path_header import read_path_header
-    from ..planning import FlightLevel
+    from .. import progress
+    from ..io import EXPORT_FILES, parse_formats
 
     formats = parse_formats(",".join(fmt))
     outdir = output.dir([EXPORT_FILES[f] for f in formats] + ["summary.json", "terrain"]
                         + (["report.html"] if output.report else []))
-    world, base, mission_level, where = _world(mission_file, scenario, seed)
+    with output.progress():
+        progress.step("building the world", 0.4)
+        world, base, mission_level, where = _world(mission_file, scenario, seed)
+        progress.step("building the mission (altitudes, waypoints, firmware checks)", 0.5)
+        rows, summary = _export(outdir, path_file, world, base, mission_level, where,
+                                formats, mission, agl, report=output.report)
+    output.summary("fm2uav export", rows, summary)
+
+
+def _export(outdir, path_file: Path, world, base, mission_level, where: str, formats,
+            mission, agl, *, report: bool = False):
+    """Read the path, build its mission, write the files (and report.html with ``report``);
+    ``(printed rows, summary)``."""
+    from .. import progress
+    from ..geometry import path_length
+    from ..io import export_mission
+    from ..io.path_header import read_path_header
+    from ..planning import FlightLevel
+
     header = read_path_header(path_file)
     path, w, floor = _read_path(path_file, header, world, where)
     options = mission.export_options(base)
@@ -100,13 +116,14 @@ def export_cmd(
         length=path_length(path))
     built, files = export_mission(track, formats, options,
                                   agl=None if level is None else level.agl)
+    progress.step("writing the files", 0.1)
     write_exports(outdir, files)
     summary = {"path_file": str(path_file), "world": where, "path_crs": header["crs"],
                "points": len(path), "length_m": round(track.length, 3),
                "autopilot": built.summary()}
     rows = {"path": f"{path_file} ({len(path)} points, {track.length:.1f} m)",
             "world": where, **mission_rows(built)}
-    if output.report:
+    if report:
         from ..viz.report import report_html
 
         write_text(outdir, "report.html", report_html(
@@ -119,7 +136,7 @@ def export_cmd(
             metrics=rows, files=[p.name for p in outdir.written] + ["summary.json"]))
     write_json(outdir, "summary.json", {**summary, "files": [p.name for p in outdir.written]
                                         + ["summary.json"]})
-    output.summary("fm2uav export", rows, summary)
+    return rows, summary
 
 
 def _read_path(path_file: Path, header: dict, world, where: str):

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 import typer
@@ -65,9 +64,10 @@ def _outputs(gif: bool, report: bool) -> tuple[str, ...]:
 
 
 def _write_case(outdir: OutputDir, result, summary: dict[str, Any], *, title: str, gif: bool,
-                frames: int, report: bool = False, subtitle: str = "",
-                step: Callable[[str], None] = lambda message: None) -> None:
-    """The figures, tables, summary.json (animation, report.html) of one formation flight."""
+                frames: int, report: bool = False, subtitle: str = "") -> None:
+    """The figures, tables, summary.json (animation, report.html) of one formation flight;
+    each file a :mod:`fm2uav.progress` step of the caller's current part."""
+    from .. import progress
     from ..viz.formation import (
         formation_animation,
         formation_metrics_figure,
@@ -76,9 +76,11 @@ def _write_case(outdir: OutputDir, result, summary: dict[str, Any], *, title: st
         formation_report_html,
     )
 
+    # shares: a figure ~1, the animation ~4, the report ~2 (plotly and the map inlined)
+    parts = len(FIGURES) + (4 if gif else 0) + (2 if report else 0)
     for name, make in zip(FIGURES, (formation_paths_figure, formation_profiles_figure,
                                     formation_metrics_figure)):
-        step(f"{title}: writing {name}")
+        progress.step(f"drawing {name}", 1 / parts)
         fig = make(result, title=title)
         tmp = outdir.target(name)
         fig.savefig(tmp, dpi=100)
@@ -86,12 +88,12 @@ def _write_case(outdir: OutputDir, result, summary: dict[str, Any], *, title: st
     _write_tables(outdir, result)
     write_json(outdir, "summary.json", summary)
     if gif:
-        step(f"{title}: writing {ANIMATION}")
+        progress.step(f"drawing {ANIMATION}", 4 / parts)
         tmp = outdir.target(ANIMATION)
         formation_animation(result, tmp, max_frames=frames)
         outdir.commit(tmp, ANIMATION)
     if report:
-        step(f"{title}: writing {REPORT}")
+        progress.step(f"writing {REPORT}", 2 / parts)
         write_text(outdir, REPORT, formation_report_html(
             result, summary, title=title, subtitle=subtitle, files=list(_outputs(gif, False))))
 
@@ -207,23 +209,28 @@ def formation_cmd(
     sc = Scenario(world=w, start=s, goal=g,
                   description=sc.description if sc else f"real data: {scenario}")
     title = f"formation — {scenario}" + (f", flight level {agl:g} m" if agl else "")
-    with output.progress() as step:
-        step(f"{title}: flying the formation (FM² re-planning every cycle)")
+    from .. import progress
+
+    with output.progress():
+        progress.step("the formation flight", 0.75)
         config = FormationConfig(n_followers=followers, shape=shape, dist=dist,
                                  leader_speed=speed, follower_speed=follower_speed,
                                  cycle=cycle, grey=grey)
         result, summary = fly_and_summarise(
             sc, config=config, level=flight_level,
             **({} if shaping is None else {"shaping": shaping}))
-        step("building one mission per UAV")
+        progress.step("building one mission per UAV", 0.05)
         missions, files = export_formation(result, MISSION_FORMATS, mission_options,
                                            fences=fences)
         summary = {"scenario": scenario, "world": world_summary(w), **summary,
                    "missions": {n: m.summary() for n, m in missions.items()},
                    "safety": _safety(result, missions, flight_level, fences, fence_warnings)}
-        write_exports(outdir, files, step)
-        _write_case(outdir, result, summary, title=title, gif=gif, frames=frames,
-                    report=output.report, subtitle=sc.description, step=step)
+        progress.step("writing the missions", 0.05)
+        write_exports(outdir, files)
+        progress.step("figures, tables" + (" and the report" if output.report else ""), 0.15)
+        with progress.span("", 1.0):    # _write_case's steps divide this part
+            _write_case(outdir, result, summary, title=title, gif=gif, frames=frames,
+                        report=output.report, subtitle=sc.description)
     output.summary("FM² formation",
                    {**summary_rows(summary), **_timing_rows(missions),
                     **_safety_rows(summary["safety"]), **world_rows(w)}, summary)
@@ -308,13 +315,16 @@ def reproduce_formation_cmd(
     for case in THESIS_CASES:
         OutputDir(out / case.folder, force=output.force).check(_outputs(gif, report))
     subtitle = get_scenario("fissure", seed=seed).description
-    with output.progress() as step:
-        def write(case, result, summary) -> None:  # each case's folder as soon as it flew
-            _write_case(OutputDir(out / case.folder, force=output.force), result, summary,
-                        title=case.title, gif=gif, frames=60, report=report,
-                        subtitle=subtitle, step=step)
+    from .. import progress
 
-        run = reproduce_formation(seed, on_case=write, on_step=step)
+    with output.progress():
+        def write(case, result, summary) -> None:  # each case's folder as soon as it flew
+            with progress.span("writing its folder", 0.0):   # the case's time is its flight
+                _write_case(OutputDir(out / case.folder, force=output.force), result,
+                            summary, title=case.title, gif=gif, frames=60, report=report,
+                            subtitle=subtitle)
+
+        run = reproduce_formation(seed, on_case=write)
     lines = thesis_markdown(run)
     write_text(root, "table.md", lines)
     write_json(root, "summary.json", run.summaries)

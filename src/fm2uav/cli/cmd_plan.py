@@ -114,58 +114,67 @@ def plan_cmd(
     announce_compile(quiet=output.quiet,
                      child_group=fmm_group(order=order, ndim=2 if scenario == "city2d" else 3),
                      preload=("fm2uav.missions.route", "fm2uav.viz", "fm2uav.io"))
+    from .. import progress
     from ..missions.route import plan_route
     from ..world.load import world_summary
 
     returns.check()
-    w, sc, scenario = world.build(scenario, start, goal, seed=seed, lonlat=lonlat, agl=agl)
-    description = sc.description if sc is not None else f"real data: {scenario}"
-    extra = _extra_formats(export, output.report)
-    export_options = mission.export_options(_export_options(anchor, thin))
-    outdir = output.dir(PLAN_FILES + tuple(output_names(extra)))
+    with output.progress():
+        progress.step("building the world", 0.1)
+        w, sc, scenario = world.build(scenario, start, goal, seed=seed, lonlat=lonlat, agl=agl)
+        description = sc.description if sc is not None else f"real data: {scenario}"
+        extra = _extra_formats(export, output.report)
+        export_options = mission.export_options(_export_options(anchor, thin))
+        outdir = output.dir(PLAN_FILES + tuple(output_names(extra)))
 
-    w, start_m, goal_m, via_m = _points(
-        w, sc, start, goal, mission.via, world=world, no_fly=no_fly, lonlat=lonlat,
-        cells=cells, agl=agl, anchor=getattr(export_options, "anchor", None))
-    shaping, level, options = _planner(
-        dict(saturation=saturation, saturation_distance=saturation_distance, exponent=exponent,
-             order=order, storage=storage),
-        dict(agl=agl, p1=p1, p2=p2, band=band, graded=graded, mode=mode, min_agl=min_agl,
-             max_agl=max_agl))
-    route = plan_route(w, start_m, goal_m, via=via_m,
-                       return_to_start=bool(mission.return_to_start), shaping=shaping,
-                       level=level, options=options)
-    p = route.plan
-    built = None
-    info: dict = {}
-    if extra:
-        from ..pipeline.outputs import flown
+        w, start_m, goal_m, via_m = _points(
+            w, sc, start, goal, mission.via, world=world, no_fly=no_fly, lonlat=lonlat,
+            cells=cells, agl=agl, anchor=getattr(export_options, "anchor", None))
+        shaping, level, options = _planner(
+            dict(saturation=saturation, saturation_distance=saturation_distance,
+                 exponent=exponent, order=order, storage=storage),
+            dict(agl=agl, p1=p1, p2=p2, band=band, graded=graded, mode=mode, min_agl=min_agl,
+                 max_agl=max_agl))
+        progress.step("planning (FM²)", 0.6)
+        route = plan_route(w, start_m, goal_m, via=via_m,
+                           return_to_start=bool(mission.return_to_start), shaping=shaping,
+                           level=level, options=options)
+        p = route.plan
+        built = None
+        info: dict = {}
+        if extra:
+            from ..pipeline.outputs import flown
 
-        ret = returns.options(w, anchor=getattr(export_options, "anchor", None), crs=world.crs)
-        info, built = plan_outputs(outdir, p, extra, export_options,
-                                   title=f"FM² plan — {scenario}", subtitle=description,
-                                   via=route.junctions[1:-1], returns=ret)
-        p = flown(p, built)  # with the planned safe return when the mission carries one
-    summary = {"scenario": scenario, "world": world_summary(w), **p.summary(),
-               "route": route.summary()}
-    if p.path.shape[1] == 3:  # measured on the continuous ground (legs: with the exports)
-        from ..analysis.known_ground import check_ground
-        from ..analysis.safety import safety_summary
+            progress.step("the mission, its safe returns and the report", 0.15)
+            ret = returns.options(w, anchor=getattr(export_options, "anchor", None),
+                                  crs=world.crs)
+            info, built = plan_outputs(outdir, p, extra, export_options,
+                                       title=f"FM² plan — {scenario}", subtitle=description,
+                                       via=route.junctions[1:-1], returns=ret)
+            p = flown(p, built)  # with the planned safe return when the mission carries one
+        progress.step("measuring the flight against the ground", 0.05)
+        summary = {"scenario": scenario, "world": world_summary(w), **p.summary(),
+                   "route": route.summary()}
+        if p.path.shape[1] == 3:  # measured on the continuous ground (legs: with the exports)
+            from ..analysis.known_ground import check_ground
+            from ..analysis.safety import safety_summary
 
-        summary["safety"] = safety_summary(w, p.path, requested=agl, phase=p.phase,
-                                           level=p.level)
-        if not extra:  # else plan_outputs measures the legs too, and says it there
-            check_ground(w, summary["safety"])
-    _write_plan(outdir, p, w, title=f"FM² plan — {scenario}",
-                ground=summary.get("safety", {}).get("ground"))
-    if built is not None:
-        summary.update(waypoints=info["waypoints"], mavlink_frame=info["mavlink_frame"],
-                       home_lat_lon_alt=info["home_lat_lon_alt"], autopilot=info["autopilot"],
-                       safety=info["safety"])
-        for key in ("returns", "point_of_no_return"):
-            if key in info:
-                summary[key] = info[key]
-    write_json(outdir, "summary.json", summary)
+            summary["safety"] = safety_summary(w, p.path, requested=agl, phase=p.phase,
+                                               level=p.level)
+            if not extra:  # else plan_outputs measures the legs too, and says it there
+                check_ground(w, summary["safety"])
+        progress.step("drawing plan.png, writing path.csv", 0.1 if extra else 0.25)
+        _write_plan(outdir, p, w, title=f"FM² plan — {scenario}",
+                    ground=summary.get("safety", {}).get("ground"),
+                    anchor=getattr(export_options, "anchor", None))
+        if built is not None:
+            summary.update(waypoints=info["waypoints"], mavlink_frame=info["mavlink_frame"],
+                           home_lat_lon_alt=info["home_lat_lon_alt"],
+                           autopilot=info["autopilot"], safety=info["safety"])
+            for key in ("returns", "point_of_no_return"):
+                if key in info:
+                    summary[key] = info[key]
+        write_json(outdir, "summary.json", summary)
     output.summary("FM² plan", _rows(scenario, route, w, summary, built, p), summary)
 
 
@@ -214,7 +223,8 @@ def _points(w, sc, start: str | None, goal: str | None, via: list[str] | None, *
     return w, start_m, goal_m, via_m
 
 
-def _write_plan(outdir, p, world, *, title: str, ground: dict | None = None) -> None:
+def _write_plan(outdir, p, world, *, title: str, ground: dict | None = None,
+                anchor=None) -> None:
     """plan.png (with the known/unknown ground split ``ground``) and path.csv (with the final
     profile's floor) of a plan on ``world``."""
     import numpy as np
@@ -223,7 +233,7 @@ def _write_plan(outdir, p, world, *, title: str, ground: dict | None = None) -> 
     from ..viz import plan_figure
 
     georef = getattr(world, "georef", None)
-    fig = plan_figure(p, title=title, ground=ground)
+    fig = plan_figure(p, title=title, ground=ground, anchor=anchor)
     tmp_png = outdir.target("plan.png")
     fig.savefig(tmp_png, dpi=110)
     with outdir.open("path.csv") as fh:

@@ -99,7 +99,6 @@ def run_cmd(
     from ..pipeline.outputs import flown
     from ..pipeline.rows import returns_rows
     from ..pipeline.run import run_mission
-    from ..progress import reporting
 
     returns.check()
     points = point_overrides(start=start, goal=goal, lonlat=lonlat) or {}
@@ -123,7 +122,7 @@ def run_cmd(
     outdir = output.dir(output_names(formats), path=target)
     planner = {k: v for k, v in (("min_agl", min_agl), ("max_agl", max_agl),
                                  ("saturation_distance", saturation_distance)) if v is not None}
-    with output.progress() as step, reporting(lambda e: step(e.message)):
+    with output.progress():
         run = run_mission(m, outdir, mission_file=mission_file, options=options,
                           planner=planner, no_fly=no_fly or (), formats=formats,
                           returns=lambda mi, w: returns.options(

@@ -46,25 +46,6 @@ REPORT_FILES = (
     "curvature_frechet.png",
     "curvature_area.png",
 )
-def _progress(quiet: bool):
-    if quiet:
-        return None, None
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
-
-    prog = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                    TextColumn("failed {task.fields[failed]}"), TimeRemainingColumn(),
-                    transient=False)
-    tasks: dict[str, Any] = {}
-
-    def update(stage: str, done: int, total: int, failed: int) -> None:
-        if stage not in tasks:
-            label = "references" if stage == "references" else "FM² cases"
-            tasks[stage] = prog.add_task(label, total=total, failed=0)
-        prog.update(tasks[stage], completed=done, total=total, failed=failed)
-
-    return prog, update
-
-
 def _warning(message: str) -> None:
     err_console.print(f"[bold yellow]warning:[/] {escape(message)}", highlight=False, soft_wrap=True)
 
@@ -133,19 +114,27 @@ def _fail(message: str, code: int, prefix: str = "error: ") -> None:
 def _run_and_report(config, out: Path, outdir: OutputDir, *, fresh: bool, scheduler: str | None,
                     workers: int | None, retry_failed: bool, as_json: bool, quiet: bool,
                     title: str, report: bool = False) -> Any:
-    from ..experiments.curvature import summarise_run, sweep_payload, tables_markdown
+    from .. import progress
     from ..experiments.runner import run_sweep
+    from ._common import progress as progress_display
 
-    prog, update = _progress(quiet or as_json)
-    if prog is not None:
-        prog.start()
-    try:
+    with progress_display(not (quiet or as_json)):
+        progress.step("the sweep", 0.9)
         result = run_sweep(config, out, workers=workers, scheduler=scheduler,
-                           retry_failed=retry_failed, fresh=fresh, on_progress=update,
-                           on_warning=_warning)
-    finally:
-        if prog is not None:
-            prog.stop()
+                           retry_failed=retry_failed, fresh=fresh, on_warning=_warning)
+        progress.step("writing the tables and figures", 0.1)
+        payload, rows = _write_report(config, out, outdir, result, report=report, title=title)
+    print_summary(title, payload if as_json else rows, as_json=as_json, quiet=quiet,
+                  files=outdir.written + [out / config.results, result.log])
+    return result
+
+
+def _write_report(config, out: Path, outdir: OutputDir, result: Any, *,
+                  report: bool = False, title: str = "") -> tuple[dict, dict]:
+    """The sweep's tables, figures, summary.json (and report.html with ``report``); returns the JSON payload and the
+    printed rows."""
+    from ..experiments.curvature import summarise_run, sweep_payload, tables_markdown
+
     world, summary = summarise_run(config, result)
     from ..viz.sweep import best_paths_figure, curvature_figure, heatmap_figure
 
@@ -201,9 +190,7 @@ def _run_and_report(config, out: Path, outdir: OutputDir, *, fresh: bool, schedu
     t = summary["timing"]
     rows["Table 1 [s]"] = ", ".join(
         [f"{m} {t[f'{m}_s']:.3f} (×{t[f'{m}_ratio']:.0f})" for m in config.models] + [f"FM² {t['fm2_s']:.4f}"])
-    print_summary(title, payload if as_json else rows, as_json=as_json, quiet=quiet,
-                  files=outdir.written + [out / config.results, result.log])
-    return result
+    return payload, rows
 
 
 SWEEP_HELP = (

@@ -97,8 +97,21 @@ def _write_tune_report(outdir: OutputDir, res, sc, s, g, *, agl: float, scenario
             "min_turn_radius_m", "length_m", "feasible")
     pareto = [{k: (round(r[k], 3) if isinstance(r[k], float) else r[k]) for k in keys}
               for r in res.pareto]
+    from ..viz.report import path_figures
     from ..viz.tff import tff_report_html
 
+    keeps = res.best_plan is not None
+    figures = {
+        "tuned parameters" if keeps else "closest parameters": (f"p1 {row['p1']:g}, p2 {row['p2']:g}, saturation α "
+                             f"{row['saturation']:g}, exponent β {row['exponent']:g}"),
+        "airframe limits": (
+            f"{'kept' if keeps else 'NOT kept by any candidate: the closest is shown'} "
+            f"(max climb {limits.max_climb_deg:g}°: path {row['climb_max_deg']:.1f}°; "
+            f"min turn radius {limits.min_turn_radius:g} m: path "
+            f"{row['min_turn_radius_m']:.0f} m)"),
+        "on the flight level (±1 cell)": f"{m['within']:.0%} of the path",
+        **path_figures(sc.world, {label: p.path}),
+    }
     html = tff_report_html(
         [p], [m], [label], sc, title=f"Auto-tuning — {scenario}, {agl:g} m above ground",
         params={"scenario": scenario, "agl [m]": agl,
@@ -106,7 +119,8 @@ def _write_tune_report(outdir: OutputDir, res, sc, s, g, *, agl: float, scenario
                 "min turn radius [m]": limits.min_turn_radius,
                 **{f"grid {k}": v for k, v in grid.items()}},
         files=list(TUNE_FILES), table_title="The tuned path",
-        extra_tables={"Pareto front (deviation ↓, max climb ↓, min turn radius ↑)": pareto})
+        extra_tables={"Pareto front (deviation ↓, max climb ↓, min turn radius ↑)": pareto},
+        figures=figures)
     write_text(outdir, REPORT, html)
 
 
@@ -155,10 +169,12 @@ def reproduce_tff_cmd(
     tff_cases(mode)  # bad --mode fails before anything is written
     outdir = output.dir(TFF_FILES + ((REPORT,) if output.report else ()))
     t0 = time.perf_counter()
-    with output.progress() as step:
-        step(f"planning the terrain-following cases on {scenario}")
+    from .. import progress
+
+    with output.progress():
+        progress.step(f"terrain-following cases on {scenario}", 0.85)
         run = run_tff(scenario, seed, mode)
-        step("drawing the figures")
+        progress.step("drawing the figures", 0.15)
         _write_tff_outputs(outdir, run, report=output.report)
     summary = {
         r["case"]: f"within {r['within']:.0%}, mean|dev| {r['mean_dev_all_m']:.1f} m, "
@@ -202,13 +218,28 @@ def tune_cmd(
     world: WorldFlags = None,
 ) -> None:
     """``fm2uav tune``: parse, :func:`~fm2uav.analysis.tune.tune`, write, print."""
-    from ..analysis.tune import tune
-    from ..planning import FlightLevel
     from ..vehicles import AirframeLimits
-    from ..world.load import world_summary
 
     grid = _grid(p1=p1, p2=p2, saturation=saturation, exponent=exponent)
     limits = AirframeLimits.from_degrees(max_climb, min_turn_radius)
+    with output.progress():
+        rows, payload = _tune_run(
+            output, world, scenario=scenario, start=start, goal=goal, seed=seed,
+            lonlat=lonlat, agl=agl, grid=grid, limits=limits, max_climb=max_climb,
+            min_turn_radius=min_turn_radius)
+    output.summary("Auto-tuning", rows, payload)
+
+
+def _tune_run(output: Output, world: WorldFlags, *, scenario, start, goal, seed, lonlat, agl,
+              grid, limits, max_climb, min_turn_radius) -> tuple[dict, dict]:
+    """The body of ``fm2uav tune`` (inside its progress display): the summary rows and the
+    JSON payload."""
+    from .. import progress
+    from ..analysis.tune import tune
+    from ..planning import FlightLevel
+    from ..world.load import world_summary
+
+    progress.step("building the world", 0.1)
     w, sc, scenario = world.build(scenario, start, goal, seed=seed, lonlat=lonlat, agl=agl)
     s = cli_point(start, "start", w, lonlat=lonlat, agl=agl, default=sc.start if sc else None)
     g = cli_point(goal, "goal", w, lonlat=lonlat, agl=agl, default=sc.goal if sc else None)
@@ -219,10 +250,11 @@ def tune_cmd(
         check_points(w, {"start": s, "goal": g}, allow_filled=world.allow_filled)
         sc = Scenario(world=w, start=s, goal=g, description=f"real data: {scenario}")
     outdir = output.dir(TUNE_FILES + ((REPORT,) if output.report else ()))
-    with output.progress() as step:
-        n = sum(1 for a in grid["p1"] for b in grid["p2"] if b > a)
-        step(f"planning {n * len(grid['saturation']) * len(grid['exponent'])} candidates")
-        res = tune(sc.world, s, g, limits, FlightLevel(agl=agl), grid=grid)
+    n = sum(1 for a in grid["p1"] for b in grid["p2"] if b > a)
+    progress.step(f"planning {n * len(grid['saturation']) * len(grid['exponent'])} "
+                  "candidates", 0.8)
+    res = tune(sc.world, s, g, limits, FlightLevel(agl=agl), grid=grid)
+    progress.step("writing the files", 0.1)
     _write_tune_best(outdir, res, w, agl)
     write_text(outdir, "tune_table.md", res.markdown(
         f"Auto-tuning — {scenario}, agl {agl:g} m, max climb {max_climb:g}°, "
@@ -232,7 +264,7 @@ def tune_cmd(
     if output.report:
         _write_tune_report(outdir, res, sc, s, g, agl=agl, scenario=scenario, limits=limits,
                            grid=grid)
-    output.summary("Auto-tuning", {**res.summary_rows(), **world_rows(w)}, payload)
+    return {**res.summary_rows(), **world_rows(w)}, payload
 
 
 def _write_tune_best(outdir: OutputDir, res, world, agl: float) -> None:

@@ -55,10 +55,12 @@ def tracking_cmd(
     outdir = output.dir(TRACKING_FILES + (("report.html",) if output.report else ()))
     out = output.out
     sweep = sweep_dir if sweep_dir is not None else out.with_name(out.name + "-sweep")
-    with output.progress() as stage:
-        run = reproduce_tracking(sweep, step=step, pairs=pairs, xi=xi, workers=workers,
-                                 on_step=stage)
-        stage("writing the tables")
+    from .. import progress
+
+    with output.progress():
+        progress.step("the experiment", 0.95)
+        run = reproduce_tracking(sweep, step=step, pairs=pairs, xi=xi, workers=workers)
+        progress.step("writing the tables", 0.05)
         write_text(outdir, "table.md", "# Seed 004 §3.5 — tracking the best Dubins-like FM² "
                    "paths\n\n" + tracking_markdown(run) + "\n")
         if output.report and run.tracks:

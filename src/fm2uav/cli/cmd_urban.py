@@ -35,9 +35,12 @@ def urban_cmd(
     from ..io import write_path_csv
 
     outdir = output.dir(URBAN_FILES + (("report.html",) if output.report else ()))
-    with output.progress() as step:
-        run = reproduce_urban(seed, on_step=step)
-        step("writing the table and paths")
+    from .. import progress
+
+    with output.progress():
+        progress.step("the six cases", 0.95)
+        run = reproduce_urban(seed)
+        progress.step("writing the table and paths", 0.05)
         for i, p in enumerate(run.plans):
             with outdir.open(f"case{i + 1}.csv") as fh:
                 write_path_csv(fh, p.path, p.w)

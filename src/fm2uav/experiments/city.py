@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import progress
 from ..geometry import arc_length
 from ..planning import Plan, Shaping, plan
 from ..vehicles import FeasibilityReport, TrackingOptions, check_feasibility, get_airframe
@@ -252,9 +253,10 @@ class CityRun:
             arc_length(c.path3), c.plan.w) for c in self.cases}
 
 
+@progress.stage()
 def reproduce_city(seed: int = 0, airframe: Any = "disco", *, tolerance: float = 5.0,
-                   rrt: bool = True, rrt_time: float = 5.0, rrtstar_time: float = 1.0,
-                   on_step: Any = lambda message: None) -> CityRun:
+                   rrt: bool = True, rrt_time: float = 5.0, rrtstar_time: float = 1.0
+                   ) -> CityRun:
     """Thesis ch. 3: :func:`city_table` and (``rrt``) :func:`rrt_comparison` on the low mission.
 
     Parameters
@@ -267,15 +269,16 @@ def reproduce_city(seed: int = 0, airframe: Any = "disco", *, tolerance: float =
         Largest admissible separation [m].
     rrt_time, rrtstar_time : float
         Time cap of RRT / RRT-Connect and planning time of RRT* [s].
-    on_step : callable
-        Called with a one-line description before each stage.
+
+    Each stage is a :mod:`fm2uav.progress` step.
     """
     af = get_airframe(airframe)
-    on_step("planning both missions with W^1, W^1/2, W^1/4 and flying them")
+    progress.step("planning both missions with W^1, W^1/2, W^1/4 and flying them",
+                  0.6 if rrt else 1.0)
     run = CityRun(seed=seed, airframe=af, tolerance=tolerance,
                   cases=city_table(seed, af, tolerance=tolerance), missions=city_missions(seed))
     if rrt:
-        on_step("FM² vs OMPL RRT / RRT-Connect / RRT* (low mission)")
+        progress.step("FM² vs OMPL RRT / RRT-Connect / RRT* (low mission)", 0.4)
         sc = run.missions["low"]
         run.rrt_rows, run.rrt = rrt_comparison(sc, "low", af, time_limit=rrt_time,
                                                rrtstar_time=rrtstar_time, tolerance=tolerance,

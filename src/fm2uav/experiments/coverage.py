@@ -14,12 +14,13 @@ from __future__ import annotations
 
 import csv
 import io
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from .. import progress
 from ..missions.coverage import (
     CoveragePlan,
     differential_evolution,
@@ -105,18 +106,16 @@ class CoverageRun:
     s1_angles: dict[int, float] = field(default_factory=dict)
 
 
-def reproduce_coverage(seed: int = 0, *,
-                       on_step: Callable[[str], None] = lambda message: None) -> CoverageRun:
-    """Tables 5.1 and 5.2 on the coverage map of ``seed`` (terrain and DE seed).
-
-    ``on_step`` is called with a one-line description before each stage.
-    """
+@progress.stage()
+def reproduce_coverage(seed: int = 0) -> CoverageRun:
+    """Tables 5.1 and 5.2 on the coverage map of ``seed`` (terrain and DE seed); each area
+    and spacing is a :mod:`fm2uav.progress` step."""
     from .._validate import seed_value
 
     seed = seed_value(seed, "seed", where=(None, "--seed"))
     run = CoverageRun(seed=seed, world=coverage_world(seed))
-    for n in COVERAGE_AREAS:
-        on_step(f"area {n}: DE, 0.1° sweep, scipy DE and FM² along the bands")
+    for n in progress.each(list(COVERAGE_AREAS), lambda n: f"Table 5.1, area {n}: DE, 0.1° "
+                           "sweep, scipy DE and FM² along the bands"):
         poly = coverage_area(n)
         differential_evolution(poly, COVERAGE_SPACING, seed=seed)  # untimed: compiles
         de, r = angle_search_row(poly, COVERAGE_SPACING, seed)
@@ -130,8 +129,7 @@ def reproduce_coverage(seed: int = 0, *,
         run.table_5_1[n] = r
         run.plans[n] = cp
     s1 = coverage_area("S1")
-    for d in TABLE_5_2_SPACINGS:
-        on_step(f"S1 with D = {d} m")
+    for d in progress.each(list(TABLE_5_2_SPACINGS), lambda d: f"Table 5.2, S1 with D = {d} m"):
         de, r = angle_search_row(s1, float(d), seed)
         run.table_5_2[d] = r
         run.s1_angles[d] = float(de.angle)

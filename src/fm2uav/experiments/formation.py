@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from functools import lru_cache
 from typing import Any
 
+from .. import progress
 from ..analysis.flight_level import flight_level_deviation
 from ..errors import WorldError
 from ..missions.formation import FormationConfig, FormationResult, fly_formation, inside_terrain
@@ -185,22 +186,21 @@ class ThesisRun:
         return all(s["completed"] for s in self.summaries.values())
 
 
+@progress.stage()
 def reproduce_formation(
     seed: int = 0, *, cases: tuple[FormationCase, ...] = THESIS_CASES,
     on_case: Callable[[FormationCase, FormationResult, dict[str, Any]], None] = (
         lambda case, result, summary: None),
-    on_step: Callable[[str], None] = lambda message: None,
 ) -> ThesisRun:
     """Fly the thesis' cases across the fissure of ``seed``.
 
     ``on_case`` is called after each flight (e.g. to write its folder, so a
-    flight's arrays can be dropped early); ``on_step`` before each flight.
+    flight's arrays can be dropped early); each flight is a :mod:`fm2uav.progress` step.
     """
     sc = get_scenario("fissure", seed=seed)
     dz = sc.world.spacing[2]
     run = ThesisRun(seed=seed, scenario=sc, cases=cases, flights={}, summaries={})
-    for case in cases:
-        on_step(f"{case.title}: flying the formation (FM² re-planning every cycle)")
+    for case in progress.each(cases, lambda c: c.title):
         csc = case_scenario(seed, case)
         run.scenarios[case.folder] = csc
         (result, summary), _ = warm(lambda: fly_and_summarise(csc, **case.options(dz)),

@@ -73,6 +73,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 from pydantic import model_validator
 
+from .. import progress as _progress
 from ..errors import InputError
 from ..world import World
 from ..baselines.reference import MODELS, reference_path
@@ -534,6 +535,7 @@ def _executor(workers: int | None, scheduler: str | None, client: Any) -> Any:
     return InlinePool() if n == 1 else LocalPool(n)
 
 
+@_progress.stage()
 def run_sweep(
     config: SweepConfig,
     out_dir: str | os.PathLike[str],
@@ -650,7 +652,13 @@ def _run(config: SweepConfig, out: Path, log: CaseLog, history: list[dict[str, A
     refs_total = n_pairs * len(config.models)
     refs_dirty = False
 
-    progress = on_progress if on_progress is not None else _no_progress
+    events = _ProgressEvents()
+    if on_progress is None:
+        progress = events
+    else:
+        def progress(*args: Any) -> None:
+            events(*args)
+            on_progress(*args)
 
     with signals:  # installed until the cleanup is over (a second Ctrl-C waits)
         try:
@@ -765,8 +773,21 @@ def _references_to_run(config: SweepConfig, refs: dict[tuple[int, str], dict[str
     return need, done, failed
 
 
-def _no_progress(*args: Any) -> None:
-    """The progress callback of a sweep run without one."""
+class _ProgressEvents:
+    """The sweep's ``(stage, done, total, failed)`` reports as :mod:`fm2uav.progress` steps and
+    counts: the references a fifth of the run, the FM² cases the rest."""
+
+    def __init__(self) -> None:
+        self.stage: str | None = None
+
+    def __call__(self, stage: str, done: int, total: int, failed: int) -> None:
+        if stage != self.stage:
+            self.stage = stage
+            if stage == "references":
+                _progress.step("reference paths (Dubins, elastica, Reeds–Shepp)", 0.2)
+            else:
+                _progress.step("FM² cases", 1.0)
+        _progress.count(done, total, "done" + (f", {failed} failed" if failed else ""))
 
 
 def _reference_jobs(config: SweepConfig, base_ctx: dict[str, Any], starts: Any, goals: Any,

@@ -22,6 +22,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from .. import progress
 from ..analysis.flight_level import flight_level_deviation, tff_metrics
 from ..errors import InputError
 from ..planning import FlightLevel, Plan, Shaping, plan
@@ -122,6 +123,7 @@ def fm2_geodesic(p: Plan) -> Any:
                            clearance=float(surface_clearance(world, path).min()))
 
 
+@progress.stage()
 def run_tff(scenario: str = "open-field", seed: int = 0,
             mode: FlightLevelMode = "capped") -> TffRun:
     """Plan and measure the seeds' cases on the built-in ``scenario`` (needs terrain).
@@ -139,7 +141,8 @@ def run_tff(scenario: str = "open-field", seed: int = 0,
     sc = get_scenario(scenario, seed=seed)
     dz = sc.world.spacing[2]
     rows, plans = [], []
-    for case in cases:
+    for case in progress.each(cases, lambda c: f"{c.name}: level {c.level}, p1 = {c.p1:g}, "
+                                               f"p2 = {c.p2:g}"):
         agl = case.level * dz
         # the seeds' experiment measures the FM² path itself (heights="fm2")
         level = FlightLevel(agl=agl, p1=case.p1, p2=case.p2, mode=case.mode, heights="fm2")

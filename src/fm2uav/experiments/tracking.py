@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import progress
 from ..vehicles import TrackingOptions, get_airframe, track_dubins, track_multirotor
 from .curvature import curvature_config, summarise_run
 from .runner import make_config, run_sweep
@@ -69,10 +70,10 @@ class TrackingRun:
     tracks: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list, repr=False)
 
 
+@progress.stage()
 def reproduce_tracking(out_dir: str | Path, *, step: float = 0.1, pairs: int = 24,
                        xi: float = 10.0, workers: int = 1,
-                       summary: dict[str, Any] | None = None,
-                       on_step: Callable[[str], None] = lambda message: None) -> TrackingRun:
+                       summary: dict[str, Any] | None = None) -> TrackingRun:
     """The tracking experiment on the best area match to Dubins (see the module docstring).
 
     ``out_dir`` holds the Dubins sweep (resumed when it exists); ``summary``: use the
@@ -80,13 +81,14 @@ def reproduce_tracking(out_dir: str | Path, *, step: float = 0.1, pairs: int = 2
     the Dubins model (on the grid ``step``) instead.
     """
     if summary is None:
-        on_step(f"sweeping α, β (step {step:g}) against the Dubins reference ({pairs} pairs)")
+        progress.step(f"sweeping α, β (step {step:g}) against the Dubins reference "
+                      f"({pairs} pairs)", 0.8)
         _config, summary = best_dubins_match(out_dir, step=step, pairs=pairs, xi=xi,
                                              workers=workers)
     best = summary["best"]["area"]["dubins"]
     run = TrackingRun(alpha=best["alpha"], beta=best["beta"], xi=xi, step=step)
     bound = 1.0 / xi
-    on_step(f"flying the FM² paths at α = {best['alpha']:g}, β = {best['beta']:g}")
+    progress.step(f"flying the FM² paths at α = {best['alpha']:g}, β = {best['beta']:g}", 1.0)
     for k, pair in enumerate(summary["paths"]["area"]["dubins"]):
         if pair is None:
             continue

@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import progress
 from ..analysis.flight_level import flight_level_deviation
 from ..analysis.profiles import path_profiles
 from ..analysis.similarity import frechet_distance
@@ -131,8 +132,8 @@ def _xy_frechet(a: np.ndarray, b: np.ndarray) -> float:
     return frechet_distance(resample_path(a[:, :2], CITY_CELL), resample_path(b[:, :2], CITY_CELL))
 
 
-def reproduce_urban(seed: int | None = None, *,
-                    on_step: Any = lambda message: None) -> UrbanRun:
+@progress.stage()
+def reproduce_urban(seed: int | None = None) -> UrbanRun:
     """Plan and measure the six cases of thesis §4.4 (``seed=None``: :func:`urban_seed`)."""
     from .._validate import seed_value
 
@@ -146,8 +147,8 @@ def reproduce_urban(seed: int | None = None, *,
     cases = list(LEVEL_CASES + SMOOTH_CASES)
     rows, plans = [], []
     dz = world.spacing[2]
-    for case in cases:
-        on_step(f"§4.4 {case.experiment}: level {case.level}, p1 = {case.p1:g}, p2 = {case.p2:g}")
+    for case in progress.each(cases, lambda c: f"§4.4 {c.experiment}: level {c.level}, "
+                                               f"p1 = {c.p1:g}, p2 = {c.p2:g}"):
         agl = case.level * dz
         level = FlightLevel(agl=agl, p1=case.p1, p2=case.p2, heights="fm2")
         p, seconds = warm(lambda: plan(world, start, goal, level=level), [world])

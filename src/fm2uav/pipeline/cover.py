@@ -102,35 +102,54 @@ def run_cover(outdir: Any, world: Any, area: Any, *, area_label: str, spacing: f
                         trigger_distance=trigger_distance)
     built, safety = cover_outputs(outdir, cp, area_label, report=report,
                                   title=f"coverage of {area_label}", options=options,
-                                  camera=shots)
+                                  camera=shots, cam=camera)
     doc = {**(summary or {}), **cp.summary(), "autopilot": built.summary(), "safety": safety}
     write_json(outdir, "summary.json", doc)
     return CoverRun(coverage=cp, shots=shots, built=built, safety=safety, summary=doc)
 
 
 def _cover_report(outdir: Any, cp, *, title: str, subtitle: str, metrics: dict,
-                  waypoints=None, files=(), notes=()) -> None:
+                  mission: Any, shots: Any, safety: dict, options: Any = None,
+                  camera: Any = None, files=(), notes=()) -> None:
+    """report.html of a coverage mission: the map (area, bands, photo footprints, the
+    route by height above ground, numbered items) and the survey's figures first."""
     from ..viz.coverage import coverage_overlays
+    from ..viz.mapdata import coverage_features, mission_map
     from ..viz.overlays import filled_overlay, filled_path_overlay, zone_overlays
     from ..viz.report import report_html
+    from .outputs import _not_on_map
+    from .rows import coverage_figures, mission_figures
 
     name = "FM² path"
     world = cp.plan.world
-    overlays = {**filled_overlay(world), **filled_path_overlay(world, cp.path),
-                **coverage_overlays(cp),
-                **zone_overlays(getattr(world, "zones", ()))}
+    anchor = getattr(options, "anchor", None)
+    doc = mission_map(cp.plan, mission, safety, anchor=anchor,
+                      points={"start": cp.path[0], "goal": cp.path[-1]})
+    photos = coverage_features(cp, shots, camera, anchor, merge_above=2000)
+    doc["features"] += photos
+    n_photos = sum(f["properties"].get("photos", 1) for f in photos
+                   if f["properties"]["kind"] == "photo")
+    many = cp.zigzag.n_bands > 40
+    cover = {k: {**v, "map": False, **({"scene": False} if many and k == "bands" else {})}
+             for k, v in coverage_overlays(cp).items()}
+    overlays = {**_not_on_map(filled_overlay(world)),
+                **_not_on_map(filled_path_overlay(world, cp.path)), **cover,
+                **_not_on_map(zone_overlays(getattr(world, "zones", ())))}
+    figures = {**mission_figures(cp.plan.length, mission, safety, world, anchor=anchor),
+               **coverage_figures(cp, shots, mission, photos=n_photos, camera=camera)}
     html = report_html(
         world, {name: cp.path}, title=title, subtitle=subtitle,
         speeds={name: cp.plan.w}, ideal_agl={name: cp.level.agl},
-        waypoints=None if waypoints is None else {name: waypoints},
-        overlays=overlays, params=cp.params, metrics=metrics, files=files, notes=notes)
+        waypoints={name: mission.waypoints.points_m}, styles={name: {"colorby": "distance"}}
+        if many else None, overlays=overlays, params=cp.params, metrics=metrics,
+        files=files, notes=notes, map_doc=doc, anchor=anchor, figures=figures)
     with outdir.open(REPORT) as fh:
         fh.write(html)
 
 
 @progress.stage()
 def cover_outputs(outdir: Any, cp, area: str, *, report: bool, title: str,
-                         options=None, camera=None):
+                  options=None, camera=None, cam=None):
     """The mission files (path.csv, mission.plan, .waypoints, KML/KMZ, GeoJSON), zigzag.csv,
     PNGs, coverage.html and report.html; returns ``(built mission, safety figures)`` (the
     no-fly zones of the world go into the .plan geoFence)."""
@@ -164,7 +183,9 @@ def cover_outputs(outdir: Any, cp, area: str, *, report: bool, title: str,
     with outdir.open("zigzag.csv") as fh:
         write_path_csv(fh, cp.zigzag.path(), comment=comment)
     write_figure(outdir, bands_figure(cp.zigzag, title=f"zigzag over {area}"), "bands.png")
-    write_figure(outdir, coverage_figure(cp, title=title), "coverage.png")
+    write_figure(outdir, coverage_figure(cp, title=title,
+                                         anchor=getattr(options, "anchor", None)),
+                 "coverage.png")
     with outdir.open("coverage.html") as fh:
         fh.write(coverage_html(cp, title=title))
     if report:
@@ -185,11 +206,13 @@ def cover_outputs(outdir: Any, cp, area: str, *, report: bool, title: str,
             "planning time [s]": round(cp.timings.get("total", 0.0), 3),
             **safety_rows(safety),
         }
+        notes = list(ground_notes(world, safety, what="the survey path").values())
+        notes += [w for w in list(mission.warnings) + list(fence_warnings) if w not in notes]
         _cover_report(outdir, cp, title=title,
                       subtitle=f"zigzag bands over {area}, FM² at "
                                f"{cp.level.agl:g} m above the terrain",
-                      metrics=metrics, waypoints=wps.points_m, files=list(COVER_FILES),
-                      notes=list(ground_notes(world, safety, what="the survey path").values()))
+                      metrics=metrics, mission=mission, shots=camera, safety=safety,
+                      options=options, camera=cam, files=list(COVER_FILES), notes=notes)
     return mission, safety
 
 

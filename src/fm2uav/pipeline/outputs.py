@@ -9,7 +9,7 @@ set is complete). Stages are reported through :mod:`fm2uav.progress`.
 from __future__ import annotations
 
 import json
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -77,16 +77,13 @@ def output_names(formats: Sequence[str]) -> list[str]:
 
 
 @progress.stage()
-def write_exports(outdir: Any, files: dict[str, Any],
-                  step: Callable[[str], None] | None = None) -> None:
+def write_exports(outdir: Any, files: dict[str, Any]) -> None:
     """Write :func:`fm2uav.io.export_mission` files into ``outdir`` (atomically each).
 
-    Each file is a :mod:`fm2uav.progress` step; ``step(message)`` is also told, if given.
+    Each file is a :mod:`fm2uav.progress` step.
     """
     for name, f in files.items():
         progress.step(f"writing {name}", 1.0 / max(1, len(files)))
-        if step is not None:
-            step(f"writing {name}")
         with outdir.open(name, mode="wb" if f.binary else "w") as fh:
             f.write(fh)
 
@@ -179,14 +176,15 @@ def plan_outputs(
     if "html" in formats:
         progress.step("writing report.html", 0.2)
         write_text(outdir, "report.html", _plan_report(
-            plan, info, wps, options, formats, title=title, subtitle=subtitle, zones=zones,
-            fence_warnings=fence_warnings, returns=mission.returns))
+            plan, info, mission, options, formats, title=title, subtitle=subtitle, zones=zones,
+            fence_warnings=fence_warnings, via=mission_inputs.get("via"),
+            returns=mission.returns))
     if "png" in formats:
         from ..viz import plan_figure
 
         progress.step("writing plan.png", 0.1)
-        write_figure(outdir, plan_figure(plan, title=title, ground=safety.get("ground")),
-                     "plan.png")
+        write_figure(outdir, plan_figure(plan, title=title, ground=safety.get("ground"),
+                                         anchor=getattr(options, "anchor", None)), "plan.png")
     if "json" in formats:
         write_json(outdir, "summary.json", {**info, "files": [str(p.name) for p in outdir.written]
                                             + ["summary.json"]})
@@ -237,18 +235,23 @@ def _return_overlays(returns: Any) -> dict[str, Any]:
     return out
 
 
-def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
+def _plan_report(plan: Any, info: dict[str, Any], mission: Any, options: Any,
                  formats: Sequence[str], *, title: str, subtitle: str, zones: Any,
-                 fence_warnings: list[str], returns: Any = None) -> str:
-    """report.html of a plan and its autopilot mission's waypoints ``wps`` (see
-    :func:`plan_outputs`)."""
+                 fence_warnings: list[str], via: Any = None,
+                 returns: Any = None) -> str:
+    """report.html of a plan and its autopilot mission (see :func:`plan_outputs`): the
+    mission's map and the operator's figures first, the planner's details folded away."""
     import numpy as np
 
     from ..analysis.known_ground import ground_notes
+    from ..viz.mapdata import mission_map
     from ..viz.overlays import filled_overlay, filled_path_overlay, zone_overlays
     from ..viz.report import report_html
+    from .rows import mission_figures
 
+    wps = mission.waypoints
     ms, level = info["autopilot"], getattr(plan, "level", None)
+    anchor = getattr(options, "anchor", None)
     params = {**plan.params, "waypoint tolerance [m]": options.tolerance,
               "firmware / airframe": f"{ms['firmware']} / {ms['vehicle']}",
               "MAVLink frame": {0: "0 (AMSL: DEM ground + AGL)", 3: "3 (relative to home)",
@@ -268,16 +271,33 @@ def _plan_report(plan: Any, info: dict[str, Any], wps: Any, options: Any,
         "planning time [s]": round(float(plan.timings.get("total", 0.0)), 3),
         **safety_rows(info["safety"]),
         **returns_rows(info),
-        **{f"warning {k + 1}": w for k, w in enumerate(ms["warnings"] + fence_warnings)},
     }
+    path = np.asarray(plan.path, dtype=float)
+    junctions = None if via is None else [0, *[int(v) for v in via], len(path) - 1]
+    points = {"start": path[0], **{f"via {k + 1}": path[int(v)] for k, v in
+                                   enumerate(via if via is not None else [])},
+              "goal": path[-1]}
+    doc = mission_map(plan, mission, info["safety"], points=points, anchor=anchor,
+                      junctions=junctions)
+    warnings = list(ground_notes(plan.world, info["safety"]).values())
+    warnings += [w for w in ms["warnings"] + fence_warnings if w not in warnings]
     return report_html(
         plan.world, {"FM² path": plan.path}, title=title, subtitle=subtitle,
         speeds={"FM² path": plan.w}, waypoints={"FM² path": wps.points_m},
         params=params, metrics=metrics, files=output_names(formats),
         agl=None if level is None else level.agl,
-        overlays={**filled_overlay(plan.world), **filled_path_overlay(plan.world, plan.path),
-                  **zone_overlays(zones), **_return_overlays(returns)},
-        notes=list(ground_notes(plan.world, info["safety"]).values()))
+        overlays={**_not_on_map(filled_overlay(plan.world)),
+                  **_not_on_map(filled_path_overlay(plan.world, plan.path)),
+                  **_not_on_map(zone_overlays(zones)),
+                  **_not_on_map(_return_overlays(returns))},
+        notes=warnings, map_doc=doc, anchor=anchor,
+        figures=mission_figures(plan.length, mission, info["safety"], plan.world,
+                                anchor=anchor))
+
+
+def _not_on_map(overlays: dict[str, Any]) -> dict[str, Any]:
+    """Report overlays for the 3D view only (the map draws zones and filled ground itself)."""
+    return {k: {**v, "map": False} for k, v in overlays.items()}
 
 
 def export_options(base: Any = None, *, firmware: str | None = None, vehicle: str | None = None,

@@ -6,7 +6,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-__all__ = ["plan_rows", "world_rows", "mission_rows", "safety_rows", "ground_rows"]
+__all__ = ["plan_rows", "world_rows", "mission_rows", "safety_rows", "ground_rows",
+           "returns_rows", "mission_figures", "coverage_figures"]
 
 
 def mission_rows(mission: Any) -> dict[str, str]:
@@ -215,3 +216,124 @@ def returns_rows(info: dict[str, Any]) -> dict[str, str]:
     if r.get("mission_carries_safe_return"):
         rows["safe return in the mission"] = str(r["mission_carries_safe_return"])
     return rows
+
+
+def _km(m: float) -> str:
+    return f"{m / 1000:.2f} km" if m >= 1000 else f"{m:.0f} m"
+
+
+def _minutes(s: float) -> str:
+    m, sec = divmod(int(round(s)), 60)
+    return f"{m} min {sec:02d} s" if m < 60 else f"{m // 60} h {m % 60:02d} min"
+
+
+def _place(world: Any, point_m: Any, anchor: Any = None) -> str:
+    import numpy as np
+
+    from ..viz.report import latlon_text
+    from ..world.geo import to_lonlat
+
+    q = np.asarray(to_lonlat(world, np.asarray(point_m, dtype=float)[:2], anchor=anchor),
+                   dtype=float)
+    return latlon_text(float(q[0]), float(q[1]))
+
+
+def mission_figures(length_m: float, mission: Any, safety: dict[str, Any], world: Any, *,
+                    anchor: Any = None) -> dict[str, str]:
+    """The operator's figures of a mission, first in its report beside the map: how long,
+    how long in time (and energy, when the mission has it), where it takes off, how high
+    above the ground (lowest, where), the nearest no-fly zone, filled ground.
+
+    Every number comes from the built mission (:meth:`MissionExport.summary`) and the
+    safety figures (:func:`fm2uav.analysis.safety.safety_summary`), as ``summary.json``
+    records them.
+    """
+    s = mission.summary()
+    fl = s["flight"]
+    out = {"route length": _km(float(length_m)),
+           "flight time": f"{_minutes(fl['flight_time_s'])} ({_km(fl['flight_distance_m'])} "
+                          "with take-off and landing)"}
+    for key, label in (("energy_wh", "energy"), ("energy_Wh", "energy")):
+        if fl.get(key) is not None:
+            out[label] = f"{fl[key]:.0f} Wh"
+    if fl.get("endurance_s"):
+        out["endurance"] = (f"{100 * fl['flight_time_s'] / fl['endurance_s']:.0f} % of "
+                            f"{fl['endurance_s'] / 60:.0f} min"
+                            + ("" if fl.get("ok", True) else " — NOT ENOUGH"))
+    h = s["home"]
+    out["take-off (home)"] = (f"{_place_ll(h['lon'], h['lat'])}, {h['alt_amsl_m']:.0f} m AMSL")
+    out["mission"] = (f"{s['waypoints']} waypoints, {s['items']} items — {s['firmware']} "
+                      f"{s['vehicle']}, altitudes {s['frame']['name']} (MAVLink frame "
+                      f"{s['frame']['mav_frame']}), ends with {s['end']}")
+    out.update(_height_figures(safety, world, anchor))
+    z = safety.get("zones")
+    if z:
+        if z["distance_m"]:
+            name, d = min(z["distance_m"].items(), key=lambda kv: kv[1])
+            out["nearest no-fly zone"] = f"{d:.0f} m ({name})"
+        if z["path_entries"]:
+            out["ZONE ENTERED"] = ", ".join(sorted({e["zone"] for e in z["path_entries"]}))
+    bad = [k for k, c in safety.get("checks", {}).items() if not c.get("ok", True)]
+    if bad:
+        out["limits NOT met"] = ", ".join(bad)
+    return out
+
+
+def _place_ll(lon: float, lat: float) -> str:
+    from ..viz.report import latlon_text
+
+    return latlon_text(float(lon), float(lat))
+
+
+def _height_figures(safety: dict[str, Any], world: Any, anchor: Any) -> dict[str, str]:
+    """Lowest / highest height above the ground (whole path and cruise), where; clearance
+    to roofs; the length over filled (unknown) ground."""
+    out: dict[str, str] = {}
+    hag = safety.get("height_above_ground", {})
+    path = hag.get("path")
+    if path and path.get("n"):
+        where = ""
+        if "lowest_point_m" in path:
+            at = float(path.get("lowest_at_m", 0.0))
+            where = (f", {'at the start' if at < 1.0 else f'{_km(at)} along the route'} "
+                     f"({_place(world, path['lowest_point_m'], anchor)})")
+        out["lowest above ground"] = f"{path['min_m']:.0f} m{where}"
+        cruise = hag.get("cruise")
+        if cruise and cruise.get("n") and abs(cruise["min_m"] - path["min_m"]) >= 0.5:
+            out["lowest above ground, cruise"] = f"{cruise['min_m']:.0f} m"
+        out["highest above ground"] = f"{path['max_m']:.0f} m"
+    surf = safety.get("height_above_surface", {}).get("path")
+    if surf and surf.get("n"):
+        out["lowest above roofs / ground"] = f"{surf['min_m']:.0f} m"
+    if "clearance_m" in safety:
+        out["clearance to terrain and buildings"] = f"{safety['clearance_m']:.0f} m"
+    g = safety.get("ground")
+    if g and g["filled"]["length_m"] > 0:
+        f = g["filled"]
+        out["over FILLED ground (unknown)"] = (f"{_km(f['length_m'])} ({100 * f['share']:.0f} %"
+                                               " of the route): heights there are invented")
+    return out
+
+
+def coverage_figures(cp: Any, shots: Any, mission: Any, *, photos: int,
+                     camera: Any = None) -> dict[str, str]:
+    """The survey's figures for its report: area, photos, ground sample distance, bands,
+    spacing, coverage and the camera trigger distance."""
+    cam = mission.info.get("camera", {})
+    area = float(cp.zigzag.area.area)
+    out = {"survey area": f"{area / 1e4:.1f} ha ({area / 1e6:.3f} km²)",
+           "photos": f"{photos} (one every {shots.trigger_distance:.0f} m along the bands)",
+           "bands": f"{cp.zigzag.n_bands}, {cp.zigzag.spacing:.0f} m apart, steering angle "
+                    f"{cp.zigzag.angle_deg:.1f}°",
+           "covered": f"{100 * cp.coverage:.1f} % of the area"}
+    if cam.get("gsd_cm_per_px") is not None:
+        out["ground sample distance"] = f"{cam['gsd_cm_per_px']:.2f} cm/px"
+    else:
+        out["ground sample distance"] = "not known: no camera given (--camera)"
+    if camera is not None:
+        across, along = camera.footprint(float(cp.level.agl))
+        out["photo footprint"] = f"{across:.0f} m × {along:.0f} m on the ground"
+    if cam.get("side_overlap") is not None:
+        out["overlap side / front"] = (f"{100 * float(cam['side_overlap']):.0f} % / "
+                                       f"{100 * float(cam.get('front_overlap', 0)):.0f} %")
+    return out

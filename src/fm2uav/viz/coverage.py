@@ -10,9 +10,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-import matplotlib
 import numpy as np
-from matplotlib.colors import LightSource
 from matplotlib.figure import Figure
 
 from ..geometry import arc_length
@@ -68,30 +66,39 @@ def bands_figure(zz: Zigzag, *, title: str | None = None) -> Figure:
     return fig
 
 
-def coverage_figure(cp: CoveragePlan, *, title: str | None = None) -> Figure:
-    """Top view on the terrain, 3D view and altitude profile (path vs ideal) of a coverage plan."""
+def coverage_figure(cp: CoveragePlan, *, title: str | None = None, anchor: Any = None) -> Figure:
+    """Map in lon/lat (relief, buildings, zones, the area, the zigzag and the path coloured by
+    height above ground), 3D view and altitude profile (path vs ideal) of a coverage plan."""
+    from .mapfigure import LonLatMap
+
     world = cp.plan.world
     path = cp.path
     b = world.bounds
-    fig = Figure(figsize=(17, 5.4))
+    fig = Figure(figsize=(18, 5.8))
     ax = fig.add_subplot(1, 3, 1)
-    if world.terrain is not None:
-        ls = LightSource(azdeg=315, altdeg=45)
-        rgb = ls.shade(world.terrain.T, cmap=matplotlib.colormaps["gist_earth"], vert_exag=2.0,
-                       dx=world.spacing[0], dy=world.spacing[1], blend_mode="soft")
-        ax.imshow(rgb, origin="lower", extent=(b[0, 0], b[0, 1], b[1, 0], b[1, 1]))
-    _draw_area(ax, cp.zigzag.area, color="white", label="area")
-    zz = cp.zigzag.path()
-    ax.plot(zz[:, 0], zz[:, 1], color="k", lw=1.0, ls="--", label="zigzag")
-    ax.plot(path[:, 0], path[:, 1], color="crimson", lw=1.8, label="FM² path")
-    ax.set_xlim(b[0, 0], b[0, 1])
-    ax.set_ylim(b[1, 0], b[1, 1])
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.legend(loc="upper left", fontsize=7)
-    ax.set_title("top view", fontsize=10)
+    m = LonLatMap(ax, world, anchor)
+    area = cp.zigzag.area
+    for k, ring in enumerate([area.exterior, *area.interiors]):
+        ll = m.lonlat(np.asarray(ring.coords)[:, :2])
+        ax.plot(ll[:, 0], ll[:, 1], color="#1f4e9e", lw=2.0 if k == 0 else 1.2,
+                ls="-" if k == 0 else "--", zorder=6, label="area" if k == 0 else None)
+    zz = m.lonlat(cp.zigzag.path())
+    ax.plot(zz[:, 0], zz[:, 1], color="k", lw=0.6, ls=":", zorder=5, label="zigzag (planned)")
+    if world.ndim == 3:
+        agl = path[:, 2] - np.asarray(world.ground_height(path[:, 0], path[:, 1]), dtype=float)
+        # hundreds of bands stay apart: thinner lines the more there are
+        n = cp.zigzag.n_bands
+        m.agl_path(path, agl, float(cp.level.agl), lw=1.8 if n <= 40 else max(0.4, 60.0 / n),
+                   label="FM² path")
+    else:
+        m.path(path, color="crimson", lw=1.4, label="FM² path")
+    m.points(path[0], path[-1])
+    m.scale_bar()
+    m.legend()
+    ax.set_title("map", fontsize=10)
 
     ax3 = fig.add_subplot(1, 3, 2, projection="3d")
+    thin = max(1, len(path) // 4000)
     if world.terrain is not None:
         step = max(1, world.shape[0] // 60)
         gx = world.origin[0] + world.spacing[0] * np.arange(world.shape[0])[::step]
@@ -99,7 +106,16 @@ def coverage_figure(cp: CoveragePlan, *, title: str | None = None) -> Figure:
         X, Y = np.meshgrid(gx, gy, indexing="ij")
         ax3.plot_surface(X, Y, world.terrain[::step, ::step], cmap="gist_earth", alpha=0.6,
                          linewidth=0, antialiased=False)
-    ax3.plot(path[:, 0], path[:, 1], path[:, 2], color="crimson", lw=1.5)
+    q = path[::thin]
+    if cp.zigzag.n_bands > 40:   # hundreds of bands: thin lines coloured by band order
+        from mpl_toolkits.mplot3d.art3d import Line3DCollection
+
+        segs = np.stack([q[:-1], q[1:]], axis=1)
+        lc = Line3DCollection(segs, cmap="turbo", lw=0.6)
+        lc.set_array(np.linspace(0.0, 1.0, len(segs)))
+        ax3.add_collection3d(lc)
+    else:
+        ax3.plot(q[:, 0], q[:, 1], q[:, 2], color="crimson", lw=1.5)
     ax3.set_xlabel("x [m]")
     ax3.set_ylabel("y [m]")
     ax3.set_zlabel("z [m]")

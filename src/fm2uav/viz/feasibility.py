@@ -34,25 +34,40 @@ def _footprint(ax: Any, world: World | None) -> None:
 
 
 def tracking_figure(report: FeasibilityReport, world: World | None = None, *,
-                    title: str | None = None) -> Figure:
-    """Planned vs flown path (top view, altitude, separation) of one feasibility report."""
+                    title: str | None = None, anchor: Any = None) -> Figure:
+    """Planned vs flown path (map in lon/lat on a world, else a top view in the path's
+    metres; altitude; separation) of one feasibility report."""
     tr = report.tracking
     planned, flown = tr.planned, tr.trajectory
     fig = Figure(figsize=(16, 5))
     axes = fig.subplots(1, 3, gridspec_kw={"width_ratios": [1.1, 1.3, 1.3]})
     ax = axes[0]
-    _footprint(ax, world)
-    ax.plot(planned[:, 0], planned[:, 1], color="tab:blue", lw=2, label="planned")
-    ax.plot(flown[:, 0], flown[:, 1], color="crimson", lw=1.2, ls="--", label="flown")
     sat = np.zeros(len(flown), bool)
     for v in tr.saturated.values():
         sat |= v
-    if sat.any():
-        ax.plot(flown[sat, 0], flown[sat, 1], ".", color="orange", ms=3, label="limit saturated")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_title("top view")
-    ax.legend(fontsize=8, loc="upper left")
+    if world is not None:      # a map in lon/lat: relief, buildings, zones
+        from .mapfigure import LonLatMap
+
+        m = LonLatMap(ax, world, anchor)
+        m.path(planned, color="tab:blue", lw=2, label="planned")
+        m.path(flown, color="crimson", lw=1.2, ls="--", label="flown")
+        if sat.any():
+            m.path(flown[sat], ls="none", marker=".", color="orange", ms=3,
+                   label="limit saturated")
+        m.scale_bar()
+        m.legend(ncol=2)
+        ax.set_title("map")
+    else:
+        ax.plot(planned[:, 0], planned[:, 1], color="tab:blue", lw=2, label="planned")
+        ax.plot(flown[:, 0], flown[:, 1], color="crimson", lw=1.2, ls="--", label="flown")
+        if sat.any():
+            ax.plot(flown[sat, 0], flown[sat, 1], ".", color="orange", ms=3,
+                    label="limit saturated")
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.set_aspect("equal")
+        ax.set_title("top view (no world: x/y of the path file)")
+        ax.legend(fontsize=8, loc="upper left")
     ax = axes[1]
     ax.plot(arc_length(planned), planned[:, 2], color="tab:blue", lw=2, label="planned")
     ax.plot(tr.progress, flown[:, 2], color="crimson", lw=1.2, ls="--", label="flown")

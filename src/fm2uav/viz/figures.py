@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
-import matplotlib
 import numpy as np
-from matplotlib.colors import LightSource
 from matplotlib.figure import Figure
 
 from ..geometry import arc_length
@@ -23,13 +21,17 @@ FILLED_COLOUR = "#ff7f0e"
 
 
 def plan_figure(plan: Plan, *, title: str | None = None,
-                ground: dict | None = None) -> Figure:
-    """Top view (on terrain shading or the occupancy) and side profile of a plan.
+                ground: dict | None = None, anchor: Any = None) -> Figure:
+    """Map in lon/lat and side profile of a plan.
 
-    Filled DEM nodata (unknown ground, ``World.filled``) is hatched on the top
-    view, the path over it is drawn in orange there and on the side profile
-    (with the span shaded), and the subtitle says how much of the path flies over
-    it.
+    The map (:class:`fm2uav.viz.mapfigure.LonLatMap`) shows the ground as shaded
+    relief with contours, buildings as filled outlines, the no-fly zones with
+    their floor and ceiling, the path coloured by its height above ground (colour
+    bar), start and goal, a scale bar and lon/lat ticks. Filled DEM nodata (unknown
+    ground, ``World.filled``) is hatched orange, the path over it is drawn in
+    orange there and on the side profile (with the span shaded), and the subtitle
+    says how much of the path flies over it. The side profile shows the ground,
+    the roofs under the path and the requested level.
 
     Parameters
     ----------
@@ -41,59 +43,53 @@ def plan_figure(plan: Plan, *, title: str | None = None,
         The known/unknown ground split of the summary
         (:func:`fm2uav.analysis.known_ground.ground_split`): its lengths go into
         the subtitle.
+    anchor : Anchor, optional
+        Placement of a world without CRS (the exports' default anchor).
 
     Returns
     -------
     matplotlib.figure.Figure
         Save it with ``fig.savefig(path, dpi=...)``.
     """
+    from .mapfigure import LonLatMap
+
     world = plan.world
     path = plan.path
     b = world.bounds
-    extent = (b[0, 0], b[0, 1], b[1, 0], b[1, 1])
     three_d = world.ndim == 3
-    fig = Figure(figsize=(13 if three_d else 7, 5.2))
+    fig = Figure(figsize=(14 if three_d else 8, 6.0))
     axes = fig.subplots(1, 2 if three_d else 1, squeeze=False,
-                        gridspec_kw={"width_ratios": [1.1, 1.4]} if three_d else None)
+                        gridspec_kw={"width_ratios": [1.25, 1.0]} if three_d else None)
     ax = axes[0, 0]
-    if three_d and world.terrain is not None:
-        ls = LightSource(azdeg=315, altdeg=45)
-        rgb = ls.shade(world.terrain.T, cmap=matplotlib.colormaps["gist_earth"], vert_exag=2.0,
-                       dx=world.spacing[0], dy=world.spacing[1], blend_mode="soft")
-        ax.imshow(rgb, origin="lower", extent=extent, aspect="equal")
-        cs = ax.contour(np.linspace(b[0, 0], b[0, 1], world.shape[0]),
-                        np.linspace(b[1, 0], b[1, 1], world.shape[1]),
-                        world.terrain.T, levels=10, colors="k", linewidths=0.4, alpha=0.5)
-        ax.clabel(cs, fontsize=6, fmt="%.0f")
-    else:
-        occ2d = world.occupancy.any(axis=2) if three_d else world.occupancy
-        ax.imshow(occ2d.T, origin="lower", extent=extent, cmap="Greys", aspect="equal")
+    m = LonLatMap(ax, world, anchor)
     unknown = _unknown(world, path)
-    if unknown is not None and np.asarray(world.filled).any():
-        xs = np.linspace(b[0, 0], b[0, 1], world.shape[0])
-        ys = np.linspace(b[1, 0], b[1, 1], world.shape[1])
-        ax.contourf(xs, ys, np.asarray(world.filled, dtype=float).T, levels=[0.5, 1.5],
-                    colors="none", hatches=["////"])
-        ax.contour(xs, ys, np.asarray(world.filled, dtype=float).T, levels=[0.5],
-                   colors=FILLED_COLOUR, linewidths=1.0)
-        ax.plot([], [], color=FILLED_COLOUR, lw=1, label="filled DEM nodata (unknown ground)")
-    ax.plot(path[:, 0], path[:, 1], color="crimson", lw=2, label="FM² path")
+    level = getattr(plan, "level", None)
+    requested = None if level is None else float(level.agl)
+    if three_d:
+        agl = path[:, 2] - np.asarray(world.ground_height(path[:, 0], path[:, 1]), dtype=float)
+        m.agl_path(path, agl, requested, label="FM² path")
+    else:
+        m.path(path, color="crimson", lw=2, label="FM² path")
     if unknown is not None and unknown.any():
-        ax.plot(np.where(_spans(unknown), path[:, 0], np.nan),
-                np.where(_spans(unknown), path[:, 1], np.nan), color=FILLED_COLOUR, lw=3.5,
-                label="path over FILLED ground")
-    ax.plot(*path[0, :2], "o", color="limegreen", mec="k", ms=8, label="start")
-    ax.plot(*path[-1, :2], "*", color="gold", mec="k", ms=13, label="goal")
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_title("top view")
-    ax.legend(loc="upper left", fontsize=8)
+        m.path(np.where(_spans(unknown)[:, None], path, np.nan), color=FILLED_COLOUR, lw=3.5,
+               label="path over FILLED ground")
+    m.points(path[0], path[-1])
+    m.scale_bar()
+    ax.set_title("map")
+    m.legend()
     if three_d:
         ax2 = axes[0, 1]
         s = arc_length(path)
+        under = np.asarray(world.ground_height(path[:, 0], path[:, 1]), dtype=float)
+        roofs = np.asarray(world.surface_height(path[:, 0], path[:, 1]), dtype=float)
         if world.terrain is not None:
-            under = world.ground_height(path[:, 0], path[:, 1])
-            ax2.fill_between(s, b[2, 0], under, color="saddlebrown", alpha=0.5, label="terrain")
+            ax2.fill_between(s, b[2, 0], under, color="saddlebrown", alpha=0.5, label="ground")
+        if np.any(roofs > under + 0.5 * world.spacing[2]):
+            ax2.fill_between(s, under, np.maximum(roofs, under), color="#5f5f66", alpha=0.8,
+                             lw=0, label="buildings under the path", step="mid")
+        if requested is not None:
+            ax2.plot(s, under + requested, color="#1a9641", lw=1, ls="--",
+                     label=f"requested {requested:g} m above ground")
         ax2.plot(s, path[:, 2], color="crimson", lw=2, label="path altitude")
         if unknown is not None and unknown.any():
             on = _spans(unknown)
@@ -110,6 +106,9 @@ def plan_figure(plan: Plan, *, title: str | None = None,
     p = plan.params
     sub = (f"length {plan.length:.0f} m · clearance {plan.clearance:.1f} m · "
            f"α={p.get('saturation', 1):g} β={p.get('exponent', 1):g}")
+    if three_d:
+        k = int(np.argmin(agl))
+        sub += f" · lowest {agl[k]:.0f} m above ground at {s[k]:.0f} m"
     from ..world.ground import has_unknown_ground
 
     has_gaps = getattr(world, "filled", None) is not None and has_unknown_ground(world)

@@ -328,6 +328,12 @@ def formation_animation(
     return path
 
 
+def _duration(seconds: float) -> str:
+    """``"2 min 41 s"`` (``"41 s"`` under a minute)."""
+    m, s = divmod(int(round(seconds)), 60)
+    return f"{m} min {s:02d} s" if m else f"{s} s"
+
+
 def formation_report_html(result: FormationResult, summary: dict[str, Any], *, title: str,
                           subtitle: str, files: list[str]) -> str:
     """report.html of one formation flight: every UAV's track, the leader's FM² plan.
@@ -344,8 +350,21 @@ def formation_report_html(result: FormationResult, summary: dict[str, Any], *, t
                 "flown [m]": round(float(lengths[i]), 1),
                 **summary["level_keeping"].get(name, {})}
                for i, (name, agl) in enumerate(zip(r.names, r.agl))]
+    from .report import path_figures
+
+    figures = {
+        "UAVs": f"{len(r.names)} ({', '.join(r.names)}), shape {summary['shape']}, "
+                f"{summary['dist_m']:g} m apart",
+        "mission time (simulated)": _duration(float(summary["mission_time_s"])),
+        "closest two UAVs": f"{summary['min_separation_m']:.1f} m (bound "
+                            f"{summary['separation_bound_m']:g} m)",
+        "reached the goal / formation settled": (
+            f"{'yes' if summary['completed'] else 'NO'} / "
+            f"{'yes' if summary['settled'] else 'NO'}"),
+        **path_figures(r.world, paths),
+    }
     return report_html(
-        r.world, paths, title=title, subtitle=subtitle,
+        r.world, paths, title=title, subtitle=subtitle, figures=figures,
         ideal_agl={name: agl for name, agl in zip(r.names, r.agl) if agl is not None},
         overlays={"leader FM² plan": {"points": r.leader_plan.path, "color": "#333333",
                                       "dash": "dot", "width": 2}},

@@ -136,10 +136,13 @@ def tff_figures(run: TffRun) -> dict[str, Figure]:
 def tff_report_html(plans: Sequence[Plan], rows: list[dict[str, Any]], labels: Sequence[str],
                     sc: Scenario, *, title: str, params: dict[str, Any], files: list[str],
                     table_title: str = "Terrain-following cases",
-                    extra_tables: dict[str, list[dict[str, Any]]] | None = None) -> str:
+                    extra_tables: dict[str, list[dict[str, Any]]] | None = None,
+                    figures: dict[str, str] | None = None) -> str:
     """report.html of terrain-following paths: each path vs its ideal level, the case table.
 
-    ``rows`` are :func:`fm2uav.experiments.tff.run_tff` rows (or rows with the same keys).
+    ``rows`` are :func:`fm2uav.experiments.tff.run_tff` rows (or rows with the same keys);
+    ``figures``: the operator's figures beside the map (default: length and lowest height
+    above ground of each path).
     """
     from ..experiments.tff import tff_table_rows
     from .report import report_html
@@ -152,4 +155,5 @@ def tff_report_html(plans: Sequence[Plan], rows: list[dict[str, Any]], labels: S
         metrics={lab: f"within ±1 cell {r['within']:.0%}, mean |dev| {r['mean_dev_all_m']:.1f} m, "
                       f"max climb {r['climb_max_deg']:.0f}°, length {r['length_m']:.0f} m"
                  for lab, r in zip(labels, rows)},
-        tables={table_title: tff_table_rows(rows), **(extra_tables or {})}, files=files)
+        tables={table_title: tff_table_rows(rows), **(extra_tables or {})}, files=files,
+        figures=figures)

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ... import progress
 from ...errors import InputError, PlanningError, PointError
 from ...geometry import arc_length, at_arc_length
 from ...world import World
@@ -232,7 +233,10 @@ def fly_cycles(guide: LeaderGuide, W_stat: list[np.ndarray], pos: np.ndarray,
     log = FlightLog(times=[0.0], samples=[pos.copy()])
     s_ref = 0.0
     after = 0
+    # cycles the leader needs at its speed (the followers then settle: a few more)
+    expected = max(1, int(np.ceil(L / max(cs.speeds[0] * cs.cycle, 1e-9))))
     for c in range(int(cs.max_cycles)):
+        progress.count(min(c, expected), expected, "cycles")
         tc = time.perf_counter()
         t_now = c * cs.cycle
         # (c) partial goals: the leader's along its path, the followers' from its pose

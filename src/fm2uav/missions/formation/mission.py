@@ -42,7 +42,7 @@ from typing import Any
 
 import numpy as np
 
-from ... import _validate
+from ... import _validate, progress
 from ...errors import InputError
 from ...planning import FlightLevel, Plan, PlanOptions, Shaping, plan
 from ...world import World
@@ -192,6 +192,7 @@ class FormationResult:
 
 
 # ---------------------------------------------------------------------- mission
+@progress.stage()
 def fly_formation(
     world: World,
     start: Any,
@@ -269,11 +270,13 @@ def fly_formation(
 
     # ---- static maps (steps 1–2) and the leader's plan (steps 3–4)
     t0 = time.perf_counter()
+    progress.step(f"velocity maps of the {len(levels)} UAVs", 0.1)
     maps = StaticMaps(world, shaping, cfg.clearance)
     check_point(world, maps, start_m, "leader start")
     check_point(world, maps, goal_m, "goal")
     W_stat = [maps.speed(lv) for lv in levels]
     t1 = time.perf_counter()
+    progress.step("the leader's FM² path", 0.1)
     leader_plan, fshape, guide = _leader(world, start_m, goal_m, options, W_stat[0], maps, cfg,
                                          levels)
     t2 = time.perf_counter()
@@ -287,6 +290,7 @@ def fly_formation(
     cs = _cycle_settings(world, cfg, options, maps, guide.length)
     cfg = dataclasses.replace(cfg, max_cycles=cs.max_cycles, settle_cycles=cs.settle_cycles)
     t_loop = time.perf_counter()
+    progress.step(f"flying the {len(names)} UAVs (FM² re-planning every cycle)", 0.8)
     log = fly_cycles(guide, W_stat, pos, heading0, goal_m, cs)
     t3 = time.perf_counter()
     return _result(world, log, names, guide, leader_plan, fshape, cfg, levels, shaping, options,
