@@ -27,7 +27,7 @@ runner = CliRunner()
 # A command shaped like every fm2uav command (handle_errors + OutputDir), which writes
 # n files slowly so a signal or a second run can hit it mid-way.
 SLOW = textwrap.dedent("""
-    import sys, time
+    import os, sys, time
     import typer
     from fm2uav.cli._common import OutputDir, handle_errors
 
@@ -35,7 +35,8 @@ SLOW = textwrap.dedent("""
 
     @app.command()
     @handle_errors
-    def main(out: str, n: int = 6, pause: float = 0.3, force: bool = False) -> None:
+    def main(out: str, n: int = 6, pause: float = 0.3, force: bool = False,
+             wait_for: str = "") -> None:
         od = OutputDir(out, force=force)
         od.check([f"f{i}.txt" for i in range(n)])
         for i in range(n):
@@ -43,6 +44,9 @@ SLOW = textwrap.dedent("""
                 fh.write(f"new {i}\\n")
             print(f"wrote {i}", flush=True)
             time.sleep(pause)
+            t0 = time.monotonic()
+            while wait_for and not os.path.exists(wait_for) and time.monotonic() - t0 < 120:
+                time.sleep(0.05)  # held mid-set until the test says go
 
     app()
 """)
@@ -116,11 +120,15 @@ def test_killed_run_leftovers_are_cleaned_by_the_next_run(tmp_path):
 def test_two_concurrent_runs_one_is_refused(tmp_path):
     out = tmp_path / "out"
     script = _slow(tmp_path)
-    first = _spawn(script, out, "--n", "4", "--pause", "1.5")  # ~6 s: the second starts
+    go = tmp_path / "go"
+    # the first run holds its set open after one file until the second one has finished
+    # (a handshake, not a race against the second process's start-up time)
+    first = _spawn(script, out, "--n", "4", "--pause", "0", "--wait-for", str(go))
     assert first.stdout.readline().startswith("wrote 0")
     second = _spawn(script, out, "--n", "4", "--force", "--pause", "0")
-    _, err2 = second.communicate(timeout=60)
-    _, err1 = first.communicate(timeout=60)
+    _, err2 = second.communicate(timeout=120)
+    go.touch()
+    _, err1 = first.communicate(timeout=120)
     assert first.returncode == 0, err1
     assert second.returncode == 2, err2
     assert "being written by another fm2uav run" in err2 and "--out" in err2
