@@ -93,6 +93,18 @@ def as_index_array(points: Any, shape: tuple[int, ...], what: str) -> np.ndarray
     return arr
 
 
+#: ``(is_calm(wind, shape), march(speed, sources, wind, **options) -> times)`` of the wind
+#: march, registered by :mod:`fm2uav.eikonal.wind` (which the package imports): that module
+#: uses this one's input checks, so the dependency goes one way and ``fast_marching``
+#: finds the wind march here.
+_WIND_MARCH: list = []
+
+
+def register_wind_march(is_calm: Any, march: Any) -> None:
+    """Make ``fast_marching(wind=...)`` call ``march`` unless ``is_calm(wind, shape)``."""
+    _WIND_MARCH[:] = [(is_calm, march)]
+
+
 def _as_speed(speed: Any) -> np.ndarray:
     arr = np.ascontiguousarray(grid(speed, "speed"))
     # one compiled pass instead of three numpy passes (matters on 40 M-node maps)
@@ -118,11 +130,16 @@ def fast_marching(
     order: int = 2,
     stop_at: Any = None,
     source_ball: bool = True,
+    wind: Any = None,
 ) -> np.ndarray:
     """Arrival times of a wave started at ``sources`` over a speed field.
 
     Solves the eikonal equation ``|grad T| * speed = 1`` on a node-centred grid
     with the Fast Marching Method (Sethian 1996), upwind first- or second-order.
+    With a non-zero ``wind``, solves ``speed |grad T| + wind . grad T = 1``
+    instead (a vehicle flying at airspeed ``speed`` in the wind; see
+    :func:`fm2uav.eikonal.wind.zermelo_march`, which also gives the ground
+    tracks and the times *to* the sources).
 
     Parameters
     ----------
@@ -149,6 +166,12 @@ def fast_marching(
         Initialise the ball around point sources (default True).
         The ball is skipped automatically where the speed near a source is not
         smooth (max/min > 1.5 in its box); False disables it everywhere.
+    wind : array_like, shape (ndim,) or (nx, ny[, nz], ndim), optional
+        Wind [m/s] (x component first), constant or per node, in the units of
+        ``speed`` (then the airspeed). None or zero everywhere: the isotropic
+        march above, bit for bit. Otherwise the wind march of
+        :mod:`fm2uav.eikonal.wind`; nodes where ``|wind| >= speed`` are refused
+        (impassable, ``inf``).
 
     Returns
     -------
@@ -159,7 +182,9 @@ def fast_marching(
     ------
     fm2uav.InputError
         Bad shape, dtype, negative/non-finite speed, spacing <= 0, order not
-        1/2, source/stop index outside the grid, or a source with speed 0.
+        1/2, source/stop index outside the grid, a source with speed 0, a wind
+        of the wrong shape or not finite, or a source where the wind is at
+        least the airspeed.
 
     Examples
     --------
@@ -170,6 +195,11 @@ def fast_marching(
     """
     v = _as_speed(speed)
     shape = v.shape
+    if wind is not None:
+        is_calm, wind_march = _WIND_MARCH[0]
+        if not is_calm(wind, shape):
+            return wind_march(v, sources, wind, spacing=spacing, order=order, stop_at=stop_at,
+                              source_ball=source_ball)
     h = as_spacing(spacing, v.ndim)
     if isinstance(order, bool) or not isinstance(order, (int, np.integer)) or order not in (1, 2):
         shown = order.item() if isinstance(order, np.generic) else order

@@ -1,0 +1,128 @@
+"""Wind: the Zermelo march against the isotropic march on the same grid, and its accuracy.
+
+* Cost of wind (issue 26, goal: at most 2x the isotropic march): ``fast_marching``
+  with a wind against the same call without one (same speed field, point source at
+  the centre, ball on), at 2048^2 and 160^3, order 1 and 2, a constant wind of half
+  the airspeed and (2D) a rotating wind field of up to half the airspeed. Both run in
+  one child process, interleaved (isotropic, wind, isotropic, wind, ...): medians of
+  wall time, and the CPU time of the same runs in the notes (the machine is shared:
+  CPU time is the fairer measure). Peak memory above the process' size before the
+  march, each solver in a child process of its own. ``ratio`` = isotropic / wind.
+* Accuracy on the analytic cases of ``tests/eikonal/wind_cases.py`` (max error over
+  the nodes at least 0.1 m from the source at 321^2 and the rate from 161^2; the full
+  table is in docs/eikonal.md).
+
+The by-hand comparison with Mirebeau's HFM (its CPU ``Rander2`` model) is not run
+here: HFM is not a dependency of this project (see the closing note of issue 26).
+"""
+
+from __future__ import annotations
+
+import math
+
+from .bench_core import _child
+
+GOAL = 2.0  #: issue 26: the wind march at most this many times the isotropic one
+
+_FIELDS = """
+def field(shape, kind):
+    axes = np.meshgrid(*[np.linspace(0, 1, n) for n in shape], indexing="ij")
+    v = np.ones(shape)
+    for a in axes:
+        v += 0.4 * np.sin(3.0 * a)
+    ndim = len(shape)
+    if kind == "constant":  # |w| = 0.5 m/s, v >= 1 m/s
+        w = np.zeros(ndim); w[0] = 0.4; w[1] = 0.3
+    else:  # a vortex about the centre, |w| = 0.5 r / r_max
+        c = [a - 0.5 for a in axes]
+        w = np.zeros(shape + (ndim,))
+        w[..., 0] = -c[1]; w[..., 1] = c[0]
+        w *= 0.5 / math.sqrt(0.5)
+    return v, w
+"""
+
+
+def _timing(shape, order: int, kind: str, repeats: int) -> dict:
+    return _child(
+        "import math\n" + _FIELDS + f"""
+from fm2uav import fast_marching
+shape = {shape!r}; src = [tuple(n // 2 for n in shape)]
+v, w = field(shape, {kind!r})
+small = tuple(slice(0, 8) for _ in shape)
+fast_marching(v[small], [(4,) * len(shape)], order={order})
+fast_marching(v[small], [(4,) * len(shape)], order={order},
+              wind=w if w.ndim == 1 else w[small])
+iso, wind, iso_cpu, wind_cpu = [], [], [], []
+for _ in range({repeats}):
+    for out, cpu, kw in ((iso, iso_cpu, {{}}), (wind, wind_cpu, {{"wind": w}})):
+        c = time.process_time(); t = time.perf_counter()
+        fast_marching(v, src, order={order}, **kw)
+        out.append(time.perf_counter() - t); cpu.append(time.process_time() - c)
+med = statistics.median
+print(json.dumps({{"iso_s": med(iso), "wind_s": med(wind), "iso_cpu": med(iso_cpu),
+                  "wind_cpu": med(wind_cpu)}}))
+"""
+    )
+
+
+def _peak(shape, order: int, kind: str, wind: bool) -> float:
+    return _child(
+        "import math\n" + _FIELDS + f"""
+from fm2uav import fast_marching
+shape = {shape!r}; src = [tuple(n // 2 for n in shape)]
+v, w = field(shape, {kind!r})
+small = tuple(slice(0, 8) for _ in shape)
+kw = {{"wind": w if w.ndim == 1 else w[small]}} if {wind} else {{}}
+fast_marching(v[small], [(4,) * len(shape)], order={order}, **kw)
+kw = {{"wind": w}} if {wind} else {{}}
+base = rss_mb()
+fast_marching(v, src, order={order}, **kw)
+print(json.dumps({{"peak_mb": peak_mb() - base}}))
+"""
+    )["peak_mb"]
+
+
+def _accuracy(quick: bool) -> list[dict]:
+    from tests.eikonal.wind_cases import measure_one
+
+    rows = []
+    n_fine = 81 if quick else 321
+    for name in ("constant", "spiral", "shear"):
+        fine = measure_one(name, 2, 2, n_fine)
+        coarse = measure_one(name, 2, 2, (n_fine + 1) // 2)
+        rate = math.log2(coarse.err_max / fine.err_max)
+        rows.append({
+            "benchmark": "wind accuracy", "case": f"{name} 2D {n_fine}² order 2",
+            "ours_s": None,
+            "notes": f"max error {fine.err_max:.3g} s, L1 {fine.err_l1:.3g} s, rate {rate:.2f} "
+                     f"(from {(n_fine + 1) // 2}²)",
+        })
+    return rows
+
+
+def run(quick: bool = False) -> list[dict]:
+    if quick:
+        cases = [((128, 128), 1, "constant"), ((128, 128), 2, "vortex"), ((24, 24, 24), 2,
+                                                                          "constant")]
+        repeats = 1
+    else:
+        cases = [((2048, 2048), 1, "constant"), ((2048, 2048), 2, "constant"),
+                 ((2048, 2048), 2, "vortex"), ((160, 160, 160), 1, "constant"),
+                 ((160, 160, 160), 2, "constant")]
+        repeats = 3
+    rows = []
+    for shape, order, kind in cases:
+        t = _timing(shape, order, kind, repeats)
+        size = "×".join(map(str, shape))
+        slow = t["wind_cpu"] / t["iso_cpu"]
+        rows.append({
+            "benchmark": "wind", "case": f"{size} order {order}, {kind} wind (|w| ≤ V/2)",
+            "ours_s": t["wind_s"], "peer": "isotropic fast_marching", "peer_s": t["iso_s"],
+            "ratio": t["iso_s"] / t["wind_s"],
+            "peak_mb": _peak(shape, order, kind, True),
+            "peer_peak_mb": _peak(shape, order, kind, False),
+            "bar": f"wind ≤ {GOAL:.0f}× isotropic: {'met' if slow <= GOAL else 'NOT met'}",
+            "notes": f"CPU {t['wind_cpu']:.3g} s vs {t['iso_cpu']:.3g} s: {slow:.1f}× "
+                     f"(interleaved, median of {repeats})",
+        })
+    return rows + _accuracy(quick)
