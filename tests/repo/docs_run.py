@@ -22,6 +22,9 @@ How a block is run depends on its language (the word after the opening fence):
   fm2uav's mission parser (fragments completed with a scenario, start and goal).
 * ``text``: quoted output. Every line must be printed (``...`` stands for anything) by one of
   the commands named in its ``output`` markers.
+* a markdown table right under an ``output`` marker (no fence): a measured table; each of its
+  rows (the separator row aside) must be printed by the marked command(s), as in a ``text``
+  block (e.g. ``output "cat out/x/table.md"`` after the command that writes it).
 
 Markers: HTML comments on the lines right above the opening fence (invisible on the rendered
 page, visible in the source), ``<!-- docs-run: VERB ... -->``:
@@ -61,7 +64,7 @@ ROOT = Path(__file__).resolve().parents[2]
 #: the documents, in the order they run (README first: later docs use its outputs)
 DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 LANGS = {"bash": "bash", "sh": "bash", "shell": "bash", "console": "bash", "python": "python",
-         "yaml": "yaml", "yml": "yaml", "json": "json", "text": "text"}
+         "yaml": "yaml", "yml": "yaml", "json": "json", "text": "text", "table": "text"}
 VERBS = ("file", "output", "with", "skip")
 WIDE = {"COLUMNS": "4000", "NO_COLOR": "1", "BROWSER": "true"}
 
@@ -139,14 +142,34 @@ def parse_marker(body: str, where: str) -> Marker:
     return marker
 
 
+def _markers_above(doc: Path, lines: list[str], start: int) -> list[Marker]:
+    markers, k = [], start - 1
+    while k >= 0 and _MARK.match(lines[k]):
+        markers.insert(0, parse_marker(_MARK.match(lines[k]).group("body"),
+                                       f"{_rel(doc)}:{k + 1}"))
+        k -= 1
+    return markers
+
+
 def blocks(doc: Path) -> list[Block]:
-    """The fenced blocks of ``doc`` with their markers."""
+    """The fenced blocks of ``doc`` with their markers, and the markdown tables right under an
+    ``output`` marker (kind ``table``: checked like quoted output, row by row)."""
     lines = doc.read_text(encoding="utf-8").splitlines()
     out: list[Block] = []
     i = 0
     while i < len(lines):
         m = _FENCE.match(lines[i])
         if not m:
+            if lines[i].lstrip().startswith("|") and i > 0 and _MARK.match(lines[i - 1]):
+                j = i
+                while j < len(lines) and lines[j].lstrip().startswith("|"):
+                    j += 1
+                rows = [ln.strip() for ln in lines[i:j]
+                        if not re.fullmatch(r"\|(\s*:?-+:?\s*\|)+", ln.strip())]
+                out.append(Block(doc, i + 1, "table", "\n".join(rows) + "\n",
+                                 _markers_above(doc, lines, i)))
+                i = j
+                continue
             i += 1
             continue
         indent, start = m.group("indent"), i
@@ -155,12 +178,8 @@ def blocks(doc: Path) -> list[Block]:
             j += 1
         body = "\n".join(ln[len(indent):] if ln.startswith(indent) else ln.lstrip()
                          for ln in lines[i + 1:j])
-        markers, k = [], start - 1
-        while k >= 0 and _MARK.match(lines[k]):
-            markers.insert(0, parse_marker(_MARK.match(lines[k]).group("body"),
-                                           f"{_rel(doc)}:{k + 1}"))
-            k -= 1
-        out.append(Block(doc, start + 1, m.group("lang"), body + "\n", markers))
+        out.append(Block(doc, start + 1, m.group("lang"), body + "\n",
+                         _markers_above(doc, lines, start)))
         i = j + 1
     return out
 

@@ -101,6 +101,15 @@ def test_quoted_output_lines_must_be_printed():
         "error: the DEM has nodata under 586 of 42262 nodes"]
 
 
+def test_a_measured_table_under_an_output_marker_is_a_block(tmp_path):
+    doc = tmp_path / "d.md"
+    doc.write_text("| a | b |\n|---|---|\n| 1 | 2 |\n\ntext\n"
+                   '<!-- docs-run: output "cat t.md" -->\n| x | y |\n|:--|--:|\n| 3 | 4.5 |\n')
+    (b,) = blocks(doc)  # the unmarked table is prose
+    assert (b.kind, b.line, b.body) == ("text", 7, "| x | y |\n| 3 | 4.5 |\n")
+    assert text_lines_found(b.body, "| x | y |\n|---|---|\n| 3 | 4.50 |") == ["| 3 | 4.5 |"]
+
+
 def test_markers_are_read_and_need_reasons(tmp_path):
     doc = tmp_path / "d.md"
     doc.write_text('text\n<!-- docs-run: with "reproduce" --cell 0.1: lighter run -->\n'
