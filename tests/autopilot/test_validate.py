@@ -289,3 +289,35 @@ def test_every_rule_of_the_validators_has_a_case_in_the_table():
                if not any(code == s.code and s.pattern.fullmatch(msg) for code, msg in produced)]
     assert not missing, ("rules without a case in tests/autopilot/test_validate.py CASES "
                          "(add a minimal mission that breaks each):\n" + "\n".join(missing))
+
+
+# ---------------------------------------------------------------- thresholds at their edges
+def _px4_fw(items):
+    return [p for p in validate_mission(items, "px4", vehicle=FW, home_alt=HOME_ALT)
+            if p.code.startswith("px4-fw")]
+
+
+def test_a_landing_approached_level_with_it_is_refused():
+    level = _param(base(FW), len(base(FW)) - 1, 6, 40.0)  # touchdown at the loiter's height
+    (p,) = _px4_fw(level)
+    assert p.code == "px4-fw-approach" and "is 0.0 m above the landing point" in p.message
+
+
+def test_the_glide_slope_limit_is_fw_lnd_ang_to_a_tenth_of_a_degree():
+    items = base(FW)
+    # touchdown 880 m east of the loiter centre (80 m radius): slope = atan(rel / 876.4 m)
+    flat = math.sqrt(880.0 ** 2 - 80.0 ** 2)
+    for deg, fires in ((4.9, False), (5.3, True)):
+        rel = flat * math.tan(math.radians(deg))
+        got = _px4_fw(_param(items, len(items) - 2, 6, rel))
+        assert [p.code for p in got] == (["px4-fw-glide-slope"] if fires else []), deg
+
+
+def test_the_glide_slope_runs_from_the_loiter_circle_not_its_centre():
+    """A loiter of radius r, d from the touchdown: the glide starts where the vehicle leaves
+    the circle, sqrt(d² - r²) from the touchdown."""
+    items = _param(base(FW), len(base(FW)) - 2, 1, 300.0)  # loiter radius 300 m
+    items[-1] = _wp(6.5, 0.0, command=21)  # 500 m east of the loiter centre
+    (p,) = _px4_fw(items)  # 40 m over 400 m: 5.7 deg (over 500 m it would be 4.6 deg)
+    assert p.code == "px4-fw-glide-slope" and "is 5.7 deg" in p.message
+
