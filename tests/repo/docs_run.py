@@ -397,12 +397,11 @@ def _claims(text: str) -> list[Any]:
     the first opening parenthesis that is not part of a quoted string)."""
     out: list[Any] = []
     pos = 0
-    pat = re.compile(r"""\s*(?:≈|~)?\s*(?P<tok>'[^']*'|"[^"]*"|True|False|None|[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?)"""
-                     r"""\s*(?:[a-zA-Z%°/²³]+)?\s*,?""")
+    pat = re.compile(r"""\s*(?:≈|~)?\s*(?P<tok>'[^']*'|"[^"]*"|True|False|None"""
+                     r"""|[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?)\s*(?:[a-zA-Z%°/²³]+)?\s*,?""")
     while pos < len(text):
-        if text[pos] == "(" or text[pos] == "[" and not out:
-            if text[pos] == "(":
-                break
+        if text[pos] == "(":  # an explanation follows
+            break
         m = pat.match(text, pos)
         if not m:
             if text[pos] in " ,[]":

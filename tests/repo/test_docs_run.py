@@ -2,8 +2,9 @@
 (tests/repo/docs_run.py says how each kind of block is run and checked; tests/README.md,
 "Docs that run", says how to mark a block).
 
-The whole set of documents runs once per session (``doc_runs``), in one workspace; each block
-is one test case, so a failure names the document and line of the block.
+The documents run once per session (``doc_runs``), in one workspace; each block is one test
+case, so a failure names the document and line of the block. ``-k operator.md`` runs README.md
+and docs/operator.md only.
 """
 
 from __future__ import annotations
@@ -11,19 +12,26 @@ from __future__ import annotations
 import pytest
 
 from . import docs_data
-from .docs_run import (LANGS, Workspace, _claims, all_blocks, blocks, check_claim, commands,
-                       parse_marker, run_docs, run_python, text_lines_found, with_markers)
+from .docs_run import (DOCS, LANGS, Workspace, _claims, all_blocks, blocks, check_claim,
+                       commands, parse_marker, run_docs, run_python, text_lines_found,
+                       with_markers)
 
 BLOCKS = all_blocks()
 
 
 @pytest.fixture(scope="session")
-def doc_runs(tmp_path_factory, cli_once):
+def doc_runs(request, tmp_path_factory, cli_once):
+    """Every block of the pages this session tests (README.md always: later pages use its
+    outputs), in order, in one workspace."""
     ws = Workspace(tmp_path_factory.mktemp("docs"), cli_once, docs_data.FILES,
                    docs_data.PRODUCERS)
     for name, make in docs_data.OVERRIDES.items():
         make(ws.path / name)
-    return run_docs(ws)
+    wanted = {b.doc for b in BLOCKS if any(
+        getattr(item, "callspec", None) is not None and item.callspec.params.get("block") is b
+        and item.originalname == "test_the_block_runs_as_written"
+        for item in request.session.items)}
+    return run_docs(ws, [d for d in DOCS if d in wanted or d.name == "README.md"])
 
 
 @pytest.mark.slow
@@ -57,7 +65,8 @@ def test_skips_are_rare_and_give_their_reason():
 # ------------------------------------------------------------------ the engine itself
 def test_commands_join_continuations_and_drop_comments():
     body = "# a comment\nfm2uav plan \\\n  --scenario x   # why\n\nmake run\n"
-    assert [c.split() for c in commands(body)] == [["fm2uav", "plan", "--scenario", "x", "#", "why"], ["make", "run"]]
+    assert [c.split() for c in commands(body)] == [
+        ["fm2uav", "plan", "--scenario", "x", "#", "why"], ["make", "run"]]
 
 
 @pytest.mark.parametrize("claim, values", [
