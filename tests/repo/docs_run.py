@@ -322,11 +322,12 @@ class Workspace:
 
     def _make(self, command: str, args: list[str]) -> Result:
         """``make TARGET``: the Makefile's own recipe, run in the repository with its outputs
-        in the workspace (``OUT``) and the install step taken as done (``-o`` the stamp)."""
-        stamp = ROOT / ".venv" / ".installed-stamp"
-        res = subprocess.run(["make", "-o", str(stamp.relative_to(ROOT)), *args,
-                              f"OUT={self.path / 'out'}"], cwd=ROOT, env=self.env,
-                             capture_output=True, text=True, timeout=900)
+        in the workspace (``OUT``), in the environment running the tests (``VENV``) and the
+        install step taken as done (``-o`` the stamp)."""
+        venv = Path(sys.prefix)
+        res = subprocess.run(["make", "-o", str(venv / ".installed-stamp"), *args,
+                              f"VENV={venv}", f"OUT={self.path / 'out'}"], cwd=ROOT,
+                             env=self.env, capture_output=True, text=True, timeout=900)
         return Result(command, res.returncode, res.stdout + res.stderr)
 
 
