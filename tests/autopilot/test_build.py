@@ -75,6 +75,33 @@ def test_px4_never_gets_terrain_frame_and_ardupilot_does(firmware, vehicle):
     assert {it.frame for it in m.items if not it.has_position} <= {2}
 
 
+def test_terrain_frame_altitudes_are_heights_above_the_ground_under_each_item():
+    """Frame 10 (ArduPilot): param 7 is the height above the terrain under the item, measured
+    here independently (the item's lon/lat back to metres, scipy's bilinear ground)."""
+    p = hill_tff()
+    m, _ = export_mission(p, ["plan"], _opts(firmware="ardupilot"))
+    terrain = [it for it in m.items if it.has_position and it.frame == 10]
+    assert len(terrain) >= 3
+    ll = np.array([[it.lon, it.lat] for it in terrain])
+    ground = bilinear_ground(p.world, ll)
+    for it, g in zip(terrain, ground):
+        assert it.alt == pytest.approx(it.alt_amsl - g, abs=0.05)
+        assert 0.0 <= it.alt < it.alt_amsl - 100.0  # heights, not altitudes of the hill's z
+
+
+def test_an_ardupilot_terrain_mission_lands_on_a_glide_slope_above_home():
+    """The fixed-wing landing pattern of a terrain-frame mission is written above home
+    (frame 3): a glide in the terrain frame would follow the ground down to the touchdown."""
+    opt = _opts(firmware="ardupilot", vehicle="fixed_wing", end="land")
+    m, _ = export_mission(hill_tff(), ["plan"], opt)
+    loiter = next(it for it in m.items if it.command == 31)
+    land = next(it for it in m.items if it.command == 21)
+    assert m.frame == "terrain" and loiter.frame == land.frame == 3
+    home = m.home[2]
+    assert land.alt == pytest.approx(land.alt_amsl - home, abs=1e-6)
+    assert loiter.alt - land.alt == pytest.approx(opt.land_approach_agl, abs=1e-6)
+
+
 def test_px4_terrain_frame_on_request_is_refused_naming_the_option():
     with pytest.raises(MissionError, match=r"px4 would reject.*terrain-frame.*outputs.frame"):
         export_mission(hill_tff(), ["plan"], _opts(firmware="px4", frame="terrain"))
@@ -471,7 +498,9 @@ def test_geofences_are_written_as_qgc_does_and_checked(tmp_path):
 
 # ---------------------------------------------------------------- validators
 def _good():
-    m, _ = export_mission(hill_tff(), ["plan"], _opts(firmware="px4"))
+    """An exported PX4 mission with speed items (so the rules of DO items are reached)."""
+    m, _ = export_mission(hill_tff(), ["plan"], _opts(firmware="px4", speed_changes=True))
+    assert any(it.command == 178 for it in m.items)
     return list(m.items), m.home[2]
 
 
@@ -509,7 +538,7 @@ def test_validators_accept_our_missions_and_name_each_defect():
     low = [replace(items[0], params=(*items[0].params[:6], home - 1.0))] + items[1:]
     assert "takeoff-alt" in _codes(low, home=home)
     rtl_do = [replace(it, frame=3) if it.command == 178 else it for it in items]
-    assert "px4-frame" in _codes(rtl_do) or not any(it.command == 178 for it in items)
+    assert "px4-frame" in _codes(rtl_do)  # every rule: tests/autopilot/test_validate.py
     assert "px4-landing-required" in _codes(items[:-1] + [MissionItem.do(20)], vehicle="fixed_wing")
     # ArduCopter keeps DO_LAND_START / DO_RETURN_PATH_START as markers (mode_auto.cpp
     # start_command: "case MAV_CMD_DO_RETURN_PATH_START: case MAV_CMD_DO_LAND_START: break;")

@@ -7,7 +7,9 @@ import pytest
 from fm2uav.autopilot.thin import segment_distances
 from fm2uav.autopilot.waypoints import altitude_profile, mission_waypoints, thin_with_keep
 
-from .mission_cases import ANCHOR, hill_free, hill_tff
+from fm2uav.world.geo import to_lonlat
+
+from .mission_cases import ANCHOR, bilinear_ground, hill_free, hill_tff
 
 
 def test_waypoints_are_few_and_within_tolerance():
@@ -32,15 +34,30 @@ def test_forced_points_are_kept_and_pieces_thinned_alone():
 
 
 def test_frames_write_the_same_flown_altitude():
+    """Each frame's altitude, turned back into metres above mean sea level as its autopilot
+    reads it (10: + the ground under the waypoint, 0: as written, 3: + home), is the same
+    flown altitude: the independent bilinear ground + the requested AGL on the flight level,
+    the path's own height off it."""
     p = hill_tff()
     got = {f: mission_waypoints(p.path, p.world, anchor=ANCHOR, frame=f, agl=60.0)
            for f in ("terrain", "amsl", "relative")}
     assert {f: w.frame for f, w in got.items()} == {"terrain": 10, "amsl": 0, "relative": 3}
-    np.testing.assert_allclose(got["terrain"].alt, got["terrain"].agl)
-    np.testing.assert_allclose(got["amsl"].alt, got["amsl"].alt_amsl)
-    np.testing.assert_allclose(got["relative"].alt, got["relative"].alt_amsl - got["relative"].home[2])
-    for f in ("amsl", "relative"):
-        np.testing.assert_allclose(got[f].alt_amsl, got[f].ground_amsl + got[f].agl, atol=1e-9)
+    # the flown profile of the dense path, measured here (scipy on the height map + anchor)
+    lonlat_path = np.column_stack([*to_lonlat(p.world, p.path, anchor=ANCHOR)[:, :2].T])
+    ground = bilinear_ground(p.world, lonlat_path)
+    own = p.path[:, 2] + ANCHOR.alt - ground
+    on_level = np.abs(own - 60.0) <= p.world.spacing[2] + 1e-9
+    flown = ground + np.where(on_level, 60.0, own)
+    home = bilinear_ground(p.world, to_lonlat(p.world, p.path[:1], anchor=ANCHOR))[0]
+    for f, w in got.items():
+        g = bilinear_ground(p.world, np.column_stack([w.lon, w.lat]))
+        amsl = {"terrain": w.alt + g, "amsl": w.alt, "relative": w.alt + home}[f]
+        np.testing.assert_allclose(amsl, flown[w.indices], atol=1e-6, err_msg=f)
+        np.testing.assert_allclose(w.home[2], home, atol=1e-6)
+    assert on_level.all() and np.ptp(own) > 0.5  # the request differs from the own heights
+    # the same dense points, whichever frame thinned them, fly at the same altitude
+    common = np.intersect1d(got["amsl"].indices, got["terrain"].indices)
+    assert len(common) >= 2
 
 
 def test_relative_frame_altitudes_are_above_home():

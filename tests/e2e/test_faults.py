@@ -11,6 +11,7 @@ import subprocess
 import sys
 import textwrap
 import time
+from contextlib import contextmanager
 from pathlib import Path
 
 import pytest
@@ -26,7 +27,7 @@ runner = CliRunner()
 # A command shaped like every fm2uav command (handle_errors + OutputDir), which writes
 # n files slowly so a signal or a second run can hit it mid-way.
 SLOW = textwrap.dedent("""
-    import sys, time
+    import os, sys, time
     import typer
     from fm2uav.cli._common import OutputDir, handle_errors
 
@@ -195,17 +196,67 @@ def test_read_only_target_clear_error_nothing_written(tmp_path, monkeypatch, cod
     assert not out.exists() and _leftovers(tmp_path, "out") == []
 
 
-@pytest.mark.skipif(os.geteuid() == 0, reason="root writes into read-only folders")
+@contextmanager
+def _file_permissions_apply_to_root():
+    """Drop CAP_DAC_OVERRIDE and CAP_DAC_READ_SEARCH from this thread's effective capabilities
+    for the duration (capabilities(7): root then meets the kernel's permission checks like any
+    user), restored after from the permitted set. Nothing to do for other users.
+
+    Why this and not another way to make a folder unwritable for root: a read-only mount or
+    ``chattr +i`` need CAP_SYS_ADMIN / CAP_LINUX_IMMUTABLE and a file system that supports
+    them, which a CI container may lack; monkeypatching ``tempfile.mkdtemp`` (the test above)
+    tests the message, not the code path. Here the real ``mkdtemp``/``mkdir`` of OutputDir gets
+    EACCES from the kernel, for root as for a user (dropping a capability from the effective
+    set needs no privilege, and a thread may raise it again from its permitted set)."""
+    if os.geteuid() != 0:
+        yield
+        return
+    import ctypes
+
+    class Header(ctypes.Structure):
+        _fields_ = [("version", ctypes.c_uint32), ("pid", ctypes.c_int)]
+
+    class Data(ctypes.Structure):
+        _fields_ = [("effective", ctypes.c_uint32), ("permitted", ctypes.c_uint32),
+                    ("inheritable", ctypes.c_uint32)]
+
+    libc = ctypes.CDLL(None, use_errno=True)
+    head, data = Header(0x20080522, 0), (Data * 2)()  # _LINUX_CAPABILITY_VERSION_3, this thread
+
+    def call(fn):
+        if fn(ctypes.byref(head), data) != 0:
+            err = ctypes.get_errno()
+            raise OSError(err, f"{fn.__name__}: {os.strerror(err)}")
+
+    call(libc.capget)
+    saved = data[0].effective
+    data[0].effective = saved & ~((1 << 1) | (1 << 2))  # CAP_DAC_OVERRIDE, CAP_DAC_READ_SEARCH
+    call(libc.capset)
+    try:
+        yield
+    finally:
+        data[0].effective = saved
+        call(libc.capset)
+
+
 def test_read_only_folder_for_real(tmp_path):
+    """A folder the user cannot write into (also when the tests run as root, as in CI): the
+    kernel refuses OutputDir's own calls; one line, exit 2, nothing left behind."""
     parent = tmp_path / "ro"
     parent.mkdir()
     parent.chmod(0o555)
     try:
-        res = runner.invoke(app, ["plan", "--out", str(parent / "out"), "--quiet"])
+        with _file_permissions_apply_to_root():
+            with pytest.raises(PermissionError):  # the premise: this process cannot write here
+                (parent / "probe").mkdir()
+            res = runner.invoke(app, ["plan", "--out", str(parent / "out"), "--quiet"])
     finally:
         parent.chmod(0o755)
-    assert res.exit_code == 2 and "permission denied" in res.output
+    assert res.exit_code == 2, res.output
+    assert "permission denied" in res.output and "--out" in res.output
+    assert "Traceback" not in res.output and len(res.output.strip().splitlines()) == 1
     assert list(parent.iterdir()) == []
+    (parent / "probe").mkdir()  # and the capabilities are back
 
 
 def test_full_disk_mid_run_keeps_previous_set(tmp_path, monkeypatch):

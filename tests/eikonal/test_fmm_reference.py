@@ -302,7 +302,7 @@ def grids(draw, order2_ties: bool = True):
     return speed, source, spacing, order
 
 
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=30, deadline=None, derandomize=True)
 @given(case=grids(order2_ties=False), c=st.floats(0.01, 100.0))
 def test_scaling_speed_divides_times(case, c):
     # Every term of the scheme (ball: d/v, stencil: rhs = 1/v^2) scales with 1/c,
@@ -313,7 +313,7 @@ def test_scaling_speed_divides_times(case, c):
     assert_same_field(Tc, T / c, 1e-10)
 
 
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=30, deadline=None, derandomize=True)
 @given(case=grids())
 def test_times_bounded_below_by_fastest_straight_ray(case):
     # No path is shorter than the straight line, none faster than max(speed):
@@ -335,7 +335,7 @@ def test_times_bounded_below_by_fastest_straight_ray(case):
     assert np.all(T[finite] * vmax >= bound)
 
 
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=30, deadline=None, derandomize=True)
 @given(case=grids())
 def test_finite_iff_connected_through_free_nodes(case):
     # The stencil only uses axis neighbours, so a node is reached iff it is joined
@@ -347,7 +347,7 @@ def test_finite_iff_connected_through_free_nodes(case):
     np.testing.assert_array_equal(np.isfinite(T), connected)
 
 
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=30, deadline=None, derandomize=True)
 @given(case=grids(order2_ties=False), extra=st.integers(0, 2**32 - 1))
 def test_compiled_matches_reference_hypothesis(case, extra):
     speed, source, spacing, order = case

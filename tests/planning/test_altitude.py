@@ -119,3 +119,27 @@ def test_resample_route_keeps_ends_and_spacing():
     xy, s = resample_route(path, 4.0)
     assert xy[0].tolist() == [0, 0] and xy[-1].tolist() == [30, 40]
     assert s[-1] == pytest.approx(50.0) and np.max(np.diff(s)) <= 4.0 + 1e-9
+
+
+def test_the_cruise_floor_is_agl_minus_tolerance_or_min_agl_whichever_is_higher():
+    from fm2uav.planning.altitude import floor_agl
+
+    assert floor_agl(FlightLevel(agl=120.0)) == pytest.approx(118.0)  # tolerance 2 m
+    assert floor_agl(FlightLevel(agl=120.0, tolerance=10.0, min_agl=50.0)) == 110.0
+    assert floor_agl(FlightLevel(agl=120.0, tolerance=30.0, min_agl=100.0)) == 100.0
+
+
+def test_a_zone_floor_above_a_zone_ceiling_is_no_flyable_profile():
+    """A no-fly zone's lower bound is part of the floor: over a stretch where it lies above
+    another zone's upper bound, no profile exists (not a profile through the zone)."""
+    s = np.arange(0, 2000.0, 5.0)
+    g = np.zeros_like(s)
+    lo = np.where(np.abs(s - 1000) < 100, 300.0, -np.inf)
+    up = np.where(np.abs(s - 1000) < 100, 200.0, np.inf)
+    lim = FlightLevel(agl=100.0, max_climb=30.0, max_descent=30.0)
+    with pytest.raises(PlanningError, match="no flyable profile"):
+        solve_profile(s, g, g, lim, z_start=100, z_goal=100, ground_start=0, ground_goal=0,
+                      extra_lower=lo, extra_upper=up)
+    ok = solve_profile(s, g, g, lim, z_start=100, z_goal=100, ground_start=0, ground_goal=0,
+                       extra_lower=np.where(np.abs(s - 1000) < 100, 150.0, -np.inf))
+    assert ok["z"][np.abs(s - 1000) < 100].min() >= 150.0 - 1e-9

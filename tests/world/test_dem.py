@@ -101,6 +101,23 @@ def test_nodata_is_refused_or_filled(tmp_path):
         World.from_dem(f, 30.0)
     w = World.from_dem(f, 30.0, nodata="fill")
     assert np.all(np.isfinite(w.terrain)) and w.terrain.min() > 500
+    # the heights written: on a UTM DEM at its own pixel size (nodes on the pixel centres)
+    # the measured nodes are the file's pixels and each filled node takes the height of a
+    # nearest measured node (brute force here, every tie allowed), marked in World.filled
+    z[20:27, 30:33] = -9999.0  # a second hole, 7 x 3 pixels: most nodes have no GDAL value
+    f = _write_tif(tmp_path / "hole_utm.tif", z, crs="EPSG:32630", nodata=-9999.0,
+                   transform=from_origin(440000.0, 4467000.0, 30.0, 30.0))
+    w = World.from_dem(f, 30.0, nodata="fill")
+    assert w.crs == "EPSG:32630"
+    src = z.astype(np.float32)[::-1].T.astype(float)  # [ix, iy], rows north -> south
+    hole = src == -9999.0
+    np.testing.assert_array_equal(w.filled, hole)
+    np.testing.assert_allclose(w.terrain[~hole], src[~hole], atol=1e-6)
+    measured = np.argwhere(~hole)
+    for node in np.argwhere(hole):
+        d = np.hypot(*(measured - node).T)
+        nearest = measured[d <= d.min() + 1e-9]
+        assert any(abs(w.terrain[tuple(node)] - src[tuple(m)]) < 1e-6 for m in nearest), node
     zn = _hills()
     zn[0:60, :] = np.nan
     with pytest.raises(WorldError, match="more than half"):

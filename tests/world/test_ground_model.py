@@ -107,3 +107,28 @@ def test_ground_bulge_is_the_exact_rise_and_drop_along_a_chord(kind):
     tol = 1e-2 if kind == "two dems" else 2e-3
     assert np.all(rise - ref[:, 0] < tol) and np.all(drop - ref[:, 1] < tol)
     assert rise.max() > 0.05 and drop.max() > 0.05  # real kinks were crossed
+
+
+def test_filled_ground_is_the_nearest_measured_pixel(tmp_path):
+    """Deep in a nodata gap (the neighbour's bay of the country DEM, ``nodata="fill"``) the
+    ground is the elevation of the nearest measured pixel, found here by brute force."""
+    import rasterio
+
+    from fm2uav.world.geo import from_lonlat
+
+    from tests.world import dem_cases as dc
+
+    tif = dc.country(tmp_path / "country.tif")
+    w = World.from_dem(tif, (150.0, 150.0, 15.0), nodata="fill", agl=100.0)
+    lonlat = np.array([[10.2, 45.66], [10.19, 45.64]])
+    xy = from_lonlat(w, lonlat)
+    assert w.ground_filled(xy[:, 0], xy[:, 1]).all()
+    got = w.ground_height(xy[:, 0], xy[:, 1])
+    with rasterio.open(tif) as ds:
+        z = ds.read(1, masked=True)
+        rows, cols = np.nonzero(~z.mask)
+        for (lon, lat), g in zip(lonlat, got):
+            r, c = ds.index(lon, lat)
+            k = np.argmin((rows - r) ** 2 + (cols - c) ** 2)
+            assert np.hypot(rows[k] - r, cols[k] - c) > 20  # far inside the gap
+            assert g == pytest.approx(float(z[rows[k], cols[k]]), abs=0.5)

@@ -1,0 +1,323 @@
+"""Every firmware rule has a case that triggers it: a table of minimal missions, each breaking
+one rule of :mod:`fm2uav.autopilot.validate` or of a firmware module
+(:mod:`fm2uav.autopilot.firmware.px4`, ``ardupilot``, any new one), and a meta-test that every
+``Problem(...)`` the validators can return is produced by a case of the table (so a new rule
+without a case fails here).
+
+**Adding a rule** (a new ``Problem(index, "code", "message")`` in ``validate.py`` or in a
+module of ``autopilot/firmware/``): add one :class:`Case` to :data:`CASES` — the firmware and
+airframe, a one-line ``build`` that breaks only that rule in the valid base mission of the
+airframe (:func:`base`), the code and a regex of the message; ``also`` lists the codes that
+cannot help firing with it (a landing as the first item is also a missing takeoff). Write the
+code as a string literal in the ``Problem(...)`` call (the meta-test reads it from the source).
+"""
+
+from __future__ import annotations
+
+import ast
+import math
+import re
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Callable
+
+import pytest
+
+from fm2uav.autopilot import validate as validate_module
+from fm2uav.autopilot.geofence import FenceCircle, FencePolygon
+from fm2uav.autopilot.items import MissionItem
+from fm2uav.autopilot.validate import check_mission, validate_mission
+from fm2uav.errors import MissionError
+
+HOME_ALT = 500.0  # m AMSL, the ground under the start
+LAT, LON = 47.3977, 8.5456
+
+
+def _wp(k: int, alt: float = 60.0, command: int = 16, frame: int = 3, **kw) -> MissionItem:
+    """A position item ``k`` x 200 m east of home (frame 3: above home)."""
+    return MissionItem.at(command, frame, LAT, LON + k * 0.00265, alt, **kw)
+
+
+def base(vehicle: str = "multirotor") -> list[MissionItem]:
+    """A mission every firmware accepts on ``vehicle``: takeoff, waypoints with a speed change
+    and a camera switched on and off between them, then the airframe's usual end (fixed-wing:
+    PX4's landing pattern, a loiter down to 40 m, 2.9 deg glide to the touchdown)."""
+    takeoff = 84 if vehicle == "vtol" else 22
+    items = [_wp(0, 40.0, command=takeoff),
+             _wp(1),
+             MissionItem.do(178, 1.0 if vehicle == "multirotor" else 0.0, 8.0, -1.0),
+             MissionItem.do(206, 25.0, 0.0, 1.0),
+             _wp(2),
+             MissionItem.do(206, 0.0),
+             _wp(3)]
+    if vehicle == "fixed_wing":
+        # loiter (80 m radius) 40 m above the touchdown, which lies 880 m further east
+        return items + [MissionItem.do(189), _wp(4, 40.0, command=31, p2=80.0, p4=0.0),
+                        _wp(8.4, 0.0, command=21)]
+    return items + [_wp(3, 0.0, command=85 if vehicle == "vtol" else 21)]
+
+
+def _at(items: list[MissionItem], i: int, **changes) -> list[MissionItem]:
+    out = list(items)
+    out[i] = replace(out[i], **changes)
+    return out
+
+
+def _param(items: list[MissionItem], i: int, k: int, value: float) -> list[MissionItem]:
+    p = list(items[i].params)
+    p[k] = value
+    return _at(items, i, params=tuple(p))
+
+
+def _index(items: list[MissionItem], command: int, nth: int = 0) -> int:
+    return [i for i, it in enumerate(items) if it.command == command][nth]
+
+
+def _rtl_end(items: list[MissionItem]) -> list[MissionItem]:
+    """The mission with its landing (pattern) replaced by an RTL."""
+    first_end = next(i for i, it in enumerate(items) if it.command in (189, 21, 85)
+                     and i > 0)
+    return items[:first_end] + [MissionItem.do(20)]
+
+
+_SQUARE = FencePolygon(points=[(LAT - 0.001, LON + 0.002), (LAT + 0.001, LON + 0.002),
+                               (LAT + 0.001, LON + 0.0035), (LAT - 0.001, LON + 0.0035)],
+                       inclusion=False, name="stadium")
+
+
+@dataclass(frozen=True)
+class Case:
+    """One rule broken by one minimal mission."""
+
+    code: str  #: the Problem code expected
+    match: str  #: regex found in the Problem's message
+    build: Callable[[], list[MissionItem]]  #: the mission (after home)
+    firmware: str = "px4"
+    vehicle: str = "multirotor"
+    also: frozenset = frozenset()  #: codes that cannot help firing with it
+    fences: tuple = ()
+    home_alt: float | None = HOME_ALT
+
+    @property
+    def id(self) -> str:
+        return f"{self.firmware}-{self.vehicle}-{self.code}-{self.match[:24]}"
+
+    def problems(self, firmware: str | None = None):
+        return validate_mission(self.build(), firmware or self.firmware, vehicle=self.vehicle,
+                                home_alt=self.home_alt, fences=self.fences)
+
+
+MR, FW, VT = "multirotor", "fixed_wing", "vtol"
+NAN = math.nan
+
+#: The table: every rule, one minimal mission breaking it (more where a rule has two ways in).
+CASES: list[Case] = [
+    # ---------------------------------------------------------------- every firmware
+    Case("empty", "has no items", lambda: []),
+    Case("param-nan", r"param2 is nan; only param4", lambda: _param(base(), 1, 1, NAN)),
+    Case("param-nan", r"param4 is nan; it is not a yaw",
+         lambda: _param(base(), _index(base(), 178), 3, NAN)),
+    Case("param-nan", r"param4 is inf; it is not a yaw", lambda: _param(base(), 1, 3, math.inf)),
+    Case("param-nan", r"DO_LAND_START \(189\): param6 is nan",
+         lambda: _param(base(FW), _index(base(FW), 189), 5, NAN), vehicle=FW),
+    Case("latlon", r"latitude/longitude \(nan, ", lambda: _param(base(), 1, 4, NAN)),
+    Case("latlon", r"latitude/longitude \(91.0, ", lambda: _param(base(), 1, 4, 91.0)),
+    Case("latlon-zero", "are 0, 0", lambda: _param(_param(base(), 1, 4, 0.0), 1, 5, 0.0)),
+    Case("alt", "altitude is nan", lambda: _param(base(), 1, 6, NAN)),
+    Case("speed-type", r"speed type \(param1\) 2 is not 0",
+         lambda: _param(base(), _index(base(), 178), 0, 2.0)),
+    Case("speed", r"speed \(param2\) 0 m/s must be > 0",
+         lambda: _param(base(), _index(base(), 178), 1, 0.0)),
+    Case("trigger", "trigger distance -5 m must be >= 0",
+         lambda: _param(base(), _index(base(), 206), 0, -5.0)),
+    Case("no-takeoff", r"must be NAV_TAKEOFF .* got NAV_WAYPOINT", lambda: base()[1:]),
+    Case("no-takeoff", r"got none", lambda: [MissionItem.do(178, 1.0, 5.0, -1.0)],
+         also=frozenset({"no-end"})),
+    Case("takeoff-alt", r"takeoff altitude is -1.00 m above home",
+         lambda: _param(base(), 0, 6, -1.0)),
+    Case("takeoff-alt", r"takeoff altitude is 0.00 m above home",  # AMSL takeoff at home
+         lambda: _at(_param(base(), 0, 6, HOME_ALT), 0, frame=0)),
+    Case("no-end", r"must end with .*not NAV_WAYPOINT .*outputs.end", lambda: base()[:-1]),
+    Case("trigger-on", "still triggering", lambda: base()[:5] + base()[6:]),
+    Case("fence-inside", r"NAV_WAYPOINT \(16\) lies inside the exclusion fence 'stadium'",
+         base, fences=(_SQUARE,)),
+    Case("fence-inside", r"lies inside the exclusion fence 'tower'", base,
+         fences=(FenceCircle(center=(LAT, LON + 0.00265 * 3), radius=30.0, inclusion=False,
+                             name="tower"),)),
+    Case("fence-outside", r"NAV_WAYPOINT \(16\) lies outside the inclusion fence 'area'", base,
+         fences=(FencePolygon(points=[(LAT - 0.01, LON - 0.01), (LAT + 0.01, LON - 0.01),
+                                      (LAT + 0.01, LON + 0.0060), (LAT - 0.01, LON + 0.0060)],
+                              inclusion=True, name="area"),)),
+    Case("fence-outside", r"lies outside the inclusion fence 'circle'", base,
+         fences=(FenceCircle(center=(LAT, LON), radius=450.0, inclusion=True, name="circle"),)),
+    # ---------------------------------------------------------------- PX4
+    Case("px4-command", r"NAV_LOITER_TURNS \(18\) is not a mission command PX4 accepts",
+         lambda: _at(base(), 1, command=18, params=(0, 0, 0, 0, *base()[1].params[4:]))),
+    Case("px4-command", r"NAV_VTOL_LAND \(85\) .*VTOL items need a VTOL airframe",
+         lambda: _at(base(), len(base()) - 1, command=85)),
+    Case("px4-terrain-frame", r"uses MAV_FRAME_GLOBAL_TERRAIN_ALT; PX4 does not fly .*"
+                              r"--frame amsl", lambda: _at(base(), 1, frame=10)),
+    Case("px4-frame", r"uses 1; PX4 takes frames 0 and 3 only", lambda: _at(base(), 1, frame=1)),
+    Case("px4-frame", r"DO_CHANGE_SPEED \(178\) must use MAV_FRAME_MISSION \(2\) on PX4",
+         lambda: _at(base(), _index(base(), 178), frame=3)),
+    Case("px4-land-start", "more than one DO_LAND_START",
+         lambda: base(FW)[:-3] + [MissionItem.do(189)] + base(FW)[-3:], vehicle=FW),
+    Case("px4-land-start", "must come before the landing approach item",
+         lambda: base(FW)[:-3] + base(FW)[-2:] + [MissionItem.do(189)], vehicle=FW,
+         also=frozenset({"no-end"})),
+    Case("px4-land-before-rtl", "DO_LAND_START before an RTL",
+         lambda: base(FW)[:-2] + [MissionItem.do(20)] + base(FW)[-2:], vehicle=FW),
+    Case("px4-starts-landing", "starts with a landing", lambda: base()[-1:] + base()[1:],
+         also=frozenset({"no-takeoff"})),
+    Case("px4-landing-required", r"PX4 fixed-wing missions need a landing .*MIS_TKO_LAND_REQ",
+         lambda: _rtl_end(base(FW)), vehicle=FW),
+    Case("px4-landing-required", r"PX4 vtol missions need a landing",
+         lambda: _rtl_end(base(VT)), vehicle=VT),
+    Case("px4-fw-approach", "has no approach item before it",
+         lambda: [MissionItem.do(189), _wp(8.4, 0.0, command=21)], vehicle=FW,
+         also=frozenset({"no-takeoff"})),
+    Case("px4-fw-approach", r"approached from NAV_TAKEOFF \(22\); PX4 takes only",
+         lambda: [base(FW)[0], MissionItem.do(189), _wp(8.4, 0.0, command=21)], vehicle=FW),
+    Case("px4-fw-approach", r"the approach item is -10.0 m above the landing point",
+         lambda: _param(base(FW), len(base(FW)) - 1, 6, 50.0), vehicle=FW),
+    Case("px4-fw-approach", r"the landing point is \d+ m from the loiter centre, inside its "
+                            r"900 m radius",
+         lambda: _param(base(FW), len(base(FW)) - 2, 1, 900.0), vehicle=FW),
+    Case("px4-fw-glide-slope", r"glide slope is [\d.]+ deg, steeper than FW_LND_ANG = 5 deg",
+         lambda: _param(base(FW), len(base(FW)) - 2, 6, 160.0), vehicle=FW),
+    # ---------------------------------------------------------------- ArduPilot
+    Case("ardupilot-command", r"NAV_LOITER_TO_ALT \(31\) is not a mission command ArduPilot "
+                              r"Copter flies", lambda: _at(base(), 1, command=31, params=(0, 0, 0, 0, *base()[1].params[4:])),
+         firmware="ardupilot"),
+    Case("ardupilot-frame", r"uses frame 1; ArduPilot missions take frames 0, 3 and 10",
+         lambda: _at(base(), 1, frame=1), firmware="ardupilot"),
+    Case("ardupilot-terrain-takeoff", r"NAV_TAKEOFF \(22\) in the terrain frame.*#20142",
+         lambda: _at(base(), 0, frame=10), firmware="ardupilot"),
+]
+
+
+@pytest.mark.parametrize("firmware", ["px4", "ardupilot", "generic"])
+@pytest.mark.parametrize("vehicle", [MR, FW, VT])
+def test_the_base_missions_are_valid(firmware, vehicle):
+    items = base(vehicle)
+    assert validate_mission(items, firmware, vehicle=vehicle, home_alt=HOME_ALT) == []
+    assert {178, 206} <= {it.command for it in items}  # the DO rules are reached
+    check_mission(items, firmware, vehicle=vehicle, home_alt=HOME_ALT)
+
+
+@pytest.mark.parametrize("case", CASES, ids=lambda c: c.id)
+def test_each_rule_fires_alone_on_its_case(case):
+    problems = case.problems()
+    codes = {p.code for p in problems}
+    assert case.code in codes, [str(p) for p in problems]
+    assert codes <= {case.code} | case.also, f"other rules fire too: {[str(p) for p in problems]}"
+    assert any(re.search(case.match, p.message) for p in problems if p.code == case.code), \
+        [p.message for p in problems]
+    with pytest.raises(MissionError, match=f"{case.firmware} would reject this mission"):
+        check_mission(case.build(), case.firmware, vehicle=case.vehicle, home_alt=case.home_alt,
+                      fences=case.fences)
+
+
+@pytest.mark.parametrize("case", [c for c in CASES if c.firmware != "generic"],
+                         ids=lambda c: c.id)
+def test_generic_rejects_what_either_firmware_rejects(case):
+    assert case.code in {p.code for p in case.problems("generic")}
+
+
+# ---------------------------------------------------------------- the meta-test
+
+
+@dataclass(frozen=True)
+class Site:
+    """A ``Problem(...)`` call in the validators' source: where, its code, its message."""
+
+    where: str
+    code: str
+    pattern: re.Pattern
+
+
+def _pattern(node: ast.AST) -> str:
+    """A regex every message built by ``node`` (a str, an f-string, a concatenation) matches."""
+    if isinstance(node, ast.Constant) and isinstance(node.value, str):
+        return re.escape(node.value)
+    if isinstance(node, ast.JoinedStr):
+        return "".join(_pattern(v) if isinstance(v, ast.Constant) else "(?s:.*?)"
+                       for v in node.values)
+    if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Add):
+        return _pattern(node.left) + _pattern(node.right)
+    return "(?s:.*?)"
+
+
+def _codes(node: ast.AST, where: str) -> list[str]:
+    if isinstance(node, ast.Constant) and isinstance(node.value, str):
+        return [node.value]
+    if isinstance(node, ast.IfExp):
+        return _codes(node.body, where) + _codes(node.orelse, where)
+    raise AssertionError(f"{where}: the code of this Problem is not a string literal; write it "
+                         "as one (tests/autopilot/test_validate.py reads the codes from the "
+                         "source)")
+
+
+def rule_sites() -> list[Site]:
+    """Every ``Problem(index, code, message)`` in validate.py and autopilot/firmware/*.py."""
+    root = Path(validate_module.__file__).parent
+    files = [root / "validate.py", *sorted((root / "firmware").glob("*.py"))]
+    sites = []
+    for f in files:
+        for node in ast.walk(ast.parse(f.read_text())):
+            if not (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+                    and node.func.id == "Problem"):
+                continue
+            where = f"{f.relative_to(root.parent.parent)}:{node.lineno}"
+            args = list(node.args) + [k.value for k in node.keywords]
+            assert len(args) == 3, f"{where}: Problem(index, code, message) expected"
+            for code in _codes(args[1], where):
+                sites.append(Site(where, code, re.compile(_pattern(args[2]))))
+    return sites
+
+
+def test_the_validators_are_where_the_meta_test_looks():
+    sites = rule_sites()
+    assert len(sites) >= 30
+    assert {"px4-fw-glide-slope", "ardupilot-terrain-takeoff", "no-takeoff"} <= \
+        {s.code for s in sites}
+
+
+def test_every_rule_of_the_validators_has_a_case_in_the_table():
+    produced = [(c.code, p.message) for c in CASES for p in c.problems() if p.code == c.code]
+    missing = [f"{s.where} {s.code!r} /{s.pattern.pattern}/" for s in rule_sites()
+               if not any(code == s.code and s.pattern.fullmatch(msg) for code, msg in produced)]
+    assert not missing, ("rules without a case in tests/autopilot/test_validate.py CASES "
+                         "(add a minimal mission that breaks each):\n" + "\n".join(missing))
+
+
+# ---------------------------------------------------------------- thresholds at their edges
+def _px4_fw(items):
+    return [p for p in validate_mission(items, "px4", vehicle=FW, home_alt=HOME_ALT)
+            if p.code.startswith("px4-fw")]
+
+
+def test_a_landing_approached_level_with_it_is_refused():
+    level = _param(base(FW), len(base(FW)) - 1, 6, 40.0)  # touchdown at the loiter's height
+    (p,) = _px4_fw(level)
+    assert p.code == "px4-fw-approach" and "is 0.0 m above the landing point" in p.message
+
+
+def test_the_glide_slope_limit_is_fw_lnd_ang_to_a_tenth_of_a_degree():
+    items = base(FW)
+    # touchdown 880 m east of the loiter centre (80 m radius): slope = atan(rel / 876.4 m)
+    flat = math.sqrt(880.0 ** 2 - 80.0 ** 2)
+    for deg, fires in ((4.9, False), (5.3, True)):
+        rel = flat * math.tan(math.radians(deg))
+        got = _px4_fw(_param(items, len(items) - 2, 6, rel))
+        assert [p.code for p in got] == (["px4-fw-glide-slope"] if fires else []), deg
+
+
+def test_the_glide_slope_runs_from_the_loiter_circle_not_its_centre():
+    """A loiter of radius r, d from the touchdown: the glide starts where the vehicle leaves
+    the circle, sqrt(d² - r²) from the touchdown."""
+    items = _param(base(FW), len(base(FW)) - 2, 1, 300.0)  # loiter radius 300 m
+    items[-1] = _wp(6.5, 0.0, command=21)  # 500 m east of the loiter centre
+    (p,) = _px4_fw(items)  # 40 m over 400 m: 5.7 deg (over 500 m it would be 4.6 deg)
+    assert p.code == "px4-fw-glide-slope" and "is 5.7 deg" in p.message
+

@@ -1,0 +1,137 @@
+"""Docs that run: every fenced block of README.md and docs/*.md runs as a reader runs it
+(tests/repo/docs_run.py says how each kind of block is run and checked; tests/README.md,
+"Docs that run", says how to mark a block).
+
+The documents run once per session (``doc_runs``), in one workspace; each block is one test
+case, so a failure names the document and line of the block. ``-k operator.md`` runs README.md
+and docs/operator.md only.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from . import docs_data
+from .docs_run import (DOCS, LANGS, Workspace, _claims, all_blocks, blocks, check_claim,
+                       commands, parse_marker, run_docs, run_python, text_lines_found,
+                       with_markers)
+
+BLOCKS = all_blocks()
+
+
+@pytest.fixture(scope="session")
+def doc_runs(request, tmp_path_factory, cli_once):
+    """Every block of the pages this session tests (README.md always: later pages use its
+    outputs), in order, in one workspace."""
+    ws = Workspace(tmp_path_factory.mktemp("docs"), cli_once, docs_data.FILES,
+                   docs_data.PRODUCERS)
+    for name, make in docs_data.OVERRIDES.items():
+        make(ws.path / name)
+    wanted = {b.doc for b in BLOCKS if any(
+        getattr(item, "callspec", None) is not None and item.callspec.params.get("block") is b
+        and item.originalname == "test_the_block_runs_as_written"
+        for item in request.session.items)}
+    return run_docs(ws, [d for d in DOCS if d in wanted or d.name == "README.md"])
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("block", BLOCKS, ids=[b.id for b in BLOCKS])
+def test_the_block_runs_as_written(block, doc_runs):
+    problems = doc_runs[block.id].problems
+    assert not problems, f"{block.id} ({block.lang}):\n" + "\n\n".join(problems)
+
+
+# ------------------------------------------------------------------ static, fast checks
+@pytest.mark.parametrize("block", BLOCKS, ids=[b.id for b in BLOCKS])
+def test_every_block_has_a_kind_the_engine_runs(block):
+    """A block in an unknown language would silently not run: give it a language or a
+    visible skip marker with its reason."""
+    assert block.kind is not None or any(not m.text for m in block.marked("skip")), (
+        f"{block.id}: the fence says {block.lang!r}; write one of {', '.join(sorted(LANGS))}")
+
+
+def test_the_docs_hold_blocks_of_every_kind():
+    kinds = {b.kind for b in BLOCKS}
+    assert {"bash", "python", "text", "yaml"} <= kinds
+    assert len(BLOCKS) >= 30
+
+
+def test_skips_are_rare_and_give_their_reason():
+    skips = [(b.id, m) for b in BLOCKS for m in b.marked("skip")]
+    assert len(skips) <= 5, skips
+    assert all(m.reason for _, m in skips)
+
+
+# ------------------------------------------------------------------ the engine itself
+def test_commands_join_continuations_and_drop_comments():
+    body = "# a comment\nfm2uav plan \\\n  --scenario x   # why\n\nmake run\n"
+    assert [c.split() for c in commands(body)] == [
+        ["fm2uav", "plan", "--scenario", "x", "#", "why"], ["make", "run"]]
+
+
+@pytest.mark.parametrize("claim, values", [
+    ("0.7061 (exact: 0.7071)", [0.7061]),
+    ("True", [True]),
+    ("'disco', 12 m", ["disco", 12]),
+    ("[1.5, 2.0] m/s", [1.5, 2.0]),
+    ("≈ 3e-3", [3e-3]),
+])
+def test_arrow_claims_are_read(claim, values):
+    assert _claims(claim) == values
+
+
+def test_a_claim_is_checked_to_the_digits_written():
+    check_claim(0.70612, "0.7061", "x")
+    check_claim((3, 4.25), "3, 4.25", "x")
+    with pytest.raises(AssertionError, match="the doc says 0.7071"):
+        check_claim(0.70612, "0.7071", "x")
+    with pytest.raises(AssertionError, match="states no value"):
+        check_claim(1.0, "roughly one", "x")
+    with pytest.raises(AssertionError):
+        check_claim(True, "False", "x")
+
+
+def test_a_python_block_fails_on_a_wrong_or_unchecked_number():
+    ns: dict = {}
+    assert run_python("x = 2\nprint(x * 3)\nx / 4  # → 0.5\n", ns, "b") == "6\n"
+    with pytest.raises(AssertionError, match="the doc says 0.6"):
+        run_python("x / 4  # → 0.6\n", ns, "b")
+    with pytest.raises(AssertionError, match="a number no one checks"):
+        run_python("x / 4  # 0.5 m\n", ns, "b")
+    run_python("print([x / 4, -x])  # → [0.5, -2]: printed\n", ns, "b")
+    with pytest.raises(AssertionError, match="the doc says -3"):
+        run_python("print([x / 4, -x])  # → [0.5, -3]\n", ns, "b")
+
+
+def test_quoted_output_lines_must_be_printed():
+    out = "error: the DEM has nodata under 585 of 42262 nodes\nok\n"
+    assert text_lines_found("error: the DEM has nodata under ... nodes\nok", out) == []
+    assert text_lines_found("error: the DEM has nodata under 586 of 42262 nodes", out) == [
+        "error: the DEM has nodata under 586 of 42262 nodes"]
+
+
+def test_a_measured_table_under_an_output_marker_is_a_block(tmp_path):
+    doc = tmp_path / "d.md"
+    doc.write_text("| a | b |\n|---|---|\n| 1 | 2 |\n\ntext\n"
+                   '<!-- docs-run: output "cat t.md" -->\n| x | y |\n|:--|--:|\n| 3 | 4.5 |\n')
+    (b,) = blocks(doc)  # the unmarked table is prose
+    assert (b.kind, b.line, b.body) == ("text", 7, "| x | y |\n| 3 | 4.5 |\n")
+    assert text_lines_found(b.body, "| x | y |\n|---|---|\n| 3 | 4.50 |") == ["| 3 | 4.5 |"]
+
+
+def test_markers_are_read_and_need_reasons(tmp_path):
+    doc = tmp_path / "d.md"
+    doc.write_text('text\n<!-- docs-run: with "reproduce" --cell 0.1: lighter run -->\n'
+                   '<!-- docs-run: skip "dask-scheduler": needs a cluster -->\n'
+                   "```bash\nfm2uav reproduce x --out o\ndask-scheduler\n```\n")
+    (b,) = blocks(doc)
+    assert [m.verb for m in b.markers] == ["with", "skip"]
+    assert with_markers("fm2uav reproduce x --out o", b) == "fm2uav reproduce x --out o --cell 0.1"
+    assert with_markers("dask-scheduler", b) is None
+    # an option given again replaces the written one (equal runs share one session run)
+    assert with_markers("fm2uav reproduce x --cell 0.5 --out o  # why", b) == \
+        "fm2uav reproduce x --out o --cell 0.1 # why"
+    with pytest.raises(ValueError, match="needs a reason"):
+        parse_marker('skip "x"', "d.md:1")
+    with pytest.raises(ValueError, match="unknown docs-run marker"):
+        parse_marker("run it", "d.md:1")
