@@ -19,7 +19,7 @@ from ..pipeline.outputs import export_options, parse_anchor  # noqa: F401  (re-e
 
 __all__ = [
     "Firmware", "Vehicle", "Frame", "End", "Thin", "AnchorText", "SpeedChanges", "MinSpeed",
-    "CruiseSpeed", "HoverSpeed", "Endurance", "Reserve", "Via", "Return", "parse_anchor",
+    "CruiseSpeed", "HoverSpeed", "Endurance", "Reserve", "Power", "Battery", "Wind", "Via", "Return", "parse_anchor",
     "via_points", "export_options",
 ]
 
@@ -53,6 +53,16 @@ Endurance = Annotated[float | None, typer.Option(
     help="Airframe endurance (min): the flight time is checked against it (airframe.endurance).")]
 Reserve = Annotated[float | None, typer.Option(
     help="Share of the endurance kept in reserve (airframe.reserve). Default 0.2.")]
+Power = Annotated[str | None, typer.Option(
+    help="Power model of the energy figures: a preset (arducopter, disco, crosswind) or a "
+    ".yaml/.json file of parameters, e.g. the one `fm2uav calibrate` fits to a flight log "
+    "(airframe.power). Default: the class model of --vehicle.")]
+Battery = Annotated[float | None, typer.Option(
+    help="Battery energy (Wh) the flight's energy is checked against, with the reserve "
+    "(airframe.battery). Default: the power model's.")]
+Wind = Annotated[str | None, typer.Option(
+    help="Wind as SPEED@DIR: m/s @ degrees it blows FROM, clockwise from north (8@270: 8 m/s "
+    "from the west); the energy and times are figured in it (mission file wind:).")]
 
 
 Via = Annotated[list[str] | None, typer.Option(

@@ -124,7 +124,8 @@ _REPORT_HELP = "Also write report.html (interactive, self-contained)."
 @world_options
 @safety_options
 @mission_options("firmware", "vehicle", "frame", "end", "thin", "anchor", "speed_changes",
-                 "min_speed", "cruise_speed", "hover_speed", "endurance", "reserve")
+                 "min_speed", "cruise_speed", "hover_speed", "endurance", "reserve",
+                 "power", "battery", "wind")
 def cover_cmd(
     area: str = typer.Option(..., help="Polygon file (GeoJSON lon/lat, GPKG, SHP, "
                              "KML/KMZ) or S1..S4 (built-in map)."),

@@ -52,7 +52,8 @@ EXPORT_HELP = (
 
 @handle_errors
 @mission_options("firmware", "vehicle", "frame", "end", "thin", "anchor", "speed_changes",
-                 "min_speed", "cruise_speed", "hover_speed", "endurance", "reserve")
+                 "min_speed", "cruise_speed", "hover_speed", "endurance", "reserve",
+                 "power", "battery", "wind")
 @output_options("out/export")
 def export_cmd(
     path_file: Path = typer.Argument(..., help="Path CSV (as written by fm2uav)."),

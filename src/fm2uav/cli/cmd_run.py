@@ -57,7 +57,8 @@ RUN_HELP = (
                 "out/<mission file name>.")
 @world_options
 @mission_options("via", "return_to_start", "firmware", "vehicle", "frame", "end",
-                 "speed_changes", "endurance", "reserve")
+                 "speed_changes", "endurance", "reserve", "power", "battery",
+                 "wind")
 def run_cmd(
     mission_file: Path = typer.Argument(..., help="Mission YAML file.", show_default=False),
     output: Output = None,

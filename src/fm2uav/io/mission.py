@@ -30,7 +30,10 @@ Schema (pydantic v2, strict types, unknown keys rejected)::
                    reference: agl}]   # files or inline zones (see fm2uav.io.zone_spec)
     operating_area: area.geojson    # or {polygon: ..., lonlat: true}; the plan stays inside
     airframe: {type: multirotor, firmware: px4, cruise_speed: 12, hover_speed: 5,
-               endurance: 25, reserve: 0.2}   # [min] endurance checked with a 20 % reserve
+               endurance: 25, reserve: 0.2,   # [min] endurance checked with a 20 % reserve
+               power: arducopter, battery: 74}   # power model (preset, file, or
+                                    # {preset: .., mass_kg: ..}) and battery [Wh]
+    wind: {speed: 8, from: 270}     # [m/s] from [deg]; + ref_height, exponent: a profile
     outputs:
       dir: out/my-mission           # default out/<file name>; `fm2uav run --out` overrides
       formats: [csv, geojson, kml, plan, wpl, html, png, json]
@@ -54,7 +57,7 @@ from typing import Any, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
-from pydantic import field_validator, model_validator
+from pydantic import ValidationInfo, field_validator, model_validator
 
 from ..errors import InputError
 from ..world.load import WorldSpec as DataWorldSpec
@@ -294,6 +297,50 @@ class AirframeSpec(BaseModel):
     endurance: float | None = _num(None, unit="min", gt=0, le=10000,
                                    desc="flight endurance (battery / fuel)")
     reserve: float = _num(0.2, ge=0, lt=1, desc="share of the endurance kept in reserve")
+    power: str | dict[str, Any] | None = Field(
+        None, description="power model: a preset (arducopter, disco, crosswind), a .yaml/.json "
+        "file (fm2uav calibrate writes one) or {preset: .., <parameter>: ..}")
+    battery: float | None = _num(None, unit="Wh", gt=0, le=1_000_000,
+                                 desc="battery energy (default: the power model's)")
+
+    @field_validator("power")
+    @classmethod
+    def _power(cls, v: Any, info: ValidationInfo) -> Any:
+        from ..vehicles.power import get_power_model
+
+        if v is None:
+            return v
+        if isinstance(v, str) and Path(v).suffix.lower() in (".yaml", ".yml", ".json"):
+            p = Path(v).expanduser()
+            base = (info.context or {}).get("base_dir")
+            v = str(p if p.is_absolute() or base is None else Path(base) / p)
+        try:
+            get_power_model(v)
+        except InputError as exc:
+            raise ValueError(str(exc)) from None
+        return v
+
+
+class WindSpec(BaseModel):
+    """The wind: constant, or a power-law profile with ``ref_height`` / ``exponent``."""
+
+    model_config = ConfigDict(strict=True, extra="forbid", frozen=True, populate_by_name=True)
+    speed: float = _num(..., unit="m/s", ge=0, le=100, desc="wind speed")
+    from_deg: float = Field(..., alias="from", ge=0, le=360,
+                            description="direction the wind blows from [deg from north]")
+    ref_height: float | None = _num(None, unit="m", gt=0, le=1000,
+                                    desc="height above ground of the speed (a profile)")
+    exponent: float | None = _num(None, ge=0, le=1, desc="power-law exponent (a profile)")
+
+    def field(self) -> Any:
+        """The :class:`~fm2uav.world.wind.WindField`."""
+        from ..world.wind import WindField
+
+        if self.ref_height is None and self.exponent is None:
+            return WindField.constant(self.speed, self.from_deg, source="mission file wind:")
+        return WindField.profile(self.speed, self.from_deg, ref_height=self.ref_height or 10.0,
+                                 exponent=1 / 7 if self.exponent is None else self.exponent,
+                                 source="mission file wind:")
 
 
 class OutputSpec(BaseModel):
@@ -331,6 +378,8 @@ class Mission(BaseModel):
                                          description="no-fly zones: files or inline zones")
     operating_area: ZoneSpec | None = Field(None, description="area the mission stays in")
     airframe: AirframeSpec = Field(default_factory=AirframeSpec)
+    wind: WindSpec | None = Field(None, description="the wind: {speed, from[, ref_height, "
+                                  "exponent]}")
     outputs: OutputSpec = Field(default_factory=OutputSpec)
 
     @model_validator(mode="after")
@@ -359,7 +408,8 @@ class Mission(BaseModel):
             speed_changes=o.speed_changes, speed_step=o.speed_step, min_speed=a.min_speed,
             climb_rate=a.climb_rate, descent_rate=a.descent_rate,
             endurance_s=None if a.endurance is None else 60.0 * a.endurance,
-            reserve=a.reserve, name=self.name,
+            reserve=a.reserve, name=self.name, power=a.power, battery_wh=a.battery,
+            wind=None if self.wind is None else self.wind.field(),
         )
 
     def plan_kwargs(self) -> dict[str, Any]:

@@ -226,12 +226,14 @@ def export_options(base: Any = None, *, firmware: str | None = None, vehicle: st
                    anchor: str | None = None, speed_changes: bool | None = None,
                    min_speed: float | None = None, cruise_speed: float | None = None,
                    hover_speed: float | None = None, endurance: float | None = None,
-                   reserve: float | None = None, **more: Any) -> Any:
+                   reserve: float | None = None, power: str | None = None,
+                   battery: float | None = None, wind: str | None = None, **more: Any) -> Any:
     """``base`` (default ``ExportOptions()``) with the settings that were given (None =
     not given): the command line's mission flags, the app's aircraft and mission fields.
 
     ``thin`` is the waypoint tolerance [m], ``endurance`` in minutes, ``anchor`` the
-    ``lon,lat[,alt]`` text of ``--anchor``.
+    ``lon,lat[,alt]`` text of ``--anchor``, ``power`` a power-model preset or file,
+    ``battery`` in Wh, ``wind`` the ``SPEED@DIR`` text of ``--wind``.
 
     Raises
     ------
@@ -241,16 +243,24 @@ def export_options(base: Any = None, *, firmware: str | None = None, vehicle: st
     from dataclasses import replace
 
     from ..autopilot import ExportOptions
+    from ..world.wind import parse_wind_text
 
     given = {"firmware": firmware, "vehicle": vehicle, "frame": frame, "end": end,
              "tolerance": thin, "anchor": parse_anchor(anchor), "speed_changes": speed_changes,
              "min_speed": min_speed, "cruise_speed": cruise_speed, "hover_speed": hover_speed,
              "endurance_s": None if endurance is None else 60.0 * float(endurance),
-             "reserve": reserve, **more}
+             "reserve": reserve, "power": power, "battery_wh": battery,
+             "wind": None if wind is None else parse_wind_text(wind), **more}
     if thin is not None and not thin >= 0:
         raise InputError(f"--thin must be a tolerance >= 0 m, got {thin}")
     if endurance is not None and not endurance > 0:
         raise InputError(f"--endurance must be > 0 minutes, got {endurance}")
+    if battery is not None and not battery > 0:
+        raise InputError(f"--battery must be > 0 Wh, got {battery}")
+    if power is not None:
+        from ..vehicles.power import get_power_model
+
+        get_power_model(power)  # an unknown preset or a bad file: refused before any work
     return replace(base or ExportOptions(), **{k: v for k, v in given.items() if v is not None})
 
 

@@ -8,7 +8,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["plan_rows", "world_rows", "mission_rows", "safety_rows", "ground_rows"]
+__all__ = ["plan_rows", "world_rows", "mission_rows", "energy_rows", "safety_rows",
+           "ground_rows"]
 
 
 def mission_rows(mission: Any) -> dict[str, str]:
@@ -24,12 +25,40 @@ def mission_rows(mission: Any) -> dict[str, str]:
         "flight": f"{s['flight']['flight_distance_m'] / 1000:.2f} km, "
                   f"{s['flight']['flight_time_s'] / 60:.1f} min",
     }
+    rows.update(energy_rows(s.get("energy")))
     if s["speed_changes"]["items"]:
         rows["speed changes"] = (f"{s['speed_changes']['items']} "
                                  f"({', '.join(f'{v:g}' for v in s['speed_changes']['speeds_mps'])}"
                                  " m/s)")
     for k, w in enumerate(s["warnings"]):
         rows[f"warning {k + 1}"] = w
+    return rows
+
+
+def energy_rows(e: dict[str, Any] | None) -> dict[str, str]:
+    """Printed rows of a mission's energy figures (:func:`fm2uav.autopilot.energy.mission_energy`):
+    the energy and time against the battery, the model, the wind, the point of no return."""
+    if not e:
+        return {}
+    if e["energy_wh"] is None:
+        used = "cannot be flown in this wind"
+    else:
+        used = (f"{e['energy_wh']:.1f} Wh, {e['time_s'] / 60:.1f} min of {e['battery_wh']:g} Wh "
+                f"({e['usable_wh']:.1f} Wh usable with a {100 * e['reserve']:.0f} % reserve): "
+                f"{'OK' if e['ok'] else 'NOT ENOUGH'}")
+    rows = {"energy": used,
+            "power model": f"{e['model']} ({e['model_kind']}, {e['hover_or_cruise_power_w']:g} W "
+                           f"{'hover' if e['model_kind'] == 'multirotor' else 'cruise'}; "
+                           f"{e['model_source']})"}
+    if e.get("wind"):
+        w = e["wind"]
+        rows["wind"] = (f"{w['speed_mps']:g} m/s from {w['from_deg']:g}°" if "speed_mps" in w
+                        else f"gridded, up to {w['max_speed_mps']:g} m/s") + (
+            f"; ground speed {e['groundspeed_mps'][0]:g}–{e['groundspeed_mps'][1]:g} m/s, "
+            f"airspeed {e['airspeed_mps'][0]:g}–{e['airspeed_mps'][1]:g} m/s"
+            if e.get("groundspeed_mps") else "")
+    if "no_return_waypoint" in e:
+        rows["point of no return"] = f"waypoint {e['no_return_waypoint']}: {e['no_return_note']}"
     return rows
 
 

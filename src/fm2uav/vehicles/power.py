@@ -168,8 +168,9 @@ class _Linear:
         return float(v[np.argmin(self.power(v, 0.0))])
 
     def summary(self) -> dict[str, Any]:
-        """JSON-friendly parameters."""
-        return {f.name: getattr(self, f.name) for f in fields(self)}  # type: ignore[arg-type]
+        """JSON-friendly parameters, with ``kind`` (what :func:`get_power_model` reads back)."""
+        return {"kind": self.kind,  # type: ignore[attr-defined]
+                **{f.name: getattr(self, f.name) for f in fields(self)}}  # type: ignore[arg-type]
 
 
 @dataclass(frozen=True)
@@ -432,19 +433,72 @@ POWER_MODELS: dict[str, PowerModel] = {
 }
 
 
-def get_power_model(name: str | PowerModel | None) -> PowerModel:
-    """The power model of a preset (a model object is returned unchanged).
+def get_power_model(spec: Any) -> PowerModel:
+    """A power model from a preset name, a parameter mapping or a file.
+
+    Parameters
+    ----------
+    spec : str, Path, dict or PowerModel
+        A preset of :data:`POWER_MODELS`; a ``.yaml``/``.json`` file holding a mapping
+        (what ``fm2uav calibrate`` writes); or a mapping with ``preset`` (the model to
+        start from) and/or ``kind`` (``multirotor`` / ``fixed-wing``) and any parameters
+        of :class:`MultirotorPower` / :class:`FixedWingPower` to set. A model object is
+        returned unchanged.
 
     Raises
     ------
     InputError
-        No model for that name (the message lists those there are).
+        An unknown preset, file, kind or parameter (the message lists the valid ones).
+
+    Examples
+    --------
+    >>> get_power_model({"preset": "arducopter", "mass_kg": 2.5}).mass_kg
+    2.5
     """
-    if isinstance(name, (MultirotorPower, FixedWingPower)):
-        return name
-    key = str(name).strip().lower().replace("_", "-")
+    from pathlib import Path
+
+    from .._validate import load_json, load_yaml
+
+    if isinstance(spec, (MultirotorPower, FixedWingPower)):
+        return spec
+    if isinstance(spec, (str, Path)) and Path(spec).suffix.lower() in (".yaml", ".yml", ".json"):
+        path = Path(spec)
+        data = (load_json(path, "power model file") if path.suffix.lower() == ".json"
+                else load_yaml(path, "power model file"))
+        if isinstance(data, dict) and isinstance(data.get("model"), dict):
+            data = data["model"]  # a calibration result: its model
+        if not isinstance(data, dict):
+            raise InputError(f"power model file {path} must hold a mapping of parameters")
+        return get_power_model(data)
+    if isinstance(spec, dict):
+        d = dict(spec)
+        base = d.pop("preset", None)
+        kind = d.pop("kind", None)
+        if base is None and kind is None:
+            raise InputError("airframe.power needs 'preset' (one of "
+                             f"{', '.join(sorted(POWER_MODELS))}) or 'kind' (multirotor or "
+                             "fixed-wing) with all its parameters")
+        cls = {"multirotor": MultirotorPower, "fixed-wing": FixedWingPower,
+               "fixed_wing": FixedWingPower}.get(str(kind)) if kind is not None else None
+        if kind is not None and cls is None:
+            raise InputError(f"airframe.power kind must be multirotor or fixed-wing, got {kind!r}")
+        start = get_power_model(base) if base is not None else None
+        if start is not None and cls is not None and not isinstance(start, cls):
+            raise InputError(f"airframe.power: preset {base!r} is a {start.kind}, not a {kind}")
+        cls = cls or type(start)
+        names = {f.name for f in fields(cls)}
+        bad = sorted(set(d) - names)
+        if bad:
+            raise InputError(f"airframe.power: unknown parameter(s) {bad}; a {cls.kind} "
+                             f"model has: {', '.join(sorted(names))}")
+        try:
+            return replace(start, **d) if start is not None else cls(**d)
+        except TypeError as exc:
+            raise InputError(f"airframe.power: {exc} (give a preset to start from, or every "
+                             "parameter)") from None
+    key = str(spec).strip().lower().replace("_", "-")
     if key not in POWER_MODELS:
-        raise InputError(f"no power model for airframe {name!r}; presets with one: "
-                         f"{', '.join(sorted(POWER_MODELS))} (or give airframe.power in the "
-                         "mission file)")
+        raise InputError(f"no power model for airframe {spec!r}; presets with one: "
+                         f"{', '.join(sorted(POWER_MODELS))}, or a .yaml/.json file of "
+                         "parameters (airframe.power in the mission file, --power)")
     return POWER_MODELS[key]
