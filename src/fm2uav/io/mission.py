@@ -558,9 +558,13 @@ def _field_info(loc: tuple[Any, ...]) -> tuple[Any, str]:
         if not isinstance(key, str):
             continue
         fields = getattr(model, "model_fields", None)
-        if not fields or key not in fields:
+        by_alias = {f.alias: k for k, f in (fields or {}).items() if f.alias}
+        if fields and key in by_alias:
+            info, name = fields[by_alias[key]], key
+        elif not fields or key not in fields:
             return info, name
-        info, name = fields[key], key
+        else:
+            info, name = fields[key], key
         ann = info.annotation
         nxt = None
         for cand in (ann, *getattr(ann, "__args__", ())):
