@@ -1,6 +1,7 @@
 """Flight logs made from a known power model: a MAVLink telemetry log (.tlog) written
-with pymavlink and an ArduPilot DataFlash log (.bin) written byte by byte as its
-format describes (FMT messages first), for the power-fit tests."""
+with pymavlink (:func:`fm2uav.io.flightlog.write_power_tlog`) and an ArduPilot DataFlash
+log (.bin) written byte by byte as its format describes (FMT messages first), for the
+power-fit tests."""
 
 from __future__ import annotations
 
@@ -29,23 +30,15 @@ def flight_states(kind: str, seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.
 
 def write_tlog(path: Path, t, power, airspeed, climb, *, volts: float = 14.8,
                armed_from: float = 0.0) -> Path:
-    """A .tlog of HEARTBEAT, SYS_STATUS (volts x current in mV / cA) and VFR_HUD at ``t``."""
-    from pymavlink.dialects.v20 import ardupilotmega as mavlink
+    """A .tlog of HEARTBEAT, SYS_STATUS (volts x current in mV / cA) and VFR_HUD at ``t``
+    (:func:`fm2uav.io.flightlog.write_power_tlog`)."""
+    from fm2uav.io.flightlog import write_power_tlog
+    from fm2uav.vehicles.calibration import PowerSamples
 
-    mav = mavlink.MAVLink(None, srcSystem=1, srcComponent=1)
-    t0 = 1.7e9
-    with open(path, "wb") as f:
-        def put(ts: float, msg) -> None:
-            f.write(struct.pack(">Q", int((t0 + ts) * 1e6)) + msg.pack(mav))
-        for ti, p, a, c in zip(t, power, airspeed, climb):
-            armed = ti >= armed_from
-            put(ti, mavlink.MAVLink_heartbeat_message(2, 3, 128 * armed | 1, 4, 4, 3))
-            put(ti + 0.01, mavlink.MAVLink_vfr_hud_message(float(a), float(a), 0, 50, 50.0,
-                                                            float(c)))
-            put(ti + 0.02, mavlink.MAVLink_sys_status_message(
-                0, 0, 0, 0, int(round(volts * 1000)), int(round(p / volts * 100)), 80,
-                0, 0, 0, 0, 0, 0))
-    return path
+    t = np.asarray(t, float)
+    s = PowerSamples(t, np.asarray(power, float), np.asarray(airspeed, float),
+                     np.asarray(climb, float), np.asarray(airspeed, float))
+    return write_power_tlog(path, s, volts=volts, armed_from=armed_from)
 
 
 def write_bin(path: Path, t, power, airspeed, climb, *, volts: float = 22.2) -> Path:

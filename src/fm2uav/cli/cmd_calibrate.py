@@ -21,7 +21,7 @@ def _help() -> str:
         "it to --power or airframe.power: the energy of every later mission uses it) and "
         "calibration.json (coefficients, residual, R²).\n\n"
         "Examples:\n\n"
-        "  fm2uav calibrate flight.tlog --power arducopter --out out/calib\n\n"
+        "  fm2uav calibrate flight.tlog --power arducopter --mass 2.4 --out out/calib\n\n"
         "  fm2uav calibrate 00000042.BIN --power disco --fit cd0/efficiency --fit "
         "k/efficiency --out out/calib\n\n"
         "The starting model fixes the mass, areas and air density; fly level legs at several "
@@ -37,6 +37,9 @@ def calibrate_cmd(
     power: str = typer.Option(
         "arducopter", help="Starting power model: a preset (arducopter, disco, crosswind) or "
         "a .yaml/.json file; its mass, areas and density are kept."),
+    mass: float | None = typer.Option(
+        None, help="Take-off mass (kg) of the logged flight, if not the starting model's: the "
+        "shapes of the induced and climb terms depend on it."),
     fit: list[str] | None = typer.Option(
         None, "--fit", help="A coefficient to fit (repeat); default all but avionics_w.",
         show_default=False),
@@ -50,7 +53,15 @@ def calibrate_cmd(
     from ..vehicles.calibration import fit_power
     from ..vehicles.power import get_power_model
 
+    from ..errors import InputError
+
     start = get_power_model(power)
+    if mass is not None and not mass > 0:
+        raise InputError(f"--mass must be a take-off mass > 0 kg, got {mass}")
+    if mass is not None:
+        from dataclasses import replace
+
+        start = replace(start, mass_kg=mass)
     outdir = output.dir(CALIBRATE_FILES)
     with output.progress() as step:
         step(f"reading {log_file.name}")

@@ -12,7 +12,9 @@
 
 The speeds and climb are interpolated to the power samples' times (never beyond the
 times they cover). Reading computes nothing else; the fit is
-:func:`fm2uav.vehicles.calibration.fit_power`.
+:func:`fm2uav.vehicles.calibration.fit_power`. :func:`write_power_tlog` writes such
+samples as a telemetry log (what a ground station would have recorded), for tests and
+examples.
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ import numpy as np
 from ..errors import InputError
 from ..vehicles.calibration import PowerSamples
 
-__all__ = ["read_power_samples"]
+__all__ = ["read_power_samples", "write_power_tlog"]
 
 _ARMED = 128  # MAV_MODE_FLAG_SAFETY_ARMED
 _GCS = 6  # MAV_TYPE_GCS
@@ -136,3 +138,34 @@ def read_power_samples(path: str | Path) -> PowerSamples:
         return _bin(p)
     raise InputError(f"flight log {p}: unknown kind {ext!r}; give an ArduPilot DataFlash "
                      "log (.bin) or a telemetry log (.tlog)")
+
+
+def write_power_tlog(path: str | Path, samples: PowerSamples, *, volts: float = 14.8,
+                     armed_from: float = 0.0) -> Path:
+    """Write ``samples`` as a MAVLink 2 telemetry log (``.tlog``) with pymavlink.
+
+    At each sample time: a ``HEARTBEAT`` of a quadrotor (armed from ``armed_from`` [s]),
+    ``VFR_HUD`` (airspeed, ground speed, climb) and ``SYS_STATUS`` with the battery at
+    ``volts`` and the current ``power / volts`` (in its mV and cA units, so rounded to
+    them), each after its 8-byte big-endian microsecond timestamp.
+    """
+    import struct
+
+    from pymavlink.dialects.v20 import ardupilotmega as mavlink
+
+    mav = mavlink.MAVLink(None, srcSystem=1, srcComponent=1)
+    t0 = 1.7e9
+    p = Path(path)
+    with open(p, "wb") as f:
+        def put(ts: float, msg: Any) -> None:
+            f.write(struct.pack(">Q", int((t0 + ts) * 1e6)) + msg.pack(mav))
+        for ti, pw, a, g, c in zip(samples.t, samples.power, samples.airspeed,
+                                   samples.groundspeed, samples.climb):
+            armed = 128 if ti >= armed_from else 0
+            put(ti, mavlink.MAVLink_heartbeat_message(2, 3, armed | 1, 4, 4, 3))
+            put(ti + 0.01, mavlink.MAVLink_vfr_hud_message(float(a), float(g), 0, 50, 50.0,
+                                                            float(c)))
+            put(ti + 0.02, mavlink.MAVLink_sys_status_message(
+                0, 0, 0, 0, int(round(volts * 1000)), int(round(pw / volts * 100)), 80,
+                0, 0, 0, 0, 0, 0))
+    return p
