@@ -21,6 +21,7 @@ from .options import (
     world_rows,
 )
 from ._mission_options import parse_anchor
+from ..pipeline.outputs import wind_options
 from .cmd_run import mission_rows, output_names, plan_outputs, safety_rows
 
 PLAN_FILES = ("path.csv", "plan.png", "summary.json")
@@ -125,7 +126,7 @@ def plan_cmd(
              max_agl=max_agl))
     route = plan_route(w, start_m, goal_m, via=via_m,
                        return_to_start=bool(mission.return_to_start), shaping=shaping,
-                       level=level, options=options)
+                       level=level, options=options, wind=wind_options(export_options))
     p = route.plan
     summary = {"scenario": scenario, "world": world_summary(w), **p.summary(),
                "route": route.summary()}

@@ -161,6 +161,11 @@ def export_mission(
     speed = getattr(plan, "w", None)
     if speed is None:
         speed = getattr(plan, "speed", None)
+    timing = getattr(plan, "wind_timing", None)
+    if timing is not None and opt.vehicle == "multirotor":
+        # a multirotor is commanded ground speeds: what the safe airspeed makes good in the
+        # wind (capped at the forward speed), not the airspeed share W
+        speed = np.clip(timing.point_groundspeed() / opt.forward_speed, 0.0, 1.0)
     mission = build_mission(path, world, opt, w=speed, agl=agl, times=times, via=via,
                             camera=camera, fences=fences, start_hold=start_hold,
                             profile=getattr(plan, "profile", None))

@@ -21,7 +21,7 @@ from .rows import safety_rows
 
 __all__ = ["OUTPUT_FILES", "EXPORT_FILES", "output_names", "write_exports", "plan_outputs",
            "to_jsonable", "write_json", "write_text", "write_figure", "export_options",
-           "parse_anchor"]
+           "parse_anchor", "wind_options"]
 
 #: Export format → file name (:data:`fm2uav.io.exports.EXPORT_FILES`, repeated here so that
 #: importing this module loads no exporter; a test keeps both equal).
@@ -278,3 +278,13 @@ def parse_anchor(text: str | None) -> Any:
         raise InputError(f"--anchor must be lon,lat or lon,lat,alt (degrees, degrees, "
                          f"metres), got {text!r}")
     return Anchor(lon=v[0], lat=v[1], alt=v[2] if len(v) == 3 else 0.0)
+
+
+def wind_options(options: Any) -> Any:
+    """The :class:`~fm2uav.planning.wind.WindOptions` of a mission's export options: its
+    wind (``--wind`` / ``wind:``) at the forward speed (the airspeed at W = 1), or None."""
+    if getattr(options, "wind", None) is None:
+        return None
+    from ..planning.wind import WindOptions
+
+    return WindOptions(options.wind, options.forward_speed)

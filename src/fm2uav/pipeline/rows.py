@@ -99,12 +99,21 @@ def safety_rows(safety: dict[str, Any]) -> dict[str, str]:
 
 def plan_rows(p: Any) -> dict[str, Any]:
     """The printed summary rows every planning command shows of a plan."""
-    return {
+    rows = {
         "start [m]": np.round(p.start, 1).tolist(),
         "goal [m]": np.round(p.goal, 1).tolist(),
         "length [m]": f"{p.length:.1f}",
         "clearance [m]": f"{p.clearance:.1f}",
     }
+    w = (getattr(p, "params", None) or {}).get("wind")
+    if w:
+        g = w["groundspeed_mps"]
+        rows["route in the wind"] = (
+            (f"{w['time_s'] / 60:.1f} min" if w["time_s"] is not None else "no headway")
+            + f" at up to {w['airspeed_mps']:g} m/s airspeed"
+            + (f", ground speed {g[0]:g}–{g[1]:g} m/s" if g else "")
+            + f"; {w['refused_nodes']} nodes refused (wind ≥ safe airspeed)")
+    return rows
 
 
 def world_rows(world: Any) -> dict[str, str]:

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import progress
-from .outputs import plan_outputs
+from .outputs import plan_outputs, wind_options
 
 __all__ = ["MissionRun", "run_mission", "with_zone_files"]
 
@@ -122,7 +122,7 @@ def run_mission(
     shaping, level, popts = planner_objects({**mission.plan_kwargs(), **(planner or {})})
     route = plan_route(rm.world, rm.start, rm.goal, via=rm.via,
                        return_to_start=rm.return_to_start, shaping=shaping, level=level,
-                       options=popts)
+                       options=popts, wind=wind_options(options))
     world_name = mission.world.scenario or mission.world.describe()
     progress.step("writing the mission files", 0.3)
     info, built = plan_outputs(

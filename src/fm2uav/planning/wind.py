@@ -31,7 +31,8 @@ from .. import _validate as v
 from ..eikonal.wind import ground_speed, zermelo_march
 from ..errors import InputError, PlanningError, UnreachableError
 
-__all__ = ["WindOptions", "wind_times", "descend_track", "path_timing", "PathTiming"]
+__all__ = ["WindOptions", "wind_times", "descend_track", "path_timing", "PathTiming",
+           "join_timings"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -86,8 +87,13 @@ def wind_times(world: Any, W: np.ndarray, goal_cell: tuple[int, ...],
                 f"(W {W[cell]:.3g} x {opts.airspeed:g} m/s = {airspeed[cell]:.3g} m/s): the "
                 f"vehicle cannot hold its way; move the {what} away from obstacles, fly faster "
                 "(--cruise-speed / --hover-speed) or on a calmer day")
+    # stop once the start's neighbourhood is final: the descent interpolates around it
+    box = np.stack(np.meshgrid(*[np.arange(max(c - 2, 0), min(c + 3, n))
+                                 for c, n in zip(start_cell, W.shape)], indexing="ij"),
+                   axis=-1).reshape(-1, W.ndim)
+    box = box[W[tuple(box.T)] > 0]
     res = zermelo_march(airspeed, [goal_cell], wind, spacing=world.spacing, order=order,
-                        stop_at=[start_cell], towards=True, track=True)
+                        stop_at=box, towards=True, track=True)
     return res.times, res.track, res.refused
 
 
@@ -228,6 +234,14 @@ class PathTiming:
         """Flight time along the whole path [s]."""
         return float(self.time[-1])
 
+    def point_groundspeed(self) -> np.ndarray:
+        """Ground speed at each path point [m/s]: the slower of its two segments (0 where
+        there is no headway)."""
+        g = np.nan_to_num(self.groundspeed, nan=0.0)
+        if not len(g):
+            return np.zeros(1)
+        return np.minimum(np.concatenate([g[:1], g]), np.concatenate([g, g[-1:]]))
+
     def summary(self) -> dict[str, Any]:
         """JSON-friendly figures."""
         ok = np.isfinite(self.groundspeed)
@@ -264,3 +278,14 @@ def path_timing(world: Any, path: np.ndarray, w: np.ndarray, opts: WindOptions) 
     head_vec = np.nan_to_num(g)[:, None] * u - wind2   # air velocity: where the nose points
     heading = np.degrees(np.arctan2(head_vec[:, 0], head_vec[:, 1])) % 360.0
     return PathTiming(air, g, heading, wind2, np.concatenate([[0.0], np.cumsum(dt)]))
+
+
+def join_timings(parts: list[PathTiming]) -> PathTiming:
+    """The timing of legs flown one after the other (their paths share the junctions)."""
+    times = [parts[0].time]
+    for p in parts[1:]:
+        times.append(times[-1][-1] + p.time[1:])
+    return PathTiming(np.concatenate([p.airspeed for p in parts]),
+                      np.concatenate([p.groundspeed for p in parts]),
+                      np.concatenate([p.heading for p in parts]),
+                      np.concatenate([p.wind for p in parts]), np.concatenate(times))
