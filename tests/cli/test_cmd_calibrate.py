@@ -16,6 +16,7 @@ from ..io.synthetic_logs import flight_states, write_tlog
 runner = CliRunner()
 
 
+@pytest.mark.slow
 def test_calibrate_writes_a_model_plan_uses(tmp_path):
     true = replace(POWER_MODELS["arducopter"], profile_power_w=50.0, drag_area_m2=0.06,
                    efficiency=0.7)
@@ -55,3 +56,4 @@ def test_calibrate_refuses_a_log_it_cannot_use(tmp_path):
     (tmp_path / "x.tlog").write_bytes(b"")
     res = runner.invoke(app, ["calibrate", str(tmp_path / "x.tlog"), "--out", str(tmp_path / "o")])
     assert res.exit_code == 2 and "no battery current" in res.output
+

@@ -19,7 +19,7 @@ from ..pipeline.outputs import export_options, parse_anchor  # noqa: F401  (re-e
 
 __all__ = [
     "Firmware", "Vehicle", "Frame", "End", "Thin", "AnchorText", "SpeedChanges", "MinSpeed",
-    "CruiseSpeed", "HoverSpeed", "Endurance", "Reserve", "Power", "Battery", "Wind", "Via", "Return", "parse_anchor",
+    "CruiseSpeed", "HoverSpeed", "Endurance", "Reserve", "Power", "Battery", "Wind", "WindFile", "Via", "Return", "parse_anchor",
     "via_points", "export_options",
 ]
 
@@ -62,7 +62,11 @@ Battery = Annotated[float | None, typer.Option(
     "(airframe.battery). Default: the power model's.")]
 Wind = Annotated[str | None, typer.Option(
     help="Wind as SPEED@DIR: m/s @ degrees it blows FROM, clockwise from north (8@270: 8 m/s "
-    "from the west); the energy and times are figured in it (mission file wind:).")]
+    "from the west); the route is planned time-optimal in it and the energy and times "
+    "figured in it (mission file wind:).")]
+WindFile = Annotated[str | None, typer.Option(
+    help="Gridded wind: a NetCDF file (u/v, u10/v10, ... on lon/lat; its first time step) "
+    "or a two-band GeoTIFF (u, v in m/s) covering the map (mission file wind: {file: ..}).")]
 
 
 Via = Annotated[list[str] | None, typer.Option(

@@ -125,7 +125,7 @@ _REPORT_HELP = "Also write report.html (interactive, self-contained)."
 @safety_options
 @mission_options("firmware", "vehicle", "frame", "end", "thin", "anchor", "speed_changes",
                  "min_speed", "cruise_speed", "hover_speed", "endurance", "reserve",
-                 "power", "battery", "wind")
+                 "power", "battery", "wind", "wind_file")
 def cover_cmd(
     area: str = typer.Option(..., help="Polygon file (GeoJSON lon/lat, GPKG, SHP, "
                              "KML/KMZ) or S1..S4 (built-in map)."),

@@ -53,7 +53,7 @@ EXPORT_HELP = (
 @handle_errors
 @mission_options("firmware", "vehicle", "frame", "end", "thin", "anchor", "speed_changes",
                  "min_speed", "cruise_speed", "hover_speed", "endurance", "reserve",
-                 "power", "battery", "wind")
+                 "power", "battery", "wind", "wind_file")
 @output_options("out/export")
 def export_cmd(
     path_file: Path = typer.Argument(..., help="Path CSV (as written by fm2uav)."),

@@ -21,7 +21,7 @@ from .options import (
     world_rows,
 )
 from ._mission_options import parse_anchor
-from ..pipeline.outputs import wind_options
+from ..pipeline.outputs import wind_options, with_wind_on
 from .cmd_run import mission_rows, output_names, plan_outputs, safety_rows
 
 PLAN_FILES = ("path.csv", "plan.png", "summary.json")
@@ -124,6 +124,7 @@ def plan_cmd(
              order=order, storage=storage),
         dict(agl=agl, p1=p1, p2=p2, band=band, graded=graded, mode=mode, min_agl=min_agl,
              max_agl=max_agl))
+    export_options = with_wind_on(export_options, w)
     route = plan_route(w, start_m, goal_m, via=via_m,
                        return_to_start=bool(mission.return_to_start), shaping=shaping,
                        level=level, options=options, wind=wind_options(export_options))

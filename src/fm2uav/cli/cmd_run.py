@@ -58,7 +58,7 @@ RUN_HELP = (
 @world_options
 @mission_options("via", "return_to_start", "firmware", "vehicle", "frame", "end",
                  "speed_changes", "endurance", "reserve", "power", "battery",
-                 "wind")
+                 "wind", "wind_file")
 def run_cmd(
     mission_file: Path = typer.Argument(..., help="Mission YAML file.", show_default=False),
     output: Output = None,

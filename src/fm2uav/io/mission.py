@@ -33,7 +33,8 @@ Schema (pydantic v2, strict types, unknown keys rejected)::
                endurance: 25, reserve: 0.2,   # [min] endurance checked with a 20 % reserve
                power: arducopter, battery: 74}   # power model (preset, file, or
                                     # {preset: .., mass_kg: ..}) and battery [Wh]
-    wind: {speed: 8, from: 270}     # [m/s] from [deg]; + ref_height, exponent: a profile
+    wind: {speed: 8, from: 270}     # [m/s] from [deg]; + ref_height, exponent: a profile;
+                                    # or {file: wind.nc} (NetCDF u/v on lon/lat, 2-band GeoTIFF)
     outputs:
       dir: out/my-mission           # default out/<file name>; `fm2uav run --out` overrides
       formats: [csv, geojson, kml, plan, wpl, html, png, json]
@@ -322,20 +323,52 @@ class AirframeSpec(BaseModel):
 
 
 class WindSpec(BaseModel):
-    """The wind: constant, or a power-law profile with ``ref_height`` / ``exponent``."""
+    """The wind: constant, a power-law profile with ``ref_height`` / ``exponent``, or a
+    gridded ``file`` (NetCDF or two-band GeoTIFF)."""
 
     model_config = ConfigDict(strict=True, extra="forbid", frozen=True, populate_by_name=True)
-    speed: float = _num(..., unit="m/s", ge=0, le=100, desc="wind speed")
-    from_deg: float = Field(..., alias="from", ge=0, le=360,
-                            description="direction the wind blows from [deg from north]")
+    speed: float | None = _num(None, unit="m/s", ge=0, le=100, desc="wind speed")
+    from_deg: float | None = Field(None, alias="from", ge=0, le=360,
+                                   description="direction the wind blows from [deg from north]")
     ref_height: float | None = _num(None, unit="m", gt=0, le=1000,
                                     desc="height above ground of the speed (a profile)")
     exponent: float | None = _num(None, ge=0, le=1, desc="power-law exponent (a profile)")
+    file: str | None = Field(None, description="gridded wind: NetCDF (u/v on lon/lat) or "
+                             "two-band GeoTIFF, relative to the mission file")
+
+    @field_validator("file")
+    @classmethod
+    def _file(cls, v: str | None, info: ValidationInfo) -> str | None:
+        from ..world.wind_files import check_wind_file
+
+        if v is None:
+            return v
+        p = Path(v).expanduser()
+        base = (info.context or {}).get("base_dir")
+        p = p if p.is_absolute() or base is None else Path(base) / p
+        try:
+            return str(check_wind_file(p))
+        except InputError as exc:
+            raise ValueError(str(exc)) from None
+
+    @model_validator(mode="after")
+    def _one_kind(self) -> WindSpec:
+        if self.file is not None:
+            if any(x is not None for x in (self.speed, self.from_deg, self.ref_height,
+                                           self.exponent)):
+                raise ValueError("give either file or speed/from (a file holds the whole "
+                                 "field)")
+        elif self.speed is None or self.from_deg is None:
+            raise ValueError("needs speed and from (m/s and degrees the wind blows from), or "
+                             "a file")
+        return self
 
     def field(self) -> Any:
-        """The :class:`~fm2uav.world.wind.WindField`."""
+        """The :class:`~fm2uav.world.wind.WindField` (a file's: read onto the map later)."""
         from ..world.wind import WindField
 
+        if self.file is not None:
+            return WindField.from_file(self.file)
         if self.ref_height is None and self.exponent is None:
             return WindField.constant(self.speed, self.from_deg, source="mission file wind:")
         return WindField.profile(self.speed, self.from_deg, ref_height=self.ref_height or 10.0,
@@ -379,7 +412,7 @@ class Mission(BaseModel):
     operating_area: ZoneSpec | None = Field(None, description="area the mission stays in")
     airframe: AirframeSpec = Field(default_factory=AirframeSpec)
     wind: WindSpec | None = Field(None, description="the wind: {speed, from[, ref_height, "
-                                  "exponent]}")
+                                  "exponent]} or {file}")
     outputs: OutputSpec = Field(default_factory=OutputSpec)
 
     @model_validator(mode="after")

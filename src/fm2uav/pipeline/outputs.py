@@ -21,7 +21,7 @@ from .rows import safety_rows
 
 __all__ = ["OUTPUT_FILES", "EXPORT_FILES", "output_names", "write_exports", "plan_outputs",
            "to_jsonable", "write_json", "write_text", "write_figure", "export_options",
-           "parse_anchor", "wind_options"]
+           "parse_anchor", "wind_options", "with_wind_on"]
 
 #: Export format → file name (:data:`fm2uav.io.exports.EXPORT_FILES`, repeated here so that
 #: importing this module loads no exporter; a test keeps both equal).
@@ -132,6 +132,7 @@ def plan_outputs(
     from ..autopilot.geofence import zone_fences
     from ..io import export_mission
 
+    options = with_wind_on(options, plan.world)
     exports = [f for f in formats if f in EXPORT_FILES]
     zones = tuple(getattr(plan.world, "zones", ()))
     fence_warnings: list[str] = []
@@ -227,13 +228,15 @@ def export_options(base: Any = None, *, firmware: str | None = None, vehicle: st
                    min_speed: float | None = None, cruise_speed: float | None = None,
                    hover_speed: float | None = None, endurance: float | None = None,
                    reserve: float | None = None, power: str | None = None,
-                   battery: float | None = None, wind: str | None = None, **more: Any) -> Any:
+                   battery: float | None = None, wind: str | None = None,
+                   wind_file: str | None = None, **more: Any) -> Any:
     """``base`` (default ``ExportOptions()``) with the settings that were given (None =
     not given): the command line's mission flags, the app's aircraft and mission fields.
 
     ``thin`` is the waypoint tolerance [m], ``endurance`` in minutes, ``anchor`` the
     ``lon,lat[,alt]`` text of ``--anchor``, ``power`` a power-model preset or file,
-    ``battery`` in Wh, ``wind`` the ``SPEED@DIR`` text of ``--wind``.
+    ``battery`` in Wh, ``wind`` the ``SPEED@DIR`` text of ``--wind``, ``wind_file`` a
+    NetCDF / GeoTIFF wind (checked now, read onto the map by :func:`with_wind_on`).
 
     Raises
     ------
@@ -251,6 +254,13 @@ def export_options(base: Any = None, *, firmware: str | None = None, vehicle: st
              "endurance_s": None if endurance is None else 60.0 * float(endurance),
              "reserve": reserve, "power": power, "battery_wh": battery,
              "wind": None if wind is None else parse_wind_text(wind), **more}
+    if wind_file is not None:
+        if wind is not None:
+            raise InputError("give --wind or --wind-file, not both")
+        from ..world.wind import WindField
+        from ..world.wind_files import check_wind_file
+
+        given["wind"] = WindField.from_file(check_wind_file(wind_file))
     if thin is not None and not thin >= 0:
         raise InputError(f"--thin must be a tolerance >= 0 m, got {thin}")
     if endurance is not None and not endurance > 0:
@@ -288,3 +298,16 @@ def wind_options(options: Any) -> Any:
     from ..planning.wind import WindOptions
 
     return WindOptions(options.wind, options.forward_speed)
+
+
+def with_wind_on(options: Any, world: Any) -> Any:
+    """``options`` with a file's wind read onto ``world`` (any other wind unchanged)."""
+    wind = getattr(options, "wind", None)
+    if wind is None or wind.kind != "file":
+        return options
+    from dataclasses import replace
+
+    from ..world.wind_files import resolve_wind
+
+    return replace(options, wind=resolve_wind(wind, world, anchor=getattr(options, "anchor",
+                                                                           None)))

@@ -57,7 +57,7 @@ class WindField:
         Where the wind comes from (for the summary).
     """
 
-    kind: Literal["constant", "profile", "grid"] = "constant"
+    kind: Literal["constant", "profile", "grid", "file"] = "constant"
     speed: float = 0.0
     direction_deg: float = 0.0
     ref_height: float = 10.0
@@ -67,10 +67,12 @@ class WindField:
     u: np.ndarray | None = field(default=None, repr=False)
     v: np.ndarray | None = field(default=None, repr=False)
     source: str = ""
+    file: str | None = None
 
     def __post_init__(self) -> None:
-        if self.kind not in ("constant", "profile", "grid"):
-            raise InputError(f"wind kind must be constant, profile or grid, got {self.kind!r}")
+        if self.kind not in ("constant", "profile", "grid", "file"):
+            raise InputError(f"wind kind must be constant, profile, grid or file, got "
+                             f"{self.kind!r}")
         object.__setattr__(self, "speed", non_negative(self.speed, "wind speed", unit="m/s",
                                                        where=("wind.speed", "--wind")))
         object.__setattr__(self, "direction_deg", in_range(
@@ -111,6 +113,12 @@ class WindField:
         return cls("profile", speed, direction_deg, ref_height, exponent, source=source)
 
     @classmethod
+    def from_file(cls, path: Any) -> WindField:
+        """A gridded wind still in its file: :func:`fm2uav.world.wind_files.resolve_wind`
+        samples it onto a world (checked there; ``at`` refuses it until then)."""
+        return cls("file", file=str(path), source=str(path))
+
+    @classmethod
     def grid(cls, x: Any, y: Any, u: Any, v: Any, source: str = "") -> WindField:
         """A gridded wind: ``u``, ``v`` [m/s] of shape ``(len(x), len(y))`` on nodes [m]."""
         return cls("grid", x=x, y=y, u=u, v=v, source=source)
@@ -119,12 +127,19 @@ class WindField:
     @property
     def is_calm(self) -> bool:
         """No wind anywhere."""
+        self._resolved()
         if self.kind == "grid":
             return bool(np.all(self.u == 0) and np.all(self.v == 0))
         return self.speed == 0.0
 
+    def _resolved(self) -> None:
+        if self.kind == "file":
+            raise InputError(f"the wind of {self.file} is not on a map yet "
+                             "(fm2uav.world.wind_files.resolve_wind)")
+
     def max_speed(self) -> float:
         """An upper bound of the wind speed [m/s] (a profile's at 500 m above ground)."""
+        self._resolved()
         if self.kind == "grid":
             return float(np.max(np.hypot(self.u, self.v)))
         if self.kind == "profile":
@@ -150,6 +165,7 @@ class WindField:
         >>> np.round(p.at([[0, 0, 0]], agl=[40.0]), 12).tolist()   # from the north
         [[-0.0, -10.0]]
         """
+        self._resolved()
         p = np.asarray(points, dtype=float)
         if p.ndim == 0 or p.shape[-1] not in (2, 3):
             raise InputError(f"wind points must be (..., 2|3) coordinates, got shape {p.shape}")
