@@ -141,6 +141,10 @@ def cover_cmd(
         None, help="Distance between photos (m); default: from --camera, else D."),
     mission: MissionFlags = None,
     angle: float | None = typer.Option(None, help="Steering angle (deg); default: searched."),
+    bands: str = typer.Option(
+        "search", "--bands", help="Band orientation: search (the steering angle of least "
+        "zigzag cost, --search) or wind (across the wind of --wind / --wind-file: the "
+        "fastest legs out and back)."),
     search: str = typer.Option("de", help="Angle search: de (seeds), sweep, scipy-de."),
     full_range: bool = typer.Option(False, "--full-range",
                                     help="Search α in [0°, 180°) instead of [1°, 89°]."),
@@ -154,11 +158,16 @@ def cover_cmd(
 ) -> None:
     """``fm2uav cover``: parse, :func:`~fm2uav.pipeline.cover.run_cover`, print."""
     from ..missions.coverage import FULL_BOUNDS_DEG
-    from ..pipeline.cover import cover_rows, run_cover
+    from ..pipeline.cover import across_wind_angle, cover_rows, run_cover
+    from ..pipeline.outputs import with_wind_on
     from ..pipeline.rows import safety_rows
     from ..progress import reporting
     from ..world.load import world_summary
 
+    if bands not in ("search", "wind"):
+        raise InputError(f"--bands must be search or wind, got {bands!r}")
+    if bands == "wind" and angle is not None:
+        raise InputError("give --angle or --bands wind, not both")
     level = safety.level(agl, p1=p1, p2=p2)  # refuses agl outside --min-agl/--max-agl
     if (spacing is None) == (camera is None):
         raise InputError("give exactly one of --spacing (metres) or --camera")
@@ -173,6 +182,9 @@ def cover_cmd(
                                      default="coverage")
         poly, area_source = _load_area(area, w, world.crs)
         w = safety.apply(w, crs=world.crs)  # --no-fly zones become obstacles
+        if bands == "wind":
+            mission_options = with_wind_on(mission_options, w)
+            angle = across_wind_angle(mission_options.wind, w, poly)
         run = run_cover(outdir, w, poly, area_label=area, spacing=d, level=level,
                         options=mission_options, camera=cam, front_overlap=front_overlap,
                         trigger_distance=trigger_distance, angle_deg=angle, search=search,
@@ -181,7 +193,8 @@ def cover_cmd(
                             "area": area, "scenario": scenario, "world": world_summary(w),
                             **({"area_source": area_source.as_dict()} if area_source
                                else {})})
-    output.summary("coverage plan", {**cover_rows(area, d, run.coverage, run.built, w),
+    output.summary("coverage plan", {**cover_rows(area, d, run.coverage, run.built, w,
+                                                  run.summary.get("sorties")),
                                      **safety_rows(run.safety)}, run.summary)
 
 
