@@ -32,7 +32,8 @@ def test_calibrate_writes_a_model_plan_uses(tmp_path):
     assert model.efficiency == pytest.approx(0.7, rel=0.01)
     assert model.hover_power() == pytest.approx(true.hover_power(), rel=0.005)
     res = runner.invoke(app, ["plan", "--export", "plan", "--power", str(out / "power.yaml"),
-                              "--battery", "50", "--wind", "5@90", "--out",
+                              "--battery", "50", "--wind", "5@90", "--hover-speed", "10",
+                              "--saturation-distance", "100", "--out",
                               str(tmp_path / "p"), "--json"])
     assert res.exit_code == 0, res.output
     e = json.loads((tmp_path / "p" / "summary.json").read_text())["autopilot"]["energy"]

@@ -283,6 +283,13 @@ def _planner_values(spec: PlannerSpec) -> dict[str, Any]:
     return out
 
 
+def _beside_mission(v: str, info: ValidationInfo) -> Path:
+    """A path of the mission file: relative ones are taken from the file's folder."""
+    p = Path(v).expanduser()
+    base = (info.context or {}).get("base_dir")
+    return p if p.is_absolute() or base is None else Path(base) / p
+
+
 class AirframeSpec(BaseModel):
     """The aircraft, as far as the exports need it."""
 
@@ -312,9 +319,7 @@ class AirframeSpec(BaseModel):
         if v is None:
             return v
         if isinstance(v, str) and Path(v).suffix.lower() in (".yaml", ".yml", ".json"):
-            p = Path(v).expanduser()
-            base = (info.context or {}).get("base_dir")
-            v = str(p if p.is_absolute() or base is None else Path(base) / p)
+            v = str(_beside_mission(v, info))
         try:
             get_power_model(v)
         except InputError as exc:
@@ -343,11 +348,8 @@ class WindSpec(BaseModel):
 
         if v is None:
             return v
-        p = Path(v).expanduser()
-        base = (info.context or {}).get("base_dir")
-        p = p if p.is_absolute() or base is None else Path(base) / p
         try:
-            return str(check_wind_file(p))
+            return str(check_wind_file(_beside_mission(v, info)))
         except InputError as exc:
             raise ValueError(str(exc)) from None
 

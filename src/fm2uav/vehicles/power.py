@@ -414,8 +414,9 @@ POWER_MODELS: dict[str, PowerModel] = {
         source="a 2 kg survey quad of the ArduCopter class: 4 x 10 inch props (R 0.127 m) at "
         "about 6000 rpm (tip 80 m/s), kappa 1.15 and profile power ~1/4 of the ideal induced "
         "power (Leishman ch. 2), drag area 0.04 m^2 (a 0.2 m^2 frame and payload, CD ~0.2), "
-        "ESC x motor 0.75, descent as momentum theory (r = 1), 4S 5000 mAh LiPo (14.8 V x 5 Ah = 74 Wh), ANGLE_MAX 30 deg "
-        "(ArduCopter default); hover about 255 W, 125 W/kg, as measured on such quads"),
+        "ESC x motor 0.75, descent as momentum theory (r = 1), 4S 5000 mAh LiPo (14.8 V x "
+        "5 Ah = 74 Wh), ANGLE_MAX 30 deg (ArduCopter default); hover about 246 W, 123 W/kg, "
+        "within the 100-150 W/kg measured on such quads"),
     "disco": FixedWingPower(
         "disco", mass_kg=0.94, wing_area_m2=0.28, cd0=0.03, k=0.085, efficiency=0.5,
         descent_recovery=1.0, avionics_w=5.0, battery_wh=30.0,
