@@ -29,6 +29,12 @@ def test_plan_in_a_wind_file_and_a_mission_wind(tmp_path):
     s = json.loads((tmp_path / "p" / "summary.json").read_text())
     assert s["params"]["wind"]["kind"] == "grid" and s["params"]["wind"]["refused_nodes"] >= 0
     assert s["autopilot"]["energy"]["wind"]["max_speed_mps"] == pytest.approx(5 ** 0.5, abs=1e-3)
+    ex = runner.invoke(app, ["export", str(tmp_path / "p" / "path.csv"), "--scenario",
+                             "open-field", "--wind-file", str(tmp_path / "wind.nc"), "--out",
+                             str(tmp_path / "e"), "--json"])
+    assert ex.exit_code == 0, ex.output
+    e = json.loads((tmp_path / "e" / "summary.json").read_text())["autopilot"]["energy"]
+    assert e["wind"]["kind"] == "grid" and e["wind"]["source"] == "wind.nc: u/v"
     both = runner.invoke(app, ["plan", "--wind", "3@90", "--wind-file", str(tmp_path / "wind.nc"),
                                "--out", str(tmp_path / "q")])
     assert both.exit_code == 2 and "not both" in both.output

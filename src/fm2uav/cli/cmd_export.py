@@ -81,7 +81,9 @@ def export_cmd(
     world, base, mission_level, where = _world(mission_file, scenario, seed)
     header = read_path_header(path_file)
     path, w, floor = _read_path(path_file, header, world, where)
-    options = mission.export_options(base)
+    from ..pipeline.outputs import with_wind_on
+
+    options = with_wind_on(mission.export_options(base), world)
     if options.speed_changes and w is None:
         raise InputError(f"--speed-changes needs W along the path: {path_file} has no "
                          "speed column (write it with fm2uav plan / run)")
