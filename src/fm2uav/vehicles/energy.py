@@ -39,8 +39,8 @@ from .._validate import positive
 from ..errors import InputError
 from .power import FixedWingPower, PowerModel
 
-__all__ = ["Flight", "BatteryReport", "fly_legs", "check_battery", "no_return_point",
-           "ground_speed_at_airspeed"]
+__all__ = ["Flight", "BatteryReport", "fly_legs", "check_battery", "home_legs",
+           "no_return_point", "ground_speed_at_airspeed"]
 
 _J_PER_WH = 3600.0
 
@@ -388,6 +388,37 @@ def check_battery(flight: Flight, *, battery_wh: float, reserve: float = 0.2) ->
                          float(reserve), usable, ok, reach, k, n, bad)
 
 
+def home_legs(points: Any, model: PowerModel, *, home: Any, speed: float, climb_rate: float,
+              descent_rate: float, wind: Any = None
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(out_wh, out_s, back_wh, back_s)`` at every waypoint: take-off at ``home``, climb to
+    the waypoint's altitude, fly straight to it; and the flight straight back at its
+    altitude, descent and landing at ``home`` (``wind``: (u, v) [m/s], one or one per
+    waypoint)."""
+    p = np.asarray(points, dtype=float)
+    h = np.asarray(home, dtype=float)
+    n = len(p)
+    top = np.column_stack([np.full(n, h[0]), np.full(n, h[1]), p[:, 2]])
+    w = None if wind is None else np.broadcast_to(np.asarray(wind, dtype=float), (n, 2))
+    # one flight through top_0, p_0, top_1, p_1, ...: the even legs are the ones wanted
+    go_path = np.empty((2 * n, 3))
+    go_path[0::2], go_path[1::2] = top, p
+    back_path = np.empty((2 * n, 3))
+    back_path[0::2], back_path[1::2] = p, top
+    leg_w = None if w is None else np.repeat(w, 2, axis=0)[:-1]
+    kw = dict(speed=speed, climb_rate=climb_rate, descent_rate=descent_rate, wind=leg_w)
+    go = fly_legs(go_path, model, **kw)
+    back = fly_legs(back_path, model, **kw)
+    height = np.maximum(p[:, 2] - h[2], 0.0)
+    fixed = model.kind == "fixed-wing"
+    air = float(speed) if fixed else 0.0
+    t_up, t_dn = height / climb_rate, height / descent_rate
+    e_up = float(model.power(air, climb_rate)) * t_up
+    e_dn = float(model.power(air, -descent_rate)) * t_dn
+    return ((go.leg_energy_j[0::2] + e_up) / 3600.0, go.leg_time[0::2] + t_up,
+            (back.leg_energy_j[0::2] + e_dn) / 3600.0, back.leg_time[0::2] + t_dn)
+
+
 def no_return_point(points: Any, flight: Flight, model: PowerModel, *, home: Any,
                     speed: float, climb_rate: float, descent_rate: float, wind: Any = None,
                     battery_wh: float, reserve: float = 0.2) -> tuple[int, np.ndarray]:
@@ -416,16 +447,10 @@ def no_return_point(points: Any, flight: Flight, model: PowerModel, *, home: Any
         ``usable − used − home`` [Wh] at every waypoint (``-inf`` where the way home
         cannot be flown in the wind).
     """
-    p = np.asarray(points, dtype=float)
-    h = np.asarray(home, dtype=float)
     usable = _budget(battery_wh, reserve)
-    back = np.empty(len(p))
-    for i, q in enumerate(p):
-        leg = np.array([q, [h[0], h[1], q[2]]])
-        f = fly_legs(leg, model, speed=speed, climb_rate=climb_rate, descent_rate=descent_rate,
-                     wind=wind, final_descent=max(q[2] - h[2], 0.0))
-        back[i] = f.energy_wh
+    back = home_legs(points, model, home=home, speed=speed, climb_rate=climb_rate,
+                     descent_rate=descent_rate, wind=wind)[2]
     margin = usable - flight.used_wh() - back
     margin = np.where(np.isfinite(margin), margin, -np.inf)
     bad = np.flatnonzero(~(margin >= 0))
-    return (int(bad[0]) - 1 if len(bad) else len(p) - 1), margin
+    return (int(bad[0]) - 1 if len(bad) else len(margin) - 1), margin

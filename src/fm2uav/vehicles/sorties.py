@@ -24,10 +24,10 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError, PlanningError
-from .energy import _budget, fly_legs
+from .energy import _budget, fly_legs, home_legs
 from .power import PowerModel
 
-__all__ = ["Sortie", "SortiePlan", "split_sorties", "even_split", "home_legs"]
+__all__ = ["Sortie", "SortiePlan", "split_sorties", "even_split"]
 
 
 @dataclass(frozen=True)
@@ -93,37 +93,6 @@ class SortiePlan:
                          "home_wh": round(s.back_wh, 2),
                          "resume_m": np.round(s.resume, 2).tolist(),
                          "home_from_m": np.round(s.stop, 2).tolist()} for s in self.sorties]}
-
-
-def home_legs(points: Any, model: PowerModel, *, home: Any, speed: float, climb_rate: float,
-              descent_rate: float, wind: Any = None
-              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """``(out_wh, out_s, back_wh, back_s)`` at every waypoint: take-off at ``home``, climb to
-    the waypoint's altitude, fly straight to it; and the flight straight back at its
-    altitude, descent and landing at ``home`` (``wind``: (u, v) [m/s], one or one per
-    waypoint)."""
-    p = np.asarray(points, dtype=float)
-    h = np.asarray(home, dtype=float)
-    n = len(p)
-    top = np.column_stack([np.full(n, h[0]), np.full(n, h[1]), p[:, 2]])
-    w = None if wind is None else np.broadcast_to(np.asarray(wind, dtype=float), (n, 2))
-    # one flight through top_0, p_0, top_1, p_1, ...: the even legs are the ones wanted
-    go_path = np.empty((2 * n, 3))
-    go_path[0::2], go_path[1::2] = top, p
-    back_path = np.empty((2 * n, 3))
-    back_path[0::2], back_path[1::2] = p, top
-    leg_w = None if w is None else np.repeat(w, 2, axis=0)[:-1]
-    kw = dict(speed=speed, climb_rate=climb_rate, descent_rate=descent_rate, wind=leg_w)
-    go = fly_legs(go_path, model, **kw)
-    back = fly_legs(back_path, model, **kw)
-    height = np.maximum(p[:, 2] - h[2], 0.0)
-    fixed = model.kind == "fixed-wing"
-    air = float(speed) if fixed else 0.0
-    t_up, t_dn = height / climb_rate, height / descent_rate
-    e_up = float(model.power(air, climb_rate)) * t_up
-    e_dn = float(model.power(air, -descent_rate)) * t_dn
-    return ((go.leg_energy_j[0::2] + e_up) / 3600.0, go.leg_time[0::2] + t_up,
-            (back.leg_energy_j[0::2] + e_dn) / 3600.0, back.leg_time[0::2] + t_dn)
 
 
 def _fits(route: Any, out: np.ndarray, back: np.ndarray, a: int) -> np.ndarray:
