@@ -12,6 +12,12 @@
   the nodes at least 0.1 m from the source at 321^2 and the rate from 161^2; the full
   table is in docs/eikonal.md).
 
+* Cost of wind in a whole plan (issue 26): ``fm2uav.plan`` on the Jacksboro terrain
+  (3D, flight level 300 m AGL, W saturated beyond 300 m) with a 6 m/s wind from the
+  west at 15 m/s airspeed (``WindOptions``) against the same plan in still air: the
+  velocity map, the march and the descent, interleaved, medians. ``ratio`` = still /
+  wind.
+
 The by-hand comparison with Mirebeau's HFM (its CPU ``Rander2`` model) is not run
 here: HFM is not a dependency of this project (see the closing note of issue 26).
 """
@@ -100,6 +106,41 @@ def _accuracy(quick: bool) -> list[dict]:
     return rows
 
 
+def _whole_plan(quick: bool, repeats: int) -> dict:
+    cell = 600.0 if quick else None
+    t = _child(f"""
+from fm2uav import plan
+from fm2uav.planning import FlightLevel, Shaping
+from fm2uav.planning.wind import WindOptions
+from fm2uav.scenarios import get_scenario
+from fm2uav.scenarios.jacksboro import jacksboro_world
+from fm2uav.world.wind import WindField
+sc = get_scenario("jacksboro")
+if {cell!r} is not None:
+    sc = sc.__class__(**{{**sc.__dict__, "world": jacksboro_world({cell!r})}})
+kw = dict(level=FlightLevel(agl=300.0), shaping=Shaping(saturation_distance=300.0))
+wind = WindOptions(WindField.constant(6.0, 270.0), 15.0)
+plan(sc.world, sc.start, sc.goal, **kw); plan(sc.world, sc.start, sc.goal, wind=wind, **kw)
+still, windy, still_cpu, windy_cpu = [], [], [], []
+for _ in range({repeats}):
+    for out, cpu, extra in ((still, still_cpu, {{}}), (windy, windy_cpu, {{"wind": wind}})):
+        c = time.process_time(); t = time.perf_counter()
+        p = plan(sc.world, sc.start, sc.goal, **kw, **extra)
+        out.append(time.perf_counter() - t); cpu.append(time.process_time() - c)
+med = statistics.median
+print(json.dumps({{"still_s": med(still), "wind_s": med(windy), "still_cpu": med(still_cpu),
+                  "wind_cpu": med(windy_cpu), "nodes": int(sc.world.occupancy.size),
+                  "time_s": p.wind_timing.total_s}}))
+""")
+    slow = t["wind_cpu"] / t["still_cpu"]
+    return {"benchmark": "wind", "case": f"whole plan, Jacksboro ({t['nodes']:,} nodes), "
+            "agl 300, 6 m/s from 270° at 15 m/s",
+            "ours_s": t["wind_s"], "peer": "the same plan in still air", "peer_s": t["still_s"],
+            "ratio": t["still_s"] / t["wind_s"],
+            "notes": f"CPU {t['wind_cpu']:.3g} s vs {t['still_cpu']:.3g} s: {slow:.1f}x "
+                     f"(interleaved, median of {repeats}); route {t['time_s'] / 60:.1f} min"}
+
+
 def run(quick: bool = False) -> list[dict]:
     if quick:
         cases = [((128, 128), 1, "constant"), ((128, 128), 2, "vortex"), ((24, 24, 24), 2,
@@ -125,4 +166,4 @@ def run(quick: bool = False) -> list[dict]:
             "notes": f"CPU {t['wind_cpu']:.3g} s vs {t['iso_cpu']:.3g} s: {slow:.1f}× "
                      f"(interleaved, median of {repeats})",
         })
-    return rows + _accuracy(quick)
+    return rows + [_whole_plan(quick, repeats)] + _accuracy(quick)

@@ -160,6 +160,13 @@ class ExportOptions:
         Share of the endurance kept in reserve. Default 0.2.
     name : str
         Mission name (KML, GeoJSON).
+    power : str, MultirotorPower, FixedWingPower or None
+        Power model of the energy figures (:mod:`fm2uav.autopilot.energy`; None: the
+        class model of ``vehicle``).
+    battery_wh : float or None
+        Battery energy [Wh] (None: the power model's).
+    wind : WindField or None
+        The wind the energy and times are figured in (None: still air).
     """
 
     tolerance: float = 5.0
@@ -190,6 +197,9 @@ class ExportOptions:
     endurance_s: float | None = None
     reserve: float = 0.2
     name: str = "fm2uav mission"
+    power: Any = None
+    battery_wh: float | None = None
+    wind: Any = None
 
     def __post_init__(self) -> None:
         if self.firmware not in FIRMWARES:
@@ -215,7 +225,7 @@ class ExportOptions:
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v >= 0):
                 raise InputError(f"export option {name} must be a number >= 0, got {v!r}")
         for name in ("min_speed", "max_speed", "max_bank", "climb_rate", "descent_rate",
-                     "endurance_s"):
+                     "endurance_s", "battery_wh"):
             v = getattr(self, name)
             if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
                 raise InputError(f"export option {name} must be a number > 0, got {v!r}")
@@ -523,6 +533,7 @@ def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: Speeds, start_hold
     """
     from ..vehicles.airframes import default_endurance
     from ..vehicles.endurance import FlightTime, check_endurance, flight_time
+    from .energy import mission_energy
 
     climb = opt.climb_rate or DEFAULT_CLIMB[opt.vehicle]
     descent = opt.descent_rate or DEFAULT_DESCENT[opt.vehicle]
@@ -566,7 +577,11 @@ def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: Speeds, start_hold
         if opt.endurance_s is None:
             warning += (f" (endurance: {source.split('; give')[0]}; give your vehicle's with "
                         "airframe.endurance / --endurance)")
-    info: dict[str, Any] = {"flight": {
+    energy = mission_energy(wps.points_m, wps.agl, vehicle=opt.vehicle, power=opt.power,
+                            battery_wh=opt.battery_wh, reserve=opt.reserve, speeds=sp.commanded,
+                            holds=sp.holds, forward_speed=opt.forward_speed, climb_rate=climb,
+                            descent_rate=descent, end=end, wind=opt.wind)
+    info: dict[str, Any] = {"energy": energy, "flight": {
         **rep.summary(), "warning": warning, "endurance_source": source, **where,
         "climb_rate_mps": climb, "descent_rate_mps": descent,
         "forward_speed_mps": opt.forward_speed,
@@ -755,6 +770,8 @@ def build_mission(
                                      world)
     if endurance_warning:
         warnings.append(endurance_warning)
+    if info["energy"]["warning"]:
+        warnings.append(info["energy"]["warning"])
     if "warning" in info.get("timing", {}):
         warnings.append(info["timing"]["warning"])
     info["speed_changes"] = sp.summary(opt.speed_step, speed_type)

@@ -19,8 +19,8 @@ from ..pipeline.outputs import export_options, parse_anchor  # noqa: F401  (re-e
 
 __all__ = [
     "Firmware", "Vehicle", "Frame", "End", "Thin", "AnchorText", "SpeedChanges", "MinSpeed",
-    "CruiseSpeed", "HoverSpeed", "Endurance", "Reserve", "Terrain", "TerrainSpacing", "Via",
-    "Return", "parse_anchor",
+    "CruiseSpeed", "HoverSpeed", "Endurance", "Reserve", "Terrain", "TerrainSpacing", "Power",
+    "Battery", "Wind", "WindFile", "Via", "Return", "parse_anchor",
     "via_points", "export_options",
 ]
 
@@ -62,6 +62,20 @@ Terrain = Annotated[bool | None, typer.Option(
 TerrainSpacing = Annotated[int | None, typer.Option(
     help="Grid spacing (m) of the terrain files = the vehicle's TERRAIN_SPACING "
     "(outputs.terrain_spacing). Default: half the DEM's resolution, 30 to 100 m.")]
+Power = Annotated[str | None, typer.Option(
+    help="Power model of the energy figures: a preset (arducopter, disco, crosswind) or a "
+    ".yaml/.json file of parameters, e.g. the one `fm2uav calibrate` fits to a flight log "
+    "(airframe.power). Default: the class model of --vehicle.")]
+Battery = Annotated[float | None, typer.Option(
+    help="Battery energy (Wh) the flight's energy is checked against, with the reserve "
+    "(airframe.battery). Default: the power model's.")]
+Wind = Annotated[str | None, typer.Option(
+    help="Wind as SPEED@DIR: m/s @ degrees it blows FROM, clockwise from north (8@270: 8 m/s "
+    "from the west); the route is planned time-optimal in it and the energy and times "
+    "figured in it (mission file wind:).")]
+WindFile = Annotated[str | None, typer.Option(
+    help="Gridded wind: a NetCDF file (u/v, u10/v10, ... on lon/lat; its first time step) "
+    "or a two-band GeoTIFF (u, v in m/s) covering the map (mission file wind: {file: ..}).")]
 
 
 Via = Annotated[list[str] | None, typer.Option(

@@ -127,7 +127,8 @@ _REPORT_HELP = "Also write report.html (interactive, self-contained)."
 @world_options
 @safety_options
 @mission_options("firmware", "vehicle", "frame", "end", "thin", "anchor", "speed_changes",
-                 "min_speed", "cruise_speed", "hover_speed", "endurance", "reserve")
+                 "min_speed", "cruise_speed", "hover_speed", "endurance", "reserve",
+                 "power", "battery", "wind", "wind_file")
 def cover_cmd(
     area: str = typer.Option(..., help="Polygon file (GeoJSON lon/lat, GPKG, SHP, "
                              "KML/KMZ) or S1..S4 (built-in map)."),
@@ -143,6 +144,10 @@ def cover_cmd(
         None, help="Distance between photos (m); default: from --camera, else D."),
     mission: MissionFlags = None,
     angle: float | None = typer.Option(None, help="Steering angle (deg); default: searched."),
+    bands: str = typer.Option(
+        "search", "--bands", help="Band orientation: search (the steering angle of least "
+        "zigzag cost, --search) or wind (across the wind of --wind / --wind-file: the "
+        "fastest legs out and back)."),
     search: str = typer.Option("de", help="Angle search: de (seeds), sweep, scipy-de."),
     full_range: bool = typer.Option(False, "--full-range",
                                     help="Search α in [0°, 180°) instead of [1°, 89°]."),
@@ -157,10 +162,16 @@ def cover_cmd(
     """``fm2uav cover``: parse, :func:`~fm2uav.pipeline.cover.run_cover`, print."""
     from ..missions.coverage import FULL_BOUNDS_DEG
     from .. import progress
-    from ..pipeline.cover import COVER_FILES, REPORT, band_cell, cover_rows, run_cover
+    from ..pipeline.cover import (COVER_FILES, REPORT, across_wind_angle, band_cell,
+                                  cover_rows, run_cover)
+    from ..pipeline.outputs import with_wind_on
     from ..pipeline.rows import safety_rows
     from ..world.load import world_summary
 
+    if bands not in ("search", "wind"):
+        raise InputError(f"--bands must be search or wind, got {bands!r}")
+    if bands == "wind" and angle is not None:
+        raise InputError("give --angle or --bands wind, not both")
     level = safety.level(agl, p1=p1, p2=p2)  # refuses agl outside --min-agl/--max-agl
     from .. import _validate
 
@@ -187,6 +198,9 @@ def cover_cmd(
                                      max_cell=band_cell(d, bool(safety.no_fly)))
         poly, area_source = _load_area(area, w, world.crs)
         w = safety.apply(w, crs=world.crs)  # --no-fly zones become obstacles
+        if bands == "wind":
+            mission_options = with_wind_on(mission_options, w)
+            angle = across_wind_angle(mission_options.wind, w, poly)
         progress.step(f"coverage of {area}", 0.9)
         run = run_cover(outdir, w, poly, area_label=area, spacing=d, level=level,
                         options=mission_options, camera=cam, front_overlap=front_overlap,
@@ -196,7 +210,8 @@ def cover_cmd(
                             "area": area, "scenario": scenario, "world": world_summary(w),
                             **({"area_source": area_source.as_dict()} if area_source
                                else {})})
-    output.summary("coverage plan", {**cover_rows(area, d, run.coverage, run.built, w),
+    output.summary("coverage plan", {**cover_rows(area, d, run.coverage, run.built, w,
+                                                  run.summary.get("sorties")),
                                      **safety_rows(run.safety)}, run.summary)
 
 

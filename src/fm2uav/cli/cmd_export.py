@@ -54,7 +54,7 @@ EXPORT_HELP = (
 @handle_errors
 @mission_options("firmware", "vehicle", "frame", "end", "thin", "anchor", "speed_changes",
                  "min_speed", "cruise_speed", "hover_speed", "endurance", "reserve", "terrain",
-                 "terrain_spacing")
+                 "terrain_spacing", "power", "battery", "wind", "wind_file")
 @output_options("out/export", report_help="Also write report.html (interactive, "
                 "self-contained: the path, its waypoints and the mission's numbers on the world).")
 def export_cmd(
@@ -101,7 +101,9 @@ def _export(outdir, path_file: Path, world, base, mission_level, where: str, for
 
     header = read_path_header(path_file)
     path, w, floor = _read_path(path_file, header, world, where)
-    options = mission.export_options(base)
+    from ..pipeline.outputs import with_wind_on
+
+    options = with_wind_on(mission.export_options(base), world)
     if options.speed_changes and w is None:
         raise InputError(f"--speed-changes needs W along the path: {path_file} has no "
                          "speed column (write it with fm2uav plan / run)")

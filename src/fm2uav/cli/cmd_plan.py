@@ -22,6 +22,7 @@ from .options import (
 )
 from ._mission_options import parse_anchor
 from ._return_options import ReturnFlags, return_options
+from ..pipeline.outputs import wind_options, with_wind_on
 from .cmd_run import mission_rows, output_names, plan_outputs, safety_rows
 
 PLAN_FILES = ("path.csv", "plan.png", "summary.json")
@@ -135,10 +136,12 @@ def plan_cmd(
                  exponent=exponent, order=order, storage=storage),
             dict(agl=agl, p1=p1, p2=p2, band=band, graded=graded, mode=mode, min_agl=min_agl,
                  max_agl=max_agl))
+        export_options = with_wind_on(export_options, w)
         progress.step("planning (FM²)", 0.6)
         route = plan_route(w, start_m, goal_m, via=via_m,
                            return_to_start=bool(mission.return_to_start), shaping=shaping,
-                           level=level, options=options)
+                           level=level, options=options,
+                           wind=wind_options(export_options))
         p = route.plan
         built = None
         info: dict = {}

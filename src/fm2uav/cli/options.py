@@ -475,13 +475,15 @@ def _mission_params() -> dict[str, Any]:
             "anchor": m.AnchorText, "speed_changes": m.SpeedChanges, "min_speed": m.MinSpeed,
             "cruise_speed": m.CruiseSpeed, "hover_speed": m.HoverSpeed,
             "endurance": m.Endurance, "reserve": m.Reserve, "terrain": m.Terrain,
-            "terrain_spacing": m.TerrainSpacing}
+            "terrain_spacing": m.TerrainSpacing, "power": m.Power, "battery": m.Battery,
+            "wind": m.Wind, "wind_file": m.WindFile}
 
 
 #: The mission flags of ``plan``/``formation`` (in their ``--help`` order).
 MISSION_FLAGS = ("via", "return_to_start", "firmware", "vehicle", "frame", "end",
                  "speed_changes", "min_speed", "cruise_speed", "hover_speed", "endurance",
-                 "reserve", "terrain", "terrain_spacing")
+                 "reserve", "terrain", "terrain_spacing", "power", "battery", "wind",
+                 "wind_file")
 
 
 def _mission_flags(via: list[str] | None = None, return_to_start: bool | None = None,

@@ -194,6 +194,11 @@ def export_mission(
         except InputError:  # a regional plan: no world-sized map to read it from
             if opt.speed_changes:
                 raise
+    timing = getattr(plan, "wind_timing", None)
+    if timing is not None and opt.vehicle == "multirotor":
+        # a multirotor is commanded ground speeds: what the safe airspeed makes good in the
+        # wind (capped at the forward speed), not the airspeed share W
+        speed = np.clip(timing.point_groundspeed() / opt.forward_speed, 0.0, 1.0)
     inputs = dict(w=speed, agl=agl, times=times, via=via, camera=camera, fences=fences,
                   start_hold=start_hold, profile=getattr(plan, "profile", None))
     if returns is not None:

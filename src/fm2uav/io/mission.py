@@ -31,7 +31,11 @@ Schema (pydantic v2, strict types, unknown keys rejected)::
                    reference: agl}]   # files or inline zones (see fm2uav.io.zone_spec)
     operating_area: area.geojson    # or {polygon: ..., lonlat: true}; the plan stays inside
     airframe: {type: multirotor, firmware: px4, cruise_speed: 12, hover_speed: 5,
-               endurance: 25, reserve: 0.2}   # [min] endurance checked with a 20 % reserve
+               endurance: 25, reserve: 0.2,   # [min] endurance checked with a 20 % reserve
+               power: arducopter, battery: 74}   # power model (preset, file, or
+                                    # {preset: .., mass_kg: ..}) and battery [Wh]
+    wind: {speed: 8, from: 270}     # [m/s] from [deg]; + ref_height, exponent: a profile;
+                                    # or {file: wind.nc} (NetCDF u/v on lon/lat, 2-band GeoTIFF)
     outputs:
       dir: out/my-mission           # relative to this file; default out/<file name> in the
                                     # current folder; `fm2uav run --out` overrides
@@ -70,7 +74,7 @@ from typing import Any, Literal
 
 import numpy as np
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, PrivateAttr, ValidationError
-from pydantic import field_validator, model_validator
+from pydantic import ValidationInfo, field_validator, model_validator
 
 from ..errors import InputError
 from ..world.load import WorldSpec as DataWorldSpec
@@ -320,6 +324,13 @@ def _planner_values(spec: PlannerSpec) -> dict[str, Any]:
     return out
 
 
+def _beside_mission(v: str, info: ValidationInfo) -> Path:
+    """A path of the mission file: relative ones are taken from the file's folder."""
+    p = Path(v).expanduser()
+    base = (info.context or {}).get("base_dir")
+    return p if p.is_absolute() or base is None else Path(base) / p
+
+
 class AirframeSpec(BaseModel):
     """The aircraft, as far as the exports need it."""
 
@@ -339,6 +350,77 @@ class AirframeSpec(BaseModel):
     endurance: float | None = _num(None, unit="min", gt=0, le=10000,
                                    desc="flight endurance (battery / fuel)")
     reserve: float = _num(0.2, ge=0, lt=1, desc="share of the endurance kept in reserve")
+    power: str | dict[str, Any] | None = Field(
+        None, description="power model: a preset (arducopter, disco, crosswind), a .yaml/.json "
+        "file (fm2uav calibrate writes one) or {preset: .., <parameter>: ..}")
+    battery: float | None = _num(None, unit="Wh", gt=0, le=1_000_000,
+                                 desc="battery energy (default: the power model's)")
+
+    @field_validator("power")
+    @classmethod
+    def _power(cls, v: Any, info: ValidationInfo) -> Any:
+        from ..vehicles.power import get_power_model
+
+        if v is None:
+            return v
+        if isinstance(v, str) and Path(v).suffix.lower() in (".yaml", ".yml", ".json"):
+            v = str(_beside_mission(v, info))
+        try:
+            get_power_model(v)
+        except InputError as exc:
+            raise ValueError(str(exc)) from None
+        return v
+
+
+class WindSpec(BaseModel):
+    """The wind: constant, a power-law profile with ``ref_height`` / ``exponent``, or a
+    gridded ``file`` (NetCDF or two-band GeoTIFF)."""
+
+    model_config = ConfigDict(strict=True, extra="forbid", frozen=True, populate_by_name=True)
+    speed: float | None = _num(None, unit="m/s", ge=0, le=100, desc="wind speed")
+    from_deg: float | None = Field(None, alias="from", ge=0, le=360,
+                                   description="direction the wind blows from [deg from north]")
+    ref_height: float | None = _num(None, unit="m", gt=0, le=1000,
+                                    desc="height above ground of the speed (a profile)")
+    exponent: float | None = _num(None, ge=0, le=1, desc="power-law exponent (a profile)")
+    file: str | None = Field(None, description="gridded wind: NetCDF (u/v on lon/lat) or "
+                             "two-band GeoTIFF, relative to the mission file")
+
+    @field_validator("file")
+    @classmethod
+    def _file(cls, v: str | None, info: ValidationInfo) -> str | None:
+        from ..world.wind_files import check_wind_file
+
+        if v is None:
+            return v
+        try:
+            return str(check_wind_file(_beside_mission(v, info)))
+        except InputError as exc:
+            raise ValueError(str(exc)) from None
+
+    @model_validator(mode="after")
+    def _one_kind(self) -> WindSpec:
+        if self.file is not None:
+            if any(x is not None for x in (self.speed, self.from_deg, self.ref_height,
+                                           self.exponent)):
+                raise ValueError("give either file or speed/from (a file holds the whole "
+                                 "field)")
+        elif self.speed is None or self.from_deg is None:
+            raise ValueError("needs speed and from (m/s and degrees the wind blows from), or "
+                             "a file")
+        return self
+
+    def field(self) -> Any:
+        """The :class:`~fm2uav.world.wind.WindField` (a file's: read onto the map later)."""
+        from ..world.wind import WindField
+
+        if self.file is not None:
+            return WindField.from_file(self.file)
+        if self.ref_height is None and self.exponent is None:
+            return WindField.constant(self.speed, self.from_deg, source="mission file wind:")
+        return WindField.profile(self.speed, self.from_deg, ref_height=self.ref_height or 10.0,
+                                 exponent=1 / 7 if self.exponent is None else self.exponent,
+                                 source="mission file wind:")
 
     @model_validator(mode="after")
     def _speeds(self) -> AirframeSpec:
@@ -464,6 +546,8 @@ class Mission(BaseModel):
                                          description="no-fly zones: files or inline zones")
     operating_area: ZoneSpec | None = Field(None, description="area the mission stays in")
     airframe: AirframeSpec = Field(default_factory=AirframeSpec)
+    wind: WindSpec | None = Field(None, description="the wind: {speed, from[, ref_height, "
+                                  "exponent]} or {file}")
     outputs: OutputSpec = Field(default_factory=OutputSpec)
     _base_dir: Path | None = PrivateAttr(None)
     rally: RallySpec | None = Field(None, description="rally points: sites, a file or auto")
@@ -526,7 +610,8 @@ class Mission(BaseModel):
             terrain_spacing=o.terrain_spacing,
             climb_rate=a.climb_rate, descent_rate=a.descent_rate,
             endurance_s=None if a.endurance is None else 60.0 * a.endurance,
-            reserve=a.reserve, name=self.name,
+            reserve=a.reserve, name=self.name, power=a.power, battery_wh=a.battery,
+            wind=None if self.wind is None else self.wind.field(),
         )
 
     def return_options(self, world: Any) -> Any:
@@ -720,9 +805,13 @@ def _field_info(loc: tuple[Any, ...]) -> tuple[Any, str]:
         if not isinstance(key, str):
             continue
         fields = getattr(model, "model_fields", None)
-        if not fields or key not in fields:
+        by_alias = {f.alias: k for k, f in (fields or {}).items() if f.alias}
+        if fields and key in by_alias:
+            info, name = fields[by_alias[key]], key
+        elif not fields or key not in fields:
             return info, name
-        info, name = fields[key], key
+        else:
+            info, name = fields[key], key
         ann = info.annotation
         nxt = None
         for cand in (ann, *getattr(ann, "__args__", ())):

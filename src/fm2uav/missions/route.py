@@ -21,6 +21,7 @@ from ..errors import InputError, PlanningError, PointError
 from ..planning import Plan, plan
 from ..planning.params import FlightLevel, PlanOptions, Shaping
 from ..planning.altitude import join_profiles
+from ..planning.wind import WindOptions, join_timings
 
 __all__ = ["Route", "plan_route"]
 
@@ -75,6 +76,7 @@ def plan_route(
     shaping: Shaping = Shaping(),
     level: FlightLevel | None = None,
     options: PlanOptions = PlanOptions(),
+    wind: WindOptions | None = None,
 ) -> Route:
     """Plan start → via... → goal (→ start) with FM² leg by leg.
 
@@ -90,6 +92,9 @@ def plan_route(
     shaping, level, options
         As :func:`fm2uav.plan`; the velocity map of the first leg is reused
         for the others (it does not depend on the points).
+    wind : WindOptions, optional
+        Plan every leg time-optimal in this wind (:mod:`fm2uav.planning.wind`); the
+        route's ``wind_timing`` runs over all legs.
 
     Raises
     ------
@@ -130,7 +135,7 @@ def plan_route(
             with progress.span(f"leg {k + 1} of {len(pts) - 1}" if len(pts) > 2 else "",
                                1.0 / (len(pts) - 1)):
                 legs.append(plan(world, pts[k], pts[k + 1], shaping=shaping, level=level,
-                                 options=opts))
+                                 options=opts, wind=wind))
         except PlanningError as exc:
             raise type(exc)(f"route leg {k + 1} of {len(pts) - 1} "
                             f"({np.round(pts[k], 1).tolist()} → {np.round(pts[k + 1], 1).tolist()}"
@@ -143,13 +148,20 @@ def plan_route(
         for key, v in lg.timings.items():
             timings[key] = timings.get(key, 0.0) + float(v)
     timings["total"] = time.perf_counter() - t0
+    params = {**legs[0].params, "legs": len(legs), "via": len(pts) - 2 - int(return_to_start),
+              "return_to_start": bool(return_to_start)}
+    timing = None
+    if wind is not None:
+        timing = join_timings([lg.wind_timing for lg in legs])
+        params["wind"] = {**params["wind"], **timing.summary(), "refused_nodes": max(
+            lg.params["wind"]["refused_nodes"] for lg in legs)}
     joined = Plan(
         path=path, w=w, length=float(sum(lg.length for lg in legs)),
         clearance=float(min(lg.clearance for lg in legs)), timings=timings,
         W=legs[0].W, T=legs[0].T, world=world,
-        params={**legs[0].params, "legs": len(legs), "via": len(pts) - 2 - int(return_to_start),
-                "return_to_start": bool(return_to_start)},
+        params=params,
         shaping=legs[0].shaping, level=legs[0].level,
         profile=join_profiles([lg.profile for lg in legs]),
+        wind_timing=timing,
     )
     return Route(plan=joined, legs=tuple(legs), points=np.array(pts), junctions=junctions)

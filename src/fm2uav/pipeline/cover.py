@@ -18,7 +18,7 @@ from .outputs import write_exports, write_figure, write_json
 from .rows import mission_rows, safety_rows, world_rows
 
 __all__ = ["COVER_EXPORTS", "COVER_FILES", "REPORT", "CoverRun", "run_cover", "cover_outputs",
-           "cover_rows", "band_cell"]
+           "cover_rows", "band_cell", "sortie_summary", "sortie_rows", "across_wind_angle"]
 
 #: Mission files of a coverage flight (written by fm2uav.io.export_mission).
 COVER_EXPORTS = ("csv", "plan", "wpl", "kml", "kmz", "geojson")
@@ -91,6 +91,9 @@ def run_cover(outdir: Any, world: Any, area: Any, *, area_label: str, spacing: f
     """
     from ..missions.coverage import plan_coverage
     from ..missions.coverage.triggers import camera_plan
+    from .outputs import with_wind_on
+
+    options = with_wind_on(options, world)
 
     progress.step("planning the bands and FM² along them", 0.75)
     cp = plan_coverage(world, area, spacing, level=level,
@@ -104,6 +107,9 @@ def run_cover(outdir: Any, world: Any, area: Any, *, area_label: str, spacing: f
                                   title=f"coverage of {area_label}", options=options,
                                   camera=shots, cam=camera)
     doc = {**(summary or {}), **cp.summary(), "autopilot": built.summary(), "safety": safety}
+    sorties = sortie_summary(built, world, options)
+    if sorties is not None:
+        doc["sorties"] = sorties
     write_json(outdir, "summary.json", doc)
     return CoverRun(coverage=cp, shots=shots, built=built, safety=safety, summary=doc)
 
@@ -216,7 +222,74 @@ def cover_outputs(outdir: Any, cp, area: str, *, report: bool, title: str,
     return mission, safety
 
 
-def cover_rows(area: str, d: float, cp, mission, world) -> dict:
+def across_wind_angle(wind: Any, world: Any, area: Any) -> float:
+    """Steering angle [deg, from the x axis] of bands across the wind (``--bands wind``).
+
+    Legs across the wind fly at ``sqrt(V² − w²)`` both ways, legs along it at ``V − w``
+    and ``V + w``: out and back, ``2L / sqrt(V² − w²)`` against ``2L V / (V² − w²)``, so
+    across is the faster (and the cheaper) orientation in any wind. The wind is the
+    field's at the area's centroid (a profile's at its reference height).
+
+    Raises
+    ------
+    InputError
+        No wind given, or a calm one (no direction to orient to).
+    """
+    from ..errors import InputError
+
+    if wind is None:
+        raise InputError("--bands wind needs a wind: give --wind SPEED@DIR or --wind-file "
+                         "(mission file wind:)")
+    c = area.centroid
+    u, v = np.asarray(wind.at([[c.x, c.y]]), dtype=float)[0]
+    if np.hypot(u, v) < 1e-9:
+        raise InputError("--bands wind: the wind is calm over the area, it gives no direction; "
+                         "give --angle or let the search choose (--bands search)")
+    return float((np.degrees(np.arctan2(v, u)) + 90.0) % 180.0)
+
+
+def sortie_summary(mission: Any, world: Any, options: Any) -> dict[str, Any] | None:
+    """The survey split into sorties by battery (:func:`fm2uav.autopilot.energy.mission_sorties`),
+    with every resume point in lon/lat; None when one battery flies it."""
+    from ..autopilot.energy import mission_sorties
+    from ..world.geo import to_lonlat
+
+    from ..errors import PlanningError
+
+    try:
+        plan = mission_sorties(mission)
+    except PlanningError as exc:
+        return {"count": None, "error": str(exc)}
+    if plan is None:
+        return None
+    out = plan.summary()
+    for s in out["sorties"]:
+        lon, lat, alt = to_lonlat(world, np.array([s["resume_m"]]),
+                                  anchor=getattr(options, "anchor", None))[0]
+        s["resume_lon_lat_alt"] = [round(float(lon), 7), round(float(lat), 7), round(float(alt), 1)]
+    return out
+
+
+def sortie_rows(sorties: dict[str, Any] | None) -> dict[str, str]:
+    """Printed rows of :func:`sortie_summary`."""
+    if not sorties:
+        return {}
+    if sorties["count"] is None:
+        return {"sorties": sorties["error"]}
+    even = sorties["even_split_count"]
+    rows = {"sorties": f"{sorties['count']} (one battery each, {sorties['usable_wh']:.1f} Wh "
+                       "usable; an even split of the waypoints needs "
+                       + (f"{even})" if even is not None else "more: one leg alone is too long)")}
+    for k, s in enumerate(sorties["sorties"], 1):
+        lon, lat, _ = s["resume_lon_lat_alt"]
+        rows[f"sortie {k}"] = (f"legs {s['from_waypoint']}→{s['to_waypoint']}, "
+                               f"{s['energy_wh']:.1f} Wh, {s['time_s'] / 60:.1f} min, resume at "
+                               f"{lat:.6f}, {lon:.6f}; straight home")
+    return rows
+
+
+def cover_rows(area: str, d: float, cp, mission, world, sorties: dict[str, Any] | None = None
+               ) -> dict:
     """The printed summary of ``fm2uav cover`` (and the app's coverage rows)."""
     return {
         "area": area,
@@ -233,6 +306,7 @@ def cover_rows(area: str, d: float, cp, mission, world) -> dict:
             if k in ("gsd_cm_per_px", "side_overlap", "front_overlap", "trigger_distance_m",
                      "trigger_items")),
         **mission_rows(mission),
+        **sortie_rows(sorties),
         "timings [ms]": ", ".join(f"{k} {v * 1e3:.0f}" for k, v in cp.timings.items()),
         **world_rows(world),
     }

@@ -19,7 +19,7 @@ from .rows import returns_rows, safety_rows
 
 __all__ = ["OUTPUT_FILES", "EXPORT_FILES", "output_names", "write_exports", "plan_outputs",
            "flown", "to_jsonable", "write_json", "write_text", "write_figure", "export_options",
-           "parse_anchor"]
+           "parse_anchor", "wind_options", "with_wind_on"]
 
 #: Export format → file name (:data:`fm2uav.io.exports.EXPORT_FILES`, repeated here so that
 #: importing this module loads no exporter; a test keeps both equal).
@@ -134,6 +134,7 @@ def plan_outputs(
     from ..autopilot.geofence import zone_fences
     from ..io import export_mission
 
+    options = with_wind_on(options, plan.world)
     exports = [f for f in formats if f in EXPORT_FILES]
     zones = tuple(getattr(plan.world, "zones", ()))
     fence_warnings: list[str] = []
@@ -306,12 +307,16 @@ def export_options(base: Any = None, *, firmware: str | None = None, vehicle: st
                    min_speed: float | None = None, cruise_speed: float | None = None,
                    hover_speed: float | None = None, endurance: float | None = None,
                    reserve: float | None = None, terrain: bool | None = None,
-                   terrain_spacing: int | None = None, **more: Any) -> Any:
+                   terrain_spacing: int | None = None, power: str | None = None,
+                   battery: float | None = None, wind: str | None = None,
+                   wind_file: str | None = None, **more: Any) -> Any:
     """``base`` (default ``ExportOptions()``) with the settings that were given (None =
     not given): the command line's mission flags, the app's aircraft and mission fields.
 
     ``thin`` is the waypoint tolerance [m], ``endurance`` in minutes, ``anchor`` the
-    ``lon,lat[,alt]`` text of ``--anchor``.
+    ``lon,lat[,alt]`` text of ``--anchor``, ``power`` a power-model preset or file,
+    ``battery`` in Wh, ``wind`` the ``SPEED@DIR`` text of ``--wind``, ``wind_file`` a
+    NetCDF / GeoTIFF wind (checked now, read onto the map by :func:`with_wind_on`).
 
     Raises
     ------
@@ -322,17 +327,33 @@ def export_options(base: Any = None, *, firmware: str | None = None, vehicle: st
     from dataclasses import replace
 
     from ..autopilot import ExportOptions
+    from ..world.wind import parse_wind_text
 
     given = {"firmware": firmware, "vehicle": vehicle, "frame": frame, "end": end,
              "tolerance": thin, "anchor": parse_anchor(anchor), "speed_changes": speed_changes,
              "min_speed": min_speed, "cruise_speed": cruise_speed, "hover_speed": hover_speed,
              "endurance_s": None if endurance is None else 60.0 * float(endurance),
-             "reserve": reserve, "terrain": terrain, "terrain_spacing": terrain_spacing, **more}
+             "reserve": reserve, "terrain": terrain, "terrain_spacing": terrain_spacing,
+             "power": power, "battery_wh": battery,
+             "wind": None if wind is None else parse_wind_text(wind), **more}
+    if wind_file is not None:
+        if wind is not None:
+            raise InputError("give --wind or --wind-file, not both")
+        from ..world.wind import WindField
+        from ..world.wind_files import check_wind_file
+
+        given["wind"] = WindField.from_file(check_wind_file(wind_file))
     if thin is not None and not 0 <= thin <= 1000:
         raise InputError(f"--thin must be a tolerance in [0, 1000] m (mission file: "
                          f"outputs.thin_tolerance), got {thin}")
     if endurance is not None and not endurance > 0:
         raise InputError(f"--endurance must be > 0 minutes, got {endurance}")
+    if battery is not None and not battery > 0:
+        raise InputError(f"--battery must be > 0 Wh, got {battery}")
+    if power is not None:
+        from ..vehicles.power import get_power_model
+
+        get_power_model(power)  # an unknown preset or a bad file: refused before any work
     return replace(base or ExportOptions(), **{k: v for k, v in given.items() if v is not None})
 
 
@@ -350,3 +371,26 @@ def parse_anchor(text: str | None) -> Any:
         raise InputError(f"--anchor must be lon,lat or lon,lat,alt (degrees, degrees, "
                          f"metres), got {text!r}")
     return Anchor(lon=v[0], lat=v[1], alt=v[2] if len(v) == 3 else 0.0)
+
+
+def wind_options(options: Any) -> Any:
+    """The :class:`~fm2uav.planning.wind.WindOptions` of a mission's export options: its
+    wind (``--wind`` / ``wind:``) at the forward speed (the airspeed at W = 1), or None."""
+    if getattr(options, "wind", None) is None:
+        return None
+    from ..planning.wind import WindOptions
+
+    return WindOptions(options.wind, options.forward_speed)
+
+
+def with_wind_on(options: Any, world: Any) -> Any:
+    """``options`` with a file's wind read onto ``world`` (any other wind unchanged)."""
+    wind = getattr(options, "wind", None)
+    if wind is None or wind.kind != "file":
+        return options
+    from dataclasses import replace
+
+    from ..world.wind_files import resolve_wind
+
+    return replace(options, wind=resolve_wind(wind, world, anchor=getattr(options, "anchor",
+                                                                           None)))

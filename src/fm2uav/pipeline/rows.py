@@ -6,8 +6,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-__all__ = ["plan_rows", "world_rows", "mission_rows", "safety_rows", "ground_rows",
-           "returns_rows", "mission_figures", "coverage_figures"]
+__all__ = ["plan_rows", "world_rows", "mission_rows", "energy_rows", "safety_rows",
+           "ground_rows", "returns_rows", "mission_figures", "coverage_figures"]
 
 
 def mission_rows(mission: Any) -> dict[str, str]:
@@ -24,6 +24,7 @@ def mission_rows(mission: Any) -> dict[str, str]:
         "flight": f"{s['flight']['flight_distance_m'] / 1000:.2f} km, "
                   f"{s['flight']['flight_time_s'] / 60:.1f} min",
     }
+    rows.update(energy_rows(s.get("energy")))
     sc = s["speed_changes"]
     kind = "airspeed" if sc.get("speed_type") == 0 else "ground speed"
     rows["speeds"] = (f"DO_CHANGE_SPEED {kind} {', '.join(f'{v:g}' for v in sc['speeds_mps'])} "
@@ -51,6 +52,34 @@ def mission_rows(mission: Any) -> dict[str, str]:
                                  f"{t['without']}{edge}")
     for k, w in enumerate(s["warnings"]):
         rows[f"warning {k + 1}"] = w
+    return rows
+
+
+def energy_rows(e: dict[str, Any] | None) -> dict[str, str]:
+    """Printed rows of a mission's energy figures (:func:`fm2uav.autopilot.energy.mission_energy`):
+    the energy and time against the battery, the model, the wind, the point of no return."""
+    if not e:
+        return {}
+    if e["energy_wh"] is None:
+        used = "cannot be flown in this wind"
+    else:
+        used = (f"{e['energy_wh']:.1f} Wh, {e['time_s'] / 60:.1f} min of {e['battery_wh']:g} Wh "
+                f"({e['usable_wh']:.1f} Wh usable with a {100 * e['reserve']:.0f} % reserve): "
+                f"{'OK' if e['ok'] else 'NOT ENOUGH'}")
+    rows = {"energy": used,
+            "power model": f"{e['model']} ({e['model_kind']}, {e['hover_or_cruise_power_w']:g} W "
+                           f"{'hover' if e['model_kind'] == 'multirotor' else 'cruise'}; "
+                           f"{e['model_source']})"}
+    if e.get("wind"):
+        w = e["wind"]
+        rows["wind"] = (f"{w['speed_mps']:g} m/s from {w['from_deg']:g}°" if "speed_mps" in w
+                        else f"gridded, up to {w['max_speed_mps']:g} m/s") + (
+            f"; ground speed {e['groundspeed_mps'][0]:g}–{e['groundspeed_mps'][1]:g} m/s, "
+            f"airspeed {e['airspeed_mps'][0]:g}–{e['airspeed_mps'][1]:g} m/s"
+            if e.get("groundspeed_mps") else "")
+    if "no_return_waypoint" in e:
+        rows["point of no return (battery, straight returns)"] = (
+            f"waypoint {e['no_return_waypoint']}: {e['no_return_note']}")
     return rows
 
 
@@ -95,12 +124,21 @@ def plan_rows(p: Any) -> dict[str, Any]:
     """The printed summary rows every planning command shows of a plan."""
     import numpy as np
 
-    return {
+    rows = {
         "start [m]": np.round(p.start, 1).tolist(),
         "goal [m]": np.round(p.goal, 1).tolist(),
         "length [m]": f"{p.length:.1f}",
         "clearance [m]": f"{p.clearance:.1f}",
     }
+    w = (getattr(p, "params", None) or {}).get("wind")
+    if w:
+        g = w["groundspeed_mps"]
+        rows["route in the wind"] = (
+            (f"{w['time_s'] / 60:.1f} min" if w["time_s"] is not None else "no headway")
+            + f" at up to {w['airspeed_mps']:g} m/s airspeed"
+            + (f", ground speed {g[0]:g}–{g[1]:g} m/s" if g else "")
+            + f"; {w['refused_nodes']} nodes refused (wind ≥ safe airspeed)")
+    return rows
 
 
 def world_rows(world: Any) -> dict[str, str]:

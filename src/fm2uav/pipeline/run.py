@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import progress
-from .outputs import plan_outputs
+from .outputs import plan_outputs, wind_options, with_wind_on
 
 __all__ = ["MissionRun", "run_mission", "with_zone_files"]
 
@@ -129,9 +129,10 @@ def run_mission(
     legs = len(rm.via) + 1 + rm.return_to_start
     progress.step("planning (FM²)" + (f", {legs} legs" if legs > 1 else ""), 0.55)
     shaping, level, popts = planner_objects({**mission.plan_kwargs(), **(planner or {})})
+    options = with_wind_on(options, rm.world)
     route = plan_route(rm.world, rm.start, rm.goal, via=rm.via,
                        return_to_start=rm.return_to_start, shaping=shaping, level=level,
-                       options=popts)
+                       options=popts, wind=wind_options(options))
     world_name = mission.world.scenario or mission.world.describe()
     progress.step("writing the mission files", 0.3)
     ret = (returns(mission, rm.world) if returns is not None

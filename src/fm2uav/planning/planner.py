@@ -29,6 +29,7 @@ from .altitude import AltitudeProfile, final_profile, height_figures
 from .flight_level import flight_level_speed
 from .geodesic import descend
 from .params import FlightLevel, PlanOptions, Shaping, plan_params
+from .wind import PathTiming, WindOptions, descend_track, path_timing, wind_times
 from .regional import check_full_grid, plan_regional, use_regional
 
 __all__ = ["Plan", "plan", "base_velocity", "shaped_velocity", "max_distance", "plan_params"]
@@ -78,6 +79,10 @@ class Plan:
         With a flight level on a 3D world: the final altitude profile that set
         the heights of ``path`` (climb-out, cruise at ``agl`` above the
         continuous ground, descent; :mod:`fm2uav.planning.altitude`).
+    wind_timing : PathTiming or None
+        Planned in a wind (``plan(..., wind=WindOptions(...))``): the safe airspeed,
+        ground speed, heading and time along ``path`` in that wind
+        (:mod:`fm2uav.planning.wind`); ``T`` is then in seconds.
     """
 
     path: np.ndarray
@@ -92,6 +97,7 @@ class Plan:
     shaping: Shaping = field(default_factory=Shaping)
     level: FlightLevel | None = None
     profile: AltitudeProfile | None = field(default=None, repr=False)
+    wind_timing: PathTiming | None = field(default=None, repr=False)
 
     @property
     def phase(self) -> np.ndarray | None:
@@ -262,6 +268,7 @@ def plan(
     shaping: Shaping = Shaping(),
     level: FlightLevel | None = None,
     options: PlanOptions = PlanOptions(),
+    wind: WindOptions | None = None,
 ) -> Plan:
     """Plan a path from ``start`` to ``goal`` with Fast Marching Square.
 
@@ -285,6 +292,11 @@ def plan(
         for one full 3D grid is planned coarse-to-fine by
         :func:`fm2uav.planning.regional.plan_regional` (``storage="auto"``).
         Default ``PlanOptions()``.
+    wind : WindOptions, optional
+        Plan the time-optimal route in a wind field at the safe airspeed
+        ``W × wind.airspeed`` (:mod:`fm2uav.planning.wind`): nodes where the wind is
+        at least that airspeed are refused. Needs the full grid (not regional).
+        Default None (still air).
 
     Returns
     -------
@@ -323,7 +335,15 @@ def plan(
     start_cell = _check_free(world, start_m, "start")
     goal_cell = _check_free(world, goal_m, "goal")
     _check_work(world, start_m, goal_m, start_cell, goal_cell, options)
-    if use_regional(world, shaping, level, options):  # too big for one full grid
+    regional = use_regional(world, shaping, level, options)
+    if wind is not None and not isinstance(wind, WindOptions):
+        raise InputError(f"wind must be a fm2uav.planning.wind.WindOptions, got "
+                         f"{type(wind).__name__}")
+    if wind is not None and regional:
+        raise InputError("planning in a wind needs the full grid, and this map is planned "
+                         "regionally (too big for one grid): use a coarser cell_size "
+                         "(--cell-size) or planner.storage: full")
+    if regional:  # too big for one full grid
         return plan_regional(world, start_m, goal_m, shaping=shaping, level=level,
                              options=options, t_all=t_all, full_plan=plan)
 
@@ -337,6 +357,12 @@ def plan(
             f"the velocity map is 0 at the {which} node; move the {which} away from obstacles"
         )
     progress.step("arrival times T (Fast Marching)", 0.45)
+    if wind is not None:
+        T, track, refused = wind_times(world, W, goal_cell, start_cell, wind,
+                                       order=options.order)
+        t2 = time.perf_counter()
+        return trace_plan(world, W, T, start_m, goal_m, shaping, level, options,
+                          (t_all, t0, t1, t2), wind=wind, track=track, refused=refused)
     T = fast_marching(W, [goal_cell], spacing=world.spacing, order=options.order,
                       stop_at=[start_cell])
     t2 = time.perf_counter()
@@ -396,15 +422,25 @@ def plan_velocity(world: World, shaping: Shaping, level: FlightLevel | None,
 
 def trace_plan(world: World, W: np.ndarray, T: np.ndarray, start_m: np.ndarray,
                goal_m: np.ndarray, shaping: Shaping, level: FlightLevel | None,
-               options: PlanOptions, marks: tuple[float, float, float, float]) -> Plan:
+               options: PlanOptions, marks: tuple[float, float, float, float], *,
+               wind: WindOptions | None = None, track: np.ndarray | None = None,
+               refused: np.ndarray | None = None) -> Plan:
     """Descend ``T`` from the start, set the final heights and measure: the end of :func:`plan`.
 
     Shared with :class:`fm2uav.planning.session.Planner`, which keeps ``W`` and ``T``
     between re-plans. ``marks`` = perf-counter times (start, before W, after W,
-    after the march) for the timings.
+    after the march) for the timings. In a wind (``wind``), the path follows the
+    march's ground ``track`` (:func:`fm2uav.planning.wind.descend_track`).
     """
     t_all, t0, t1, t2 = marks
     start_cell = world.to_cell(start_m, what="start")
+    if not np.isfinite(T[start_cell]) and wind is not None:
+        raise UnreachableError(
+            f"the goal {np.round(goal_m, 3).tolist()} m cannot be reached from the start "
+            f"{np.round(start_m, 3).tolist()} m in this wind ({wind.field.describe()}): "
+            f"{int(refused.sum()) if refused is not None else 0} nodes where the wind is at "
+            "least the safe airspeed W x airspeed are refused and close every way; fly "
+            "faster (--cruise-speed / --hover-speed), lower the saturation, or fly another day")
     if not np.isfinite(T[start_cell]):
         raise UnreachableError(
             f"the goal {np.round(goal_m, 3).tolist()} m cannot be reached from the start "
@@ -417,14 +453,19 @@ def trace_plan(world: World, W: np.ndarray, T: np.ndarray, start_m: np.ndarray,
     blocked = world.occupancy if np.isfinite(T[world.occupancy]).any() else None
     progress.step("path (geodesic descent)", 0.6)
     try:
-        path_idx = descend(
-            T,
-            world.to_index(start_m),
-            world.to_index(goal_m),
-            spacing=world.spacing,
-            blocked=blocked,
-            step=options.step,
-        )
+        if track is not None:
+            path_idx = descend_track(T, track, world.to_index(start_m), world.to_index(goal_m),
+                                     spacing=world.spacing, blocked=world.occupancy,
+                                     step=options.step)
+        else:
+            path_idx = descend(
+                T,
+                world.to_index(start_m),
+                world.to_index(goal_m),
+                spacing=world.spacing,
+                blocked=blocked,
+                step=options.step,
+            )
     except PlanningError as exc:  # "descent ... stuck": T reached the start, W too dark
         raise PlanningError(
             f"no path could be traced from the start {np.round(start_m, 3).tolist()} m to the "
@@ -459,6 +500,12 @@ def trace_plan(world: World, W: np.ndarray, T: np.ndarray, start_m: np.ndarray,
         "metrics": t4 - t3,
         "total": t4 - t_all,
     }
+    params = plan_params(shaping, level, options)
+    timing = None
+    if wind is not None:
+        timing = path_timing(world, path, w, wind)
+        params["wind"] = {**wind.summary(), "refused_nodes": int(refused.sum())
+                          if refused is not None else 0, **timing.summary()}
     return Plan(
         path=path,
         w=w,
@@ -468,10 +515,11 @@ def trace_plan(world: World, W: np.ndarray, T: np.ndarray, start_m: np.ndarray,
         W=W,
         T=T,
         world=world,
-        params=plan_params(shaping, level, options),
+        params=params,
         shaping=shaping,
         level=level if options.speed_map is None else None,
         profile=profile,
+        wind_timing=timing,
     )
 
 
