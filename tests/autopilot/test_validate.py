@@ -8,8 +8,11 @@ without a case fails here).
 module of ``autopilot/firmware/``): add one :class:`Case` to :data:`CASES` — the firmware and
 airframe, a one-line ``build`` that breaks only that rule in the valid base mission of the
 airframe (:func:`base`), the code and a regex of the message; ``also`` lists the codes that
-cannot help firing with it (a landing as the first item is also a missing takeoff). Write the
-code as a string literal in the ``Problem(...)`` call (the meta-test reads it from the source).
+cannot help firing with it (a landing as the first item is also a missing takeoff), and
+``severity="warning"`` for a rule that warns (the meta-test reads the severity from the call
+too). Write the code as a string literal in the ``Problem(...)`` call (the meta-test reads it
+from the source). The flight rules of ``autopilot/firmware/flight_rules.py`` (speeds, fixed-wing
+climb-out, loiters, legs, landing) are rules like the others: each has its case here.
 """
 
 from __future__ import annotations
@@ -38,14 +41,24 @@ def _wp(k: int, alt: float = 60.0, command: int = 16, frame: int = 3, **kw) -> M
     return MissionItem.at(command, frame, LAT, LON + k * 0.00265, alt, **kw)
 
 
+#: Cruise speed of the base missions [m/s]: a multirotor's ground speed, and a fixed-wing /
+#: VTOL airspeed inside both firmwares' ranges (PX4 FW_AIRSPD_MIN..MAX 10..20, ArduPlane
+#: AIRSPEED_MIN..MAX 9..22), slow enough that the 40 m take-off climb (40 m x 15 / 5 m/s
+#: TECS climb = 120 m, + the turn distance) ends before the first waypoint 200 m ahead.
+CRUISE = {"multirotor": 8.0, "fixed_wing": 15.0, "vtol": 15.0}
+#: The speed type each firmware takes on the airframe: ground speed 1 (multirotor), 0 airspeed.
+SPEED_TYPE = {"multirotor": 1.0, "fixed_wing": 0.0, "vtol": 0.0}
+
+
 def base(vehicle: str = "multirotor") -> list[MissionItem]:
-    """A mission every firmware accepts on ``vehicle``: takeoff, waypoints with a speed change
-    and a camera switched on and off between them, then the airframe's usual end (fixed-wing:
-    PX4's landing pattern, a loiter down to 40 m, 2.9 deg glide to the touchdown)."""
+    """A mission every firmware accepts and flies as planned on ``vehicle``: takeoff, the
+    cruise speed before the first waypoint, waypoints 200 m apart in a straight line with a
+    camera switched on and off between them, then the airframe's usual end (fixed-wing:
+    PX4's landing pattern, a loiter down to 40 m, 2.6 deg glide to the touchdown)."""
     takeoff = 84 if vehicle == "vtol" else 22
     items = [_wp(0, 40.0, command=takeoff),
+             MissionItem.do(178, SPEED_TYPE[vehicle], CRUISE[vehicle], -1.0),
              _wp(1),
-             MissionItem.do(178, 1.0 if vehicle == "multirotor" else 0.0, 8.0, -1.0),
              MissionItem.do(206, 25.0, 0.0, 1.0),
              _wp(2),
              MissionItem.do(206, 0.0),
@@ -73,6 +86,24 @@ def _index(items: list[MissionItem], command: int, nth: int = 0) -> int:
     return [i for i, it in enumerate(items) if it.command == command][nth]
 
 
+def _w1(vehicle: str = "multirotor") -> int:
+    """Index of the first waypoint of the base mission (after the cruise speed)."""
+    return _index(base(vehicle), 16)
+
+
+def _later_speed(vehicle: str, kind: float, speed: float) -> list[MissionItem]:
+    """The base mission with one more DO_CHANGE_SPEED after its second waypoint (the cruise
+    speed before the first one stays valid: only the added command breaks a rule)."""
+    items = base(vehicle)
+    k = _index(items, 16, 1) + 1
+    return items[:k] + [MissionItem.do(178, kind, speed, -1.0)] + items[k:]
+
+
+def _north(k: float, north_m: float, alt: float = 60.0, command: int = 16) -> MissionItem:
+    """A waypoint ``k`` x 200 m east of home and ``north_m`` north of that."""
+    return MissionItem.at(command, 3, LAT + north_m / 111195.0, LON + k * 0.00265, alt)
+
+
 def _rtl_end(items: list[MissionItem]) -> list[MissionItem]:
     """The mission with its landing (pattern) replaced by an RTL."""
     first_end = next(i for i, it in enumerate(items) if it.command in (189, 21, 85)
@@ -97,6 +128,8 @@ class Case:
     also: frozenset = frozenset()  #: codes that cannot help firing with it
     fences: tuple = ()
     home_alt: float | None = HOME_ALT
+    severity: str = "error"  #: the rule's severity ("warning": it flies, with a deviation)
+    home_latlon: tuple | None = None  #: where a fixed-wing launches (None: the take-off item)
 
     @property
     def id(self) -> str:
@@ -104,7 +137,8 @@ class Case:
 
     def problems(self, firmware: str | None = None):
         return validate_mission(self.build(), firmware or self.firmware, vehicle=self.vehicle,
-                                home_alt=self.home_alt, fences=self.fences)
+                                home_alt=self.home_alt, fences=self.fences,
+                                home_latlon=self.home_latlon)
 
 
 MR, FW, VT = "multirotor", "fixed_wing", "vtol"

@@ -24,8 +24,10 @@ def test_calibrate_writes_a_model_plan_uses(tmp_path):
     log = write_tlog(tmp_path / "flight.tlog", t, true.power(air, climb), air, climb)
     out = tmp_path / "cal"
     res = runner.invoke(app, ["calibrate", str(log), "--power", "arducopter", "--out", str(out),
-                              "--json"])
+                              "--json", "--report"])
     assert res.exit_code == 0, res.output
+    page = (out / "report.html").read_text()
+    assert "plotly" in page and "fitted model" in page and "R²" in page
     fit = json.loads((out / "calibration.json").read_text())
     assert fit["r2"] > 0.999 and fit["rms_w"] < 0.5
     model = get_power_model(out / "power.yaml")

@@ -30,7 +30,8 @@ def _help() -> str:
 
 
 @handle_errors
-@output_options("out/calibrate", json_help="Print the fit as JSON.")
+@output_options("out/calibrate", json_help="Print the fit as JSON.",
+                report_help="Also write report.html: measured and fitted power along the log.")
 def calibrate_cmd(
     log_file: Path = typer.Argument(..., help="ArduPilot flight log (.tlog or .bin).",
                                     show_default=False),
@@ -62,7 +63,7 @@ def calibrate_cmd(
         from dataclasses import replace
 
         start = replace(start, mass_kg=mass)
-    outdir = output.dir(CALIBRATE_FILES)
+    outdir = output.dir(CALIBRATE_FILES + (("report.html",) if output.report else ()))
     with output.progress() as step:
         step(f"reading {log_file.name}")
         samples = read_power_samples(log_file)
@@ -81,6 +82,12 @@ def calibrate_cmd(
             "efficiency": f"{cal.model.efficiency:.3f}"}
     if cal.model.kind == "multirotor":
         rows["hover power [W]"] = f"{cal.model.hover_power():.1f}"
+    if output.report:
+        from ..viz.energy import calibration_report_html
+
+        write_text(outdir, "report.html", calibration_report_html(
+            samples, cal.model, rows, title=f"fm2uav calibrate — {log_file.name}",
+            files=list(CALIBRATE_FILES)))
     output.summary("power model fit", rows, payload)
 
 

@@ -20,6 +20,8 @@ REPORT = "report.html"
 
 def _report(rep, world, rows: dict, *, title: str, subtitle: str, params: dict) -> str:
     """report.html of a check: the planned path and the flown track, saturation intervals."""
+    import numpy as np
+
     from ..viz.report import path_figures, report_html
 
     tr = rep.tracking
