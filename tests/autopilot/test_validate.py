@@ -148,20 +148,22 @@ NAN = math.nan
 CASES: list[Case] = [
     # ---------------------------------------------------------------- every firmware
     Case("empty", "has no items", lambda: []),
-    Case("param-nan", r"param2 is nan; only param4", lambda: _param(base(), 1, 1, NAN)),
+    Case("param-nan", r"param2 is nan; only param4", lambda: _param(base(), _w1(), 1, NAN)),
     Case("param-nan", r"param4 is nan; it is not a yaw",
          lambda: _param(base(), _index(base(), 178), 3, NAN)),
-    Case("param-nan", r"param4 is inf; it is not a yaw", lambda: _param(base(), 1, 3, math.inf)),
+    Case("param-nan", r"param4 is inf; it is not a yaw",
+         lambda: _param(base(), _w1(), 3, math.inf)),
     Case("param-nan", r"DO_LAND_START \(189\): param6 is nan",
          lambda: _param(base(FW), _index(base(FW), 189), 5, NAN), vehicle=FW),
-    Case("latlon", r"latitude/longitude \(nan, ", lambda: _param(base(), 1, 4, NAN)),
-    Case("latlon", r"latitude/longitude \(91.0, ", lambda: _param(base(), 1, 4, 91.0)),
-    Case("latlon-zero", "are 0, 0", lambda: _param(_param(base(), 1, 4, 0.0), 1, 5, 0.0)),
-    Case("alt", "altitude is nan", lambda: _param(base(), 1, 6, NAN)),
-    Case("speed-type", r"speed type \(param1\) 2 is not 0",
-         lambda: _param(base(), _index(base(), 178), 0, 2.0)),
-    Case("speed", r"speed \(param2\) 0 m/s must be > 0",
-         lambda: _param(base(), _index(base(), 178), 1, 0.0)),
+    Case("latlon", r"latitude/longitude \(nan, ", lambda: _param(base(), _w1(), 4, NAN)),
+    Case("latlon", r"latitude/longitude \(91.0, ", lambda: _param(base(), _w1(), 4, 91.0)),
+    Case("latlon-zero", "are 0, 0",
+         lambda: _param(_param(base(), _w1(), 4, 0.0), _w1(), 5, 0.0)),
+    Case("alt", "altitude is nan", lambda: _param(base(), _w1(), 6, NAN)),
+    # the added speed command has a type no firmware knows (2: climb speed on ArduCopter);
+    # validate.py's and the firmware's speed rule both name it, under the same code
+    Case("speed-type", r"speed type \(param1\) 2 is not 0", lambda: _later_speed(MR, 2.0, 8.0)),
+    Case("speed", r"speed \(param2\) 0 m/s must be > 0", lambda: _later_speed(MR, 1.0, 0.0)),
     Case("trigger", "trigger distance -5 m must be >= 0",
          lambda: _param(base(), _index(base(), 206), 0, -5.0)),
     Case("no-takeoff", r"must be NAV_TAKEOFF .* got NAV_WAYPOINT", lambda: base()[1:]),
@@ -172,7 +174,8 @@ CASES: list[Case] = [
     Case("takeoff-alt", r"takeoff altitude is 0.00 m above home",  # AMSL takeoff at home
          lambda: _at(_param(base(), 0, 6, HOME_ALT), 0, frame=0)),
     Case("no-end", r"must end with .*not NAV_WAYPOINT .*outputs.end", lambda: base()[:-1]),
-    Case("trigger-on", "still triggering", lambda: base()[:5] + base()[6:]),
+    Case("trigger-on", "still triggering",
+         lambda: [it for it in base() if not (it.command == 206 and it.params[0] == 0)]),
     Case("fence-inside", r"NAV_WAYPOINT \(16\) lies inside the exclusion fence 'stadium'",
          base, fences=(_SQUARE,)),
     Case("fence-inside", r"lies inside the exclusion fence 'tower'", base,
@@ -186,12 +189,14 @@ CASES: list[Case] = [
          fences=(FenceCircle(center=(LAT, LON), radius=450.0, inclusion=True, name="circle"),)),
     # ---------------------------------------------------------------- PX4
     Case("px4-command", r"NAV_LOITER_TURNS \(18\) is not a mission command PX4 accepts",
-         lambda: _at(base(), 1, command=18, params=(0, 0, 0, 0, *base()[1].params[4:]))),
+         lambda: _at(base(), _w1(), command=18,
+                     params=(0, 0, 0, 0, *base()[_w1()].params[4:]))),
     Case("px4-command", r"NAV_VTOL_LAND \(85\) .*VTOL items need a VTOL airframe",
          lambda: _at(base(), len(base()) - 1, command=85)),
     Case("px4-terrain-frame", r"uses MAV_FRAME_GLOBAL_TERRAIN_ALT; PX4 does not fly .*"
-                              r"--frame amsl", lambda: _at(base(), 1, frame=10)),
-    Case("px4-frame", r"uses 1; PX4 takes frames 0 and 3 only", lambda: _at(base(), 1, frame=1)),
+                              r"--frame amsl", lambda: _at(base(), _w1(), frame=10)),
+    Case("px4-frame", r"uses 1; PX4 takes frames 0 and 3 only",
+         lambda: _at(base(), _w1(), frame=1)),
     Case("px4-frame", r"DO_CHANGE_SPEED \(178\) must use MAV_FRAME_MISSION \(2\) on PX4",
          lambda: _at(base(), _index(base(), 178), frame=3)),
     Case("px4-land-start", "more than one DO_LAND_START",
@@ -214,19 +219,93 @@ CASES: list[Case] = [
          lambda: [base(FW)[0], MissionItem.do(189), _wp(8.4, 0.0, command=21)], vehicle=FW),
     Case("px4-fw-approach", r"the approach item is -10.0 m above the landing point",
          lambda: _param(base(FW), len(base(FW)) - 1, 6, 50.0), vehicle=FW),
+    # a touchdown inside the loiter circle is also an exit from the loiter inside its circle
+    # (the flight rule fw-loiter-exit: the item after a NAV_LOITER_TO_ALT lies inside it)
     Case("px4-fw-approach", r"the landing point is \d+ m from the loiter centre, inside its "
                             r"900 m radius",
-         lambda: _param(base(FW), len(base(FW)) - 2, 1, 900.0), vehicle=FW),
+         lambda: _param(base(FW), len(base(FW)) - 2, 1, 900.0), vehicle=FW,
+         also=frozenset({"fw-loiter-exit"})),
+    # PX4's flight rule bounds the glide by FW_LND_ANG too (fw-landing: the sink limit and
+    # FW_LND_ANG), so a glide steeper than FW_LND_ANG breaks both
     Case("px4-fw-glide-slope", r"glide slope is [\d.]+ deg, steeper than FW_LND_ANG = 5 deg",
-         lambda: _param(base(FW), len(base(FW)) - 2, 6, 160.0), vehicle=FW),
+         lambda: _param(base(FW), len(base(FW)) - 2, 6, 160.0), vehicle=FW,
+         also=frozenset({"fw-landing"})),
     # ---------------------------------------------------------------- ArduPilot
     Case("ardupilot-command", r"NAV_LOITER_TO_ALT \(31\) is not a mission command ArduPilot "
-                              r"Copter flies", lambda: _at(base(), 1, command=31, params=(0, 0, 0, 0, *base()[1].params[4:])),
+                              r"Copter flies",
+         lambda: _at(base(), _w1(), command=31, params=(0, 0, 0, 0, *base()[_w1()].params[4:])),
          firmware="ardupilot"),
     Case("ardupilot-frame", r"uses frame 1; ArduPilot missions take frames 0, 3 and 10",
-         lambda: _at(base(), 1, frame=1), firmware="ardupilot"),
+         lambda: _at(base(), _w1(), frame=1), firmware="ardupilot"),
     Case("ardupilot-terrain-takeoff", r"NAV_TAKEOFF \(22\) in the terrain frame.*#20142",
          lambda: _at(base(), 0, frame=10), firmware="ardupilot"),
+    # ---------------------------------------------------------------- flight rules: speeds
+    # (firmware/flight_rules.py; ranges PX4 FW_AIRSPD_MIN..MAX 10..20, ArduPlane 9..22 m/s)
+    Case("speed-type", r"speed type 0: PX4 takes the ground speed \(1\) on a multirotor",
+         lambda: _later_speed(MR, 0.0, 8.0)),
+    Case("speed-type", r"speed type 1: ArduPilot takes the airspeed \(0\) on a fixed-wing: "
+                       r"speed type 1 \(ground speed\) sets MIN_GROUNDSPEED",
+         lambda: _later_speed(FW, 1.0, 15.0), firmware="ardupilot", vehicle=FW),
+    Case("speed-type", r"speed type 2: ArduPilot takes the ground speed \(1\) on a multirotor: "
+                       r"speed types 2/3 set ArduCopter's climb",  # a type common rules know
+         lambda: _later_speed(MR, 2.0, 8.0), firmware="ardupilot"),
+    # 9.5 m/s: below PX4's FW_AIRSPD_MIN 10, a speed ArduPlane would take
+    Case("speed-range", r"DO_CHANGE_SPEED 9.5 m/s: it is outside the airframe's range "
+                        r"10 .. 20 m/s", lambda: _param(base(FW), 1, 1, 9.5), vehicle=FW),
+    # 23 m/s: above ArduPlane's AIRSPEED_MAX 22, which it ignores (on a VTOL, whose cruise
+    # does not climb out on a NAV_TAKEOFF, so the faster climb-out is not a second rule)
+    Case("speed-range", r"DO_CHANGE_SPEED 23 m/s: ArduPilot ignores an airspeed outside "
+                        r"AIRSPEED_MIN 9 .. AIRSPEED_MAX 22 m/s",
+         lambda: _param(base(VT), 1, 1, 23.0), firmware="ardupilot", vehicle=VT),
+    Case("no-cruise-speed", r"no DO_CHANGE_SPEED before the first waypoint: PX4 flies "
+                            r"MPC_XY_CRUISE",  # the cruise speed after the first waypoint
+         lambda: [base()[i] for i in (0, 2, 1, *range(3, len(base())))], severity="warning"),
+    Case("no-cruise-speed", r"ArduPilot flies AIRSPEED_CRUISE",  # no speed command at all
+         lambda: [it for it in base(FW) if it.command != 178], firmware="ardupilot",
+         vehicle=FW, severity="warning"),
+    # ---------------------------------------------------------------- flight rules: fixed-wing
+    # launched 200 m south of the take-off item: the climb heads north, the route lies east
+    Case("fw-climb-out", r"the first waypoint lies 90° off the take-off course", lambda: base(FW),
+         vehicle=FW, home_latlon=(LAT - 200 / 111195.0, LON)),
+    # a take-off to 60 m: 60 m x 15 / 5 m/s = 180 m of climb + 33 m of turn > 200 m
+    Case("fw-climb-out", r"the first waypoint is 200 m from the launch, but climbing 60 m at "
+                         r"5 m/s \(FW_T_CLMB_MAX\) and 15 m/s takes 180 m plus 33 m",
+         lambda: _param(base(FW), 0, 6, 60.0), vehicle=FW),
+    Case("fw-climb-out", r"the first waypoint is 10 m below the take-off altitude",
+         lambda: _param(base(FW), _w1(FW), 6, 30.0), vehicle=FW),
+    # a 10 m loiter: PX4's turn radius at 15 m/s and FW_R_LIM 50 deg is 19 m
+    Case("fw-loiter-radius", r"NAV_LOITER_TO_ALT \(31\): a 10 m loiter at 15 m/s is tighter "
+                             r"than the turn radius 19 m \(FW_R_LIM 50°\)",
+         lambda: _param(base(FW), len(base(FW)) - 2, 1, 10.0), vehicle=FW),
+    # ArduPlane: the touchdown 880 m from the centre of a 900 m loiter (no PX4 approach rule)
+    Case("fw-loiter-exit", r"NAV_LAND \(21\) is 880 m from the loiter centre, inside its 900 m "
+                           r"circle: ArduPlane leaves the loiter by altitude only",
+         lambda: _param(base(FW), len(base(FW)) - 2, 1, 900.0), firmware="ardupilot",
+         vehicle=FW),
+    # the second waypoint, 200 m after the first, with a 250 m acceptance radius (param2):
+    # ArduPlane is within it as it reaches the first one
+    Case("fw-skipped-waypoint", r"NAV_WAYPOINT \(16\) is 200 m after the previous waypoint: "
+                                r"ArduPlane reaches the previous one 0 m before it, already "
+                                r"within 250 m of this one",
+         lambda: _param(base(FW), _index(base(FW), 16, 1), 1, 250.0), firmware="ardupilot",
+         vehicle=FW),
+    # a waypoint 40 m north of the first: PX4 turns 90° onto that leg (19 m) and counts the
+    # waypoint reached 33 m before it
+    Case("fw-short-leg", r"the 40 m leg to NAV_WAYPOINT \(16\) is shorter than the 53 m PX4 "
+                         r"flies on it \(19 m to turn 90°",
+         lambda: (lambda b: b[:_w1(FW) + 1] + [_north(1, 40.0)] + b[_w1(FW) + 1:])(base(FW)),
+         vehicle=FW, severity="warning"),
+    # ArduPlane landing 60 m north of a waypoint 15 m up, after a 90° turn onto the approach:
+    # 23 m to turn + 61 m of turn distance > 60 m (glide 14°, within its 19.5°)
+    Case("fw-landing", r"the landing approach is 60 m long, shorter than the 84 m ArduPlane "
+                       r"needs to turn 90° onto it",
+         lambda: base(FW)[:-3] + [_wp(4, 15.0), _north(4, 60.0, 0.0, command=21)],
+         firmware="ardupilot", vehicle=FW),
+    # ArduPlane: loiter at 400 m, 360 m over the 876 m glide (22°) > asin(5 / 15) = 19.5°
+    Case("fw-landing", r"the landing glide slope is 22.3°, steeper than the 19.5° ArduPlane "
+                       r"can hold at 15 m/s \(TECS_SINK_MAX 5 m/s\)",
+         lambda: _param(base(FW), len(base(FW)) - 2, 6, 400.0), firmware="ardupilot",
+         vehicle=FW),
 ]
 
 

@@ -371,6 +371,16 @@ class AirframeSpec(BaseModel):
             raise ValueError(str(exc)) from None
         return v
 
+    @model_validator(mode="after")
+    def _speeds(self) -> AirframeSpec:
+        key = "hover_speed" if self.type == "multirotor" else "cruise_speed"
+        if self.min_speed is not None and self.min_speed > getattr(self, key):
+            raise ValueError(
+                f"min_speed {self.min_speed:g} m/s is above {key} {getattr(self, key):g} m/s, "
+                f"the speed this {self.type.replace('_', '-')} flies the mission at; allowed: "
+                f"min_speed <= {key}")
+        return self
+
 
 class WindSpec(BaseModel):
     """The wind: constant, a power-law profile with ``ref_height`` / ``exponent``, or a
@@ -421,16 +431,6 @@ class WindSpec(BaseModel):
         return WindField.profile(self.speed, self.from_deg, ref_height=self.ref_height or 10.0,
                                  exponent=1 / 7 if self.exponent is None else self.exponent,
                                  source="mission file wind:")
-
-    @model_validator(mode="after")
-    def _speeds(self) -> AirframeSpec:
-        key = "hover_speed" if self.type == "multirotor" else "cruise_speed"
-        if self.min_speed is not None and self.min_speed > getattr(self, key):
-            raise ValueError(
-                f"min_speed {self.min_speed:g} m/s is above {key} {getattr(self, key):g} m/s, "
-                f"the speed this {self.type.replace('_', '-')} flies the mission at; allowed: "
-                f"min_speed <= {key}")
-        return self
 
 
 class OutputSpec(BaseModel):
