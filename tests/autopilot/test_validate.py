@@ -264,11 +264,12 @@ CASES: list[Case] = [
          lambda: [it for it in base(FW) if it.command != 178], firmware="ardupilot",
          vehicle=FW, severity="warning"),
     # ---------------------------------------------------------------- flight rules: fixed-wing
-    # launched 200 m south of the take-off item: the climb heads north, the route lies east
-    Case("fw-climb-out", r"the first waypoint lies 90° off the take-off course", lambda: base(FW),
+    # launched 200 m south of the take-off item: the climb heads north, the first waypoint
+    # lies 200 m east of the take-off item, 45° off that course seen from the launch
+    Case("fw-climb-out", r"the first waypoint lies 45° off the take-off course", lambda: base(FW),
          vehicle=FW, home_latlon=(LAT - 200 / 111195.0, LON)),
-    # a take-off to 60 m: 60 m x 15 / 5 m/s = 180 m of climb + 33 m of turn > 200 m
-    Case("fw-climb-out", r"the first waypoint is 200 m from the launch, but climbing 60 m at "
+    # a take-off to 60 m: 60 m x 15 / 5 m/s = 180 m of climb + 33 m of turn > 199 m
+    Case("fw-climb-out", r"the first waypoint is 199 m from the launch, but climbing 60 m at "
                          r"5 m/s \(FW_T_CLMB_MAX\) and 15 m/s takes 180 m plus 33 m",
          lambda: _param(base(FW), 0, 6, 60.0), vehicle=FW),
     Case("fw-climb-out", r"the first waypoint is 10 m below the take-off altitude",
@@ -277,14 +278,14 @@ CASES: list[Case] = [
     Case("fw-loiter-radius", r"NAV_LOITER_TO_ALT \(31\): a 10 m loiter at 15 m/s is tighter "
                              r"than the turn radius 19 m \(FW_R_LIM 50°\)",
          lambda: _param(base(FW), len(base(FW)) - 2, 1, 10.0), vehicle=FW),
-    # ArduPlane: the touchdown 880 m from the centre of a 900 m loiter (no PX4 approach rule)
-    Case("fw-loiter-exit", r"NAV_LAND \(21\) is 880 m from the loiter centre, inside its 900 m "
+    # ArduPlane: the touchdown 878 m from the centre of a 900 m loiter (no PX4 approach rule)
+    Case("fw-loiter-exit", r"NAV_LAND \(21\) is 878 m from the loiter centre, inside its 900 m "
                            r"circle: ArduPlane leaves the loiter by altitude only",
          lambda: _param(base(FW), len(base(FW)) - 2, 1, 900.0), firmware="ardupilot",
          vehicle=FW),
-    # the second waypoint, 200 m after the first, with a 250 m acceptance radius (param2):
+    # the second waypoint, 199 m after the first, with a 250 m acceptance radius (param2):
     # ArduPlane is within it as it reaches the first one
-    Case("fw-skipped-waypoint", r"NAV_WAYPOINT \(16\) is 200 m after the previous waypoint: "
+    Case("fw-skipped-waypoint", r"NAV_WAYPOINT \(16\) is 199 m after the previous waypoint: "
                                 r"ArduPlane reaches the previous one 0 m before it, already "
                                 r"within 250 m of this one",
          lambda: _param(base(FW), _index(base(FW), 16, 1), 1, 250.0), firmware="ardupilot",
@@ -301,8 +302,9 @@ CASES: list[Case] = [
                        r"needs to turn 90° onto it",
          lambda: base(FW)[:-3] + [_wp(4, 15.0), _north(4, 60.0, 0.0, command=21)],
          firmware="ardupilot", vehicle=FW),
-    # ArduPlane: loiter at 400 m, 360 m over the 876 m glide (22°) > asin(5 / 15) = 19.5°
-    Case("fw-landing", r"the landing glide slope is 22.3°, steeper than the 19.5° ArduPlane "
+    # ArduPlane: loiter at 400 m over the touchdown, 400 m over the 876 m glide (24.6°) >
+    # asin(5 / 15) = 19.5°
+    Case("fw-landing", r"the landing glide slope is 24.6°, steeper than the 19.5° ArduPlane "
                        r"can hold at 15 m/s \(TECS_SINK_MAX 5 m/s\)",
          lambda: _param(base(FW), len(base(FW)) - 2, 6, 400.0), firmware="ardupilot",
          vehicle=FW),
@@ -324,11 +326,19 @@ def test_each_rule_fires_alone_on_its_case(case):
     codes = {p.code for p in problems}
     assert case.code in codes, [str(p) for p in problems]
     assert codes <= {case.code} | case.also, f"other rules fire too: {[str(p) for p in problems]}"
-    assert any(re.search(case.match, p.message) for p in problems if p.code == case.code), \
-        [p.message for p in problems]
-    with pytest.raises(MissionError, match=f"{case.firmware} would reject this mission"):
-        check_mission(case.build(), case.firmware, vehicle=case.vehicle, home_alt=case.home_alt,
-                      fences=case.fences)
+    hits = [p for p in problems if p.code == case.code and re.search(case.match, p.message)]
+    assert hits, [p.message for p in problems]
+    assert {p.severity for p in hits} == {case.severity}, [(p.severity, str(p)) for p in hits]
+    options = dict(vehicle=case.vehicle, home_alt=case.home_alt, fences=case.fences,
+                   home_latlon=case.home_latlon)
+    if any(p.is_error for p in problems):
+        with pytest.raises(MissionError,
+                           match=f"{case.firmware} would reject or misfly this mission"):
+            check_mission(case.build(), case.firmware, **options)
+    else:  # a warning alone: the mission is exported, the warning returned for the summary
+        assert case.severity == "warning"
+        assert [p.code for p in check_mission(case.build(), case.firmware, **options)] == \
+            [p.code for p in problems]
 
 
 @pytest.mark.parametrize("case", [c for c in CASES if c.firmware != "generic"],
@@ -342,11 +352,13 @@ def test_generic_rejects_what_either_firmware_rejects(case):
 
 @dataclass(frozen=True)
 class Site:
-    """A ``Problem(...)`` call in the validators' source: where, its code, its message."""
+    """A ``Problem(...)`` call in the validators' source: where, its code, its message, its
+    severity."""
 
     where: str
     code: str
     pattern: re.Pattern
+    severity: str = "error"
 
 
 def _pattern(node: ast.AST) -> str:
@@ -371,8 +383,18 @@ def _codes(node: ast.AST, where: str) -> list[str]:
                          "source)")
 
 
+def _severity(node: ast.AST | None, where: str) -> str:
+    if node is None:
+        return "error"  # Problem's default
+    if isinstance(node, ast.Constant) and node.value in ("error", "warning"):
+        return node.value
+    raise AssertionError(f"{where}: the severity of this Problem is not a literal \"error\" or "
+                         "\"warning\"; write it as one (the meta-test reads it from the source)")
+
+
 def rule_sites() -> list[Site]:
-    """Every ``Problem(index, code, message)`` in validate.py and autopilot/firmware/*.py."""
+    """Every ``Problem(index, code, message[, severity])`` in validate.py and
+    autopilot/firmware/*.py (the firmware profiles and their flight rules)."""
     root = Path(validate_module.__file__).parent
     files = [root / "validate.py", *sorted((root / "firmware").glob("*.py"))]
     sites = []
@@ -382,24 +404,37 @@ def rule_sites() -> list[Site]:
                     and node.func.id == "Problem"):
                 continue
             where = f"{f.relative_to(root.parent.parent)}:{node.lineno}"
-            args = list(node.args) + [k.value for k in node.keywords]
-            assert len(args) == 3, f"{where}: Problem(index, code, message) expected"
-            for code in _codes(args[1], where):
-                sites.append(Site(where, code, re.compile(_pattern(args[2]))))
+            names = ("index", "code", "message", "severity")
+            args = dict(zip(names, node.args))
+            args.update({k.arg: k.value for k in node.keywords})
+            assert len(node.args) + len(node.keywords) in (3, 4) and set(args) <= set(names) \
+                and {"index", "code", "message"} <= set(args), \
+                f"{where}: Problem(index, code, message[, severity]) expected"
+            severity = _severity(args.get("severity"), where)
+            for code in _codes(args["code"], where):
+                sites.append(Site(where, code, re.compile(_pattern(args["message"])), severity))
     return sites
 
 
 def test_the_validators_are_where_the_meta_test_looks():
     sites = rule_sites()
-    assert len(sites) >= 30
+    assert len(sites) >= 45
     assert {"px4-fw-glide-slope", "ardupilot-terrain-takeoff", "no-takeoff"} <= \
         {s.code for s in sites}
+    # the flight rules (flyable): speeds and fixed-wing geometry, errors and warnings
+    flight = {s.code: s.severity for s in sites if "flight_rules.py" in s.where}
+    assert {"speed-type", "speed-range", "fw-climb-out", "fw-loiter-radius", "fw-loiter-exit",
+            "fw-skipped-waypoint", "fw-landing"} <= set(flight)
+    assert flight["no-cruise-speed"] == flight["fw-short-leg"] == "warning"
 
 
 def test_every_rule_of_the_validators_has_a_case_in_the_table():
-    produced = [(c.code, p.message) for c in CASES for p in c.problems() if p.code == c.code]
-    missing = [f"{s.where} {s.code!r} /{s.pattern.pattern}/" for s in rule_sites()
-               if not any(code == s.code and s.pattern.fullmatch(msg) for code, msg in produced)]
+    produced = [(c.code, p.message, p.severity) for c in CASES for p in c.problems()
+                if p.code == c.code]
+    missing = [f"{s.where} {s.code!r} ({s.severity}) /{s.pattern.pattern}/"
+               for s in rule_sites()
+               if not any(code == s.code and sev == s.severity and s.pattern.fullmatch(msg)
+                          for code, msg, sev in produced)]
     assert not missing, ("rules without a case in tests/autopilot/test_validate.py CASES "
                          "(add a minimal mission that breaks each):\n" + "\n".join(missing))
 

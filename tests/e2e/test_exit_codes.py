@@ -78,7 +78,7 @@ ROWS = [
     (["fly"], 2, "No such command"),
     # files
     (["run", "{tmp}/missing.yaml"], 2, "missing.yaml not found"),
-    (["check", "{tmp}/missing.csv"], 2, "missing.csv does not exist"),
+    (["check", "{tmp}/missing.csv"], 2, "missing.csv not found"),
 
     # points: outside the map, inside the terrain, inside a no-fly zone (bad input, never 1)
     pytest.param(["plan", "--start", "-50,1,1"], 2, "outside", marks=SLOW),

@@ -62,6 +62,9 @@ FLAG_KEYS = {
     "--rally": "rally", "--rally-file": "rally", "--return-min-agl": "returns.min_agl",
     "--strict": "returns.strict", "--returns": "returns.enabled",
     "--no-returns": "returns.enabled",
+    # energy and wind
+    "--power": "airframe.power", "--battery": "airframe.battery", "--wind": "wind",
+    "--wind-file": "wind.file",
     # outputs
     "--out": "outputs.dir", "--frame": "outputs.frame", "--end": "outputs.end",
     "--speed-changes": "outputs.speed_changes", "--thin": "outputs.thin_tolerance",
