@@ -94,8 +94,10 @@ def test_an_ardupilot_terrain_mission_lands_on_a_glide_slope_above_home():
     (frame 3): a glide in the terrain frame would follow the ground down to the touchdown."""
     opt = _opts(firmware="ardupilot", vehicle="fixed_wing", end="land")
     m, _ = export_mission(hill_tff(), ["plan"], opt)
-    loiter = next(it for it in m.items if it.command == 31)
-    land = next(it for it in m.items if it.command == 21)
+    start = next(i for i, it in enumerate(m.items) if it.command == 189)  # DO_LAND_START
+    # the approach loiter after DO_LAND_START (a climb-out may loiter to altitude too)
+    loiter = next(it for it in m.items[start:] if it.command == 31)
+    land = next(it for it in m.items[start:] if it.command == 21)
     assert m.frame == "terrain" and loiter.frame == land.frame == 3
     home = m.home[2]
     assert land.alt == pytest.approx(land.alt_amsl - home, abs=1e-6)
