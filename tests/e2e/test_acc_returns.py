@@ -179,8 +179,9 @@ CASES = {
                            "--rally", at(5200.0, 1300.0) + ",50"]),
     # ArduPlane, no ceiling: RTL_ALTITUDE clears the ridge while the plane climbs home along
     # its line from wherever it is (its take-off climb included)
+    # (at 12 m/s cruise: the climb-out's loiter turns tightly enough over the rough start)
     "plane": ("EPSG:32630", ["--firmware", "ardupilot", "--vehicle", "fixed_wing",
-                             "--endurance", "12"]),
+                             "--cruise-speed", "12", "--min-speed", "10", "--endurance", "12"]),
     # ArduCopter ending with RTL under the ceiling, a lon/lat DEM and a no-fly zone: the
     # mission carries the FM² way back home
     "rtl": ("EPSG:4326", ["--firmware", "ardupilot", "--max-agl", "120", "--end", "rtl",
@@ -350,7 +351,7 @@ def _route_clock(items, home, dem, s):
     for it in items:
         if it["cmd"] == 178 and it["p"][1] > 0:
             cur = it["p"][1]
-        if it["cmd"] in (16, 22):
+        if it["cmd"] in (16, 22, 31):  # 31: a climb-out loiter to altitude (a position)
             g = float(dem(it["lon"], it["lat"]))
             zz = {0: it["alt"], 3: it["alt"] + home[2], 10: g + it["alt"]}[it["frame"]]
             pts.append([*LOCAL.xy([it["lon"]], [it["lat"]])[0], zz])
