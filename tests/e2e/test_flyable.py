@@ -126,7 +126,10 @@ def test_every_waypoint_is_flown_to_in_order_close_to_its_leg(flown):
     times = [t for (i, t, _) in f.reached if items[i].command == 16]
     assert np.all(np.diff(times) >= 1.0)  # none reached at once on reaching the one before
     xt = cross_track(f, flown["sim"])
-    assert max(xt.values()) <= 40.0, xt  # the SITL finding: 171 m
+    # the judged bound (issue 24): two turn radii at cruise speed and ArduPlane's bank limit
+    # (ROLL_LIMIT_DEG 45); the SITL finding was 171 m
+    radius = CRUISE ** 2 / (9.80665 * math.tan(math.radians(45.0)))
+    assert max(xt.values()) <= 2.0 * radius, (xt, radius)
 
 
 def test_flown_time_is_the_summary_time_within_15_percent(flown):
