@@ -140,6 +140,13 @@ results: results.csv
 """
 
 
+def huge_sweep(path: Path) -> Path:
+    """docs/sweeps.md: a sweep refused for its size (10^17 cases)."""
+    path.write_text("pairs: 1000\nalpha: {start: 1.0e-7, stop: 1, step: 1.0e-7}\n"
+                    "beta: {start: 1e-7, stop: 1, step: 1e-7}\n")
+    return path
+
+
 def light_sweep(path: Path) -> Path:
     path.write_text(LIGHT_SWEEP)
     return path
@@ -162,6 +169,7 @@ FILES = {
     "airports.geojson": airports,
     "danger.kml": danger_kml,
     "sweep.yaml": light_sweep,
+    "huge.yaml": huge_sweep,
 }
 
 #: examples/ files replaced in the workspace, and why.
