@@ -20,7 +20,19 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, settings
 from typer.testing import CliRunner, Result
+
+# One hypothesis profile on every machine. Under CI (the CI environment variable) hypothesis
+# would load its own "ci" profile, whose derandomize=True every @settings inherits — the
+# suite would then run differently there than here, and the scan for unseeded property
+# tests (tests/repo/test_property_seeds.py) would see none. Each property test carries its
+# own seed; this profile only makes the rest the same everywhere (no deadline, no example
+# database written into the checkout).
+settings.register_profile("fm2uav", deadline=None, database=None, print_blob=True,
+                          derandomize=False,
+                          suppress_health_check=[HealthCheck.too_slow])
+settings.load_profile("fm2uav")
 
 
 @dataclass(frozen=True)

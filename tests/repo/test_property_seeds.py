@@ -54,7 +54,9 @@ def test_the_scan_sees_an_unseeded_test(tmp_path, monkeypatch):
     from hypothesis import given
     from hypothesis import strategies as st
 
-    @settings(max_examples=2)
+    # derandomize=False said outright: under CI hypothesis loads its "ci" profile, whose
+    # derandomize=True every unset @settings inherits (a scan run there sees no loose test)
+    @settings(max_examples=2, derandomize=False)
     @given(st.integers())
     def test_loose(x):
         pass
