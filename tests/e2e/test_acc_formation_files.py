@@ -17,21 +17,15 @@ from typer.testing import CliRunner
 from fm2uav.cli import app
 
 from tests.e2e.conftest import write_dem
+from tests.e2e.remeasure import dem_ground
 
 X0, Y0, PX, CRS = 465000.0, 5248200.0, 10.0, "EPSG:32632"
 AGL = 120.0
 
 
 def _ground_ll(tif, lon, lat):
-    import rasterio
-    from scipy import ndimage
-
-    with rasterio.open(tif) as ds:
-        z = ds.read(1).astype(float)
-        x, y = Transformer.from_crs("EPSG:4326", ds.crs, always_xy=True).transform(lon, lat)
-        col, row = ~ds.transform * (np.asarray(x), np.asarray(y))
-    return ndimage.map_coordinates(z, [np.asarray(row) - 0.5, np.asarray(col) - 0.5],
-                                   order=1, mode="nearest")
+    """The GeoTIFF's bilinear ground at lon/lat, measured as every acceptance test does."""
+    return dem_ground(tif)(np.asarray(lon), np.asarray(lat))
 
 
 @pytest.fixture(scope="module")
