@@ -20,11 +20,12 @@ install: $(STAMP)
 
 ## make run: the default mission — terrain-following flight (150 m above ground, the
 ## TFF paper's case 3) over the built-in open-field scenario, with ground-control
-## exports and an interactive report
+## exports and an interactive report, in $(OUT)/open_field_tff/ (the folder `fm2uav run
+## examples/open_field_tff.yaml` writes by default, so no mission.yaml of yours is overwritten)
 run: $(STAMP)
-	$(VENV)/bin/fm2uav run examples/open_field_tff.yaml --out $(OUT)/mission --force
+	$(VENV)/bin/fm2uav run examples/open_field_tff.yaml --out $(OUT)/open_field_tff --force
 	@echo ""
-	@echo "outputs written to $(OUT)/mission/ — open $(OUT)/mission/report.html in a browser;"
+	@echo "outputs written to $(OUT)/open_field_tff/ — open $(OUT)/open_field_tff/report.html in a browser;"
 	@echo "mission.plan loads in QGroundControl, mission.waypoints is a MAVLink WPL 110 file"
 
 ## make test: the layer contract (import-linter, [tool.importlinter] in pyproject.toml),
