@@ -95,3 +95,72 @@ def test_help_names_the_exit_codes_and_the_command_is_listed():
     assert "3 the batch ran to the end but some missions failed" in text
     assert "--scheduler" in text and "--workers" in text
     assert "batch" in runner.invoke(app, ["--help"]).output
+
+
+def test_an_interrupted_batch_keeps_what_finished_and_exits_130(folder, tmp_path, monkeypatch):
+    import fm2uav.pipeline.batch as batch
+
+    m, files, single = folder
+    real = batch.run_batch
+
+    def stopped_after_the_first(todo, results, pool, *, force=False, on_result=None):
+        def hook(res):
+            on_result(res)
+            raise KeyboardInterrupt  # Ctrl-C once the first mission is written
+
+        return real(todo, results, pool, force=force, on_result=hook)
+
+    monkeypatch.setattr(batch, "run_batch", stopped_after_the_first)
+    out = tmp_path / "out"
+    res = runner.invoke(app, ["batch", str(files["east"]), str(files["outside"]), "--out",
+                              str(out), "--workers", "1"])
+    assert res.exit_code == 130, res.output
+    assert "interrupted: by SIGINT (Ctrl-C); 1 of 2 missions were written, 1 not run" in \
+        " ".join(res.output.split())
+    summary = json.loads((out / "batch.json").read_text())
+    assert summary["interrupted"] == "interrupted by SIGINT (Ctrl-C)"
+    assert [r["status"] for r in summary["results"]] == ["ok", "not run"]
+    same_as_single_run(out / "east", single)
+    assert sorted(p.name for p in out.iterdir()) == ["batch.json", "east"]
+
+
+def test_resume_keeps_the_missions_written_and_plans_the_rest(tmp_path):
+    import yaml
+
+    files = write_missions(tmp_path / "m", names=("east", "outside"))
+    out = tmp_path / "out"
+    args = ["batch", str(tmp_path / "m"), "--out", str(out), "--workers", "1", "--json"]
+    res = runner.invoke(app, ["batch", str(files["east"]), "--out", str(out), "--resume"])
+    assert res.exit_code == 2 and "--resume: " in res.output and "does not exist" in res.output
+    assert runner.invoke(app, args).exit_code == 3
+    east_files = {p.name: p.stat().st_mtime_ns for p in (out / "east").iterdir()}
+
+    # fix the failed mission: --resume plans it alone, the written one is kept as it was
+    fixed = yaml.safe_load(files["outside"].read_text())
+    fixed["goal"] = {"x": 440070.0, "y": 4470330.0, "agl": 20}
+    files["outside"].write_text(yaml.safe_dump(fixed))
+    res = runner.invoke(app, [*args, "--resume"])
+    assert res.exit_code == 0, res.output
+    summary = json.loads(res.stdout)
+    assert (summary["ok"], summary["failed"], summary["resumed"]) == (2, 0, 1)
+    rows = {r["file"]: r for r in summary["results"]}
+    assert rows[str(files["east"])]["resumed"] and not rows[str(files["outside"])]["resumed"]
+    assert {p.name: p.stat().st_mtime_ns for p in (out / "east").iterdir()} == east_files
+    assert (out / "outside" / "mission.plan").is_file()
+
+    # a mission file changed since: planned again, over its folder only with --force
+    changed = yaml.safe_load(files["east"].read_text())
+    changed["name"] = "town east, renamed"
+    files["east"].write_text(yaml.safe_dump(changed))
+    res = runner.invoke(app, [*args, "--resume"])
+    assert res.exit_code == 2 and "already exists" in res.output and "--force" in res.output
+    res = runner.invoke(app, [*args, "--resume", "--force"])
+    assert res.exit_code == 0, res.output
+    rows = {r["file"]: r for r in json.loads(res.stdout)["results"]}
+    assert not rows[str(files["east"])]["resumed"] and rows[str(files["outside"])]["resumed"]
+    assert json.loads((out / "east" / "summary.json").read_text())["mission"] == \
+        "town east, renamed"
+    # a damaged batch.json is one line naming --resume
+    (out / "batch.json").write_text("{not json")
+    res = runner.invoke(app, [*args, "--resume"])
+    assert res.exit_code == 2 and "is not a batch summary of fm2uav batch" in res.output

@@ -23,7 +23,6 @@ from ._common import (
     err_console,
     handle_errors,
     to_jsonable,
-    write_json,
 )
 from .cmd_sweep import EXIT_CASES_FAILED
 from .options import output_options
@@ -51,8 +50,11 @@ BATCH_HELP = (
     "a half-written folder. A mission that fails does not stop the others. The table and "
     "OUT/batch.json give each mission's status (ok / failed / not run), its error, time, "
     "worker and folder.\n\n"
+    "--resume keeps the missions an earlier batch into the same --out wrote (unchanged "
+    "files) and plans the rest.\n\n"
     "Examples:\n\n"
     "  fm2uav batch missions/*.yaml --out out/batch --workers 2\n\n"
+    "  fm2uav batch missions/*.yaml --out out/batch --resume\n\n"
     "  fm2uav batch missions/ --scheduler tcp://10.0.0.5:8786 --out out/batch\n\n"
     "On a Dask cluster the workers read the mission files and the data they name at the "
     "same paths (a shared file system); only this process writes the outputs.\n\n"
@@ -67,7 +69,7 @@ def _results_payload(results: list[Any], pool: Any, wall_s: float, out: Path,
 
     counts = {s: sum(r.status == s for r in results) for s in ("ok", "failed", "not run")}
     payload: dict[str, Any] = {
-        "missions": len(results), **counts,
+        "missions": len(results), **counts, "resumed": sum(r.resumed for r in results),
         "worker_deaths": getattr(pool, "deaths", 0), "retried": getattr(pool, "retried", 0),
         "wall_s": round(wall_s, 3), "out": str(out),
         "results": [asdict(r) for r in results],
@@ -75,18 +77,6 @@ def _results_payload(results: list[Any], pool: Any, wall_s: float, out: Path,
     if interrupted:
         payload["interrupted"] = interrupted
     return payload
-
-
-def _write_batch_file(out: Path, payload: dict[str, Any]) -> Path:
-    """``batch.json`` into ``out``, beside the missions' folders (the file alone is merged in)."""
-    from ..io.outdir import OutputDir
-    from ..pipeline.batch import BATCH_FILE
-
-    od = OutputDir(out, force=True, merge=True)
-    od.check([BATCH_FILE])
-    write_json(od, BATCH_FILE, payload)
-    od.finish()
-    return out / BATCH_FILE
 
 
 def _table(results: list[Any], title: str) -> None:
@@ -97,7 +87,8 @@ def _table(results: list[Any], title: str) -> None:
         table.add_column(escape(col))
     style = {"ok": "green", "failed": "bold red", "not run": "yellow"}
     for r in results:
-        table.add_row(escape(r.file), Text(r.status, style=style[r.status]),
+        status = "ok (kept)" if r.resumed else r.status
+        table.add_row(escape(r.file), Text(status, style=style[r.status]),
                       "" if r.time_s is None else f"{r.time_s:.1f}",
                       escape(r.out if r.status == "ok" else (r.error or "")))
     console.print(table)
@@ -117,6 +108,10 @@ def batch_cmd(
     scheduler: str | None = typer.Option(
         None, help="Address of an existing Dask scheduler, e.g. tcp://host:8786 (default: "
         "local processes)."),
+    resume: bool = typer.Option(
+        False, "--resume", help="Keep the missions OUT/batch.json lists as ok (their mission "
+        "file unchanged, their files there) and plan the others: failed, not run, new or "
+        "changed ones."),
     output: Output = None,
 ) -> None:
     """``fm2uav batch``: :func:`~fm2uav.pipeline.batch.prepare_batch`,
@@ -124,11 +119,11 @@ def batch_cmd(
     from .. import progress
     from ..experiments._executors import check_workers, make_pool
     from ..io.outdir import Interrupted, stop_reported
-    from ..pipeline.batch import prepare_batch, run_batch
+    from ..pipeline.batch import prepare_batch, run_batch, write_batch_file
 
     n_workers = check_workers(workers)
     todo, results = prepare_batch(missions, output.out, force=output.force,
-                                  report=output.report)
+                                  report=output.report, resume=resume)
     for r in results:
         r.error = _for_this_command(r.error)
     pool = make_pool(n_workers, scheduler)
@@ -156,13 +151,13 @@ def batch_cmd(
                        else signal.Signals(signum).name)
     payload = _results_payload(results, pool, time.perf_counter() - t0, output.out,
                                interrupted=interrupted and f"interrupted by {interrupted}")
-    summary = _write_batch_file(output.out, payload)
+    summary = write_batch_file(output.out, payload)
     if interrupted:
         err_console.print(Text.assemble(
             ("interrupted: ", "bold red"),
             f"by {interrupted}; {payload['ok']} of {total} missions were written, "
-            f"{payload['not run']} not run (listed in {summary}); run the missions not run "
-            "again"), highlight=False, soft_wrap=True)
+            f"{payload['not run']} not run (listed in {summary}); the same command with "
+            "--resume plans the rest"), highlight=False, soft_wrap=True)
         raise typer.Exit(EXIT_INTERRUPTED)
     if output.as_json and not output.quiet:
         import json
@@ -181,7 +176,8 @@ def batch_cmd(
         err_console.print(Text.assemble(
             ("error: ", "bold red"),
             f"{payload['failed']} of {total} missions failed (first: {first.file}: "
-            f"{first.error}); the others are written; reasons in {summary}"),
+            f"{first.error}); the others are written; reasons in {summary}; fix them and run the "
+            "same command with --resume"),
             highlight=False, soft_wrap=True)
         raise typer.Exit(EXIT_MISSIONS_FAILED)
 

@@ -26,14 +26,14 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
 from ..errors import EXIT_INTERNAL, InputError
 
 __all__ = ["BatchMission", "MissionResult", "BATCH_FILE", "mission_files", "prepare_batch",
-           "plan_mission_files", "run_batch"]
+           "plan_mission_files", "write_mission_set", "run_batch", "write_batch_file"]
 
 #: The batch's summary file, in the batch's ``--out`` folder.
 BATCH_FILE = "batch.json"
@@ -99,6 +99,12 @@ class MissionResult:
         The mission's warnings (one line each).
     files : list of str
         The files written into ``out``.
+    path : str
+        The mission file's absolute path.
+    sha256 : str
+        The mission file's SHA-256 (``--resume`` plans a changed file again).
+    resumed : bool
+        Kept from the earlier batch by ``--resume`` (not planned now).
     """
 
     file: str
@@ -114,6 +120,9 @@ class MissionResult:
     waypoints: int | None = None
     warnings: list[str] = field(default_factory=list)
     files: list[str] = field(default_factory=list)
+    path: str = ""
+    sha256: str = ""
+    resumed: bool = False
 
     def failed(self, error: str, code: int) -> MissionResult:
         """This result marked failed with ``error`` (exit ``code``); no files."""
@@ -141,8 +150,10 @@ def mission_files(paths: Iterable[str | os.PathLike[str]]) -> list[Path]:
             if not found:
                 raise InputError(f"folder {p} holds no mission file (*.yaml, *.yml); give "
                                  "mission files or a folder of them")
-        elif p.is_file():
-            found = [p]
+        elif p.exists():
+            from .. import _validate
+
+            found = [_validate.input_file(p, "mission file")]  # a pipe, a device: refused
         else:
             raise InputError(f"mission file {p} does not exist; nothing was run (check the "
                              "name, or give a folder of mission files)")
@@ -158,7 +169,7 @@ def mission_files(paths: Iterable[str | os.PathLike[str]]) -> list[Path]:
 
 
 def prepare_batch(paths: Iterable[str | os.PathLike[str]], out: str | os.PathLike[str], *,
-                  force: bool = False, report: bool = False,
+                  force: bool = False, report: bool = False, resume: bool = False,
                   describe: Callable[[BaseException], tuple[str, int]] | None = None,
                   ) -> tuple[list[BatchMission], list[MissionResult]]:
     """The missions of a batch with their output folders, checked before any work.
@@ -177,6 +188,10 @@ def prepare_batch(paths: Iterable[str | os.PathLike[str]], out: str | os.PathLik
         Replace existing output folders as a whole (``--force``).
     report : bool
         Add ``report.html`` to every mission's formats (``--report``).
+    resume : bool
+        Keep the missions ``out/batch.json`` lists as ok whose mission file is
+        unchanged (same SHA-256) and whose files are all there (``--resume``); plan
+        the others.
     describe : callable, optional
         ``exc -> (message, exit code)`` of a mission file that cannot be read
         (default :func:`fm2uav.errors.describe_error`).
@@ -201,17 +216,25 @@ def prepare_batch(paths: Iterable[str | os.PathLike[str]], out: str | os.PathLik
     describe = describe or _describe
     files = mission_files(paths)
     summary = Path(out) / BATCH_FILE
-    if summary.exists() and not force:
+    done = _earlier_batch(summary) if resume else {}
+    if summary.exists() and not (force or resume):
         raise InputError(f"{summary} already exists (an earlier batch); pass --force to "
                          "replace it and the missions' folders, or choose another --out")
+    od = _batch_file_set(out)
+    try:
+        od.check([BATCH_FILE])  # a folder batch.json cannot go into: said now, not at the end
+    finally:
+        od.abort()
     missions: list[BatchMission] = []
     results: list[MissionResult] = []
     owners: dict[str, str] = {}
     for i, f in enumerate(files):
         target = Path(out) / f.stem
-        res = MissionResult(file=str(f), status="not run", out=str(target))
+        res = MissionResult(file=str(f), status="not run", out=str(target),
+                            path=os.path.abspath(f))
         results.append(res)
         try:
+            res.sha256 = _sha256(f)
             m = load_mission(f)
             target = m.output_dir() or target
             formats = tuple(dict.fromkeys(m.outputs.formats + (["html"] if report else [])))
@@ -227,6 +250,12 @@ def prepare_batch(paths: Iterable[str | os.PathLike[str]], out: str | os.PathLik
                 f"mission files {owners[key]} and {f} would both write {target}; rename one, "
                 "or give one an outputs.dir of its own; nothing was run")
         owners[key] = str(f)
+        kept = done.get(os.path.realpath(f))
+        if (kept is not None and kept.get("sha256") == res.sha256 and kept.get("out") == res.out
+                and kept.get("files") and all(os.path.isfile(p) for p in kept["files"])):
+            results[i] = MissionResult(**{**kept, "file": str(f), "path": res.path,
+                                          "resumed": True})
+            continue
         od = OutputDir(target, force=force)
         try:
             od.check(output_names(list(formats)))  # exists without --force, locked, an input
@@ -237,6 +266,36 @@ def prepare_batch(paths: Iterable[str | os.PathLike[str]], out: str | os.PathLik
     return missions, results
 
 
+def _sha256(path: Path) -> str:
+    import hashlib
+
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _earlier_batch(summary: Path) -> dict[str, dict[str, Any]]:
+    """The missions an earlier ``batch.json`` lists as ok, by the real path of their file.
+
+    Raises
+    ------
+    InputError
+        No such file, or not a batch.json (names ``--resume``).
+    """
+    import json
+
+    if not summary.is_file():
+        raise InputError(f"--resume: {summary} does not exist (no earlier batch in this "
+                         "--out); run without --resume")
+    try:
+        rows = json.loads(summary.read_text(encoding="utf-8"))["results"]
+        known = {f.name for f in fields(MissionResult)}
+        return {os.path.realpath(r["path"]): {k: v for k, v in r.items() if k in known}
+                for r in rows if r["status"] == "ok"}
+    except (ValueError, KeyError, TypeError) as exc:
+        raise InputError(f"--resume: {summary} is not a batch summary of fm2uav batch "
+                         f"({type(exc).__name__}: {exc}); run without --resume and with "
+                         "--force to start the batch over") from None
+
+
 def _describe(exc: BaseException) -> tuple[str, int]:
     """``(message, exit code)`` of a mission's error; a bug is exit 70 with its type."""
     from ..errors import describe_error
@@ -245,6 +304,34 @@ def _describe(exc: BaseException) -> tuple[str, int]:
     if known is None:
         return f"internal error: {type(exc).__name__}: {exc}", EXIT_INTERNAL
     return known
+
+
+def _batch_file_set(out: str | os.PathLike[str]) -> Any:
+    """The output set of ``batch.json``: merged into ``out``, beside the missions' folders."""
+    from ..io.outdir import OutputDir
+
+    return OutputDir(out, force=True, merge=True)
+
+
+def write_batch_file(out: str | os.PathLike[str], payload: dict[str, Any]) -> Path:
+    """Write ``payload`` as ``out/batch.json`` (whole: staged, then moved in).
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    from .outputs import write_json
+
+    od = _batch_file_set(out)
+    try:
+        od.check([BATCH_FILE])
+        write_json(od, BATCH_FILE, payload)
+        od.finish()
+    except BaseException:
+        od.abort()
+        raise
+    return Path(out) / BATCH_FILE
 
 
 # ----------------------------------------------------------------- on a worker
