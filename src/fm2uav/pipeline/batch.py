@@ -201,13 +201,15 @@ def prepare_batch(paths: Iterable[str | os.PathLike[str]], out: str | os.PathLik
     missions : list of BatchMission
         Those to run.
     results : list of MissionResult
-        One per file, in order: ``not run`` for those to run, ``failed`` for the others.
+        One per file, in order: ``not run`` for those to run, ``failed`` for those that
+        cannot be read, ``ok`` (``resumed``) for those ``resume`` keeps.
 
     Raises
     ------
     InputError
-        A missing path; two missions with one output folder; an output folder that
-        exists (without ``force``) or is being written by another run.
+        A missing path; two missions with one output folder; an output folder or
+        ``batch.json`` that exists (without ``force``) or is being written by another
+        run; with ``resume``, no readable ``batch.json``.
     """
     from ..io.mission import load_mission
     from ..io.outdir import OutputDir
