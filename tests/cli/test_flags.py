@@ -39,8 +39,9 @@ NOT_MESSAGES = {
 RAISED_ONLY_WITH_THE_FLAG = {
     ("fm2uav.cli.options", "give --lonlat or --cells, not both"):
         "cli_point(lonlat=..., cells=...): only plan and formation pass cells=True",
-    ("fm2uav.experiments.runner", "cannot reach the Dask scheduler {}: {}; check --scheduler"):
-        "a Dask pool is made only from a --scheduler (sweep, reproduce curvature)",
+    ("fm2uav.experiments._executors",
+     "cannot reach the Dask scheduler {}: {}; check --scheduler"):
+        "a Dask pool is made only from a --scheduler (sweep, reproduce curvature, batch)",
     ("fm2uav.missions.coverage.fm2", "--angle (degrees, within ±360)"):
         "checked only for a given angle: cover --angle (reproduce coverage searches it)",
 }
@@ -53,8 +54,8 @@ RAISED_ONLY_BY = {
     "fm2uav.experiments._store": (lambda name, flags: name in ("sweep", "reproduce curvature"),
                                   "the sweep log: opened only by the sweep runner"),
     "fm2uav.experiments._executors": (
-        lambda name, flags: name in ("sweep", "reproduce curvature"),
-        "the sweep's worker pools: made only by the sweep runner"),
+        lambda name, flags: name in ("sweep", "reproduce curvature", "batch"),
+        "the worker pools: made only by the sweep runner and fm2uav batch"),
     "fm2uav.io.outdir": (lambda name, flags: "--out" in flags,
                          "an output set is made only by a command that writes one (--out)"),
 }

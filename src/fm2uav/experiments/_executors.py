@@ -50,7 +50,8 @@ from typing import Any
 
 from ..errors import Fm2uavError
 
-__all__ = ["Job", "Outcome", "InlinePool", "LocalPool", "DaskPool", "WorkerError"]
+__all__ = ["Job", "Outcome", "InlinePool", "LocalPool", "DaskPool", "WorkerError", "max_workers",
+           "check_workers", "make_pool"]
 
 #: Seconds a worker gets to exit after SIGTERM before it is killed.
 GRACE_S = 2.0
@@ -363,7 +364,7 @@ class LocalPool:
         self._silent_deaths += 1
         if self._silent_deaths > max(4, 2 * self.size):
             raise WorkerError(
-                f"{self._silent_deaths} sweep worker processes in a row died before finishing "
+                f"{self._silent_deaths} worker processes in a row died before finishing "
                 "a single case; run with --workers 1 (in this process) to see why")
 
     def _bury(self, w: _Worker, queue: deque[Job]) -> Iterator[Outcome]:
@@ -479,3 +480,55 @@ class DaskPool:
         self._futures = []
         if self.own:
             self.client.close()
+
+
+# ----------------------------------------------------------------- choosing one
+def max_workers() -> int:
+    """Most local worker processes a sweep or batch may start: 4 per core (at least 8);
+    each is a Python process with numba's kernels loaded (~150 MB)."""
+    return max(8, 4 * (os.cpu_count() or 1))
+
+
+def check_workers(workers: Any) -> int | None:
+    """``workers`` (None = all cores) as a count of local worker processes.
+
+    Raises
+    ------
+    InputError
+        Not an integer >= 1, or more than :func:`max_workers` (names ``--workers``).
+    """
+    from .. import _validate
+    from ..errors import InputError
+
+    if workers is None:
+        return None
+    n = _validate.integer(workers, "workers", minimum=1, where=(None, "--workers"))
+    if n > max_workers():
+        raise InputError(
+            f"--workers {n} would start {n} worker processes (~150 MB each: "
+            f"{n * 0.15:.3g} GB) on {os.cpu_count() or 1} cores; the limit is {max_workers()} "
+            "(4 per core); for more, run a Dask cluster and give its scheduler address")
+    return n
+
+
+def make_pool(workers: int | None, scheduler: str | None = None,
+              client: Any = None) -> InlinePool | LocalPool | DaskPool:
+    """The executor of ``--workers`` / ``--scheduler``: a Dask cluster when a scheduler
+    address or client is given, else ``workers`` supervised local processes (None = all
+    cores), in this process for 1.
+
+    Raises
+    ------
+    InputError
+        The Dask scheduler cannot be reached (names ``--scheduler``).
+    """
+    from ..errors import InputError
+
+    if scheduler is not None or client is not None:
+        try:
+            return DaskPool(scheduler, client)
+        except (OSError, ValueError, TypeError) as exc:
+            raise InputError(f"cannot reach the Dask scheduler {scheduler}: {exc}; check "
+                             "--scheduler") from None
+    n = max(1, int(workers or os.cpu_count() or 1))
+    return InlinePool() if n == 1 else LocalPool(n)

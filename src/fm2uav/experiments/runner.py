@@ -77,7 +77,15 @@ from .. import progress as _progress
 from ..errors import InputError
 from ..world import World
 from ..baselines.reference import MODELS, reference_path
-from ._executors import DaskPool, InlinePool, Job, LocalPool
+from ._executors import (  # noqa: F401  (check_workers, max_workers: re-exported)
+    DaskPool,
+    InlinePool,
+    Job,
+    LocalPool,
+    check_workers,
+    make_pool,
+    max_workers,
+)
 from ._store import (
     LOG_NAME,
     CaseKey,
@@ -497,42 +505,7 @@ class SweepResult:
 
 
 # ----------------------------------------------------------------- run
-def max_workers() -> int:
-    """Most local worker processes a sweep may start: 4 per core (at least 8); each is a
-    Python process with numba's kernels loaded (~150 MB)."""
-    return max(8, 4 * (os.cpu_count() or 1))
-
-
-def check_workers(workers: Any) -> int | None:
-    """``workers`` (None = all cores) as a count of local worker processes.
-
-    Raises
-    ------
-    InputError
-        Not an integer >= 1, or more than :func:`max_workers` (names ``--workers``).
-    """
-    from .. import _validate
-
-    if workers is None:
-        return None
-    n = _validate.integer(workers, "workers", minimum=1, where=(None, "--workers"))
-    if n > max_workers():
-        raise InputError(
-            f"--workers {n} would start {n} worker processes (~150 MB each: "
-            f"{n * 0.15:.3g} GB) on {os.cpu_count() or 1} cores; the limit is {max_workers()} "
-            "(4 per core); for more, run a Dask cluster and give its scheduler address")
-    return n
-
-
-def _executor(workers: int | None, scheduler: str | None, client: Any) -> Any:
-    if scheduler is not None or client is not None:
-        try:
-            return DaskPool(scheduler, client)
-        except (OSError, ValueError, TypeError) as exc:
-            raise InputError(f"cannot reach the Dask scheduler {scheduler}: {exc}; check "
-                             "--scheduler") from None
-    n = max(1, int(workers or os.cpu_count() or 1))
-    return InlinePool() if n == 1 else LocalPool(n)
+_executor = make_pool  # the executor of --workers / --scheduler (shared with batches)
 
 
 @_progress.stage()
