@@ -19,7 +19,7 @@ import numpy as np
 from ..vehicles.energy import check_battery, fly_legs, no_return_point
 from ..vehicles.power import get_power_model
 
-__all__ = ["DEFAULT_POWER", "mission_energy", "mission_sorties"]
+__all__ = ["DEFAULT_POWER", "mission_energy"]
 
 #: Power model of each airframe type when the mission gives none (a VTOL in plane mode:
 #: its hover phases cost several times more and are not in the figure).
@@ -115,30 +115,3 @@ def mission_energy(points: Any, agl: Any, *, vehicle: str, power: Any, battery_w
                                  "wind at the start) still fits in the usable battery"
                                  + ("" if k < len(p) - 1 else ": every waypoint"))
     return out
-
-
-def mission_sorties(mission: Any) -> Any:
-    """The sorties of a built survey mission that one battery cannot fly
-    (:func:`fm2uav.vehicles.sorties.split_sorties`), or None when one battery does.
-
-    Home is the take-off point under the first waypoint; every sortie flies at the
-    mission's forward speed with its power model, battery, reserve and wind
-    (:func:`mission_energy`), and returns straight home.
-    """
-    from ..vehicles.sorties import split_sorties
-
-    opt = mission.options
-    energy = mission.info.get("energy") or {}
-    if energy.get("ok", True):
-        return None
-    wps = mission.waypoints
-    p = np.asarray(wps.points_m, dtype=float)
-    home = np.array([p[0, 0], p[0, 1], p[0, 2] - float(wps.agl[0])])
-    model = get_power_model(opt.power if opt.power is not None
-                            else DEFAULT_POWER.get(opt.vehicle, "arducopter"))
-    return split_sorties(p, model, home=home,
-                         battery_wh=opt.battery_wh if opt.battery_wh is not None
-                         else model.battery_wh, reserve=opt.reserve, speed=opt.forward_speed,
-                         climb_rate=mission.info["flight"]["climb_rate_mps"],
-                         descent_rate=mission.info["flight"]["descent_rate_mps"],
-                         wind=opt.wind)

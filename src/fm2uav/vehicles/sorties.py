@@ -117,7 +117,8 @@ def even_split(route_wh: Any, out_wh: Any, back_wh: Any, usable_wh: float) -> in
 
 def split_sorties(points: Any, model: PowerModel, *, home: Any, battery_wh: float,
                   reserve: float = 0.2, speed: float, climb_rate: float, descent_rate: float,
-                  wind: Any = None, resume_step: float = 25.0) -> SortiePlan:
+                  wind: Any = None, resume_step: float = 25.0, ways: Any = None,
+                  margin_wh: float = 0.0) -> SortiePlan:
     """Split the survey's waypoints into sorties that each fit in the battery.
 
     Parameters
@@ -139,6 +140,17 @@ def split_sorties(points: Any, model: PowerModel, *, home: Any, battery_wh: floa
     resume_step : float
         A sortie may end (and the next resume) every ``resume_step`` metres along the
         route, not only at its waypoints.
+    ways : callable, optional
+        ``ways(points) -> (out_wh, out_s, back_wh, back_s)``, one value per point of
+        ``points`` (m, 3) [m]: the energy [Wh] and time [s] from the take-off at home to
+        each point (climb included) and from each point home (landing included), flown
+        the way the sortie flies them (e.g. the FM² return field's paths,
+        :mod:`fm2uav.autopilot.sorties`). Default: straight lines at the point's
+        altitude (:func:`fm2uav.vehicles.energy.home_legs`) in the wind at the point.
+    margin_wh : float
+        Energy [Wh] kept aside on top of the reserve when the sorties are cut (what a
+        sortie's flown mission may need more than this estimate); the summary's usable
+        energy stays the battery's.
 
     Returns
     -------
@@ -156,6 +168,7 @@ def split_sorties(points: Any, model: PowerModel, *, home: Any, battery_wh: floa
     from ..geometry import densify
 
     usable = _budget(battery_wh, reserve)
+    budget = usable - float(margin_wh)
     h = np.asarray(home, dtype=float)
     wp = p
     p, leg = densify(wp, float(resume_step), horizontal=True)
@@ -170,25 +183,29 @@ def split_sorties(points: Any, model: PowerModel, *, home: Any, battery_wh: floa
                             "no headway")
     e = route.used_wh()
     t = route.elapsed()
-    # the wind of the flights home: at the resume point
-    home_w = None if wind is None else np.asarray(
-        wind.at(p, np.maximum(p[:, 2] - h[2], 1.0)), dtype=float)
-    out, out_s, back, back_s = home_legs(p, model, home=h, speed=float(speed),
-                                         climb_rate=climb_rate, descent_rate=descent_rate,
-                                         wind=home_w)
+    if ways is None:
+        # the wind of the flights home: at the resume point
+        home_w = None if wind is None else np.asarray(
+            wind.at(p, np.maximum(p[:, 2] - h[2], 1.0)), dtype=float)
+        out, out_s, back, back_s = home_legs(p, model, home=h, speed=float(speed),
+                                             climb_rate=climb_rate, descent_rate=descent_rate,
+                                             wind=home_w)
+    else:
+        out, out_s, back, back_s = (np.asarray(v, dtype=float) for v in ways(p))
     sorties: list[Sortie] = []
     a = 0
     while a < len(p) - 1:
         cost = _fits(e, out, back, a)
-        if not cost[1] <= usable:
+        if not cost[1] <= budget:
             raise PlanningError(
                 f"the survey cannot be split into sorties: going on {resume_step:g} m past "
                 f"{np.round(p[a], 1).tolist()} m (leg {int(leg[a])}) and flying home needs "
-                f"{cost[1]:.1f} Wh, {usable:.1f} Wh are usable: a bigger battery, a lower "
-                "reserve or a home closer to the survey")
+                f"{cost[1]:.1f} Wh, {budget:.1f} Wh are usable"
+                + (f" ({usable:.1f} Wh less a {margin_wh:.1f} Wh margin)" if margin_wh else "")
+                + ": a bigger battery, a lower reserve or a home closer to the survey")
         # the furthest end with every waypoint before it still within a way home: the
         # vehicle can turn home from anywhere on its sortie
-        over = np.flatnonzero(cost[1:] > usable)
+        over = np.flatnonzero(cost[1:] > budget)
         b = a + (int(over[0]) if len(over) else len(cost) - 1)
         sorties.append(Sortie(int(leg[a]), int(leg[b]) + (b == len(p) - 1), float(out[a]),
                               float(e[b] - e[a]), float(back[b]),
@@ -197,4 +214,4 @@ def split_sorties(points: Any, model: PowerModel, *, home: Any, battery_wh: floa
         a = b
     on_wp = np.flatnonzero(np.r_[True, np.diff(leg) != 0])   # the waypoints among the points
     on_wp = np.unique(np.r_[on_wp, len(p) - 1])
-    return SortiePlan(sorties, usable, even_split(e[on_wp], out[on_wp], back[on_wp], usable))
+    return SortiePlan(sorties, usable, even_split(e[on_wp], out[on_wp], back[on_wp], budget))
