@@ -41,13 +41,19 @@ def test_sortie_rows_say_the_count_and_the_baseline():
     assert rows["sorties"].startswith("2 (one battery each, 24.0 Wh usable")
     assert "one leg alone is too long" in rows["sorties"]
     assert rows["sortie 2"].startswith("legs 5→9, 20.0 Wh, 5.0 min, resume at 40.340000, -3.740000")
+    s["sorties"][1].update(resume_waypoint=3, files=["sortie-02.csv", "sortie-02.plan",
+                                                     "sortie-02.waypoints"])
+    s["ways"] = {"kind": "return field"}
+    rows = sortie_rows(s)
+    assert rows["sortie 2"].endswith("(waypoint 3); sortie-02.plan / sortie-02.waypoints")
+    assert rows["sorties: ways out and home"] == "return field"
     assert sortie_rows(None) == {}
 
 
 def test_cover_splits_a_long_survey_with_the_bands_across_the_wind(tmp_path):
     out = tmp_path / "c"
     res = runner.invoke(app, ["cover", "--area", "S3", "--spacing", "80", "--agl", "100",
-                              "--battery", "30", "--wind", "6@200", "--bands", "wind",
+                              "--battery", "40", "--wind", "6@200", "--bands", "wind",
                               "--out", str(out), "--json"])
     assert res.exit_code == 0, res.output
     s = json.loads((out / "summary.json").read_text())
@@ -61,6 +67,15 @@ def test_cover_splits_a_long_survey_with_the_bands_across_the_wind(tmp_path):
     route = sum(x["survey_wh"] for x in sorties["sorties"])
     assert 0.6 * s["autopilot"]["energy"]["energy_wh"] < route < s["autopilot"]["energy"][
         "energy_wh"]
+    # one mission per sortie, in every format of the whole mission, listed in the summary
+    for k, x in enumerate(sorties["sorties"], 1):
+        names = {f"sortie-{k:02d}.{e}" for e in ("plan", "waypoints", "csv", "kml", "kmz",
+                                                 "geojson")}
+        assert set(x["files"]) == names and all((out / n).is_file() for n in names)
+        assert json.loads((out / f"sortie-{k:02d}.plan").read_text())["mission"]["items"]
+    assert not (out / f"sortie-{sorties['count'] + 1:02d}.plan").exists()
+    assert sorties["ways"]["kind"] == "return field"
+    assert str(out / "sortie-01.waypoints") in json.loads(res.output)["files"]
     bad = runner.invoke(app, ["cover", "--area", "S3", "--spacing", "80", "--bands", "wind",
                               "--out", str(tmp_path / "d")])
     assert bad.exit_code == 2 and "needs a wind" in bad.output
