@@ -79,3 +79,29 @@ def test_cover_splits_a_long_survey_with_the_bands_across_the_wind(tmp_path):
     bad = runner.invoke(app, ["cover", "--area", "S3", "--spacing", "80", "--bands", "wind",
                               "--out", str(tmp_path / "d")])
     assert bad.exit_code == 2 and "needs a wind" in bad.output
+
+
+def test_the_printed_point_of_no_return_names_its_budget_and_model():
+    from fm2uav.pipeline.rows import energy_rows, returns_rows
+
+    base = {"worst": {}, "destinations": [], "firmware": None}
+    reached = {"computed": True, "budget": "energy", "reached": True, "distance_m": 2500.0,
+               "after_waypoint": 4, "t_mission_s": 300.0, "passed_before_end": True,
+               "model": "energy model arducopter (class default) along the route and the FM² "
+                        "ways back, battery 74 Wh; no endurance given"}
+    rows = returns_rows({"returns": {**base, "point_of_no_return": reached}})
+    assert rows["point of no return (battery binds; FM² ways back)"] == (
+        "2.50 km along the route (after waypoint 4, 5.0 min) — BEFORE the route's end")
+    assert rows["point of no return: model"].startswith("energy model arducopter")
+    none = {"computed": True, "budget": "energy", "reached": False, "smallest_margin_wh": 3.25}
+    rows = returns_rows({"returns": {**base, "point_of_no_return": none}})
+    assert rows["point of no return (battery binds; FM² ways back)"] == (
+        "none on the route (smallest margin 3.2 Wh)")
+    # without returns the energy summary's straight one is the only one, and says its model
+    e = {"energy_wh": 10.0, "time_s": 600.0, "battery_wh": 74.0, "usable_wh": 59.2,
+         "reserve": 0.2, "ok": True, "model": "arducopter", "model_kind": "multirotor",
+         "hover_or_cruise_power_w": 300.0, "model_source": "airframe.power",
+         "no_return_waypoint": 7, "no_return_note": "the last waypoint ..."}
+    assert "point of no return (battery, straight returns)" in energy_rows(e)
+    e.pop("no_return_waypoint")
+    assert not any("no return" in k for k in energy_rows(e))

@@ -234,26 +234,20 @@ def _nearest(path: np.ndarray, lo: int, hi: int, q: np.ndarray) -> int:
     return lo + int(np.argmin(np.hypot(*(seg - q[:2]).T)))
 
 
-def _way_costs(ways: HomeWays, model: Any, *, speed: float, climb: float, descent: float,
-               wind: Any, ground: float):
-    """``ways(points)`` for :func:`~fm2uav.vehicles.sorties.split_sorties`: the energy and
-    time out (take-off climb at home, the way reversed) and home (the way, the landing)."""
-    from ..vehicles.energy import fly_legs
+def _way_costs(ways: HomeWays, power: Any, ground: float):
+    """``ways(points)`` for :func:`~fm2uav.vehicles.sorties.split_sorties`: the energy [Wh]
+    and time [s] out (take-off climb at home, the way reversed) and home (the way, the
+    landing), flown by the mission's energy model
+    (:class:`~fm2uav.autopilot.energy.MissionPower`)."""
 
     def cost(points: Any) -> tuple[np.ndarray, ...]:
         pts = np.asarray(points, dtype=float)
         res = np.zeros((4, len(pts)))
         for k, path in enumerate(ways.paths(pts)):
-            climb_h = max(float(path[-1, 2]) - ground, 0.0)
-            for row, p, kw in ((0, path[::-1], {"takeoff_climb": climb_h}),
-                               (2, path, {"final_descent": climb_h})):
-                w = None
-                if wind is not None and len(p) > 1:
-                    mid = 0.5 * (p[1:] + p[:-1])
-                    w = np.asarray(wind.at(mid, np.maximum(mid[:, 2] - ground, 1.0)), float)
-                f = fly_legs(p, model, speed=speed, climb_rate=climb, descent_rate=descent,
-                             wind=w, **kw)
-                res[row, k], res[row + 1, k] = f.energy_wh, f.time_s
+            height = float(path[-1, 2]) - ground
+            out = power.fly(path[::-1], takeoff=height)
+            back = power.fly(path, landing=height)
+            res[:, k] = out.energy_wh, out.time_s, back.energy_wh, back.time_s
         return tuple(res)
 
     return cost
@@ -346,9 +340,8 @@ def build_sorties(mission: Any, plan: Any, *, ways: HomeWays, camera: Any = None
     MissionError
         The firmware would reject a sortie's mission.
     """
-    from ..vehicles.power import get_power_model
     from ..vehicles.sorties import split_sorties
-    from .energy import DEFAULT_POWER
+    from .energy import MissionPower
 
     energy = mission.info.get("energy") or {}
     if energy.get("ok", True):
@@ -360,13 +353,8 @@ def build_sorties(mission: Any, plan: Any, *, ways: HomeWays, camera: Any = None
     wps = mission.waypoints
     p = np.asarray(wps.points_m, dtype=float)
     ground = float(p[0, 2] - wps.agl[0])
-    model = get_power_model(opt.power if opt.power is not None
-                            else DEFAULT_POWER.get(opt.vehicle, "arducopter"))
-    battery = opt.battery_wh if opt.battery_wh is not None else model.battery_wh
-    climb = mission.info["flight"]["climb_rate_mps"]
-    descent = mission.info["flight"]["descent_rate_mps"]
-    cost = _way_costs(ways, model, speed=opt.forward_speed, climb=climb, descent=descent,
-                      wind=opt.wind, ground=ground)
+    power = MissionPower.of(mission)
+    cost = _way_costs(ways, power, ground)
     cached: dict[bytes, tuple[np.ndarray, ...]] = {}
 
     def ways_cost(points: Any) -> tuple[np.ndarray, ...]:  # the same points every round
@@ -379,10 +367,11 @@ def build_sorties(mission: Any, plan: Any, *, ways: HomeWays, camera: Any = None
     idx = np.asarray(wps.indices, dtype=int)
     margin = 0.0
     for rounds in range(1, MAX_ROUNDS + 1):
-        split = split_sorties(p, model, home=[p[0, 0], p[0, 1], ground], battery_wh=battery,
-                              reserve=opt.reserve, speed=opt.forward_speed, climb_rate=climb,
-                              descent_rate=descent, wind=opt.wind, resume_step=resume_step,
-                              ways=ways_cost, margin_wh=margin)
+        split = split_sorties(p, power.model, home=[p[0, 0], p[0, 1], ground],
+                              battery_wh=power.battery_wh, reserve=power.reserve,
+                              speed=power.speed, climb_rate=power.climb_rate,
+                              descent_rate=power.descent_rate, wind=power.wind,
+                              resume_step=resume_step, ways=ways_cost, margin_wh=margin)
         n = len(split.sorties)
         built: list[SortieMission] = []
         ia = 0
