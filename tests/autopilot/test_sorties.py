@@ -84,6 +84,11 @@ def test_each_written_sortie_flies_the_energy_and_time_of_the_summary(survey, so
         fh = io.StringIO()
         sm.files[f"sortie-{s['sorties'].index(row) + 1:02d}.waypoints"].write(fh)
         e, t = flown(fh.getvalue(), world, model, climb=2.5, descent=1.5, wind=WIND)
+        # the resume point named is the item of that number in the file
+        seq = fh.getvalue().strip().splitlines()[1 + row["resume_item"]].split("\t")
+        assert int(seq[0]) == row["resume_item"] and int(seq[3]) in (16, 22)
+        lon, lat, _ = row["resume_lon_lat_alt"]
+        assert (float(seq[8]), float(seq[9])) == pytest.approx((lat, lon), abs=2e-7)
         assert row["energy_wh"] == pytest.approx(e, rel=2e-3)
         assert row["time_s"] == pytest.approx(t, rel=2e-3)
         assert e <= usable and row["ok"]

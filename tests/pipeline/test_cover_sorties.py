@@ -41,11 +41,11 @@ def test_sortie_rows_say_the_count_and_the_baseline():
     assert rows["sorties"].startswith("2 (one battery each, 24.0 Wh usable")
     assert "one leg alone is too long" in rows["sorties"]
     assert rows["sortie 2"].startswith("legs 5→9, 20.0 Wh, 5.0 min, resume at 40.340000, -3.740000")
-    s["sorties"][1].update(resume_waypoint=3, files=["sortie-02.csv", "sortie-02.plan",
+    s["sorties"][1].update(resume_item=9, files=["sortie-02.csv", "sortie-02.plan",
                                                      "sortie-02.waypoints"])
     s["ways"] = {"kind": "return field"}
     rows = sortie_rows(s)
-    assert rows["sortie 2"].endswith("(waypoint 3); sortie-02.plan / sortie-02.waypoints")
+    assert rows["sortie 2"].endswith("(item 9); sortie-02.plan / sortie-02.waypoints")
     assert rows["sorties: ways out and home"] == "return field"
     assert sortie_rows(None) == {}
 

@@ -166,6 +166,11 @@ class SortieMission:
         The dense survey path's indices it flies (first, last).
     resume_waypoint : int
         Index of the resume point among the sortie's waypoints.
+
+    Notes
+    -----
+    :attr:`resume_item` is the resume point's item number in the written mission (``seq``
+    of the ``.waypoints`` file, home being 0).
     """
 
     mission: Any
@@ -174,6 +179,15 @@ class SortieMission:
     stop: np.ndarray
     survey: tuple[int, int]
     resume_waypoint: int
+
+    @property
+    def resume_item(self) -> int:
+        """``seq`` of the resume point's item in the written mission (home is 0): the
+        waypoint labelled ``via 1``, or the take-off (1) when the sortie resumes at home."""
+        for i, it in enumerate(self.mission.items):
+            if it.label == "via 1":
+                return i + 1
+        return 1
 
     @property
     def energy_wh(self) -> float:
@@ -220,7 +234,7 @@ class SortieSet:
                 "home_from_m": np.round(m.stop, 2).tolist(),
                 "resume_lon_lat_alt": [round(float(lon), 7), round(float(lat), 7),
                                        round(float(alt), 1)],
-                "resume_waypoint": m.resume_waypoint,
+                "resume_waypoint": m.resume_waypoint, "resume_item": m.resume_item,
                 "survey_path_indices": list(m.survey),
                 "items": len(m.mission.items), "waypoints": len(m.mission.waypoints),
                 "files": sorted(m.files),

@@ -307,7 +307,7 @@ def sortie_rows(sorties: dict[str, Any] | None) -> dict[str, str]:
         rows[f"sortie {k}"] = (f"legs {s['from_waypoint']}→{s['to_waypoint']}, "
                                f"{s['energy_wh']:.1f} Wh, {s['time_s'] / 60:.1f} min, resume at "
                                f"{lat:.6f}, {lon:.6f}"
-                               + (f" (waypoint {s['resume_waypoint']}); {' / '.join(files)}"
+                               + (f" (item {s['resume_item']}); {' / '.join(files)}"
                                   if files else ""))
     if "ways" in sorties:
         rows["sorties: ways out and home"] = sorties["ways"]["kind"]
