@@ -92,8 +92,11 @@ def test_each_written_sortie_flies_the_energy_and_time_of_the_summary(survey, so
         assert row["energy_wh"] == pytest.approx(e, rel=2e-3)
         assert row["time_s"] == pytest.approx(t, rel=2e-3)
         assert e <= usable and row["ok"]
-    # never more sorties than equal parts of the waypoint list (here, in this wind, as many)
+    # never more sorties than equal parts of the waypoint list (here, in this wind, as many),
+    # whose energies the summary gives beside the sorties'
     assert s["even_split_count"] is None or s["count"] <= s["even_split_count"]
+    assert len(s["even_split_energy_wh"]) == (s["even_split_count"] or 0)
+    assert all(0 < v <= usable for v in s["even_split_energy_wh"])
 
 
 def test_sorties_are_complete_valid_missions_that_fly_the_whole_survey(survey, sorties):

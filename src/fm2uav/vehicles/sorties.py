@@ -18,7 +18,7 @@ split adapts each sortie to how far it is from home and how the wind treats it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -27,7 +27,7 @@ from ..errors import InputError, PlanningError
 from .energy import _budget, fly_legs, home_legs
 from .power import PowerModel
 
-__all__ = ["Sortie", "SortiePlan", "split_sorties", "even_split"]
+__all__ = ["Sortie", "SortiePlan", "split_sorties", "even_split", "even_parts"]
 
 
 @dataclass(frozen=True)
@@ -76,16 +76,20 @@ class SortiePlan:
     even_sorties : int or None
         Sorties needed when the waypoint list is split into equal parts (None: no such
         split fits, a single leg is already too long).
+    even_energy_wh : list of float
+        The energy [Wh] of each of those equal parts (out, along, home; empty with None).
     """
 
     sorties: list[Sortie]
     usable_wh: float
     even_sorties: int | None
+    even_energy_wh: list[float] = field(default_factory=list)
 
     def summary(self) -> dict[str, Any]:
         """JSON-friendly figures."""
         return {
             "count": len(self.sorties), "even_split_count": self.even_sorties,
+            "even_split_energy_wh": [round(v, 2) for v in self.even_energy_wh],
             "usable_wh": round(self.usable_wh, 2),
             "sorties": [{"from_waypoint": s.start, "to_waypoint": s.end,
                          "energy_wh": round(s.energy_wh, 2), "time_s": round(s.time_s, 1),
@@ -100,19 +104,25 @@ def _fits(route: Any, out: np.ndarray, back: np.ndarray, a: int) -> np.ndarray:
     return out[a] + (route[a:] - route[a]) + back[a:]
 
 
-def even_split(route_wh: Any, out_wh: Any, back_wh: Any, usable_wh: float) -> int | None:
-    """Fewest equal parts of the waypoint list (consecutive parts share their junction
-    waypoint) each of which fits in ``usable_wh``; None when not even one leg per part
-    fits (a waypoint split cannot fly the survey at all)."""
+def even_parts(route_wh: Any, out_wh: Any, back_wh: Any, usable_wh: float) -> list[float]:
+    """The energy [Wh] of each part of the fewest equal parts of the waypoint list
+    (consecutive parts share their junction waypoint) each of which fits in ``usable_wh``
+    — ``out[a] + E_route[b] − E_route[a] + back[b]`` — ([] when not even one leg per part
+    fits: a waypoint split cannot fly the survey at all)."""
     e = np.asarray(route_wh, dtype=float)
     out, back = np.asarray(out_wh, float), np.asarray(back_wh, float)
     n = len(e)
     for k in range(1, n):
         edges = np.unique(np.rint(np.linspace(0, n - 1, k + 1)).astype(int))
-        if all(out[a] + e[b] - e[a] + back[b] <= usable_wh for a, b in zip(edges[:-1],
-                                                                           edges[1:])):
-            return len(edges) - 1
-    return None
+        parts = [float(out[a] + e[b] - e[a] + back[b]) for a, b in zip(edges[:-1], edges[1:])]
+        if all(v <= usable_wh for v in parts):
+            return parts
+    return []
+
+
+def even_split(route_wh: Any, out_wh: Any, back_wh: Any, usable_wh: float) -> int | None:
+    """How many parts :func:`even_parts` needs (None: no equal split fits)."""
+    return len(even_parts(route_wh, out_wh, back_wh, usable_wh)) or None
 
 
 def split_sorties(points: Any, model: PowerModel, *, home: Any, battery_wh: float,
@@ -214,4 +224,5 @@ def split_sorties(points: Any, model: PowerModel, *, home: Any, battery_wh: floa
         a = b
     on_wp = np.flatnonzero(np.r_[True, np.diff(leg) != 0])   # the waypoints among the points
     on_wp = np.unique(np.r_[on_wp, len(p) - 1])
-    return SortiePlan(sorties, usable, even_split(e[on_wp], out[on_wp], back[on_wp], budget))
+    even = even_parts(e[on_wp], out[on_wp], back[on_wp], budget)
+    return SortiePlan(sorties, usable, len(even) or None, even)
