@@ -73,10 +73,67 @@ def test_the_point_of_no_return_balances_the_budget(ridge_plan):
         build(ridge_plan, endurance_s=240.0, returns=ReturnOptions(strict=True))
 
 
-def test_without_an_endurance_there_is_no_point_of_no_return(ridge_plan):
+def _battery_for(ridge_plan, share):
+    """A battery [Wh] whose usable 80 % is ``share`` of the mission's energy."""
     m = build(ridge_plan, endurance_s=None, firmware="px4")
-    assert m.returns.pnr == {"computed": False, "why": m.returns.pnr["why"]}
-    assert "--endurance" in m.returns.pnr["why"]
+    return share * m.info["energy"]["energy_wh"] / 0.8
+
+
+def test_without_an_endurance_the_battery_gives_the_point_of_no_return(ridge_plan):
+    from fm2uav.autopilot.returns import leg_speeds
+    from fm2uav.vehicles.energy import fly_legs
+    from fm2uav.vehicles.power import get_power_model
+
+    battery = _battery_for(ridge_plan, 0.8)
+    m = build(ridge_plan, endurance_s=None, firmware="px4", battery_wh=battery)
+    pnr = m.returns.pnr
+    assert pnr["computed"] and pnr["budget"] == "energy" and pnr["reached"]
+    assert pnr["passed_before_end"] and "endurance_s" not in pnr
+    assert "energy model arducopter (class default)" in pnr["model"]
+    usable = 0.8 * battery
+    assert pnr["usable_wh"] == pytest.approx(usable, abs=1e-3)
+    assert pnr["spent_wh"] + pnr["return"]["energy_wh"] == pytest.approx(usable, abs=0.05)
+    assert 0 <= pnr["margin_wh"] < 0.05
+    # flown again here: the legs as written up to the point, then its way back as written
+    quad = get_power_model("arducopter")
+    wps = m.waypoints
+    p = wps.points_m
+    k = pnr["after_waypoint"]
+    speeds, holds = leg_speeds(m.items, len(p), m.options.forward_speed)
+    route = np.vstack([p[:k + 1], pnr["point_m"]])
+    rates = dict(climb_rate=m.info["flight"]["climb_rate_mps"],
+                 descent_rate=m.info["flight"]["descent_rate_mps"])
+    out = fly_legs(route, quad, speed=speeds[:k + 1], holds=np.r_[holds[:k + 1], 0.0],
+                   takeoff_climb=wps.agl[0], **rates)
+    back = m.returns.pnr_path
+    g = m.world.ground_height(back[-1, 0], back[-1, 1])
+    home = fly_legs(back, quad, speed=m.options.forward_speed, final_descent=back[-1, 2] - g,
+                    **rates)
+    assert out.energy_wh == pytest.approx(pnr["spent_wh"], abs=0.02)
+    assert home.energy_wh == pytest.approx(pnr["return"]["energy_wh"], abs=1e-3)
+    assert out.energy_wh + home.energy_wh == pytest.approx(usable, abs=0.1)
+    # one point of no return: the energy block no longer gives the straight one
+    assert "no_return_waypoint" not in m.info["energy"]
+    assert m.info["energy"]["no_return"].startswith("point_of_no_return")
+    assert any("battery" in w and "point of no return" in w for w in m.warnings)
+    with pytest.raises(PlanningError, match="--battery"):
+        build(ridge_plan, endurance_s=None, firmware="px4", battery_wh=battery,
+              returns=ReturnOptions(strict=True))
+
+
+def test_the_first_budget_reached_binds_and_the_other_is_told(ridge_plan):
+    battery = _battery_for(ridge_plan, 0.8)
+    e_only = build(ridge_plan, endurance_s=None, battery_wh=battery).returns.pnr
+    t_only = build(ridge_plan, endurance_s=240.0).returns.pnr        # a big default battery
+    assert t_only["budget"] == "endurance" and t_only["other_budgets"]["energy"]["reached"] \
+        is False
+    both = build(ridge_plan, endurance_s=240.0, battery_wh=battery).returns.pnr
+    first = min((e_only, t_only), key=lambda p: p["distance_m"])
+    assert both["budget"] == first["budget"]
+    assert both["distance_m"] == pytest.approx(first["distance_m"], abs=0.5)
+    other = "endurance" if both["budget"] == "energy" else "energy"
+    assert both["other_budgets"][other]["distance_m"] >= both["distance_m"]
+    assert both["endurance_s"] == 240.0 and both["battery_wh"] == pytest.approx(battery, 1e-3)
 
 
 @pytest.mark.parametrize("end", ["land", "auto"])

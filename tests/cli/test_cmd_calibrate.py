@@ -11,7 +11,7 @@ from typer.testing import CliRunner
 from fm2uav.cli import app
 from fm2uav.vehicles.power import POWER_MODELS, get_power_model
 
-from ..io.synthetic_logs import flight_states, write_tlog
+from ..io.synthetic_logs import flight_states, write_tlog, write_ulg
 
 runner = CliRunner()
 
@@ -41,6 +41,22 @@ def test_calibrate_writes_a_model_plan_uses(tmp_path):
     e = json.loads((tmp_path / "p" / "summary.json").read_text())["autopilot"]["energy"]
     assert e["model_source"] == "airframe.power" and e["battery_wh"] == 50.0
     assert e["wind"]["from_deg"] == 90.0 and e["energy_wh"] > 0
+
+
+def test_calibrate_reads_a_px4_ulg(tmp_path):
+    true = replace(POWER_MODELS["crosswind"], efficiency=0.62)
+    t, air, climb = flight_states("fixed-wing", seed=2)
+    log = write_ulg(tmp_path / "log_1.ulg", t, true.power(air, climb), air, climb,
+                    groundspeed=air - 3.0, armed_from=30.0)
+    out = tmp_path / "cal"
+    res = runner.invoke(app, ["calibrate", str(log), "--power", "crosswind", "--out", str(out),
+                              "--json"])
+    assert res.exit_code == 0, res.output
+    fit = json.loads((out / "calibration.json").read_text())
+    assert fit["r2"] > 0.999 and fit["samples"] < len(t) - 50     # disarmed minute dropped
+    model = get_power_model(out / "power.yaml")
+    assert model.efficiency == pytest.approx(0.62, rel=0.01)
+    assert "log_1.ulg (log_1.ulg: battery_status" in model.source
 
 
 @pytest.mark.parametrize("args, part", [

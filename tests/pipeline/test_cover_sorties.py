@@ -41,13 +41,19 @@ def test_sortie_rows_say_the_count_and_the_baseline():
     assert rows["sorties"].startswith("2 (one battery each, 24.0 Wh usable")
     assert "one leg alone is too long" in rows["sorties"]
     assert rows["sortie 2"].startswith("legs 5→9, 20.0 Wh, 5.0 min, resume at 40.340000, -3.740000")
+    s["sorties"][1].update(resume_item=9, files=["sortie-02.csv", "sortie-02.plan",
+                                                     "sortie-02.waypoints"])
+    s["ways"] = {"kind": "return field"}
+    rows = sortie_rows(s)
+    assert rows["sortie 2"].endswith("(item 9); sortie-02.plan / sortie-02.waypoints")
+    assert rows["sorties: ways out and home"] == "return field"
     assert sortie_rows(None) == {}
 
 
 def test_cover_splits_a_long_survey_with_the_bands_across_the_wind(tmp_path):
     out = tmp_path / "c"
     res = runner.invoke(app, ["cover", "--area", "S3", "--spacing", "80", "--agl", "100",
-                              "--battery", "30", "--wind", "6@200", "--bands", "wind",
+                              "--battery", "40", "--wind", "6@200", "--bands", "wind",
                               "--out", str(out), "--json"])
     assert res.exit_code == 0, res.output
     s = json.loads((out / "summary.json").read_text())
@@ -61,6 +67,41 @@ def test_cover_splits_a_long_survey_with_the_bands_across_the_wind(tmp_path):
     route = sum(x["survey_wh"] for x in sorties["sorties"])
     assert 0.6 * s["autopilot"]["energy"]["energy_wh"] < route < s["autopilot"]["energy"][
         "energy_wh"]
+    # one mission per sortie, in every format of the whole mission, listed in the summary
+    for k, x in enumerate(sorties["sorties"], 1):
+        names = {f"sortie-{k:02d}.{e}" for e in ("plan", "waypoints", "csv", "kml", "kmz",
+                                                 "geojson")}
+        assert set(x["files"]) == names and all((out / n).is_file() for n in names)
+        assert json.loads((out / f"sortie-{k:02d}.plan").read_text())["mission"]["items"]
+    assert not (out / f"sortie-{sorties['count'] + 1:02d}.plan").exists()
+    assert sorties["ways"]["kind"] == "return field"
+    assert str(out / "sortie-01.waypoints") in json.loads(res.output)["files"]
     bad = runner.invoke(app, ["cover", "--area", "S3", "--spacing", "80", "--bands", "wind",
                               "--out", str(tmp_path / "d")])
     assert bad.exit_code == 2 and "needs a wind" in bad.output
+
+
+def test_the_printed_point_of_no_return_names_its_budget_and_model():
+    from fm2uav.pipeline.rows import energy_rows, returns_rows
+
+    base = {"worst": {}, "destinations": [], "firmware": None}
+    reached = {"computed": True, "budget": "energy", "reached": True, "distance_m": 2500.0,
+               "after_waypoint": 4, "t_mission_s": 300.0, "passed_before_end": True,
+               "model": "energy model arducopter (class default) along the route and the FM² "
+                        "ways back, battery 74 Wh; no endurance given"}
+    rows = returns_rows({"returns": {**base, "point_of_no_return": reached}})
+    assert rows["point of no return (battery binds; FM² ways back)"] == (
+        "2.50 km along the route (after waypoint 4, 5.0 min) — BEFORE the route's end")
+    assert rows["point of no return: model"].startswith("energy model arducopter")
+    none = {"computed": True, "budget": "energy", "reached": False, "smallest_margin_wh": 3.25}
+    rows = returns_rows({"returns": {**base, "point_of_no_return": none}})
+    assert rows["point of no return (battery binds; FM² ways back)"] == (
+        "none on the route (smallest margin 3.2 Wh)")
+    # without returns the energy summary's straight one is the only one, and says its model
+    e = {"energy_wh": 10.0, "time_s": 600.0, "battery_wh": 74.0, "usable_wh": 59.2,
+         "reserve": 0.2, "ok": True, "model": "arducopter", "model_kind": "multirotor",
+         "hover_or_cruise_power_w": 300.0, "model_source": "airframe.power",
+         "no_return_waypoint": 7, "no_return_note": "the last waypoint ..."}
+    assert "point of no return (battery, straight returns)" in energy_rows(e)
+    e.pop("no_return_waypoint")
+    assert not any("no return" in k for k in energy_rows(e))

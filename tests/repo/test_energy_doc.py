@@ -56,8 +56,9 @@ def test_the_python_block_runs():
 
 
 def _commands() -> list[str]:
-    block = re.search(r"```bash\n(.*?)```", DOC.read_text(), flags=re.S).group(1)
-    return [line.split("  #")[0].strip() for line in block.splitlines() if line.strip()]
+    blocks = re.findall(r"```bash\n(.*?)```", DOC.read_text(), flags=re.S)
+    return [line.split("  #")[0].strip() for block in blocks for line in block.splitlines()
+            if line.strip()]
 
 
 @pytest.mark.slow
@@ -69,6 +70,8 @@ def test_the_guides_commands_run():
             args += ["--force", "--quiet"]
         subprocess.run(args, cwd=ROOT, check=True, env=env, timeout=300)
     assert (ROOT / "out" / "calibrate" / "power.yaml").is_file()
+    assert (ROOT / "out" / "sorties" / "sortie-03.waypoints").is_file()
+    assert not (ROOT / "out" / "sorties" / "sortie-04.waypoints").exists()
     assert (ROOT / "out" / "energy" / "summary.json").is_file()
 
 

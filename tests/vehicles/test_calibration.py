@@ -12,7 +12,7 @@ from fm2uav.io.flightlog import read_power_samples
 from fm2uav.vehicles.calibration import PowerSamples, fit_power
 from fm2uav.vehicles.power import POWER_MODELS
 
-from ..io.synthetic_logs import flight_states, write_bin, write_tlog
+from ..io.synthetic_logs import flight_states, write_bin, write_tlog, write_ulg
 
 QUAD = POWER_MODELS["arducopter"]
 DISCO = POWER_MODELS["disco"]
@@ -40,6 +40,16 @@ def test_a_plane_bin_is_fitted_back_exactly(tmp_path):
     cal = fit_power(start, read_power_samples(log))
     np.testing.assert_allclose(cal.model.coefficients(), DISCO.coefficients(), rtol=1e-3)
     assert (cal.model.cd0, cal.model.k) == pytest.approx((DISCO.cd0, DISCO.k), rel=1e-3)
+
+
+def test_a_px4_plane_ulg_is_fitted_back_exactly(tmp_path):
+    t, air, climb = flight_states("fixed-wing", seed=3)
+    log = write_ulg(tmp_path / "disco.ulg", t, DISCO.power(air, climb), air, climb,
+                    groundspeed=air + 2.0, armed_from=0.0)
+    start = replace(DISCO, cd0=0.05, k=0.05, efficiency=0.7, descent_recovery=0.5)
+    cal = fit_power(start, read_power_samples(log))
+    np.testing.assert_allclose(cal.model.coefficients(), DISCO.coefficients(), rtol=1e-3)
+    assert cal.samples > 1000 and cal.r2 > 0.999
 
 
 def test_what_the_log_does_not_excite_is_held():

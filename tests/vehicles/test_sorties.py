@@ -8,7 +8,7 @@ import pytest
 from fm2uav.errors import PlanningError
 from fm2uav.vehicles.energy import fly_legs
 from fm2uav.vehicles.power import POWER_MODELS
-from fm2uav.vehicles.sorties import even_split, split_sorties
+from fm2uav.vehicles.sorties import even_parts, even_split, split_sorties
 from fm2uav.world.wind import WindField
 
 QUAD = POWER_MODELS["arducopter"]
@@ -82,3 +82,8 @@ def test_even_split_is_the_fewest_equal_parts():
     assert even_split(e, zero, zero, 5.0) == 2
     assert even_split(e, zero, zero, 3.0) == 4      # 4 parts of 2-3 legs: 3 Wh each
     assert even_split(e, zero, zero, 0.5) is None
+    assert even_parts(e, zero, zero, 3.0) == [2.0, 3.0, 3.0, 2.0]  # edges 0, 2, 5, 8, 10
+    out, back = np.linspace(0.0, 1.0, 11), np.linspace(1.0, 0.0, 11)
+    # out[a] + 3 legs + back[b]: 3 parts would need 4.6 Wh for the middle one
+    assert even_parts(e, out, back, 4.0) == pytest.approx([2.8, 3.7, 3.7, 2.8])
+    assert even_parts(e, zero, zero, 0.5) == []

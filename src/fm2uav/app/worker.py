@@ -160,7 +160,8 @@ def _cover_job(payload: dict[str, Any]) -> dict[str, Any]:
                             "world": world_summary(world),
                             **({"area_source": area_source.as_dict()} if area_source else {})})
     np.save(out.parent / "path_m.npy", np.asarray(run.coverage.path, dtype=float))
-    rows = {**cover_rows(area_name, d, run.coverage, run.built, world),
+    rows = {**cover_rows(area_name, d, run.coverage, run.built, world,
+                         run.summary.get("sorties")),
             **safety_rows(run.safety)}
     doc = mission_map(run.coverage.plan, run.built, run.safety,
                       rows={k: str(v) for k, v in rows.items()})

@@ -12,18 +12,89 @@ the wind of each leg is the field's at the leg's midpoint and height above groun
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from ..vehicles.energy import check_battery, fly_legs, no_return_point
-from ..vehicles.power import get_power_model
+from ..vehicles.energy import Flight, _budget, check_battery, fly_legs, no_return_point
+from ..vehicles.power import PowerModel, get_power_model
 
-__all__ = ["DEFAULT_POWER", "mission_energy", "mission_sorties"]
+__all__ = ["DEFAULT_POWER", "MissionPower", "mission_energy", "power_model"]
 
 #: Power model of each airframe type when the mission gives none (a VTOL in plane mode:
 #: its hover phases cost several times more and are not in the figure).
 DEFAULT_POWER = {"multirotor": "arducopter", "fixed_wing": "disco", "vtol": "crosswind"}
+
+
+def power_model(power: Any, vehicle: str) -> PowerModel:
+    """The mission's power model: ``power`` (``airframe.power``) or, when None, the class
+    model of the airframe type (:data:`DEFAULT_POWER`)."""
+    return get_power_model(power if power is not None else DEFAULT_POWER.get(vehicle,
+                                                                               "arducopter"))
+
+
+@dataclass(frozen=True, eq=False)
+class MissionPower:
+    """The energy model of a built mission, for flights it did not write (ways home, ways
+    out): its power model, battery and reserve, forward speed, climb and descent rates and
+    wind (:func:`mission_energy`'s), and its world for the heights above ground the wind
+    profile is read at.
+
+    Attributes
+    ----------
+    model : PowerModel
+    battery_wh, reserve : float
+        Battery [Wh] and the share of it kept.
+    speed, climb_rate, descent_rate : float
+        Forward speed and vertical speed limits [m/s].
+    wind : WindField or None
+    world : World
+    """
+
+    model: PowerModel
+    battery_wh: float
+    reserve: float
+    speed: float
+    climb_rate: float
+    descent_rate: float
+    wind: Any
+    world: Any
+
+    @classmethod
+    def of(cls, mission: Any) -> MissionPower:
+        """The energy model of ``mission`` (a :class:`~fm2uav.autopilot.build.MissionExport`)."""
+        opt = mission.options
+        model = power_model(opt.power, opt.vehicle)
+        flight = mission.info["flight"]
+        return cls(model, float(opt.battery_wh if opt.battery_wh is not None
+                                else model.battery_wh), float(opt.reserve),
+                   float(opt.forward_speed), float(flight["climb_rate_mps"]),
+                   float(flight["descent_rate_mps"]), opt.wind, mission.world)
+
+    @property
+    def usable_wh(self) -> float:
+        """Battery × (1 − reserve) [Wh]."""
+        return _budget(self.battery_wh, self.reserve)
+
+    def agl(self, points: Any) -> np.ndarray:
+        """Height above the world's ground of ``points`` [m] (a 2D world's: their z)."""
+        p = np.atleast_2d(np.asarray(points, dtype=float))
+        if getattr(self.world, "ndim", 3) != 3 or p.shape[1] < 3:
+            return p[:, -1].copy() if p.shape[1] >= 3 else np.zeros(len(p))
+        return p[:, 2] - np.asarray(self.world.ground_height(p[:, 0], p[:, 1]), dtype=float)
+
+    def fly(self, path: Any, *, speeds: Any = None, holds: Any = None, takeoff: float = 0.0,
+            landing: float = 0.0) -> Flight:
+        """:func:`~fm2uav.vehicles.energy.fly_legs` along ``path`` (n, 3) [m] at ``speeds``
+        (default the forward speed) in the wind at each leg's midpoint and height above
+        ground, after a ``takeoff`` climb and before a ``landing`` descent [m]."""
+        p = np.asarray(path, dtype=float)
+        return fly_legs(p, self.model, speed=self.speed if speeds is None else speeds,
+                        climb_rate=self.climb_rate, descent_rate=self.descent_rate,
+                        wind=_leg_wind(self.wind, p, self.agl(p)), holds=holds,
+                        takeoff_climb=max(float(takeoff), 0.0),
+                        final_descent=max(float(landing), 0.0))
 
 
 def _leg_wind(wind: Any, pts: np.ndarray, agl: np.ndarray) -> np.ndarray | None:
@@ -70,7 +141,7 @@ def mission_energy(points: Any, agl: Any, *, vehicle: str, power: Any, battery_w
         does not last or a leg cannot be flown in the wind.
     """
     given = power is not None
-    model = get_power_model(power if given else DEFAULT_POWER.get(vehicle, "arducopter"))
+    model = power_model(power, vehicle)
     p = np.asarray(points, dtype=float)
     h = np.asarray(agl, dtype=float)
     legs_p, legs_agl = p, h
@@ -115,30 +186,3 @@ def mission_energy(points: Any, agl: Any, *, vehicle: str, power: Any, battery_w
                                  "wind at the start) still fits in the usable battery"
                                  + ("" if k < len(p) - 1 else ": every waypoint"))
     return out
-
-
-def mission_sorties(mission: Any) -> Any:
-    """The sorties of a built survey mission that one battery cannot fly
-    (:func:`fm2uav.vehicles.sorties.split_sorties`), or None when one battery does.
-
-    Home is the take-off point under the first waypoint; every sortie flies at the
-    mission's forward speed with its power model, battery, reserve and wind
-    (:func:`mission_energy`), and returns straight home.
-    """
-    from ..vehicles.sorties import split_sorties
-
-    opt = mission.options
-    energy = mission.info.get("energy") or {}
-    if energy.get("ok", True):
-        return None
-    wps = mission.waypoints
-    p = np.asarray(wps.points_m, dtype=float)
-    home = np.array([p[0, 0], p[0, 1], p[0, 2] - float(wps.agl[0])])
-    model = get_power_model(opt.power if opt.power is not None
-                            else DEFAULT_POWER.get(opt.vehicle, "arducopter"))
-    return split_sorties(p, model, home=home,
-                         battery_wh=opt.battery_wh if opt.battery_wh is not None
-                         else model.battery_wh, reserve=opt.reserve, speed=opt.forward_speed,
-                         climb_rate=mission.info["flight"]["climb_rate_mps"],
-                         descent_rate=mission.info["flight"]["descent_rate_mps"],
-                         wind=opt.wind)

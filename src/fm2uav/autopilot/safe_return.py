@@ -14,15 +14,20 @@ and then, on the plan's own map:
    get the descent of the field whose way back is fastest: its path, length, time
    (legs at the forward speed and the climb / descent rates, then the landing
    descent, as the mission's own estimate: :func:`~fm2uav.vehicles.endurance.return_time`)
-   and share of the battery (the endurance check's constant power; Wh with an
-   ``energy`` model).
-4. **The point of no return**: with the airframe's endurance and reserve, the last
-   point of the route from which the time flown plus the time back stays within the
-   usable endurance ``endurance × (1 − reserve)``; located between two route
-   samples and refined there by bisection with exact descents, so the time flown to
-   it (the exported legs at their commanded speeds) plus its way back equals the
-   usable endurance to a fraction of a second. Passed before the route's end, the
-   mission warns (``strict``: refuses).
+   and energy (the mission's energy model, :class:`~fm2uav.autopilot.energy.MissionPower`:
+   its power model at the forward speed in the wind, the landing) — and, with an
+   endurance, its share of it.
+4. **The point of no return**, one figure in every budget the mission has — the usable
+   battery ``battery × (1 − reserve)`` (the energy model along the legs as written and
+   along the way back) and, with the airframe's endurance, the usable endurance
+   ``endurance × (1 − reserve)`` (the mission's clock and the time back) — the first
+   reached binds: the last point of the route from which what is spent plus what the
+   way back needs stays within the budget; located between two route samples
+   (:func:`~fm2uav.vehicles.endurance.first_shortfall`) and refined there by bisection
+   with exact descents, so spent + way back equals the usable budget to a fraction of a
+   second or a few mWh. Passed before the route's end, the mission warns (``strict``:
+   refuses). The mission's energy summary then drops its straight-line point of no
+   return (``no_return`` points here).
 5. **The firmware's return** (:func:`~fm2uav.autopilot.returns.firmware_returns`):
    the lowest safe return altitude per firmware and airframe (``mission.param``).
    When none is safe, the mission carries a planned safe return instead, marked with
@@ -109,9 +114,6 @@ class ReturnOptions:
     strict : bool
         Refuse (PlanningError) a mission that passes its point of no return before
         its end.
-    energy : callable or None
-        ``energy(path_m, speed_mps) -> Wh`` of a way back (a power model); without it
-        the energy is the share of the endurance (constant power).
     max_returns : int
         Most FM² ways back along the route.
     """
@@ -122,7 +124,6 @@ class ReturnOptions:
     rally_agl: float | None = None
     min_agl: float | None = None
     strict: bool = False
-    energy: Callable[[np.ndarray, float], float] | None = None
     max_returns: int = DEFAULT_MAX_RETURNS
 
     def __post_init__(self) -> None:
@@ -154,7 +155,8 @@ class ReturnsReport:
         Each way back as timed [m]: thinned (:data:`RETURN_THIN_M`) from the waypoints (the
         ways back written), dense between them.
     energy_wh : ndarray or None
-        Energy of each way back with an ``energy`` model.
+        Energy of each way back [Wh] (the mission's energy model,
+        :class:`~fm2uav.autopilot.energy.MissionPower`: power model, wind, landing).
     pnr : dict
         The point of no return (``summary()["point_of_no_return"]``).
     pnr_path : ndarray or None
@@ -235,7 +237,8 @@ class ReturnsReport:
             "worst": {"time_s": round(float(self.time[worst]), 1) if len(self.time) else None,
                       "distance_m": round(float(s.distance[worst]), 1) if len(s) else None,
                       "to": self.to[worst] if self.to else None},
-            "energy": ("energy model (Wh)" if self.energy_wh is not None else
+            "energy": ("the mission's energy model (Wh): its power model in the wind, "
+                       "landing included" if self.energy_wh is not None else
                        "share of the endurance at constant power (the endurance check's model)"),
             "point_of_no_return": self.pnr,
             "firmware": None if self.firmware is None else self.firmware.summary(),
@@ -274,9 +277,9 @@ class _Backs:
     """Ways back from route points to the fastest destination, timed."""
 
     def __init__(self, fields: dict[str, ReturnField], speeds: dict[str, float],
-                 world: Any, flight_alt: float) -> None:
+                 world: Any, flight_alt: float, power: Any = None) -> None:
         self.fields, self.sp, self.world = fields, speeds, world
-        self.flight_alt = flight_alt
+        self.flight_alt, self.power = flight_alt, power
         self.land = {n: (_landing_height(world, f) if world.ndim == 3 else flight_alt)
                      for n, f in fields.items()}
 
@@ -284,15 +287,28 @@ class _Backs:
               ) -> tuple[float, float, np.ndarray]:
         """(time, length, path) of a way back; ``thin``: the path thinned to
         :data:`RETURN_THIN_M` first (the polyline written), timed as written."""
-        p = np.asarray(path, dtype=float)
-        if p.shape[1] == 2:
-            p = np.column_stack([p, np.full(len(p), self.flight_alt)])
+        p = self._as3(path)
         if thin and len(p) > 2:
             p = thin_path(p, RETURN_THIN_M)
         t, L = return_time(p, speed=self.sp["forward_mps"], climb_rate=self.sp["climb_mps"],
                            descent_rate=self.sp["descent_mps"],
                            landing_height=self.land[destination])
         return t, L, p
+
+    def _as3(self, path: Any) -> np.ndarray:
+        p = np.asarray(path, dtype=float)
+        if p.shape[1] == 2:
+            p = np.column_stack([p, np.full(len(p), self.flight_alt)])
+        return p
+
+    def energy(self, path: Any, destination: str) -> float:
+        """Energy [Wh] of a way back by the mission's energy model (``power``): at the
+        forward speed in the wind, then the landing descent at the destination
+        (``inf``: no way back)."""
+        p = self._as3(path)
+        if not len(p) or not destination:
+            return math.inf
+        return float(self.power.fly(p, landing=self.land[destination]).energy_wh)
 
     def best(self, points: np.ndarray) -> list[tuple[str, float, float, np.ndarray]]:
         """(destination, time, length, path) of each point's fastest way back (the dense
@@ -414,53 +430,118 @@ def _embed(mission: MissionExport, plan: Any, home: ReturnField, inputs: dict[st
 
 
 # ---------------------------------------------------------------- the point of no return
-def _pnr(mission: MissionExport, samples: RouteSamples, t_back: np.ndarray, to: list[str],
-         backs: _Backs, usable: float | None, endurance: float | None, reserve: float
-         ) -> tuple[dict[str, Any], np.ndarray | None]:
-    if usable is None:
-        return {"computed": False,
-                "why": "no airframe endurance: give airframe.endurance (--endurance, minutes)"}, \
-            None
+@dataclass(frozen=True, eq=False)
+class _Budget:
+    """One budget the point of no return is found in: the battery's usable energy [Wh] or
+    the airframe's usable endurance [s]; what reaching each route sample spends of it and
+    what its way back needs."""
+
+    name: str                   # "energy" or "endurance"
+    unit: str                   # "wh" or "s" (the summary's key suffix)
+    usable: float
+    total: float                # the battery [Wh] or the endurance [s]
+    spent: np.ndarray           # on reaching each sample
+    back: np.ndarray            # the way back from each sample
+    spent_at: Callable[[RouteSamples], float]             # at a point of route_samples(legs=)
+    back_of: Callable[[str, np.ndarray, float], float]    # (destination, path, time) of a way
+
+    def describe(self, reserve: float) -> str:
+        if self.name == "energy":
+            return f"{100 * reserve:.0f} % reserve of its {self.total:.1f} Wh battery"
+        return f"{100 * reserve:.0f} % reserve of its {self.total / 60:.1f} min endurance"
+
+
+def _energy_budget(mission: MissionExport, samples: RouteSamples, backs: _Backs,
+                   energy: np.ndarray) -> _Budget:
+    """The battery budget: the energy model along the mission's legs as written (commanded
+    speeds, holds, the take-off climb) and along each FM² way back."""
+    from .returns import leg_speeds
+
+    power = backs.power
+    wps = mission.waypoints
+    p = np.asarray(wps.points_m, dtype=float)
+    speeds, holds = leg_speeds(mission.items, len(p), power.speed)
+    takeoff = float(wps.agl[0])
+    if len(p) > 1:
+        flown = power.fly(p, speeds=speeds, holds=holds, takeoff=takeoff)
+        still = power.fly(p, speeds=speeds, takeoff=takeoff)   # the legs without the holds
+        used = flown.used_wh()
+        travel = still.leg_energy_j / 3600.0
+        hold = flown.leg_energy_j / 3600.0 - travel
+    else:
+        used, travel, hold = np.array([power.fly(p[:1], takeoff=takeoff).used_wh()[0]]), \
+            np.zeros(0), np.zeros(0)
+
+    def spent(rs: RouteSamples) -> np.ndarray:
+        if len(p) < 2:
+            return np.full(len(rs), used[0])
+        k, f = rs.leg, rs.fraction
+        return used[k] + f * travel[k] + np.where(f >= 1.0, hold[k], 0.0)
+
+    return _Budget("energy", "wh", power.usable_wh, power.battery_wh, spent(samples), energy,
+                   lambda rs: float(spent(rs)[0]),
+                   lambda dest, path, t: backs.energy(path, dest))
+
+
+def _time_budget(samples: RouteSamples, t_back: np.ndarray, endurance: float,
+                 reserve: float) -> _Budget:
+    """The endurance budget: the mission's clock and the time of each way back."""
+    return _Budget("endurance", "s", endurance * (1.0 - reserve), endurance, samples.time,
+                   t_back, lambda rs: float(rs.time[0]), lambda dest, path, t: float(t))
+
+
+def _pnr_in(mission: MissionExport, samples: RouteSamples, to: list[str], backs: _Backs,
+            b: _Budget, t_back: np.ndarray) -> tuple[dict[str, Any], np.ndarray | None]:
+    """The point of no return in one budget (``vehicles.endurance.first_shortfall``, then a
+    bisection on the straight piece of leg with exact descents)."""
+    u = b.unit
     total = float(samples.distance[-1]) if len(samples) else 0.0
-    base = {"computed": True, "endurance_s": round(endurance, 1), "reserve": reserve,
-            "usable_s": round(usable, 1), "route_distance_m": round(total, 1)}
-    hit = first_shortfall(samples.time, t_back, usable)
+    base = {"computed": True, "budget": b.name, f"usable_{u}": round(b.usable, 3),
+            "route_distance_m": round(total, 1)}
+    hit = first_shortfall(b.spent, b.back, b.usable)
     if hit is None:
-        k = int(np.argmin(usable - samples.time - t_back))
+        k = int(np.argmin(b.usable - b.spent - b.back))
         return {**base, "reached": False, "passed_before_end": False,
-                "smallest_margin_s": round(float(usable - samples.time[k] - t_back[k]), 1),
+                f"smallest_margin_{u}": round(float(b.usable - b.spent[k] - b.back[k]), 3),
                 "smallest_margin_at_m": round(float(samples.distance[k]), 1)}, None
     k, _ = hit
     if k == 0:
         info = {**base, "reached": True, "passed_before_end": True, "distance_m": 0.0,
                 "after_waypoint": 0, "t_mission_s": round(float(samples.time[0]), 1),
-                "return": {"to": to[0] or None, "time_s": _r(t_back[0])},
-                "margin_s": _r(usable - samples.time[0] - t_back[0])}
+                f"spent_{u}": round(float(b.spent[0]), 3),
+                "return": {"to": to[0] or None, "time_s": _r(t_back[0]),
+                           f"{'energy_wh' if u == 'wh' else 'time_s'}": _r(b.back[0])},
+                f"margin_{u}": _r(b.usable - b.spent[0] - b.back[0])}
         return info, None
     # bisection on the straight piece between samples k-1 and k (exact ways back)
     leg = int(samples.leg[k - 1])
     f_lo = float(samples.fraction[k - 1])
     f_hi = float(samples.fraction[k]) if int(samples.leg[k]) == leg else 1.0
     lo = (f_lo, samples.points[k - 1], float(samples.distance[k - 1]), float(samples.time[k - 1]),
-          (to[k - 1], float(t_back[k - 1]), math.nan, None))
+          float(b.spent[k - 1]), (to[k - 1], float(t_back[k - 1]), math.nan, None))
     for _ in range(10):
         f = 0.5 * (f_lo + f_hi)
         rs = route_samples(mission, legs=[(leg, f)])
         back = backs.best(rs.points[:1])[0]
-        if usable - float(rs.time[0]) - back[1] >= 0:
+        spent = b.spent_at(rs)
+        if back[3] is not None and b.usable - spent - b.back_of(back[0], back[3], back[1]) >= 0:
             f_lo = f
-            lo = (f, rs.points[0], float(rs.distance[0]), float(rs.time[0]), back)
+            lo = (f, rs.points[0], float(rs.distance[0]), float(rs.time[0]), spent, back)
         else:
             f_hi = f
-    f, pt, dist, t_out, back = lo
+    f, pt, dist, t_out, spent, back = lo
     if back[3] is None:  # the sample itself: its way back again, with the path
         back = backs.best(np.asarray(pt)[None, :])[0]
     t_b, l_b, thin = backs.timed(back[3], back[0], thin=True)  # as written
+    need = b.back_of(back[0], thin, t_b)
     back = (back[0], t_b, l_b, thin)
     from ..world.geo import to_lonlat
 
     lo_, la_, amsl = to_lonlat(mission.world, [pt], anchor=mission.options.anchor)[0]
     wps = mission.waypoints
+    ret = {"to": back[0], "time_s": round(back[1], 2), "length_m": round(back[2], 1)}
+    if u == "wh":
+        ret["energy_wh"] = round(need, 3)
     info = {
         **base, "reached": True,
         "passed_before_end": bool(dist < total - 1e-6),
@@ -469,11 +550,43 @@ def _pnr(mission: MissionExport, samples: RouteSamples, t_back: np.ndarray, to: 
         "alt_amsl_m": round(float(amsl), 2),
         "point_m": [round(float(v), 2) for v in pt],
         "t_mission_s": round(t_out, 2),
-        "return": {"to": back[0], "time_s": round(back[1], 2), "length_m": round(back[2], 1)},
-        "margin_s": round(usable - t_out - back[1], 3),
+        f"spent_{u}": round(spent, 3) if u == "wh" else round(t_out, 2),
+        "return": ret,
+        f"margin_{u}": round(b.usable - spent - need, 3),
         "waypoints": len(wps),
     }
     return info, back[3]
+
+
+def _pnr(mission: MissionExport, samples: RouteSamples, t_back: np.ndarray, to: list[str],
+         backs: _Backs, energy: np.ndarray, endurance: float | None, reserve: float
+         ) -> tuple[dict[str, Any], np.ndarray | None, _Budget]:
+    """The point of no return: the first reached of the battery's (the energy model along
+    the route and the FM² ways back) and, with an endurance, the endurance's; one figure,
+    saying which budget binds and where the other one lies."""
+    budgets = [_energy_budget(mission, samples, backs, energy)]
+    if endurance is not None:
+        budgets.append(_time_budget(samples, t_back, endurance, reserve))
+    found = [(b, *_pnr_in(mission, samples, to, backs, b, t_back)) for b in budgets]
+    reached = [x for x in found if x[1].get("reached")]
+    b, info, path = (min(reached, key=lambda x: x[1]["distance_m"]) if reached
+                     else found[0])
+    power = backs.power
+    given = "airframe.power" if mission.options.power is not None else "class default"
+    model = (f"energy model {power.model.name} ({given}) along the route and the FM² ways "
+             f"back, battery {power.battery_wh:g} Wh")
+    out = {**info, "reserve": reserve,
+           "battery_wh": round(power.battery_wh, 3),
+           **({"endurance_s": round(endurance, 1)} if endurance is not None else {}),
+           "model": model + (f"; endurance {endurance / 60:.1f} min (constant power)"
+                             if endurance is not None else "; no endurance given "
+                             "(airframe.endurance / --endurance)")}
+    others = {x[0].name: {k: v for k, v in x[1].items() if k in (
+        "reached", "distance_m", "t_mission_s", f"margin_{x[0].unit}",
+        f"smallest_margin_{x[0].unit}")} for x in found if x[0] is not b}
+    if others:
+        out["other_budgets"] = others
+    return out, path, b
 
 
 def _r(v: float) -> float | None:
@@ -573,8 +686,10 @@ def build_with_returns(path_m: Any, world: Any, options: Any, returns: ReturnOpt
         notes.append(f"firmware return made safe: return altitude {alt} (mission.param) clears "
                      f"{min_agl:g} m above the surface on every straight return line")
     # the way back from every point of the final mission
+    from .energy import MissionPower
+
     speeds = _speeds(mission)
-    backs = _Backs(fields, speeds, world, float(opt.flight_alt))
+    backs = _Backs(fields, speeds, world, float(opt.flight_alt), MissionPower.of(mission))
     samples = route_samples(mission, step=float(min(world.spacing[:2])),
                             max_points=returns.max_returns)
     best = backs.best(samples.points)
@@ -585,35 +700,32 @@ def build_with_returns(path_m: Any, world: Any, options: Any, returns: ReturnOpt
     t_back = np.array([b[1] for b in best])
     length = np.array([b[2] for b in best])
     paths = [b[3] for b in best]
-    energy = None
-    if returns.energy is not None:
-        energy = np.array([float(returns.energy(p, speeds["forward_mps"])) if len(p) else math.nan
-                           for p in paths])
+    energy = np.array([backs.energy(p, d) for p, d in zip(paths, to)])
     cut = [i for i, t in enumerate(t_back) if not math.isfinite(t)]
     if cut:
         warnings.append(f"{len(cut)} route point(s) have no way back on the mission's map "
                         f"(first at {samples.distance[cut[0]]:.0f} m along the route)")
     endurance = opt.endurance_s
-    usable = None if endurance is None else endurance * (1.0 - opt.reserve)
-    pnr, pnr_path = _pnr(mission, samples, t_back, to, backs, usable, endurance, opt.reserve)
+    pnr, pnr_path, budget = _pnr(mission, samples, t_back, to, backs, energy, endurance,
+                                 opt.reserve)
     if pnr.get("passed_before_end"):
         msg = (f"point of no return {pnr['distance_m'] / 1000:.2f} km along the route (after "
                f"waypoint {pnr['after_waypoint']}, {pnr['t_mission_s'] / 60:.1f} min into the "
                f"mission): beyond it the vehicle cannot come back "
                f"{'home or to a rally point ' if rally else 'home '}within the "
-               f"{100 * opt.reserve:.0f} % reserve of its {endurance / 60:.1f} min endurance "
-               f"before the route ends")
+               f"{budget.describe(opt.reserve)} before the route ends")
         if returns.strict:
             raise PlanningError(msg + "; refused (--strict / returns.strict): shorten the "
                                 "route, add rally points (--rally auto) or give the airframe's "
-                                "real endurance (--endurance)")
+                                + ("real endurance (--endurance)" if budget.name == "endurance"
+                                   else "real battery and power model (--battery, --power)"))
         warnings.append(msg)
     if pnr.get("computed") and pnr.get("reached"):
         notes.append(f"point of no return: {pnr.get('distance_m', 0) / 1000:.2f} km along the "
                      f"route, {pnr.get('t_mission_s', 0) / 60:.1f} min into the mission")
     elif pnr.get("computed"):
         notes.append("no point of no return on the route: the way back from every point fits "
-                     "the usable endurance")
+                     "the usable battery" + (" and endurance" if endurance is not None else ""))
     params = param_set(fw.params, header=(
         f"fm2uav return settings for {opt.firmware} {opt.vehicle}: "
         + ", ".join(r.model.label + (f" {r.altitude_m:g} m" if r.feasible else
@@ -628,6 +740,10 @@ def build_with_returns(path_m: Any, world: Any, options: Any, returns: ReturnOpt
         embedded=embedded, rally_report=rally_report, warnings=warnings, notes=notes,
         speeds=speeds, endurance_s=endurance, flight_w=flight_w, flight_profile=flight_profile)
     info = {**mission.info, "notes": list(mission.info.get("notes", [])) + notes}
+    if "energy" in info:  # one point of no return: the returns' (the straight one is dropped)
+        info["energy"] = {**{k: v for k, v in info["energy"].items()
+                             if not k.startswith("no_return")},
+                          "no_return": "point_of_no_return (FM² ways back, this energy model)"}
     kept = list(mission.warnings)
     if fw.feasible:  # the RTL line is checked now: the note says how (mission.param)
         kept = [w for w in kept if not w.startswith(RTL_WARNING)]

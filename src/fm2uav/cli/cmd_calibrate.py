@@ -14,9 +14,11 @@ CALIBRATE_FILES = ("power.yaml", "calibration.json")
 
 def _help() -> str:
     return (
-        "Fit the power model of an airframe to the power measured in an ArduPilot flight log "
+        "Fit the power model of an airframe to the power measured in a flight log: ArduPilot "
         "(.tlog from the ground station: SYS_STATUS/BATTERY_STATUS and VFR_HUD; .bin from "
-        "the SD card: BAT, ARSP, GPS): battery voltage x current against airspeed and climb "
+        "the SD card: BAT, ARSP, GPS) or PX4 (.ulg: battery_status, airspeed_validated, "
+        "vehicle_local_position, vehicle_status): battery voltage x current against airspeed "
+        "and climb "
         "rate, linear least squares over the model's coefficients. Writes power.yaml (give "
         "it to --power or airframe.power: the energy of every later mission uses it) and "
         "calibration.json (coefficients, residual, R²).\n\n"
@@ -24,6 +26,7 @@ def _help() -> str:
         "  fm2uav calibrate flight.tlog --power arducopter --mass 2.4 --out out/calib\n\n"
         "  fm2uav calibrate 00000042.BIN --power disco --fit cd0/efficiency --fit "
         "k/efficiency --out out/calib\n\n"
+        "  fm2uav calibrate log_12_2026-5-4-10-20-31.ulg --power crosswind --out out/calib\n\n"
         "The starting model fixes the mass, areas and air density; fly level legs at several "
         "speeds, climbs and descents so that every term shows in the log."
     )
@@ -33,7 +36,7 @@ def _help() -> str:
 @output_options("out/calibrate", json_help="Print the fit as JSON.",
                 report_help="Also write report.html: measured and fitted power along the log.")
 def calibrate_cmd(
-    log_file: Path = typer.Argument(..., help="ArduPilot flight log (.tlog or .bin).",
+    log_file: Path = typer.Argument(..., help="Flight log: ArduPilot .tlog or .bin, PX4 .ulg.",
                                     show_default=False),
     power: str = typer.Option(
         "arducopter", help="Starting power model: a preset (arducopter, disco, crosswind) or "

@@ -1,4 +1,4 @@
-"""Flight logs read with pymavlink: the power and the flight state for the power fit.
+"""Flight logs read with pymavlink and pyulog: the power and the flight state for the power fit.
 
 * **Telemetry logs** (``.tlog``, what a ground station records: each MAVLink message
   after an 8-byte timestamp): the power is ``SYS_STATUS.voltage_battery`` [mV] ×
@@ -9,6 +9,13 @@
   older firmware) ``Volt`` × ``Curr``, the airspeed from ``ARSP.Airspeed`` (the ground
   speed where there is none), ground speed ``GPS.Spd`` and climb ``−GPS.VZ`` (GPS
   velocities are north-east-down).
+* **PX4 logs** (``.ulg``, ULog written on board by PX4, read with pyulog): the power is
+  ``battery_status`` ``voltage_v`` × ``current_a`` (samples with PX4's −1 "unknown
+  current" dropped); the true airspeed is ``airspeed_validated.true_airspeed_m_s``
+  (``airspeed.true_airspeed_m_s`` in logs without it, the ground speed where there is
+  neither); ground speed ``hypot(vx, vy)`` and climb ``−vz`` of ``vehicle_local_position``
+  (north-east-down); samples while ``vehicle_status.arming_state`` is not armed (2) are
+  dropped. The first instance of each topic is read (``multi_id`` 0).
 
 The speeds and climb are interpolated to the power samples' times (never beyond the
 times they cover). Reading computes nothing else; the fit is
@@ -119,8 +126,68 @@ def _bin(path: Path) -> PowerSamples:
                         source=f"{path.name}: {'BAT' if msgs['BAT'] else 'CURR'} x {which}, GPS")
 
 
+_ULOG_TOPICS = ["battery_status", "vehicle_local_position", "airspeed_validated", "airspeed",
+                "vehicle_status"]
+_PX4_ARMED = 2  # vehicle_status.ARMING_STATE_ARMED
+
+
+def _ulg(path: Path) -> PowerSamples:
+    try:
+        from pyulog import ULog
+    except ImportError:  # pragma: no cover - a dependency of fm2uav
+        raise InputError(f"{path}: reading a PX4 .ulg log needs the pyulog package "
+                         "(pip install pyulog)") from None
+    try:
+        log = ULog(str(path), _ULOG_TOPICS)
+    except Exception as exc:  # pyulog raises many kinds on a foreign or truncated file
+        raise InputError(f"{path}: not a ULog file pyulog can read ({exc})") from None
+
+    def topic(name: str, *fields: str) -> dict[str, np.ndarray] | None:
+        for d in log.data_list:
+            if d.name == name and d.multi_id == 0 and all(f in d.data for f in fields):
+                return d.data
+        return None
+
+    bat = topic("battery_status", "timestamp", "voltage_v", "current_a")
+    pos = topic("vehicle_local_position", "timestamp", "vx", "vy", "vz")
+    if bat is None or pos is None:
+        raise InputError(f"{path}: the PX4 log has no battery_status (voltage_v, current_a) or "
+                         "no vehicle_local_position (vx, vy, vz): it cannot calibrate a power "
+                         "model")
+    volts = np.asarray(bat["voltage_v"], float)
+    amps = np.asarray(bat["current_a"], float)
+    good = (volts > 0) & (amps >= 0)
+    tp = np.asarray(bat["timestamp"], float)[good] * 1e-6
+    power = volts[good] * amps[good]
+    if not len(tp):
+        raise InputError(f"{path}: battery_status never measures the current (current_a is "
+                         "-1, unknown, throughout): it cannot calibrate a power model")
+    tl = np.asarray(pos["timestamp"], float) * 1e-6
+    gs = _interp(tp, tl, np.hypot(np.asarray(pos["vx"], float), np.asarray(pos["vy"], float)))
+    climb = _interp(tp, tl, -np.asarray(pos["vz"], float))
+    which = "ground speed as airspeed"
+    air = gs
+    for name in ("airspeed_validated", "airspeed"):
+        a = topic(name, "timestamp", "true_airspeed_m_s")
+        if a is not None:
+            air = _interp(tp, np.asarray(a["timestamp"], float) * 1e-6,
+                          np.asarray(a["true_airspeed_m_s"], float))
+            which = f"{name}.true_airspeed_m_s"
+            break
+    st = topic("vehicle_status", "timestamp", "arming_state")
+    if st is not None:
+        ts = np.asarray(st["timestamp"], float) * 1e-6
+        armed = np.asarray(st["arming_state"]) == _PX4_ARMED
+        k = np.searchsorted(ts, tp, side="right") - 1
+        power = np.where((k >= 0) & armed[np.maximum(k, 0)], power, np.nan)
+    return PowerSamples(tp - tp[0], power, air, climb, gs,
+                        source=f"{path.name}: battery_status voltage_v x current_a, {which}, "
+                               "vehicle_local_position")
+
+
 def read_power_samples(path: str | Path) -> PowerSamples:
-    """The power, airspeed and climb samples of an ArduPilot ``.tlog`` or ``.bin`` log.
+    """The power, airspeed and climb samples of an ArduPilot ``.tlog`` or ``.bin`` log or a
+    PX4 ``.ulg`` log.
 
     Raises
     ------
@@ -130,14 +197,17 @@ def read_power_samples(path: str | Path) -> PowerSamples:
     """
     p = Path(path)
     if not p.is_file():
-        raise InputError(f"flight log {p} not found (give an ArduPilot .bin or .tlog)")
+        raise InputError(f"flight log {p} not found (give an ArduPilot .bin or .tlog, or a PX4 "
+                         ".ulg)")
     ext = p.suffix.lower()
     if ext == ".tlog":
         return _tlog(p)
     if ext in (".bin", ".log"):
         return _bin(p)
+    if ext == ".ulg":
+        return _ulg(p)
     raise InputError(f"flight log {p}: unknown kind {ext!r}; give an ArduPilot DataFlash "
-                     "log (.bin) or a telemetry log (.tlog)")
+                     "log (.bin), a telemetry log (.tlog) or a PX4 log (.ulg)")
 
 
 def write_power_tlog(path: str | Path, samples: PowerSamples, *, volts: float = 14.8,

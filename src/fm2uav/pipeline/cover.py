@@ -18,7 +18,7 @@ from .outputs import write_exports, write_figure, write_json
 from .rows import mission_rows, safety_rows, world_rows
 
 __all__ = ["COVER_EXPORTS", "COVER_FILES", "REPORT", "CoverRun", "run_cover", "cover_outputs",
-           "cover_rows", "band_cell", "sortie_summary", "sortie_rows", "across_wind_angle"]
+           "cover_rows", "band_cell", "cover_sorties", "sortie_rows", "across_wind_angle"]
 
 #: Mission files of a coverage flight (written by fm2uav.io.export_mission).
 COVER_EXPORTS = ("csv", "plan", "wpl", "kml", "kmz", "geojson")
@@ -107,7 +107,8 @@ def run_cover(outdir: Any, world: Any, area: Any, *, area_label: str, spacing: f
                                   title=f"coverage of {area_label}", options=options,
                                   camera=shots, cam=camera)
     doc = {**(summary or {}), **cp.summary(), "autopilot": built.summary(), "safety": safety}
-    sorties = sortie_summary(built, world, options)
+    progress.step("splitting the survey by battery", 0.0)
+    sorties = cover_sorties(outdir, cp, built, shots, options=options, shaping=shaping)
     if sorties is not None:
         doc["sorties"] = sorties
     write_json(outdir, "summary.json", doc)
@@ -248,30 +249,50 @@ def across_wind_angle(wind: Any, world: Any, area: Any) -> float:
     return float((np.degrees(np.arctan2(v, u)) + 90.0) % 180.0)
 
 
-def sortie_summary(mission: Any, world: Any, options: Any) -> dict[str, Any] | None:
-    """The survey split into sorties by battery (:func:`fm2uav.autopilot.energy.mission_sorties`),
-    with every resume point in lon/lat; None when one battery flies it."""
-    from ..autopilot.energy import mission_sorties
-    from ..world.geo import to_lonlat
+def cover_sorties(outdir: Any, cp: Any, mission: Any, camera: Any, *, options: Any,
+                  shaping: Any = None) -> dict[str, Any] | None:
+    """The survey split into sorties by battery, one mission each
+    (:func:`fm2uav.autopilot.sorties.build_sorties`): writes ``sortie-01.plan``,
+    ``sortie-01.waypoints``, ... (every format of :data:`COVER_EXPORTS`) and returns the
+    summary's ``sorties`` (None when one battery flies the survey; ``count`` None and the
+    reason when it cannot be split).
 
-    from ..errors import PlanningError
+    The ways between home and the survey are the FM² return field of home on the
+    planner's map of the survey's world, flight level and ``shaping``; where no field can
+    be marched, straight lines clearing the surface (the summary says which).
+    """
+    from ..autopilot.sorties import build_sorties, field_ways, straight_ways
+    from ..errors import InputError, MissionError, PlanningError
+    from ..io import export_mission
+
+    if (mission.info.get("energy") or {}).get("ok", True):
+        return None
+    world = cp.plan.world
+    home = np.asarray(cp.path[0], dtype=float)
+    agl = None if cp.level is None else float(cp.level.agl)
+    try:
+        ways = field_ways(world, home, shaping=shaping, level=cp.level)
+    except (InputError, PlanningError) as exc:
+        ways = straight_ways(world, home, agl=agl, note=f"straight lines clearing the surface "
+                             f"by the flight level's height (no return field: {exc})")
+
+    def build(plan: Any, opt: Any, **inputs: Any) -> tuple[Any, dict[str, Any]]:
+        return export_mission(plan, COVER_EXPORTS, opt, **inputs)
 
     try:
-        plan = mission_sorties(mission)
-    except PlanningError as exc:
+        found = build_sorties(mission, cp.plan, ways=ways, camera=camera,
+                              fences=mission.fences, agl=agl, build=build)
+    except (PlanningError, MissionError) as exc:
         return {"count": None, "error": str(exc)}
-    if plan is None:
+    if found is None:
         return None
-    out = plan.summary()
-    for s in out["sorties"]:
-        lon, lat, alt = to_lonlat(world, np.array([s["resume_m"]]),
-                                  anchor=getattr(options, "anchor", None))[0]
-        s["resume_lon_lat_alt"] = [round(float(lon), 7), round(float(lat), 7), round(float(alt), 1)]
-    return out
+    for s in found.sorties:
+        write_exports(outdir, s.files)
+    return found.summary(anchor=getattr(options, "anchor", None))
 
 
 def sortie_rows(sorties: dict[str, Any] | None) -> dict[str, str]:
-    """Printed rows of :func:`sortie_summary`."""
+    """Printed rows of :func:`cover_sorties`."""
     if not sorties:
         return {}
     if sorties["count"] is None:
@@ -282,9 +303,14 @@ def sortie_rows(sorties: dict[str, Any] | None) -> dict[str, str]:
                        + (f"{even})" if even is not None else "more: one leg alone is too long)")}
     for k, s in enumerate(sorties["sorties"], 1):
         lon, lat, _ = s["resume_lon_lat_alt"]
+        files = [f for f in s.get("files", ()) if f.endswith((".plan", ".waypoints"))]
         rows[f"sortie {k}"] = (f"legs {s['from_waypoint']}→{s['to_waypoint']}, "
                                f"{s['energy_wh']:.1f} Wh, {s['time_s'] / 60:.1f} min, resume at "
-                               f"{lat:.6f}, {lon:.6f}; straight home")
+                               f"{lat:.6f}, {lon:.6f}"
+                               + (f" (item {s['resume_item']}); {' / '.join(files)}"
+                                  if files else ""))
+    if "ways" in sorties:
+        rows["sorties: ways out and home"] = sorties["ways"]["kind"]
     return rows
 
 

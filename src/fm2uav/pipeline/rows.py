@@ -233,17 +233,21 @@ def returns_rows(info: dict[str, Any]) -> dict[str, str]:
             f"{d['name']} ({d.get('chosen_by', 'user')}) {d.get('lon', 0):.5f}, "
             f"{d.get('lat', 0):.5f}" for d in rally)
     p = r["point_of_no_return"]
+    budget = {"energy": "battery", "endurance": "endurance"}.get(p.get("budget", ""), "")
+    label = "point of no return" + (f" ({budget} binds; FM² ways back)" if budget else "")
     if not p.get("computed"):
         rows["point of no return"] = "not computed: " + p.get("why", "")
     elif p.get("reached"):
-        rows["point of no return"] = (f"{p['distance_m'] / 1000:.2f} km along the route "
-                                      f"(after waypoint {p['after_waypoint']}, "
-                                      f"{p['t_mission_s'] / 60:.1f} min)"
-                                      + (" — BEFORE the route's end" if p["passed_before_end"]
-                                         else ""))
+        rows[label] = (f"{p['distance_m'] / 1000:.2f} km along the route "
+                       f"(after waypoint {p['after_waypoint']}, "
+                       f"{p['t_mission_s'] / 60:.1f} min)"
+                       + (" — BEFORE the route's end" if p["passed_before_end"] else ""))
     else:
-        rows["point of no return"] = (f"none on the route (smallest margin "
-                                      f"{p['smallest_margin_s'] / 60:.1f} min)")
+        margin = (f"{p['smallest_margin_s'] / 60:.1f} min" if "smallest_margin_s" in p
+                  else f"{p['smallest_margin_wh']:.1f} Wh")
+        rows[label] = f"none on the route (smallest margin {margin})"
+    if p.get("model"):
+        rows["point of no return: model"] = p["model"]
     fw = r.get("firmware")
     if fw:
         alts = "; ".join(

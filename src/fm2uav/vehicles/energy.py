@@ -447,10 +447,13 @@ def no_return_point(points: Any, flight: Flight, model: PowerModel, *, home: Any
         ``usable − used − home`` [Wh] at every waypoint (``-inf`` where the way home
         cannot be flown in the wind).
     """
+    from .endurance import first_shortfall
+
     usable = _budget(battery_wh, reserve)
     back = home_legs(points, model, home=home, speed=speed, climb_rate=climb_rate,
                      descent_rate=descent_rate, wind=wind)[2]
-    margin = usable - flight.used_wh() - back
+    used = flight.used_wh()
+    margin = usable - used - back
     margin = np.where(np.isfinite(margin), margin, -np.inf)
-    bad = np.flatnonzero(~(margin >= 0))
-    return (int(bad[0]) - 1 if len(bad) else len(margin) - 1), margin
+    hit = first_shortfall(used, back, usable)  # the returns layer's rule, on waypoints
+    return (hit[0] - 1 if hit is not None else len(margin) - 1), margin
