@@ -20,6 +20,7 @@ Two questions:
 
 from __future__ import annotations
 
+from itertools import chain
 from typing import Any
 
 import numpy as np
@@ -151,8 +152,15 @@ def min_surface_clearances(world: World, paths: list[Any]) -> np.ndarray:
     pts, owner = pts[keep], owner[keep]
     c, _ = _box_tree(world)[0].query(pts)  # the nearest centre exactly
     keep = within(c - half_diag, c, owner)
-    exact = _box_distances(world, pts[keep], c[keep])
-    np.minimum.at(out, owner[keep], exact)
+    pts, owner, c = pts[keep], owner[keep], c[keep]
+    # measure each path's nearest centre first: its exact distance bounds the others
+    order = np.lexsort((c, owner))
+    first = order[np.r_[True, owner[order][1:] != owner[order][:-1]]]
+    np.minimum.at(out, owner[first], _box_distances(world, pts[first], c[first]))
+    rest = np.ones(len(pts), dtype=bool)
+    rest[first] = False
+    rest &= c - half_diag <= out[owner] * (1 + 1e-12) + 1e-12
+    np.minimum.at(out, owner[rest], _box_distances(world, pts[rest], c[rest]))
     return out
 
 
@@ -175,12 +183,14 @@ def _box_distances(world: World, pts: np.ndarray, d_node: np.ndarray) -> np.ndar
     h = np.asarray(world.spacing, dtype=float)
     half_diag = 0.5 * float(np.linalg.norm(h))
     out = np.empty(len(pts))
+    if len(pts) == 0:
+        return out
     chunk = 4096  # points per vectorised batch (bounds the candidate arrays)
     for a in range(0, len(pts), chunk):
         p = pts[a:a + chunk]
         near = tree.query_ball_point(p, d_node[a:a + chunk] + half_diag)
         counts = np.fromiter((len(c) for c in near), dtype=np.int64, count=len(near))
-        idx = np.fromiter((i for c in near for i in c), dtype=np.int64, count=int(counts.sum()))
+        idx = np.fromiter(chain.from_iterable(near), dtype=np.int64, count=int(counts.sum()))
         owner = np.repeat(np.arange(len(p)), counts)
         gap = np.maximum(np.abs(centres[idx] - p[owner]) - 0.5 * h, 0.0)
         dist = np.sqrt((gap * gap).sum(axis=1))
