@@ -94,12 +94,12 @@ def routes_cmd(
     from ..pipeline.routes import ROUTES_FILES, RouteSettings, routes_rows, run_routes
     from ..world.load import world_summary
     from .cmd_plan import _planner
-    from .options import cli_point
+    from .options import lonlat_point
 
-    for value, flag, low in ((speed, "--speed", 0.0), (thin, "--thin", None)):
-        if not np.isfinite(value) or (value <= low if low is not None else value < 0):
-            raise InputError(f"{flag} must be {'> 0 m/s' if low is not None else '>= 0 m'}, "
-                             f"got {value:g}")
+    if not (np.isfinite(speed) and 0.1 <= speed <= 300.0):
+        raise InputError(f"--speed must be a ground speed in [0.1, 300] m/s, got {speed:g}")
+    if not (np.isfinite(thin) and 0.0 <= thin <= 1000.0):
+        raise InputError(f"--thin must be a tolerance in [0, 1000] m, got {thin:g}")
     if threads is not None and threads < 1:
         raise InputError(f"--threads must be at least 1, got {threads}")
     with output.progress():
@@ -108,9 +108,7 @@ def routes_cmd(
                                   default="open-field")
         anchor_ll = parse_anchor(anchor)
         outdir = output.dir(ROUTES_FILES)
-        # a 2D map has no heights: any positive AGL places the goal alone
-        goal_m = cli_point(goal, "goal", w, lonlat=True, agl=agl if w.ndim == 3 else 1.0,
-                           anchor=anchor_ll)
+        goal_m = lonlat_point(goal, "goal", w, agl=agl, anchor=anchor_ll)
         if no_fly:
             from ..io.zone_spec import zones_from_cli
             from ..world.zones import check_points_allowed, with_zones
