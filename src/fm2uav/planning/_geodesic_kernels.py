@@ -156,16 +156,19 @@ def _smoothing(h, hmin):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _bspline_weights(x, n, lam):
+def _bspline_weights(x, n, lam, w):
     """Uniform cubic B-spline weights of the 4 nodes around ``x`` on an axis of ``n``.
 
-    Returns ``(i0 - 1, (w0, w1, w2, w3))``: the first node and the weights of nodes
-    ``i0 - 1 .. i0 + 2`` (``i0 = floor(x)``, summing to 1), a tuple rather than an
-    array (no allocation in the descent's hot loop). A single-node axis gets weight 1
-    on node 0. Nodes off the grid are skipped by the caller.
+    Fills ``w[0:4]`` (weights of nodes ``i0 - 1 .. i0 + 2``, ``i0 = floor(x)``,
+    summing to 1) and returns ``i0 - 1``. A single-node axis gets weight 1 on
+    node 0. Nodes off the grid are skipped by the caller.
     """
     if n == 1:
-        return 0, (1.0, 0.0, 0.0, 0.0)
+        w[0] = 1.0
+        w[1] = 0.0
+        w[2] = 0.0
+        w[3] = 0.0
+        return 0
     i0 = int(math.floor(x))
     if i0 > n - 2:
         i0 = n - 2
@@ -173,10 +176,11 @@ def _bspline_weights(x, n, lam):
         i0 = 0
     f = x - i0
     g = 1.0 - f
-    return i0 - 1, (lam * g * g * g / 6.0,
-                    lam * (3.0 * f * f * f - 6.0 * f * f + 4.0) / 6.0 + (1.0 - lam) * g,
-                    lam * (3.0 * g * g * g - 6.0 * g * g + 4.0) / 6.0 + (1.0 - lam) * f,
-                    lam * f * f * f / 6.0)
+    w[0] = lam * g * g * g / 6.0
+    w[1] = lam * (3.0 * f * f * f - 6.0 * f * f + 4.0) / 6.0 + (1.0 - lam) * g
+    w[2] = lam * (3.0 * g * g * g - 6.0 * g * g + 4.0) / 6.0 + (1.0 - lam) * f
+    w[3] = lam * f * f * f / 6.0
+    return i0 - 1
 
 
 @njit(cache=True, error_model="numpy")
@@ -197,9 +201,12 @@ def _direction(T, x, y, z, hx, hy, hz, hmin, smooth):
     blend vanishes.
     """
     nx, ny, nz = T.shape
-    ia, wx = _bspline_weights(x, nx, smooth * _smoothing(hx, hmin))
-    ja, wy = _bspline_weights(y, ny, smooth * _smoothing(hy, hmin))
-    ka, wz = _bspline_weights(z, nz, smooth * _smoothing(hz, hmin))
+    wx = np.empty(4)
+    wy = np.empty(4)
+    wz = np.empty(4)
+    ia = _bspline_weights(x, nx, smooth * _smoothing(hx, hmin), wx)
+    ja = _bspline_weights(y, ny, smooth * _smoothing(hy, hmin), wy)
+    ka = _bspline_weights(z, nz, smooth * _smoothing(hz, hmin), wz)
     gx = 0.0
     gy = 0.0
     gz = 0.0

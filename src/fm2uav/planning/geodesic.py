@@ -67,6 +67,7 @@ the goal is appended exactly and the descent stops.
 from __future__ import annotations
 
 from collections.abc import Sequence
+import threading
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
@@ -530,6 +531,8 @@ def descend_stopped(
     order, vals = _sorted_nodes(flat, np.isfinite(flat) & ~in_ball.reshape(-1)
                                 & (flat >= (late[-1][0] if late else np.inf)))
 
+    stop = threading.Event()
+
     def run(items: list, base: np.ndarray, sweep: bool) -> None:
         work = base.copy()
         work_nd = work.reshape(shape)
@@ -537,6 +540,8 @@ def descend_stopped(
         hi = len(vals)  # vals[hi:] are inf in work
         batch: list[int] = []
         for t, sflat, k, s in items:
+            if stop.is_set():  # the caller was interrupted: leave at once
+                return
             if on_done is not None and len(batch) >= _BATCH:
                 on_done(batch, [out[b] for b in batch])
                 batch = []
@@ -581,6 +586,11 @@ def descend_stopped(
             run(*task)
     else:
         with ThreadPoolExecutor(max_workers=int(threads)) as pool:
-            for f in [pool.submit(run, *task) for task in tasks]:
-                f.result()
+            futures = [pool.submit(run, *task) for task in tasks]
+            try:
+                for f in futures:
+                    f.result()
+            except BaseException:  # Ctrl-C or a failing on_done: stop the other threads
+                stop.set()
+                raise
     return out
