@@ -152,7 +152,27 @@ def light_sweep(path: Path) -> Path:
     return path
 
 
+def addresses(path: Path) -> Path:
+    """docs/operator.md section 11: delivery addresses on the built-in 2D city (lon/lat at
+    the default anchor): 40 seeded points of its free streets, one on a building, one off
+    the map."""
+    from fm2uav.scenarios import get_scenario
+    from fm2uav.world.geo import to_lonlat
+
+    w = get_scenario("city2d").world
+    free = np.argwhere(~w.occupancy)
+    rng = np.random.default_rng(27)
+    pts = w.to_world(free[rng.choice(len(free), 40, replace=False)].astype(float))
+    built = w.to_world(np.argwhere(w.occupancy)[0].astype(float))
+    pts = np.vstack([pts, built, [-60.0, 20.0]])
+    ll = to_lonlat(w, pts)
+    rows = [f"{lo:.8f},{la:.8f},addr-{k + 1:02d}" for k, (lo, la) in enumerate(ll[:, :2])]
+    path.write_text("lon,lat,id\n" + "\n".join(rows) + "\n")
+    return path
+
+
 FILES = {
+    "addresses.csv": addresses,
     "country.tif": dc.country,
     "neighbour_90m.tif": dc.neighbour,
     "coast.tif": gd.topo_bathy,

@@ -37,8 +37,8 @@ __all__ = [
     "NodataOpt", "NodataValueOpt", "CrsOpt", "DefaultHeightOpt", "AllowFilledOpt", "LonLatOpt",
     "GroundElevationOpt", "MarginOpt",
     "ScenarioOpt", "SCENARIO_NAMES", "AIRFRAME_NAMES", "WORLD_FLAGS", "world_spec",
-    "build_world", "cli_point", "world_rows", "requested_heights", "world_overrides",
-    "point_overrides", "option_group", "WorldFlags", "world_options", "MissionFlags",
+    "build_world", "cli_point", "lonlat_point", "world_rows", "requested_heights",
+    "world_overrides", "point_overrides", "option_group", "WorldFlags", "world_options", "MissionFlags",
     "MISSION_FLAGS", "mission_options", "output_options", "NoFlyOpt", "MinAglOpt", "MaxAglOpt",
     "SaturationDistanceOpt", "SafetyFlags", "safety_options",
 ]
@@ -315,28 +315,42 @@ def cli_point(text: str | None, what: str, world: Any, *, lonlat: bool = False,
     if lonlat and cells:
         raise InputError("give --lonlat or --cells, not both")
     if lonlat:
-        from ..io.mission import PointSpec, resolve_point
-
-        parts = [p for p in text.replace(",", " ").split() if p]
-        try:
-            v = [float(p) for p in parts]
-        except ValueError:
-            v = []
-        if len(v) not in (2, 3):
-            raise InputError(f"--{what} with --lonlat must be LON,LAT or LON,LAT,AGL (degrees, "
-                             f"degrees, metres above the ground), got {text!r}")
-        if not (-180 <= v[0] <= 180 and -90 <= v[1] <= 90):
-            raise InputError(f"--{what} = {text!r}: longitude must be in [-180, 180] and "
-                             "latitude in [-90, 90] degrees (order LON,LAT)")
-        h = v[2] if len(v) == 3 else agl
-        if h is None:
-            raise InputError(f"--{what} {text!r} has no height: add ,AGL (metres above the "
-                             "ground) or give --agl")
-        if h <= 0:
-            raise InputError(f"--{what}: the height above ground must be > 0 m, got {h:g}")
-        return resolve_point(PointSpec(lon=v[0], lat=v[1], agl=float(h)), world, anchor, what)
+        return lonlat_point(text, what, world, agl=agl, anchor=anchor)
     p = parse_point(text, world.ndim, what)
     return world.to_world(p) if cells else p
+
+
+def lonlat_point(text: str, what: str, world: Any, *, agl: float | None = None,
+                 anchor: Any = None) -> np.ndarray:
+    """A ``--<what> LON,LAT[,AGL]`` value in world metres (through the world's CRS, or
+    ``anchor`` on a built-in scenario; AGL metres above the ground, default ``agl``; a 2D
+    map takes no height).
+
+    Raises
+    ------
+    InputError
+        Not 2 or 3 numbers, not a WGS84 position, no height on a 3D map, a height <= 0.
+    """
+    from ..io.mission import PointSpec, resolve_point
+
+    parts = [p for p in text.replace(",", " ").split() if p]
+    try:
+        v = [float(p) for p in parts]
+    except ValueError:
+        v = []
+    if len(v) not in (2, 3):
+        raise InputError(f"--{what} must be LON,LAT or LON,LAT,AGL (degrees, degrees, metres "
+                         f"above the ground), got {text!r}")
+    if not (-180 <= v[0] <= 180 and -90 <= v[1] <= 90):
+        raise InputError(f"--{what} = {text!r}: longitude must be in [-180, 180] and "
+                         "latitude in [-90, 90] degrees (order LON,LAT)")
+    h = v[2] if len(v) == 3 else (agl if world.ndim == 3 else 1.0)  # 2D: xy alone
+    if h is None:
+        raise InputError(f"--{what} {text!r} has no height: add ,AGL (metres above the "
+                         "ground) or give --agl")
+    if h <= 0:
+        raise InputError(f"--{what}: the height above ground must be > 0 m, got {h:g}")
+    return resolve_point(PointSpec(lon=v[0], lat=v[1], agl=float(h)), world, anchor, what)
 
 
 def requested_heights(*texts: str | None, lonlat: bool, agl: float | None

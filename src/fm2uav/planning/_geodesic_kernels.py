@@ -563,8 +563,9 @@ def _nanmax(a):
 
 
 # --------------------------------------------------------------------------- kernel
-# long on purpose: one compiled loop (numba kernel); helpers would add calls in the hot path
-@njit(cache=True, error_model="numpy")
+# long on purpose: one compiled loop (numba kernel); helpers would add calls in the hot path;
+# nogil: the many-routes descent (geodesic.descend_stopped) runs it in several threads
+@njit(cache=True, error_model="numpy", nogil=True)
 def descend_kernel(T, start, goal, hx, hy, hz, step, max_steps):
     """Descend ``T`` from ``start`` to ``goal``; see the module docstring.
 

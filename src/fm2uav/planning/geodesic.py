@@ -67,6 +67,8 @@ the goal is appended exactly and the descent stops.
 from __future__ import annotations
 
 from collections.abc import Sequence
+import threading
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
@@ -76,7 +78,8 @@ from ..eikonal.fmm import as_spacing
 from ..errors import InputError, PlanningError, PointError, UnreachableError
 from . import _geodesic_kernels as _k
 
-__all__ = ["descend", "descend_batch", "nearest_node", "default_max_steps"]
+__all__ = ["descend", "descend_batch", "descend_stopped", "drop_ties", "nearest_node",
+           "default_max_steps"]
 
 
 def nearest_node(points: Any) -> np.ndarray:
@@ -383,4 +386,211 @@ def descend_batch(
         s = _as_point(start, shape, "start")
         _check_start(field, mask, s, g)
         out.append(_run(field, field3, h3, s, g, gn, step, max_steps))
+    return out
+
+
+def drop_ties(T: np.ndarray, node: tuple[int, ...]) -> np.ndarray:
+    """``inf``, in place, on every node whose time equals ``T[node]``, except ``node``.
+
+    A march stopped as soon as ``node`` froze (``fast_marching(..., stop_at=[node])``)
+    has frozen the nodes of a smaller time, and, of the nodes of exactly the same time,
+    whichever its queue popped first (ties in any order). Dropping those ties makes the
+    field the start ``node`` descends a function of the times alone, so that
+    :func:`descend_stopped` can rebuild it from a whole march (what :func:`fm2uav.plan`
+    and :func:`fm2uav.planning.many.plan_many` share).
+
+    Parameters
+    ----------
+    T : ndarray
+        Arrival times [s] of a march stopped at ``node`` (written in place).
+    node : tuple of int
+        The stop node.
+
+    Returns
+    -------
+    ndarray
+        ``T`` itself.
+    """
+    t = T[node]
+    if np.isfinite(t):
+        ties = T == t
+        if np.count_nonzero(ties) > 1:
+            T[ties] = np.inf
+            T[node] = t
+    return T
+
+
+def _sorted_nodes(values: np.ndarray, where: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Flat indices of the nodes ``where`` is True, sorted by ``values``, and their values."""
+    idx = np.flatnonzero(where)
+    v = values[idx]
+    order = np.argsort(v, kind="stable")
+    return idx[order], v[order]
+
+
+#: Starts per call of ``descend_stopped``'s ``on_done``.
+_BATCH = 256
+
+
+def descend_stopped(
+    T: Any,
+    starts: Sequence[Any],
+    goal: Any,
+    *,
+    frozen: Any,
+    spacing: float | Sequence[float] = 1.0,
+    blocked: Any = None,
+    step: float = 0.5,
+    max_steps: int | None = None,
+    threads: int = 1,
+    on_done: Any = None,
+) -> list[np.ndarray | Exception]:
+    """Descents of one whole march from many starts, each as a march stopped there sees it.
+
+    :func:`fm2uav.plan` marches from the goal only until the start freezes
+    (``stop_at``) and descends that field: nodes later than the start are ``inf``
+    there, which the descent reads (the smoothing blends free nodes only). This gives
+    every start exactly that field, rebuilt from one march to the end: the nodes frozen
+    before the march (``frozen``, the source ball), and of the others those earlier than
+    the start; the start's ties dropped on both sides (:func:`drop_ties`). So each path
+    equals :func:`descend` of ``drop_ties(fast_marching(..., stop_at=[start]))``, element
+    for element, at the cost of one march and one descent per start.
+
+    Starts are taken from the latest to the earliest, each thread on its own copy of the
+    field, which it makes ``inf`` from the top as the starts get earlier (one sort of the
+    nodes, no copy per start).
+
+    Parameters
+    ----------
+    T : array_like, shape (nx, ny) or (nx, ny, nz)
+        Arrival times [s] of a march from ``goal``'s nearest node, to the end (no stop).
+    starts : sequence of array_like
+        Start points in index coordinates [cells].
+    goal : array_like
+        The source in index coordinates [cells].
+    frozen : array_like, same shape as ``T``
+        The times frozen before the march (``fast_marching(speed, [goal_node],
+        stop_at=[goal_node])``: the source and its ball), ``inf`` elsewhere.
+    spacing, blocked, step, max_steps
+        As :func:`descend`.
+    threads : int, optional
+        Threads running the descents (the compiled kernel releases the GIL). Default 1.
+    on_done : callable, optional
+        Called as ``on_done(positions, results)`` in the descending thread after every
+        few hundred starts (positions in ``starts``, their entries of the returned list):
+        the caller's work on finished paths overlaps the other threads' descents.
+
+    Returns
+    -------
+    list
+        Per start, its path (N, ndim) in index coordinates, or the error :func:`descend`
+        would raise for it (:class:`~fm2uav.errors.PointError` outside the grid or in a
+        blocked node, :class:`~fm2uav.errors.UnreachableError` never reached,
+        :class:`~fm2uav.errors.PlanningError` stuck), as an exception object.
+
+    Raises
+    ------
+    fm2uav.InputError
+        Bad ``T``, ``frozen``, spacing, step or goal; ``threads`` < 1.
+    fm2uav.PlanningError
+        ``T`` not a march from the goal (:func:`descend`).
+    """
+    field = _as_field(T)
+    shape = field.shape
+    h = as_spacing(spacing, field.ndim)
+    step, max_steps = _check_step(step, max_steps, shape, h)
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
+        raise InputError(f"threads must be a positive integer, got {threads!r}")
+    ball = np.asarray(frozen, dtype=float)
+    if ball.shape != shape:
+        raise InputError(f"frozen has shape {ball.shape} but T has shape {shape}; they must match")
+    g = _as_point(goal, shape, "goal")
+    field, mask = _with_blocked(field, blocked)
+    gn = _check_goal(field, mask, g)
+    in_ball = np.isfinite(ball)
+    if mask is not None:
+        in_ball &= ~mask
+    flat = field.reshape(-1)
+    ball_field = np.where(in_ball, field, np.inf).reshape(-1)
+    out: list[Any] = [None] * len(starts)
+    late: list[tuple[float, int, int, np.ndarray]] = []  # (time, flat node, k, start)
+    near: list[tuple[float, int, int, np.ndarray]] = []
+    for k, start in enumerate(starts):
+        try:
+            s = _as_point(start, shape, "start")
+            _check_start(field, mask, s, g)
+        except (PlanningError, InputError) as exc:
+            out[k] = exc
+            continue
+        sn = tuple(nearest_node(s).tolist())
+        item = (float(field[sn]), int(np.ravel_multi_index(sn, shape)), k, s)
+        (near if in_ball[sn] else late).append(item)
+    late.sort(key=lambda it: -it[0])
+    ball_idx, ball_vals = _sorted_nodes(flat, in_ball.reshape(-1))
+    # the nodes outside the ball a march stopped at the earliest start has not frozen
+    order, vals = _sorted_nodes(flat, np.isfinite(flat) & ~in_ball.reshape(-1)
+                                & (flat >= (late[-1][0] if late else np.inf)))
+
+    stop = threading.Event()
+
+    def run(items: list, base: np.ndarray, sweep: bool) -> None:
+        work = base.copy()
+        work_nd = work.reshape(shape)
+        work3, h3 = _padded(work_nd, h)
+        hi = len(vals)  # vals[hi:] are inf in work
+        batch: list[int] = []
+        for t, sflat, k, s in items:
+            if stop.is_set():  # the caller was interrupted: leave at once
+                return
+            if on_done is not None and len(batch) >= _BATCH:
+                on_done(batch, [out[b] for b in batch])
+                batch = []
+            batch.append(k)
+            if sweep:
+                lo = int(np.searchsorted(vals, t, side="left"))
+                if lo < hi:
+                    work[order[lo:hi]] = np.inf
+                    hi = lo
+                work[sflat] = t
+            a = int(np.searchsorted(ball_vals, t, side="left"))
+            b = int(np.searchsorted(ball_vals, t, side="right"))
+            ties = ball_idx[a:b]
+            ties = ties[ties != sflat]
+            work[ties] = np.inf
+            try:
+                out[k] = _run(work_nd, work3, h3, s, g, gn, step, max_steps)
+            except PlanningError as exc:
+                out[k] = exc
+            work[ties] = flat[ties]
+            if sweep:
+                work[sflat] = np.inf
+        if on_done is not None and batch:
+            on_done(batch, [out[b] for b in batch])
+
+    if on_done is not None:
+        bad = [k for k, r in enumerate(out) if r is not None]  # refused before descending
+        if bad:
+            on_done(bad, [out[b] for b in bad])
+    tasks: list[tuple[list, np.ndarray, bool]] = []
+    if near:
+        tasks.append((near, ball_field, False))
+    # several chunks per thread, taken as threads free up: the latest starts have the
+    # longest paths, so equal shares of the starts are not equal work
+    n_chunks = max(1, min(int(threads) * (4 if threads > 1 else 1), len(late)))
+    for c in range(n_chunks):
+        part = late[c * len(late) // n_chunks:(c + 1) * len(late) // n_chunks]
+        if part:
+            tasks.append((part, flat, True))
+    if threads == 1 or len(tasks) == 1:
+        for task in tasks:
+            run(*task)
+    else:
+        with ThreadPoolExecutor(max_workers=int(threads)) as pool:
+            futures = [pool.submit(run, *task) for task in tasks]
+            try:
+                for f in futures:
+                    f.result()
+            except BaseException:  # Ctrl-C or a failing on_done: stop the other threads
+                stop.set()
+                raise
     return out

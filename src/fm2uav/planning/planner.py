@@ -23,11 +23,11 @@ from ..eikonal.velocity import distance_map, distance_scale, normalise_distance,
 from ..errors import InputError, PlanningError, PointError, UnreachableError
 from ..geometry import path_length
 from ..world import World
-from ..world.clearance import surface_clearance
+from ..world.clearance import min_surface_clearances
 from ..world.zones import check_points_allowed, zone_violations
 from .altitude import AltitudeProfile, final_profile, height_figures
 from .flight_level import flight_level_speed
-from .geodesic import descend
+from .geodesic import descend, drop_ties
 from .params import FlightLevel, PlanOptions, Shaping, plan_params
 from .wind import PathTiming, WindOptions, descend_track, path_timing, wind_times
 from .regional import check_full_grid, plan_regional, use_regional
@@ -365,6 +365,9 @@ def plan(
                           (t_all, t0, t1, t2), wind=wind, track=track, refused=refused)
     T = fast_marching(W, [goal_cell], spacing=world.spacing, order=options.order,
                       stop_at=[start_cell])
+    # the nodes of the start's time that the queue froze before it are dropped: the field
+    # is then a function of the times alone, which plan_many rebuilds from one whole march
+    drop_ties(T, start_cell)
     t2 = time.perf_counter()
     return trace_plan(world, W, T, start_m, goal_m, shaping, level, options,
                       (t_all, t0, t1, t2))
@@ -420,6 +423,25 @@ def plan_velocity(world: World, shaping: Shaping, level: FlightLevel | None,
     return W
 
 
+def unreachable_error(start_m: np.ndarray, goal_m: np.ndarray) -> UnreachableError:
+    """The error of a start the wave from the goal never reached (points in metres)."""
+    return UnreachableError(
+        f"the goal {np.round(goal_m, 3).tolist()} m cannot be reached from the start "
+        f"{np.round(start_m, 3).tolist()} m: no free connection between them; move one "
+        "of them into the other's free region or clear the separating obstacles")
+
+
+def stuck_error(start_m: np.ndarray, goal_m: np.ndarray, shaping: Shaping,
+                exc: Exception) -> PlanningError:
+    """The error of a descent stuck on a reached start (``exc``: the descent's own)."""
+    return PlanningError(
+        f"no path could be traced from the start {np.round(start_m, 3).tolist()} m to the "
+        f"goal {np.round(goal_m, 3).tolist()} m although the goal is reachable: W is too "
+        f"small along the only passage (exponent {shaping.exponent:g}); lower "
+        "planner.exponent (CLI --exponent), raise planner.saturation (--saturation) or use "
+        f"a finer grid ({exc})")
+
+
 def trace_plan(world: World, W: np.ndarray, T: np.ndarray, start_m: np.ndarray,
                goal_m: np.ndarray, shaping: Shaping, level: FlightLevel | None,
                options: PlanOptions, marks: tuple[float, float, float, float], *,
@@ -432,7 +454,6 @@ def trace_plan(world: World, W: np.ndarray, T: np.ndarray, start_m: np.ndarray,
     after the march) for the timings. In a wind (``wind``), the path follows the
     march's ground ``track`` (:func:`fm2uav.planning.wind.descend_track`).
     """
-    t_all, t0, t1, t2 = marks
     start_cell = world.to_cell(start_m, what="start")
     if not np.isfinite(T[start_cell]) and wind is not None:
         raise UnreachableError(
@@ -442,11 +463,7 @@ def trace_plan(world: World, W: np.ndarray, T: np.ndarray, start_m: np.ndarray,
             "least the safe airspeed W x airspeed are refused and close every way; fly "
             "faster (--cruise-speed / --hover-speed), lower the saturation, or fly another day")
     if not np.isfinite(T[start_cell]):
-        raise UnreachableError(
-            f"the goal {np.round(goal_m, 3).tolist()} m cannot be reached from the start "
-            f"{np.round(start_m, 3).tolist()} m: no free connection between them; move one "
-            "of them into the other's free region or clear the separating obstacles"
-        )
+        raise unreachable_error(start_m, goal_m)
     # descend() never enters nodes with T = inf; obstacles have W = 0, hence
     # T = inf, unless a custom speed map gave them a speed: only then pass the
     # mask (it costs a copy of T, ~1 s on a 40M-node map).
@@ -467,31 +484,90 @@ def trace_plan(world: World, W: np.ndarray, T: np.ndarray, start_m: np.ndarray,
                 step=options.step,
             )
     except PlanningError as exc:  # "descent ... stuck": T reached the start, W too dark
-        raise PlanningError(
-            f"no path could be traced from the start {np.round(start_m, 3).tolist()} m to the "
-            f"goal {np.round(goal_m, 3).tolist()} m although the goal is reachable: W is too "
-            f"small along the only passage (exponent {shaping.exponent:g}); lower "
-            "planner.exponent (CLI --exponent), raise planner.saturation (--saturation) or use "
-            f"a finer grid ({exc})") from None
-    path = world.to_world(path_idx)
-    profile = None
-    if level is not None and level.heights == "ground" and world.ndim == 3:
-        # heights from the continuous ground along the FM² route (issue 13); with a
-        # custom speed map (route legs re-use the first leg's W) the level still sets them
+        raise stuck_error(start_m, goal_m, shaping, exc) from None
+    return finish_plan(world, W, T, path_idx, shaping, level, options, marks, wind=wind,
+                       refused=refused)
+
+
+def finish_plan(world: World, W: np.ndarray, T: np.ndarray, path_idx: np.ndarray,
+                shaping: Shaping, level: FlightLevel | None, options: PlanOptions,
+                marks: tuple[float, float, float, float], *, wind: WindOptions | None = None,
+                refused: np.ndarray | None = None) -> Plan:
+    """The :class:`Plan` of a descended path: :func:`finish_plans` of one path.
+
+    Raises
+    ------
+    PlanningError
+        No altitude profile meets the flight level's limits; the path enters a zone (a bug).
+    """
+    out = finish_plans(world, W, T, [path_idx], shaping, level, options, marks, wind=wind,
+                       refused=refused)[0]
+    if isinstance(out, PlanningError):
+        raise out
+    return out
+
+
+def finish_plans(world: World, W: np.ndarray, T: np.ndarray, paths_idx: list[np.ndarray],
+                 shaping: Shaping, level: FlightLevel | None, options: PlanOptions,
+                 marks: tuple[float, float, float, float], *,
+                 wind: WindOptions | None = None, refused: np.ndarray | None = None
+                 ) -> list[Plan | PlanningError]:
+    """The :class:`Plan` of each descended path: final heights, zone check, W, length, clearance.
+
+    The end of :func:`trace_plan` (one path) and of
+    :func:`fm2uav.planning.many.plan_many` (every route of a wave): one routine for the
+    altitude profile and the figures of every path. W along the paths and their
+    clearances are read for all the paths at once (the same numbers as path by path).
+
+    Parameters
+    ----------
+    paths_idx : list of ndarray, shape (N, ndim)
+        The descents in index coordinates [cells], start first, goal last.
+    marks : tuple of 4 float
+        Perf-counter times (start, before W, after W, after the march) for the timings
+        (with several paths, the batch's: ``geodesic`` and ``metrics`` cover every path).
+
+    Returns
+    -------
+    list
+        Per path its :class:`Plan`, or the :class:`~fm2uav.errors.PlanningError` it
+        raised (no altitude profile meets the flight level's limits; the path enters a
+        zone: a bug).
+    """
+    t_all, t0, t1, t2 = marks
+    finals: list[tuple[np.ndarray, np.ndarray, AltitudeProfile | None] | PlanningError] = []
+    heights = level is not None and level.heights == "ground" and world.ndim == 3
+    if heights:
         progress.step("heights above the ground", 1.0)
-        profile = final_profile(world, path, level)
-        path = profile.path
-        path_idx = world.to_index(path)
-    if world.zones:
-        bad = zone_violations(world, path)
-        if bad:  # the zone nodes are obstacles: this is a bug, never a user error
-            raise PlanningError(
-                f"the planned path enters {bad[0].zone!r} at {np.round(bad[0].point, 1).tolist()}"
-                " m; please report this (the zones were rasterised too thinly)")
+    for path_idx in paths_idx:
+        path = world.to_world(path_idx)
+        profile = None
+        try:
+            if heights:
+                # heights from the continuous ground along the FM² route (issue 13); with a
+                # custom speed map (route legs re-use the first leg's W) the level still
+                # sets them
+                profile = final_profile(world, path, level)
+                path = profile.path
+                path_idx = world.to_index(path)
+            if world.zones:
+                bad = zone_violations(world, path)
+                if bad:  # the zone nodes are obstacles: this is a bug, never a user error
+                    raise PlanningError(
+                        f"the planned path enters {bad[0].zone!r} at "
+                        f"{np.round(bad[0].point, 1).tolist()} m; please report this (the "
+                        "zones were rasterised too thinly)")
+        except PlanningError as exc:
+            finals.append(exc)
+            continue
+        finals.append((path, path_idx, profile))
     t3 = time.perf_counter()
-    w = ndimage.map_coordinates(W, path_idx.T, order=1, mode="nearest")
-    length = path_length(path)
-    clearance = float(surface_clearance(world, path).min())
+    done = [f for f in finals if not isinstance(f, PlanningError)]
+    if done:
+        ends = np.cumsum([len(f[0]) for f in done])[:-1]
+        w_all = np.split(ndimage.map_coordinates(
+            W, np.concatenate([f[1] for f in done]).T, order=1, mode="nearest"), ends)
+        clear_all = min_surface_clearances(world, [f[0] for f in done])
     t4 = time.perf_counter()
     timings = {
         "velocity_map": t1 - t0,
@@ -500,27 +576,38 @@ def trace_plan(world: World, W: np.ndarray, T: np.ndarray, start_m: np.ndarray,
         "metrics": t4 - t3,
         "total": t4 - t_all,
     }
-    params = plan_params(shaping, level, options)
-    timing = None
-    if wind is not None:
-        timing = path_timing(world, path, w, wind)
-        params["wind"] = {**wind.summary(), "refused_nodes": int(refused.sum())
-                          if refused is not None else 0, **timing.summary()}
-    return Plan(
-        path=path,
-        w=w,
-        length=length,
-        clearance=clearance,
-        timings=timings,
-        W=W,
-        T=T,
-        world=world,
-        params=params,
-        shaping=shaping,
-        level=level if options.speed_map is None else None,
-        profile=profile,
-        wind_timing=timing,
-    )
+    base_params = plan_params(shaping, level, options)
+    out: list[Plan | PlanningError] = []
+    k = 0
+    for f in finals:
+        if isinstance(f, PlanningError):
+            out.append(f)
+            continue
+        path, _, profile = f
+        w, clearance = w_all[k], float(clear_all[k])
+        k += 1
+        params = dict(base_params)
+        timing = None
+        if wind is not None:
+            timing = path_timing(world, path, w, wind)
+            params["wind"] = {**wind.summary(), "refused_nodes": int(refused.sum())
+                              if refused is not None else 0, **timing.summary()}
+        out.append(Plan(
+            path=path,
+            w=w,
+            length=path_length(path),
+            clearance=clearance,
+            timings=dict(timings),
+            W=W,
+            T=T,
+            world=world,
+            params=params,
+            shaping=shaping,
+            level=level if options.speed_map is None else None,
+            profile=profile,
+            wind_timing=timing,
+        ))
+    return out
 
 
 def _check_objects(shaping: Any, level: Any, options: Any) -> None:

@@ -1,0 +1,147 @@
+"""``fm2uav routes``: the FM² route from every start of a file to one goal, from one wave."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from ..errors import InputError
+from ._common import Output, handle_errors
+from .options import (
+    ScenarioOpt,
+    WorldFlags,
+    output_options,
+    world_options,
+    world_rows,
+)
+from ._mission_options import parse_anchor
+
+ROUTES_HELP = (
+    "Plan the FM² route from every start of a file to one goal with one Fast Marching "
+    "wave (the same W, shaping, flight level and limits as fm2uav plan; each route is "
+    "the one fm2uav plan gives from its start) and write routes.geojson, routes.csv and "
+    "summary.json. Starts that cannot be planned (outside the map, in an obstacle or a "
+    "no-fly zone, cut off from the goal, ...) are listed with the reason; the command "
+    "fails (exit 1) only when no start gets a route.\n\n"
+    "--starts: a CSV with a header naming lon,lat (WGS84 degrees) and optionally id and "
+    "agl (metres above the ground), or a GeoJSON/GeoPackage/Shapefile/KML of points (any "
+    "CRS; ids from --id-field).\n\n"
+    "Examples:\n\n"
+    "  fm2uav routes --scenario city2d --goal=-3.7630,40.3334 --starts addresses.csv "
+    "--out out/routes\n\n"
+    "  fm2uav routes --dem dem.tif --goal 10.12,45.60 --starts drops.geojson --agl 120 "
+    "--out out/fleet"
+)
+
+
+@handle_errors
+@output_options("out/routes")
+@world_options
+def routes_cmd(
+    goal: str = typer.Option(..., help="Goal (the depot) LON,LAT[,AGL]: degrees, degrees, "
+                             "metres above the ground (default --agl)."),
+    starts: Path = typer.Option(..., help="Starts file: CSV lon,lat[,id][,agl] with a "
+                                "header, or a vector file of points."),
+    scenario: ScenarioOpt = None,
+    id_field: str | None = typer.Option(
+        None, "--id-field", help="Property with each point's id (points files; default "
+        "'id', else 'name', else the feature number)."),
+    saturation: float = typer.Option(1.0, help="Saturation α in (0, 1]."),
+    saturation_distance: float | None = typer.Option(
+        None, help="Distance (m) from the obstacles beyond which W = 1 (overrides "
+        "--saturation)."),
+    exponent: float = typer.Option(1.0, help="Exponent β > 0 on W."),
+    order: int = typer.Option(2, help="Fast Marching order, 1 or 2."),
+    agl: float | None = typer.Option(
+        None, help="Flight level (m) above the ground (terrain-following); also the height "
+        "of starts without their own. Default: none."),
+    p1: float = typer.Option(0.5, help="Exponent on the flight-level cells (with --agl)."),
+    p2: float = typer.Option(1.5, help="Exponent on all other cells (with --agl)."),
+    band: float = typer.Option(0.0, help="Half-width (m) of the clarified band around the "
+                               "flight level (with --agl)."),
+    graded: bool = typer.Option(False, "--graded", help="Blend the exponent across --band."),
+    mode: str = typer.Option("capped", help="Flight-level reading: 'capped' or 'literal'."),
+    min_agl: float | None = typer.Option(None, "--min-agl", help="Hard floor (m) above the "
+                                         "ground (with --agl)."),
+    max_agl: float | None = typer.Option(None, "--max-agl", help="Hard ceiling (m) above the "
+                                         "ground (with --agl)."),
+    no_fly: list[Path] | None = typer.Option(
+        None, "--no-fly", help="No-fly zones file (GeoJSON lon/lat, KML/KMZ, GPKG, SHP); "
+        "every route keeps out of them. Repeatable.", show_default=False),
+    speed: float = typer.Option(10.0, help="Ground speed (m/s) for each route's time_s."),
+    thin: float = typer.Option(1.0, help="Douglas–Peucker tolerance (m) of the lines in "
+                               "routes.geojson (0: every point)."),
+    threads: int | None = typer.Option(None, help="Threads for the descents (default: "
+                                       "every core)."),
+    anchor: str | None = typer.Option(
+        None, help="lon,lat[,alt] of world x=y=0 on a built-in scenario (no CRS). Default: "
+        "-3.7649,40.3326,0 (UC3M Leganés)."),
+    seed: int = typer.Option(0, help="Seed of the scenario's random relief."),
+    output: Output = None,
+    world: WorldFlags = None,
+) -> None:
+    """``fm2uav routes``: parse, :func:`~fm2uav.pipeline.routes.run_routes`, print."""
+    from ._first_use import announce_compile, fmm_group
+
+    announce_compile(quiet=output.quiet,
+                     child_group=fmm_group(order=order, ndim=2 if scenario == "city2d" else 3),
+                     preload=("fm2uav.planning.many",))
+    import numpy as np
+
+    from .. import progress
+    from ..io.starts import read_starts
+    from ..pipeline.routes import ROUTES_FILES, RouteSettings, routes_rows, run_routes
+    from ..world.load import world_summary
+    from .cmd_plan import _planner
+    from .options import lonlat_point
+
+    if not (np.isfinite(speed) and 0.1 <= speed <= 300.0):
+        raise InputError(f"--speed must be a ground speed in [0.1, 300] m/s, got {speed:g}")
+    if not (np.isfinite(thin) and 0.0 <= thin <= 1000.0):
+        raise InputError(f"--thin must be a tolerance in [0, 1000] m, got {thin:g}")
+    if threads is not None and threads < 1:
+        raise InputError(f"--threads must be at least 1, got {threads}")
+    with output.progress():
+        progress.step("building the world", 0.1)
+        w, _, label = world.build(scenario, goal, seed=seed, lonlat=True, agl=agl,
+                                  default="open-field")
+        anchor_ll = parse_anchor(anchor)
+        outdir = output.dir(ROUTES_FILES)
+        goal_m = lonlat_point(goal, "goal", w, agl=agl, anchor=anchor_ll)
+        if no_fly:
+            from ..io.zone_spec import zones_from_cli
+            from ..world.zones import check_points_allowed, with_zones
+
+            w = with_zones(w, zones_from_cli(no_fly, w, crs=world.crs))
+            check_points_allowed(w, {"goal": goal_m})
+        shaping, level, options = _planner(
+            dict(saturation=saturation, saturation_distance=saturation_distance,
+                 exponent=exponent, order=order, storage="full"),
+            dict(agl=agl, p1=p1, p2=p2, band=band, graded=graded, mode=mode, min_agl=min_agl,
+                 max_agl=max_agl))
+        progress.step("reading the starts", 0.05)
+        table = read_starts(starts, w, agl=agl, crs=world.crs, id_field=id_field,
+                            anchor=anchor_ll)
+        progress.step("planning every route", 0.85)
+        run = run_routes(outdir, w, goal_m, table, shaping=shaping, level=level,
+                         options=options,
+                         settings=RouteSettings(speed=speed, thin=thin, threads=threads,
+                                                anchor=anchor_ll),
+                         summary={"world": world_summary(w), "map": label,
+                                  "starts_file": table.source})
+        if run.summary["routes"] == 0:  # nothing to fly: exit 1, no output set
+            from ..errors import PlanningError
+
+            first = run.summary["failures"][0]
+            raise PlanningError(
+                f"none of the {run.summary['starts']} starts got a route "
+                f"({', '.join(f'{n} {r}' for r, n in run.summary['failed_by_reason'].items())}"
+                f"); the first, {first['id']!r}: {first['message']}")
+    rows = {"map": label, **routes_rows(run), **world_rows(w)}
+    output.summary("FM² routes", rows, run.summary)
+
+
+def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:
+    """Add the ``routes`` command."""
+    app.command("routes", help=ROUTES_HELP)(routes_cmd)

@@ -1,0 +1,210 @@
+"""Many routes from one wave to their output set (``fm2uav routes``).
+
+:func:`run_routes` plans the route from every start to one goal with
+:func:`fm2uav.planning.many.plan_many` and writes:
+
+* ``routes.geojson``: a FeatureCollection of one LineString per route, ``[lon, lat]``
+  (``[lon, lat, alt]`` on a 3D map, alt in metres above the map's vertical datum),
+  thinned by Douglas–Peucker to ``thin`` metres, with the properties ``id``,
+  ``length_m``, ``time_s``, ``lowest_agl_m``, ``clearance_m``, ``points``;
+* ``routes.csv``: one row per start, in the file's order — ``id``, ``status`` (``ok`` or
+  ``failed``), ``reason`` (:data:`fm2uav.planning.many.FAILURE_REASONS`), ``lon``,
+  ``lat``, ``length_m``, ``time_s``, ``lowest_agl_m``, ``clearance_m``, ``message``;
+* ``summary.json``: the goal, the counts (per failure reason), the failed starts with
+  their reason and message, lengths, the settings and the timings.
+
+``length_m`` is the route's 3D length, ``time_s`` = ``length_m / speed`` (a constant
+ground speed, no wind), ``lowest_agl_m`` the lowest height above the ground along the
+route as ``fm2uav plan`` reports it (``height_above_ground.path.min_m``; empty on a 2D
+map), ``clearance_m`` the plan's clearance to the terrain/building surface.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .. import progress
+from .outputs import to_jsonable, write_json
+
+__all__ = ["ROUTES_FILES", "RoutesRun", "RouteSettings", "run_routes", "routes_rows"]
+
+#: The files of a ``fm2uav routes`` output set.
+ROUTES_FILES = ("routes.geojson", "routes.csv", "summary.json")
+
+_CSV_COLUMNS = ("id", "status", "reason", "lon", "lat", "length_m", "time_s", "lowest_agl_m",
+                "clearance_m", "message")
+
+
+@dataclass(frozen=True)
+class RouteSettings:
+    """How :func:`run_routes` plans and writes.
+
+    Attributes
+    ----------
+    speed : float
+        Ground speed [m/s] for ``time_s`` (> 0).
+    thin : float
+        Douglas–Peucker tolerance [m] of the GeoJSON lines (0: every point).
+    threads : int or None
+        Threads of the descents (None: every core).
+    anchor : optional
+        lon/lat of x = y = 0 on a world without a CRS (default the exports' anchor).
+    """
+
+    speed: float = 10.0
+    thin: float = 1.0
+    threads: int | None = None
+    anchor: Any = None
+
+
+@dataclass(frozen=True)
+class RoutesRun:
+    """What :func:`run_routes` planned and wrote."""
+
+    many: Any
+    rows: list[dict[str, Any]]
+    summary: dict[str, Any]
+
+
+def _lowest_agl(plan: Any) -> float | None:
+    """The lowest height above the ground [m] along a plan, as ``fm2uav plan`` reports it."""
+    from ..planning.altitude import height_figures
+
+    h = plan.height_above_ground()
+    return None if h is None else height_figures(h)["min_m"]
+
+
+@progress.stage()
+def run_routes(outdir: Any, world: Any, goal_m: Any, starts: Any, *, shaping: Any, level: Any,
+               options: Any, settings: RouteSettings = RouteSettings(),
+               summary: dict[str, Any] | None = None) -> RoutesRun:
+    """Plan the route from every start to ``goal_m`` and write the output set.
+
+    Parameters
+    ----------
+    outdir : fm2uav.io.outdir.OutputDir
+    world : World
+    goal_m : array_like
+        The goal [m].
+    starts : fm2uav.io.starts.Starts
+        The starts (ids, points in metres, rows without a point).
+    shaping, level, options
+        As :func:`fm2uav.plan`.
+    settings : RouteSettings
+    summary : dict, optional
+        Entries put first in ``summary.json`` (e.g. the world).
+
+    Returns
+    -------
+    RoutesRun
+    """
+    from ..autopilot.thin import thin_indices
+    from ..planning.many import RouteFailure, plan_many
+    from ..world.geo import to_lonlat
+
+    progress.step("routes (one wave, every start)", 0.8)
+    pts = np.asarray(starts.points, dtype=float)
+    many = plan_many(world, goal_m, list(pts), shaping=shaping, level=level, options=options,
+                     threads=settings.threads)
+    progress.step("writing routes.geojson, routes.csv, summary.json", 0.2)
+    routes = list(many.routes)
+    for k, why in starts.problems.items():  # the row's own words, not "start must be finite"
+        routes[k] = RouteFailure("invalid", why)
+    start_ll = np.full((len(pts), 2), np.nan)
+    known = np.isfinite(pts).all(axis=1)
+    if known.any():
+        start_ll[known] = to_lonlat(world, pts[known], anchor=settings.anchor)[:, :2]
+    ok = [k for k, r in enumerate(routes) if not isinstance(r, RouteFailure)]
+    lines: dict[int, np.ndarray] = {}
+    if ok:
+        keep = [routes[k].path[thin_indices(routes[k].path, settings.thin)] for k in ok]
+        ends = np.cumsum([len(q) for q in keep])[:-1]
+        geo = np.split(to_lonlat(world, np.concatenate(keep), anchor=settings.anchor), ends)
+        lines = dict(zip(ok, geo))
+    rows: list[dict[str, Any]] = []
+    features: list[dict[str, Any]] = []
+    for k, r in enumerate(routes):
+        row: dict[str, Any] = {"id": starts.ids[k], "lon": _deg(start_ll[k, 0]),
+                               "lat": _deg(start_ll[k, 1])}
+        if isinstance(r, RouteFailure):
+            row.update(status="failed", reason=r.reason, length_m=None, time_s=None,
+                       lowest_agl_m=None, clearance_m=None, message=r.message)
+        else:
+            length = round(float(r.length), 3)
+            row.update(status="ok", reason="", length_m=length,
+                       time_s=round(float(r.length) / settings.speed, 3),
+                       lowest_agl_m=_lowest_agl(r),
+                       clearance_m=(round(float(r.clearance), 3)
+                                    if np.isfinite(r.clearance) else None), message="")
+            props = {key: row[key] for key in ("id", "length_m", "time_s", "lowest_agl_m",
+                                               "clearance_m")}
+            features.append({"type": "Feature", "properties": {**props,
+                                                               "points": int(len(r.path))},
+                             "geometry": {"type": "LineString",
+                                          "coordinates": _coords(lines[k], world.ndim)}})
+        rows.append(row)
+    with outdir.open("routes.geojson") as fh:
+        json.dump({"type": "FeatureCollection", "features": features}, fh,
+                  separators=(",", ":"))
+    with outdir.open("routes.csv") as fh:
+        fh.write(_csv_text(rows))
+    doc = {**(summary or {}), **many.summary(), "goal_lonlat": _goal_lonlat(world, many.goal,
+                                                                             settings.anchor),
+           "speed_m_s": settings.speed, "thin_m": settings.thin,
+           "params": many.routes[ok[0]].params if ok else None,
+           "failures": [{"id": row["id"], "reason": row["reason"], "message": row["message"]}
+                        for row in rows if row["status"] == "failed"]}
+    failed = [row["reason"] for row in rows if row["status"] == "failed"]
+    doc["failed"] = len(failed)
+    doc["routes"] = len(rows) - len(failed)
+    doc["failed_by_reason"] = {r: failed.count(r) for r in sorted(set(failed))}
+    write_json(outdir, "summary.json", to_jsonable(doc))
+    return RoutesRun(many=many, rows=rows, summary=doc)
+
+
+def _deg(v: float) -> float | None:
+    return round(float(v), 7) if np.isfinite(v) else None
+
+
+def _coords(geo: np.ndarray, ndim: int) -> list[list[float]]:
+    """GeoJSON positions: lon/lat to 1e-7 degrees (~1 cm), altitude to the millimetre."""
+    if ndim == 2:
+        return np.round(geo[:, :2], 7).tolist()
+    return np.column_stack([np.round(geo[:, :2], 7), np.round(geo[:, 2], 3)]).tolist()
+
+
+def _goal_lonlat(world: Any, goal: np.ndarray, anchor: Any) -> list[float]:
+    from ..world.geo import to_lonlat
+
+    ll = to_lonlat(world, np.asarray(goal, dtype=float)[None], anchor=anchor)[0]
+    return [round(float(v), 7) for v in ll[:2]]
+
+
+def _csv_text(rows: list[dict[str, Any]]) -> str:
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=list(_CSV_COLUMNS), lineterminator="\n")
+    w.writeheader()
+    for row in rows:
+        w.writerow({k: ("" if row.get(k) is None else row.get(k)) for k in _CSV_COLUMNS})
+    return buf.getvalue()
+
+
+def routes_rows(run: RoutesRun) -> dict[str, str]:
+    """The printed summary of ``fm2uav routes``."""
+    s = run.summary
+    out = {"starts": str(s["starts"]), "routes": str(s["routes"])}
+    if s["failed"]:
+        out["failed"] = ", ".join(f"{n} {r}" for r, n in s["failed_by_reason"].items())
+    if s["length_m"]:
+        L = s["length_m"]
+        out["length [m]"] = f"{L['min']:.0f} / {L['median']:.0f} / {L['max']:.0f} (min/median/max)"
+    t = s["timings_s"]
+    out["time [s]"] = (f"{t['total']:.2f} wall, {t['cpu']:.2f} CPU ({s['threads']} threads; "
+                       f"march {t['fast_marching']:.2f}, routes {t['routes']:.2f})")
+    return out
