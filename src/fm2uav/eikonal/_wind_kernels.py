@@ -666,7 +666,7 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
                     f = eid[eptr[k] + q - nf]
                     nv = 2
                 down = np.inf  # the most negative slope from k (convexity: the face's
-                # minimum is at least Gk + that slope, so it cannot beat best if that is higher)
+                # minimum is at least Gk + that slope, so it cannot beat bound if that is higher)
                 ok = True
                 for i in range(nv):
                     j = fvert[f, i] if q < nf else evert[f, i]
