@@ -553,7 +553,7 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
         at physical point ``fsrc`` [m] with airspeed ``fV`` and wind ``fw``.
     track : (n, 3) ground-track direction (not normalised) of each node's
         last improvement, or (0, 3) not to record it.
-    scratch : float[7, K] per-vertex cache of one evaluation.
+    scratch : float[8, K] per-vertex cache of one evaluation.
     """
     doff, uoff, oph, fvert, fminv, fptr, fid, evert, eptr, eid, bptr, bdoff, fbig, ebig, ndim = st
     K = doff.shape[0]
@@ -568,9 +568,11 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
     Dv = scratch[4]  # slope of the face objective from vertex k towards vertex j
     Bv = scratch[5]  # box of vertex j passable: epoch (yes), -epoch (no), else unknown
     Iv = scratch[6]  # 1 / Sv
+    Av = scratch[7]  # epoch: a full face through vertex k and vertex j had a candidate
     for j in range(K):
         seen[j] = -1.0
         Bv[j] = 0.0
+        Av[j] = -1.0
     epoch = 0.0
     hn = cnt[0]
     left = cnt[1]
@@ -665,6 +667,10 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
                 else:
                     f = eid[eptr[k] + q - nf]
                     nv = 2
+                    # a full face through this edge had its minimum inside: that minimum
+                    # of the convex objective is at most the edge's (3D: faces come first)
+                    if Av[evert[f, 0] + evert[f, 1] - k] == epoch:
+                        continue
                 down = np.inf  # the most negative slope from k (convexity: the face's
                 # minimum is at least Gk + that slope, so it cannot beat bound if that is higher)
                 ok = True
@@ -728,6 +734,10 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
                         lo = min(lo, Uv[fvert[f, 2]])
                     if cand < lo:
                         cand = np.inf
+                if q < nf and ndim == 3 and cand < np.inf:
+                    Av[fvert[f, 0]] = epoch
+                    Av[fvert[f, 1]] = epoch
+                    Av[fvert[f, 2]] = epoch
                 if cand < best:
                     best = cand
                     bvx, bvy, bvz = vx, vy, vz

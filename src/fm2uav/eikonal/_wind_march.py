@@ -152,7 +152,7 @@ def run(grid: WindGrid, start_idx: np.ndarray, start_t: np.ndarray, start_fixed:
         (fsrc, fV, fw), fac = factor, True
     acute2 = st.acute ** 2
     cnt = np.array([hn, nstop, 0, 0], dtype=np.int64)
-    scratch = np.zeros((7, st.off.shape[0]))
+    scratch = np.zeros((8, st.off.shape[0]))
     fsrc = np.asarray(fsrc, dtype=float)
     fw = np.asarray(fw, dtype=float)
     shape3 = np.asarray(grid.shape3, dtype=np.uint64)
