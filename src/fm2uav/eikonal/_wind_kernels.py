@@ -524,7 +524,7 @@ def _box_ok(T, y, j, bptr, bdoff, Bv, epoch):
 
 @njit(**_OPT)
 def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt,
-          can_stop, acute2, fac, fsrc, fV, fw, track, scratch):
+          can_stop, acute2, all_acute, fac, fsrc, fV, fw, track, scratch):
     """Run (or resume) the march; returns True when done, False when the heap is full.
 
     Resumable: everything it needs is in its arguments, so the caller grows the
@@ -547,12 +547,13 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
     cnt : int64[4] ``(heap size, STOP nodes not popped yet, pops, re-opened
         nodes)``; the march ends when no STOP node is left if ``can_stop``.
     acute2 : ``acute**2``; a node with ``|w|^2 > acute2 V^2`` is non-acute
-        (label correction, order 1).
+        (label correction, order 1). all_acute : no passable node is non-acute (or
+        factored mode): frozen nodes are never re-evaluated.
     fac, fsrc, fV, fw : factored mode (the source box): the cone of the source
         at physical point ``fsrc`` [m] with airspeed ``fV`` and wind ``fw``.
     track : (n, 3) ground-track direction (not normalised) of each node's
         last improvement, or (0, 3) not to record it.
-    scratch : float[7, K] per-vertex cache of one evaluation.
+    scratch : float[8, K] per-vertex cache of one evaluation.
     """
     doff, uoff, oph, fvert, fminv, fptr, fid, evert, eptr, eid, bptr, bdoff, fbig, ebig, ndim = st
     K = doff.shape[0]
@@ -567,9 +568,11 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
     Dv = scratch[4]  # slope of the face objective from vertex k towards vertex j
     Bv = scratch[5]  # box of vertex j passable: epoch (yes), -epoch (no), else unknown
     Iv = scratch[6]  # 1 / Sv
+    Av = scratch[7]  # epoch: a full face through vertex k and vertex j had a candidate
     for j in range(K):
         seen[j] = -1.0
         Bv[j] = 0.0
+        Av[j] = -1.0
     epoch = 0.0
     hn = cnt[0]
     left = cnt[1]
@@ -599,6 +602,8 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
             y = c - doff[k]
             yu = cu - uoff[k]
             ty = T[y]
+            if ty >= 0.0 and not again and all_acute:
+                continue  # frozen, and no node of the grid needs label correction
             if not (ty == ty) or (flag[y] & FIXED) != 0:
                 continue
             V = speed[yu]
@@ -637,6 +642,9 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
             Gk = Fk + sk * (tk - (gx * okx + gy * oky + gz * okz))
             if _box_ok(T, y, k, bptr, bdoff, Bv, epoch) and not (fac and Gk < Uk):
                 best = Gk
+            # a candidate counts only if below both best and the node's value now
+            # (band: -ty; frozen: ty less the re-opening margin; far: inf)
+            bound = min(best, ty - REOPEN_RTOL * ty if ty >= 0.0 else -ty)
             # grad F at -o_k: n / (V + w.n), n the heading flying along -o_k (minus
             # g, factored). The face objective (interpolated value + F) is convex:
             # it can only be below vertex k's value on a face where it decreases
@@ -659,8 +667,12 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
                 else:
                     f = eid[eptr[k] + q - nf]
                     nv = 2
+                    # a full face through this edge had its minimum inside: that minimum
+                    # of the convex objective is at most the edge's (3D: faces come first)
+                    if Av[evert[f, 0] + evert[f, 1] - k] == epoch:
+                        continue
                 down = np.inf  # the most negative slope from k (convexity: the face's
-                # minimum is at least Gk + that slope, so it cannot beat best if that is higher)
+                # minimum is at least Gk + that slope, so it cannot beat bound if that is higher)
                 ok = True
                 for i in range(nv):
                     j = fvert[f, i] if q < nf else evert[f, i]
@@ -685,7 +697,7 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
                         break
                     if Dv[j] < down:
                         down = Dv[j]
-                if not ok or not (down < 0.0) or not (Gk + down < best):
+                if not ok or not (down < 0.0) or not (Gk + down < bound):
                     continue
                 if not _box_ok(T, y, fbig[f] if q < nf else ebig[f], bptr, bdoff, Bv, epoch):
                     continue
@@ -722,9 +734,15 @@ def march(T, flag, speed, wind, wconst, dims, h, st, order, hk, hc, hu, pos, cnt
                         lo = min(lo, Uv[fvert[f, 2]])
                     if cand < lo:
                         cand = np.inf
+                if q < nf and ndim == 3 and cand < np.inf:
+                    Av[fvert[f, 0]] = epoch
+                    Av[fvert[f, 1]] = epoch
+                    Av[fvert[f, 2]] = epoch
                 if cand < best:
                     best = cand
                     bvx, bvy, bvz = vx, vy, vz
+                    if cand < bound:
+                        bound = cand
             if ty >= 0.0:
                 if not (best < ty - REOPEN_RTOL * ty):
                     continue

@@ -152,13 +152,13 @@ def run(grid: WindGrid, start_idx: np.ndarray, start_t: np.ndarray, start_fixed:
         (fsrc, fV, fw), fac = factor, True
     acute2 = st.acute ** 2
     cnt = np.array([hn, nstop, 0, 0], dtype=np.int64)
-    scratch = np.zeros((7, st.off.shape[0]))
+    scratch = np.zeros((8, st.off.shape[0]))
     fsrc = np.asarray(fsrc, dtype=float)
     fw = np.asarray(fw, dtype=float)
     shape3 = np.asarray(grid.shape3, dtype=np.uint64)
     h3 = np.asarray(grid.h3, dtype=float)
     while not wk.march(T, flag, grid.speed, grid.wind, grid.wconst, shape3, h3, tables, order,
-                       hk, hc, hu, pos, cnt, can_stop, acute2, fac, fsrc, float(fV), fw, track,
+                       hk, hc, hu, pos, cnt, can_stop, acute2, fac or not any_na, fac, fsrc, float(fV), fw, track,
                        scratch):
         n = int(cnt[0])  # the heap is full: double it and resume
         hk = np.concatenate([hk[:n], np.empty(hk.size)])
