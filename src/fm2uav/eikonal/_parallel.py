@@ -40,8 +40,15 @@ from numba import njit, prange
 from . import _kernels
 from ._heap import sift_down, sift_up
 from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _U, _ZERO, RESERVE_BLOCKS, BLOCK,
-                       _axis_term, _bits, _bucket, _combine, _pop, _push, _side_min,
+                       _axis_term, _bits, _bucket, _prefetch, _combine, _pop, _push, _side_min,
                        _solve_iso)
+
+#: The windows meet at a barrier several hundred times per march: a thread that waits
+#: there sleeps instead of spinning (OpenMP's default spins), or on a busy machine the
+#: spinning thread takes the core its partner needs (measured on 2048^2 with 10 runnable
+#: processes on 2 cores: 3.4 CPU-s spinning, 0.56 s passive, serial 0.53 s). Read by
+#: libgomp when numba first starts its thread pool; a value set by the user stays.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 __all__ = ["march", "resolve_threads", "PARALLEL_MIN_NODES", "THREADS_ENV"]
 
@@ -53,6 +60,12 @@ THREADS_ENV = "FM2UAV_THREADS"
 PARALLEL_MIN_NODES = 1_000_000
 #: Each slab gets at least this many x-slabs (rows), else fewer slabs are used.
 MIN_SLAB_ROWS = 16
+#: Slabs per thread, thread ``t`` marching slabs ``t, t + threads, ...``: strips
+#: interleaved across the grid keep both threads busy when the wave starts off-centre.
+#: Measured on the FM²-shaped fields (source at 0.3 of x), 2 threads: 2D 1/2/4 slabs
+#: per thread let the windows run 1.38x/1.44x/1.64x in parallel for +15/+6/+3 % CPU;
+#: 3D 1.47x/1.59x/1.77x for +23/+7/+24 % CPU (more repairs per interface in 3D).
+SLABS_PER_THREAD = {2: 4, 3: 2}
 #: Target number of nodes frozen per window (all slabs together); the window
 #: width adapts to it. Fewer, wider windows cost fewer barriers and more repairs.
 WINDOW_NODES = 16384
@@ -174,7 +187,26 @@ def _update(T, V, c, sx, sy, ih, hh, iso, three):  # noqa: PLR0913
 
 
 @njit(cache=True, inline="always", error_model="numpy", _nrt=False)
-def _lower(T, c, t, fixed, pool, nxt, bk, mw, st, rkey, ritem, ctl):
+def _prefetch_rows(T, V, c, sx, sy, three):
+    """Prefetch ``T`` and ``V`` one and two rows (planes) away across x (and y)."""
+    n = _U(T.size)
+    _prefetch(T, c - sx)
+    _prefetch(T, c + sx)
+    _prefetch(V, c - sx)
+    _prefetch(V, c + sx)
+    _prefetch(T, c - sx - sx if c >= sx + sx else c)
+    _prefetch(T, c + sx + sx if c + sx + sx < n else c)
+    if three:
+        _prefetch(T, c - sy)
+        _prefetch(T, c + sy)
+        _prefetch(V, c - sy)
+        _prefetch(V, c + sy)
+        _prefetch(T, c - sy - sy)
+        _prefetch(T, c + sy + sy)
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _lower(T, V, c, t, fixed, sx, sy, three, pool, nxt, bk, mw, st, rkey, ritem, ctl):
     """Give node ``c`` the time ``t`` if that is lower than its band or frozen time.
 
     A frozen node lowered is re-opened (band again), unless it was frozen on entry
@@ -184,6 +216,8 @@ def _lower(T, c, t, fixed, pool, nxt, bk, mw, st, rkey, ritem, ctl):
     if x < 0.0:
         if t < -x:
             T[c] = -t
+            if x == -_INF:  # a new band node: fetch the rows its freezing reads (as _relax)
+                _prefetch_rows(T, V, c, sx, sy, three)
             _enq(_bits(t), c, pool, nxt, bk, mw, st, rkey, ritem)
     elif t < x and (fixed[c >> _U(3)] >> (c & _U(7))) & _ONE == _ZERO:
         T[c] = -t
@@ -244,7 +278,7 @@ def _slab_kernels(three):
                 y = T[nb]
                 if y < 0.0 or (y > t and nb >= lo and nb < hi):
                     # band/far, or frozen later than c in this slab: c may lower it
-                    _lower(T, nb, _update(T, V, nb, sx, sy, ih, hh, iso, three), fixed, pool, nxt, bk,
+                    _lower(T, V, nb, _update(T, V, nb, sx, sy, ih, hh, iso, three), fixed, sx, sy, three, pool, nxt, bk,
                            mw, st, rkey, ritem, ctl)
         ctl[_C_POPS] = pops
 
@@ -266,7 +300,7 @@ def _slab_kernels(three):
                     return False
                 for nb in _nbs(c, sx, sy, three):
                     if T[nb] < 0.0:
-                        _lower(T, nb, _update(T, V, nb, sx, sy, ih, hh, iso, three), fixed, pool, nxt,
+                        _lower(T, V, nb, _update(T, V, nb, sx, sy, ih, hh, iso, three), fixed, sx, sy, three, pool, nxt,
                                bk, mw, st, rkey, ritem, ctl)
             c += _ONE
         return True
@@ -285,8 +319,10 @@ def _slab_kernels(three):
                 T[g + j] = v
                 c = own + j
                 if T[c] == T[c]:  # not a wall
-                    _lower(T, c, _update(T, V, c, sx, sy, ih, hh, iso, three), fixed, pool, nxt, bk,
-                           mw, st, rkey, ritem, ctl)
+                    _lower(T, V, c, _update(T, V, c, sx, sy, ih, hh, iso, three), fixed, sx, sy,
+                           three, pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                    if T[c] < 0.0 and -T[c] < ctl[_C_NEXT]:  # queued: the next window knows
+                        ctl[_C_NEXT] = -T[c]
             j += _ONE
         return True
 
@@ -337,43 +373,48 @@ def _heap_next(T, st, ritem, ctl):
 
 def _drive_kernel(three):
     """The compiled driver of one dimension (the parallel region runs the slabs)."""
-    def drive(Tp, Vp, fx, off, end, rows, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem,
-              ctl, win, first):
+    def drive(nth, Tp, Vp, fx, off, end, rows, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem,
+              ctl, win, first, stops):
         """Run windows until every queue is empty; 0 done, 1/2 grow pool/heap and call again.
 
-        ``win`` (float64): [0] window end, [1] width, [2] windows run, [3] target pops.
+        ``win`` (float64): [0] window end, [1] width, [2] windows run, [3] target pops,
+        [4] nodes frozen (re-freezes included), [5] sum over windows of the most a slab
+        froze (the critical path: ``[4] / [5]`` bounds the speed-up), [6] the latest
+        stop node's time when the stop nodes ``stops`` (indices into ``Tp``) ended it.
         """
         K = off.size
         sxi = np.int64(sx)
         if first:
-            for k in prange(K):
-                if not _start(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]], fx[off[k] >> 3:], sx,
-                              sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
-                              ritem[k], ctl[k]):
-                    ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < _U(RESERVE_BLOCKS) else 2.0
+            for t in prange(nth):  # thread t runs slabs t, t + nth, ...
+                for k in range(t, K, nth):
+                    if not _start(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]], fx[off[k] >> 3:], sx,
+                                  sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
+                                  ritem[k], ctl[k]):
+                        ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < _U(RESERVE_BLOCKS) else 2.0
             for k in range(K):
                 if ctl[k, _C_STATUS] != 0.0:
                     return int(ctl[k, _C_STATUS])
         while True:
             # exchange: each slab refreshes its own ghosts and the rows next to them
-            for k in prange(K):
-                T = Tp[off[k]:end[k]]
-                V = Vp[off[k]:end[k]]
-                F = fx[off[k] >> 3:]
-                ok = True
-                if k > 0:
-                    o = end[k - 1] - 2 * sxi  # last own row of the slab below
-                    ok = _exchange(three, T, V, F, Tp[o:o + sxi], _ZERO, sx, sx, sy, ih, hh, iso, pool[k],
-                                  nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k])
-                if ok and k < K - 1:
-                    o = off[k + 1] + sxi  # first own row of the slab above
-                    r = _U(rows[k])
-                    ok = _exchange(three, T, V, F, Tp[o:o + sxi], (r + _ONE) * sx, r * sx, sx, sy, ih, hh,
-                                  iso, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k],
-                                  ctl[k])
-                if not ok:
-                    ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < _U(RESERVE_BLOCKS) else 2.0
-                _heap_next(T, st[k], ritem[k], ctl[k])
+            for t in prange(nth):  # thread t runs slabs t, t + nth, ...
+                for k in range(t, K, nth):
+                    T = Tp[off[k]:end[k]]
+                    V = Vp[off[k]:end[k]]
+                    F = fx[off[k] >> 3:]
+                    ok = True
+                    if k > 0:
+                        o = end[k - 1] - 2 * sxi  # last own row of the slab below
+                        ok = _exchange(three, T, V, F, Tp[o:o + sxi], _ZERO, sx, sx, sy, ih, hh, iso, pool[k],
+                                      nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k])
+                    if ok and k < K - 1:
+                        o = off[k + 1] + sxi  # first own row of the slab above
+                        r = _U(rows[k])
+                        ok = _exchange(three, T, V, F, Tp[o:o + sxi], (r + _ONE) * sx, r * sx, sx, sy, ih, hh,
+                                      iso, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k],
+                                      ctl[k])
+                    if not ok:
+                        ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < _U(RESERVE_BLOCKS) else 2.0
+                    _heap_next(T, st[k], ritem[k], ctl[k])
             for k in range(K):
                 if ctl[k, _C_STATUS] != 0.0:
                     return int(ctl[k, _C_STATUS])
@@ -387,6 +428,19 @@ def _drive_kernel(three):
                 for w in range(_NW):
                     if mw[k, w] != _ZERO:
                         empty = False
+            # stop nodes: done once all are frozen no later than every queued time
+            # (nothing queued can lower them: an update is later than its inputs)
+            if stops.size > 0:
+                smax = 0.0
+                for i in range(stops.size):
+                    x = Tp[stops[i]]
+                    if not x >= 0.0:
+                        smax = _INF
+                        break
+                    smax = max(smax, x)
+                if smax <= tmin:
+                    win[6] = smax
+                    return 0
             if empty:
                 return 0
             if tmin < _INF:
@@ -394,13 +448,21 @@ def _drive_kernel(three):
             else:
                 win[0] = win[0] + win[1]
             tw = win[0]
-            for k in prange(K):
-                _window(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]], fx[off[k] >> 3:], sx, sy, ih, hh, iso, tw, pool[k],
-                       nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k])
+            for t in prange(nth):  # thread t runs slabs t, t + nth, ...
+                for k in range(t, K, nth):
+                    _window(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]], fx[off[k] >> 3:], sx, sy, ih, hh, iso, tw, pool[k],
+                           nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k])
             win[2] += 1.0
             pops = 0.0
-            for k in range(K):
-                pops += ctl[k, _C_POPS]
+            most = 0.0
+            for t in range(nth):
+                mine = 0.0
+                for k in range(t, K, nth):
+                    mine += ctl[k, _C_POPS]
+                pops += mine
+                most = max(most, mine)
+            win[4] += pops
+            win[5] += most
             for k in range(K):
                 if ctl[k, _C_STATUS] != 0.0:
                     return int(ctl[k, _C_STATUS])
@@ -416,12 +478,67 @@ _drive2d = _drive_kernel(False)
 _drive3d = _drive_kernel(True)
 
 
-def slab_bounds(nx: int, k: int) -> np.ndarray:
-    """Row bounds of ``k`` slabs of (nearly) equal size along x: ``k + 1`` ints."""
-    return np.linspace(0, nx, k + 1).round().astype(np.int64)
+#: The split of two slabs is chosen on a march over every ``COARSE``-th node per axis
+#: (2D; 3D: ``COARSE_3D``), ~1.5 % of the work of the full march.
+COARSE = 8
+COARSE_3D = 4
+#: Time bins of the split estimate (stand-ins for the windows).
+SPLIT_BINS = 256
 
 
-def march(speed, start, shape3, h3, threads):
+def slab_bounds(speed, start, shape3, h3, k: int) -> np.ndarray:
+    """Row bounds (``k + 1`` ints) of ``k`` slabs along x.
+
+    Two slabs are split where a coarse march predicts the best balance: the
+    row ``s`` minimising ``sum over time bins of max(nodes below s, nodes from s
+    on)``, the windows' critical path (a source off-centre would otherwise leave
+    one slab idle while the wave crosses the other). Otherwise, or when the start
+    is not a few point sources (its box over a quarter of the grid), equal slabs.
+    """
+    nx = int(shape3[0])
+    even = np.linspace(0, nx, k + 1).round().astype(np.int64)
+    if k != 2 or 4 * int(np.prod(start.shape)) > int(np.prod(shape3)):
+        return even
+    three = shape3[2] > 1
+    f = COARSE_3D if three else COARSE
+    grid = speed.reshape(shape3)
+    coarse = np.ascontiguousarray(grid[::f, ::f, ::f] if three else grid[::f, ::f, :])
+    cshape = coarse.shape
+    if cshape[0] < 4:
+        return even
+    box = np.argwhere(start.state.reshape(start.shape) == _kernels.FROZEN)
+    if len(box) == 0:
+        return even
+    cells = np.unique((box + np.asarray(start.lo)) // np.array([f, f, f if three else 1]),
+                      axis=0)
+    lo = cells.min(axis=0)
+    bshape = tuple(int(n) for n in cells.max(axis=0) - lo + 1)
+    Tb = np.full(int(np.prod(bshape)), np.inf)
+    sb = np.zeros(Tb.size, dtype=np.uint8)
+    flat = np.ravel_multi_index(tuple((cells - lo).T), bshape)
+    Tb[flat] = 0.0
+    sb[flat] = _kernels.FROZEN
+    cstart = _kernels.Start(tuple(int(a) for a in lo), bshape, Tb, sb)
+    hc = tuple(h * f for h in h3[:2]) + ((h3[2] * f,) if three else (h3[2],))
+    T, _ = _kernels.march(coarse.reshape(-1), cstart, cshape, hc, 1,
+                          np.zeros((0, 3), dtype=np.int64))
+    T = T.reshape(cshape[0], -1)
+    fin = np.isfinite(T)
+    tmax = float(T[fin].max()) if fin.any() else 0.0
+    if not tmax > 0.0:
+        return even
+    rows = np.broadcast_to(np.arange(cshape[0])[:, None], T.shape)[fin]
+    bins = np.minimum((T[fin] / tmax * SPLIT_BINS).astype(np.int64), SPLIT_BINS - 1)
+    hist = np.bincount(rows * SPLIT_BINS + bins,
+                       minlength=cshape[0] * SPLIT_BINS).reshape(cshape[0], SPLIT_BINS)
+    below = np.cumsum(hist, axis=0)[:-1]  # nodes of rows < s + 1, s = 0 .. n - 2
+    cost = np.maximum(below, below[-1] + hist[-1] - below).sum(axis=1)
+    cut = (int(np.argmin(cost)) + 1) * f
+    cut = min(max(cut, MIN_SLAB_ROWS), nx - MIN_SLAB_ROWS)
+    return np.array([0, cut, nx], dtype=np.int64)
+
+
+def march(speed, start, shape3, h3, threads, stop_cells=None):
     """The order-1 Fast Marching from ``start`` on ``threads`` slabs in parallel.
 
     Parameters
@@ -435,22 +552,29 @@ def march(speed, start, shape3, h3, threads):
     h3 : tuple of 3 float
         Spacing per axis [m].
     threads : int
-        Slabs (and threads), ``>= 2``; fewer where a slab would get fewer than
-        :data:`MIN_SLAB_ROWS` rows.
+        Threads, ``>= 2`` (each marches :data:`SLABS_PER_THREAD` slabs, fewer
+        where a slab would get fewer than :data:`MIN_SLAB_ROWS` rows).
+    stop_cells : ndarray, int, shape (m, 3), optional
+        Stop once these nodes are frozen and final; nodes later than the latest
+        of them are then ``inf``, as in the serial march.
 
     Returns
     -------
     T : ndarray, float64, shape (nx*ny*nz,)
         Arrival times [s], ``inf`` where unreachable.
     stats : dict
-        ``slabs``, ``windows`` and ``reopened`` (nodes re-opened by a ghost).
+        ``slabs``, ``windows``, ``reopened`` (nodes lowered after they were frozen) and
+        ``balance``: nodes frozen over the sum of each window's largest slab share, the
+        speed-up the windows allow if every freeze cost the same (``slabs`` at best).
     """
     import numba
 
     nx, ny, nz = (int(n) for n in shape3)
     three = nz > 1
-    K = int(max(1, min(threads, nx // MIN_SLAB_ROWS, numba.config.NUMBA_NUM_THREADS)))
-    bounds = slab_bounds(nx, K)
+    nth = int(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
+    K = int(max(1, min(nth * SLABS_PER_THREAD[3 if three else 2], nx // MIN_SLAB_ROWS)))
+    nth = min(nth, K)
+    bounds = slab_bounds(speed, start, shape3, h3, K)
     rows = np.diff(bounds).astype(np.int64)
     sx = (ny + 2) * (nz + 2) if three else ny + 2
     sy = nz + 2 if three else 1
@@ -497,15 +621,23 @@ def march(speed, start, shape3, h3, threads):
     hh = float(1.0 / ih[0])
     vmax = float(speed.max()) if speed.size else 1.0
     width = 2.0 * min(h3[:3 if three else 2]) / max(vmax, 1e-300)
-    win = np.array([0.0, width, 0.0, float(WINDOW_NODES)])
+    win = np.array([0.0, width, 0.0, float(WINDOW_NODES), 0.0, 0.0, np.inf])
+    stop_idx = np.zeros(0, dtype=np.int64)
+    if stop_cells is not None and len(stop_cells):
+        cells = np.asarray(stop_cells, dtype=np.int64).reshape(-1, 3)
+        k = np.searchsorted(bounds, cells[:, 0], side="right") - 1
+        local = ((cells[:, 0] - bounds[k] + 1) * (ny + 2) + cells[:, 1] + 1)
+        if three:
+            local = local * (nz + 2) + cells[:, 2] + 1
+        stop_idx = off[k] + local
     drive = _drive3d if three else _drive2d
     first = True
     prev = numba.get_num_threads()
-    numba.set_num_threads(K)
+    numba.set_num_threads(nth)
     try:
         while True:
-            status = drive(Tp, Vp, fixed, off, off + sizes, rows, _U(sx), _U(sy), ih, hh, iso, pool,
-                           nxt, bk, mw, st, rkey, ritem, ctl, win, first)
+            status = drive(nth, Tp, Vp, fixed, off, off + sizes, rows, _U(sx), _U(sy), ih, hh, iso, pool,
+                           nxt, bk, mw, st, rkey, ritem, ctl, win, first, stop_idx)
             first = False
             if status == 0:
                 break
@@ -521,7 +653,14 @@ def march(speed, start, shape3, h3, threads):
         a, b = int(bounds[k]), int(bounds[k + 1])
         seg = slice(int(off[k]), int(off[k] + sizes[k]))
         _kernels.unpad_grid(Tp[seg], b - a, ny, nz, T[a * plane:b * plane])
-    return T, {"slabs": K, "windows": int(win[2]), "reopened": int(ctl[:, _C_REOPEN].sum())}
+    if win[6] < np.inf:  # stopped: what the serial march would not have frozen yet
+        T[T > win[6]] = np.inf
+        sel = tuple(slice(a, a + m) for a, m in zip(start.lo, start.shape))
+        box = T.reshape(shape3)[sel]  # nodes frozen on entry stay, whatever their time
+        frozen = (start.state == _kernels.FROZEN).reshape(start.shape)
+        box[frozen] = start.T.reshape(start.shape)[frozen]
+    return T, {"slabs": K, "windows": int(win[2]), "reopened": int(ctl[:, _C_REOPEN].sum()),
+               "balance": float(win[4] / max(win[5], 1.0))}
 
 
 def _grow_pools(pool, nxt, st):
