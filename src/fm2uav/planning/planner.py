@@ -364,7 +364,7 @@ def plan(
         return trace_plan(world, W, T, start_m, goal_m, shaping, level, options,
                           (t_all, t0, t1, t2), wind=wind, track=track, refused=refused)
     T = fast_marching(W, [goal_cell], spacing=world.spacing, order=options.order,
-                      stop_at=[start_cell])
+                      stop_at=[start_cell], threads=options.threads)
     t2 = time.perf_counter()
     return trace_plan(world, W, T, start_m, goal_m, shaping, level, options,
                       (t_all, t0, t1, t2))
