@@ -2,12 +2,17 @@
 
 Private module: :func:`fm2uav.eikonal.fast_marching` calls :func:`march` for
 grids of at least :data:`PARALLEL_MIN_NODES` nodes when more than one thread is
-allowed (``threads``, ``FM2UAV_THREADS``), order 1 and no ``stop_at``.
+allowed (``threads``, ``FM2UAV_THREADS``) and the order is 1 (``stop_at`` too).
+Order 2 marches serially: its stencil reads two nodes upwind, so the ghosts and
+the repairs would have to reach two rows, which is not built (nor tested) yet.
 
 Design (Yang & Stern 2017, domain-decomposition FMM)
 ----------------------------------------------------
 * The grid is cut along x (the slowest-varying axis of the C layout) into
-  ``K`` slabs. Each slab is a padded grid of its own, laid out exactly as the
+  ``K`` slabs, :data:`SLABS_PER_THREAD` per thread, thread ``t`` marching slabs
+  ``t, t + threads, ...`` (interleaved strips keep both threads busy when the
+  wave starts off-centre; with one slab per thread a coarse march picks the cut,
+  :func:`slab_bounds`). Each slab is a padded grid of its own, laid out exactly as the
   serial march's (:func:`fm2uav.eikonal._kernels.pad_grid`), one after the other
   in one buffer: its two ghost x-slabs hold, between windows, the *frozen*
   times of the neighbouring slab's boundary rows (``NaN`` where not frozen), so
@@ -25,6 +30,10 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
 * Queued times below the radix queue's lower bound (re-opened nodes) go to a
   small binary heap (:mod:`._heap`) that is emptied first: its keys are all
   below the radix queue's, so the slab still pops its exact minimum.
+* Nodes frozen on entry (sources, their balls) are never lowered, as in the
+  serial march. With stop nodes, the march ends once they are all frozen no
+  later than every queued time (nothing queued can lower them), and nodes
+  later than the latest of them are ``inf``, as the serial march leaves them.
 * It ends when every queue is empty after an exchange. The result is the fixed
   point of the upwind scheme, which is what the serial march computes: the
   times agree to round-off (tests/eikonal/test_fmm_parallel.py).
@@ -54,9 +63,11 @@ __all__ = ["march", "resolve_threads", "PARALLEL_MIN_NODES", "THREADS_ENV"]
 
 #: Environment variable with the default thread count of the march (an integer >= 1).
 THREADS_ENV = "FM2UAV_THREADS"
-#: Grids of fewer nodes march serially whatever the thread count: below this the
-#: windows' barriers cost more than the second core saves (benchmarks/bench_core.py,
-#: the "threads" rows, measure both sides).
+#: Grids of fewer nodes march serially whatever the thread count. Measured
+#: (benchmarks/bench_core.py, "threads" rows, a machine at load 9 on 2 cores):
+#: on 1024^2 the busiest thread takes 0.06 s of the serial 0.099 CPU-s (1.65x on
+#: an idle machine) and the wall time is equal; below, a window holds fewer nodes
+#: per barrier and the wall time on a busy machine decides: kept serial.
 PARALLEL_MIN_NODES = 1_000_000
 #: Each slab gets at least this many x-slabs (rows), else fewer slabs are used.
 MIN_SLAB_ROWS = 16
@@ -278,8 +289,9 @@ def _slab_kernels(three):
                 y = T[nb]
                 if y < 0.0 or (y > t and nb >= lo and nb < hi):
                     # band/far, or frozen later than c in this slab: c may lower it
-                    _lower(T, V, nb, _update(T, V, nb, sx, sy, ih, hh, iso, three), fixed, sx, sy, three, pool, nxt, bk,
-                           mw, st, rkey, ritem, ctl)
+                    t_nb = _update(T, V, nb, sx, sy, ih, hh, iso, three)
+                    _lower(T, V, nb, t_nb, fixed, sx, sy, three, pool, nxt, bk, mw, st, rkey,
+                           ritem, ctl)
         ctl[_C_POPS] = pops
 
     def start(T, V, fixed, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl):
@@ -300,8 +312,9 @@ def _slab_kernels(three):
                     return False
                 for nb in _nbs(c, sx, sy, three):
                     if T[nb] < 0.0:
-                        _lower(T, V, nb, _update(T, V, nb, sx, sy, ih, hh, iso, three), fixed, sx, sy, three, pool, nxt,
-                               bk, mw, st, rkey, ritem, ctl)
+                        t_nb = _update(T, V, nb, sx, sy, ih, hh, iso, three)
+                        _lower(T, V, nb, t_nb, fixed, sx, sy, three, pool, nxt, bk, mw, st,
+                               rkey, ritem, ctl)
             c += _ONE
         return True
 
@@ -373,8 +386,8 @@ def _heap_next(T, st, ritem, ctl):
 
 def _drive_kernel(three):
     """The compiled driver of one dimension (the parallel region runs the slabs)."""
-    def drive(nth, Tp, Vp, fx, off, end, rows, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem,
-              ctl, win, first, stops):
+    def drive(nth, Tp, Vp, fx, off, end, rows, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey,
+              ritem, ctl, win, first, stops):
         """Run windows until every queue is empty; 0 done, 1/2 grow pool/heap and call again.
 
         ``win`` (float64): [0] window end, [1] width, [2] windows run, [3] target pops,
@@ -404,14 +417,15 @@ def _drive_kernel(three):
                     ok = True
                     if k > 0:
                         o = end[k - 1] - 2 * sxi  # last own row of the slab below
-                        ok = _exchange(three, T, V, F, Tp[o:o + sxi], _ZERO, sx, sx, sy, ih, hh, iso, pool[k],
-                                      nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k])
+                        ok = _exchange(three, T, V, F, Tp[o:o + sxi], _ZERO, sx, sx, sy, ih, hh,
+                                       iso, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
+                                       ritem[k], ctl[k])
                     if ok and k < K - 1:
                         o = off[k + 1] + sxi  # first own row of the slab above
                         r = _U(rows[k])
-                        ok = _exchange(three, T, V, F, Tp[o:o + sxi], (r + _ONE) * sx, r * sx, sx, sy, ih, hh,
-                                      iso, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k],
-                                      ctl[k])
+                        ok = _exchange(three, T, V, F, Tp[o:o + sxi], (r + _ONE) * sx, r * sx,
+                                       sx, sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
+                                       rkey[k], ritem[k], ctl[k])
                     if not ok:
                         ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < _U(RESERVE_BLOCKS) else 2.0
                     _heap_next(T, st[k], ritem[k], ctl[k])
@@ -450,8 +464,9 @@ def _drive_kernel(three):
             tw = win[0]
             for t in prange(nth):  # thread t runs slabs t, t + nth, ...
                 for k in range(t, K, nth):
-                    _window(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]], fx[off[k] >> 3:], sx, sy, ih, hh, iso, tw, pool[k],
-                           nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k])
+                    _window(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]], fx[off[k] >> 3:], sx,
+                            sy, ih, hh, iso, tw, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
+                            ritem[k], ctl[k])
             win[2] += 1.0
             pops = 0.0
             most = 0.0
@@ -636,8 +651,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
     numba.set_num_threads(nth)
     try:
         while True:
-            status = drive(nth, Tp, Vp, fixed, off, off + sizes, rows, _U(sx), _U(sy), ih, hh, iso, pool,
-                           nxt, bk, mw, st, rkey, ritem, ctl, win, first, stop_idx)
+            status = drive(nth, Tp, Vp, fixed, off, off + sizes, rows, _U(sx), _U(sy), ih, hh,
+                           iso, pool, nxt, bk, mw, st, rkey, ritem, ctl, win, first, stop_idx)
             first = False
             if status == 0:
                 break

@@ -284,7 +284,8 @@ def run_march(
     Shared by :func:`fast_marching` and :func:`fm2uav.eikonal.restart.remarch`:
     nodes frozen on entry (state 2) are expanded first, band nodes (state 1)
     carry tentative times. ``stop_at`` as in :func:`fast_marching`; ``threads``
-    (resolved, ``>= 1``) as there: the parallel march for order 1 on grids of at least :data:`~fm2uav.eikonal._parallel.PARALLEL_MIN_NODES` nodes.
+    (resolved, ``>= 1``) as there: the parallel march for order 1 on grids of at
+    least :data:`~fm2uav.eikonal._parallel.PARALLEL_MIN_NODES` nodes.
 
     Returns
     -------
