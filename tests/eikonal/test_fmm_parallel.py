@@ -159,3 +159,20 @@ def test_plan_options_take_threads():
     assert PlanOptions().threads is None
     with pytest.raises(InputError, match=r"threads must be an integer >= 1.*planner\.threads"):
         PlanOptions(threads=0)
+
+
+def test_queues_that_run_low_grow_and_the_march_resumes(monkeypatch):
+    """Tiny entry pools and repair heaps: the start and the windows stop when a slab runs
+    low, the queues double, and the march goes on to the serial times."""
+    monkeypatch.setattr(_parallel, "POOL_MIN_BLOCKS", 8)
+    monkeypatch.setattr(_parallel, "HEAP_START", 8)
+    v = np.full((200, 60), 0.2)
+    v[:, 28:32] = 5.0
+    flat, start, shape3 = _start(v, (2, 30))
+    T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, 2)
+    assert stats["reopened"] > 0
+    serial = fast_marching(v, [(2, 30)], order=1, threads=1, source_ball=False)
+    assert_equal_times(serial.reshape(-1), T)
+    for name, v, src in _fields((64, 48, 40)):
+        assert_equal_times(fast_marching(v, [src], order=1, threads=1),
+                           fast_marching_parallel(v, [src], order=1))

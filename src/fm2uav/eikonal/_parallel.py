@@ -82,6 +82,10 @@ SLABS_PER_THREAD = {2: 4, 3: 2}
 WINDOW_NODES = 16384
 #: Free repair-heap slots kept before each node's pushes (one pop pushes at most 7).
 HEAP_RESERVE = 8
+#: Smallest start of a slab's repair heap (entries; at least 4 boundary rows) and
+#: entry pool (blocks); both double when a window runs low.
+HEAP_START = 4096
+POOL_MIN_BLOCKS = 2 * RESERVE_BLOCKS
 
 # slots of the per-slab control array ``ctl`` (float64)
 _C_NEXT = 0    # smallest queued time after the last window or exchange (inf: none)
@@ -393,7 +397,8 @@ def _drive_kernel(three):
         ``win`` (float64): [0] window end, [1] width, [2] windows run, [3] target pops,
         [4] nodes frozen (re-freezes included), [5] sum over windows of the most a slab
         froze (the critical path: ``[4] / [5]`` bounds the speed-up), [6] the latest
-        stop node's time when the stop nodes ``stops`` (indices into ``Tp``) ended it.
+        stop node's time when the stop nodes ``stops`` (indices into ``Tp``) ended it,
+        [7] 1 once the start (``first``) is done.
         """
         K = off.size
         sxi = np.int64(sx)
@@ -406,7 +411,8 @@ def _drive_kernel(three):
                         ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < _U(RESERVE_BLOCKS) else 2.0
             for k in range(K):
                 if ctl[k, _C_STATUS] != 0.0:
-                    return int(ctl[k, _C_STATUS])
+                    return int(ctl[k, _C_STATUS])  # grown, the start runs again
+            win[7] = 1.0
         while True:
             # exchange: each slab refreshes its own ghosts and the rows next to them
             for t in prange(nth):  # thread t runs slabs t, t + nth, ...
@@ -619,7 +625,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
     # the nodes frozen on entry (sources, balls) stay as they are, as in the serial march
     fixed = np.packbits(Tp >= 0.0, bitorder="little")
     # queues: one radix queue and one repair heap per slab
-    nblk = max(2 * RESERVE_BLOCKS, int(sizes.max()) // (16 * BLOCK))
+    nblk = max(POOL_MIN_BLOCKS, int(sizes.max()) // (16 * BLOCK))
     pool = np.empty((K, 2 * nblk * BLOCK), dtype=np.uint64)
     nxt = np.empty((K, nblk), dtype=np.uint32)
     bk = np.empty((K, 2 * int(_NB)), dtype=np.uint32)
@@ -627,7 +633,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
     st = np.zeros((K, _ST), dtype=np.uint64)
     for k in range(K):
         _kernels.init_queue(nxt[k], bk[k], mw[k], st[k])
-    rcap = max(4096, 4 * sx)
+    rcap = max(HEAP_START, HEAP_RESERVE)
     rkey = np.empty((K, rcap), dtype=np.uint64)
     ritem = np.empty((K, rcap), dtype=np.uint64)
     ctl = np.zeros((K, _C_SIZE))
@@ -636,7 +642,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
     hh = float(1.0 / ih[0])
     vmax = float(speed.max()) if speed.size else 1.0
     width = 2.0 * min(h3[:3 if three else 2]) / max(vmax, 1e-300)
-    win = np.array([0.0, width, 0.0, float(WINDOW_NODES), 0.0, 0.0, np.inf])
+    win = np.array([0.0, width, 0.0, float(WINDOW_NODES), 0.0, 0.0, np.inf, 0.0])
     stop_idx = np.zeros(0, dtype=np.int64)
     if stop_cells is not None and len(stop_cells):
         cells = np.asarray(stop_cells, dtype=np.int64).reshape(-1, 3)
@@ -653,7 +659,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
         while True:
             status = drive(nth, Tp, Vp, fixed, off, off + sizes, rows, _U(sx), _U(sy), ih, hh,
                            iso, pool, nxt, bk, mw, st, rkey, ritem, ctl, win, first, stop_idx)
-            first = False
+            first = win[7] == 0.0
             if status == 0:
                 break
             ctl[:, _C_STATUS] = 0.0
