@@ -68,7 +68,7 @@ def _ours_fmm(shape: tuple[int, ...], order: int, repeats: int) -> dict:
         shape = {shape!r}; v = speed_field(shape); src = [tuple(n // 2 for n in shape)]
         fast_marching(v[tuple(slice(0, 8) for _ in shape)], [tuple(4 for _ in shape)], order={order})
         base = rss_mb()
-        t = median_time(lambda: fast_marching(v, src, order={order}), {repeats})
+        t = median_time(lambda: fast_marching(v, src, order={order}, threads=1), {repeats})
         print(json.dumps({{"s": t, "peak_mb": peak_mb() - base}}))
         """
     )
@@ -145,7 +145,7 @@ def _fmm_interleaved(shape: tuple[int, ...], order: int, repeats: int,
         v, src = fields.smooth(shape) if {field!r} == "smooth" else fields.fm2_shaped(shape)
         dx = (1.0,) * len(shape)
         phi, vs = fields.skfmm_point_source(v, src)
-        solvers = {{"ours": lambda: fast_marching(v, [src], order=order),
+        solvers = {{"ours": lambda: fast_marching(v, [src], order=order, threads=1),
                    "scikit-fmm": lambda: skfmm.travel_time(phi, vs, order=order)}}
         if eikonalfm is not None and {field!r} == "smooth":
             tau0 = eikonalfm.distance(shape, dx, src, indexing="ij")
@@ -415,16 +415,90 @@ def jit_rows(quick: bool) -> list[dict]:
     ]
 
 
+def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
+    """The parallel march (issue 27): ``threads=2`` against ``threads=1``, order 1.
+
+    2048² and 160³ with constant speed (centre source), the smooth field and the
+    FM²-shaped field (:mod:`benchmarks.fields`), and the smaller grids around the size
+    below which the march stays serial (``PARALLEL_MIN_NODES``). Interleaved in one child,
+    medians of ``repeats`` rounds. Three ratios: wall time (what a user waits; on a busy
+    machine the second thread waits for a core), process CPU time (the work both threads
+    do) and serial CPU over the busiest thread's CPU time (from ``/proc/self/task``; what
+    the wall ratio is on an idle machine, barrier waits aside: the waiting thread sleeps).
+    Bar (issue 27): >= 1.6x on 2048² and 160³.
+    """
+    cases = ([("256x256", "smooth"), ("32x32x32", "smooth")] if quick else
+             [(s, f) for s in ("2048x2048", "160x160x160") for f in ("constant", "smooth", "fm2")]
+             + [("512x512", "smooth"), ("1024x1024", "smooth")])
+    res = _child(
+        f"""
+        import os
+        from fm2uav import fast_marching
+        from fm2uav.eikonal import _parallel
+        from benchmarks import fields
+
+        def task_cpu():
+            out = {{}}
+            for tid in os.listdir("/proc/self/task"):
+                try:
+                    f = open(f"/proc/self/task/{{tid}}/stat").read().rsplit(")", 1)[1].split()
+                except OSError:
+                    continue
+                out[tid] = (int(f[11]) + int(f[12])) / os.sysconf("SC_CLK_TCK")
+            return out
+
+        out = []
+        for case, field in {cases!r}:
+            shape = tuple(int(n) for n in case.split("x"))
+            if field == "constant":
+                v, src = np.ones(shape), tuple(n // 2 for n in shape)
+            else:
+                v, src = getattr(fields, "smooth" if field == "smooth" else "fm2_shaped")(shape)
+            for th in (1, 2):  # JIT and first-touch warm-up
+                fast_marching(v, [src], order=1, threads=th)
+            runs = {{1: [], 2: []}}
+            for _ in range({repeats}):
+                for th in (1, 2):
+                    a = task_cpu(); w = time.perf_counter(); c = time.process_time()
+                    fast_marching(v, [src], order=1, threads=th)
+                    w = time.perf_counter() - w; c = time.process_time() - c
+                    b = task_cpu()
+                    busiest = max(b[t] - a.get(t, 0.0) for t in b)
+                    runs[th].append((w, c, busiest))
+            med = {{th: [statistics.median(r[i] for r in runs[th]) for i in range(3)]
+                    for th in runs}}
+            out.append(dict(case=case, field=field, nodes=int(v.size),
+                            parallel=v.size >= _parallel.PARALLEL_MIN_NODES,
+                            serial=med[1], threads2=med[2]))
+        print(json.dumps(out))
+        """
+    )
+    rows = []
+    for r in res:
+        (w1, c1, _), (w2, c2, b2) = r["serial"], r["threads2"]
+        big = r["case"] in ("2048x2048", "160x160x160")
+        rows.append({
+            "benchmark": "fmm threads",
+            "case": f"{r['case']} {r['field']} order 1, 2 threads",
+            "ours_s": w2, "peer": "fm2uav 1 thread", "peer_s": w1, "ratio": w1 / w2,
+            "bar": ">= 1.6x (issue 27)" if big else ("never slower" if r["parallel"] else ""),
+            "notes": (f"{'parallel' if r['parallel'] else 'serial (below PARALLEL_MIN_NODES)'}; "
+                      f"CPU 1 thread {c1:.3f} s, 2 threads {c2:.3f} s (ratio {c1 / c2:.2f}x); "
+                      f"busiest thread {b2:.3f} s: idle-machine ratio {c1 / max(b2, 1e-9):.2f}x; "
+                      f"load average {os.getloadavg()[0]:.1f}")})
+    return rows
+
+
 def run(quick: bool = False) -> list[dict]:
     """All core benchmark rows (see module docstring)."""
     # the cold-compile measurement takes ~20 s whatever the size: full runs only
-    return (fmm_rows(quick) + plan_rows(quick) + regional_rows(quick)
+    return (fmm_rows(quick) + threads_rows(quick) + plan_rows(quick) + regional_rows(quick)
             + regional_vs_full_rows(quick) + ([] if quick else jit_rows(quick)))
 
 
 #: ``python -m benchmarks.bench_core big`` runs only the big-map rows (issue 15, deliverable 3).
-GROUPS = {"fmm": fmm_rows, "plan": plan_rows, "big": lambda quick: big_rows(quick),
-          "jit": jit_rows}
+GROUPS = {"fmm": fmm_rows, "threads": threads_rows, "plan": plan_rows,
+          "big": lambda quick: big_rows(quick), "jit": jit_rows}
 
 
 def big_rows(quick: bool) -> list[dict]:

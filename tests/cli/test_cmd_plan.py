@@ -53,6 +53,7 @@ def test_bad_inputs_exit_2_with_one_line(tmp_path):
         ["--start", "1,2"],
         ["--exponent", "-1"],
         ["--order", "3"],
+        ["--threads", "0"],
         ["--start", "99999,0,0"],
     ]
     for i, extra in enumerate(cases):

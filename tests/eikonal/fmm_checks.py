@@ -13,8 +13,6 @@ import numpy as np
 from fm2uav.eikonal import fast_marching
 from fm2uav.eikonal._reference import fast_marching_reference
 
-#: The two implementations of the same discretisation; exact-value tests run on both.
-SOLVERS = {"compiled": fast_marching, "reference": fast_marching_reference}
 
 
 def node_coords(shape: Sequence[int], spacing: Sequence[float]) -> list[np.ndarray]:
@@ -50,3 +48,22 @@ def assert_same_field(actual: np.ndarray, desired: np.ndarray, rtol: float) -> N
     np.testing.assert_array_equal(np.isinf(actual), np.isinf(desired))
     finite = np.isfinite(desired)
     np.testing.assert_allclose(actual[finite], desired[finite], rtol=rtol, atol=0.0)
+
+
+def fast_marching_parallel(*args, threads: int = 2, **kwargs) -> np.ndarray:
+    """:func:`fast_marching` with the parallel march on every grid (no size floor, slabs
+    of one row on): the small exactness cases then run through the slabs, windows and
+    repairs of :mod:`fm2uav.eikonal._parallel` (order 1; order 2 marches serially)."""
+    from fm2uav.eikonal import _parallel
+
+    saved = _parallel.PARALLEL_MIN_NODES, _parallel.MIN_SLAB_ROWS
+    _parallel.PARALLEL_MIN_NODES, _parallel.MIN_SLAB_ROWS = 0, 1
+    try:
+        return fast_marching(*args, threads=threads, **kwargs)
+    finally:
+        _parallel.PARALLEL_MIN_NODES, _parallel.MIN_SLAB_ROWS = saved
+
+
+#: The implementations of the same discretisation; exact-value tests run on each.
+SOLVERS = {"compiled": fast_marching, "reference": fast_marching_reference,
+           "parallel": fast_marching_parallel}

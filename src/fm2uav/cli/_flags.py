@@ -50,7 +50,7 @@ FLAG_KEYS = {
     "--agl": "planner.agl", "--p1": "planner.p1", "--p2": "planner.p2",
     "--band": "planner.band", "--graded": "planner.graded", "--mode": "planner.mode",
     "--min-agl": "planner.min_agl", "--max-agl": "planner.max_agl", "--step": "planner.step",
-    "--storage": "planner.storage",
+    "--storage": "planner.storage", "--threads": "planner.threads",
     # zones
     "--no-fly": "no_fly_zones",
     # airframe

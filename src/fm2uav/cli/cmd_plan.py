@@ -69,6 +69,9 @@ def plan_cmd(
         "--saturation)."),
     exponent: float = typer.Option(1.0, help="Exponent β > 0 on W (thesis' adjustment)."),
     order: int = typer.Option(2, help="Fast Marching order, 1 or 2."),
+    threads: int | None = typer.Option(
+        None, help="Threads of the Fast Marching (>= 1; order 1 on grids of 1 M nodes or more "
+        "marches in parallel). Default: FM2UAV_THREADS, else every core."),
     storage: str = typer.Option(
         "auto", help="Grid storage: 'full' (one 3D grid), 'regional' (coarse plan, then "
         "full-resolution windows along it; terrain + --agl) or 'auto' (regional when the full "
@@ -133,7 +136,8 @@ def plan_cmd(
             cells=cells, agl=agl, anchor=getattr(export_options, "anchor", None))
         shaping, level, options = _planner(
             dict(saturation=saturation, saturation_distance=saturation_distance,
-                 exponent=exponent, order=order, storage=storage),
+                 exponent=exponent, order=order, storage=storage,
+                 threads=threads),
             dict(agl=agl, p1=p1, p2=p2, band=band, graded=graded, mode=mode, min_agl=min_agl,
                  max_agl=max_agl))
         export_options = with_wind_on(export_options, w)

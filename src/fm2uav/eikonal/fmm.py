@@ -13,7 +13,7 @@ import numpy as np
 
 from .._validate import grid
 from ..errors import InputError
-from . import _kernels, _sources
+from . import _kernels, _parallel, _sources
 
 __all__ = ["fast_marching", "as_spacing", "as_index_array"]
 
@@ -131,6 +131,7 @@ def fast_marching(
     stop_at: Any = None,
     source_ball: bool = True,
     wind: Any = None,
+    threads: int | None = None,
 ) -> np.ndarray:
     """Arrival times of a wave started at ``sources`` over a speed field.
 
@@ -172,6 +173,14 @@ def fast_marching(
         march above, bit for bit. Otherwise the wind march of
         :mod:`fm2uav.eikonal.wind`; nodes where ``|wind| >= speed`` are refused
         (impassable, ``inf``).
+    threads : int, optional
+        Threads the march may use (``>= 1``). None (default): the environment
+        variable ``FM2UAV_THREADS`` if set, else every core this process may run
+        on. With 2 or more, order 1 without ``stop_at`` on grids of at least
+        ``PARALLEL_MIN_NODES`` (1 M) nodes marches slabs of the grid in parallel
+        (:mod:`fm2uav.eikonal._parallel`; times equal to the serial march's to
+        round-off, ``stop_at`` included); order 2, the wind march and smaller
+        grids march on one thread.
 
     Returns
     -------
@@ -183,8 +192,9 @@ def fast_marching(
     fm2uav.InputError
         Bad shape, dtype, negative/non-finite speed, spacing <= 0, order not
         1/2, source/stop index outside the grid, a source with speed 0, a wind
-        of the wrong shape or not finite, or a source where the wind is at
-        least the airspeed.
+        of the wrong shape or not finite, a source where the wind is at
+        least the airspeed, or ``threads`` (or ``FM2UAV_THREADS``) not an
+        integer >= 1.
 
     Examples
     --------
@@ -195,6 +205,7 @@ def fast_marching(
     """
     v = _as_speed(speed)
     shape = v.shape
+    nthreads = _parallel.resolve_threads(threads)
     if wind is not None:
         is_calm, wind_march = _WIND_MARCH[0]
         if not is_calm(wind, shape):
@@ -223,7 +234,7 @@ def fast_marching(
     if src.shape[0] > MAX_BALL_SOURCES or not source_ball:
         radius = 0.0
     start = _source_start(v, src3, shape3, h3, radius, SOURCE_INIT_CELLS * max(h))
-    return run_march(flat_speed, start, shape, h3, order, stop_at)
+    return run_march(flat_speed, start, shape, h3, order, stop_at, threads=nthreads)
 
 
 def _source_start(v: np.ndarray, src3: np.ndarray, shape3: tuple[int, ...],
@@ -266,12 +277,15 @@ def run_march(
     h3: tuple[float, float, float],
     order: int,
     stop_at: Any,
+    threads: int = 1,
 ) -> np.ndarray:
     """March from the frozen/band nodes of ``start`` (a :class:`~fm2uav.eikonal._kernels.Start`).
 
     Shared by :func:`fast_marching` and :func:`fm2uav.eikonal.restart.remarch`:
     nodes frozen on entry (state 2) are expanded first, band nodes (state 1)
-    carry tentative times. ``stop_at`` as in :func:`fast_marching`.
+    carry tentative times. ``stop_at`` as in :func:`fast_marching`; ``threads``
+    (resolved, ``>= 1``) as there: the parallel march for order 1 on grids of at
+    least :data:`~fm2uav.eikonal._parallel.PARALLEL_MIN_NODES` nodes.
 
     Returns
     -------
@@ -286,5 +300,9 @@ def run_march(
         stops[:, : len(shape)] = idx
         if start.frozen_at(stops).all():  # every stop node is a source or in its ball
             return start.frozen_times(shape3).reshape(shape)
-    T, _ = _kernels.march(flat_speed, start, shape3, h3, order, stops)
+    if threads > 1 and order == 1 and flat_speed.size >= _parallel.PARALLEL_MIN_NODES:
+        T, _ = _parallel.march(flat_speed, start, shape3, h3, threads,
+                               stops[~start.frozen_at(stops)])
+    else:
+        T, _ = _kernels.march(flat_speed, start, shape3, h3, order, stops)
     return T.reshape(shape)

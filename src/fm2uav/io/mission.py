@@ -298,6 +298,8 @@ class PlannerSpec(BaseModel):
     storage: Literal["auto", "full", "regional"] = Field(
         "auto", description="grid storage: full 3D grid, regional (coarse-to-fine windows, "
         "terrain + agl), or auto by memory")
+    threads: int | None = Field(None, ge=1, le=4096, description="threads of the Fast "
+                                "Marching (default: FM2UAV_THREADS, else every core)")
 
     @model_validator(mode="after")
     def _objects(self) -> PlannerSpec:

@@ -261,12 +261,18 @@ class PlanOptions:
         full grid would take more than
         :data:`fm2uav.planning.regional.FULL_PLAN_MEMORY_SHARE` of this machine's
         memory and the world allows it, else "full".
+    threads : int or None
+        Threads of the Fast Marching runs (``>= 1``); None (default): the
+        environment variable ``FM2UAV_THREADS``, else every core. Order 1 on
+        grids of 1 M nodes or more marches in parallel (the same times to
+        round-off); see :func:`fm2uav.eikonal.fast_marching`.
     """
 
     order: Literal[1, 2] = 2
     step: float = 0.5
     speed_map: np.ndarray | None = None
     storage: Literal["auto", "full", "regional"] = "auto"
+    threads: int | None = None
 
     def __post_init__(self) -> None:
         _set(self, "order", v.integer(self.order, "order", where=_where("order")))
@@ -284,6 +290,9 @@ class PlanOptions:
                     f"{type(self.speed_map).__name__}") from None
             _set(self, "speed_map", W)
         v.choice(self.storage, STORAGE_MODES, "storage", where=_where("storage"))
+        if self.threads is not None:
+            _set(self, "threads", v.integer(self.threads, "threads", minimum=1,
+                                            where=_where("threads")))
 
 
 _CLASSES = (Shaping, FlightLevel, PlanOptions)

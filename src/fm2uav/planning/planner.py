@@ -364,7 +364,7 @@ def plan(
         return trace_plan(world, W, T, start_m, goal_m, shaping, level, options,
                           (t_all, t0, t1, t2), wind=wind, track=track, refused=refused)
     T = fast_marching(W, [goal_cell], spacing=world.spacing, order=options.order,
-                      stop_at=[start_cell])
+                      stop_at=[start_cell], threads=options.threads)
     # the nodes of the start's time that the queue froze before it are dropped: the field
     # is then a function of the times alone, which plan_many rebuilds from one whole march
     drop_ties(T, start_cell)

@@ -289,7 +289,8 @@ def _leg(sub: World, a: np.ndarray, b: np.ndarray, top_distance: float, shaping:
     W = window_velocity(sub, top_distance, shaping, level)
     t1 = time.perf_counter()
     ca, cb = sub.to_cell(a), sub.to_cell(b)
-    T = fast_marching(W, [cb], spacing=sub.spacing, order=options.order, stop_at=[ca])
+    T = fast_marching(W, [cb], spacing=sub.spacing, order=options.order, stop_at=[ca],
+                      threads=options.threads)
     t2 = time.perf_counter()
     if not np.isfinite(T[ca]):
         raise PlanningError(

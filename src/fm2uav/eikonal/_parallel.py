@@ -1,0 +1,710 @@
+"""The parallel Fast Marching (order 1): slabs, time windows, ghost exchange, repair.
+
+Private module: :func:`fm2uav.eikonal.fast_marching` calls :func:`march` for
+grids of at least :data:`PARALLEL_MIN_NODES` nodes when more than one thread is
+allowed (``threads``, ``FM2UAV_THREADS``) and the order is 1 (``stop_at`` too).
+Order 2 marches serially: its stencil reads two nodes upwind, so the ghosts and
+the repairs would have to reach two rows, which is not built (nor tested) yet.
+
+Design (Yang & Stern 2017, domain-decomposition FMM)
+----------------------------------------------------
+* The grid is cut along x (the slowest-varying axis of the C layout) into
+  ``K`` slabs, :data:`SLABS_PER_THREAD` per thread, thread ``t`` marching slabs
+  ``t, t + threads, ...`` (interleaved strips keep both threads busy when the
+  wave starts off-centre; with one slab per thread a coarse march picks the cut,
+  :func:`slab_bounds`). Each slab is a padded grid of its own, laid out exactly as the
+  serial march's (:func:`fm2uav.eikonal._kernels.pad_grid`), one after the other
+  in one buffer: its two ghost x-slabs hold, between windows, the *frozen*
+  times of the neighbouring slab's boundary rows (``NaN`` where not frozen), so
+  the serial kernels' update (``_solve_iso``, ``_axis_term``, ``_combine``) and
+  radix queue (``_push``, ``_pop``) run unchanged on a slab.
+* Time windows: every slab pops, with its own queue and in parallel, the nodes
+  whose time is below ``t_w``; then (barrier) every slab copies the neighbours'
+  boundary rows into its ghosts. A node next to a ghost whose value changed is
+  updated again; if that lowers a node frozen already, it is **re-opened**
+  (band again, queued). When a node is frozen, each frozen neighbour later
+  than it is updated again too and re-opened if that lowers it, so the
+  corrections cascade in time order (through the same queues, never a stack).
+  ``t_w`` then advances to the smallest queued time plus a width that adapts
+  so a window freezes ~``WINDOW_NODES`` nodes.
+* Queued times below the radix queue's lower bound (re-opened nodes) go to a
+  small binary heap (:mod:`._heap`) that is emptied first: its keys are all
+  below the radix queue's, so the slab still pops its exact minimum.
+* Nodes frozen on entry (sources, their balls) are never lowered, as in the
+  serial march. With stop nodes, the march ends once they are all frozen no
+  later than every queued time (nothing queued can lower them), and nodes
+  later than the latest of them are ``inf``, as the serial march leaves them.
+* It ends when every queue is empty after an exchange. The result is the fixed
+  point of the upwind scheme, which is what the serial march computes: the
+  times agree to round-off (tests/eikonal/test_fmm_parallel.py).
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+from numba import njit, prange
+
+from . import _kernels
+from ._heap import sift_down, sift_up
+from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _U, _ZERO, RESERVE_BLOCKS, BLOCK,
+                       _axis_term, _bits, _bucket, _prefetch, _combine, _pop, _push, _side_min,
+                       _solve_iso)
+
+#: The windows meet at a barrier several hundred times per march: a thread that waits
+#: there sleeps instead of spinning (OpenMP's default spins), or on a busy machine the
+#: spinning thread takes the core its partner needs (measured on 2048^2 with 10 runnable
+#: processes on 2 cores: 3.4 CPU-s spinning, 0.56 s passive, serial 0.53 s). Read by
+#: libgomp when numba first starts its thread pool; a value set by the user stays.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+__all__ = ["march", "resolve_threads", "PARALLEL_MIN_NODES", "THREADS_ENV"]
+
+#: Environment variable with the default thread count of the march (an integer >= 1).
+THREADS_ENV = "FM2UAV_THREADS"
+#: Grids of fewer nodes march serially whatever the thread count. Measured
+#: (benchmarks/bench_core.py, "threads" rows, a machine at load 9 on 2 cores):
+#: on 1024^2 the busiest thread takes 0.06 s of the serial 0.099 CPU-s (1.65x on
+#: an idle machine) and the wall time is equal; below, a window holds fewer nodes
+#: per barrier and the wall time on a busy machine decides: kept serial.
+PARALLEL_MIN_NODES = 1_000_000
+#: Each slab gets at least this many x-slabs (rows), else fewer slabs are used.
+MIN_SLAB_ROWS = 16
+#: Slabs per thread, thread ``t`` marching slabs ``t, t + threads, ...``: strips
+#: interleaved across the grid keep both threads busy when the wave starts off-centre.
+#: Measured on the FM²-shaped fields (source at 0.3 of x), 2 threads: 2D 1/2/4 slabs
+#: per thread let the windows run 1.38x/1.44x/1.64x in parallel for +15/+6/+3 % CPU;
+#: 3D 1.47x/1.59x/1.77x for +23/+7/+24 % CPU (more repairs per interface in 3D).
+SLABS_PER_THREAD = {2: 4, 3: 2}
+#: Target number of nodes frozen per window (all slabs together); the window
+#: width adapts to it. Fewer, wider windows cost fewer barriers and more repairs.
+WINDOW_NODES = 16384
+#: Free repair-heap slots kept before each node's pushes (one pop pushes at most 7).
+HEAP_RESERVE = 8
+#: Smallest start of a slab's repair heap (entries; at least 4 boundary rows) and
+#: entry pool (blocks); both double when a window runs low.
+HEAP_START = 4096
+POOL_MIN_BLOCKS = 2 * RESERVE_BLOCKS
+
+# slots of the per-slab control array ``ctl`` (float64)
+_C_NEXT = 0    # smallest queued time after the last window or exchange (inf: none)
+_C_POPS = 1    # nodes frozen in the last window
+_C_REOPEN = 2  # nodes re-opened so far
+_C_STATUS = 3  # 0 ok, 1 entry pool low, 2 repair heap full
+_C_SIZE = 4
+
+# slots of the march state ``st`` (uint64), shared with the serial layout
+_NFREE = 2
+_FH = 3
+_CUR = 4
+_LAST = 5
+_RSIZE = 8    # entries in the repair heap
+_ST = 9
+
+
+def resolve_threads(threads) -> int:
+    """The thread count of a march: ``threads``, else ``FM2UAV_THREADS``, else every core.
+
+    Parameters
+    ----------
+    threads : int or None
+        Threads the march may use (``>= 1``); None: the environment variable
+        ``FM2UAV_THREADS`` if set, else the cores this process may run on
+        (``os.sched_getaffinity``).
+
+    Returns
+    -------
+    int
+        The thread count, ``>= 1``.
+
+    Raises
+    ------
+    fm2uav.InputError
+        ``threads`` (or the environment variable) is not an integer ``>= 1``.
+    """
+    from ..errors import InputError
+
+    if threads is None:
+        env = os.environ.get(THREADS_ENV, "").strip()
+        if env:
+            try:
+                threads = int(env)
+            except ValueError:
+                raise InputError(
+                    f"{THREADS_ENV} must be an integer >= 1 (threads of the Fast Marching), "
+                    f"got {env!r}") from None
+            if threads < 1:
+                raise InputError(
+                    f"{THREADS_ENV} must be an integer >= 1 (threads of the Fast Marching), "
+                    f"got {env!r}")
+            return threads
+        try:
+            return max(1, len(os.sched_getaffinity(0)))
+        except AttributeError:  # not Linux
+            return max(1, os.cpu_count() or 1)
+    if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
+        raise InputError(f"threads must be an integer >= 1, got {threads!r}")
+    return int(threads)
+
+
+# ------------------------------------------------------------------ queue glue
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _enq(k, c, pool, nxt, bk, mw, st, rkey, ritem):
+    """Queue node ``c`` with key bits ``k``: the radix queue if ``k`` is not below its
+    lower bound, else the repair heap (the caller keeps :data:`HEAP_RESERVE` slots free)."""
+    last = st[_LAST]
+    if k >= last:
+        nfree, fh, cur = _push(_bucket(k, last), k, c, pool, nxt, bk, mw, st[_NFREE],
+                               st[_FH], st[_CUR])
+        st[_NFREE] = nfree
+        st[_FH] = fh
+        st[_CUR] = cur
+        return
+    size = st[_RSIZE]
+    sift_up(rkey, ritem, rkey[:0], np.int64(size), k, c)
+    st[_RSIZE] = size + _ONE
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _deq(T, pool, nxt, bk, mw, st, rkey, ritem):
+    """Remove the smallest queued entry (repair heap first); its node or ``_NIL``."""
+    size = st[_RSIZE]
+    if size > _ZERO:
+        c = ritem[0]
+        size -= _ONE
+        st[_RSIZE] = size
+        if size > _ZERO:
+            sift_down(rkey, ritem, rkey[:0], np.int64(size), rkey[size], ritem[size])
+        return c
+    c, nfree, fh, cur, last = _pop(T, pool, nxt, bk, mw, st[_NFREE], st[_FH], st[_CUR],
+                                   st[_LAST])
+    st[_NFREE] = nfree
+    st[_FH] = fh
+    st[_CUR] = cur
+    st[_LAST] = last
+    return c
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _update(T, V, c, sx, sy, ih, hh, iso, three):  # noqa: PLR0913
+    """The order-1 upwind time of node ``c`` from its frozen neighbours (as the serial march)."""
+    if iso:
+        tz = _side_min(T, c, _ONE) if three else _INF
+        return _solve_iso(_side_min(T, c, sx), _side_min(T, c, sy), tz, V[c] * hh)
+    ta, aa = _axis_term(T, V, c, sx, ih[0], 1)
+    tb, ab = _axis_term(T, V, c, sy, ih[1], 1)
+    if three:
+        tc, ac = _axis_term(T, V, c, _ONE, ih[2], 1)
+    else:
+        tc, ac = _INF, 0.0
+    return _combine(ta, aa, tb, ab, tc, ac, V[c])
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _prefetch_rows(T, V, c, sx, sy, three):
+    """Prefetch ``T`` and ``V`` one and two rows (planes) away across x (and y)."""
+    n = _U(T.size)
+    _prefetch(T, c - sx)
+    _prefetch(T, c + sx)
+    _prefetch(V, c - sx)
+    _prefetch(V, c + sx)
+    _prefetch(T, c - sx - sx if c >= sx + sx else c)
+    _prefetch(T, c + sx + sx if c + sx + sx < n else c)
+    if three:
+        _prefetch(T, c - sy)
+        _prefetch(T, c + sy)
+        _prefetch(V, c - sy)
+        _prefetch(V, c + sy)
+        _prefetch(T, c - sy - sy)
+        _prefetch(T, c + sy + sy)
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _lower(T, V, c, t, fixed, sx, sy, three, pool, nxt, bk, mw, st, rkey, ritem, ctl):
+    """Give node ``c`` the time ``t`` if that is lower than its band or frozen time.
+
+    A frozen node lowered is re-opened (band again), unless it was frozen on entry
+    (bit ``c`` of ``fixed``: a source or its ball, final as in the serial march).
+    """
+    x = T[c]
+    if x < 0.0:
+        if t < -x:
+            T[c] = -t
+            if x == -_INF:  # a new band node: fetch the rows its freezing reads (as _relax)
+                _prefetch_rows(T, V, c, sx, sy, three)
+            _enq(_bits(t), c, pool, nxt, bk, mw, st, rkey, ritem)
+    elif t < x and (fixed[c >> _U(3)] >> (c & _U(7))) & _ONE == _ZERO:
+        T[c] = -t
+        ctl[_C_REOPEN] += 1.0
+        _enq(_bits(t), c, pool, nxt, bk, mw, st, rkey, ritem)
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _room(st, rkey):
+    """Whether the pool and the repair heap have room for the pushes of one node."""
+    return st[_NFREE] >= _U(RESERVE_BLOCKS) and st[_RSIZE] + _U(HEAP_RESERVE) <= _U(rkey.size)
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _nbs(c, sx, sy, three):
+    """The neighbours of node ``c``: six in 3D; in 2D four, then ``c`` twice (frozen: skipped)."""
+    if three:
+        return (c - sx, c + sx, c - sy, c + sy, c - _ONE, c + _ONE)
+    return (c - sx, c + sx, c - _ONE, c + _ONE, c, c)
+
+
+def _slab_kernels(three):
+    """The compiled window, start and exchange of one dimension (``three``: 3D)."""
+
+    # closure variables are part of numba's cache key: only ``three`` (a bool) may be
+    # one (a dispatcher's pickle differs per process and would defeat the cache)
+    def window(T, V, fixed, sx, sy, ih, hh, iso, tw, pool, nxt, bk, mw, st, rkey, ritem, ctl):
+        """Freeze the slab's queued nodes with a time below ``tw`` (resumable).
+
+        ``T`` is the slab's padded grid (ghost x-slabs first and last). Sets
+        ``ctl[_C_NEXT]`` to the smallest time left queued (inf if none).
+        """
+        n = _U(T.size)
+        lo = sx  # the slab's own nodes: [sx, n - sx)
+        hi = n - sx
+        kw = _bits(tw)
+        pops = 0
+        ctl[_C_NEXT] = _INF
+        while True:
+            if not _room(st, rkey):
+                ctl[_C_STATUS] = 1.0 if st[_NFREE] < _U(RESERVE_BLOCKS) else 2.0
+                break
+            c = _deq(T, pool, nxt, bk, mw, st, rkey, ritem)
+            if c == _NIL:
+                break
+            x = T[c]
+            if not x < 0.0:  # outdated entry of a frozen node
+                continue
+            t = -x
+            k = _bits(t)
+            if k >= kw:  # the window is done: put it back
+                _enq(k, c, pool, nxt, bk, mw, st, rkey, ritem)
+                ctl[_C_NEXT] = t
+                break
+            T[c] = t
+            pops += 1
+            for nb in _nbs(c, sx, sy, three):
+                y = T[nb]
+                if y < 0.0 or (y > t and nb >= lo and nb < hi):
+                    # band/far, or frozen later than c in this slab: c may lower it
+                    t_nb = _update(T, V, nb, sx, sy, ih, hh, iso, three)
+                    _lower(T, V, nb, t_nb, fixed, sx, sy, three, pool, nxt, bk, mw, st, rkey,
+                           ritem, ctl)
+        ctl[_C_POPS] = pops
+
+    def start(T, V, fixed, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl):
+        """Queue the slab's band nodes given on entry and expand its frozen ones."""
+        n = _U(T.size)
+        c = sx
+        while c < n - sx:
+            x = T[c]
+            if x < 0.0 and x > -_INF:
+                if not _room(st, rkey):
+                    return False
+                _enq(_bits(-x), c, pool, nxt, bk, mw, st, rkey, ritem)
+            c += _ONE
+        c = sx
+        while c < n - sx:
+            if T[c] >= 0.0:
+                if not _room(st, rkey):
+                    return False
+                for nb in _nbs(c, sx, sy, three):
+                    if T[nb] < 0.0:
+                        t_nb = _update(T, V, nb, sx, sy, ih, hh, iso, three)
+                        _lower(T, V, nb, t_nb, fixed, sx, sy, three, pool, nxt, bk, mw, st,
+                               rkey, ritem, ctl)
+            c += _ONE
+        return True
+
+    def exchange(T, V, fixed, src, g, own, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem,
+                 ctl):
+        """Copy the neighbour's boundary row ``src`` (its frozen times) into the ghost row
+        starting at ``g``; update the own node next to each ghost that changed (``own``:
+        the start of that row). Resumable: False when a queue is full."""
+        j = _ZERO
+        while j < sx:
+            v = src[j]
+            if v >= 0.0 and not v >= T[g + j]:  # newly frozen or lowered there
+                if not _room(st, rkey):
+                    return False
+                T[g + j] = v
+                c = own + j
+                if T[c] == T[c]:  # not a wall
+                    _lower(T, V, c, _update(T, V, c, sx, sy, ih, hh, iso, three), fixed, sx, sy,
+                           three, pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                    if T[c] < 0.0 and -T[c] < ctl[_C_NEXT]:  # queued: the next window knows
+                        ctl[_C_NEXT] = -T[c]
+            j += _ONE
+        return True
+
+    d = 3 if three else 2
+    out = []
+    for f in (window, start, exchange):
+        f.__name__ = f.__qualname__ = f"{f.__name__}{d}d"
+        out.append(njit(cache=True, error_model="numpy", _nrt=False)(f))
+    return out
+
+
+_window2d, _start2d, _exchange2d = _slab_kernels(False)
+_window3d, _start3d, _exchange3d = _slab_kernels(True)
+
+
+@njit(cache=True, _nrt=False)
+def _window(three, *args):
+    """The 3D or the 2D kernel."""
+    if three:
+        return _window3d(*args)
+    return _window2d(*args)
+
+
+@njit(cache=True, _nrt=False)
+def _start(three, *args):
+    """The 3D or the 2D kernel."""
+    if three:
+        return _start3d(*args)
+    return _start2d(*args)
+
+
+@njit(cache=True, _nrt=False)
+def _exchange(three, *args):
+    """The 3D or the 2D kernel."""
+    if three:
+        return _exchange3d(*args)
+    return _exchange2d(*args)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _heap_next(T, st, ritem, ctl):
+    """Lower ``ctl[_C_NEXT]`` to the repair heap's smallest time (a hint for the window)."""
+    if st[_RSIZE] > _ZERO:
+        x = T[ritem[0]]
+        if x < 0.0 and -x < ctl[_C_NEXT]:
+            ctl[_C_NEXT] = -x
+
+
+def _drive_kernel(three):
+    """The compiled driver of one dimension (the parallel region runs the slabs)."""
+    def drive(nth, Tp, Vp, fx, off, end, rows, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey,
+              ritem, ctl, win, first, stops):
+        """Run windows until every queue is empty; 0 done, 1/2 grow pool/heap and call again.
+
+        ``win`` (float64): [0] window end, [1] width, [2] windows run, [3] target pops,
+        [4] nodes frozen (re-freezes included), [5] sum over windows of the most a slab
+        froze (the critical path: ``[4] / [5]`` bounds the speed-up), [6] the latest
+        stop node's time when the stop nodes ``stops`` (indices into ``Tp``) ended it,
+        [7] 1 once the start (``first``) is done.
+        """
+        K = off.size
+        sxi = np.int64(sx)
+        if first:
+            for t in prange(nth):  # thread t runs slabs t, t + nth, ...
+                for k in range(t, K, nth):
+                    if not _start(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]], fx[off[k] >> 3:], sx,
+                                  sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
+                                  ritem[k], ctl[k]):
+                        ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < _U(RESERVE_BLOCKS) else 2.0
+            for k in range(K):
+                if ctl[k, _C_STATUS] != 0.0:
+                    return int(ctl[k, _C_STATUS])  # grown, the start runs again
+            win[7] = 1.0
+        while True:
+            # exchange: each slab refreshes its own ghosts and the rows next to them
+            for t in prange(nth):  # thread t runs slabs t, t + nth, ...
+                for k in range(t, K, nth):
+                    T = Tp[off[k]:end[k]]
+                    V = Vp[off[k]:end[k]]
+                    F = fx[off[k] >> 3:]
+                    ok = True
+                    if k > 0:
+                        o = end[k - 1] - 2 * sxi  # last own row of the slab below
+                        ok = _exchange(three, T, V, F, Tp[o:o + sxi], _ZERO, sx, sx, sy, ih, hh,
+                                       iso, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
+                                       ritem[k], ctl[k])
+                    if ok and k < K - 1:
+                        o = off[k + 1] + sxi  # first own row of the slab above
+                        r = _U(rows[k])
+                        ok = _exchange(three, T, V, F, Tp[o:o + sxi], (r + _ONE) * sx, r * sx,
+                                       sx, sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
+                                       rkey[k], ritem[k], ctl[k])
+                    if not ok:
+                        ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < _U(RESERVE_BLOCKS) else 2.0
+                    _heap_next(T, st[k], ritem[k], ctl[k])
+            for k in range(K):
+                if ctl[k, _C_STATUS] != 0.0:
+                    return int(ctl[k, _C_STATUS])
+            # the next window
+            tmin = _INF
+            empty = True
+            for k in range(K):
+                tmin = min(tmin, ctl[k, _C_NEXT])
+                if st[k, _RSIZE] > _ZERO:
+                    empty = False
+                for w in range(_NW):
+                    if mw[k, w] != _ZERO:
+                        empty = False
+            # stop nodes: done once all are frozen no later than every queued time
+            # (nothing queued can lower them: an update is later than its inputs)
+            if stops.size > 0:
+                smax = 0.0
+                for i in range(stops.size):
+                    x = Tp[stops[i]]
+                    if not x >= 0.0:
+                        smax = _INF
+                        break
+                    smax = max(smax, x)
+                if smax <= tmin:
+                    win[6] = smax
+                    return 0
+            if empty:
+                return 0
+            if tmin < _INF:
+                win[0] = max(win[0], tmin) + win[1]
+            else:
+                win[0] = win[0] + win[1]
+            tw = win[0]
+            for t in prange(nth):  # thread t runs slabs t, t + nth, ...
+                for k in range(t, K, nth):
+                    _window(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]], fx[off[k] >> 3:], sx,
+                            sy, ih, hh, iso, tw, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
+                            ritem[k], ctl[k])
+            win[2] += 1.0
+            pops = 0.0
+            most = 0.0
+            for t in range(nth):
+                mine = 0.0
+                for k in range(t, K, nth):
+                    mine += ctl[k, _C_POPS]
+                pops += mine
+                most = max(most, mine)
+            win[4] += pops
+            win[5] += most
+            for k in range(K):
+                if ctl[k, _C_STATUS] != 0.0:
+                    return int(ctl[k, _C_STATUS])
+            # adapt the width toward the target pops per window
+            f = win[3] / max(pops, 1.0)
+            win[1] *= min(2.0, max(0.5, f))
+
+    drive.__name__ = drive.__qualname__ = f"drive{3 if three else 2}d"
+    return njit(cache=True, parallel=True, error_model="numpy")(drive)
+
+
+_drive2d = _drive_kernel(False)
+_drive3d = _drive_kernel(True)
+
+
+#: The split of two slabs is chosen on a march over every ``COARSE``-th node per axis
+#: (2D; 3D: ``COARSE_3D``), ~1.5 % of the work of the full march.
+COARSE = 8
+COARSE_3D = 4
+#: Time bins of the split estimate (stand-ins for the windows).
+SPLIT_BINS = 256
+
+
+def slab_bounds(speed, start, shape3, h3, k: int) -> np.ndarray:
+    """Row bounds (``k + 1`` ints) of ``k`` slabs along x.
+
+    Two slabs are split where a coarse march predicts the best balance: the
+    row ``s`` minimising ``sum over time bins of max(nodes below s, nodes from s
+    on)``, the windows' critical path (a source off-centre would otherwise leave
+    one slab idle while the wave crosses the other). Otherwise, or when the start
+    is not a few point sources (its box over a quarter of the grid), equal slabs.
+    """
+    nx = int(shape3[0])
+    even = np.linspace(0, nx, k + 1).round().astype(np.int64)
+    if k != 2 or 4 * int(np.prod(start.shape)) > int(np.prod(shape3)):
+        return even
+    three = shape3[2] > 1
+    f = COARSE_3D if three else COARSE
+    grid = speed.reshape(shape3)
+    coarse = np.ascontiguousarray(grid[::f, ::f, ::f] if three else grid[::f, ::f, :])
+    cshape = coarse.shape
+    if cshape[0] < 4:
+        return even
+    box = np.argwhere(start.state.reshape(start.shape) == _kernels.FROZEN)
+    if len(box) == 0:
+        return even
+    cells = np.unique((box + np.asarray(start.lo)) // np.array([f, f, f if three else 1]),
+                      axis=0)
+    lo = cells.min(axis=0)
+    bshape = tuple(int(n) for n in cells.max(axis=0) - lo + 1)
+    Tb = np.full(int(np.prod(bshape)), np.inf)
+    sb = np.zeros(Tb.size, dtype=np.uint8)
+    flat = np.ravel_multi_index(tuple((cells - lo).T), bshape)
+    Tb[flat] = 0.0
+    sb[flat] = _kernels.FROZEN
+    cstart = _kernels.Start(tuple(int(a) for a in lo), bshape, Tb, sb)
+    hc = tuple(h * f for h in h3[:2]) + ((h3[2] * f,) if three else (h3[2],))
+    T, _ = _kernels.march(coarse.reshape(-1), cstart, cshape, hc, 1,
+                          np.zeros((0, 3), dtype=np.int64))
+    T = T.reshape(cshape[0], -1)
+    fin = np.isfinite(T)
+    tmax = float(T[fin].max()) if fin.any() else 0.0
+    if not tmax > 0.0:
+        return even
+    rows = np.broadcast_to(np.arange(cshape[0])[:, None], T.shape)[fin]
+    bins = np.minimum((T[fin] / tmax * SPLIT_BINS).astype(np.int64), SPLIT_BINS - 1)
+    hist = np.bincount(rows * SPLIT_BINS + bins,
+                       minlength=cshape[0] * SPLIT_BINS).reshape(cshape[0], SPLIT_BINS)
+    below = np.cumsum(hist, axis=0)[:-1]  # nodes of rows < s + 1, s = 0 .. n - 2
+    cost = np.maximum(below, below[-1] + hist[-1] - below).sum(axis=1)
+    cut = (int(np.argmin(cost)) + 1) * f
+    cut = min(max(cut, MIN_SLAB_ROWS), nx - MIN_SLAB_ROWS)
+    return np.array([0, cut, nx], dtype=np.int64)
+
+
+def march(speed, start, shape3, h3, threads, stop_cells=None):
+    """The order-1 Fast Marching from ``start`` on ``threads`` slabs in parallel.
+
+    Parameters
+    ----------
+    speed : ndarray, float64, shape (nx*ny*nz,)
+        Propagation speed [m/s]; nodes with 0 are never entered.
+    start : fm2uav.eikonal._kernels.Start
+        The initial frozen/band nodes.
+    shape3 : tuple of 3 int
+        Grid shape ``(nx, ny, nz)`` (``nz = 1`` for 2D).
+    h3 : tuple of 3 float
+        Spacing per axis [m].
+    threads : int
+        Threads, ``>= 2`` (each marches :data:`SLABS_PER_THREAD` slabs, fewer
+        where a slab would get fewer than :data:`MIN_SLAB_ROWS` rows).
+    stop_cells : ndarray, int, shape (m, 3), optional
+        Stop once these nodes are frozen and final; nodes later than the latest
+        of them are then ``inf``, as in the serial march.
+
+    Returns
+    -------
+    T : ndarray, float64, shape (nx*ny*nz,)
+        Arrival times [s], ``inf`` where unreachable.
+    stats : dict
+        ``slabs``, ``windows``, ``reopened`` (nodes lowered after they were frozen) and
+        ``balance``: nodes frozen over the sum of each window's largest slab share, the
+        speed-up the windows allow if every freeze cost the same (``slabs`` at best).
+    """
+    import numba
+
+    nx, ny, nz = (int(n) for n in shape3)
+    three = nz > 1
+    nth = int(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
+    K = int(max(1, min(nth * SLABS_PER_THREAD[3 if three else 2], nx // MIN_SLAB_ROWS)))
+    nth = min(nth, K)
+    bounds = slab_bounds(speed, start, shape3, h3, K)
+    rows = np.diff(bounds).astype(np.int64)
+    sx = (ny + 2) * (nz + 2) if three else ny + 2
+    sy = nz + 2 if three else 1
+    sizes = (rows + 2) * sx
+    # slabs start at multiples of 8 nodes: each slab's bits of ``fixed`` start a byte
+    off = np.concatenate([[0], np.cumsum(-(-sizes // 8) * 8)[:-1]]).astype(np.int64)
+    npad = int(off[-1] + sizes[-1])
+    lean = (nx + 2) * sx > _kernels.LEAN_NODES  # V in float32 as the serial march
+    Tp = np.empty(npad)
+    Vp = np.empty(npad, dtype=np.float32 if lean else np.float64)
+    plane = ny * nz
+    lo, bshape = start.lo, start.shape
+    bplane = bshape[1] * bshape[2]
+    for k in range(K):
+        a, b = int(bounds[k]), int(bounds[k + 1])
+        i0, i1 = max(lo[0], a), min(lo[0] + bshape[0], b)
+        if i1 > i0:
+            Tb = start.T[(i0 - lo[0]) * bplane:(i1 - lo[0]) * bplane]
+            sb = start.state[(i0 - lo[0]) * bplane:(i1 - lo[0]) * bplane]
+            box = (i0 - a, lo[1], lo[2], i1 - i0, bshape[1], bshape[2])
+        else:
+            Tb, sb = start.T[:0], start.state[:0]
+            box = (0, 0, 0, 0, 0, 0)
+        seg = slice(int(off[k]), int(off[k] + sizes[k]))
+        _kernels.pad_grid(_kernels._readonly(speed[a * plane:b * plane]), Tb, sb, *box,
+                          b - a, ny, nz, Tp[seg], Vp[seg])
+    # the nodes frozen on entry (sources, balls) stay as they are, as in the serial march
+    fixed = np.packbits(Tp >= 0.0, bitorder="little")
+    # queues: one radix queue and one repair heap per slab
+    nblk = max(POOL_MIN_BLOCKS, int(sizes.max()) // (16 * BLOCK))
+    pool = np.empty((K, 2 * nblk * BLOCK), dtype=np.uint64)
+    nxt = np.empty((K, nblk), dtype=np.uint32)
+    bk = np.empty((K, 2 * int(_NB)), dtype=np.uint32)
+    mw = np.empty((K, _NW), dtype=np.uint64)
+    st = np.zeros((K, _ST), dtype=np.uint64)
+    for k in range(K):
+        _kernels.init_queue(nxt[k], bk[k], mw[k], st[k])
+    rcap = max(HEAP_START, HEAP_RESERVE)
+    rkey = np.empty((K, rcap), dtype=np.uint64)
+    ritem = np.empty((K, rcap), dtype=np.uint64)
+    ctl = np.zeros((K, _C_SIZE))
+    ih = np.array([1.0 / (h * h) for h in h3])
+    iso = bool(ih[0] == ih[1] and (not three or ih[1] == ih[2]))
+    hh = float(1.0 / ih[0])
+    vmax = float(speed.max()) if speed.size else 1.0
+    width = 2.0 * min(h3[:3 if three else 2]) / max(vmax, 1e-300)
+    win = np.array([0.0, width, 0.0, float(WINDOW_NODES), 0.0, 0.0, np.inf, 0.0])
+    stop_idx = np.zeros(0, dtype=np.int64)
+    if stop_cells is not None and len(stop_cells):
+        cells = np.asarray(stop_cells, dtype=np.int64).reshape(-1, 3)
+        k = np.searchsorted(bounds, cells[:, 0], side="right") - 1
+        local = ((cells[:, 0] - bounds[k] + 1) * (ny + 2) + cells[:, 1] + 1)
+        if three:
+            local = local * (nz + 2) + cells[:, 2] + 1
+        stop_idx = off[k] + local
+    drive = _drive3d if three else _drive2d
+    first = True
+    prev = numba.get_num_threads()
+    numba.set_num_threads(nth)
+    try:
+        while True:
+            status = drive(nth, Tp, Vp, fixed, off, off + sizes, rows, _U(sx), _U(sy), ih, hh,
+                           iso, pool, nxt, bk, mw, st, rkey, ritem, ctl, win, first, stop_idx)
+            first = win[7] == 0.0
+            if status == 0:
+                break
+            ctl[:, _C_STATUS] = 0.0
+            if status == 1:
+                pool, nxt = _grow_pools(pool, nxt, st)
+            else:
+                rkey, ritem = _grow_heaps(rkey, ritem)
+    finally:
+        numba.set_num_threads(prev)
+    T = np.empty(nx * ny * nz)
+    for k in range(K):
+        a, b = int(bounds[k]), int(bounds[k + 1])
+        seg = slice(int(off[k]), int(off[k] + sizes[k]))
+        _kernels.unpad_grid(Tp[seg], b - a, ny, nz, T[a * plane:b * plane])
+    if win[6] < np.inf:  # stopped: what the serial march would not have frozen yet
+        T[T > win[6]] = np.inf
+        sel = tuple(slice(a, a + m) for a, m in zip(start.lo, start.shape))
+        box = T.reshape(shape3)[sel]  # nodes frozen on entry stay, whatever their time
+        frozen = (start.state == _kernels.FROZEN).reshape(start.shape)
+        box[frozen] = start.T.reshape(start.shape)[frozen]
+    return T, {"slabs": K, "windows": int(win[2]), "reopened": int(ctl[:, _C_REOPEN].sum()),
+               "balance": float(win[4] / max(win[5], 1.0))}
+
+
+def _grow_pools(pool, nxt, st):
+    """Double every slab's entry pool; the new blocks join each slab's free list."""
+    K, old = nxt.shape
+    new = 2 * old
+    pool2 = np.empty((K, 2 * new * BLOCK), dtype=np.uint64)
+    pool2[:, :pool.shape[1]] = pool
+    nxt2 = np.empty((K, new), dtype=np.uint32)
+    nxt2[:, :old] = nxt
+    for k in range(K):
+        nxt2[k, old:-1] = np.arange(old + 1, new, dtype=np.uint32)
+        nxt2[k, -1] = np.uint32(st[k, _FH]) if st[k, _NFREE] > 0 else np.uint32(_NIL)
+        st[k, _FH] = old
+        st[k, _NFREE] = int(st[k, _NFREE]) + (new - old)
+    return pool2, nxt2
+
+
+def _grow_heaps(rkey, ritem):
+    """Double every slab's repair heap (entries kept in place: still a heap)."""
+    K, cap = rkey.shape
+    rkey2 = np.empty((K, 2 * cap), dtype=np.uint64)
+    ritem2 = np.empty((K, 2 * cap), dtype=np.uint64)
+    rkey2[:, :cap] = rkey
+    ritem2[:, :cap] = ritem
+    return rkey2, ritem2

@@ -1,0 +1,178 @@
+"""The parallel order-1 march (issue 27): the serial march's times on slabs of the grid.
+
+``fast_marching(..., threads=k)`` with ``k >= 2`` marches slabs of the grid in time windows
+(:mod:`fm2uav.eikonal._parallel`); its arrival times must equal the serial march's to
+round-off, on every field, spacing, thread count and with ``stop_at``. The exactness cases of
+``test_fmm_exact.py`` also run on it (the ``parallel`` solver of ``fmm_checks``). Speed is
+measured in ``benchmarks/bench_core.py`` (the ``threads`` rows), never here.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fm2uav.errors import InputError
+from fm2uav.eikonal import _parallel, fast_marching
+from fm2uav.eikonal.fmm import _as_speed, _source_start
+
+from .fmm_checks import fast_marching_parallel
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+from benchmarks.fields import fm2_shaped, smooth  # noqa: E402
+
+RTOL = 1e-12
+
+
+def _fields(shape):
+    """Constant speed from a corner, the smooth field, an FM²-shaped map (walls, W -> 0)."""
+    yield "constant", np.ones(shape), (0,) * len(shape)
+    v, src = smooth(shape)
+    yield "smooth", v, src
+    v, src = fm2_shaped(shape, seed=1)
+    yield "fm2", v, src
+
+
+def assert_equal_times(a, b):
+    fa, fb = np.isfinite(a), np.isfinite(b)
+    assert np.array_equal(fa, fb), f"{int(fa.sum())} vs {int(fb.sum())} nodes reached"
+    np.testing.assert_allclose(b[fa], a[fa], rtol=RTOL, atol=0)
+
+
+@pytest.mark.parametrize("shape", [(97, 81), (41, 37, 29)])
+@pytest.mark.parametrize("threads", [2, 3])
+def test_parallel_times_equal_the_serial_march(shape, threads):
+    for name, v, src in _fields(shape):
+        for h in (1.0, (1.0, 0.7, 1.3)[:len(shape)]):
+            serial = fast_marching(v, [src], order=1, spacing=h, threads=1)
+            par = fast_marching_parallel(v, [src], order=1, spacing=h, threads=threads)
+            assert_equal_times(serial, par)
+            assert np.isfinite(par).sum() > 0.5 * par.size, name
+
+
+@pytest.mark.parametrize("shape", [(97, 81), (41, 37, 29)])
+def test_parallel_stop_at_freezes_what_the_serial_march_freezes(shape):
+    for name, v, src in _fields(shape):
+        free = np.argwhere(v > 0)
+        for stop in ([tuple(free[-1])], [tuple(free[len(free) // 3]), tuple(free[-7])]):
+            serial = fast_marching(v, [src], order=1, stop_at=stop, threads=1)
+            par = fast_marching_parallel(v, [src], order=1, stop_at=stop)
+            assert_equal_times(serial, par)
+            assert all(np.isfinite(par[s]) for s in stop), name
+
+
+def test_several_sources_and_no_ball_equal_the_serial_march():
+    v, _ = fm2_shaped((120, 90), seed=2)
+    free = np.argwhere(v > 0.3)
+    rng = np.random.default_rng(0)
+    sources = [tuple(c) for c in free[rng.choice(len(free), 70, replace=False)]]  # > 64: no ball
+    assert_equal_times(fast_marching(v, sources, order=1, threads=1),
+                       fast_marching_parallel(v, sources, order=1))
+    src = [tuple(free[5])]
+    assert_equal_times(fast_marching(v, src, order=1, threads=1, source_ball=False),
+                       fast_marching_parallel(v, src, order=1, source_ball=False))
+
+
+def _start(v, src):
+    v = _as_speed(v)
+    shape3 = v.shape + (1,) * (3 - v.ndim)
+    src3 = np.zeros((1, 3), dtype=np.int64)
+    src3[0, :v.ndim] = src
+    return v.reshape(-1), _source_start(v, src3, shape3, (1.0,) * 3, 2.0, 2.0), shape3
+
+
+def test_windows_repair_nodes_the_other_slab_reaches_first():
+    """The case the repairs exist for: a fast channel along x crossing the slab interface
+    lets the wave arrive there from the other slab after this one froze its side; the
+    re-opened nodes must end at the serial times."""
+    v = np.full((200, 60), 0.2)
+    v[:, 28:32] = 5.0  # fast lane across every slab
+    flat, start, shape3 = _start(v, (2, 30))
+    T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, 2)
+    serial = fast_marching(v, [(2, 30)], order=1, threads=1, source_ball=False)
+    assert stats["slabs"] >= 2 and stats["windows"] > 1
+    assert stats["reopened"] > 0
+    assert_equal_times(serial.reshape(-1), T)
+
+
+def test_slab_split_follows_the_wave_of_an_off_centre_source():
+    """Two slabs are cut where a coarse march balances the windows: near the source when
+    it sits off-centre (an even cut would leave one slab idle while the wave crosses the
+    other), in the middle for a centred one."""
+    n = 512
+    v = np.ones((n, 64))
+    flat, start, shape3 = _start(v, (40, 32))
+    cut = _parallel.slab_bounds(flat, start, shape3, (1.0,) * 3, 2)[1]
+    assert cut < n // 3
+    flat, start, shape3 = _start(v, (n // 2, 32))
+    cut = _parallel.slab_bounds(flat, start, shape3, (1.0,) * 3, 2)[1]
+    assert abs(cut - n // 2) <= 16
+
+
+@pytest.mark.parametrize("bad", [0, -2, 1.5, True, "2"])
+def test_bad_threads_are_refused(bad):
+    with pytest.raises(InputError, match="threads must be an integer >= 1"):
+        fast_marching(np.ones((4, 4)), [(0, 0)], threads=bad)
+
+
+@pytest.mark.parametrize("bad", ["0", "two", "-1"])
+def test_bad_environment_variable_is_refused_by_name(monkeypatch, bad):
+    monkeypatch.setenv("FM2UAV_THREADS", bad)
+    with pytest.raises(InputError, match="FM2UAV_THREADS must be an integer >= 1"):
+        fast_marching(np.ones((4, 4)), [(0, 0)])
+
+
+def test_threads_default_to_the_variable_then_every_core(monkeypatch):
+    monkeypatch.setenv("FM2UAV_THREADS", "3")
+    assert _parallel.resolve_threads(None) == 3
+    assert _parallel.resolve_threads(1) == 1  # the argument wins
+    monkeypatch.delenv("FM2UAV_THREADS")
+    assert _parallel.resolve_threads(None) == len(os.sched_getaffinity(0))
+
+
+def _no_parallel(*args, **kwargs):
+    raise AssertionError("the parallel march ran")
+
+
+def test_small_grids_order_2_and_one_thread_march_serially(monkeypatch):
+    monkeypatch.setattr(_parallel, "march", _no_parallel)
+    small = int(np.sqrt(_parallel.PARALLEL_MIN_NODES)) - 1
+    fast_marching(np.ones((small, small)), [(0, 0)], order=1, threads=2)
+    monkeypatch.setattr(_parallel, "PARALLEL_MIN_NODES", 0)
+    fast_marching(np.ones((40, 40)), [(0, 0)], order=2, threads=2)
+    fast_marching(np.ones((40, 40)), [(0, 0)], order=1, threads=1)
+    monkeypatch.setenv("FM2UAV_THREADS", "1")
+    fast_marching(np.ones((40, 40)), [(0, 0)], order=1)
+    monkeypatch.setenv("FM2UAV_THREADS", "2")
+    with pytest.raises(AssertionError, match="parallel march ran"):
+        fast_marching(np.ones((40, 40)), [(0, 0)], order=1)
+
+
+def test_plan_options_take_threads():
+    from fm2uav.planning.params import PlanOptions
+
+    assert PlanOptions(threads=2).threads == 2
+    assert PlanOptions().threads is None
+    with pytest.raises(InputError, match=r"threads must be an integer >= 1.*planner\.threads"):
+        PlanOptions(threads=0)
+
+
+def test_queues_that_run_low_grow_and_the_march_resumes(monkeypatch):
+    """Tiny entry pools and repair heaps: the start and the windows stop when a slab runs
+    low, the queues double, and the march goes on to the serial times."""
+    monkeypatch.setattr(_parallel, "POOL_MIN_BLOCKS", 8)
+    monkeypatch.setattr(_parallel, "HEAP_START", 8)
+    v = np.full((200, 60), 0.2)
+    v[:, 28:32] = 5.0
+    flat, start, shape3 = _start(v, (2, 30))
+    T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, 2)
+    assert stats["reopened"] > 0
+    serial = fast_marching(v, [(2, 30)], order=1, threads=1, source_ball=False)
+    assert_equal_times(serial.reshape(-1), T)
+    for name, v, src in _fields((64, 48, 40)):
+        assert_equal_times(fast_marching(v, [src], order=1, threads=1),
+                           fast_marching_parallel(v, [src], order=1))
