@@ -312,9 +312,11 @@ def plan_many(
     t_checks = time.perf_counter() - t1
     t1 = time.perf_counter()
     progress.step("arrival times T (Fast Marching, once)", 0.2)
-    T = fast_marching(W, [goal_cell], spacing=world.spacing, order=options.order)
+    # the march plan() runs (threads too: the parallel order-1 march on large grids)
+    T = fast_marching(W, [goal_cell], spacing=world.spacing, order=options.order,
+                      threads=options.threads)
     ball = fast_marching(W, [goal_cell], spacing=world.spacing, order=options.order,
-                         stop_at=[goal_cell])  # the nodes frozen before the march
+                         stop_at=[goal_cell], threads=options.threads)  # frozen before the march
     t2 = time.perf_counter()
     routes: list[Plan | RouteFailure | None] = [None] * len(checked)
     todo: list[int] = []
