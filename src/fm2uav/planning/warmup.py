@@ -25,7 +25,7 @@ from collections.abc import Callable, Iterable
 
 import numpy as np
 
-from ..eikonal import _kernels, distance_map, fast_marching
+from ..eikonal import _kernels, _parallel, distance_map, fast_marching
 from ..world import World
 from ..world.clearance import surface_clearance
 from .geodesic import descend
@@ -65,6 +65,20 @@ def _fmm_lean(order: int) -> Callable[[], None]:
     return run
 
 
+def _fmm_parallel(ndim: int) -> Callable[[], None]:
+    """The order-1 march on both cores (grids of ``PARALLEL_MIN_NODES`` nodes and more), its
+    size floor lowered for a 16-node-wide grid while it compiles."""
+    def run() -> None:
+        floor = _parallel.PARALLEL_MIN_NODES
+        _parallel.PARALLEL_MIN_NODES = 0
+        try:
+            fast_marching(np.ones((16,) * ndim), [(3,) * ndim], order=1, threads=2)
+        finally:
+            _parallel.PARALLEL_MIN_NODES = floor
+
+    return run
+
+
 def _descent() -> None:
     g = np.array([4.0, 4.0, 4.0])
     axes = np.meshgrid(*[np.arange(5.0)] * 3, indexing="ij")
@@ -87,6 +101,8 @@ GROUPS: dict[str, Callable[[], None]] = {
     "fmm3d_o2": _fmm(3, 2),
     "fmm3d_o1_lean": _fmm_lean(1),
     "fmm3d_o2_lean": _fmm_lean(2),
+    "fmm2d_parallel": _fmm_parallel(2),
+    "fmm3d_parallel": _fmm_parallel(3),
     "descent": _descent,
     "surface": _surface,
 }
