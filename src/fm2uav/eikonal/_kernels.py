@@ -36,6 +36,11 @@ Layout of the march (see docs/performance.md for the measurements behind it)
   march needs no node-sized position array. Measured on 2048^2 order 1 (march
   only, interleaved): 0.91x the time of the position-array queue with lazy
   entries, 0.70x with the splits dropping the outdated ones.
+* **Plateau**: where the grid's largest speed covers at least half of the nodes (or
+  every passable node has one speed), the march takes ``1 / speed^2`` of those nodes
+  from a register, a bit mask telling which (:func:`_plateau`), instead of reading the
+  speed grid, half of the memory the march touches (measured -24 % on 2048^2 constant
+  speed); the times are bit for bit the same.
 * Unsigned (``uint64``) indices throughout: numba emits negative-index
   wraparound code for signed indices, measured 1.8x slower in the hot loop.
 
