@@ -20,12 +20,13 @@ install: $(STAMP)
 
 ## make run: the default mission — terrain-following flight (150 m above ground, the
 ## TFF paper's case 3) over the built-in open-field scenario, with ground-control
-## exports and an interactive report, in $(OUT)/open_field_tff/ (the folder `fm2uav run
-## examples/open_field_tff.yaml` writes by default, so no mission.yaml of yours is overwritten)
+## exports and an interactive report, in $(OUT)/default_mission/: a folder of its own, not the
+## default folder of any mission file (`fm2uav run mission.yaml` writes out/mission/, `fm2uav run
+## examples/open_field_tff.yaml` out/open_field_tff/), so --force replaces nothing of yours
 run: $(STAMP)
-	$(VENV)/bin/fm2uav run examples/open_field_tff.yaml --out $(OUT)/open_field_tff --force
+	$(VENV)/bin/fm2uav run examples/open_field_tff.yaml --out $(OUT)/default_mission --force
 	@echo ""
-	@echo "outputs written to $(OUT)/open_field_tff/ — open $(OUT)/open_field_tff/report.html in a browser;"
+	@echo "outputs written to $(OUT)/default_mission/ — open $(OUT)/default_mission/report.html in a browser;"
 	@echo "mission.plan loads in QGroundControl, mission.waypoints is a MAVLink WPL 110 file"
 
 ## make test: the layer contract (import-linter, [tool.importlinter] in pyproject.toml),

@@ -84,3 +84,27 @@ def test_exit_codes_and_one_line_errors(tmp_path, city_starts):
     assert res.exit_code == 1, res.output
     assert "none of the 2 starts got a route" in res.output
     assert not (tmp_path / "o2").exists()
+
+
+def test_report_draws_every_route_and_lists_the_failed_starts(tmp_path, city_starts):
+    """``--report``: report.html beside the three files, opening on the map with the longest
+    route as the main one and every other route as one layer, the failed starts listed."""
+    import re
+
+    _, _, f, goal = city_starts
+    out = tmp_path / "rep"
+    res = runner.invoke(app, ["routes", "--scenario", "city2d", f"--goal={goal}", "--starts",
+                              str(f), "--report", "--out", str(out), "--quiet"])
+    assert res.exit_code == 0, res.output
+    assert sorted(p.name for p in out.iterdir()) == ["report.html", "routes.csv",
+                                                      "routes.geojson", "summary.json"]
+    page = (out / "report.html").read_text(encoding="utf-8")
+    rows = list(csv.DictReader(open(out / "routes.csv")))
+    ok = [r for r in rows if r["status"] == "ok"]
+    longest = max(ok, key=lambda r: float(r["length_m"]))
+    assert 'id="fm2uav-map"' in page
+    assert f"longest route ({longest['id']})" in page
+    assert f"every route ({len(ok)})" in page
+    for r in rows:
+        if r["status"] == "failed":  # each failed start named with its reason
+            assert re.search(rf">{re.escape(r['id'])}<.*?>{r['reason']}<", page, re.S), r["id"]

@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 
 from ..errors import InputError
-from ._common import Output, handle_errors
+from ._common import Output, handle_errors, write_text
 from .options import (
     ScenarioOpt,
     WorldFlags,
@@ -36,7 +36,8 @@ ROUTES_HELP = (
 
 
 @handle_errors
-@output_options("out/routes")
+@output_options("out/routes", report_help="Also write report.html: every route on the map "
+                "(the longest coloured by height above ground), the figures, the starts table.")
 @world_options
 def routes_cmd(
     goal: str = typer.Option(..., help="Goal (the depot) LON,LAT[,AGL]: degrees, degrees, "
@@ -107,7 +108,7 @@ def routes_cmd(
         w, _, label = world.build(scenario, goal, seed=seed, lonlat=True, agl=agl,
                                   default="open-field")
         anchor_ll = parse_anchor(anchor)
-        outdir = output.dir(ROUTES_FILES)
+        outdir = output.dir(ROUTES_FILES + (("report.html",) if output.report else ()))
         goal_m = lonlat_point(goal, "goal", w, agl=agl, anchor=anchor_ll)
         if no_fly:
             from ..io.zone_spec import zones_from_cli
@@ -138,7 +139,14 @@ def routes_cmd(
                 f"none of the {run.summary['starts']} starts got a route "
                 f"({', '.join(f'{n} {r}' for r, n in run.summary['failed_by_reason'].items())}"
                 f"); the first, {first['id']!r}: {first['message']}")
-    rows = {"map": label, **routes_rows(run), **world_rows(w)}
+        rows = {"map": label, **routes_rows(run), **world_rows(w)}
+        if output.report:
+            from ..viz.routes import routes_report_html
+
+            progress.step("writing report.html", 0.0)
+            write_text(outdir, "report.html", routes_report_html(
+                w, run, rows, title=f"FM² routes to {goal}", files=ROUTES_FILES,
+                anchor=anchor_ll))
     output.summary("FM² routes", rows, run.summary)
 
 
