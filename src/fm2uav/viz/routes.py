@@ -56,7 +56,8 @@ def routes_report_html(world: Any, run: Any, figures: Mapping[str, Any], *, titl
                                              np.linspace(0, len(ok) - 1, MAX_DRAWN).astype(int)]
     others = [k for k in drawn if k != longest]
     main = f"longest route ({run.rows[longest]['id']})"
-    paths = {main: np.asarray(run.many.routes[longest].path, dtype=float)}
+    route = run.many.routes[longest]
+    paths = {main: np.asarray(route.path, dtype=float)}
     overlays: dict[str, Any] = {}
     if others:
         label = (f"every route ({len(ok)})" if len(drawn) == len(ok)
@@ -72,9 +73,9 @@ def routes_report_html(world: Any, run: Any, figures: Mapping[str, Any], *, titl
     head = (f"Starts ({len(run.rows)}; failed first"
             + (f", the first {MAX_ROWS} shown — every row is in routes.csv)"
                if len(run.rows) > MAX_ROWS else ")"))
-    level = getattr(run.many.routes[longest], "level", None)
-    agl = getattr(level, "agl", None)
+    agl = getattr(getattr(route, "level", None), "agl", None)
     return report_html(world, paths, title=title, overlays=overlays, figures=dict(figures),
+                       speeds={main: route.w},
                        tables={head: table}, files=files, anchor=anchor,
                        agl=float(agl) if agl is not None else None,
                        params=run.summary.get("params") or {})
