@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 from collections import Counter
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -565,10 +565,14 @@ def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: Speeds, start_hold
     if endurance_s is None:  # the check runs by default (issue 25)
         endurance_s, source = default_endurance(opt.vehicle)
     rep = check_endurance(ft, endurance_s=endurance_s, reserve=opt.reserve)
+    # the legs timed start where the climb-out leaves (waypoint ``first - 1``): the report
+    # counts waypoints of the whole list, as the summary and its warning name them
+    rep = replace(rep, reach_waypoint=int(rep.reach_waypoint) + first - 1,
+                              waypoints=int(rep.waypoints) + first - 1)
     warning = rep.warning
     where: dict[str, Any] = {}
     if warning is not None:
-        k = int(rep.reach_waypoint) + first - 1  # the legs timed start where the climb-out leaves
+        k = rep.reach_waypoint
         q = p[k] if k + 1 >= len(p) else p[k] + rep.reach_fraction * (p[k + 1] - p[k])
         where = {"reserve_reached_at_m": [round(float(v), 2) for v in q], "reach_waypoint": k}
         lon, lat, _ = to_lonlat(world, q, anchor=opt.anchor)
