@@ -164,3 +164,27 @@ def test_resume_keeps_the_missions_written_and_plans_the_rest(tmp_path):
     (out / "batch.json").write_text("{not json")
     res = runner.invoke(app, [*args, "--resume"])
     assert res.exit_code == 2 and "is not a batch summary of fm2uav batch" in res.output
+
+
+def test_a_second_batch_into_the_same_out_is_refused_while_the_first_runs(folder, tmp_path):
+    """Two batches into one --out would both write batch.json (each mission folder is
+    locked on its own): the batch holds its folder from the first check to batch.json."""
+    from fm2uav.pipeline.batch import batch_lock
+
+    m, files, single = folder
+    out = tmp_path / "runs" / "out"
+    args = ["batch", str(files["east"]), "--out", str(out), "--workers", "1"]
+    with batch_lock(out):  # another batch is running (its lock is beside the folder)
+        lock = tmp_path / "runs" / ".out.batch.lock"
+        assert lock.is_file() and not out.exists()
+        res = runner.invoke(app, args)
+        text = " ".join(res.output.split())
+        assert res.exit_code == 2, res.output
+        assert f"--out {out} is being written by another fm2uav batch" in text
+        assert "Traceback" not in res.output and not out.exists()
+    # released: no lock file left, the folder it made for the lock removed again
+    assert not (tmp_path / "runs").exists()
+    res = runner.invoke(app, args)
+    assert res.exit_code == 0, res.output
+    same_as_single_run(out / "east", single)
+    assert sorted(p.name for p in (tmp_path / "runs").iterdir()) == ["out"]

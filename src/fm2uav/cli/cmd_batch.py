@@ -116,12 +116,22 @@ def batch_cmd(
 ) -> None:
     """``fm2uav batch``: :func:`~fm2uav.pipeline.batch.prepare_batch`,
     :func:`~fm2uav.pipeline.batch.run_batch`, the table and ``batch.json``."""
+    from ..experiments._executors import check_workers
+    from ..pipeline.batch import batch_lock
+
+    n_workers = check_workers(workers)
+    with batch_lock(output.out):  # one batch at a time writes a folder and its batch.json
+        _batch_locked(missions, n_workers, scheduler, resume, output)
+
+
+def _batch_locked(missions: list[Path], n_workers: int, scheduler: str | None, resume: bool,
+                  output: Output) -> None:
+    """The batch itself, with its folder held (:func:`batch_cmd`)."""
     from .. import progress
-    from ..experiments._executors import check_workers, make_pool
+    from ..experiments._executors import make_pool
     from ..io.outdir import Interrupted, stop_reported
     from ..pipeline.batch import prepare_batch, run_batch, write_batch_file
 
-    n_workers = check_workers(workers)
     todo, results = prepare_batch(missions, output.out, force=output.force,
                                   report=output.report, resume=resume)
     for r in results:

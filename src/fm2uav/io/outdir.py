@@ -503,43 +503,16 @@ class OutputDir:
 
     # -- the lock -----------------------------------------------------------------------
     def _lock(self) -> None:
-        import fcntl
-
         if self._lock_fd is not None:
             return
-        parent = self._parent()
-        lock = parent / f".{self.path.name}.lock"
-        while True:
-            try:
-                fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o666)
-            except OSError as exc:
-                raise _os_error(exc, lock, "create the lock file of") from None
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except BlockingIOError:
-                os.close(fd)
-                raise InputError(
-                    f"--out {self.given} is being written by another fm2uav run (lock {lock} "
-                    "is held); wait for it to finish or choose another --out") from None
-            try:  # the holder before us may have removed the file: lock the live one
-                same = os.fstat(fd).st_ino == os.stat(lock).st_ino
-            except FileNotFoundError:
-                same = False
-            if same:
-                break
-            os.close(fd)
-        self._lock_fd, self._lock_path = fd, lock
+        lock = self._parent() / f".{self.path.name}.lock"
+        self._lock_fd, self._lock_path = take_lock(lock, self.given, "fm2uav run"), lock
         self._clean_stale()
 
     def _unlock(self) -> None:
         if self._lock_fd is None:
             return
-        try:
-            if self._lock_path is not None:
-                self._lock_path.unlink(missing_ok=True)
-        except OSError:
-            pass
-        os.close(self._lock_fd)
+        release_lock(self._lock_fd, self._lock_path)
         self._lock_fd = None
 
     def _clean_stale(self) -> None:
@@ -555,18 +528,7 @@ class OutputDir:
             shutil.rmtree(s, ignore_errors=True)
 
     def _parent(self) -> Path:
-        parent = self.path.parent if str(self.path.parent) else Path(".")
-        missing = []
-        q = parent
-        while not q.exists():
-            missing.append(q)
-            if q.parent == q:
-                break
-            q = q.parent
-        try:
-            parent.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise _os_error(exc, parent, "create") from None
+        parent, missing = make_parent(self.path)
         self._made_dirs.extend(missing)  # innermost first
         return parent
 
@@ -699,16 +661,126 @@ class OutputDir:
                 self._stage = None
             self.written.clear()
             self._unlock()
-            for d in self._made_dirs:  # parents this set created, innermost first
-                try:
-                    d.rmdir()
-                except OSError:
-                    break
+            remove_empty(self._made_dirs)  # parents this set created, innermost first
             self._forget()
 
     def _forget(self) -> None:
         if self in _ACTIVE:
             _ACTIVE.remove(self)
+
+
+def take_lock(lock: Path, given: Any, holder: str) -> int:
+    """Lock the file ``lock`` (``flock``, created if missing) or refuse at once.
+
+    The lock dies with its process; :func:`release_lock` removes the file, and a
+    waiter that locked a file removed meanwhile locks the live one.
+
+    Parameters
+    ----------
+    lock : Path
+        The lock file (its folder exists).
+    given : path
+        The ``--out`` folder as the user gave it (for the message).
+    holder : str
+        What holds such a lock (``"fm2uav run"``, ``"fm2uav batch"``), for the message.
+
+    Returns
+    -------
+    int
+        The file descriptor holding the lock.
+
+    Raises
+    ------
+    InputError
+        Another process holds it (naming ``--out`` and the lock file), or the file
+        cannot be created.
+    """
+    import fcntl
+
+    while True:
+        try:
+            fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o666)
+        except OSError as exc:
+            raise _os_error(exc, lock, "create the lock file of") from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(fd)
+            raise InputError(
+                f"--out {given} is being written by another {holder} (lock {lock} "
+                "is held); wait for it to finish or choose another --out") from None
+        try:  # the holder before us may have removed the file: lock the live one
+            same = os.fstat(fd).st_ino == os.stat(lock).st_ino
+        except FileNotFoundError:
+            same = False
+        if same:
+            return fd
+        os.close(fd)
+
+
+def release_lock(fd: int, lock: Path | None) -> None:
+    """Remove the lock file ``lock`` and release the lock held by ``fd`` (:func:`take_lock`)."""
+    try:
+        if lock is not None:
+            lock.unlink(missing_ok=True)
+    except OSError:
+        pass
+    os.close(fd)
+
+
+@contextmanager
+def folder_lock(out: str | os.PathLike[str], kind: str, holder: str) -> Iterator[None]:
+    """Hold ``out`` for a run that writes many output sets into it (``fm2uav batch``).
+
+    The lock file ``.<out name>.<kind>.lock`` sits beside ``out`` (as each output
+    set's own lock does), so ``out`` is not created by taking it; folders made for it
+    are removed again when it is released, if empty.
+
+    Raises
+    ------
+    InputError
+        Another process holds it (see :func:`take_lock`).
+    """
+    path = Path(out)
+    parent, missing = make_parent(path)
+    lock = parent / f".{path.name}.{kind}.lock"
+    try:
+        fd = take_lock(lock, out, holder)
+    except BaseException:
+        remove_empty(missing)
+        raise
+    try:
+        yield
+    finally:
+        release_lock(fd, lock)
+        remove_empty(missing)
+
+
+def make_parent(path: Path) -> tuple[Path, list[Path]]:
+    """Create the folder that holds ``path``; returns it and the folders made for it
+    (innermost first, for :func:`remove_empty`). An OSError is an InputError naming it."""
+    parent = path.parent if str(path.parent) else Path(".")
+    missing = []
+    q = parent
+    while not q.exists():
+        missing.append(q)
+        if q.parent == q:
+            break
+        q = q.parent
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise _os_error(exc, parent, "create") from None
+    return parent, missing
+
+
+def remove_empty(dirs: list[Path]) -> None:
+    """Remove the folders ``dirs`` (innermost first) while they are empty."""
+    for d in dirs:
+        try:
+            d.rmdir()
+        except OSError:
+            break
 
 
 _WRITE_ERRNOS = (errno.ENOSPC, errno.EROFS, errno.EDQUOT, errno.EFBIG)

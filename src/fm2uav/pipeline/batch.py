@@ -23,6 +23,7 @@ Same files as ``fm2uav run FILE``
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
 from collections.abc import Callable, Iterable, Sequence
@@ -306,6 +307,19 @@ def _describe(exc: BaseException) -> tuple[str, int]:
     if known is None:
         return f"internal error: {type(exc).__name__}: {exc}", EXIT_INTERNAL
     return known
+
+
+def batch_lock(out: str | os.PathLike[str]) -> contextlib.AbstractContextManager[None]:
+    """Hold the batch's folder ``out`` from the first check to ``batch.json``
+    (``.<out name>.batch.lock`` beside it, removed when released).
+
+    A second batch into the same ``--out`` is refused at once with an
+    :class:`~fm2uav.InputError` naming the holder (each mission folder is locked on its
+    own as it is written; this keeps two batches from both writing ``batch.json``).
+    """
+    from ..io.outdir import folder_lock
+
+    return folder_lock(out, "batch", "fm2uav batch")
 
 
 def _batch_file_set(out: str | os.PathLike[str]) -> Any:
