@@ -108,3 +108,13 @@ def test_report_draws_every_route_and_lists_the_failed_starts(tmp_path, city_sta
     for r in rows:
         if r["status"] == "failed":  # each failed start named with its reason
             assert re.search(rf">{re.escape(r['id'])}<.*?>{r['reason']}<", page, re.S), r["id"]
+    # the failed starts with a position are a map layer of their own, where routes.csv says
+    from tests.viz.test_reportmap import _map_document
+
+    failed = [r for r in rows if r["status"] == "failed" and r["lon"]]
+    assert failed, "the case needs failed starts on the map"
+    layers = [f for f in _map_document(page)["features"]
+              if f["properties"].get("layer") == f"failed starts ({len(failed)})"]
+    assert len(layers) == 1 and layers[0]["geometry"]["type"] == "MultiPoint"
+    np.testing.assert_allclose(layers[0]["geometry"]["coordinates"],
+                               [[float(r["lon"]), float(r["lat"])] for r in failed], atol=2e-7)

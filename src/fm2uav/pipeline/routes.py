@@ -70,6 +70,8 @@ class RoutesRun:
     many: Any
     rows: list[dict[str, Any]]
     summary: dict[str, Any]
+    #: The starts [m], one row per start in the file's order (NaN where a row had none).
+    starts: Any = None
 
 
 def _lowest_agl(plan: Any) -> float | None:
@@ -165,7 +167,7 @@ def run_routes(outdir: Any, world: Any, goal_m: Any, starts: Any, *, shaping: An
     doc["routes"] = len(rows) - len(failed)
     doc["failed_by_reason"] = {r: failed.count(r) for r in sorted(set(failed))}
     write_json(outdir, "summary.json", to_jsonable(doc))
-    return RoutesRun(many=many, rows=rows, summary=doc)
+    return RoutesRun(many=many, rows=rows, summary=doc, starts=pts)
 
 
 def _deg(v: float) -> float | None:

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["routes_report_html", "MAX_DRAWN", "MAX_POINTS", "MAX_ROWS"]
+__all__ = ["routes_report_html", "FAILED_LAYER", "MAX_DRAWN", "MAX_POINTS", "MAX_ROWS"]
 
 #: Routes drawn on the map at most (evenly chosen through the starts file beyond it).
 MAX_DRAWN = 2000
@@ -17,6 +17,8 @@ MAX_DRAWN = 2000
 MAX_POINTS = 60
 #: Rows of the starts table at most (the failed starts first).
 MAX_ROWS = 500
+#: Name of the map layer of the failed starts (every one with a position).
+FAILED_LAYER = "failed starts ({n})"
 
 
 def _thinned(path: np.ndarray) -> np.ndarray:
@@ -26,7 +28,9 @@ def _thinned(path: np.ndarray) -> np.ndarray:
 
 def routes_report_html(world: Any, run: Any, figures: Mapping[str, Any], *, title: str,
                        files: Sequence[str] = (), anchor: Any = None) -> str:
-    """report.html of ``fm2uav routes``.
+    """report.html of ``fm2uav routes``: the routes on the map (the longest coloured by
+    height above ground, the others as one layer), the failed starts as a layer of their
+    own (red points, where the file puts them), the starts table (the failed first).
 
     Parameters
     ----------
@@ -46,6 +50,7 @@ def routes_report_html(world: Any, run: Any, figures: Mapping[str, Any], *, titl
     str
         A self-contained HTML page (:func:`fm2uav.viz.report.report_html`).
     """
+    from .mapdata import extra_feature
     from .report import join_polylines, report_html
 
     ok = [k for k, row in enumerate(run.rows) if row["status"] == "ok"]
@@ -73,9 +78,21 @@ def routes_report_html(world: Any, run: Any, figures: Mapping[str, Any], *, titl
     head = (f"Starts ({len(run.rows)}; failed first"
             + (f", the first {MAX_ROWS} shown — every row is in routes.csv)"
                if len(run.rows) > MAX_ROWS else ")"))
+    layers = []
+    where = [k for k, row in enumerate(run.rows) if row["status"] != "ok"]
+    if where and run.starts is not None:
+        pts = np.asarray(run.starts, dtype=float)[where]
+        pts = pts[np.isfinite(pts).all(axis=1)]
+        if len(pts):
+            layers.append(extra_feature(
+                world, FAILED_LAYER.format(n=len(pts)), pts[:, :2], anchor,
+                style={"color": "#d62728", "fillColor": "#d62728", "fillOpacity": 0.8,
+                       "radius": 5, "weight": 1},
+                label="failed start (no route: reasons in the starts table)",
+                geometry="MultiPoint"))
     agl = getattr(getattr(route, "level", None), "agl", None)
     return report_html(world, paths, title=title, overlays=overlays, figures=dict(figures),
-                       speeds={main: route.w},
+                       speeds={main: route.w}, map_layers=layers,
                        tables={head: table}, files=files, anchor=anchor,
                        agl=float(agl) if agl is not None else None,
                        params=run.summary.get("params") or {})
