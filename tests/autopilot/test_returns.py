@@ -175,6 +175,27 @@ def test_route_samples_keep_the_missions_clock(world):
     assert one.time[0] == pytest.approx(0.5 * (ft.elapsed()[0] + ft.elapsed()[1]))
 
 
+@pytest.mark.parametrize("vehicle", ["multirotor", "fixed_wing", "vtol"])
+def test_route_samples_run_on_the_clock_of_the_summarys_flight_time(world, vehicle):
+    """One clock: the safe returns time the route as the summary's flight time does — a
+    fixed wing's climb-out (not a vertical take-off) and legs at airspeed (a plane does
+    not wait for its altitude); it counted a vertical climb and a hovering vehicle's legs."""
+    path = [[700.0, 200.0, 60.0], [200.0, 200.0, 150.0], [200.0, 50.0, 90.0],
+            [600.0, 50.0, 90.0]]
+    m = mission(world, path, firmware="ardupilot", vehicle=vehicle, end="land",
+                cruise_speed=14.0, **({} if vehicle == "multirotor" else {"min_speed": 10.0}))
+    f = m.info["flight"]
+    s = route_samples(m, step=7.0)
+    at = s.waypoint >= 0
+    first = m.info.get("climb_out", {}).get("dropped_waypoints", 0)  # waypoints it replaces
+    assert s.time[at][first] == pytest.approx(f["takeoff_s"], abs=0.06)
+    assert s.time[-1] == pytest.approx(f["takeoff_s"] + f["route_s"], abs=0.11)
+    assert s.time[-1] + f["end_s"] == pytest.approx(f["flight_time_s"], abs=0.16)
+    assert np.all(np.diff(s.time) >= 0)
+    if vehicle == "fixed_wing":  # the climb-out is not a vertical take-off at 150 m
+        assert m.info["climb_out"]["mode"] in ("loiter", "straight")
+
+
 def test_every_firmware_and_airframe_has_a_return_model():
     for name, prof in PROFILES.items():
         for v in ("multirotor", "fixed_wing", "vtol"):

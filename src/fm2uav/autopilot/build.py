@@ -297,6 +297,11 @@ class MissionExport:
     returns : ReturnsReport or None
         The safe returns (:mod:`fm2uav.autopilot.safe_return`): ways back, point of no
         return, rally points, firmware return settings; None when not computed.
+    waypoint_times : ndarray, shape (len(waypoints),), optional
+        Time from the launch at which each waypoint is reached [s], on the clock of the
+        flight time in ``info["flight"]`` (a fixed-wing's climb-out, legs at airspeed;
+        waypoints a climb-out replaces: along its time by distance). The safe returns
+        time the route on it (:func:`fm2uav.autopilot.returns.route_samples`).
     """
 
     items: list[MissionItem]
@@ -310,6 +315,7 @@ class MissionExport:
     info: dict[str, Any]
     fences: list[Any] = field(default_factory=list)
     returns: Any = None
+    waypoint_times: np.ndarray | None = None
 
     @property
     def home(self) -> tuple[float, float, float]:
@@ -515,9 +521,10 @@ def start_holds(starts: Any, world: Any, options: ExportOptions) -> np.ndarray:
 
 def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: Speeds, start_hold: float,
             climb_out: ClimbOut, items: list[MissionItem], nav: FixedWingNav | None,
-            world: Any = None) -> tuple[dict[str, Any], str | None]:
+            world: Any = None) -> tuple[dict[str, Any], str | None, np.ndarray]:
     """Flight time / endurance figures (and the endurance warning, with the point where the
-    reserve is reached).
+    reserve is reached), and the time each waypoint is reached on that clock
+    (:attr:`MissionExport.waypoint_times`).
 
     Multirotors and VTOL: the take-off climb at the vertical speed, the legs at the
     commanded speeds (a multirotor waits for its altitude: climbs and descents at the
@@ -606,7 +613,19 @@ def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: Speeds, start_hold
                 f"timing: the mission's route takes {route_t:.0f} s, {late:.0f} s more than the "
                 f"planned {sp.timing['planned_s']:.0f} s: the trajectory climbs or descends "
                 f"faster than {climb:g} / {descent:g} m/s (airframe climb_rate / descent_rate)")
-    return info, warning
+    return info, warning, _waypoint_times(ft, p, first)
+
+
+def _waypoint_times(ft: Any, p: np.ndarray, first: int) -> np.ndarray:
+    """Time [s] each waypoint of ``p`` is reached: ``ft`` times the legs from waypoint
+    ``first - 1`` (where the climb-out leaves); the waypoints before it, which the
+    climb-out replaces, along the take-off time by horizontal distance."""
+    t = np.empty(len(p))
+    t[first - 1:] = ft.elapsed()
+    if first > 1:
+        d = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(p[:first, :2], axis=0).T))])
+        t[:first - 1] = float(ft.takeoff_s) * d[:first - 1] / max(float(d[-1]), 1e-9)
+    return t
 
 
 def _entry_length(climb_out: ClimbOut, p: np.ndarray, first: int) -> float:
@@ -770,8 +789,8 @@ def build_mission(
         home_latlon=wps.home[:2], max_land_slope_deg=opt.max_land_slope_deg,
         fences=fence_list, airframe=opt.airframe_nav())
     warnings += [str(w_) for w_ in flight_warnings]
-    info, endurance_warning = _flight(wps, opt, end, sp, start_hold, climb_out, items, nav,
-                                     world)
+    info, endurance_warning, waypoint_times = _flight(wps, opt, end, sp, start_hold, climb_out,
+                                                     items, nav, world)
     if endurance_warning:
         warnings.append(endurance_warning)
     if info["energy"]["warning"]:
@@ -805,4 +824,4 @@ def build_mission(
             warnings.append(line)
     return MissionExport(items=items, waypoints=wps, options=opt, frame=frame, end=end,
                          path_m=p, world=world, warnings=warnings, info=info,
-                         fences=fence_list)
+                         fences=fence_list, waypoint_times=waypoint_times)

@@ -190,13 +190,19 @@ def route_samples(mission: Any, step: float | None = None, *, max_points: int | 
     n = len(p)
     terrain = wps.frame == 10
     speeds, holds = leg_speeds(mission.items, n, opt.forward_speed)
-    climb, descent = _rates(mission)
-    ft = flight_time(p, speeds if len(speeds) else opt.forward_speed, climb_rate=climb,
-                     descent_rate=descent, takeoff_climb=float(wps.agl[0]), holds=holds)
-    t_wp = ft.elapsed()
+    t_wp = getattr(mission, "waypoint_times", None)
+    if t_wp is None or len(t_wp) != n:  # a mission built without its clock: the legs as written
+        climb, descent = _rates(mission)
+        ft = flight_time(p, speeds if len(speeds) else opt.forward_speed, climb_rate=climb,
+                         descent_rate=descent, takeoff_climb=float(wps.agl[0]), holds=holds,
+                         hover=opt.vehicle == "multirotor")
+        t_wp = ft.elapsed()
+    t_wp = np.asarray(t_wp, dtype=float)
     seg3 = np.linalg.norm(np.diff(p, axis=0), axis=1)
     cum3 = np.concatenate([[0.0], np.cumsum(seg3)])
-    travel = ft.leg_time - holds[1:]  # the hold at a leg's end counts once it is reached
+    # the mission's clock (MissionExport.waypoint_times, the summary's flight time); the hold
+    # at a leg's end counts once it is reached
+    travel = np.maximum(np.diff(t_wp) - holds[1:], 0.0)
     if legs is not None:
         rows = [(int(k), float(f)) for k, f in legs]
         leg_i = np.array([k for k, _ in rows], dtype=int)
