@@ -183,6 +183,9 @@ def lazy_group(table: Mapping[str, str], *, package: str, section: str,
             _coerce.install(self)
             return option
 
+        def list_commands(self, ctx: Any) -> list[str]:
+            return list(self.commands)  # typer's reads the items: it would build them all
+
         def get_command(self, ctx: Any, cmd_name: str) -> Any:
             if self._listing:  # the help page's list: names and help only
                 return self.commands.summary(cmd_name, self.rich_markup_mode)
