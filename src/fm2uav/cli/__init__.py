@@ -20,7 +20,10 @@ from __future__ import annotations
 
 import typer
 
+from . import _rich_light
 from ._lazy import lazy_group
+
+_rich_light.install()  # help pages and usage errors without rich.markdown / rich.traceback
 
 __all__ = ["COMMANDS", "REPRODUCE", "app", "main"]
 
