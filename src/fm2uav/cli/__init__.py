@@ -8,7 +8,9 @@ thin: parse, call the library, print a summary (see :mod:`._common`).
 
 The command line stays light: importing this package (and so ``fm2uav --help``,
 ``fm2uav <cmd> --help`` and every error typer reports while parsing) loads
-typer, rich and the ``cmd_*`` modules only. A ``cmd_*`` module imports at its
+typer, rich and the light modules of this package only (the ``cmd_*`` module of the
+command asked for; typer's pydantic coercion and rich's markdown and traceback modules
+only when used: :mod:`._coerce`, :mod:`._rich_light`). A ``cmd_*`` module imports at its
 top only the standard library, typer, rich, :mod:`fm2uav.errors` and the
 light modules of this package (``_common``, ``options``, ``_mission_options``,
 other ``cmd_*``); numpy, numba, scipy, matplotlib, the geodata libraries and the
