@@ -5,9 +5,10 @@ whole session (the reproductions, the default mission) and hands every caller th
 result and output folder. Tests that read such a run must not write into its folder (a
 second run without ``--force`` is fine: it is refused and leaves the folder as it was).
 
-``rough_tif`` (a seeded rough GeoTIFF DEM) and ``corridor`` (the formation corridor world) are
-shared by test folders that mirror different packages, so they live here too; fixtures used by
-one folder only stay in that folder's conftest.py.
+``rough_tif`` (a seeded rough GeoTIFF DEM), ``corridor`` (the formation corridor world) and
+``dask_cluster`` (a local Dask cluster of two worker processes, to kill one of) are shared by
+test folders that mirror different packages, so they live here too; fixtures used by one
+folder only stay in that folder's conftest.py.
 
 Long end-to-end tests are marked ``@pytest.mark.slow``: ``make test`` runs them,
 ``make test-fast`` (``-m "not slow"``) leaves them out.
@@ -15,9 +16,12 @@ Long end-to-end tests are marked ``@pytest.mark.slow``: ``make test`` runs them,
 
 from __future__ import annotations
 
+import os
 import re
-from dataclasses import dataclass
+import signal
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import pytest
 from hypothesis import HealthCheck, settings
@@ -108,3 +112,42 @@ def returns_mission():
     from tests.autopilot.return_cases import build, ridge_plan
 
     return build(ridge_plan(), ReturnOptions(rally=((1100.0, 700.0),)), end="rtl")
+
+
+@dataclass
+class DaskCluster:
+    """A running two-worker Dask cluster (:func:`dask_cluster`): its client, each worker's
+    process id by address, and the worker :meth:`kill_a_busy_worker` killed."""
+
+    client: Any
+    pids: dict[str, int]
+    killed: dict[str, list] = field(default_factory=dict)
+
+    def kill_a_busy_worker(self) -> bool:
+        """SIGKILL the first worker that holds a task, once per cluster; True when this call
+        killed one (its address → the keys it held: :attr:`killed`)."""
+        if self.killed:
+            return False
+        for addr, keys in self.client.processing().items():
+            if keys:
+                os.kill(self.pids[addr], signal.SIGKILL)
+                self.killed[addr] = list(keys)
+                return True
+        return False
+
+
+@pytest.fixture
+def dask_cluster():
+    """A local Dask cluster of two single-thread worker processes and its client (skipped
+    without dask.distributed). The scheduler retries a task once (as the local pool) and gives
+    each worker one task at a time, so a worker's death counts only against the task it was
+    running (Dask counts it against every task assigned to that worker)."""
+    dask = pytest.importorskip("dask")
+    distributed = pytest.importorskip("dask.distributed")
+    settings = {"distributed.scheduler.allowed-failures": 1,
+                "distributed.scheduler.worker-saturation": 1.0}
+    with dask.config.set(settings), \
+            distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                     dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        yield DaskCluster(client, client.run(os.getpid))

@@ -20,11 +20,12 @@ fm2uav.errors.InputError: agl must be a finite number > 0 m, got -1 (mission fil
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from .errors import InputError
+
+if TYPE_CHECKING:  # numpy is imported by the checks that need it: the file checks
+    import numpy as np  # (input_file, read_text, ...) stay light for the command line
 
 __all__ = [
     "Where",
@@ -79,6 +80,8 @@ def number(value: Any, what: str, *, unit: str = "", where: Where = None) -> flo
     InputError
         Not a number (booleans are refused), NaN or inf.
     """
+    import numpy as np
+
     u = f" {unit}" if unit else ""
     if isinstance(value, (bool, np.bool_)):
         raise InputError(f"{what} must be a number{u}, got {value!r}{where_text(where)}")
@@ -154,6 +157,8 @@ def integer(
     value: Any, what: str, *, minimum: int | None = None, where: Where = None
 ) -> int:
     """``value`` as an int (an integral float such as ``2.0`` is accepted), ``>= minimum``."""
+    import numpy as np
+
     ok = not isinstance(value, (bool, np.bool_))
     if ok and isinstance(value, (int, np.integer)):
         v = int(value)
@@ -199,6 +204,8 @@ def choice(value: Any, options: Sequence[Any], what: str, *, where: Where = None
 
 def flag(value: Any, what: str, *, where: Where = None) -> bool:
     """``value`` as a bool; only ``True``/``False`` (and numpy bools) are accepted."""
+    import numpy as np
+
     if not isinstance(value, (bool, np.bool_)):
         raise InputError(f"{what} must be true or false, got {value!r}{where_text(where)}")
     return bool(value)
@@ -212,6 +219,8 @@ def point(value: Any, ndim: int, what: str, *, where: Where = None) -> np.ndarra
     InputError
         Not numeric, wrong number of coordinates, NaN or inf.
     """
+    import numpy as np
+
     try:
         arr = np.asarray(value, dtype=float).reshape(-1)
     except (TypeError, ValueError):
@@ -248,6 +257,8 @@ def grid(value: Any, what: str, *, holding: str = "") -> np.ndarray:
     ...
     fm2uav.errors.InputError: speed must be a 2D or 3D array, got 1D with shape (2,)
     """
+    import numpy as np
+
     arr = np.asarray(value)
     if arr.dtype == bool or arr.dtype.kind not in "iuf":
         raise InputError(f"{what} must be a numeric array{holding}, got dtype {arr.dtype}")

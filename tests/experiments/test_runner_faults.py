@@ -450,43 +450,27 @@ def test_failed_cases_exit_3_and_retry(tmp_path, baseline):
 
 # ----------------------------------------------------------------- Dask
 @pytest.mark.slow
-def test_dask_killed_worker_tasks_rerun(tmp_path, baseline):
-    dask = pytest.importorskip("dask")
-    distributed = pytest.importorskip("dask.distributed")
+def test_dask_killed_worker_tasks_rerun(tmp_path, baseline, dask_cluster):
     from fm2uav.experiments._executors import DaskPool
 
     out = _seed(tmp_path / "d", baseline)
-    # one retry by the scheduler (as the local pool); one task per worker thread, so a worker's
-    # death counts only against the task it was running (Dask counts it against every task
-    # assigned to that worker)
-    settings = {"distributed.scheduler.allowed-failures": 1,
-                "distributed.scheduler.worker-saturation": 1.0}
-    with dask.config.set(settings), \
-            distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                     dashboard_address=None) as cluster, \
-            distributed.Client(cluster) as client:
-        pids = client.run(os.getpid)
-        killed: dict = {}
+    client = dask_cluster.client
 
-        def on_progress(stage, done, total, failed):
-            if stage == "fm2" and done >= 1 and not killed:
-                for addr, keys in client.processing().items():
-                    if keys:
-                        os.kill(pids[addr], signal.SIGKILL)
-                        killed[addr] = list(keys)
-                        break
+    def on_progress(stage, done, total, failed):
+        if stage == "fm2" and done >= 1:
+            dask_cluster.kill_a_busy_worker()
 
-        res = run_sweep(make_config(LONG), out, client=client, on_progress=on_progress)
-        assert killed, "no worker was busy"
-        _assert_each_case_once(res, out, N_LONG)  # the scheduler ran its tasks again
-        _same_values(res, baseline)
+    res = run_sweep(make_config(LONG), out, client=client, on_progress=on_progress)
+    assert dask_cluster.killed, "no worker was busy"
+    _assert_each_case_once(res, out, N_LONG)  # the scheduler ran its tasks again
+    _same_values(res, baseline)
 
-        # a case that kills every worker it runs on: its job is split, only it fails
-        pool = DaskPool(None, client)
-        outs = list(pool.run(_explode, [Job(0.01, ["a", "boom", "c"])]))
-        by = {o.unit: o for o in outs}
-        assert len(outs) == 3 and by["a"].ok and by["c"].ok
-        assert not by["boom"].ok and "KilledWorker" in by["boom"].value
+    # a case that kills every worker it runs on: its job is split, only it fails
+    pool = DaskPool(None, client)
+    outs = list(pool.run(_explode, [Job(0.01, ["a", "boom", "c"])]))
+    by = {o.unit: o for o in outs}
+    assert len(outs) == 3 and by["a"].ok and by["c"].ok
+    assert not by["boom"].ok and "KilledWorker" in by["boom"].value
 
 
 def test_a_signal_deferred_while_closing_is_raised_when_the_block_ends():

@@ -181,32 +181,14 @@ def test_a_worker_killed_mid_mission_costs_one_attempt_and_nothing_else(missions
 
 
 @pytest.mark.slow  # a Dask cluster of two worker processes
-def test_dask_worker_killed_mid_batch_reruns_its_mission(missions, tmp_path):
-    dask = pytest.importorskip("dask")
-    distributed = pytest.importorskip("dask.distributed")
+def test_dask_worker_killed_mid_batch_reruns_its_mission(missions, tmp_path, dask_cluster):
     files, single = missions
     out = tmp_path / "out"
     order = ["outside", "big", "east", "north", "far"]
     todo, results = prepare_batch([files[n] for n in order], out)
-    settings = {"distributed.scheduler.allowed-failures": 1,
-                "distributed.scheduler.worker-saturation": 1.0}
-    with dask.config.set(settings), \
-            distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                     dashboard_address=None) as cluster, \
-            distributed.Client(cluster) as client:
-        pids = client.run(os.getpid)
-        killed: dict = {}
-
-        def on_result(res):
-            if killed:
-                return
-            for addr, keys in client.processing().items():
-                if keys:
-                    os.kill(pids[addr], signal.SIGKILL)
-                    killed[addr] = list(keys)
-                    break
-
-        run_batch(todo, results, make_pool(None, client=client), on_result=on_result)
+    run_batch(todo, results, make_pool(None, client=dask_cluster.client),
+              on_result=lambda res: dask_cluster.kill_a_busy_worker())
+    killed = dask_cluster.killed
     assert killed, "no worker was busy"
     assert [r.status for r in results] == ["failed", "ok", "ok", "ok", "ok"]
     for name in ("big", "east", "north", "far"):

@@ -1,12 +1,16 @@
 """The ``fm2uav`` command line.
 
 The application is assembled from the modules ``fm2uav/cli/cmd_*.py``: each
-defines ``register(app, reproduce_app)`` and adds its commands. Commands are
+defines ``register(app, reproduce_app)`` and adds its commands; :data:`COMMANDS`
+and :data:`REPRODUCE` name the module of each command, which is imported and built
+only when that command is run or asked for its help (:mod:`._lazy`). Commands are
 thin: parse, call the library, print a summary (see :mod:`._common`).
 
 The command line stays light: importing this package (and so ``fm2uav --help``,
 ``fm2uav <cmd> --help`` and every error typer reports while parsing) loads
-typer, rich and the ``cmd_*`` modules only. A ``cmd_*`` module imports at its
+typer, rich and the light modules of this package only (the ``cmd_*`` module of the
+command asked for; typer's pydantic coercion and rich's markdown and traceback modules
+only when used: :mod:`._coerce`, :mod:`._rich_light`). A ``cmd_*`` module imports at its
 top only the standard library, typer, rich, :mod:`fm2uav.errors` and the
 light modules of this package (``_common``, ``options``, ``_mission_options``,
 other ``cmd_*``); numpy, numba, scipy, matplotlib, the geodata libraries and the
@@ -16,12 +20,29 @@ that needs them (tests/cli/test_init.py checks every ``cli/*.py`` module).
 
 from __future__ import annotations
 
-import importlib
-import pkgutil
-
 import typer
 
-__all__ = ["app", "main"]
+from . import _rich_light
+from ._lazy import lazy_group
+
+_rich_light.install()  # help pages and usage errors without rich.markdown / rich.traceback
+
+__all__ = ["COMMANDS", "REPRODUCE", "app", "main"]
+
+#: ``fm2uav <name>`` → the ``cmd_*`` module that registers it, in the order of the help page
+#: (each command is built only when it is run or asked for its help: :mod:`._lazy`;
+#: tests/cli/test_lazy.py holds this table to what the modules register).
+COMMANDS = {
+    "app": "cmd_app", "batch": "cmd_batch", "calibrate": "cmd_calibrate", "check": "cmd_check",
+    "cover": "cmd_cover", "export": "cmd_export", "formation": "cmd_formation",
+    "plan": "cmd_plan", "routes": "cmd_routes", "run": "cmd_run", "sweep": "cmd_sweep",
+    "tune": "cmd_tff",
+}
+#: ``fm2uav reproduce <name>`` → its ``cmd_*`` module, likewise.
+REPRODUCE = {
+    "city": "cmd_city", "coverage": "cmd_cover", "formation": "cmd_formation",
+    "curvature": "cmd_sweep", "tff": "cmd_tff", "tracking": "cmd_tracking", "urban": "cmd_urban",
+}
 
 app = typer.Typer(
     name="fm2uav",
@@ -33,23 +54,15 @@ app = typer.Typer(
     add_completion=False,
     pretty_exceptions_enable=False,
     rich_markup_mode="rich",
+    cls=lazy_group(COMMANDS, package=__name__, section="app"),
 )
 reproduce_app = typer.Typer(
     help="Reproduce the experiments of the source papers (tables and figures).\n\n"
     "Example:  fm2uav reproduce tff --out out/tff",
     no_args_is_help=True,
+    cls=lazy_group(REPRODUCE, package=__name__, section="reproduce"),
 )
 app.add_typer(reproduce_app, name="reproduce")
-
-
-def _register_all() -> None:
-    for mod in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
-        if mod.name.startswith("cmd_"):
-            module = importlib.import_module(f"{__name__}.{mod.name}")
-            module.register(app, reproduce_app)
-
-
-_register_all()
 
 
 def main() -> None:

@@ -21,6 +21,7 @@ from .options import (
     world_rows,
 )
 from ._mission_options import parse_anchor
+from ._planner_options import PlannerFlags, planner_options
 from ._return_options import ReturnFlags, return_options
 from ..pipeline.outputs import wind_options, with_wind_on
 from .cmd_run import mission_rows, output_names, plan_outputs, safety_rows
@@ -51,6 +52,7 @@ PLAN_HELP = (
 @world_options
 @mission_options()
 @return_options
+@planner_options(march=True)
 def plan_cmd(
     scenario: ScenarioOpt = None,
     start: str | None = typer.Option(
@@ -63,36 +65,7 @@ def plan_cmd(
     ),
     lonlat: LonLatOpt = False,
     cells: bool = typer.Option(False, "--cells", help="Read --start/--goal as grid cells."),
-    saturation: float = typer.Option(1.0, help="Saturation α in (0, 1]."),
-    saturation_distance: float | None = typer.Option(
-        None, help="Distance (m) from the obstacles beyond which W = 1 (overrides "
-        "--saturation)."),
-    exponent: float = typer.Option(1.0, help="Exponent β > 0 on W (thesis' adjustment)."),
-    order: int = typer.Option(2, help="Fast Marching order, 1 or 2."),
-    threads: int | None = typer.Option(
-        None, help="Threads of the Fast Marching (>= 1; order 1 on grids of 1 M nodes or more "
-        "marches in parallel). Default: FM2UAV_THREADS, else every core."),
-    storage: str = typer.Option(
-        "auto", help="Grid storage: 'full' (one 3D grid), 'regional' (coarse plan, then "
-        "full-resolution windows along it; terrain + --agl) or 'auto' (regional when the full "
-        "grid would not fit in a quarter of the memory)."),
-    agl: float | None = typer.Option(
-        None, help="Flight level (m) above the ground (terrain-following, thesis "
-        "Algorithm 2). Default: none."),
-    p1: float = typer.Option(0.5, help="Exponent on the flight-level cells (with --agl)."),
-    p2: float = typer.Option(1.5, help="Exponent on all other cells (with --agl)."),
-    band: float = typer.Option(
-        0.0, help="Half-width (m) of the clarified band around the flight level (with "
-        "--agl; 0 = the seeds' single layer)."),
-    graded: bool = typer.Option(
-        False, "--graded", help="Blend the exponent from p1 to p2 across --band."),
-    mode: str = typer.Option(
-        "capped", help="Flight-level reading: 'capped' or 'literal' (W**p as is)."),
-    min_agl: float | None = typer.Option(
-        None, "--min-agl", help="Hard floor (m) above the ground for the whole flight except "
-        "the take-off/landing points (with --agl)."),
-    max_agl: float | None = typer.Option(
-        None, "--max-agl", help="Hard ceiling (m) above the ground, e.g. 120 (with --agl)."),
+    planner: PlannerFlags = None,
     no_fly: list[Path] | None = typer.Option(
         None, "--no-fly", help="No-fly zones file (GeoJSON lon/lat, KML/KMZ, GPKG, SHP; points "
         "need a 'radius' in metres); the plan keeps out of them and the .plan carries them "
@@ -116,7 +89,8 @@ def plan_cmd(
     from ._first_use import announce_compile, fmm_group
 
     announce_compile(quiet=output.quiet,
-                     child_group=fmm_group(order=order, ndim=2 if scenario == "city2d" else 3),
+                     child_group=fmm_group(order=planner.order,
+                                           ndim=2 if scenario == "city2d" else 3),
                      preload=("fm2uav.missions.route", "fm2uav.viz", "fm2uav.io"))
     from .. import progress
     from ..missions.route import plan_route
@@ -125,6 +99,7 @@ def plan_cmd(
     returns.check()
     with output.progress():
         progress.step("building the world", 0.1)
+        agl = planner.agl
         w, sc, scenario = world.build(scenario, start, goal, seed=seed, lonlat=lonlat, agl=agl)
         description = sc.description if sc is not None else f"real data: {scenario}"
         extra = _extra_formats(export, output.report)
@@ -134,12 +109,7 @@ def plan_cmd(
         w, start_m, goal_m, via_m = _points(
             w, sc, start, goal, mission.via, world=world, no_fly=no_fly, lonlat=lonlat,
             cells=cells, agl=agl, anchor=getattr(export_options, "anchor", None))
-        shaping, level, options = _planner(
-            dict(saturation=saturation, saturation_distance=saturation_distance,
-                 exponent=exponent, order=order, storage=storage,
-                 threads=threads),
-            dict(agl=agl, p1=p1, p2=p2, band=band, graded=graded, mode=mode, min_agl=min_agl,
-                 max_agl=max_agl))
+        shaping, level, options = planner.objects()
         export_options = with_wind_on(export_options, w)
         progress.step("planning (FM²)", 0.6)
         route = plan_route(w, start_m, goal_m, via=via_m,
@@ -183,26 +153,6 @@ def plan_cmd(
                     summary[key] = info[key]
         write_json(outdir, "summary.json", summary)
     output.summary("FM² plan", _rows(scenario, route, w, summary, built, p), summary)
-
-
-def _planner(shaping: dict, level: dict) -> tuple:
-    """``(Shaping, FlightLevel or None, PlanOptions)`` of the planner flags (the flight-level
-    ones only with ``--agl``; unset ``--min-agl``/``--max-agl`` left out)."""
-    from ..planning.params import planner_objects
-
-    if level["agl"] is None:
-        if level["min_agl"] is not None or level["max_agl"] is not None:
-            raise InputError("--min-agl / --max-agl limit a terrain-following flight; give "
-                             "--agl too (the requested height above ground)")
-        from .. import _validate
-
-        # unused without --agl, but never silently garbage (the mission file's ranges)
-        for k, hi, low_open in (("p1", 10.0, True), ("p2", 10.0, True), ("band", 5000.0, False)):
-            _validate.in_range(level[k], k, 0.0, hi, low_open=low_open,
-                               where=(f"planner.{k}", f"--{k}"))
-        level = {}
-    level = {k: v for k, v in level.items() if v is not None or k not in ("min_agl", "max_agl")}
-    return planner_objects({**shaping, **level})
 
 
 def _points(w, sc, start: str | None, goal: str | None, via: list[str] | None, *,

@@ -16,6 +16,7 @@ from .options import (
     world_rows,
 )
 from ._mission_options import parse_anchor
+from ._planner_options import PlannerFlags, planner_options
 
 ROUTES_HELP = (
     "Plan the FM² route from every start of a file to one goal with one Fast Marching "
@@ -39,6 +40,8 @@ ROUTES_HELP = (
 @output_options("out/routes", report_help="Also write report.html: every route on the map "
                 "(the longest coloured by height above ground), the figures, the starts table.")
 @world_options
+@planner_options(agl_help="Flight level (m) above the ground (terrain-following); also the "
+                 "height of starts without their own. Default: none.")
 def routes_cmd(
     goal: str = typer.Option(..., help="Goal (the depot) LON,LAT[,AGL]: degrees, degrees, "
                              "metres above the ground (default --agl)."),
@@ -48,25 +51,7 @@ def routes_cmd(
     id_field: str | None = typer.Option(
         None, "--id-field", help="Property with each point's id (points files; default "
         "'id', else 'name', else the feature number)."),
-    saturation: float = typer.Option(1.0, help="Saturation α in (0, 1]."),
-    saturation_distance: float | None = typer.Option(
-        None, help="Distance (m) from the obstacles beyond which W = 1 (overrides "
-        "--saturation)."),
-    exponent: float = typer.Option(1.0, help="Exponent β > 0 on W."),
-    order: int = typer.Option(2, help="Fast Marching order, 1 or 2."),
-    agl: float | None = typer.Option(
-        None, help="Flight level (m) above the ground (terrain-following); also the height "
-        "of starts without their own. Default: none."),
-    p1: float = typer.Option(0.5, help="Exponent on the flight-level cells (with --agl)."),
-    p2: float = typer.Option(1.5, help="Exponent on all other cells (with --agl)."),
-    band: float = typer.Option(0.0, help="Half-width (m) of the clarified band around the "
-                               "flight level (with --agl)."),
-    graded: bool = typer.Option(False, "--graded", help="Blend the exponent across --band."),
-    mode: str = typer.Option("capped", help="Flight-level reading: 'capped' or 'literal'."),
-    min_agl: float | None = typer.Option(None, "--min-agl", help="Hard floor (m) above the "
-                                         "ground (with --agl)."),
-    max_agl: float | None = typer.Option(None, "--max-agl", help="Hard ceiling (m) above the "
-                                         "ground (with --agl)."),
+    planner: PlannerFlags = None,
     no_fly: list[Path] | None = typer.Option(
         None, "--no-fly", help="No-fly zones file (GeoJSON lon/lat, KML/KMZ, GPKG, SHP); "
         "every route keeps out of them. Repeatable.", show_default=False),
@@ -86,7 +71,8 @@ def routes_cmd(
     from ._first_use import announce_compile, fmm_group
 
     announce_compile(quiet=output.quiet,
-                     child_group=fmm_group(order=order, ndim=2 if scenario == "city2d" else 3),
+                     child_group=fmm_group(order=planner.order,
+                                           ndim=2 if scenario == "city2d" else 3),
                      preload=("fm2uav.planning.many",))
     import numpy as np
 
@@ -94,7 +80,6 @@ def routes_cmd(
     from ..io.starts import read_starts
     from ..pipeline.routes import ROUTES_FILES, RouteSettings, routes_rows, run_routes
     from ..world.load import world_summary
-    from .cmd_plan import _planner
     from .options import lonlat_point
 
     if not (np.isfinite(speed) and 0.1 <= speed <= 300.0):
@@ -103,6 +88,7 @@ def routes_cmd(
         raise InputError(f"--thin must be a tolerance in [0, 1000] m, got {thin:g}")
     if threads is not None and threads < 1:
         raise InputError(f"--threads must be at least 1, got {threads}")
+    agl = planner.agl
     with output.progress():
         progress.step("building the world", 0.1)
         w, _, label = world.build(scenario, goal, seed=seed, lonlat=True, agl=agl,
@@ -116,11 +102,7 @@ def routes_cmd(
 
             w = with_zones(w, zones_from_cli(no_fly, w, crs=world.crs))
             check_points_allowed(w, {"goal": goal_m})
-        shaping, level, options = _planner(
-            dict(saturation=saturation, saturation_distance=saturation_distance,
-                 exponent=exponent, order=order, storage="full"),
-            dict(agl=agl, p1=p1, p2=p2, band=band, graded=graded, mode=mode, min_agl=min_agl,
-                 max_agl=max_agl))
+        shaping, level, options = planner.objects(storage="full")
         progress.step("reading the starts", 0.05)
         table = read_starts(starts, w, agl=agl, crs=world.crs, id_field=id_field,
                             anchor=anchor_ll)
