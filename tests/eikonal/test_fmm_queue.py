@@ -10,8 +10,9 @@ import math
 
 import numpy as np
 import pytest
-from .fmm_checks import assert_same_field
+from numba import njit
 
+from .fmm_checks import assert_same_field
 from fm2uav.eikonal import _kernels, fast_marching
 from fm2uav.eikonal._reference import fast_marching_reference
 
@@ -123,3 +124,74 @@ def test_kept_work_buffers_leave_no_trace(shape):
     assert set(_kernels._KEPT.bufs) == {"pair", "pool"}
     again = fast_marching(speed, src, order=2)
     np.testing.assert_array_equal(again, first)
+
+
+@njit(cache=False)
+def _drain(ahead, T, V, nodes, seed, s1, s2, steps):
+    """A march's queue workload on the band times ``-T[nodes]``: pop the smallest entry,
+    skip it if its node is frozen, freeze it, then lower a few pseudo-random band nodes
+    to the popped time plus 0 (exact ties) to 1/8 (new entries; the old ones stay behind,
+    outdated). ``ahead``: pop with ``_pop_ahead`` (strides ``s1``, ``s2``), else ``_pop``.
+    Returns the popped nodes (outdated entries as ``-1``) in order."""
+    nblk = 8 * nodes.size // _kernels.BLOCK + 2 * _kernels.RESERVE_BLOCKS
+    pool = np.empty(2 * nblk * _kernels.BLOCK, dtype=np.uint64)
+    nxt = np.empty(nblk, dtype=np.uint32)
+    bk = np.empty(2 * 258, dtype=np.uint32)
+    mw = np.empty(5, dtype=np.uint64)
+    st = np.zeros(_kernels.ST_SIZE, dtype=np.uint64)
+    _kernels.init_queue(nxt, bk, mw, st)
+    nfree, fh, cur, last = np.uint64(st[2]), np.uint64(st[3]), np.uint64(st[4]), np.uint64(0)
+    for c in nodes:
+        k = _kernels._bits(-T[c])
+        nfree, fh, cur = _kernels._push(_kernels._bucket(k, last), k, np.uint64(c), pool, nxt,
+                                        bk, mw, nfree, fh, cur)
+    out = np.full(steps, -2, dtype=np.int64)
+    x = np.uint64(seed)
+    for i in range(steps):
+        if ahead:
+            c, nfree, fh, cur, last = _kernels._pop_ahead(T, V, pool, nxt, bk, mw, nfree, fh,
+                                                          cur, last, s1, s2, True)
+        else:
+            c, nfree, fh, cur, last = _kernels._pop(T, pool, nxt, bk, mw, nfree, fh, cur, last)
+        if c == np.uint64(0xFFFFFFFF):
+            break
+        if not T[c] < 0.0:
+            out[i] = -1
+            continue
+        t = -T[c]
+        T[c] = t
+        out[i] = c
+        for _ in range(3):
+            x = x * np.uint64(6364136223846793005) + np.uint64(1442695040888963407)
+            nb = nodes[(x >> np.uint64(33)) % np.uint64(nodes.size)]
+            new = t + float((x >> np.uint64(20)) & np.uint64(7)) / 64.0
+            if T[nb] < 0.0 and new < -T[nb]:
+                T[nb] = -new
+                k = _kernels._bits(new)
+                nfree, fh, cur = _kernels._push(_kernels._bucket(k, last), k, nb, pool, nxt,
+                                                bk, mw, nfree, fh, cur)
+    return out
+
+
+@pytest.mark.parametrize("s1, s2", [(64, 8), (40, 0)])
+def test_pop_ahead_pops_the_same_nodes_as_pop(s1, s2):
+    # The 3D march pops with _pop_ahead (prefetching the lines of the next pops); the
+    # prefetches must not change the queue: the same nodes in the same order as _pop,
+    # on a workload with exact ties, outdated entries and keys spread over many radix
+    # levels (splits, scans, multi-block buckets). The nodes sit where the prefetch's
+    # strides stay inside T, as inner nodes of a padded grid do.
+    rng = np.random.default_rng(11)
+    m = 3000
+    margin = 2 * (s1 + s2)
+    nodes = np.arange(margin, margin + m, dtype=np.uint64)
+    T0 = np.full(m + 2 * margin, np.nan)
+    times = (np.round(rng.uniform(0.0, 50.0, m) * 16.0) + 1.0) / 16.0  # many exact ties
+    times[::7] *= 10.0 ** rng.uniform(-9, 3, times[::7].size)  # many binary orders
+    T0[margin:margin + m] = -times
+    V = np.ones(T0.size)
+    seqs = [_drain(ahead, T0.copy(), V, nodes, 3, np.uint64(s1), np.uint64(s2), 6 * m)
+            for ahead in (False, True)]
+    np.testing.assert_array_equal(seqs[1], seqs[0])
+    popped = seqs[0][seqs[0] >= 0]
+    assert np.array_equal(np.sort(popped), nodes.astype(np.int64))  # each node once
+    assert (seqs[0] == -1).any() and (seqs[0] == -2).any()  # outdated entries; drained
