@@ -4,6 +4,9 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-stamp
 OUT    ?= out
+## pytest-xdist workers for make test / test-fast (auto: one per core; WORKERS=0 runs serially)
+WORKERS ?= auto
+XDIST  := -n $(WORKERS) --dist loadgroup
 
 .PHONY: run test test-fast bench install clean
 
@@ -30,16 +33,17 @@ run: $(STAMP)
 	@echo "mission.plan loads in QGroundControl, mission.waypoints is a MAVLink WPL 110 file"
 
 ## make test: the layer contract (import-linter, [tool.importlinter] in pyproject.toml),
-## then the whole suite
+## then the whole suite, in parallel (pytest-xdist; tests sharing a set-up share a worker,
+## tests/conftest.py)
 test: $(STAMP)
 	$(VENV)/bin/lint-imports
-	$(VENV)/bin/pytest -q
+	$(VENV)/bin/pytest -q $(XDIST)
 
 ## make test-fast: for development — the same suite without the tests marked `slow`
 ## (long end-to-end runs: reproductions, sweeps, CLI missions); `make test` runs them too
 test-fast: $(STAMP)
 	$(VENV)/bin/lint-imports
-	$(VENV)/bin/pytest -q -m "not slow"
+	$(VENV)/bin/pytest -q $(XDIST) -m "not slow"
 
 ## make bench: speed and memory against peers (writes benchmarks/results/bench.json, the
 ## table in docs/performance.md and the summary in README.md)

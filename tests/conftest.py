@@ -35,6 +35,35 @@ settings.register_profile("fm2uav", deadline=None, database=None, print_blob=Tru
 settings.load_profile("fm2uav")
 
 
+#: session fixtures whose runs are worth sharing across test files: their users run in one
+#: pytest-xdist worker (the docs' blocks and the CLI tests giving the same arguments share runs)
+SHARED_RUNS = frozenset({"cli_once", "doc_runs"})
+
+
+def xdist_group_of(item) -> str | None:
+    """The pytest-xdist group ``item`` runs in under ``make test`` (``-n auto --dist
+    loadgroup``): ``"cli_once"`` for the users of :data:`SHARED_RUNS`, its file for a test
+    that uses a module-scoped fixture (each module's set-up made once, in one worker), None
+    (any worker) for the rest."""
+    names = set(getattr(item, "fixturenames", ()))
+    if names & SHARED_RUNS:
+        return "cli_once"
+    info = getattr(item, "_fixtureinfo", None)
+    defs = info.name2fixturedefs.values() if info is not None else ()
+    if any(d and d[-1].scope in ("module", "package", "class") for d in defs):
+        return item.nodeid.split("::", 1)[0]
+    return None
+
+
+def pytest_collection_modifyitems(config, items):
+    """Mark each test with its :func:`xdist_group_of` (``xdist_group``; without ``--dist
+    loadgroup``, or without pytest-xdist, the marks change nothing)."""
+    for item in items:
+        group = xdist_group_of(item)
+        if group is not None:
+            item.add_marker(pytest.mark.xdist_group(group))
+
+
 @dataclass(frozen=True)
 class CliRun:
     """One shared CLI run: its result, its output folder and its arguments (without --out)."""
