@@ -15,6 +15,7 @@ Long end-to-end tests are marked ``@pytest.mark.slow``: ``make test`` runs them,
 
 from __future__ import annotations
 
+import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,33 +36,60 @@ settings.register_profile("fm2uav", deadline=None, database=None, print_blob=Tru
 settings.load_profile("fm2uav")
 
 
-#: session fixtures whose runs are worth sharing across test files: their users run in one
-#: pytest-xdist worker (the docs' blocks and the CLI tests giving the same arguments share runs)
-SHARED_RUNS = frozenset({"cli_once", "doc_runs"})
+# ------------------------------------------------------------------ parallel runs (xdist)
+#: the session fixtures whose runs are shared across test files (cli_once: one run per
+#: distinct CLI argument list; doc_runs: the docs' blocks, made through cli_once)
+SHARED_RUNS = ("cli_once", "doc_runs")
 
 
-def xdist_group_of(item) -> str | None:
-    """The pytest-xdist group ``item`` runs in under ``make test`` (``-n auto --dist
-    loadgroup``): ``"cli_once"`` for the users of :data:`SHARED_RUNS`, its file for a test
-    that uses a module-scoped fixture (each module's set-up made once, in one worker), None
-    (any worker) for the rest."""
-    names = set(getattr(item, "fixturenames", ()))
-    if names & SHARED_RUNS:
-        return "cli_once"
-    info = getattr(item, "_fixtureinfo", None)
-    defs = info.name2fixturedefs.values() if info is not None else ()
-    if any(d and d[-1].scope in ("module", "package", "class") for d in defs):
-        return item.nodeid.split("::", 1)[0]
-    return None
+def shared_run_files(root: Path) -> frozenset[str]:
+    """The test files (as node ids name them) whose tests or fixtures take one of
+    :data:`SHARED_RUNS` as an argument: their tests run in one pytest-xdist worker, so that
+    each shared run is made once per ``make test``."""
+    pat = re.compile(r"\bdef \w+\([^)]*\b(?:" + "|".join(SHARED_RUNS) + r")\b")
+    return frozenset(p.relative_to(root).as_posix() for p in (root / "tests").rglob("test_*.py")
+                     if pat.search(p.read_text(encoding="utf-8")))
+
+
+def xdist_scope(nodeid: str, shared: frozenset[str]) -> str:
+    """The unit of work ``nodeid`` is handed out in: its file (a module's set-up is made in one
+    worker), or ``"shared-runs"`` for every file of ``shared``."""
+    path = nodeid.split("::", 1)[0]
+    return "shared-runs" if path in shared else path
+
+
+class XdistScheduling:
+    """``make test``'s scheduler (``pytest -n auto --dist loadfile``): pytest-xdist's file
+    scheduling with the files of :func:`shared_run_files` as one unit, handed out in
+    collection order (the workers put the slow tests first: the long units start early)."""
+
+    @pytest.hookimpl(tryfirst=True)
+    def pytest_xdist_make_scheduler(self, config, log):
+        if config.getvalue("dist") != "loadfile":
+            return None
+        from xdist.scheduler import LoadFileScheduling
+
+        shared = shared_run_files(config.rootpath)
+        config.option.loadscopereorder = False
+
+        class Scheduling(LoadFileScheduling):
+            def _split_scope(self, nodeid: str) -> str:
+                return xdist_scope(nodeid, shared)
+
+        return Scheduling(config, log)
+
+
+def pytest_configure(config):
+    if config.pluginmanager.hasplugin("xdist"):
+        config.pluginmanager.register(XdistScheduling(), "fm2uav-xdist-scheduling")
 
 
 def pytest_collection_modifyitems(config, items):
-    """Mark each test with its :func:`xdist_group_of` (``xdist_group``; without ``--dist
-    loadgroup``, or without pytest-xdist, the marks change nothing)."""
-    for item in items:
-        group = xdist_group_of(item)
-        if group is not None:
-            item.add_marker(pytest.mark.xdist_group(group))
+    """In a pytest-xdist worker the slow tests come first (a stable sort, the same in every
+    worker): the files holding them are handed out first (:class:`XdistScheduling`), so the run
+    does not end with one worker alone in a long test."""
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        items.sort(key=lambda item: item.get_closest_marker("slow") is None)
 
 
 @dataclass(frozen=True)
