@@ -4,6 +4,12 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed-stamp
 OUT    ?= out
+## pytest-xdist workers for make test / test-fast (auto: one per core; WORKERS=0 runs serially)
+WORKERS ?= auto
+XDIST  := -n $(WORKERS) --dist loadfile
+## the test modules' assertion-rewritten bytecode is kept (__pycache__, git-ignored) even
+## where the environment sets PYTHONDONTWRITEBYTECODE: rewriting them costs each worker ~7 s
+PYTEST := PYTHONDONTWRITEBYTECODE= $(VENV)/bin/pytest
 
 .PHONY: run test test-fast bench install clean
 
@@ -30,16 +36,17 @@ run: $(STAMP)
 	@echo "mission.plan loads in QGroundControl, mission.waypoints is a MAVLink WPL 110 file"
 
 ## make test: the layer contract (import-linter, [tool.importlinter] in pyproject.toml),
-## then the whole suite
+## then the whole suite, in parallel (pytest-xdist: one file's tests in one worker, and the
+## files sharing cli_once's runs in one worker too, tests/conftest.py)
 test: $(STAMP)
 	$(VENV)/bin/lint-imports
-	$(VENV)/bin/pytest -q
+	$(PYTEST) -q $(XDIST)
 
 ## make test-fast: for development — the same suite without the tests marked `slow`
 ## (long end-to-end runs: reproductions, sweeps, CLI missions); `make test` runs them too
 test-fast: $(STAMP)
 	$(VENV)/bin/lint-imports
-	$(VENV)/bin/pytest -q -m "not slow"
+	$(PYTEST) -q $(XDIST) -m "not slow"
 
 ## make bench: speed and memory against peers (writes benchmarks/results/bench.json, the
 ## table in docs/performance.md and the summary in README.md)

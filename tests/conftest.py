@@ -39,6 +39,62 @@ settings.register_profile("fm2uav", deadline=None, database=None, print_blob=Tru
 settings.load_profile("fm2uav")
 
 
+# ------------------------------------------------------------------ parallel runs (xdist)
+#: the session fixtures whose runs are shared across test files (cli_once: one run per
+#: distinct CLI argument list; doc_runs: the docs' blocks, made through cli_once)
+SHARED_RUNS = ("cli_once", "doc_runs")
+
+
+def shared_run_files(root: Path) -> frozenset[str]:
+    """The test files (as node ids name them) whose tests or fixtures take one of
+    :data:`SHARED_RUNS` as an argument: their tests run in one pytest-xdist worker, so that
+    each shared run is made once per ``make test``."""
+    pat = re.compile(r"\bdef \w+\([^)]*\b(?:" + "|".join(SHARED_RUNS) + r")\b")
+    return frozenset(p.relative_to(root).as_posix() for p in (root / "tests").rglob("test_*.py")
+                     if pat.search(p.read_text(encoding="utf-8")))
+
+
+def xdist_scope(nodeid: str, shared: frozenset[str]) -> str:
+    """The unit of work ``nodeid`` is handed out in: its file (a module's set-up is made in one
+    worker), or ``"shared-runs"`` for every file of ``shared``."""
+    path = nodeid.split("::", 1)[0]
+    return "shared-runs" if path in shared else path
+
+
+class XdistScheduling:
+    """``make test``'s scheduler (``pytest -n auto --dist loadfile``): pytest-xdist's file
+    scheduling with the files of :func:`shared_run_files` as one unit, handed out in
+    collection order (the workers put the slow tests first: the long units start early)."""
+
+    @pytest.hookimpl(tryfirst=True)
+    def pytest_xdist_make_scheduler(self, config, log):
+        if config.getvalue("dist") != "loadfile":
+            return None
+        from xdist.scheduler import LoadFileScheduling
+
+        shared = shared_run_files(config.rootpath)
+        config.option.loadscopereorder = False
+
+        class Scheduling(LoadFileScheduling):
+            def _split_scope(self, nodeid: str) -> str:
+                return xdist_scope(nodeid, shared)
+
+        return Scheduling(config, log)
+
+
+def pytest_configure(config):
+    if config.pluginmanager.hasplugin("xdist"):
+        config.pluginmanager.register(XdistScheduling(), "fm2uav-xdist-scheduling")
+
+
+def pytest_collection_modifyitems(config, items):
+    """In a pytest-xdist worker the slow tests come first (a stable sort, the same in every
+    worker): the files holding them are handed out first (:class:`XdistScheduling`), so the run
+    does not end with one worker alone in a long test."""
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        items.sort(key=lambda item: item.get_closest_marker("slow") is None)
+
+
 @dataclass(frozen=True)
 class CliRun:
     """One shared CLI run: its result, its output folder and its arguments (without --out)."""

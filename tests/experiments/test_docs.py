@@ -55,10 +55,27 @@ def test_fast_blocks_match_a_fresh_run():
     assert docs.check(names) == []
 
 
+#: the slow blocks by the run they share (``docs._city()``, ``docs._curvature()``, ...): one
+#: test case per run, so that pytest-xdist's workers make them side by side
+SLOW_RUNS = {
+    "tff-jacksboro": ["tff-jacksboro"],
+    "tff-readings-jacksboro": ["tff-readings-jacksboro"],
+    "urban": ["urban-table"],
+    "city": ["city-table", "city-rrt", "city-claims", "city-rrt-claims"],
+    "formation": ["formation-table"],
+    "curvature": ["curvature-results", "curvature-timing", "tracking"],
+}
+
+
+def test_the_slow_runs_hold_every_slow_block_once():
+    listed = [n for names in SLOW_RUNS.values() for n in names]
+    assert sorted(listed) == sorted(n for n, b in docs.BLOCKS.items() if b.slow)
+
+
 @pytest.mark.slow
-def test_slow_blocks_match_a_fresh_run():
-    names = [n for n, b in docs.BLOCKS.items() if b.slow]
-    assert docs.check(names) == []
+@pytest.mark.parametrize("run", SLOW_RUNS)
+def test_slow_blocks_match_a_fresh_run(run):
+    assert docs.check(SLOW_RUNS[run]) == []
 
 
 def test_near_best_reports_the_flat_valley():
