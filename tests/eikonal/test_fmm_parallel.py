@@ -147,6 +147,30 @@ def test_slab_split_follows_the_wave_of_an_off_centre_source():
     assert abs(cut - n // 2) <= 16
 
 
+@pytest.mark.parametrize("shape", [(1024, 1024), (160, 120, 100)])
+def test_balanced_cuts_of_many_slabs_shorten_the_windows_critical_path(shape, monkeypatch):
+    """With several slabs per thread the cuts follow the wave too (the bench's FM²-shaped
+    map, source at 0.3 of x): the windows' balance (nodes frozen over the sum of each
+    window's busiest thread's share, the speed-up they allow) beats equal slabs, and the
+    times stay the serial march's."""
+    v, src = fm2_shaped(shape)
+    flat, start, shape3 = _start(v, src)
+    k = 2 * _parallel.SLABS_PER_THREAD[len(shape)]
+    cuts = _parallel.slab_bounds(flat, start, shape3, (1.0,) * 3, k, 2)
+    assert cuts[0] == 0 and cuts[-1] == shape[0] and len(cuts) == k + 1
+    assert np.all(np.diff(cuts) >= _parallel.MIN_SLAB_ROWS)
+    T, balanced = _parallel.march(flat, start, shape3, (1.0,) * 3, 2)
+    serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 1, np.zeros((0, 3), dtype=int))
+    assert_equal_times(serial, T)
+    even = np.linspace(0, shape[0], k + 1).round().astype(np.int64)
+    assert not np.array_equal(cuts, even)
+    monkeypatch.setattr(_parallel, "slab_bounds", lambda *a: even)
+    T, equal = _parallel.march(flat, start, shape3, (1.0,) * 3, 2)
+    assert_equal_times(serial, T)
+    assert balanced["slabs"] == equal["slabs"] == k
+    assert balanced["balance"] > 1.02 * equal["balance"]
+
+
 @pytest.mark.parametrize("bad", [0, -2, 1.5, True, "2"])
 def test_bad_threads_are_refused(bad):
     with pytest.raises(InputError, match="threads must be an integer >= 1"):

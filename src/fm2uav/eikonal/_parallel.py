@@ -72,14 +72,19 @@ PARALLEL_MIN_NODES = 1_000_000
 #: Each slab gets at least this many x-slabs (rows), else fewer slabs are used.
 MIN_SLAB_ROWS = 16
 #: Slabs per thread, thread ``t`` marching slabs ``t, t + threads, ...``: strips
-#: interleaved across the grid keep both threads busy when the wave starts off-centre.
-#: Measured on the FM²-shaped fields (source at 0.3 of x), 2 threads: 2D 1/2/4 slabs
-#: per thread let the windows run 1.38x/1.44x/1.64x in parallel for +15/+6/+3 % CPU;
-#: 3D 1.47x/1.59x/1.77x for +23/+7/+24 % CPU (more repairs per interface in 3D).
-SLABS_PER_THREAD = {2: 4, 3: 2}
+#: interleaved across the grid keep both threads busy when the wave starts off-centre
+#: (and :func:`slab_bounds` places the cuts). Measured on the FM²-shaped fields (source
+#: at 0.3 of x), 2 threads, windows of 32768 nodes, balanced cuts: the windows' balance
+#: (``stats["balance"]``, the speed-up they allow) 2D 4/8 slabs per thread 1.69/1.76,
+#: 3D 2/4 1.65/1.84, process CPU the same within noise (0.88-0.96x the serial march's;
+#: the exchange reads only the nodes frozen in the boundary rows).
+SLABS_PER_THREAD = {2: 8, 3: 4}
 #: Target number of nodes frozen per window (all slabs together); the window
-#: width adapts to it. Fewer, wider windows cost fewer barriers and more repairs.
-WINDOW_NODES = 16384
+#: width adapts to it. Fewer, wider windows cost fewer barriers and more repairs:
+#: measured on 160^3 (2 threads, CPU over the serial march's, loaded machine) constant
+#: speed 8192/16384/32768 nodes 1.15x/0.97x/0.85x; FM²-shaped 32768/65536 0.92x/2.4x
+#: (wider windows than the wave's crossing of a slab re-open nodes in cascades).
+WINDOW_NODES = 32768
 #: Free repair-heap slots kept before each node's pushes (one pop pushes at most 7).
 HEAP_RESERVE = 8
 #: Smallest start of a slab's repair heap (entries; at least 4 boundary rows) and
@@ -547,33 +552,84 @@ _drive3d = _drive_kernel(True)
 #: (2D; 3D: ``COARSE_3D``), ~1.5 % of the work of the full march.
 COARSE = 8
 COARSE_3D = 4
-#: Time bins of the split estimate (stand-ins for the windows).
+#: Bins of the split estimate, each as many coarse nodes in time order (stand-ins for
+#: the windows).
 SPLIT_BINS = 256
 
 
-def slab_bounds(speed, start, shape3, h3, k: int) -> np.ndarray:
-    """Row bounds (``k + 1`` ints) of ``k`` slabs along x.
+def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarray:
+    """Row bounds (``k + 1`` ints) of ``k`` slabs along x, slab ``j`` marched by thread
+    ``j % threads``.
 
-    Two slabs are split where a coarse march predicts the best balance: the
-    row ``s`` minimising ``sum over time bins of max(nodes below s, nodes from s
-    on)``, the windows' critical path (a source off-centre would otherwise leave
-    one slab idle while the wave crosses the other). Otherwise, or when the start
-    is not a few point sources (its box over a quarter of the grid), equal slabs.
+    The cuts are placed where a coarse march predicts the best balance: they minimise
+    ``sum over time bins of max over threads of the nodes it marches in that bin``, the
+    windows' critical path (a source off-centre would otherwise leave one thread idle
+    while the wave crosses the other's slabs), by coordinate descent from equal slabs
+    (each cut in turn moved to its best row between its neighbours, until none moves;
+    exhaustive for two slabs). Equal slabs when the start is not a few point sources
+    (its box over a quarter of the grid) or the grid is too thin for a coarse march.
     """
     nx = int(shape3[0])
     even = np.linspace(0, nx, k + 1).round().astype(np.int64)
-    if k != 2 or 4 * int(np.prod(start.shape)) > int(np.prod(shape3)):
+    if k < 2 or threads < 2 or 4 * int(np.prod(start.shape)) > int(np.prod(shape3)):
         return even
+    hist, f = _coarse_histogram(speed, start, shape3, h3)
+    if hist is None:
+        return even
+    rows = hist.shape[0]
+    gap = max(1, -(-MIN_SLAB_ROWS // f))  # coarse rows per slab at least
+    if rows < k * gap:
+        return even
+    cum = np.vstack([np.zeros((1, hist.shape[1]), dtype=np.int64), np.cumsum(hist, axis=0)])
+    cuts = np.clip(np.linspace(0, rows, k + 1).round().astype(np.int64), 0, rows)
+    owner = np.arange(k) % threads
+
+    def loads(c):  # nodes per thread and time bin, shape (threads, bins)
+        out = np.zeros((threads, hist.shape[1]), dtype=np.int64)
+        np.add.at(out, owner, cum[c[1:]] - cum[c[:-1]])
+        return out
+
+    for _ in range(4 * k):
+        moved = False
+        for i in range(1, k):
+            cand = np.arange(cuts[i - 1] + gap, cuts[i + 1] - gap + 1)
+            if cand.size == 0:
+                continue
+            base = loads(cuts)
+            base[owner[i - 1]] -= cum[cuts[i]] - cum[cuts[i - 1]]
+            base[owner[i]] -= cum[cuts[i + 1]] - cum[cuts[i]]
+            trial = np.repeat(base[None], cand.size, axis=0)
+            trial[:, owner[i - 1]] += cum[cand] - cum[cuts[i - 1]]
+            trial[:, owner[i]] += cum[cuts[i + 1]] - cum[cand]
+            best = int(cand[np.argmin(trial.max(axis=1).sum(axis=1))])
+            if best != cuts[i]:
+                cuts[i] = best
+                moved = True
+        if not moved:
+            break
+    bounds = np.minimum(cuts * f, nx)
+    bounds[-1] = nx
+    for i in range(1, k):  # fine rows: at least MIN_SLAB_ROWS per slab where they fit
+        bounds[i] = min(max(bounds[i], bounds[i - 1] + MIN_SLAB_ROWS), nx - (k - i) * MIN_SLAB_ROWS)
+    if np.any(np.diff(bounds) < 1):
+        return even
+    return bounds.astype(np.int64)
+
+
+def _coarse_histogram(speed, start, shape3, h3):
+    """Nodes per coarse x-row and time bin of a march over every ``COARSE``-th node
+    (``COARSE_3D`` in 3D) from the start's frozen nodes: ``(hist, f)``, ``hist`` of shape
+    ``(coarse rows, SPLIT_BINS)`` and ``f`` the coarsening; ``(None, f)`` if no estimate."""
     three = shape3[2] > 1
     f = COARSE_3D if three else COARSE
     grid = speed.reshape(shape3)
     coarse = np.ascontiguousarray(grid[::f, ::f, ::f] if three else grid[::f, ::f, :])
     cshape = coarse.shape
     if cshape[0] < 4:
-        return even
+        return None, f
     box = np.argwhere(start.state.reshape(start.shape) == _kernels.FROZEN)
     if len(box) == 0:
-        return even
+        return None, f
     cells = np.unique((box + np.asarray(start.lo)) // np.array([f, f, f if three else 1]),
                       axis=0)
     lo = cells.min(axis=0)
@@ -591,16 +647,16 @@ def slab_bounds(speed, start, shape3, h3, k: int) -> np.ndarray:
     fin = np.isfinite(T)
     tmax = float(T[fin].max()) if fin.any() else 0.0
     if not tmax > 0.0:
-        return even
+        return None, f
     rows = np.broadcast_to(np.arange(cshape[0])[:, None], T.shape)[fin]
-    bins = np.minimum((T[fin] / tmax * SPLIT_BINS).astype(np.int64), SPLIT_BINS - 1)
+    # bins of equal node counts in time order, as the windows (~WINDOW_NODES nodes each);
+    # equal times share a bin (a node's bin from the rank of the first of its time)
+    times = T[fin]
+    rank = np.searchsorted(np.sort(times), times, side="left")
+    bins = rank * SPLIT_BINS // times.size
     hist = np.bincount(rows * SPLIT_BINS + bins,
                        minlength=cshape[0] * SPLIT_BINS).reshape(cshape[0], SPLIT_BINS)
-    below = np.cumsum(hist, axis=0)[:-1]  # nodes of rows < s + 1, s = 0 .. n - 2
-    cost = np.maximum(below, below[-1] + hist[-1] - below).sum(axis=1)
-    cut = (int(np.argmin(cost)) + 1) * f
-    cut = min(max(cut, MIN_SLAB_ROWS), nx - MIN_SLAB_ROWS)
-    return np.array([0, cut, nx], dtype=np.int64)
+    return hist, f
 
 
 def march(speed, start, shape3, h3, threads, stop_cells=None):
@@ -639,7 +695,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
     nth = int(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
     K = int(max(1, min(nth * SLABS_PER_THREAD[3 if three else 2], nx // MIN_SLAB_ROWS)))
     nth = min(nth, K)
-    bounds = slab_bounds(speed, start, shape3, h3, K)
+    bounds = slab_bounds(speed, start, shape3, h3, K, nth)
     rows = np.diff(bounds).astype(np.int64)
     sx = (ny + 2) * (nz + 2) if three else ny + 2
     sy = nz + 2 if three else 1
