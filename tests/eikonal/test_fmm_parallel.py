@@ -153,6 +153,7 @@ def test_balanced_cuts_of_many_slabs_shorten_the_windows_critical_path(shape, mo
     map, source at 0.3 of x): the windows' balance (nodes frozen over the sum of each
     window's busiest thread's share, the speed-up they allow) beats equal slabs, and the
     times stay the serial march's."""
+    monkeypatch.setattr(_parallel, "MIN_SLAB_NODES", 0)  # slab counts of 2048^2 and 160^3
     v, src = fm2_shaped(shape)
     flat, start, shape3 = _start(v, src)
     k = 2 * _parallel.SLABS_PER_THREAD[len(shape)]
@@ -217,6 +218,17 @@ def test_plan_options_take_threads():
     assert PlanOptions().threads is None
     with pytest.raises(InputError, match=r"threads must be an integer >= 1.*planner\.threads"):
         PlanOptions(threads=0)
+
+
+def test_slab_count_keeps_slabs_of_a_minimum_size():
+    v = np.ones((1024, 1024))
+    flat, start, shape3 = _start(v, (300, 500))
+    _, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, 2)
+    assert stats["slabs"] == v.size // _parallel.MIN_SLAB_NODES == 8  # not 2 * 8
+    v = np.ones((96, 40))
+    flat, start, shape3 = _start(v, (30, 20))
+    _, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, 2)
+    assert stats["slabs"] == 2  # one per thread however small
 
 
 def test_queues_that_run_low_grow_and_the_march_resumes(monkeypatch):

@@ -11,16 +11,21 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
 * The grid is cut along x (the slowest-varying axis of the C layout) into
   ``K`` slabs, :data:`SLABS_PER_THREAD` per thread, thread ``t`` marching slabs
   ``t, t + threads, ...`` (interleaved strips keep both threads busy when the
-  wave starts off-centre; with one slab per thread a coarse march picks the cut,
-  :func:`slab_bounds`). Each slab is a padded grid of its own, laid out exactly as the
+  wave starts off-centre, and a coarse march places the cuts, :func:`slab_bounds`).
+  Each slab is a padded grid of its own, laid out exactly as the
   serial march's (:func:`fm2uav.eikonal._kernels.pad_grid`), one after the other
-  in one buffer: its two ghost x-slabs hold, between windows, the *frozen*
+  in one buffer (the serial march's kept huge-page buffers; in the lean layout of big
+  grids float32 ``V`` and the times compacted in place, as there): its two ghost
+  x-slabs hold, between windows, the *frozen*
   times of the neighbouring slab's boundary rows (``NaN`` where not frozen), so
-  the serial kernels' update (``_solve_iso``, ``_axis_term``, ``_combine``) and
-  radix queue (``_push``, ``_pop``) run unchanged on a slab.
+  the serial kernels' update (``_solve_iso``, ``_axis_term``, ``_combine``, the
+  plateau register ``_rhs``) and radix queue (``_push``, ``_pop``) run unchanged on a
+  slab.
 * Time windows: every slab pops, with its own queue and in parallel, the nodes
-  whose time is below ``t_w``; then (barrier) every slab copies the neighbours'
-  boundary rows into its ghosts. A node next to a ghost whose value changed is
+  whose time is below ``t_w``, and lists the nodes it froze in its two boundary rows;
+  then (barrier) every slab copies those of its neighbours into its ghosts (not the
+  whole rows, e.g. 162x162 planes per slab and window on 160^3). A node next to a
+  ghost whose value changed is
   updated again; if that lowers a node frozen already, it is **re-opened**
   (band again, queued). When a node is frozen, each frozen neighbour later
   than it is updated again too and re-opened if that lowers it, so the
@@ -71,6 +76,10 @@ THREADS_ENV = "FM2UAV_THREADS"
 PARALLEL_MIN_NODES = 1_000_000
 #: Each slab gets at least this many x-slabs (rows), else fewer slabs are used.
 MIN_SLAB_ROWS = 16
+#: ... and at least this many nodes (but every thread one slab): thin slabs cost repairs.
+#: Measured on 1024^2 smooth (2 threads, CPU over the serial march's, loaded machine):
+#: 2/4/8 slabs per thread 1.05x/1.08x/1.24x at the same windows' balance (1.94-1.96).
+MIN_SLAB_NODES = 2**17
 #: Slabs per thread, thread ``t`` marching slabs ``t, t + threads, ...``: strips
 #: interleaved across the grid keep both threads busy when the wave starts off-centre
 #: (and :func:`slab_bounds` places the cuts). Measured on the FM²-shaped fields (source
@@ -674,7 +683,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
         Spacing per axis [m].
     threads : int
         Threads, ``>= 2`` (each marches :data:`SLABS_PER_THREAD` slabs, fewer
-        where a slab would get fewer than :data:`MIN_SLAB_ROWS` rows).
+        where a slab would get fewer than :data:`MIN_SLAB_ROWS` rows or
+        :data:`MIN_SLAB_NODES` nodes).
     stop_cells : ndarray, int, shape (m, 3), optional
         Stop once these nodes are frozen and final; nodes later than the latest
         of them are then ``inf``, as in the serial march.
@@ -693,7 +703,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
     nx, ny, nz = (int(n) for n in shape3)
     three = nz > 1
     nth = int(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
-    K = int(max(1, min(nth * SLABS_PER_THREAD[3 if three else 2], nx // MIN_SLAB_ROWS)))
+    K = int(max(1, min(nth * SLABS_PER_THREAD[3 if three else 2], nx // MIN_SLAB_ROWS,
+                       max(nth, nx * ny * nz // max(MIN_SLAB_NODES, 1)))))
     nth = min(nth, K)
     bounds = slab_bounds(speed, start, shape3, h3, K, nth)
     rows = np.diff(bounds).astype(np.int64)
