@@ -76,3 +76,44 @@ def test_the_command_line_child_compiles_the_first_plan_child_groups():
 
     assert not set(warmup.FIRST_PLAN_CHILD) & set(warmup.FIRST_PLAN_MAIN)
     assert set(warmup.FIRST_PLAN_CHILD + warmup.FIRST_PLAN_MAIN) <= set(warmup.GROUPS)
+
+
+_LATER_PARALLEL_RUN = textwrap.dedent(
+    """
+    import numpy as np
+    from fm2uav import _jit
+    compiled = []
+    _jit.on_first_compile(lambda: compiled.append(1))
+    from fm2uav.eikonal import _kernels, _parallel, fast_marching
+    _kernels.LEAN_NODES = 0          # a big grid's two-thread march (lean layout, float32
+    _parallel.PARALLEL_MIN_NODES = 0  # speed), on a small one
+    v = np.ones((40, 36, 20))
+    v[10:14, :30, :] = 0.0
+    T = fast_marching(v, [(30, 5, 3)], spacing=(15.0, 15.0, 10.0), order=1, threads=2)
+    assert np.isfinite(T[0, 0, 1])
+    print("compiled" if compiled else "cached")
+    """
+)
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(reason="open: after the groups this run still compiles one function (not "
+                          "identified yet; the group now runs the lean march too)", strict=False)
+def test_parallel_group_caches_the_lean_layout_of_a_big_two_thread_march(tmp_path):
+    # a 1000x1000x40 terrain plan marches on both cores in the lean layout (float32 speed):
+    # after the install's groups it compiles nothing (it compiled for ~50 s before)
+    groups = ["fmm3d_o1", "fmm3d_parallel"]
+    res = _run(["-m", "fm2uav.planning.warmup", *groups], tmp_path)
+    assert res.returncode == 0, res.stderr
+    res = _run(["-c", _LATER_PARALLEL_RUN], tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.split() == ["cached"]
+    # the check can fail: the float64 layout alone (the group before) leaves the lean
+    # march to compile
+    float64_only = ("import numpy as np\n"
+                    "from fm2uav.eikonal import _parallel, fast_marching\n"
+                    "_parallel.PARALLEL_MIN_NODES = 0\n"
+                    "fast_marching(np.ones((16, 16, 16)), [(3, 3, 3)], order=1, threads=2)\n")
+    res = _run(["-c", float64_only], tmp_path / "small")
+    assert res.returncode == 0, res.stderr
+    assert _run(["-c", _LATER_PARALLEL_RUN], tmp_path / "small").stdout.split() == ["compiled"]

@@ -1066,7 +1066,7 @@ def march(speed, start, shape3, h3, order, stop_cells, *, lean=None):
 PLATEAU_MIN_SHARE = 0.5
 
 
-def _plateau(speed, Vp, shape3, npad):
+def _plateau(speed, Vp, shape3, npad, fill=None):
     """The plateau mask of the padded grid and the plateau's ``V`` (``qp = 0.0``: none).
 
     The mask marks the nodes whose speed equals the grid's largest (see
@@ -1075,7 +1075,8 @@ def _plateau(speed, Vp, shape3, npad):
     :func:`pad_grid` rounds it into ``Vp`` (float32 in the lean layout), so the times
     are bit for bit those read from ``Vp``. A sample of every ``_PLATEAU_STRIDE``-th
     node decides first whether a plateau is likely (the full pass over the speeds
-    cost 2 % of the march on a map without one).
+    cost 2 % of the march on a map without one). ``fill(vmax, bits)``, if given, sets the
+    bits in another layout (the parallel march's slabs) and returns how many.
     """
     sample = speed[::_PLATEAU_STRIDE]
     top = sample.max()
@@ -1088,7 +1089,10 @@ def _plateau(speed, Vp, shape3, npad):
     if vmin == vmax:
         return _ONE_BYTE, qp
     bits = np.zeros(npad // 8 + 1, dtype=np.uint8)
-    count = plateau_bits(speed, vmax, *(int(n) for n in shape3), bits)
+    if fill is None:
+        count = plateau_bits(speed, vmax, *(int(n) for n in shape3), bits)
+    else:
+        count = fill(vmax, bits)
     if count < PLATEAU_MIN_SHARE * speed.size:
         return _NO_BITS, 0.0
     return bits, qp

@@ -11,16 +11,21 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
 * The grid is cut along x (the slowest-varying axis of the C layout) into
   ``K`` slabs, :data:`SLABS_PER_THREAD` per thread, thread ``t`` marching slabs
   ``t, t + threads, ...`` (interleaved strips keep both threads busy when the
-  wave starts off-centre; with one slab per thread a coarse march picks the cut,
-  :func:`slab_bounds`). Each slab is a padded grid of its own, laid out exactly as the
+  wave starts off-centre, and a coarse march places the cuts, :func:`slab_bounds`).
+  Each slab is a padded grid of its own, laid out exactly as the
   serial march's (:func:`fm2uav.eikonal._kernels.pad_grid`), one after the other
-  in one buffer: its two ghost x-slabs hold, between windows, the *frozen*
+  in one buffer (the serial march's kept huge-page buffers; in the lean layout of big
+  grids float32 ``V`` and the times compacted in place, as there): its two ghost
+  x-slabs hold, between windows, the *frozen*
   times of the neighbouring slab's boundary rows (``NaN`` where not frozen), so
-  the serial kernels' update (``_solve_iso``, ``_axis_term``, ``_combine``) and
-  radix queue (``_push``, ``_pop``) run unchanged on a slab.
+  the serial kernels' update (``_solve_iso``, ``_axis_term``, ``_combine``, the
+  plateau register ``_rhs``) and radix queue (``_push``, ``_pop``) run unchanged on a
+  slab.
 * Time windows: every slab pops, with its own queue and in parallel, the nodes
-  whose time is below ``t_w``; then (barrier) every slab copies the neighbours'
-  boundary rows into its ghosts. A node next to a ghost whose value changed is
+  whose time is below ``t_w``, and lists the nodes it froze in its two boundary rows;
+  then (barrier) every slab copies those of its neighbours into its ghosts (not the
+  whole rows, e.g. 162x162 planes per slab and window on 160^3). A node next to a
+  ghost whose value changed is
   updated again; if that lowers a node frozen already, it is **re-opened**
   (band again, queued). When a node is frozen, each frozen neighbour later
   than it is updated again too and re-opened if that lowers it, so the
@@ -49,8 +54,8 @@ from numba import njit, prange
 from . import _kernels
 from ._heap import sift_down, sift_up
 from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _U, _ZERO, RESERVE_BLOCKS, BLOCK,
-                       _axis_term, _bits, _bucket, _prefetch, _combine, _pop, _push, _side_min,
-                       _solve_iso)
+                       _at_plateau, _axis_term, _bits, _bucket, _prefetch, _combine, _pop, _push,
+                       _rhs, _side_min, _solve_iso)
 
 #: The windows meet at a barrier several hundred times per march: a thread that waits
 #: there sleeps instead of spinning (OpenMP's default spins), or on a busy machine the
@@ -71,15 +76,24 @@ THREADS_ENV = "FM2UAV_THREADS"
 PARALLEL_MIN_NODES = 1_000_000
 #: Each slab gets at least this many x-slabs (rows), else fewer slabs are used.
 MIN_SLAB_ROWS = 16
+#: ... and at least this many nodes (but every thread one slab): thin slabs cost repairs.
+#: Measured on 1024^2 smooth (2 threads, CPU over the serial march's, loaded machine):
+#: 2/4/8 slabs per thread 1.05x/1.08x/1.24x at the same windows' balance (1.94-1.96).
+MIN_SLAB_NODES = 2**17
 #: Slabs per thread, thread ``t`` marching slabs ``t, t + threads, ...``: strips
-#: interleaved across the grid keep both threads busy when the wave starts off-centre.
-#: Measured on the FM²-shaped fields (source at 0.3 of x), 2 threads: 2D 1/2/4 slabs
-#: per thread let the windows run 1.38x/1.44x/1.64x in parallel for +15/+6/+3 % CPU;
-#: 3D 1.47x/1.59x/1.77x for +23/+7/+24 % CPU (more repairs per interface in 3D).
-SLABS_PER_THREAD = {2: 4, 3: 2}
+#: interleaved across the grid keep both threads busy when the wave starts off-centre
+#: (and :func:`slab_bounds` places the cuts). Measured on the FM²-shaped fields (source
+#: at 0.3 of x), 2 threads, windows of 32768 nodes, balanced cuts: the windows' balance
+#: (``stats["balance"]``, the speed-up they allow) 2D 4/8 slabs per thread 1.69/1.76,
+#: 3D 2/4 1.65/1.84, process CPU the same within noise (0.88-0.96x the serial march's;
+#: the exchange reads only the nodes frozen in the boundary rows).
+SLABS_PER_THREAD = {2: 8, 3: 4}
 #: Target number of nodes frozen per window (all slabs together); the window
-#: width adapts to it. Fewer, wider windows cost fewer barriers and more repairs.
-WINDOW_NODES = 16384
+#: width adapts to it. Fewer, wider windows cost fewer barriers and more repairs:
+#: measured on 160^3 (2 threads, CPU over the serial march's, loaded machine) constant
+#: speed 8192/16384/32768 nodes 1.15x/0.97x/0.85x; FM²-shaped 32768/65536 0.92x/2.4x
+#: (wider windows than the wave's crossing of a slab re-open nodes in cascades).
+WINDOW_NODES = 32768
 #: Free repair-heap slots kept before each node's pushes (one pop pushes at most 7).
 HEAP_RESERVE = 8
 #: Smallest start of a slab's repair heap (entries; at least 4 boundary rows) and
@@ -187,52 +201,57 @@ def _deq(T, pool, nxt, bk, mw, st, rkey, ritem):
 
 
 @njit(cache=True, inline="always", error_model="numpy", _nrt=False)
-def _update(T, V, c, sx, sy, ih, hh, iso, three):  # noqa: PLR0913
-    """The order-1 upwind time of node ``c`` from its frozen neighbours (as the serial march)."""
+def _update(T, V, U, use_u, qp, c, sx, sy, ih, hh, iso, three):  # noqa: PLR0913
+    """The order-1 upwind time of node ``c`` from its frozen neighbours (as the serial march;
+    ``1 / speed^2`` from the plateau register ``qp`` where the mask ``U`` says so)."""
+    q = _rhs(V, U, use_u, qp, c)
     if iso:
         tz = _side_min(T, c, _ONE) if three else _INF
-        return _solve_iso(_side_min(T, c, sx), _side_min(T, c, sy), tz, V[c] * hh)
+        return _solve_iso(_side_min(T, c, sx), _side_min(T, c, sy), tz, q * hh)
     ta, aa = _axis_term(T, V, c, sx, ih[0], 1)
     tb, ab = _axis_term(T, V, c, sy, ih[1], 1)
     if three:
         tc, ac = _axis_term(T, V, c, _ONE, ih[2], 1)
     else:
         tc, ac = _INF, 0.0
-    return _combine(ta, aa, tb, ab, tc, ac, V[c])
+    return _combine(ta, aa, tb, ab, tc, ac, q)
 
 
 @njit(cache=True, inline="always", error_model="numpy", _nrt=False)
-def _prefetch_rows(T, V, c, sx, sy, three):
-    """Prefetch ``T`` and ``V`` one and two rows (planes) away across x (and y)."""
+def _prefetch_rows(T, V, c, sx, sy, three, pv):
+    """Prefetch ``T`` (and ``V`` if ``pv``) one and two rows (planes) away across x (and y)."""
     n = _U(T.size)
     _prefetch(T, c - sx)
     _prefetch(T, c + sx)
-    _prefetch(V, c - sx)
-    _prefetch(V, c + sx)
+    if pv:
+        _prefetch(V, c - sx)
+        _prefetch(V, c + sx)
     _prefetch(T, c - sx - sx if c >= sx + sx else c)
     _prefetch(T, c + sx + sx if c + sx + sx < n else c)
     if three:
         _prefetch(T, c - sy)
         _prefetch(T, c + sy)
-        _prefetch(V, c - sy)
-        _prefetch(V, c + sy)
+        if pv:
+            _prefetch(V, c - sy)
+            _prefetch(V, c + sy)
         _prefetch(T, c - sy - sy)
         _prefetch(T, c + sy + sy)
 
 
 @njit(cache=True, inline="always", error_model="numpy", _nrt=False)
-def _lower(T, V, c, t, fixed, sx, sy, three, pool, nxt, bk, mw, st, rkey, ritem, ctl):
+def _lower(T, V, c, t, fixed, sx, sy, three, pv, pool, nxt, bk, mw, st, rkey, ritem, ctl):
     """Give node ``c`` the time ``t`` if that is lower than its band or frozen time.
 
     A frozen node lowered is re-opened (band again), unless it was frozen on entry
     (bit ``c`` of ``fixed``: a source or its ball, final as in the serial march).
+    ``pv``: prefetch the speeds of a new band node's neighbours too (off the plateau).
     """
     x = T[c]
     if x < 0.0:
         if t < -x:
             T[c] = -t
             if x == -_INF:  # a new band node: fetch the rows its freezing reads (as _relax)
-                _prefetch_rows(T, V, c, sx, sy, three)
+                _prefetch_rows(T, V, c, sx, sy, three, pv)
             _enq(_bits(t), c, pool, nxt, bk, mw, st, rkey, ritem)
     elif t < x and (fixed[c >> _U(3)] >> (c & _U(7))) & _ONE == _ZERO:
         T[c] = -t
@@ -254,22 +273,42 @@ def _nbs(c, sx, sy, three):
     return (c - sx, c + sx, c - _ONE, c + _ONE, c, c)
 
 
+@njit(cache=True, inline="always", _nrt=False)
+def _note(sent, ns, side, c):
+    """Append node ``c`` (frozen in a boundary row) to the list ``side`` of the slab's
+    sent nodes, or mark the list overflowed (``> capacity``: the exchange scans the row)."""
+    m = ns[side]
+    if m < _U(sent.shape[1]):
+        sent[side, m] = c
+        ns[side] = m + _ONE
+    else:
+        ns[side] = _U(sent.shape[1]) + _ONE
+
+
 def _slab_kernels(three):
     """The compiled window, start and exchange of one dimension (``three``: 3D)."""
 
     # closure variables are part of numba's cache key: only ``three`` (a bool) may be
     # one (a dispatcher's pickle differs per process and would defeat the cache)
-    def window(T, V, fixed, sx, sy, ih, hh, iso, tw, pool, nxt, bk, mw, st, rkey, ritem, ctl):
+    def window(T, V, U, qp, fixed, sx, sy, ih, hh, iso, tw, pool, nxt, bk, mw, st, rkey, ritem,
+               ctl, sent, ns):
         """Freeze the slab's queued nodes with a time below ``tw`` (resumable).
 
         ``T`` is the slab's padded grid (ghost x-slabs first and last). Sets
-        ``ctl[_C_NEXT]`` to the smallest time left queued (inf if none).
+        ``ctl[_C_NEXT]`` to the smallest time left queued (inf if none). The nodes it
+        freezes in its first and last own rows go to ``sent[0]`` and ``sent[1]``
+        (``ns`` their counts, reset here): the neighbours' exchange reads only those.
         """
         n = _U(T.size)
         lo = sx  # the slab's own nodes: [sx, n - sx)
         hi = n - sx
+        lo2 = lo + sx  # the first own row is [lo, lo2), the last [hi2, hi)
+        hi2 = hi - sx
+        use_u = qp > 0.0
         kw = _bits(tw)
         pops = 0
+        ns[0] = _ZERO
+        ns[1] = _ZERO
         ctl[_C_NEXT] = _INF
         while True:
             if not _room(st, rkey):
@@ -289,18 +328,24 @@ def _slab_kernels(three):
                 break
             T[c] = t
             pops += 1
+            if c < lo2:
+                _note(sent, ns, 0, c)
+            if c >= hi2:
+                _note(sent, ns, 1, c)
+            pv = not (use_u and _at_plateau(U, c))
             for nb in _nbs(c, sx, sy, three):
                 y = T[nb]
                 if y < 0.0 or (y > t and nb >= lo and nb < hi):
                     # band/far, or frozen later than c in this slab: c may lower it
-                    t_nb = _update(T, V, nb, sx, sy, ih, hh, iso, three)
-                    _lower(T, V, nb, t_nb, fixed, sx, sy, three, pool, nxt, bk, mw, st, rkey,
-                           ritem, ctl)
+                    t_nb = _update(T, V, U, use_u, qp, nb, sx, sy, ih, hh, iso, three)
+                    _lower(T, V, nb, t_nb, fixed, sx, sy, three, pv, pool, nxt, bk, mw, st,
+                           rkey, ritem, ctl)
         ctl[_C_POPS] = pops
 
-    def start(T, V, fixed, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl):
+    def start(T, V, U, qp, fixed, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl):
         """Queue the slab's band nodes given on entry and expand its frozen ones."""
         n = _U(T.size)
+        use_u = qp > 0.0
         c = sx
         while c < n - sx:
             x = T[c]
@@ -316,19 +361,26 @@ def _slab_kernels(three):
                     return False
                 for nb in _nbs(c, sx, sy, three):
                     if T[nb] < 0.0:
-                        t_nb = _update(T, V, nb, sx, sy, ih, hh, iso, three)
-                        _lower(T, V, nb, t_nb, fixed, sx, sy, three, pool, nxt, bk, mw, st,
-                               rkey, ritem, ctl)
+                        t_nb = _update(T, V, U, use_u, qp, nb, sx, sy, ih, hh, iso, three)
+                        _lower(T, V, nb, t_nb, fixed, sx, sy, three, True, pool, nxt, bk, mw,
+                               st, rkey, ritem, ctl)
             c += _ONE
         return True
 
-    def exchange(T, V, fixed, src, g, own, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem,
-                 ctl):
+    def exchange(T, V, U, qp, fixed, src, sent, m, base, g, own, sx, sy, ih, hh, iso, pool, nxt,
+                 bk, mw, st, rkey, ritem, ctl):
         """Copy the neighbour's boundary row ``src`` (its frozen times) into the ghost row
         starting at ``g``; update the own node next to each ghost that changed (``own``:
-        the start of that row). Resumable: False when a queue is full."""
-        j = _ZERO
-        while j < sx:
+        the start of that row). Only the neighbour's nodes ``sent[:m] - base`` are read
+        (those it froze in its last window), the whole row when ``m`` exceeds the list's
+        capacity. Resumable: False when a queue is full."""
+        use_u = qp > 0.0
+        full = m > _U(sent.size)
+        count = sx if full else m
+        i = _ZERO
+        while i < count:
+            j = i if full else sent[i] - base
+            i += _ONE
             v = src[j]
             if v >= 0.0 and not v >= T[g + j]:  # newly frozen or lowered there
                 if not _room(st, rkey):
@@ -336,11 +388,10 @@ def _slab_kernels(three):
                 T[g + j] = v
                 c = own + j
                 if T[c] == T[c]:  # not a wall
-                    _lower(T, V, c, _update(T, V, c, sx, sy, ih, hh, iso, three), fixed, sx, sy,
-                           three, pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                    _lower(T, V, c, _update(T, V, U, use_u, qp, c, sx, sy, ih, hh, iso, three),
+                           fixed, sx, sy, three, True, pool, nxt, bk, mw, st, rkey, ritem, ctl)
                     if T[c] < 0.0 and -T[c] < ctl[_C_NEXT]:  # queued: the next window knows
                         ctl[_C_NEXT] = -T[c]
-            j += _ONE
         return True
 
     d = 3 if three else 2
@@ -390,24 +441,27 @@ def _heap_next(T, st, ritem, ctl):
 
 def _drive_kernel(three):
     """The compiled driver of one dimension (the parallel region runs the slabs)."""
-    def drive(nth, Tp, Vp, fx, off, end, rows, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey,
-              ritem, ctl, win, first, stops):
+    def drive(nth, Tp, Vp, U, qp, fx, off, end, rows, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st,
+              rkey, ritem, ctl, sent, ns, win, first, stops):
         """Run windows until every queue is empty; 0 done, 1/2 grow pool/heap and call again.
 
         ``win`` (float64): [0] window end, [1] width, [2] windows run, [3] target pops,
         [4] nodes frozen (re-freezes included), [5] sum over windows of the most a slab
         froze (the critical path: ``[4] / [5]`` bounds the speed-up), [6] the latest
         stop node's time when the stop nodes ``stops`` (indices into ``Tp``) ended it,
-        [7] 1 once the start (``first``) is done.
+        [7] 1 once the start (``first``) is done. ``U``, ``qp``: the plateau mask over
+        ``Tp`` (one byte: every node) and its ``1 / speed^2`` (0: none); ``sent``, ``ns``:
+        each slab's nodes frozen in its boundary rows in the last window (see ``window``).
         """
         K = off.size
         sxi = np.int64(sx)
         if first:
             for t in prange(nth):  # thread t runs slabs t, t + nth, ...
                 for k in range(t, K, nth):
-                    if not _start(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]], fx[off[k] >> 3:], sx,
-                                  sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
-                                  ritem[k], ctl[k]):
+                    if not _start(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]],
+                                  U[0 if U.size == 1 else off[k] >> 3:], qp, fx[off[k] >> 3:],
+                                  sx, sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
+                                  rkey[k], ritem[k], ctl[k]):
                         ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < _U(RESERVE_BLOCKS) else 2.0
             for k in range(K):
                 if ctl[k, _C_STATUS] != 0.0:
@@ -419,19 +473,22 @@ def _drive_kernel(three):
                 for k in range(t, K, nth):
                     T = Tp[off[k]:end[k]]
                     V = Vp[off[k]:end[k]]
+                    Uk = U[0 if U.size == 1 else off[k] >> 3:]
                     F = fx[off[k] >> 3:]
                     ok = True
                     if k > 0:
                         o = end[k - 1] - 2 * sxi  # last own row of the slab below
-                        ok = _exchange(three, T, V, F, Tp[o:o + sxi], _ZERO, sx, sx, sy, ih, hh,
-                                       iso, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
+                        ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k - 1, 1],
+                                       ns[k - 1, 1], _U(rows[k - 1]) * sx, _ZERO, sx, sx, sy, ih,
+                                       hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
                                        ritem[k], ctl[k])
                     if ok and k < K - 1:
                         o = off[k + 1] + sxi  # first own row of the slab above
                         r = _U(rows[k])
-                        ok = _exchange(three, T, V, F, Tp[o:o + sxi], (r + _ONE) * sx, r * sx,
-                                       sx, sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
-                                       rkey[k], ritem[k], ctl[k])
+                        ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k + 1, 0],
+                                       ns[k + 1, 0], sx, (r + _ONE) * sx, r * sx, sx, sy, ih, hh,
+                                       iso, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
+                                       ritem[k], ctl[k])
                     if not ok:
                         ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < _U(RESERVE_BLOCKS) else 2.0
                     _heap_next(T, st[k], ritem[k], ctl[k])
@@ -470,9 +527,10 @@ def _drive_kernel(three):
             tw = win[0]
             for t in prange(nth):  # thread t runs slabs t, t + nth, ...
                 for k in range(t, K, nth):
-                    _window(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]], fx[off[k] >> 3:], sx,
-                            sy, ih, hh, iso, tw, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
-                            ritem[k], ctl[k])
+                    _window(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]],
+                            U[0 if U.size == 1 else off[k] >> 3:], qp, fx[off[k] >> 3:], sx, sy,
+                            ih, hh, iso, tw, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
+                            ritem[k], ctl[k], sent[k], ns[k])
             win[2] += 1.0
             pops = 0.0
             most = 0.0
@@ -503,33 +561,84 @@ _drive3d = _drive_kernel(True)
 #: (2D; 3D: ``COARSE_3D``), ~1.5 % of the work of the full march.
 COARSE = 8
 COARSE_3D = 4
-#: Time bins of the split estimate (stand-ins for the windows).
+#: Bins of the split estimate, each as many coarse nodes in time order (stand-ins for
+#: the windows).
 SPLIT_BINS = 256
 
 
-def slab_bounds(speed, start, shape3, h3, k: int) -> np.ndarray:
-    """Row bounds (``k + 1`` ints) of ``k`` slabs along x.
+def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarray:
+    """Row bounds (``k + 1`` ints) of ``k`` slabs along x, slab ``j`` marched by thread
+    ``j % threads``.
 
-    Two slabs are split where a coarse march predicts the best balance: the
-    row ``s`` minimising ``sum over time bins of max(nodes below s, nodes from s
-    on)``, the windows' critical path (a source off-centre would otherwise leave
-    one slab idle while the wave crosses the other). Otherwise, or when the start
-    is not a few point sources (its box over a quarter of the grid), equal slabs.
+    The cuts are placed where a coarse march predicts the best balance: they minimise
+    ``sum over time bins of max over threads of the nodes it marches in that bin``, the
+    windows' critical path (a source off-centre would otherwise leave one thread idle
+    while the wave crosses the other's slabs), by coordinate descent from equal slabs
+    (each cut in turn moved to its best row between its neighbours, until none moves;
+    exhaustive for two slabs). Equal slabs when the start is not a few point sources
+    (its box over a quarter of the grid) or the grid is too thin for a coarse march.
     """
     nx = int(shape3[0])
     even = np.linspace(0, nx, k + 1).round().astype(np.int64)
-    if k != 2 or 4 * int(np.prod(start.shape)) > int(np.prod(shape3)):
+    if k < 2 or threads < 2 or 4 * int(np.prod(start.shape)) > int(np.prod(shape3)):
         return even
+    hist, f = _coarse_histogram(speed, start, shape3, h3)
+    if hist is None:
+        return even
+    rows = hist.shape[0]
+    gap = max(1, -(-MIN_SLAB_ROWS // f))  # coarse rows per slab at least
+    if rows < k * gap:
+        return even
+    cum = np.vstack([np.zeros((1, hist.shape[1]), dtype=np.int64), np.cumsum(hist, axis=0)])
+    cuts = np.clip(np.linspace(0, rows, k + 1).round().astype(np.int64), 0, rows)
+    owner = np.arange(k) % threads
+
+    def loads(c):  # nodes per thread and time bin, shape (threads, bins)
+        out = np.zeros((threads, hist.shape[1]), dtype=np.int64)
+        np.add.at(out, owner, cum[c[1:]] - cum[c[:-1]])
+        return out
+
+    for _ in range(4 * k):
+        moved = False
+        for i in range(1, k):
+            cand = np.arange(cuts[i - 1] + gap, cuts[i + 1] - gap + 1)
+            if cand.size == 0:
+                continue
+            base = loads(cuts)
+            base[owner[i - 1]] -= cum[cuts[i]] - cum[cuts[i - 1]]
+            base[owner[i]] -= cum[cuts[i + 1]] - cum[cuts[i]]
+            trial = np.repeat(base[None], cand.size, axis=0)
+            trial[:, owner[i - 1]] += cum[cand] - cum[cuts[i - 1]]
+            trial[:, owner[i]] += cum[cuts[i + 1]] - cum[cand]
+            best = int(cand[np.argmin(trial.max(axis=1).sum(axis=1))])
+            if best != cuts[i]:
+                cuts[i] = best
+                moved = True
+        if not moved:
+            break
+    bounds = np.minimum(cuts * f, nx)
+    bounds[-1] = nx
+    for i in range(1, k):  # fine rows: at least MIN_SLAB_ROWS per slab where they fit
+        bounds[i] = min(max(bounds[i], bounds[i - 1] + MIN_SLAB_ROWS), nx - (k - i) * MIN_SLAB_ROWS)
+    if np.any(np.diff(bounds) < 1):
+        return even
+    return bounds.astype(np.int64)
+
+
+def _coarse_histogram(speed, start, shape3, h3):
+    """Nodes per coarse x-row and time bin of a march over every ``COARSE``-th node
+    (``COARSE_3D`` in 3D) from the start's frozen nodes: ``(hist, f)``, ``hist`` of shape
+    ``(coarse rows, SPLIT_BINS)`` and ``f`` the coarsening; ``(None, f)`` if no estimate."""
     three = shape3[2] > 1
     f = COARSE_3D if three else COARSE
     grid = speed.reshape(shape3)
     coarse = np.ascontiguousarray(grid[::f, ::f, ::f] if three else grid[::f, ::f, :])
     cshape = coarse.shape
     if cshape[0] < 4:
-        return even
+        return None, f
     box = np.argwhere(start.state.reshape(start.shape) == _kernels.FROZEN)
     if len(box) == 0:
-        return even
+        return None, f
     cells = np.unique((box + np.asarray(start.lo)) // np.array([f, f, f if three else 1]),
                       axis=0)
     lo = cells.min(axis=0)
@@ -547,16 +656,16 @@ def slab_bounds(speed, start, shape3, h3, k: int) -> np.ndarray:
     fin = np.isfinite(T)
     tmax = float(T[fin].max()) if fin.any() else 0.0
     if not tmax > 0.0:
-        return even
+        return None, f
     rows = np.broadcast_to(np.arange(cshape[0])[:, None], T.shape)[fin]
-    bins = np.minimum((T[fin] / tmax * SPLIT_BINS).astype(np.int64), SPLIT_BINS - 1)
+    # bins of equal node counts in time order, as the windows (~WINDOW_NODES nodes each);
+    # equal times share a bin (a node's bin from the rank of the first of its time)
+    times = T[fin]
+    rank = np.searchsorted(np.sort(times), times, side="left")
+    bins = rank * SPLIT_BINS // times.size
     hist = np.bincount(rows * SPLIT_BINS + bins,
                        minlength=cshape[0] * SPLIT_BINS).reshape(cshape[0], SPLIT_BINS)
-    below = np.cumsum(hist, axis=0)[:-1]  # nodes of rows < s + 1, s = 0 .. n - 2
-    cost = np.maximum(below, below[-1] + hist[-1] - below).sum(axis=1)
-    cut = (int(np.argmin(cost)) + 1) * f
-    cut = min(max(cut, MIN_SLAB_ROWS), nx - MIN_SLAB_ROWS)
-    return np.array([0, cut, nx], dtype=np.int64)
+    return hist, f
 
 
 def march(speed, start, shape3, h3, threads, stop_cells=None):
@@ -574,7 +683,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
         Spacing per axis [m].
     threads : int
         Threads, ``>= 2`` (each marches :data:`SLABS_PER_THREAD` slabs, fewer
-        where a slab would get fewer than :data:`MIN_SLAB_ROWS` rows).
+        where a slab would get fewer than :data:`MIN_SLAB_ROWS` rows or
+        :data:`MIN_SLAB_NODES` nodes).
     stop_cells : ndarray, int, shape (m, 3), optional
         Stop once these nodes are frozen and final; nodes later than the latest
         of them are then ``inf``, as in the serial march.
@@ -593,9 +703,10 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
     nx, ny, nz = (int(n) for n in shape3)
     three = nz > 1
     nth = int(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
-    K = int(max(1, min(nth * SLABS_PER_THREAD[3 if three else 2], nx // MIN_SLAB_ROWS)))
+    K = int(max(1, min(nth * SLABS_PER_THREAD[3 if three else 2], nx // MIN_SLAB_ROWS,
+                       max(nth, nx * ny * nz // max(MIN_SLAB_NODES, 1)))))
     nth = min(nth, K)
-    bounds = slab_bounds(speed, start, shape3, h3, K)
+    bounds = slab_bounds(speed, start, shape3, h3, K, nth)
     rows = np.diff(bounds).astype(np.int64)
     sx = (ny + 2) * (nz + 2) if three else ny + 2
     sy = nz + 2 if three else 1
@@ -604,8 +715,11 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
     off = np.concatenate([[0], np.cumsum(-(-sizes // 8) * 8)[:-1]]).astype(np.int64)
     npad = int(off[-1] + sizes[-1])
     lean = (nx + 2) * sx > _kernels.LEAN_NODES  # V in float32 as the serial march
-    Tp = np.empty(npad)
-    Vp = np.empty(npad, dtype=np.float32 if lean else np.float64)
+    if lean:  # plain mappings, as the serial march's (the times compacted in place below)
+        Tp = _kernels._work(8 * npad).view(np.float64)
+        Vp = _kernels._work(4 * npad).view(np.float32)
+    else:  # the serial march's kept buffers (huge pages, no page faults on a repeat)
+        Tp, Vp = _kernels._work_pair(npad)
     plane = ny * nz
     lo, bshape = start.lo, start.shape
     bplane = bshape[1] * bshape[2]
@@ -624,6 +738,14 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
                           b - a, ny, nz, Tp[seg], Vp[seg])
     # the nodes frozen on entry (sources, balls) stay as they are, as in the serial march
     fixed = np.packbits(Tp >= 0.0, bitorder="little")
+    U, qp = _kernels._plateau(speed, Vp, shape3, npad,
+                              fill=lambda vmax, bits: _slab_plateau(speed, vmax, bounds, off,
+                                                                    shape3, bits))
+    # each slab's nodes frozen in its first and last own rows in the last window (the
+    # neighbours' exchange reads those); a count over the capacity: read the whole row
+    # (so the first exchange, after the start)
+    sent = np.empty((K, 2, sx), dtype=np.uint64)
+    ns = np.full((K, 2), sx + 1, dtype=np.uint64)
     # queues: one radix queue and one repair heap per slab
     nblk = max(POOL_MIN_BLOCKS, int(sizes.max()) // (16 * BLOCK))
     pool = np.empty((K, 2 * nblk * BLOCK), dtype=np.uint64)
@@ -657,8 +779,9 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
     numba.set_num_threads(nth)
     try:
         while True:
-            status = drive(nth, Tp, Vp, fixed, off, off + sizes, rows, _U(sx), _U(sy), ih, hh,
-                           iso, pool, nxt, bk, mw, st, rkey, ritem, ctl, win, first, stop_idx)
+            status = drive(nth, Tp, Vp, U, qp, fixed, off, off + sizes, rows, _U(sx), _U(sy), ih,
+                           hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win, first,
+                           stop_idx)
             first = win[7] == 0.0
             if status == 0:
                 break
@@ -669,11 +792,17 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
                 rkey, ritem = _grow_heaps(rkey, ritem)
     finally:
         numba.set_num_threads(prev)
-    T = np.empty(nx * ny * nz)
+    del Vp, pool, nxt
+    # lean: in place, slab after slab, as the serial march: slab k's times go to
+    # [a * plane, b * plane), from no later than its padded grid's start to before slab
+    # k + 1's, so every node moves to a lower index and is read before it is written
+    T = Tp if lean else np.empty(nx * ny * nz)
     for k in range(K):
         a, b = int(bounds[k]), int(bounds[k + 1])
         seg = slice(int(off[k]), int(off[k] + sizes[k]))
         _kernels.unpad_grid(Tp[seg], b - a, ny, nz, T[a * plane:b * plane])
+    if lean:
+        T = T[:nx * ny * nz]
     if win[6] < np.inf:  # stopped: what the serial march would not have frozen yet
         T[T > win[6]] = np.inf
         sel = tuple(slice(a, a + m) for a, m in zip(start.lo, start.shape))
@@ -682,6 +811,19 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
         box[frozen] = start.T.reshape(start.shape)[frozen]
     return T, {"slabs": K, "windows": int(win[2]), "reopened": int(ctl[:, _C_REOPEN].sum()),
                "balance": float(win[4] / max(win[5], 1.0))}
+
+
+def _slab_plateau(speed, vmax, bounds, off, shape3, bits):
+    """Set the plateau bits (speed ``vmax``) of every slab in its own padded layout (slab
+    ``k`` from byte ``off[k] / 8`` of ``bits``); returns how many nodes have ``vmax``."""
+    _, ny, nz = (int(n) for n in shape3)
+    plane = ny * nz
+    count = 0
+    for k in range(len(bounds) - 1):
+        a, b = int(bounds[k]), int(bounds[k + 1])
+        count += _kernels.plateau_bits(speed[a * plane:b * plane], vmax, b - a, ny, nz,
+                                       bits[int(off[k]) >> 3:])
+    return count
 
 
 def _grow_pools(pool, nxt, st):
