@@ -86,8 +86,11 @@ MIN_SLAB_NODES = 2**17
 #: at 0.3 of x), 2 threads, windows of 32768 nodes, balanced cuts: the windows' balance
 #: (``stats["balance"]``, the speed-up they allow) 2D 4/8 slabs per thread 1.69/1.76,
 #: 3D 2/4 1.65/1.84, process CPU the same within noise (0.88-0.96x the serial march's;
-#: the exchange reads only the nodes frozen in the boundary rows).
-SLABS_PER_THREAD = {2: 8, 3: 4}
+#: the exchange reads only the nodes frozen in the boundary rows). In 2D the better
+#: balance of 8 did not show in wall time on the idle machine (2048², 2 threads, medians
+#: of 5 interleaved: constant 0.257/0.261 s, smooth 0.292/0.302 s, FM²-shaped
+#: 0.234/0.248 s with 4/8 slabs per thread): 2D keeps 4.
+SLABS_PER_THREAD = {2: 4, 3: 4}
 #: Target number of nodes frozen per window (all slabs together); the window
 #: width adapts to it. Fewer, wider windows cost fewer barriers and more repairs:
 #: measured on 160^3 (2 threads, CPU over the serial march's, loaded machine) constant
