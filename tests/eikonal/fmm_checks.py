@@ -53,7 +53,7 @@ def assert_same_field(actual: np.ndarray, desired: np.ndarray, rtol: float) -> N
 def fast_marching_parallel(*args, threads: int = 2, **kwargs) -> np.ndarray:
     """:func:`fast_marching` with the parallel march on every grid (no size floor, slabs
     of one row or node on): the small exactness cases then run through the slabs, windows and
-    repairs of :mod:`fm2uav.eikonal._parallel` (order 1; order 2 marches serially)."""
+    repairs of :mod:`fm2uav.eikonal._parallel`, at order 1 and 2."""
     from fm2uav.eikonal import _parallel
 
     saved = _parallel.PARALLEL_MIN_NODES, _parallel.MIN_SLAB_ROWS, _parallel.MIN_SLAB_NODES

@@ -89,7 +89,7 @@ _LATER_PARALLEL_RUN = textwrap.dedent(
     _parallel.PARALLEL_MIN_NODES = 0  # speed), on a small one
     v = np.ones((40, 36, 20))
     v[10:14, :30, :] = 0.0
-    T = fast_marching(v, [(30, 5, 3)], spacing=(15.0, 15.0, 10.0), order=1, threads=2)
+    T = fast_marching(v, [(30, 5, 3)], spacing=(15.0, 15.0, 10.0), order=ORDER, threads=2)
     assert np.isfinite(T[0, 0, 1])
     print("compiled" if compiled else "cached")
     """
@@ -97,15 +97,18 @@ _LATER_PARALLEL_RUN = textwrap.dedent(
 
 
 @pytest.mark.slow
-def test_parallel_group_caches_the_lean_layout_of_a_big_two_thread_march(tmp_path):
-    # a 1000x1000x40 terrain plan marches on both cores in the lean layout (float32 speed):
-    # after the install's groups it compiles nothing (it compiled for ~50 s before); its
-    # serial pieces in the lean layout (a slab too small to split marches serially, the
-    # speed range) are the lean group's
-    groups = ["fmm3d_o1", "fmm3d_o1_lean", "fmm3d_parallel"]
+@pytest.mark.parametrize("order", [1, 2])
+def test_parallel_group_caches_the_lean_layout_of_a_big_two_thread_march(tmp_path, order):
+    # a 1000x1000x40 terrain plan (order 2 by default) marches on both cores in the lean
+    # layout (float32 speed): after the install's groups it compiles nothing (it compiled
+    # for ~50 s before); its serial pieces in the lean layout (a slab too small to split
+    # marches serially, the speed range) are the lean group's, the coarse order-1 march
+    # that places the cuts fmm3d_o1's
+    groups = ["fmm3d_o1", f"fmm3d_o{order}_lean", "fmm3d_parallel"]
     res = _run(["-m", "fm2uav.planning.warmup", *groups], tmp_path)
     assert res.returncode == 0, res.stderr
-    res = _run(["-c", _LATER_PARALLEL_RUN], tmp_path)
+    later = _LATER_PARALLEL_RUN.replace("ORDER", str(order))
+    res = _run(["-c", later], tmp_path)
     assert res.returncode == 0, res.stderr
     assert res.stdout.split() == ["cached"]
     # the check can fail: the float64 layout alone (the group before) leaves the lean
@@ -113,7 +116,8 @@ def test_parallel_group_caches_the_lean_layout_of_a_big_two_thread_march(tmp_pat
     float64_only = ("import numpy as np\n"
                     "from fm2uav.eikonal import _parallel, fast_marching\n"
                     "_parallel.PARALLEL_MIN_NODES = 0\n"
-                    "fast_marching(np.ones((16, 16, 16)), [(3, 3, 3)], order=1, threads=2)\n")
+                    f"fast_marching(np.ones((16, 16, 16)), [(3, 3, 3)], order={order}, "
+                    "threads=2)\n")
     res = _run(["-c", float64_only], tmp_path / "small")
     assert res.returncode == 0, res.stderr
-    assert _run(["-c", _LATER_PARALLEL_RUN], tmp_path / "small").stdout.split() == ["compiled"]
+    assert _run(["-c", later], tmp_path / "small").stdout.split() == ["compiled"]

@@ -1,10 +1,12 @@
-"""The parallel Fast Marching (order 1): slabs, time windows, ghost exchange, repair.
+"""The parallel Fast Marching (order 1 and 2): slabs, time windows, ghost exchange, repair.
 
 Private module: :func:`fm2uav.eikonal.fast_marching` calls :func:`march` for
 grids of at least :data:`PARALLEL_MIN_NODES` nodes when more than one thread is
-allowed (``threads``, ``FM2UAV_THREADS``) and the order is 1 (``stop_at`` too).
-Order 2 marches serially: its stencil reads two nodes upwind, so the ghosts and
-the repairs would have to reach two rows, which is not built (nor tested) yet.
+allowed (``threads``, ``FM2UAV_THREADS``), at either order (``stop_at`` too).
+Order 2's stencil reads two nodes upwind: its slabs have two ghost x-slabs per
+side, the exchange copies two rows, and a changed time updates again the nodes one
+*and two* away along each axis; its update is not monotone, so a repair may also
+raise a time (the notes above :func:`_update2`).
 
 Design (Yang & Stern 2017, domain-decomposition FMM)
 ----------------------------------------------------
@@ -49,13 +51,15 @@ from __future__ import annotations
 import os
 
 import numpy as np
-from numba import njit, prange
+from llvmlite import ir
+from numba import njit, prange, types
+from numba.extending import intrinsic
 
 from . import _kernels
 from ._heap import sift_down, sift_up
 from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _U, _ZERO, RESERVE_BLOCKS, BLOCK,
-                       _at_plateau, _axis_term, _bits, _bucket, _prefetch, _combine, _pop, _push,
-                       _rhs, _side_min, _solve_iso)
+                       _at_plateau, _axis_term, _axis_term_u, _bits, _bucket, _prefetch, _combine,
+                       _pop, _push, _rhs, _side_min, _solve_iso)
 
 #: The windows meet at a barrier several hundred times per march: a thread that waits
 #: there sleeps instead of spinning (OpenMP's default spins), or on a busy machine the
@@ -99,6 +103,10 @@ SLABS_PER_THREAD = {2: 4, 3: 4}
 WINDOW_NODES = 32768
 #: Free repair-heap slots kept before each node's pushes (one pop pushes at most 7).
 HEAP_RESERVE = 8
+#: Order 2: one pop queues at most 13 entries (six neighbours, the six nodes two away, the
+#: put-back), so more free repair-heap slots and entry-pool blocks are kept than for order 1.
+HEAP_RESERVE_2 = 16
+POOL_EXTRA_2 = 16
 #: Smallest start of a slab's repair heap (entries; at least 4 boundary rows) and
 #: entry pool (blocks); both double when a window runs low.
 HEAP_START = 4096
@@ -109,7 +117,10 @@ _C_NEXT = 0    # smallest queued time after the last window or exchange (inf: no
 _C_POPS = 1    # nodes frozen in the last window
 _C_REOPEN = 2  # nodes re-opened so far
 _C_STATUS = 3  # 0 ok, 1 entry pool low, 2 repair heap full
-_C_SIZE = 4
+_C_PEND = 4    # order 2: re-opened nodes raised above their old time, not frozen again
+_C_RMIN = 5    # order 2: a time no later than the old times of those (inf: none)
+_C_RAISED = 6  # order 2: updates that found a later time than the node had (suspects)
+_C_SIZE = 7
 
 # slots of the march state ``st`` (uint64), shared with the serial layout
 _NFREE = 2
@@ -433,6 +444,274 @@ def _exchange(three, *args):
     return _exchange2d(*args)
 
 
+# ------------------------------------------------------------------ order 2
+# The serial order-2 time of a node is its update from the final times of its neighbours
+# and of the nodes two away (:func:`_update2`): an axis's term takes the earlier of its two
+# neighbours, and the node beyond it (order 2) when that one is frozen no later than it
+# (and the speed ratio is bounded); nodes later than the result do not change it. So the
+# serial times are the one solution of ``T = update(T)`` in which every node depends on
+# earlier nodes only (unique by induction in time order), and the parallel march ends there:
+# whenever a frozen time that an update read changes (a ghost exchanged, a node frozen again
+# at another time) its dependants -- the neighbours and the nodes two away along each axis
+# -- are updated again. Unlike order 1 the update is not monotone (a lower time two away
+# raises the order-2 term), so a dependant may have to go *up*: a band node keeps its
+# (lower) time and is marked suspect (bit ``sf``), updated again when popped; a frozen one
+# is re-opened at its old time, suspect too (its queue key stays a lower bound of its
+# time, which the windows and the stop test rely on). A re-opened node (bit ``rf``)
+# updates all its dependants again when frozen again, since they may have read its old time.
+
+@intrinsic
+def _from_bits(typingctx, k):
+    """The float64 of an IEEE-754 bit pattern (the inverse of ``_bits``)."""
+    sig = types.float64(types.uint64)
+
+    def codegen(context, builder, signature, args):
+        return builder.bitcast(args[0], ir.DoubleType())
+
+    return sig, codegen
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _bit(a, c):
+    """Bit ``c`` of the bit mask ``a`` (uint8)."""
+    return (a[c >> _U(3)] >> (c & _U(7))) & _ONE != _ZERO
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _set_bit(a, c):
+    a[c >> _U(3)] |= np.uint8(_ONE << (c & _U(7)))
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _clear_bit(a, c):
+    i = c >> _U(3)
+    a[i] = np.uint8(a[i] & (np.uint8(255) ^ np.uint8(_ONE << (c & _U(7)))))
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _update2(T, V, U, use_u, qp, c, sx, sy, ih, three):
+    """The order-2 upwind time of node ``c`` from its frozen neighbours, as the serial
+    order-2 march computes it (the same terms in the same order: the same bits)."""
+    q = _rhs(V, U, use_u, qp, c)
+    ta, aa = _axis_term_u(T, V, U, use_u, c, sx, ih[0], 2)
+    tb, ab = _axis_term_u(T, V, U, use_u, c, sy, ih[1], 2)
+    if three:
+        tc, ac = _axis_term_u(T, V, U, use_u, c, _ONE, ih[2], 2)
+    else:
+        tc, ac = _INF, 0.0
+    return _combine(ta, aa, tb, ab, tc, ac, q)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)  # a call (rare): compiles once
+def _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf, pool, nxt, bk, mw, st,
+             rkey, ritem, ctl):
+    """Update the slab's own node ``d`` again after a time it may read changed (order 2).
+
+    Far or band: a lower time is taken and queued; a higher one marks the node suspect
+    (updated again when popped). Frozen: a different time re-opens it (``rf``), at the new
+    time if lower, else at its old time and suspect. Walls and nodes frozen on entry stay.
+    """
+    x = T[d]
+    if x != x or _bit(fixed, d):
+        return
+    t = _update2(T, V, U, use_u, qp, d, sx, sy, ih, three)
+    if x < 0.0:
+        if t < -x:
+            T[d] = -t
+            _enq(_bits(t), d, pool, nxt, bk, mw, st, rkey, ritem)
+        elif t > -x and x > -_INF:
+            _set_bit(sf, d)
+            ctl[_C_RAISED] += 1.0
+    elif t != x:
+        ctl[_C_REOPEN] += 1.0
+        _set_bit(rf, d)
+        if t < x:
+            T[d] = -t
+            _enq(_bits(t), d, pool, nxt, bk, mw, st, rkey, ritem)
+        else:
+            T[d] = -x
+            _set_bit(sf, d)
+            ctl[_C_RAISED] += 1.0
+            _enq(_bits(x), d, pool, nxt, bk, mw, st, rkey, ritem)
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _room2(st, rkey):
+    """Whether the pool and the repair heap have room for the pushes of one order-2 pop."""
+    return (st[_NFREE] >= _U(RESERVE_BLOCKS + POOL_EXTRA_2)
+            and st[_RSIZE] + _U(HEAP_RESERVE_2) <= _U(rkey.size))
+
+
+def _slab_kernels2(three):
+    """The compiled order-2 window, start and exchange of one dimension (``three``: 3D);
+    the slab has two ghost x-slabs on each side (the order-2 stencil reads two rows)."""
+
+    def window(T, V, U, qp, fixed, rf, sf, pf, sx, sy, ih, tw, pool, nxt, bk, mw, st, rkey,
+               ritem, ctl, sent, ns):
+        """Freeze the slab's queued nodes with a time below ``tw`` (resumable), order 2.
+
+        As the order-1 window; the boundary lists hold the nodes frozen in the first and
+        last *two* own rows, and a frozen node's dependants include the nodes two away.
+        """
+        n = _U(T.size)
+        g = sx + sx
+        lo = g  # the slab's own nodes: [lo, hi)
+        hi = n - g
+        lo2 = lo + g  # the first two own rows are [lo, lo2), the last two [hi2, hi)
+        hi2 = hi - g
+        use_u = qp > 0.0
+        kw = _bits(tw)
+        pops = 0
+        ns[0] = _ZERO
+        ns[1] = _ZERO
+        ctl[_C_NEXT] = _INF
+        while True:
+            if not _room2(st, rkey):
+                ctl[_C_STATUS] = 1.0 if st[_NFREE] < _U(RESERVE_BLOCKS + POOL_EXTRA_2) else 2.0
+                break
+            heap = st[_RSIZE] > _ZERO
+            kb = rkey[0] if heap else _ZERO
+            c = _deq(T, pool, nxt, bk, mw, st, rkey, ritem)
+            if c == _NIL:
+                break
+            if not heap:  # a lower bound of the popped key and of every key left
+                kb = st[_LAST]
+            x = T[c]
+            if not x < 0.0 or x == -_INF:  # outdated entry (frozen, or far again)
+                continue
+            t = -x
+            k = _bits(t)
+            if k >= kw:  # the window is done: put it back
+                _enq(k, c, pool, nxt, bk, mw, st, rkey, ritem)
+                ctl[_C_NEXT] = min(t, _from_bits(kb))
+                break
+            if _bit(sf, c):  # suspect: its time may have to go up
+                _clear_bit(sf, c)
+                t2 = _update2(T, V, U, use_u, qp, c, sx, sy, ih, three)
+                if t2 != t:
+                    if t2 > t and _bit(rf, c) and not _bit(pf, c):
+                        # nodes may still read its old time (>= t): the stop test must not
+                        # pass t before it is frozen again
+                        _set_bit(pf, c)
+                        ctl[_C_PEND] += 1.0
+                        ctl[_C_RMIN] = min(ctl[_C_RMIN], t)
+                    T[c] = -t2
+                    if t2 < _INF:
+                        _enq(_bits(t2), c, pool, nxt, bk, mw, st, rkey, ritem)
+                    continue
+            T[c] = t
+            pops += 1
+            if c < lo2:
+                _note(sent, ns, 0, c)
+            if c >= hi2:
+                _note(sent, ns, 1, c)
+            if _bit(pf, c):
+                _clear_bit(pf, c)
+                ctl[_C_PEND] -= 1.0
+                if ctl[_C_PEND] == 0.0:
+                    ctl[_C_RMIN] = _INF
+            full = _bit(rf, c)  # frozen again: every dependant may have read its old time
+            if full:
+                _clear_bit(rf, c)
+            pv = not (use_u and _at_plateau(U, c))
+            for nb in _nbs(c, sx, sy, three):
+                if nb == c:
+                    continue
+                y = T[nb]
+                if y < 0.0:  # band or far: an own node
+                    if full:
+                        _recheck(T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf,
+                                 pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                    else:  # the serial march's relaxation
+                        _lower(T, V, nb, _update2(T, V, U, use_u, qp, nb, sx, sy, ih, three),
+                               fixed, sx, sy, three, pv, pool, nxt, bk, mw, st, rkey, ritem,
+                               ctl)
+                elif y >= 0.0 and nb >= lo and nb < hi and (full or y > t):
+                    # frozen later than c in this slab: c may change it
+                    _recheck(T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf, pool,
+                             nxt, bk, mw, st, rkey, ritem, ctl)
+                # the node two away reads c beyond nb when nb is frozen no earlier than c
+                y = T[nb]
+                if y >= 0.0 and (full or t <= y):
+                    d2 = nb + nb - c
+                    if d2 >= lo and d2 < hi:
+                        z = T[d2]
+                        if z < 0.0 or (z >= 0.0 and (full or z > t)):
+                            _recheck(T, V, U, use_u, qp, d2, sx, sy, ih, three, fixed, rf, sf,
+                                     pool, nxt, bk, mw, st, rkey, ritem, ctl)
+        ctl[_C_POPS] = pops
+
+    def start(T, V, U, qp, fixed, sx, sy, ih, pool, nxt, bk, mw, st, rkey, ritem, ctl):
+        """Queue the slab's band nodes given on entry and expand its frozen ones (order 2)."""
+        n = _U(T.size)
+        g = sx + sx
+        use_u = qp > 0.0
+        c = g
+        while c < n - g:
+            x = T[c]
+            if x < 0.0 and x > -_INF:
+                if not _room2(st, rkey):
+                    return False
+                _enq(_bits(-x), c, pool, nxt, bk, mw, st, rkey, ritem)
+            c += _ONE
+        c = g
+        while c < n - g:
+            if T[c] >= 0.0:
+                if not _room2(st, rkey):
+                    return False
+                for nb in _nbs(c, sx, sy, three):
+                    if T[nb] < 0.0:
+                        _lower(T, V, nb, _update2(T, V, U, use_u, qp, nb, sx, sy, ih, three),
+                               fixed, sx, sy, three, True, pool, nxt, bk, mw, st, rkey, ritem,
+                               ctl)
+            c += _ONE
+        return True
+
+    def exchange(T, V, U, qp, fixed, rf, sf, src, sent, m, base, g, up, sx, sy, ih, pool, nxt,
+                 bk, mw, st, rkey, ritem, ctl):
+        """Copy the neighbour's two boundary rows ``src`` (their frozen times) into the two
+        ghost rows starting at ``g``; update again the own nodes one and two rows away
+        from each ghost that changed (toward +x if ``up``). Only the neighbour's nodes
+        ``sent[:m] - base`` are read (those it froze in its last window), both rows when
+        ``m`` exceeds the list's capacity. Resumable: False when a queue is full."""
+        use_u = qp > 0.0
+        n = _U(T.size)
+        lo = sx + sx
+        hi = n - lo
+        full = m > _U(sent.size)
+        count = lo if full else m
+        i = _ZERO
+        while i < count:
+            j = i if full else sent[i] - base
+            i += _ONE
+            v = src[j]
+            if v >= 0.0 and v != T[g + j]:  # newly frozen, or frozen again at another time
+                if not _room2(st, rkey):
+                    return False
+                gj = g + j
+                T[gj] = v
+                for step in (sx, lo):
+                    d = gj + step if up else gj - step
+                    if d >= lo and d < hi:
+                        _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf,
+                                 pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                        x = T[d]
+                        if x < 0.0 and -x < ctl[_C_NEXT]:  # queued: the next window knows
+                            ctl[_C_NEXT] = -x
+        return True
+
+    d = 3 if three else 2
+    out = []
+    for f in (window, start, exchange):
+        f.__name__ = f.__qualname__ = f"{f.__name__}{d}d_o2"
+        out.append(njit(cache=True, error_model="numpy", _nrt=False)(f))
+    return out
+
+
+_window2d_o2, _start2d_o2, _exchange2d_o2 = _slab_kernels2(False)
+_window3d_o2, _start3d_o2, _exchange3d_o2 = _slab_kernels2(True)
+
+
 @njit(cache=True, error_model="numpy", _nrt=False)
 def _heap_next(T, st, ritem, ctl):
     """Lower ``ctl[_C_NEXT]`` to the repair heap's smallest time (a hint for the window)."""
@@ -442,10 +721,10 @@ def _heap_next(T, st, ritem, ctl):
             ctl[_C_NEXT] = -x
 
 
-def _drive_kernel(three):
-    """The compiled driver of one dimension (the parallel region runs the slabs)."""
-    def drive(nth, Tp, Vp, U, qp, fx, off, end, rows, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st,
-              rkey, ritem, ctl, sent, ns, win, first, stops):
+def _drive_kernel(three, order=1):
+    """The compiled driver of one dimension and order (the parallel region runs the slabs)."""
+    def drive(nth, Tp, Vp, U, qp, fx, fl, off, end, rows, sx, sy, ih, hh, iso, pool, nxt, bk, mw,
+              st, rkey, ritem, ctl, sent, ns, win, first, stops):
         """Run windows until every queue is empty; 0 done, 1/2 grow pool/heap and call again.
 
         ``win`` (float64): [0] window end, [1] width, [2] windows run, [3] target pops,
@@ -455,17 +734,31 @@ def _drive_kernel(three):
         [7] 1 once the start (``first``) is done. ``U``, ``qp``: the plateau mask over
         ``Tp`` (one byte: every node) and its ``1 / speed^2`` (0: none); ``sent``, ``ns``:
         each slab's nodes frozen in its boundary rows in the last window (see ``window``).
+        ``fl``: order 2's bit masks over ``Tp`` (re-opened, suspect, raised; unused by
+        order 1); each slab has ``order`` ghost x-slabs on each side.
         """
         K = off.size
         sxi = np.int64(sx)
+        G = np.int64(order)  # ghost rows on each side of a slab
+        low = _U(RESERVE_BLOCKS + (POOL_EXTRA_2 if order == 2 else 0))
         if first:
             for t in prange(nth):  # thread t runs slabs t, t + nth, ...
                 for k in range(t, K, nth):
-                    if not _start(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]],
-                                  U[0 if U.size == 1 else off[k] >> 3:], qp, fx[off[k] >> 3:],
-                                  sx, sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
-                                  rkey[k], ritem[k], ctl[k]):
-                        ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < _U(RESERVE_BLOCKS) else 2.0
+                    T = Tp[off[k]:end[k]]
+                    V = Vp[off[k]:end[k]]
+                    Uk = U[0 if U.size == 1 else off[k] >> 3:]
+                    F = fx[off[k] >> 3:]
+                    if order == 2 and three:
+                        ok = _start3d_o2(T, V, Uk, qp, F, sx, sy, ih, pool[k], nxt[k], bk[k],
+                                         mw[k], st[k], rkey[k], ritem[k], ctl[k])
+                    elif order == 2:
+                        ok = _start2d_o2(T, V, Uk, qp, F, sx, sy, ih, pool[k], nxt[k], bk[k],
+                                         mw[k], st[k], rkey[k], ritem[k], ctl[k])
+                    else:
+                        ok = _start(three, T, V, Uk, qp, F, sx, sy, ih, hh, iso, pool[k], nxt[k],
+                                    bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k])
+                    if not ok:
+                        ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < low else 2.0
             for k in range(K):
                 if ctl[k, _C_STATUS] != 0.0:
                     return int(ctl[k, _C_STATUS])  # grown, the start runs again
@@ -478,22 +771,38 @@ def _drive_kernel(three):
                     V = Vp[off[k]:end[k]]
                     Uk = U[0 if U.size == 1 else off[k] >> 3:]
                     F = fx[off[k] >> 3:]
+                    R = fl[0, off[k] >> 3:]
+                    S = fl[1, off[k] >> 3:]
                     ok = True
+                    r = _U(rows[k])
                     if k > 0:
-                        o = end[k - 1] - 2 * sxi  # last own row of the slab below
-                        ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k - 1, 1],
-                                       ns[k - 1, 1], _U(rows[k - 1]) * sx, _ZERO, sx, sx, sy, ih,
-                                       hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
-                                       ritem[k], ctl[k])
+                        o = off[k - 1] + rows[k - 1] * sxi  # last own rows of the slab below
+                        if order == 2:
+                            args = (T, V, Uk, qp, F, R, S, Tp[o:o + G * sxi], sent[k - 1, 1],
+                                    ns[k - 1, 1], _U(rows[k - 1]) * sx, _ZERO, True, sx, sy, ih,
+                                    pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k],
+                                    ctl[k])
+                            ok = _exchange3d_o2(*args) if three else _exchange2d_o2(*args)
+                        else:
+                            ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k - 1, 1],
+                                           ns[k - 1, 1], _U(rows[k - 1]) * sx, _ZERO, sx, sx,
+                                           sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
+                                           rkey[k], ritem[k], ctl[k])
                     if ok and k < K - 1:
-                        o = off[k + 1] + sxi  # first own row of the slab above
-                        r = _U(rows[k])
-                        ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k + 1, 0],
-                                       ns[k + 1, 0], sx, (r + _ONE) * sx, r * sx, sx, sy, ih, hh,
-                                       iso, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
-                                       ritem[k], ctl[k])
+                        o = off[k + 1] + G * sxi  # first own rows of the slab above
+                        if order == 2:
+                            args = (T, V, Uk, qp, F, R, S, Tp[o:o + G * sxi], sent[k + 1, 0],
+                                    ns[k + 1, 0], _U(G) * sx, (r + _U(G)) * sx, False, sx, sy,
+                                    ih, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
+                                    ritem[k], ctl[k])
+                            ok = _exchange3d_o2(*args) if three else _exchange2d_o2(*args)
+                        else:
+                            ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k + 1, 0],
+                                           ns[k + 1, 0], sx, (r + _ONE) * sx, r * sx, sx, sy,
+                                           ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
+                                           rkey[k], ritem[k], ctl[k])
                     if not ok:
-                        ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < _U(RESERVE_BLOCKS) else 2.0
+                        ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < low else 2.0
                     _heap_next(T, st[k], ritem[k], ctl[k])
             for k in range(K):
                 if ctl[k, _C_STATUS] != 0.0:
@@ -509,7 +818,9 @@ def _drive_kernel(three):
                     if mw[k, w] != _ZERO:
                         empty = False
             # stop nodes: done once all are frozen no later than every queued time
-            # (nothing queued can lower them: an update is later than its inputs)
+            # (nothing queued can lower them: an update is later than its inputs) and, for
+            # order 2, than the old time of every node re-opened and raised (nodes may
+            # still read it)
             if stops.size > 0:
                 smax = 0.0
                 for i in range(stops.size):
@@ -518,7 +829,10 @@ def _drive_kernel(three):
                         smax = _INF
                         break
                     smax = max(smax, x)
-                if smax <= tmin:
+                tlow = tmin
+                for k in range(K):
+                    tlow = min(tlow, ctl[k, _C_RMIN])
+                if smax <= tlow:
                     win[6] = smax
                     return 0
             if empty:
@@ -530,10 +844,21 @@ def _drive_kernel(three):
             tw = win[0]
             for t in prange(nth):  # thread t runs slabs t, t + nth, ...
                 for k in range(t, K, nth):
-                    _window(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]],
-                            U[0 if U.size == 1 else off[k] >> 3:], qp, fx[off[k] >> 3:], sx, sy,
-                            ih, hh, iso, tw, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
-                            ritem[k], ctl[k], sent[k], ns[k])
+                    if order == 2:
+                        args = (Tp[off[k]:end[k]], Vp[off[k]:end[k]],
+                                U[0 if U.size == 1 else off[k] >> 3:], qp, fx[off[k] >> 3:],
+                                fl[0, off[k] >> 3:], fl[1, off[k] >> 3:], fl[2, off[k] >> 3:],
+                                sx, sy, ih, tw, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
+                                ritem[k], ctl[k], sent[k], ns[k])
+                        if three:
+                            _window3d_o2(*args)
+                        else:
+                            _window2d_o2(*args)
+                    else:
+                        _window(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]],
+                                U[0 if U.size == 1 else off[k] >> 3:], qp, fx[off[k] >> 3:], sx,
+                                sy, ih, hh, iso, tw, pool[k], nxt[k], bk[k], mw[k], st[k],
+                                rkey[k], ritem[k], ctl[k], sent[k], ns[k])
             win[2] += 1.0
             pops = 0.0
             most = 0.0
@@ -552,12 +877,13 @@ def _drive_kernel(three):
             f = win[3] / max(pops, 1.0)
             win[1] *= min(2.0, max(0.5, f))
 
-    drive.__name__ = drive.__qualname__ = f"drive{3 if three else 2}d"
+    drive.__name__ = drive.__qualname__ = f"drive{3 if three else 2}d" + (
+        "_o2" if order == 2 else "")
     return njit(cache=True, parallel=True, error_model="numpy")(drive)
 
 
-_drive2d = _drive_kernel(False)
-_drive3d = _drive_kernel(True)
+#: The drivers by (dimension, order).
+_DRIVES = {(d, o): _drive_kernel(d == 3, o) for d in (2, 3) for o in (1, 2)}
 
 
 #: The split of two slabs is chosen on a march over every ``COARSE``-th node per axis
@@ -671,8 +997,8 @@ def _coarse_histogram(speed, start, shape3, h3):
     return hist, f
 
 
-def march(speed, start, shape3, h3, threads, stop_cells=None):
-    """The order-1 Fast Marching from ``start`` on ``threads`` slabs in parallel.
+def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
+    """The Fast Marching from ``start`` on ``threads`` slabs in parallel.
 
     Parameters
     ----------
@@ -691,13 +1017,18 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
     stop_cells : ndarray, int, shape (m, 3), optional
         Stop once these nodes are frozen and final; nodes later than the latest
         of them are then ``inf``, as in the serial march.
+    order : {1, 2}, optional
+        Order of the upwind stencil, as in the serial march (order 2: two ghost
+        x-slabs per side, the dependants two away updated again; see the notes above
+        :func:`_update2`).
 
     Returns
     -------
     T : ndarray, float64, shape (nx*ny*nz,)
         Arrival times [s], ``inf`` where unreachable.
     stats : dict
-        ``slabs``, ``windows``, ``reopened`` (nodes lowered after they were frozen) and
+        ``slabs``, ``windows``, ``reopened`` (nodes changed after they were frozen),
+        ``raised`` (order 2: updates that found a later time than the node had) and
         ``balance``: nodes frozen over the sum of each window's largest slab share, the
         speed-up the windows allow if every freeze cost the same (``slabs`` at best).
     """
@@ -708,12 +1039,16 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
     nth = int(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
     K = int(max(1, min(nth * SLABS_PER_THREAD[3 if three else 2], nx // MIN_SLAB_ROWS,
                        max(nth, nx * ny * nz // max(MIN_SLAB_NODES, 1)))))
+    G = 2 if order == 2 else 1  # ghost x-slabs on each side (the rows the stencil reads)
+    K = max(1, min(K, nx // G))  # a slab at least as thick as its ghosts
     nth = min(nth, K)
     bounds = slab_bounds(speed, start, shape3, h3, K, nth)
+    if np.diff(bounds).min() < G:  # only the neighbours' rows are exchanged
+        bounds = np.linspace(0, nx, K + 1).round().astype(np.int64)
     rows = np.diff(bounds).astype(np.int64)
     sx = (ny + 2) * (nz + 2) if three else ny + 2
     sy = nz + 2 if three else 1
-    sizes = (rows + 2) * sx
+    sizes = (rows + 2 * G) * sx
     # slabs start at multiples of 8 nodes: each slab's bits of ``fixed`` start a byte
     off = np.concatenate([[0], np.cumsum(-(-sizes // 8) * 8)[:-1]]).astype(np.int64)
     npad = int(off[-1] + sizes[-1])
@@ -728,27 +1063,32 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
     bplane = bshape[1] * bshape[2]
     for k in range(K):
         a, b = int(bounds[k]), int(bounds[k + 1])
-        i0, i1 = max(lo[0], a), min(lo[0] + bshape[0], b)
+        ra, rb, p0 = _padded_rows(a, b, nx, G)
+        i0, i1 = max(lo[0], ra), min(lo[0] + bshape[0], rb)
         if i1 > i0:
             Tb = start.T[(i0 - lo[0]) * bplane:(i1 - lo[0]) * bplane]
             sb = start.state[(i0 - lo[0]) * bplane:(i1 - lo[0]) * bplane]
-            box = (i0 - a, lo[1], lo[2], i1 - i0, bshape[1], bshape[2])
+            box = (i0 - ra, lo[1], lo[2], i1 - i0, bshape[1], bshape[2])
         else:
             Tb, sb = start.T[:0], start.state[:0]
             box = (0, 0, 0, 0, 0, 0)
-        seg = slice(int(off[k]), int(off[k] + sizes[k]))
-        _kernels.pad_grid(_kernels._readonly(speed[a * plane:b * plane]), Tb, sb, *box,
-                          b - a, ny, nz, Tp[seg], Vp[seg])
+        seg = slice(int(off[k] + p0 * sx), int(off[k] + (p0 + rb - ra + 2) * sx))
+        _kernels.pad_grid(_kernels._readonly(speed[ra * plane:rb * plane]), Tb, sb, *box,
+                          rb - ra, ny, nz, Tp[seg], Vp[seg])
+        if G > 1:
+            _ghost_rows(speed, Tp, Vp, int(off[k]), a, b, shape3, G)
     # the nodes frozen on entry (sources, balls) stay as they are, as in the serial march
     fixed = np.packbits(Tp >= 0.0, bitorder="little")
     U, qp = _kernels._plateau(speed, Vp, shape3, npad,
                               fill=lambda vmax, bits: _slab_plateau(speed, vmax, bounds, off,
-                                                                    shape3, bits))
+                                                                    shape3, bits, G))
+    # order 2's bit masks: re-opened, suspect, raised (one spare byte: a 2D slice below)
+    fl = np.zeros((3, npad // 8 + 2 if order == 2 else 1), dtype=np.uint8)
     # each slab's nodes frozen in its first and last own rows in the last window (the
     # neighbours' exchange reads those); a count over the capacity: read the whole row
     # (so the first exchange, after the start)
-    sent = np.empty((K, 2, sx), dtype=np.uint64)
-    ns = np.full((K, 2), sx + 1, dtype=np.uint64)
+    sent = np.empty((K, 2, G * sx), dtype=np.uint64)
+    ns = np.full((K, 2), G * sx + 1, dtype=np.uint64)
     # queues: one radix queue and one repair heap per slab
     nblk = max(POOL_MIN_BLOCKS, int(sizes.max()) // (16 * BLOCK))
     pool = np.empty((K, 2 * nblk * BLOCK), dtype=np.uint64)
@@ -758,10 +1098,11 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
     st = np.zeros((K, _ST), dtype=np.uint64)
     for k in range(K):
         _kernels.init_queue(nxt[k], bk[k], mw[k], st[k])
-    rcap = max(HEAP_START, HEAP_RESERVE)
+    rcap = max(HEAP_START, HEAP_RESERVE_2 if order == 2 else HEAP_RESERVE)
     rkey = np.empty((K, rcap), dtype=np.uint64)
     ritem = np.empty((K, rcap), dtype=np.uint64)
     ctl = np.zeros((K, _C_SIZE))
+    ctl[:, _C_RMIN] = np.inf
     ih = np.array([1.0 / (h * h) for h in h3])
     iso = bool(ih[0] == ih[1] and (not three or ih[1] == ih[2]))
     hh = float(1.0 / ih[0])
@@ -772,19 +1113,19 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
     if stop_cells is not None and len(stop_cells):
         cells = np.asarray(stop_cells, dtype=np.int64).reshape(-1, 3)
         k = np.searchsorted(bounds, cells[:, 0], side="right") - 1
-        local = ((cells[:, 0] - bounds[k] + 1) * (ny + 2) + cells[:, 1] + 1)
+        local = ((cells[:, 0] - bounds[k] + G) * (ny + 2) + cells[:, 1] + 1)
         if three:
             local = local * (nz + 2) + cells[:, 2] + 1
         stop_idx = off[k] + local
-    drive = _drive3d if three else _drive2d
+    drive = _DRIVES[3 if three else 2, G]
     first = True
     prev = numba.get_num_threads()
     numba.set_num_threads(nth)
     try:
         while True:
-            status = drive(nth, Tp, Vp, U, qp, fixed, off, off + sizes, rows, _U(sx), _U(sy), ih,
-                           hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win, first,
-                           stop_idx)
+            status = drive(nth, Tp, Vp, U, qp, fixed, fl, off, off + sizes, rows, _U(sx), _U(sy),
+                           ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win,
+                           first, stop_idx)
             first = win[7] == 0.0
             if status == 0:
                 break
@@ -800,9 +1141,9 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
     # [a * plane, b * plane), from no later than its padded grid's start to before slab
     # k + 1's, so every node moves to a lower index and is read before it is written
     T = Tp if lean else np.empty(nx * ny * nz)
-    for k in range(K):
+    for k in range(K):  # from the ghost x-slab next to the own ones (unpad_grid's layout)
         a, b = int(bounds[k]), int(bounds[k + 1])
-        seg = slice(int(off[k]), int(off[k] + sizes[k]))
+        seg = slice(int(off[k] + (G - 1) * sx), int(off[k] + sizes[k] - (G - 1) * sx))
         _kernels.unpad_grid(Tp[seg], b - a, ny, nz, T[a * plane:b * plane])
     if lean:
         T = T[:nx * ny * nz]
@@ -813,20 +1154,70 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
         frozen = (start.state == _kernels.FROZEN).reshape(start.shape)
         box[frozen] = start.T.reshape(start.shape)[frozen]
     return T, {"slabs": K, "windows": int(win[2]), "reopened": int(ctl[:, _C_REOPEN].sum()),
+               "raised": int(ctl[:, _C_RAISED].sum()),
                "balance": float(win[4] / max(win[5], 1.0))}
 
 
-def _slab_plateau(speed, vmax, bounds, off, shape3, bits):
+def _padded_rows(a, b, nx, G):
+    """The grid rows ``[ra, rb)`` padded into slab ``[a, b)``'s grid and the slab row of the
+    padded grid's first x-slab (its ghost), ``p0``: the slab's padded grid has ``G`` ghost
+    x-slabs on each side, slab row ``p`` is grid row ``a - G + p``; rows ``a - G + 1`` to
+    ``b + G - 2`` that exist are padded by :func:`~fm2uav.eikonal._kernels.pad_grid`."""
+    ra, rb = max(a - G + 1, 0), min(b + G - 1, nx)
+    return ra, rb, ra - 1 - a + G
+
+
+def _ghost_rows(speed, Tp, Vp, o, a, b, shape3, G):
+    """Make the ``G`` x-slabs on each side of slab ``[a, b)`` (its grid from ``Tp[o]``)
+    ghosts (``NaN`` until the exchange) with the grid's ``1 / speed^2`` where the grid has
+    the row (the order-2 speed check reads it), as :func:`~fm2uav.eikonal._kernels.pad_grid`
+    rounds it."""
+    nx, ny, nz = (int(n) for n in shape3)
+    three = nz > 1
+    rows = b - a + 2 * G
+    pz = nz + 2 if three else 1
+    Tv = Tp[o:o + rows * (ny + 2) * pz].reshape(rows, ny + 2, pz)
+    Vv = Vp[o:o + rows * (ny + 2) * pz].reshape(rows, ny + 2, pz)
+    inner = (slice(1, ny + 1), slice(1, nz + 1) if three else slice(0, 1))
+    with np.errstate(divide="ignore"):
+        for p in (*range(G), *range(rows - G, rows)):
+            Tv[p] = np.nan
+            i = a - G + p
+            if 0 <= i < nx:
+                v = speed[i * ny * nz:(i + 1) * ny * nz].reshape(ny, nz)
+                Vv[p][inner] = 1.0 / (v * v)
+
+
+def _slab_plateau(speed, vmax, bounds, off, shape3, bits, G=1):
     """Set the plateau bits (speed ``vmax``) of every slab in its own padded layout (slab
-    ``k`` from byte ``off[k] / 8`` of ``bits``); returns how many nodes have ``vmax``."""
-    _, ny, nz = (int(n) for n in shape3)
+    ``k`` from byte ``off[k] / 8`` of ``bits``; the rows that :func:`_padded_rows` pads);
+    returns how many nodes have ``vmax`` (with ``G = 2`` the rows next to a cut twice)."""
+    nx, ny, nz = (int(n) for n in shape3)
     plane = ny * nz
+    sx = (ny + 2) * (nz + 2 if nz > 1 else 1)
     count = 0
     for k in range(len(bounds) - 1):
         a, b = int(bounds[k]), int(bounds[k + 1])
-        count += _kernels.plateau_bits(speed[a * plane:b * plane], vmax, b - a, ny, nz,
-                                       bits[int(off[k]) >> 3:])
+        ra, rb, p0 = _padded_rows(a, b, nx, G)
+        pos = int(off[k]) + p0 * sx
+        if pos % 8 == 0:
+            count += _kernels.plateau_bits(speed[ra * plane:rb * plane], vmax, rb - ra, ny, nz,
+                                           bits[pos >> 3:])
+        else:  # the first slab of order 2: its grid starts one row into its bits
+            part = np.zeros((rb - ra + 2) * sx // 8 + 1, dtype=np.uint8)
+            count += _kernels.plateau_bits(speed[ra * plane:rb * plane], vmax, rb - ra, ny, nz,
+                                           part)
+            _or_bits_at(bits, part, pos, (rb - ra + 2) * sx)
     return count
+
+
+@njit(cache=True, _nrt=False)
+def _or_bits_at(dst, src, pos, m):
+    """Set bit ``pos + i`` of ``dst`` for every set bit ``i < m`` of ``src``."""
+    for i in range(m):
+        if (src[i >> 3] >> (i & 7)) & 1:
+            j = pos + i
+            dst[j >> 3] |= np.uint8(1 << (j & 7))
 
 
 def _grow_pools(pool, nxt, st):

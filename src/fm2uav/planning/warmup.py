@@ -14,8 +14,8 @@ dimension and order), ``descent`` (geodesic extraction), ``surface``
 (continuous clearance to a terrain surface), and two of big grids only, which
 call their kernels directly: ``edt_parallel`` (the distance map's lines in
 parallel) and ``fmm3d_o{1,2}_lean`` (the 3D march in the lean layout, see
-``fm2uav.eikonal._kernels.LEAN_NODES``); ``fmm{2,3}d_parallel`` (the order-1 march on
-both cores) compile both layouts. Numbers: docs/performance.md.
+``fm2uav.eikonal._kernels.LEAN_NODES``); ``fmm{2,3}d_parallel`` (the march on both cores,
+order 1 and 2) compile both layouts. Numbers: docs/performance.md.
 """
 
 from __future__ import annotations
@@ -67,10 +67,10 @@ def _fmm_lean(order: int) -> Callable[[], None]:
 
 
 def _fmm_parallel(ndim: int) -> Callable[[], None]:
-    """The order-1 march on both cores (grids of ``PARALLEL_MIN_NODES`` nodes and more), in
-    both layouts (float64 ``V``, and the lean float32 ``V`` of grids over ``LEAN_NODES``
-    padded nodes, e.g. a 1000x1000x40 terrain plan), its size floors lowered for a
-    16-node-wide grid while it compiles."""
+    """The march on both cores (grids of ``PARALLEL_MIN_NODES`` nodes and more), order 1 and
+    2, in both layouts (float64 ``V``, and the lean float32 ``V`` of grids over
+    ``LEAN_NODES`` padded nodes, e.g. a 1000x1000x40 terrain plan), its size floors lowered
+    for a 16-node-wide grid while it compiles."""
     def run() -> None:
         speed = np.ones((16,) * ndim)
         speed[(0,) * ndim] = 0.5  # a plateau with its mask (a uniform grid needs none)
@@ -79,7 +79,8 @@ def _fmm_parallel(ndim: int) -> Callable[[], None]:
         try:
             for lean_nodes in (lean, 0):
                 _kernels.LEAN_NODES = lean_nodes
-                fast_marching(speed, [(3,) * ndim], order=1, threads=2)
+                for order in (1, 2):
+                    fast_marching(speed, [(3,) * ndim], order=order, threads=2)
         finally:
             _parallel.PARALLEL_MIN_NODES, _kernels.LEAN_NODES = floor, lean
 
