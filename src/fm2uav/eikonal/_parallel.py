@@ -502,19 +502,33 @@ def _update2(T, V, U, use_u, qp, c, sx, sy, ih, three):
     return _combine(ta, aa, tb, ab, tc, ac, q)
 
 
+@njit(cache=True, inline="always", _nrt=False)
+def _entry_cap(eidx, evals, g, t):
+    """``t``, or the time node ``g`` (an index into the slabs' buffer) had in the band on
+    entry if lower: the serial march keeps it (sorted ``eidx``, times ``evals``)."""
+    if eidx.size == 0:
+        return t
+    i = np.searchsorted(eidx, g)
+    if i < eidx.size and eidx[i] == g:
+        return min(t, evals[i])
+    return t
+
+
 @njit(cache=True, error_model="numpy", _nrt=False)  # a call (rare): compiles once
-def _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf, pool, nxt, bk, mw, st,
-             rkey, ritem, ctl):
+def _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf, eidx, evals, base, pool,
+             nxt, bk, mw, st, rkey, ritem, ctl):
     """Update the slab's own node ``d`` again after a time it may read changed (order 2).
 
     Far or band: a lower time is taken and queued; a higher one marks the node suspect
     (updated again when popped). Frozen: a different time re-opens it (``rf``), at the new
-    time if lower, else at its old time and suspect. Walls and nodes frozen on entry stay.
+    time if lower, else at its old time and suspect. Walls and nodes frozen on entry stay;
+    a node in the band on entry keeps that time if lower (``eidx``, ``evals``: those nodes
+    by their index in the slabs' buffer, ``base + d`` for ``d``).
     """
     x = T[d]
     if x != x or _bit(fixed, d):
         return
-    t = _update2(T, V, U, use_u, qp, d, sx, sy, ih, three)
+    t = _entry_cap(eidx, evals, base + d, _update2(T, V, U, use_u, qp, d, sx, sy, ih, three))
     if x < 0.0:
         if t < -x:
             T[d] = -t
@@ -546,8 +560,8 @@ def _slab_kernels2(three):
     """The compiled order-2 window, start and exchange of one dimension (``three``: 3D);
     the slab has two ghost x-slabs on each side (the order-2 stencil reads two rows)."""
 
-    def window(T, V, U, qp, fixed, rf, sf, pf, sx, sy, ih, tw, pool, nxt, bk, mw, st, rkey,
-               ritem, ctl, sent, ns):
+    def window(T, V, U, qp, fixed, rf, sf, pf, eidx, evals, base, sx, sy, ih, tw, pool, nxt, bk,
+               mw, st, rkey, ritem, ctl, sent, ns):
         """Freeze the slab's queued nodes with a time below ``tw`` (resumable), order 2.
 
         As the order-1 window; the boundary lists hold the nodes frozen in the first and
@@ -587,7 +601,8 @@ def _slab_kernels2(three):
                 break
             if _bit(sf, c):  # suspect: its time may have to go up
                 _clear_bit(sf, c)
-                t2 = _update2(T, V, U, use_u, qp, c, sx, sy, ih, three)
+                t2 = _entry_cap(eidx, evals, base + c,
+                                _update2(T, V, U, use_u, qp, c, sx, sy, ih, three))
                 if t2 != t:
                     if t2 > t and _bit(rf, c) and not _bit(pf, c):
                         # nodes may still read its old time (>= t): the stop test must not
@@ -621,15 +636,15 @@ def _slab_kernels2(three):
                 if y < 0.0:  # band or far: an own node
                     if full:
                         _recheck(T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf,
-                                 pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                                 eidx, evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl)
                     else:  # the serial march's relaxation
                         _lower(T, V, nb, _update2(T, V, U, use_u, qp, nb, sx, sy, ih, three),
                                fixed, sx, sy, three, pv, pool, nxt, bk, mw, st, rkey, ritem,
                                ctl)
                 elif y >= 0.0 and nb >= lo and nb < hi and (full or y > t):
                     # frozen later than c in this slab: c may change it
-                    _recheck(T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf, pool,
-                             nxt, bk, mw, st, rkey, ritem, ctl)
+                    _recheck(T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf, eidx,
+                             evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl)
                 # the node two away reads c beyond nb when nb is frozen no earlier than c
                 y = T[nb]
                 if y >= 0.0 and (full or t <= y):
@@ -638,7 +653,7 @@ def _slab_kernels2(three):
                         z = T[d2]
                         if z < 0.0 or (z >= 0.0 and (full or z > t)):
                             _recheck(T, V, U, use_u, qp, d2, sx, sy, ih, three, fixed, rf, sf,
-                                     pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                                     eidx, evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl)
         ctl[_C_POPS] = pops
 
     def start(T, V, U, qp, fixed, sx, sy, ih, pool, nxt, bk, mw, st, rkey, ritem, ctl):
@@ -667,8 +682,8 @@ def _slab_kernels2(three):
             c += _ONE
         return True
 
-    def exchange(T, V, U, qp, fixed, rf, sf, src, sent, m, base, g, up, sx, sy, ih, pool, nxt,
-                 bk, mw, st, rkey, ritem, ctl):
+    def exchange(T, V, U, qp, fixed, rf, sf, eidx, evals, ebase, src, sent, m, base, g, up, sx,
+                 sy, ih, pool, nxt, bk, mw, st, rkey, ritem, ctl):
         """Copy the neighbour's two boundary rows ``src`` (their frozen times) into the two
         ghost rows starting at ``g``; update again the own nodes one and two rows away
         from each ghost that changed (toward +x if ``up``). Only the neighbour's nodes
@@ -694,7 +709,7 @@ def _slab_kernels2(three):
                     d = gj + step if up else gj - step
                     if d >= lo and d < hi:
                         _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf,
-                                 pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                                 eidx, evals, ebase, pool, nxt, bk, mw, st, rkey, ritem, ctl)
                         x = T[d]
                         if x < 0.0 and -x < ctl[_C_NEXT]:  # queued: the next window knows
                             ctl[_C_NEXT] = -x
@@ -723,8 +738,8 @@ def _heap_next(T, st, ritem, ctl):
 
 def _drive_kernel(three, order=1):
     """The compiled driver of one dimension and order (the parallel region runs the slabs)."""
-    def drive(nth, Tp, Vp, U, qp, fx, fl, off, end, rows, sx, sy, ih, hh, iso, pool, nxt, bk, mw,
-              st, rkey, ritem, ctl, sent, ns, win, first, stops):
+    def drive(nth, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, rows, sx, sy, ih, hh, iso, pool,
+              nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win, first, stops):
         """Run windows until every queue is empty; 0 done, 1/2 grow pool/heap and call again.
 
         ``win`` (float64): [0] window end, [1] width, [2] windows run, [3] target pops,
@@ -735,7 +750,8 @@ def _drive_kernel(three, order=1):
         ``Tp`` (one byte: every node) and its ``1 / speed^2`` (0: none); ``sent``, ``ns``:
         each slab's nodes frozen in its boundary rows in the last window (see ``window``).
         ``fl``: order 2's bit masks over ``Tp`` (re-opened, suspect, raised; unused by
-        order 1); each slab has ``order`` ghost x-slabs on each side.
+        order 1), ``eidx``, ``evals`` its nodes in the band on entry (indices into ``Tp``,
+        sorted) and their times; each slab has ``order`` ghost x-slabs on each side.
         """
         K = off.size
         sxi = np.int64(sx)
@@ -778,7 +794,8 @@ def _drive_kernel(three, order=1):
                     if k > 0:
                         o = off[k - 1] + rows[k - 1] * sxi  # last own rows of the slab below
                         if order == 2:
-                            args = (T, V, Uk, qp, F, R, S, Tp[o:o + G * sxi], sent[k - 1, 1],
+                            args = (T, V, Uk, qp, F, R, S, eidx, evals, _U(off[k]),
+                                    Tp[o:o + G * sxi], sent[k - 1, 1],
                                     ns[k - 1, 1], _U(rows[k - 1]) * sx, _ZERO, True, sx, sy, ih,
                                     pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k],
                                     ctl[k])
@@ -791,7 +808,8 @@ def _drive_kernel(three, order=1):
                     if ok and k < K - 1:
                         o = off[k + 1] + G * sxi  # first own rows of the slab above
                         if order == 2:
-                            args = (T, V, Uk, qp, F, R, S, Tp[o:o + G * sxi], sent[k + 1, 0],
+                            args = (T, V, Uk, qp, F, R, S, eidx, evals, _U(off[k]),
+                                    Tp[o:o + G * sxi], sent[k + 1, 0],
                                     ns[k + 1, 0], _U(G) * sx, (r + _U(G)) * sx, False, sx, sy,
                                     ih, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
                                     ritem[k], ctl[k])
@@ -848,7 +866,7 @@ def _drive_kernel(three, order=1):
                         args = (Tp[off[k]:end[k]], Vp[off[k]:end[k]],
                                 U[0 if U.size == 1 else off[k] >> 3:], qp, fx[off[k] >> 3:],
                                 fl[0, off[k] >> 3:], fl[1, off[k] >> 3:], fl[2, off[k] >> 3:],
-                                sx, sy, ih, tw, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
+                                eidx, evals, _U(off[k]), sx, sy, ih, tw, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
                                 ritem[k], ctl[k], sent[k], ns[k])
                         if three:
                             _window3d_o2(*args)
@@ -1082,8 +1100,13 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
     U, qp = _kernels._plateau(speed, Vp, shape3, npad,
                               fill=lambda vmax, bits: _slab_plateau(speed, vmax, bounds, off,
                                                                     shape3, bits, G))
-    # order 2's bit masks: re-opened, suspect, raised (one spare byte: a 2D slice below)
+    # order 2's bit masks: re-opened, suspect, raised (one spare byte: a 2D slice below),
+    # and the nodes in the band on entry with their times (a repair keeps them if lower)
     fl = np.zeros((3, npad // 8 + 2 if order == 2 else 1), dtype=np.uint8)
+    eidx = np.zeros(0, dtype=np.uint64)
+    if order == 2:
+        eidx = np.flatnonzero((Tp < 0.0) & (Tp > -np.inf)).astype(np.uint64)
+    evals = -Tp[eidx]
     # each slab's nodes frozen in its first and last own rows in the last window (the
     # neighbours' exchange reads those); a count over the capacity: read the whole row
     # (so the first exchange, after the start)
@@ -1123,9 +1146,9 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
     numba.set_num_threads(nth)
     try:
         while True:
-            status = drive(nth, Tp, Vp, U, qp, fixed, fl, off, off + sizes, rows, _U(sx), _U(sy),
-                           ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win,
-                           first, stop_idx)
+            status = drive(nth, Tp, Vp, U, qp, fixed, fl, eidx, evals, off, off + sizes, rows,
+                           _U(sx), _U(sy), ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl,
+                           sent, ns, win, first, stop_idx)
             first = win[7] == 0.0
             if status == 0:
                 break
