@@ -637,10 +637,17 @@ def _slab_kernels2(three):
                     if full:
                         _recheck(T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf,
                                  eidx, evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl)
-                    else:  # the serial march's relaxation
-                        _lower(T, V, nb, _update2(T, V, U, use_u, qp, nb, sx, sy, ih, three),
-                               fixed, sx, sy, three, pv, pool, nxt, bk, mw, st, rkey, ritem,
-                               ctl)
+                    else:  # the serial march's relaxation, but a band time that read
+                        # nodes out of time order (a ghost ahead of this slab) may be too
+                        # low: a later update marks it suspect
+                        tn = _update2(T, V, U, use_u, qp, nb, sx, sy, ih, three)
+                        if tn < -y:
+                            _lower(T, V, nb, tn, fixed, sx, sy, three, pv, pool, nxt, bk, mw,
+                                   st, rkey, ritem, ctl)
+                        elif (tn > -y and y > -_INF
+                              and _entry_cap(eidx, evals, base + nb, tn) > -y):
+                            _set_bit(sf, nb)
+                            ctl[_C_RAISED] += 1.0
                 elif y >= 0.0 and nb >= lo and nb < hi and (full or y > t):
                     # frozen later than c in this slab: c may change it
                     _recheck(T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf, eidx,
