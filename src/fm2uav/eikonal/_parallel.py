@@ -2,7 +2,8 @@
 
 Private module: :func:`fm2uav.eikonal.fast_marching` calls :func:`march` for
 grids of at least :data:`PARALLEL_MIN_NODES` nodes when more than one thread is
-allowed (``threads``, ``FM2UAV_THREADS``), at either order (``stop_at`` too).
+allowed (``threads``, ``FM2UAV_THREADS``), at order 1, and at order 2 when
+:data:`ORDER2` is set (off: see there) (``stop_at`` too).
 Order 2's stencil reads two nodes upwind: its slabs have two ghost x-slabs per
 side, the exchange copies two rows, and a changed time updates again the nodes one
 *and two* away along each axis; its update is not monotone, so a repair may also
@@ -72,6 +73,16 @@ __all__ = ["march", "resolve_threads", "PARALLEL_MIN_NODES", "THREADS_ENV"]
 
 #: Environment variable with the default thread count of the march (an integer >= 1).
 THREADS_ENV = "FM2UAV_THREADS"
+#: Whether :func:`fm2uav.eikonal.fast_marching` marches order 2 in parallel too. Off: the
+#: order-2 slabs give the serial times to 1e-12 (relative) on every test case (the
+#: fields of tests/eikonal/test_fmm_parallel.py, 84 random FM²-shaped fields on slabs of 2
+#: to 6 rows), but not on big grids: 3.0e-11 on the 2048² FM²-shaped map, 1.6e-11 on the
+#: 1000 x 1000 x 40 terrain march (2 December 2026). The order-2 stencil
+#: ``(4 T1 - T2) / 3`` can amplify a difference along the wave (the likely cause, not
+#: proven: an ulp where the serial march keeps the minimum of its updates and a slab the
+#: last one grows over thousands of cells); ignoring raises below 1e-13 made it worse
+#: (11 M nodes of the terrain over 1e-12), so it was not kept.
+ORDER2 = False
 #: Grids of fewer nodes march serially whatever the thread count. Measured
 #: (benchmarks/bench_core.py, "threads" rows, a machine at load 9 on 2 cores):
 #: on 1024^2 the busiest thread takes 0.06 s of the serial 0.099 CPU-s (1.65x on

@@ -176,11 +176,13 @@ def fast_marching(
     threads : int, optional
         Threads the march may use (``>= 1``). None (default): the environment
         variable ``FM2UAV_THREADS`` if set, else every core this process may run
-        on. With 2 or more, grids of at least ``PARALLEL_MIN_NODES`` (1 M) nodes
-        march slabs of the grid in parallel, at order 1 and 2
+        on. With 2 or more, order 1 on grids of at least ``PARALLEL_MIN_NODES``
+        (1 M) nodes marches slabs of the grid in parallel
         (:mod:`fm2uav.eikonal._parallel`; times equal to the serial march's to
-        round-off, ``stop_at`` included); the wind march and smaller grids march
-        on one thread.
+        round-off, ``stop_at`` included); order 2 too when
+        ``fm2uav.eikonal._parallel.ORDER2`` is set (off: its times differ from the
+        serial march's by up to 3e-11 relative on big grids); the wind march and
+        smaller grids march on one thread.
 
     Returns
     -------
@@ -284,9 +286,9 @@ def run_march(
     Shared by :func:`fast_marching` and :func:`fm2uav.eikonal.restart.remarch`:
     nodes frozen on entry (state 2) are expanded first, band nodes (state 1)
     carry tentative times. ``stop_at`` as in :func:`fast_marching`; ``threads``
-    (resolved, ``>= 1``) as there: the parallel march (order 1 or 2) on grids of at
-    least :data:`~fm2uav.eikonal._parallel.PARALLEL_MIN_NODES` nodes when ``threads
-    > 1``, else the serial one.
+    (resolved, ``>= 1``) as there: the parallel march on grids of at least
+    :data:`~fm2uav.eikonal._parallel.PARALLEL_MIN_NODES` nodes when ``threads > 1``, for
+    order 1 (order 2 if :data:`~fm2uav.eikonal._parallel.ORDER2`), else the serial one.
 
     Returns
     -------
@@ -301,7 +303,8 @@ def run_march(
         stops[:, : len(shape)] = idx
         if start.frozen_at(stops).all():  # every stop node is a source or in its ball
             return start.frozen_times(shape3).reshape(shape)
-    if threads > 1 and flat_speed.size >= _parallel.PARALLEL_MIN_NODES:
+    if (threads > 1 and (order == 1 or _parallel.ORDER2)
+            and flat_speed.size >= _parallel.PARALLEL_MIN_NODES):
         T, _ = _parallel.march(flat_speed, start, shape3, h3, threads,
                                stops[~start.frozen_at(stops)], order=order)
     else:

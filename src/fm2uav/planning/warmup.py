@@ -15,7 +15,7 @@ dimension and order), ``descent`` (geodesic extraction), ``surface``
 call their kernels directly: ``edt_parallel`` (the distance map's lines in
 parallel) and ``fmm3d_o{1,2}_lean`` (the 3D march in the lean layout, see
 ``fm2uav.eikonal._kernels.LEAN_NODES``); ``fmm{2,3}d_parallel`` (the march on both cores,
-order 1 and 2) compile both layouts. Numbers: docs/performance.md.
+order 1, and order 2 when ``_parallel.ORDER2`` is set) compile both layouts. Numbers: docs/performance.md.
 """
 
 from __future__ import annotations
@@ -67,8 +67,8 @@ def _fmm_lean(order: int) -> Callable[[], None]:
 
 
 def _fmm_parallel(ndim: int) -> Callable[[], None]:
-    """The march on both cores (grids of ``PARALLEL_MIN_NODES`` nodes and more), order 1 and
-    2, in both layouts (float64 ``V``, and the lean float32 ``V`` of grids over
+    """The march on both cores (grids of ``PARALLEL_MIN_NODES`` nodes and more), order 1 (and 2
+    when ``_parallel.ORDER2`` is set), in both layouts (float64 ``V``, and the lean float32 ``V`` of grids over
     ``LEAN_NODES`` padded nodes, e.g. a 1000x1000x40 terrain plan), its size floors lowered
     for a 16-node-wide grid while it compiles."""
     def run() -> None:
@@ -79,7 +79,7 @@ def _fmm_parallel(ndim: int) -> Callable[[], None]:
         try:
             for lean_nodes in (lean, 0):
                 _kernels.LEAN_NODES = lean_nodes
-                for order in (1, 2):
+                for order in (1, 2) if _parallel.ORDER2 else (1,):
                     fast_marching(speed, [(3,) * ndim], order=order, threads=2)
         finally:
             _parallel.PARALLEL_MIN_NODES, _kernels.LEAN_NODES = floor, lean
