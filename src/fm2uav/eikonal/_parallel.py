@@ -78,10 +78,10 @@ THREADS_ENV = "FM2UAV_THREADS"
 #: fields of tests/eikonal/test_fmm_parallel.py, 84 random FM²-shaped fields on slabs of 2
 #: to 6 rows), but not on big grids: 3.0e-11 on the 2048² FM²-shaped map, 1.6e-11 on the
 #: 1000 x 1000 x 40 terrain march (2 December 2026). The order-2 stencil
-#: ``(4 T1 - T2) / 3`` can amplify a difference along the wave (the likely cause, not
-#: proven: an ulp where the serial march keeps the minimum of its updates and a slab the
-#: last one grows over thousands of cells); ignoring raises below 1e-13 made it worse
-#: (11 M nodes of the terrain over 1e-12), so it was not kept.
+#: ``(4 T1 - T2) / 3`` amplifies a difference along the wave: on 2048² every node before
+#: T = 600.73 s is equal, the first that differs by 4e-14 (a discrete choice of the update,
+#: likely a tie the serial march decides by the order of its updates), 1.37 M nodes end
+#: over 1e-12 (docs/performance.md, "Both cores").
 ORDER2 = False
 #: Grids of fewer nodes march serially whatever the thread count. Measured
 #: (benchmarks/bench_core.py, "threads" rows, a machine at load 9 on 2 cores):
