@@ -158,7 +158,7 @@ def test_the_scenarios_dimensions_are_the_library_s():
     assert scenario_ndim(None) == 3  # a --dem/--buildings world, or the default open field
 
 
-#: One-line value errors of the planning commands: each answered before the world, numpy or
+#: One-line value errors of the planning commands (and a missing input file): each answered before the world, numpy or
 #: the kernels load (issue 27: "any one-line input error in <= 0.3 s"). (argv, words the
 #: message must hold.)
 VALUE_ERRORS = [
@@ -180,6 +180,8 @@ VALUE_ERRORS = [
     (["routes", "--goal", "1,2,30", "--starts", "s.csv", "--speed", "0"], ["--speed"]),
     (["routes", "--goal", "1", "--starts", "s.csv"], ["--goal", "LON,LAT"]),
     (["routes", "--goal", "1,2,30", "--starts", "s.csv", "--exponent", "0"], ["--exponent"]),
+    (["check", "missing.csv"], ["path file", "missing.csv", "not found"]),
+    (["export", "missing.csv", "--scenario", "open-field"], ["path file", "not found"]),
 ]
 
 VALUE_PROBE = """
