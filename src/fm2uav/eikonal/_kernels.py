@@ -637,7 +637,7 @@ def _march2d_kernel(order):
 
         ``U`` is the plateau mask (bit ``c & 7`` of ``U[c >> 3]``: node ``c`` has the
         speed whose ``V`` is ``qp``; :func:`plateau_bits`), ``qp = 0`` for none; the
-        interleaved layout reads every speed (a plateau map marches in the separate one).
+        interleaved layout reads every speed (a uniform map marches in the separate one).
 
         Resumable: returns 0 when done, 1 when fewer than ``RESERVE_BLOCKS`` free
         blocks are left (the caller grows the pool and calls again with the same
@@ -1028,8 +1028,8 @@ def march(speed, start, shape3, h3, order, stop_cells, *, lean=None, interleave=
     interleave : bool, optional
         2D grids outside the lean layout: ``T`` and ``1 / speed^2`` interleaved in one
         array (:func:`_work_interleaved`) instead of two, and no plateau register.
-        Default: where there is no plateau (:func:`_plateau`). The times are the same
-        bit for bit either way. Ignored in 3D and in the lean layout.
+        Default: unless every passable node has one speed (:func:`_buffers`). The times
+        are the same bit for bit either way. Ignored in 3D and in the lean layout.
 
     Returns
     -------
@@ -1099,11 +1099,12 @@ def _buffers(speed, shape3, npad, lean, interleave):
     Returns ``(Tp, Vp, Tk, Vk, unit, plateau)``: the arrays :func:`pad_grid` fills and
     :func:`unpad_grid` reads (strided views in the interleaved layout), those the kernel
     takes, its ``unit`` (1, or 2 interleaved) and the plateau ``(U, qp)`` where it was
-    decided here (None: not yet). A 2D map without a plateau reads a speed with every
-    update, so by default its ``T`` and ``V`` are interleaved, a neighbour's time and
-    speed in one cache line: measured on 2048^2 FM²-shaped order 1 -8 %, smooth -17 %
-    (docs/performance.md); where the plateau register spares the speed reads the separate
-    arrays are kept (interleaved +15 % on a constant speed).
+    decided here (None: not yet). By default a 2D map marches interleaved, a neighbour's
+    time and speed in one cache line, unless all its passable nodes have one speed (then
+    the march reads no speed at all and the separate arrays hold twice the nodes per
+    line of ``T``). Measured on 2048^2 (docs/performance.md): FM²-shaped order 1 -8 %,
+    smooth -17 %; FM² maps saturated (W = 1) on 57 % and 70 % of the nodes -8 % and
+    -6 % against the separate arrays with the plateau mask; a uniform speed +10 %.
     """
     if lean:  # two plain mappings: V goes as soon as the march is done
         Tp = _work(8 * npad).view(np.float64)
@@ -1112,7 +1113,7 @@ def _buffers(speed, shape3, npad, lean, interleave):
     two = shape3[2] == 1
     plat = None
     if two and interleave is None:
-        plat = _plateau(speed, _F64_TYPE, shape3, npad)
+        plat = _plateau(speed, _F64_TYPE, shape3, npad, None, False)
         interleave = plat[1] == 0.0
     if two and interleave:
         Tk = _work_interleaved(npad)
@@ -1141,7 +1142,7 @@ def _padded_index(node, pshape):
 PLATEAU_MIN_SHARE = 0.5
 
 
-def _plateau(speed, Vp, shape3, npad, fill=None):
+def _plateau(speed, Vp, shape3, npad, fill=None, mask=True):
     """The plateau mask of the padded grid and the plateau's ``V`` (``qp = 0.0``: none).
 
     The mask marks the nodes whose speed equals the grid's largest (see
@@ -1152,6 +1153,7 @@ def _plateau(speed, Vp, shape3, npad, fill=None):
     node decides first whether a plateau is likely (the full pass over the speeds
     cost 2 % of the march on a map without one). ``fill(vmax, bits)``, if given, sets the
     bits in another layout (the parallel march's slabs) and returns how many.
+    ``mask=False``: a uniform grid's plateau only (a mixed grid gets none, its mask unbuilt).
     """
     sample = speed[::_PLATEAU_STRIDE]
     top = sample.max()
@@ -1163,6 +1165,8 @@ def _plateau(speed, Vp, shape3, npad, fill=None):
     qp = float(Vp.dtype.type(1.0 / (vmax * vmax)))
     if vmin == vmax:
         return _ONE_BYTE, qp
+    if not mask:
+        return _NO_BITS, 0.0
     bits = np.zeros(npad // 8 + 1, dtype=np.uint8)
     if fill is None:
         count = plateau_bits(speed, vmax, *(int(n) for n in shape3), bits)
