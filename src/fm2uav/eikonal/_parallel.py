@@ -597,9 +597,8 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarra
     owner = np.arange(k) % threads
 
     def loads(c):  # nodes per thread and time bin, shape (threads, bins)
-        out = np.zeros((threads, hist.shape[1]), dtype=np.int64)
-        np.add.at(out, owner, cum[c[1:]] - cum[c[:-1]])
-        return out
+        per_slab = cum[c[1:]] - cum[c[:-1]]
+        return np.stack([per_slab[t::threads].sum(axis=0) for t in range(threads)])
 
     for _ in range(4 * k):
         moved = False
@@ -642,15 +641,16 @@ def _coarse_histogram(speed, start, shape3, h3):
     box = np.argwhere(start.state.reshape(start.shape) == _kernels.FROZEN)
     if len(box) == 0:
         return None, f
-    cells = np.unique((box + np.asarray(start.lo)) // np.array([f, f, f if three else 1]),
-                      axis=0)
+    # the coarse nodes of the frozen ones (a mask over their box: a source ball on constant
+    # speed holds ~33,000 nodes on 2048^2, and np.unique of rows took 38 ms of serial time)
+    cells = (box + np.asarray(start.lo)) // np.array([f, f, f if three else 1])
     lo = cells.min(axis=0)
     bshape = tuple(int(n) for n in cells.max(axis=0) - lo + 1)
-    Tb = np.full(int(np.prod(bshape)), np.inf)
-    sb = np.zeros(Tb.size, dtype=np.uint8)
-    flat = np.ravel_multi_index(tuple((cells - lo).T), bshape)
-    Tb[flat] = 0.0
-    sb[flat] = _kernels.FROZEN
+    frozen = np.zeros(bshape, dtype=bool)
+    frozen[tuple((cells - lo).T)] = True
+    frozen = frozen.reshape(-1)
+    Tb = np.where(frozen, 0.0, np.inf)
+    sb = np.where(frozen, _kernels.FROZEN, 0).astype(np.uint8)
     cstart = _kernels.Start(tuple(int(a) for a in lo), bshape, Tb, sb)
     hc = tuple(h * f for h in h3[:2]) + ((h3[2] * f,) if three else (h3[2],))
     T, _ = _kernels.march(coarse.reshape(-1), cstart, cshape, hc, 1,
@@ -662,10 +662,13 @@ def _coarse_histogram(speed, start, shape3, h3):
         return None, f
     rows = np.broadcast_to(np.arange(cshape[0])[:, None], T.shape)[fin]
     # bins of equal node counts in time order, as the windows (~WINDOW_NODES nodes each);
-    # equal times share a bin (a node's bin from the rank of the first of its time)
+    # equal times share a bin: node bin ``rank * SPLIT_BINS // n``, ``rank`` the count of
+    # earlier times, i.e. how many of the sorted times ending each bin's share are earlier
+    # (a search among SPLIT_BINS - 1 edges instead of among all the times: 4 -> 0.5 ms)
     times = T[fin]
-    rank = np.searchsorted(np.sort(times), times, side="left")
-    bins = rank * SPLIT_BINS // times.size
+    n = times.size
+    ends = -(-np.arange(1, SPLIT_BINS) * n // SPLIT_BINS) - 1  # ceil(b n / bins) - 1 >= 0
+    bins = np.searchsorted(np.sort(times)[ends], times, side="left")
     hist = np.bincount(rows * SPLIT_BINS + bins,
                        minlength=cshape[0] * SPLIT_BINS).reshape(cshape[0], SPLIT_BINS)
     return hist, f
