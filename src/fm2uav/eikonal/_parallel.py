@@ -789,7 +789,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
     stats : dict
         ``slabs``, ``windows``, ``reopened`` (nodes lowered after they were frozen) and
         ``balance``: nodes frozen over the sum of each window's largest slab share, the
-        speed-up the windows allow if every freeze cost the same (``slabs`` at best).
+        speed-up the windows allow if every freeze cost the same (``slabs`` at best), and
+        ``greedy``: the windows whose slabs :func:`_assign` shared longest first.
     """
     import numba
 
