@@ -37,10 +37,11 @@ run: $(STAMP)
 
 ## make test: the layer contract (import-linter, [tool.importlinter] in pyproject.toml),
 ## then the whole suite, in parallel (pytest-xdist: one file's tests in one worker, and the
-## files sharing cli_once's runs in one worker too, tests/conftest.py)
+## files sharing cli_once's runs in one worker too, tests/conftest.py); the 15 slowest tests
+## are listed at the end (what to split when the suite grows)
 test: $(STAMP)
 	$(VENV)/bin/lint-imports
-	$(PYTEST) -q $(XDIST)
+	$(PYTEST) -q $(XDIST) --durations=15
 
 ## make test-fast: for development — the same suite without the tests marked `slow`
 ## (long end-to-end runs: reproductions, sweeps, CLI missions); `make test` runs them too

@@ -8,7 +8,9 @@ the machine, whatever the load). Cases:
 
 * ``fm2uav --help`` and ``fm2uav plan --help`` (the largest help page, 50+ options);
 * ``fm2uav plan --bogus``: a bad flag, refused by the parser;
-* ``fm2uav run missing.yaml``: a one-line input error found by the command itself.
+* ``fm2uav run missing.yaml``: a one-line input error found by the command itself;
+* ``fm2uav plan --threads 0`` and ``fm2uav plan --start 1,2``: a bad value of a planner flag
+  and of a point, found by the command before the library loads.
 
 Output goes to a pipe (as under ``| less``); the help pages are timed in a terminal too
 (a pseudo-terminal: rich's colours, the notes' "tty CPU"), which renders the same page.
@@ -117,6 +119,10 @@ def run(quick: bool = False) -> list[dict]:
              peer_cmd + ["main", "--bogus"], [2]),
             ("`fm2uav run missing.yaml` (a missing mission file)",
              ["run", str(Path(tmp) / "missing.yaml")], None, [2]),
+            ("`fm2uav plan --threads 0` (a bad flag value)",
+             ["plan", "--threads", "0", "--out", str(Path(tmp) / "out")], None, [2]),
+            ("`fm2uav plan --start 1,2` (a bad point)",
+             ["plan", "--start", "1,2", "--out", str(Path(tmp) / "out")], None, [2]),
         ]
         rows = []
         for case, args, peer_args, codes in cases:

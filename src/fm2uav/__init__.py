@@ -11,10 +11,10 @@ docs/architecture.md): ``errors``, ``geometry`` → ``eikonal`` → ``world`` �
 ``scenarios`` → ``experiments`` → ``autopilot`` → ``io`` → ``viz`` → ``cli``.
 """
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from . import errors
+from ._lazy import lazy_names
 from .errors import *  # noqa: F403 -- the error hierarchy (pure Python), listed once in errors.__all__
 
 if TYPE_CHECKING:  # loaded on first attribute access (PEP 562), see __getattr__
@@ -45,30 +45,30 @@ if TYPE_CHECKING:  # loaded on first attribute access (PEP 562), see __getattr__
 #: scipy and the kernels cost ~1 s): each is imported on first access (PEP 562),
 #: so the command line can speak before the heavy imports.
 _LAZY_NAMES = {
-    "flight_level_deviation": "analysis",
-    "path_profiles": "analysis",
-    "tune": "analysis.tune",
-    "distance_map": "eikonal",
-    "fast_marching": "eikonal",
-    "velocity_map": "eikonal",
-    "CoveragePlan": "missions",
-    "FormationConfig": "missions",
-    "FormationResult": "missions",
-    "fly_formation": "missions",
-    "plan_coverage": "missions",
-    "zigzag": "missions",
-    "FlightLevel": "planning",
-    "Plan": "planning",
-    "PlanOptions": "planning",
-    "Shaping": "planning",
-    "plan": "planning",
-    "Scenario": "scenarios",
-    "AIRFRAMES": "vehicles",
-    "AirframeLimits": "vehicles",
-    "FeasibilityReport": "vehicles",
-    "check_feasibility": "vehicles",
-    "get_airframe": "vehicles",
-    "World": "world",
+    "flight_level_deviation": ".analysis",
+    "path_profiles": ".analysis",
+    "tune": ".analysis.tune",
+    "distance_map": ".eikonal",
+    "fast_marching": ".eikonal",
+    "velocity_map": ".eikonal",
+    "CoveragePlan": ".missions",
+    "FormationConfig": ".missions",
+    "FormationResult": ".missions",
+    "fly_formation": ".missions",
+    "plan_coverage": ".missions",
+    "zigzag": ".missions",
+    "FlightLevel": ".planning",
+    "Plan": ".planning",
+    "PlanOptions": ".planning",
+    "Shaping": ".planning",
+    "plan": ".planning",
+    "Scenario": ".scenarios",
+    "AIRFRAMES": ".vehicles",
+    "AirframeLimits": ".vehicles",
+    "FeasibilityReport": ".vehicles",
+    "check_feasibility": ".vehicles",
+    "get_airframe": ".vehicles",
+    "World": ".world",
 }
 
 #: Subpackages, also imported on first use (``fm2uav.scenarios.open_field()``
@@ -79,19 +79,7 @@ _LAZY_SUBMODULES = (
 )
 
 
-def __getattr__(name: str) -> Any:
-    if name in _LAZY_NAMES:
-        value = getattr(importlib.import_module(f".{_LAZY_NAMES[name]}", __name__), name)
-        globals()[name] = value  # later accesses skip __getattr__
-        return value
-    if name in _LAZY_SUBMODULES:
-        return importlib.import_module(f".{name}", __name__)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY_NAMES) | set(_LAZY_SUBMODULES))
-
+__getattr__, __dir__ = lazy_names(__name__, _LAZY_NAMES, _LAZY_SUBMODULES)
 
 __version__ = "0.1.0"
 

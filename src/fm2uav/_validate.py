@@ -19,6 +19,9 @@ fm2uav.errors.InputError: agl must be a finite number > 0 m, got -1 (mission fil
 
 from __future__ import annotations
 
+import math
+import numbers
+import sys
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -72,6 +75,13 @@ def _fmt(v: float) -> str:
     return f"{v:g}"
 
 
+def _is_bool(value: Any) -> bool:
+    """A Python or numpy bool (numpy is not imported for it: without numpy loaded, no
+    value can be a numpy one — the command line checks its flags before numpy loads)."""
+    np = sys.modules.get("numpy")
+    return isinstance(value, bool) or (np is not None and isinstance(value, np.bool_))
+
+
 def number(value: Any, what: str, *, unit: str = "", where: Where = None) -> float:
     """``value`` as a finite float.
 
@@ -80,18 +90,18 @@ def number(value: Any, what: str, *, unit: str = "", where: Where = None) -> flo
     InputError
         Not a number (booleans are refused), NaN or inf.
     """
-    import numpy as np
-
     u = f" {unit}" if unit else ""
-    if isinstance(value, (bool, np.bool_)):
+    if _is_bool(value):
         raise InputError(f"{what} must be a number{u}, got {value!r}{where_text(where)}")
     try:
         v = float(value)
+    except OverflowError:  # an int beyond float's range
+        v = math.inf
     except (TypeError, ValueError):
         raise InputError(
             f"{what} must be a number{u}, got {value!r}{where_text(where)}"
         ) from None
-    if not np.isfinite(v):
+    if not math.isfinite(v):
         raise InputError(f"{what} must be a finite number{u}, got {value!r}{where_text(where)}")
     return v
 
@@ -157,12 +167,10 @@ def integer(
     value: Any, what: str, *, minimum: int | None = None, where: Where = None
 ) -> int:
     """``value`` as an int (an integral float such as ``2.0`` is accepted), ``>= minimum``."""
-    import numpy as np
-
-    ok = not isinstance(value, (bool, np.bool_))
-    if ok and isinstance(value, (int, np.integer)):
+    ok = not _is_bool(value)
+    if ok and isinstance(value, numbers.Integral):  # int and numpy's integers
         v = int(value)
-    elif ok and isinstance(value, (float, np.floating)) and float(value).is_integer():
+    elif ok and isinstance(value, numbers.Real) and float(value).is_integer():
         v = int(value)
     else:
         raise InputError(f"{what} must be an integer, got {value!r}{where_text(where)}")
@@ -204,9 +212,7 @@ def choice(value: Any, options: Sequence[Any], what: str, *, where: Where = None
 
 def flag(value: Any, what: str, *, where: Where = None) -> bool:
     """``value`` as a bool; only ``True``/``False`` (and numpy bools) are accepted."""
-    import numpy as np
-
-    if not isinstance(value, (bool, np.bool_)):
+    if not _is_bool(value):
         raise InputError(f"{what} must be true or false, got {value!r}{where_text(where)}")
     return bool(value)
 

@@ -72,3 +72,61 @@ def test_build_mission_reports_the_energy_and_warns():
     assert calm["energy"]["ok"] and calm["energy"]["wind"] is None
     # the same legs as the flight-time figure: the mission's time agrees
     assert calm["energy"]["time_s"] == pytest.approx(calm["flight"]["flight_time_s"], abs=0.2)
+
+
+@pytest.mark.parametrize("vehicle,end", [("multirotor", "land"), ("multirotor", "rtl"),
+                                         ("vtol", "land"), ("vtol", "rtl"),
+                                         ("fixed_wing", "land"), ("fixed_wing", "rtl")])
+def test_in_still_air_the_energy_flies_the_flight_time_s_clock(vehicle, end):
+    # one flight: the energy's time is the summary's flight time, a fixed-wing's climb-out
+    # and landing pattern included (before, its energy flew a vertical take-off and no
+    # pattern: 60 s against a flight time of 140.8 s here)
+    m = build_mission(hill_tff().path, hill(), ExportOptions(anchor=ANCHOR, vehicle=vehicle,
+                                                              end=end), agl=60.0)
+    s = m.summary()
+    assert s["energy"]["time_s"] == pytest.approx(s["flight"]["flight_time_s"], abs=0.11)
+    assert s["energy"]["time_s"] == pytest.approx(
+        float(m.waypoint_times[-1]) + s["flight"]["end_s"], abs=0.11)
+    n = len(m.waypoints.points_m)
+    assert 0 <= s["energy"]["no_return_waypoint"] <= n - 1  # a waypoint of the whole list
+
+
+def test_a_fixed_wing_pattern_costs_its_descent_s_power_over_its_time():
+    def fly(end):
+        m = build_mission(hill_tff().path, hill(), ExportOptions(
+            anchor=ANCHOR, vehicle="fixed_wing", end=end), agl=60.0)
+        return m, m.summary()
+
+    (land, ls), (rtl, rs) = fly("land"), fly("rtl")
+    v = land.options.forward_speed
+    assert land.info["flight"]["forward_speed_mps"] == v
+    model = POWER_MODELS[DEFAULT_POWER["fixed_wing"]]
+    # the same climb-out and route; the ends: the pattern (down from the last waypoint's
+    # height above ground over its time) against the line home at the forward speed
+    pattern_s, home_s = ls["flight"]["end_s"], rs["flight"]["end_s"]
+    assert pattern_s > 30.0  # loiter down, line up, approach
+    sink = land.waypoints.agl[-1] / pattern_s
+    expected_j = (float(model.power(v, -sink)) * pattern_s - float(model.power(v, 0.0))
+                  * home_s)
+    got_j = (ls["energy"]["energy_wh"] - rs["energy"]["energy_wh"]) * 3600.0
+    assert got_j == pytest.approx(expected_j, abs=0.02 * 3600.0)  # the summary's 0.01 Wh
+
+
+def test_an_rtl_descends_from_the_last_altitude_to_the_launch_s_ground():
+    w = hill()
+    g = lambda x, y: float(w.ground_height(x, y))  # noqa: E731
+    # from the low corner to the hilltop (ground ~90 m): the way home ends over the low
+    # launch, so the descent there is the last altitude above the launch's ground
+    path = np.array([[20.0, 20.0, g(20, 20) + 40], [120, 100, g(120, 100) + 40],
+                     [200.0, 150.0, g(200, 150) + 40]])
+    m = build_mission(path, w, ExportOptions(anchor=ANCHOR, vehicle="multirotor", end="rtl",
+                                             tolerance=0.0), agl=40.0)
+    s = m.summary()
+    p = m.waypoints.points_m
+    launch_ground = p[0, 2] - m.waypoints.agl[0]
+    descent = p[-1, 2] - launch_ground
+    assert descent > m.waypoints.agl[-1] + 50.0  # not the last waypoint's own height
+    home_s = np.hypot(*(p[-1, :2] - p[0, :2])) / m.options.forward_speed
+    assert s["flight"]["end_s"] == pytest.approx(
+        home_s + descent / s["flight"]["descent_rate_mps"], abs=0.11)
+    assert s["energy"]["time_s"] == pytest.approx(s["flight"]["flight_time_s"], abs=0.11)

@@ -146,3 +146,77 @@ def test_the_help_lists_the_library_s_scenarios_and_airframes():
 
     assert SCENARIO_NAMES == tuple(SCENARIOS)
     assert AIRFRAME_NAMES == tuple(AIRFRAMES)
+
+
+def test_the_scenarios_dimensions_are_the_library_s():
+    from fm2uav.cli.options import SCENARIOS_2D, scenario_ndim
+    from fm2uav.scenarios import SCENARIOS, get_scenario
+
+    assert SCENARIOS_2D == tuple(n for n in SCENARIOS if get_scenario(n).world.ndim == 2)
+    assert [scenario_ndim(n) for n in SCENARIOS] == [get_scenario(n).world.ndim
+                                                      for n in SCENARIOS]
+    assert scenario_ndim(None) == 3  # a --dem/--buildings world, or the default open field
+
+
+#: One-line value errors of the planning commands (and a missing input file): each answered before the world, numpy or
+#: the kernels load (issue 27: "any one-line input error in <= 0.3 s"). (argv, words the
+#: message must hold.)
+VALUE_ERRORS = [
+    (["plan", "--threads", "0"], ["threads", "--threads", ">= 1"]),
+    (["plan", "--order", "3"], ["--order", "1, 2"]),
+    (["plan", "--saturation", "2"], ["--saturation", "(0, 1]"]),
+    (["plan", "--storage", "bogus"], ["--storage", "'regional'"]),
+    (["plan", "--p1", "-1"], ["--p1"]),
+    (["plan", "--min-agl", "10"], ["--min-agl", "--agl"]),
+    (["plan", "--export", "foo"], ["--export", "'foo'"]),
+    (["plan", "--rally", "bogus"], ["--rally", "auto"]),
+    (["plan", "--start", "1,2"], ["--start", "3 numbers", "'1,2'"]),
+    (["plan", "--scenario", "city2d", "--goal", "1,2,3"], ["--goal", "2 numbers"]),
+    (["plan", "--via", "1,x,3"], ["--via 1", "numbers"]),
+    (["plan", "--lonlat", "--start", "200,40,50"], ["--start", "longitude"]),
+    (["plan", "--lonlat", "--start", "10,40"], ["--start", "no height", "--agl"]),
+    (["plan", "--lonlat", "--cells", "--start", "10,40,5"], ["--lonlat", "--cells"]),
+    (["routes", "--goal", "1,2,30", "--starts", "s.csv", "--threads", "0"], ["--threads"]),
+    (["routes", "--goal", "1,2,30", "--starts", "s.csv", "--speed", "0"], ["--speed"]),
+    (["routes", "--goal", "1", "--starts", "s.csv"], ["--goal", "LON,LAT"]),
+    (["routes", "--goal", "1,2,30", "--starts", "s.csv", "--exponent", "0"], ["--exponent"]),
+    (["check", "missing.csv"], ["path file", "missing.csv", "not found"]),
+    (["export", "missing.csv", "--scenario", "open-field"], ["path file", "not found"]),
+    # the formation's settings read the shapes (numpy): numpy, but not the planner
+    (["formation", "--followers", "0"], ["--followers", ">= 1"], {"numpy"}),
+]
+
+VALUE_PROBE = """
+import json, sys
+from typer.testing import CliRunner
+from fm2uav.cli import app
+
+heavy = {heavy!r}
+res = CliRunner().invoke(app, {argv!r})
+print(json.dumps({{"code": res.exit_code, "out": res.output,
+                  "loaded": sorted(m for m in heavy if m in sys.modules)}}))
+"""
+
+
+def test_value_errors_are_answered_before_the_heavy_libraries_load(tmp_path):
+    # the libraries (and fm2uav's modules that import them); the packages themselves
+    # (fm2uav.planning, .missions, .autopilot: lazy), fm2uav.planning.params,
+    # fm2uav.missions.formation.config and fm2uav._validate are light and may load: they
+    # make the checks
+    heavy = ("numpy", "numba", "llvmlite", "scipy", "matplotlib", "plotly", "rasterio",
+             "shapely", "pyproj", "pyogrio", "yaml", "fm2uav.eikonal", "fm2uav.world",
+             "fm2uav.planning.planner", "fm2uav.missions.route", "fm2uav.missions.coverage",
+             "fm2uav.missions.formation.mission", "fm2uav.scenarios", "fm2uav.autopilot.build",
+             "fm2uav.pipeline.routes", "fm2uav.experiments", "fm2uav.viz")
+    for argv, words, *allowed in VALUE_ERRORS:
+        argv = [*argv, "--out", str(tmp_path / "out")]
+        res = subprocess.run([sys.executable, "-c", VALUE_PROBE.format(heavy=heavy, argv=argv)],
+                             capture_output=True, text=True, timeout=300)
+        assert res.returncode == 0, res.stderr
+        report = json.loads(res.stdout.strip().splitlines()[-1])
+        assert report["code"] == 2, (argv, report)
+        message = " ".join(report["out"].split())
+        assert all(w in message for w in words), (argv, message)
+        assert "Traceback" not in report["out"]
+        assert set(report["loaded"]) <= (allowed[0] if allowed else set()), (argv, report)
+    assert not (tmp_path / "out").exists()  # refused before any output

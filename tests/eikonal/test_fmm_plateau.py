@@ -29,6 +29,16 @@ def paths(monkeypatch):
     return used
 
 
+@pytest.fixture
+def separate(monkeypatch):
+    """2D marches in the separate arrays, whose plateau mask these tests check: by default
+    a 2D map that is not uniform marches interleaved and reads every speed
+    (``_kernels._buffers``, tests/eikonal/test_kernels_layout.py)."""
+    original = _kernels._buffers
+    monkeypatch.setattr(_kernels, "_buffers", lambda speed, shape3, npad, lean, interleave:
+                        original(speed, shape3, npad, lean, False))
+
+
 def _without_plateau(fn):
     """``fn()`` with the plateau switched off (every speed read from the grid)."""
     with pytest.MonkeyPatch.context() as mp:
@@ -61,7 +71,7 @@ CASES = [((67, 53), 1.0), ((67, 53), (0.7, 1.1)), ((19, 23, 17), 1.0),
 @pytest.mark.parametrize("shape,spacing", CASES)
 @pytest.mark.parametrize("seed", [0, 1])
 def test_mask_gives_the_times_of_the_march_that_reads_every_speed(shape, spacing, order,
-                                                                   seed, paths):
+                                                                   seed, paths, separate):
     v = _plateau_field(shape, seed)
     src = _sources(v)
     T = fast_marching(v, src, order=order, spacing=spacing)
@@ -102,7 +112,7 @@ def test_lean_layout_plateau_is_the_float32_value_of_the_grid(shape, order, path
     np.testing.assert_array_equal(T, ref)
 
 
-def test_restart_keeps_the_plateau_times(paths):
+def test_restart_keeps_the_plateau_times(paths, separate):
     v = _plateau_field((50, 44), 2)
     src = _sources(v)[:1]
     T0 = fast_marching(v, src, order=1)
@@ -134,7 +144,7 @@ def test_plateau_bits_mark_the_padded_nodes_at_the_largest_speed(shape3):
 
 
 @pytest.mark.parametrize("share,path", [(0.3, "none"), (0.8, "mask")])
-def test_mask_only_above_the_share_that_pays(share, path, paths):
+def test_mask_only_above_the_share_that_pays(share, path, paths, separate):
     v = _plateau_field((60, 60), 4, share=share, walls=0.0)
     fast_marching(v, [(30, 30)], order=1)
     assert paths == [path]
@@ -144,3 +154,21 @@ def test_speed_range_ignores_walls():
     assert _kernels.speed_range(np.array([0.0, 2.0, 0.5, 0.0])) == (0.5, 2.0)
     lo, hi = _kernels.speed_range(np.zeros(4))
     assert lo == np.inf and hi == 0.0
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_a_2d_map_with_a_plateau_marches_interleaved_without_the_mask(order, paths):
+    # the interleaved layout reads a speed beside each time faster than the mask spares
+    # it (docs/performance.md): a mixed 2D map builds no mask, and its times are those
+    # of the separate arrays with the mask
+    v = _plateau_field((67, 53), 0)
+    src = _sources(v)
+    T = fast_marching(v, src, order=order)
+    assert paths == ["none"]
+    with pytest.MonkeyPatch.context() as mp:
+        original = _kernels._buffers
+        mp.setattr(_kernels, "_buffers", lambda speed, shape3, npad, lean, interleave:
+                   original(speed, shape3, npad, lean, False))
+        ref = fast_marching(v, src, order=order)
+    assert paths == ["none", "mask"]
+    np.testing.assert_array_equal(T, ref)

@@ -121,3 +121,45 @@ def test_parallel_group_caches_the_lean_layout_of_a_big_two_thread_march(tmp_pat
     res = _run(["-c", float64_only], tmp_path / "small")
     assert res.returncode == 0, res.stderr
     assert _run(["-c", later], tmp_path / "small").stdout.split() == ["compiled"]
+
+
+_LATER_2D_RUN = textwrap.dedent(
+    """
+    import numpy as np
+    from fm2uav import _jit
+    compiled = []
+    _jit.on_first_compile(lambda: compiled.append(1))
+    from fm2uav.eikonal import distance_map, fast_marching
+    occ = np.zeros((40, 36), dtype=bool)
+    occ[10:14, :30] = True
+    W = np.sqrt(distance_map(occ, spacing=15.0))
+    for speed in (W / W.max(), (W > 0) * 1.0):  # an FM² map (interleaved), a uniform one
+        for order in ORDERS:
+            T = fast_marching(speed, [(30, 5)], spacing=15.0, order=order, stop_at=[(0, 0)])
+            assert np.isfinite(T[0, 0])
+    print("compiled" if compiled else "cached")
+    """
+)
+
+
+@pytest.mark.slow
+def test_2d_groups_cache_both_layouts_of_a_2d_plan(tmp_path):
+    # a 2D FM² map marches interleaved, a uniform one in separate arrays (their padding
+    # compiles per layout): after the 2D groups neither compiles; a march of a uniform
+    # speed alone (the groups' run before the interleaved layout) leaves one to compile
+    groups = ["edt", "fmm2d_o1", "fmm2d_o2"]
+    res = _run(["-m", "fm2uav.planning.warmup", *groups], tmp_path / "groups")
+    assert res.returncode == 0, res.stderr
+    later = _LATER_2D_RUN.replace("ORDERS", "(1, 2)")
+    res = _run(["-c", later], tmp_path / "groups")
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.split() == ["cached"]
+    uniform_only = ("import numpy as np\n"
+                    "from fm2uav.eikonal import distance_map, fast_marching\n"
+                    "distance_map(np.eye(4, dtype=bool))\n"
+                    "fast_marching(np.ones((5, 5)), [(2, 2)], order=1)\n")
+    res = _run(["-c", uniform_only], tmp_path / "uniform")
+    assert res.returncode == 0, res.stderr
+    res = _run(["-c", _LATER_2D_RUN.replace("ORDERS", "(1,)")], tmp_path / "uniform")
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.split() == ["compiled"]

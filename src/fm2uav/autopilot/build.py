@@ -540,7 +540,7 @@ def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: Speeds, start_hold
     """
     from ..vehicles.airframes import default_endurance
     from ..vehicles.endurance import FlightTime, check_endurance, flight_time
-    from .energy import mission_energy
+    from .energy import ClimbOutClock, mission_energy
 
     climb = opt.climb_rate or DEFAULT_CLIMB[opt.vehicle]
     descent = opt.descent_rate or DEFAULT_DESCENT[opt.vehicle]
@@ -549,7 +549,11 @@ def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: Speeds, start_hold
     start_xy, end_xy = p[0, :2], p[-1, :2]
     fixed = opt.vehicle == "fixed_wing"
     hover = opt.vehicle == "multirotor"
-    final = 0.0 if end == "loiter" or (fixed and end in ("rtl", "land")) else float(wps.agl[-1])
+    # the final descent: at the last waypoint (land), or over home after the line back (rtl:
+    # from the last waypoint's altitude to the launch's ground)
+    final = (0.0 if end == "loiter" or (fixed and end in ("rtl", "land")) else
+             float(max(p[-1, 2] - (p[0, 2] - wps.agl[0]), 0.0)) if end == "rtl" else
+             float(wps.agl[-1]))
     holds = sp.holds[first - 1:].copy()
     ft = flight_time(p[first - 1:], sp.commanded[first - 1:], climb_rate=climb,
                      descent_rate=descent, takeoff_climb=0.0 if fixed else float(wps.agl[0]),
@@ -588,10 +592,14 @@ def _flight(wps: Waypoints, opt: ExportOptions, end: str, sp: Speeds, start_hold
         if opt.endurance_s is None:
             warning += (f" (endurance: {source.split('; give')[0]}; give your vehicle's with "
                         "airframe.endurance / --endurance)")
+    # the energy flies the flight time's phases (a fixed-wing's climb-out and pattern too)
     energy = mission_energy(wps.points_m, wps.agl, vehicle=opt.vehicle, power=opt.power,
                             battery_wh=opt.battery_wh, reserve=opt.reserve, speeds=sp.commanded,
                             holds=sp.holds, forward_speed=opt.forward_speed, climb_rate=climb,
-                            descent_rate=descent, end=end, wind=opt.wind)
+                            descent_rate=descent, end=end, wind=opt.wind,
+                            climb_out=ClimbOutClock(first, float(takeoff_s),
+                                                    _entry_length(climb_out, p, first),
+                                                    float(landing_s)) if fixed else None)
     info: dict[str, Any] = {"energy": energy, "flight": {
         **rep.summary(), "warning": warning, "endurance_source": source, **where,
         "climb_rate_mps": climb, "descent_rate_mps": descent,

@@ -180,9 +180,13 @@ def route_samples(mission: Any, step: float | None = None, *, max_points: int | 
     Returns
     -------
     RouteSamples
-    """
-    from ..vehicles.endurance import flight_time
+        Timed on the mission's own clock (:attr:`MissionExport.waypoint_times`).
 
+    Raises
+    ------
+    ValueError
+        A mission without its waypoint times (not made by ``build_mission``).
+    """
     wps = mission.waypoints
     world = mission.world
     opt = mission.options
@@ -191,12 +195,9 @@ def route_samples(mission: Any, step: float | None = None, *, max_points: int | 
     terrain = wps.frame == 10
     speeds, holds = leg_speeds(mission.items, n, opt.forward_speed)
     t_wp = getattr(mission, "waypoint_times", None)
-    if t_wp is None or len(t_wp) != n:  # a mission built without its clock: the legs as written
-        climb, descent = _rates(mission)
-        ft = flight_time(p, speeds if len(speeds) else opt.forward_speed, climb_rate=climb,
-                         descent_rate=descent, takeoff_climb=float(wps.agl[0]), holds=holds,
-                         hover=opt.vehicle == "multirotor")
-        t_wp = ft.elapsed()
+    if t_wp is None or len(t_wp) != n:  # build_mission always sets it: one clock, no other
+        raise ValueError("route_samples needs the mission's waypoint_times (one per waypoint, "
+                         "as build_mission sets them)")
     t_wp = np.asarray(t_wp, dtype=float)
     seg3 = np.linalg.norm(np.diff(p, axis=0), axis=1)
     cum3 = np.concatenate([[0.0], np.cumsum(seg3)])

@@ -264,18 +264,31 @@ def handle_errors(func: F) -> F:
     return wrapper  # type: ignore[return-value]
 
 
-def parse_point(text: str, ndim: int, what: str) -> np.ndarray:
-    """Parse ``"x,y,z"`` (commas or spaces) into a float array of length ``ndim``."""
-    import numpy as np
+def point_numbers(text: str, ndim: int, what: str) -> list[float]:
+    """The ``ndim`` numbers of ``"x,y,z"`` (commas or spaces), pure Python: the command line
+    checks a point's text before the world (and numpy) loads.
 
+    Raises
+    ------
+    InputError
+        Not numbers, or not ``ndim`` of them (names ``--<what>``).
+    """
     parts = [p for p in text.replace(",", " ").split() if p]
     try:
-        values = np.array([float(p) for p in parts])
+        values = [float(p) for p in parts]
     except ValueError:
         raise InputError(f"--{what} must be {ndim} numbers like 300,300,300; got {text!r}") from None
-    if values.size != ndim:
-        raise InputError(f"--{what} needs {ndim} numbers (x,y[,z]); got {values.size} in {text!r}")
+    if len(values) != ndim:
+        raise InputError(f"--{what} needs {ndim} numbers (x,y[,z]); got {len(values)} in {text!r}")
     return values
+
+
+def parse_point(text: str, ndim: int, what: str) -> np.ndarray:
+    """Parse ``"x,y,z"`` (commas or spaces) into a float array of length ``ndim``
+    (:func:`point_numbers`)."""
+    import numpy as np
+
+    return np.array(point_numbers(text, ndim, what))
 
 
 def print_summary(

@@ -81,6 +81,9 @@ def check_cmd(
     world: WorldFlags = None,
 ) -> None:
     """``fm2uav check``: parse, :func:`~fm2uav.vehicles.check_feasibility`, write, print."""
+    from .._validate import input_file
+
+    input_file(path_file, "path file")  # before the library loads: a wrong name answers at once
     from .. import progress
     from ..io import read_path_csv
     from ..vehicles import TrackingOptions, check_feasibility, get_airframe

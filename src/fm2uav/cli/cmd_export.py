@@ -74,6 +74,9 @@ def export_cmd(
     output: Output = None,
 ) -> None:
     """``fm2uav export``: read the path, :func:`~fm2uav.io.export_mission`, write, print."""
+    from .._validate import input_file
+
+    input_file(path_file, "path file")  # before the library loads: a wrong name answers at once
     from .. import progress
     from ..io import EXPORT_FILES, parse_formats
 

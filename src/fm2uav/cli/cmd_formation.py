@@ -167,22 +167,23 @@ def formation_cmd(
 ) -> None:
     """``fm2uav formation``: parse, :func:`~fm2uav.experiments.formation.fly_and_summarise`,
     one mission per UAV, write, print."""
+    from ..missions.formation.config import MAX_FOLLOWERS, FormationConfig
+
+    # before a name per follower is made, and before the planner loads
+    if not 1 <= followers <= MAX_FOLLOWERS:
+        FormationConfig(n_followers=followers)  # raises the one-line error naming --followers
     import numpy as np
 
     from ..errors import InputError
     from ..experiments.formation import fly_and_summarise, summary_rows
     from ..io.exports import EXPORT_FILES, export_formation, file_prefix
-    from ..missions.formation import FormationConfig
     from ..autopilot.geofence import zone_fences
     from ..scenarios.scenario import Scenario
     from ..world.load import check_points, world_summary
-    from ..missions.formation.config import MAX_FOLLOWERS
     from ..viz.formation import check_frames
     from .cmd_run import write_exports
 
     check_frames(frames)  # also with --no-gif: a given value is never silently garbage
-    if not 1 <= followers <= MAX_FOLLOWERS:  # before a name per follower is made
-        FormationConfig(n_followers=followers)  # raises the one-line error naming --followers
     w, sc, scenario = world.build(scenario, start, goal, seed=seed, lonlat=lonlat, agl=agl,
                                   default="fissure")
     if agl is not None and level is not None:

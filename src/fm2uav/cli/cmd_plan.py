@@ -14,9 +14,11 @@ from .options import (
     MissionFlags,
     ScenarioOpt,
     WorldFlags,
+    check_point_texts,
     cli_point,
     mission_options,
     output_options,
+    scenario_ndim,
     world_options,
     world_rows,
 )
@@ -88,28 +90,31 @@ def plan_cmd(
     """``fm2uav plan``: parse, :func:`~fm2uav.missions.route.plan_route`, write, print."""
     from ._first_use import announce_compile, fmm_group
 
+    # the flags' own checks before any heavy import (a bad value answers in ~0.2 s)
+    returns.check()
+    shaping, level, options = planner.objects()
+    extra = _extra_formats(export, output.report)
+    check_point_texts({"start": start, "goal": goal,
+                       **{f"via {k + 1}": v for k, v in enumerate(mission.via or [])}},
+                      scenario=scenario, lonlat=lonlat, cells=cells, agl=planner.agl)
     announce_compile(quiet=output.quiet,
-                     child_group=fmm_group(order=planner.order,
-                                           ndim=2 if scenario == "city2d" else 3),
+                     child_group=fmm_group(order=planner.order, ndim=scenario_ndim(scenario)),
                      preload=("fm2uav.missions.route", "fm2uav.viz", "fm2uav.io"))
     from .. import progress
     from ..missions.route import plan_route
     from ..world.load import world_summary
 
-    returns.check()
     with output.progress():
         progress.step("building the world", 0.1)
         agl = planner.agl
         w, sc, scenario = world.build(scenario, start, goal, seed=seed, lonlat=lonlat, agl=agl)
         description = sc.description if sc is not None else f"real data: {scenario}"
-        extra = _extra_formats(export, output.report)
         export_options = mission.export_options(_export_options(anchor, thin))
         outdir = output.dir(PLAN_FILES + tuple(output_names(extra)))
 
         w, start_m, goal_m, via_m = _points(
             w, sc, start, goal, mission.via, world=world, no_fly=no_fly, lonlat=lonlat,
             cells=cells, agl=agl, anchor=getattr(export_options, "anchor", None))
-        shaping, level, options = planner.objects()
         export_options = with_wind_on(export_options, w)
         progress.step("planning (FM²)", 0.6)
         route = plan_route(w, start_m, goal_m, via=via_m,

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import typer
@@ -11,7 +12,9 @@ from ._common import Output, handle_errors, write_text
 from .options import (
     ScenarioOpt,
     WorldFlags,
+    check_point_texts,
     output_options,
+    scenario_ndim,
     world_options,
     world_rows,
 )
@@ -70,24 +73,25 @@ def routes_cmd(
     """``fm2uav routes``: parse, :func:`~fm2uav.pipeline.routes.run_routes`, print."""
     from ._first_use import announce_compile, fmm_group
 
+    # the flags' own checks before any heavy import (a bad value answers in ~0.2 s)
+    if not (math.isfinite(speed) and 0.1 <= speed <= 300.0):
+        raise InputError(f"--speed must be a ground speed in [0.1, 300] m/s, got {speed:g}")
+    if not (math.isfinite(thin) and 0.0 <= thin <= 1000.0):
+        raise InputError(f"--thin must be a tolerance in [0, 1000] m, got {thin:g}")
+    if threads is not None and threads < 1:
+        raise InputError(f"--threads must be at least 1, got {threads}")
+    shaping, level, options = planner.objects(storage="full")
+    check_point_texts({"goal": goal}, scenario=scenario, lonlat=True, cells=False,
+                      agl=planner.agl)
     announce_compile(quiet=output.quiet,
-                     child_group=fmm_group(order=planner.order,
-                                           ndim=2 if scenario == "city2d" else 3),
+                     child_group=fmm_group(order=planner.order, ndim=scenario_ndim(scenario)),
                      preload=("fm2uav.planning.many",))
-    import numpy as np
-
     from .. import progress
     from ..io.starts import read_starts
     from ..pipeline.routes import ROUTES_FILES, RouteSettings, routes_rows, run_routes
     from ..world.load import world_summary
     from .options import lonlat_point
 
-    if not (np.isfinite(speed) and 0.1 <= speed <= 300.0):
-        raise InputError(f"--speed must be a ground speed in [0.1, 300] m/s, got {speed:g}")
-    if not (np.isfinite(thin) and 0.0 <= thin <= 1000.0):
-        raise InputError(f"--thin must be a tolerance in [0, 1000] m, got {thin:g}")
-    if threads is not None and threads < 1:
-        raise InputError(f"--threads must be at least 1, got {threads}")
     agl = planner.agl
     with output.progress():
         progress.step("building the world", 0.1)
@@ -102,7 +106,6 @@ def routes_cmd(
 
             w = with_zones(w, zones_from_cli(no_fly, w, crs=world.crs))
             check_points_allowed(w, {"goal": goal_m})
-        shaping, level, options = planner.objects(storage="full")
         progress.step("reading the starts", 0.05)
         table = read_starts(starts, w, agl=agl, crs=world.crs, id_field=id_field,
                             anchor=anchor_ll)

@@ -37,7 +37,7 @@ __all__ = [
     "NodataOpt", "NodataValueOpt", "CrsOpt", "DefaultHeightOpt", "AllowFilledOpt", "LonLatOpt",
     "GroundElevationOpt", "MarginOpt",
     "ScenarioOpt", "SCENARIO_NAMES", "AIRFRAME_NAMES", "WORLD_FLAGS", "world_spec",
-    "build_world", "cli_point", "lonlat_point", "world_rows", "requested_heights",
+    "build_world", "cli_point", "lonlat_point", "check_point_texts", "scenario_ndim", "world_rows", "requested_heights",
     "world_overrides", "point_overrides", "option_group", "WorldFlags", "world_options", "MissionFlags",
     "MISSION_FLAGS", "mission_options", "output_options", "NoFlyOpt", "MinAglOpt", "MaxAglOpt",
     "SaturationDistanceOpt", "SafetyFlags", "safety_options",
@@ -116,6 +116,9 @@ LonLatOpt = Annotated[bool, typer.Option(
 SCENARIO_NAMES = ("open-field", "fissure", "jacksboro", "city", "city-high", "coverage",
                   "city2d")
 AIRFRAME_NAMES = ("disco", "crosswind", "plane-jet", "arducopter")
+#: The built-in scenarios on a 2D map (every other one, and every --dem/--buildings world,
+#: is 3D; tests/cli/test_light.py keeps it equal to the library's).
+SCENARIOS_2D = ("city2d",)
 
 ScenarioOpt = Annotated[str | None, typer.Option(
 
@@ -333,6 +336,21 @@ def lonlat_point(text: str, what: str, world: Any, *, agl: float | None = None,
     """
     from ..io.mission import PointSpec, resolve_point
 
+    lon, lat, h = lonlat_numbers(text, what, ndim=world.ndim, agl=agl)
+    return resolve_point(PointSpec(lon=lon, lat=lat, agl=h), world, anchor, what)
+
+
+def lonlat_numbers(text: str, what: str, *, ndim: int, agl: float | None
+                   ) -> tuple[float, float, float]:
+    """``(lon, lat, agl)`` of a ``--<what> LON,LAT[,AGL]`` text, checked (pure Python: also
+    before the world loads); the height defaults to ``agl``; a 2D map (``ndim`` 2) takes
+    none (1.0 is returned).
+
+    Raises
+    ------
+    InputError
+        Not 2 or 3 numbers, not a WGS84 position, no height on a 3D map, a height <= 0.
+    """
     parts = [p for p in text.replace(",", " ").split() if p]
     try:
         v = [float(p) for p in parts]
@@ -344,13 +362,52 @@ def lonlat_point(text: str, what: str, world: Any, *, agl: float | None = None,
     if not (-180 <= v[0] <= 180 and -90 <= v[1] <= 90):
         raise InputError(f"--{what} = {text!r}: longitude must be in [-180, 180] and "
                          "latitude in [-90, 90] degrees (order LON,LAT)")
-    h = v[2] if len(v) == 3 else (agl if world.ndim == 3 else 1.0)  # 2D: xy alone
+    h = v[2] if len(v) == 3 else (agl if ndim == 3 else 1.0)  # 2D: xy alone
     if h is None:
         raise InputError(f"--{what} {text!r} has no height: add ,AGL (metres above the "
                          "ground) or give --agl")
-    if h <= 0:
+    if not h > 0:
         raise InputError(f"--{what}: the height above ground must be > 0 m, got {h:g}")
-    return resolve_point(PointSpec(lon=v[0], lat=v[1], agl=float(h)), world, anchor, what)
+    return v[0], v[1], float(h)
+
+
+def scenario_ndim(scenario: str | None) -> int:
+    """The dimensions of the map of ``--scenario`` (3 for a data world or the default)."""
+    return 2 if scenario in SCENARIOS_2D else 3
+
+
+def check_point_texts(points: dict[str, str | None], *, scenario: str | None, lonlat: bool,
+                      cells: bool, agl: float | None) -> None:
+    """The ``--start``/``--goal``/``--via`` texts checked before the world loads.
+
+    The numbers and their count (metres or cells: the map's dimensions,
+    :func:`scenario_ndim`), a ``LON,LAT[,AGL]`` text as :func:`lonlat_numbers` checks it
+    (``agl``: ``--agl``), ``--lonlat`` with ``--cells``. Where the points fall on the map is
+    checked once it is built (:func:`cli_point`, ``check_points``).
+
+    Parameters
+    ----------
+    points
+        ``{"start": text, "goal": text, "via 1": text, ...}``; None: not given.
+    scenario, lonlat, cells, agl
+        ``--scenario``, ``--lonlat``, ``--cells``, ``--agl``.
+
+    Raises
+    ------
+    InputError
+        Naming the flag, as :func:`cli_point` would later.
+    """
+    from ._common import point_numbers
+
+    given = {what: text for what, text in points.items() if text is not None}
+    if lonlat and cells and given:
+        raise InputError("give --lonlat or --cells, not both")
+    ndim = scenario_ndim(scenario)
+    for what, text in given.items():
+        if lonlat:
+            lonlat_numbers(text, what, ndim=ndim, agl=agl)
+        else:
+            point_numbers(text, ndim, what)
 
 
 def requested_heights(*texts: str | None, lonlat: bool, agl: float | None

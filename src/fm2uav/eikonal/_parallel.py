@@ -14,7 +14,10 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
 * The grid is cut along x (the slowest-varying axis of the C layout) into
   ``K`` slabs, :data:`SLABS_PER_THREAD` per thread, thread ``t`` marching slabs
   ``t, t + threads, ...`` (interleaved strips keep both threads busy when the
-  wave starts off-centre, and a coarse march places the cuts, :func:`slab_bounds`).
+  wave starts off-centre, and a coarse march places the cuts, :func:`slab_bounds`),
+  unless sharing them longest first by the last window's freezes promises a shorter
+  window (:func:`_assign`, before every window). The set-up pads the slabs in parallel
+  (:func:`_pad_slabs`) and the result is unpadded so (:func:`_unpad_slabs`).
   Each slab is a padded grid of its own, laid out exactly as the
   serial march's (:func:`fm2uav.eikonal._kernels.pad_grid`), one after the other
   in one buffer (the serial march's kept huge-page buffers; in the lean layout of big
@@ -49,6 +52,7 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
 
 from __future__ import annotations
 
+import contextlib
 import os
 
 import numpy as np
@@ -60,7 +64,7 @@ from . import _kernels
 from ._heap import sift_down, sift_up
 from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _U, _ZERO, RESERVE_BLOCKS, BLOCK,
                        _at_plateau, _axis_term, _axis_term_u, _bits, _bucket, _prefetch, _combine,
-                       _pop, _push, _rhs, _side_min, _solve_iso)
+                       _pop, _push, _rhs, _side_min, _solve_iso, pad_grid, unpad_grid)
 
 #: The windows meet at a barrier several hundred times per march: a thread that waits
 #: there sleeps instead of spinning (OpenMP's default spins), or on a busy machine the
@@ -104,7 +108,8 @@ MIN_SLAB_NODES = 2**17
 #: the exchange reads only the nodes frozen in the boundary rows). In 2D the better
 #: balance of 8 did not show in wall time on the idle machine (2048², 2 threads, medians
 #: of 5 interleaved: constant 0.257/0.261 s, smooth 0.292/0.302 s, FM²-shaped
-#: 0.234/0.248 s with 4/8 slabs per thread): 2D keeps 4.
+#: 0.234/0.248 s with 4/8 slabs per thread): 2D keeps 4. (With :data:`SHARE_SLABS`, 2D
+#: FM²-shaped 4/8: balance 1.76/1.81 for 2.2x the re-opened nodes.)
 SLABS_PER_THREAD = {2: 4, 3: 4}
 #: Target number of nodes frozen per window (all slabs together); the window
 #: width adapts to it. Fewer, wider windows cost fewer barriers and more repairs:
@@ -112,6 +117,12 @@ SLABS_PER_THREAD = {2: 4, 3: 4}
 #: speed 8192/16384/32768 nodes 1.15x/0.97x/0.85x; FM²-shaped 32768/65536 0.92x/2.4x
 #: (wider windows than the wave's crossing of a slab re-open nodes in cascades).
 WINDOW_NODES = 32768
+#: Share the slabs among the threads anew before every window, longest first by the
+#: freezes of the last window, when that predicts a shorter window than the fixed
+#: interleave (:func:`_assign`); False: always the interleave. Windows' balance with /
+#: without (2 threads, 4 slabs per thread): FM²-shaped 2048^2 1.654 -> 1.759, 160^3 1.84 ->
+#: 1.90; constant speed the same (1.99, 1.93 -> 1.95).
+SHARE_SLABS = True
 #: Free repair-heap slots kept before each node's pushes (one pop pushes at most 7).
 HEAP_RESERVE = 8
 #: Order 2: one pop queues at most 13 entries (six neighbours, the six nodes two away, the
@@ -367,20 +378,21 @@ def _slab_kernels(three):
                            rkey, ritem, ctl)
         ctl[_C_POPS] = pops
 
-    def start(T, V, U, qp, fixed, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl):
-        """Queue the slab's band nodes given on entry and expand its frozen ones."""
-        n = _U(T.size)
+    def start(T, V, U, qp, fixed, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl,
+              c0, c1):
+        """Queue the slab's band nodes given on entry and expand its frozen ones (all in
+        its nodes ``[c0, c1)``, the rows of the start box: the others are far or walls)."""
         use_u = qp > 0.0
-        c = sx
-        while c < n - sx:
+        c = c0
+        while c < c1:
             x = T[c]
             if x < 0.0 and x > -_INF:
                 if not _room(st, rkey):
                     return False
                 _enq(_bits(-x), c, pool, nxt, bk, mw, st, rkey, ritem)
             c += _ONE
-        c = sx
-        while c < n - sx:
+        c = c0
+        while c < c1:
             if T[c] >= 0.0:
                 if not _room(st, rkey):
                     return False
@@ -674,21 +686,21 @@ def _slab_kernels2(three):
                                      eidx, evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl)
         ctl[_C_POPS] = pops
 
-    def start(T, V, U, qp, fixed, sx, sy, ih, pool, nxt, bk, mw, st, rkey, ritem, ctl):
-        """Queue the slab's band nodes given on entry and expand its frozen ones (order 2)."""
-        n = _U(T.size)
-        g = sx + sx
+    def start(T, V, U, qp, fixed, sx, sy, ih, pool, nxt, bk, mw, st, rkey, ritem, ctl, c0, c1):
+        """Queue the slab's band nodes given on entry and expand its frozen ones (order 2;
+        all in its nodes ``[c0, c1)``, the rows of the start box: the others are far or
+        walls)."""
         use_u = qp > 0.0
-        c = g
-        while c < n - g:
+        c = c0
+        while c < c1:
             x = T[c]
             if x < 0.0 and x > -_INF:
                 if not _room2(st, rkey):
                     return False
                 _enq(_bits(-x), c, pool, nxt, bk, mw, st, rkey, ritem)
             c += _ONE
-        c = g
-        while c < n - g:
+        c = c0
+        while c < c1:
             if T[c] >= 0.0:
                 if not _room2(st, rkey):
                     return False
@@ -754,22 +766,89 @@ def _heap_next(T, st, ritem, ctl):
             ctl[_C_NEXT] = -x
 
 
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _assign(work, nth, slabs, first, load, share=True):
+    """Share the slabs among the threads for the next window: thread ``t`` runs slabs
+    ``slabs[first[t]:first[t + 1]]``.
+
+    ``work[k]`` predicts slab ``k``'s freezes (those of its last window: the wave moves
+    little from one window to the next). The longest-first greedy split (each slab, the
+    largest first, to the thread with the least so far) is kept when it predicts a
+    smaller largest share than the fixed interleave (slab ``k`` to thread ``k % nth``),
+    which is kept otherwise (and before the first window, all predictions 0). On the
+    FM²-shaped 2048^2 map the windows' balance rises from ~1.65 to ~1.75: while the wave
+    crosses few slabs, the fixed interleave may give two busy slabs to one thread.
+    ``load`` (``nth`` floats) and ``first[nth + 1:]`` (``K`` ints) are scratch;
+    ``share=False``: always the fixed interleave. Returns whether the greedy split was taken.
+    """
+    K = work.size
+    fixed_max = 0.0
+    for t in range(nth):
+        mine = 0.0
+        for k in range(t, K, nth):
+            mine += work[k]
+        fixed_max = max(fixed_max, mine)
+    # slabs by decreasing predicted work (insertion sort: a few dozen slabs at most)
+    for i in range(K):
+        slabs[i] = i
+    for i in range(1, K):
+        k = slabs[i]
+        j = i - 1
+        while j >= 0 and work[slabs[j]] < work[k]:
+            slabs[j + 1] = slabs[j]
+            j -= 1
+        slabs[j + 1] = k
+    for t in range(nth):
+        load[t] = 0.0
+    owner = first[nth + 1:]  # scratch: the owner of each slab (K entries)
+    for i in range(K):
+        k = slabs[i]
+        best = 0
+        for t in range(1, nth):
+            if load[t] < load[best]:
+                best = t
+        owner[k] = best
+        load[best] += work[k]
+    greedy_max = 0.0
+    for t in range(nth):
+        greedy_max = max(greedy_max, load[t])
+    greedy = share and greedy_max < fixed_max
+    if not greedy:
+        for k in range(K):
+            owner[k] = k % nth
+    # the lists, each thread's slabs in increasing order
+    i = 0
+    for t in range(nth):
+        first[t] = i
+        for k in range(K):
+            if owner[k] == t:
+                slabs[i] = k
+                i += 1
+    first[nth] = i
+    return greedy
+
+
 def _drive_kernel(three, order=1):
     """The compiled driver of one dimension and order (the parallel region runs the slabs)."""
     def drive(nth, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, rows, sx, sy, ih, hh, iso, pool,
-              nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win, first, stops):
+              nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win, first, stops, slabs, lists, load,
+              share, scan):
         """Run windows until every queue is empty; 0 done, 1/2 grow pool/heap and call again.
 
         ``win`` (float64): [0] window end, [1] width, [2] windows run, [3] target pops,
         [4] nodes frozen (re-freezes included), [5] sum over windows of the most a slab
         froze (the critical path: ``[4] / [5]`` bounds the speed-up), [6] the latest
         stop node's time when the stop nodes ``stops`` (indices into ``Tp``) ended it,
-        [7] 1 once the start (``first``) is done. ``U``, ``qp``: the plateau mask over
+        [7] 1 once the start (``first``) is done, [8] windows whose slabs :func:`_assign`
+        shared longest-first. ``U``, ``qp``: the plateau mask over
         ``Tp`` (one byte: every node) and its ``1 / speed^2`` (0: none); ``sent``, ``ns``:
         each slab's nodes frozen in its boundary rows in the last window (see ``window``).
         ``fl``: order 2's bit masks over ``Tp`` (re-opened, suspect, raised; unused by
         order 1), ``eidx``, ``evals`` its nodes in the band on entry (indices into ``Tp``,
         sorted) and their times; each slab has ``order`` ghost x-slabs on each side.
+        ``slabs`` (K), ``lists`` (nth + 1 + K), ``load`` (nth): scratch of :func:`_assign`
+        (``share``: :data:`SHARE_SLABS`). ``scan[k]``: the nodes of slab ``k`` the start
+        reads (the start box's rows).
         """
         K = off.size
         sxi = np.int64(sx)
@@ -782,15 +861,17 @@ def _drive_kernel(three, order=1):
                     V = Vp[off[k]:end[k]]
                     Uk = U[0 if U.size == 1 else off[k] >> 3:]
                     F = fx[off[k] >> 3:]
+                    c0 = _U(scan[k, 0])
+                    c1 = _U(scan[k, 1])
                     if order == 2 and three:
                         ok = _start3d_o2(T, V, Uk, qp, F, sx, sy, ih, pool[k], nxt[k], bk[k],
-                                         mw[k], st[k], rkey[k], ritem[k], ctl[k])
+                                         mw[k], st[k], rkey[k], ritem[k], ctl[k], c0, c1)
                     elif order == 2:
                         ok = _start2d_o2(T, V, Uk, qp, F, sx, sy, ih, pool[k], nxt[k], bk[k],
-                                         mw[k], st[k], rkey[k], ritem[k], ctl[k])
+                                         mw[k], st[k], rkey[k], ritem[k], ctl[k], c0, c1)
                     else:
                         ok = _start(three, T, V, Uk, qp, F, sx, sy, ih, hh, iso, pool[k], nxt[k],
-                                    bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k])
+                                    bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k], c0, c1)
                     if not ok:
                         ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < low else 2.0
             for k in range(K):
@@ -798,9 +879,14 @@ def _drive_kernel(three, order=1):
                     return int(ctl[k, _C_STATUS])  # grown, the start runs again
             win[7] = 1.0
         while True:
+            # the slabs of each thread for the exchange and the window (from the last
+            # window's freezes)
+            if _assign(ctl[:, _C_POPS], nth, slabs, lists, load, share):
+                win[8] += 1.0
             # exchange: each slab refreshes its own ghosts and the rows next to them
-            for t in prange(nth):  # thread t runs slabs t, t + nth, ...
-                for k in range(t, K, nth):
+            for t in prange(nth):  # thread t runs slabs[lists[t]:lists[t + 1]]
+                for i in range(lists[t], lists[t + 1]):
+                    k = slabs[i]
                     T = Tp[off[k]:end[k]]
                     V = Vp[off[k]:end[k]]
                     Uk = U[0 if U.size == 1 else off[k] >> 3:]
@@ -878,14 +964,15 @@ def _drive_kernel(three, order=1):
             else:
                 win[0] = win[0] + win[1]
             tw = win[0]
-            for t in prange(nth):  # thread t runs slabs t, t + nth, ...
-                for k in range(t, K, nth):
+            for t in prange(nth):  # thread t runs slabs[lists[t]:lists[t + 1]]
+                for i in range(lists[t], lists[t + 1]):
+                    k = slabs[i]
                     if order == 2:
                         args = (Tp[off[k]:end[k]], Vp[off[k]:end[k]],
                                 U[0 if U.size == 1 else off[k] >> 3:], qp, fx[off[k] >> 3:],
                                 fl[0, off[k] >> 3:], fl[1, off[k] >> 3:], fl[2, off[k] >> 3:],
-                                eidx, evals, _U(off[k]), sx, sy, ih, tw, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
-                                ritem[k], ctl[k], sent[k], ns[k])
+                                eidx, evals, _U(off[k]), sx, sy, ih, tw, pool[k], nxt[k], bk[k],
+                                mw[k], st[k], rkey[k], ritem[k], ctl[k], sent[k], ns[k])
                         if three:
                             _window3d_o2(*args)
                         else:
@@ -900,8 +987,8 @@ def _drive_kernel(three, order=1):
             most = 0.0
             for t in range(nth):
                 mine = 0.0
-                for k in range(t, K, nth):
-                    mine += ctl[k, _C_POPS]
+                for i in range(lists[t], lists[t + 1]):
+                    mine += ctl[slabs[i], _C_POPS]
                 pops += mine
                 most = max(most, mine)
             win[4] += pops
@@ -923,8 +1010,11 @@ _DRIVES = {(d, o): _drive_kernel(d == 3, o) for d in (2, 3) for o in (1, 2)}
 
 
 #: The split of two slabs is chosen on a march over every ``COARSE``-th node per axis
-#: (2D; 3D: ``COARSE_3D``), ~1.5 % of the work of the full march.
-COARSE = 8
+#: (2D; 3D: ``COARSE_3D``), ~0.5 % (2D) and ~1.5 % (3D) of the work of the full march
+#: (serial time: the second thread waits). 2D: the windows' balance on FM²-shaped 2048^2
+#: maps (seeds 0-3, with :func:`_assign`) averaged 1.827 / 1.823 / 1.813 / 1.768 with
+#: every 8th / 16th / 32nd node / equal slabs, the coarse march 8 / 2 / 0.5 ms.
+COARSE = 16
 COARSE_3D = 4
 #: Bins of the split estimate, each as many coarse nodes in time order (stand-ins for
 #: the windows).
@@ -959,9 +1049,8 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarra
     owner = np.arange(k) % threads
 
     def loads(c):  # nodes per thread and time bin, shape (threads, bins)
-        out = np.zeros((threads, hist.shape[1]), dtype=np.int64)
-        np.add.at(out, owner, cum[c[1:]] - cum[c[:-1]])
-        return out
+        per_slab = cum[c[1:]] - cum[c[:-1]]
+        return np.stack([per_slab[t::threads].sum(axis=0) for t in range(threads)])
 
     for _ in range(4 * k):
         moved = False
@@ -1004,15 +1093,16 @@ def _coarse_histogram(speed, start, shape3, h3):
     box = np.argwhere(start.state.reshape(start.shape) == _kernels.FROZEN)
     if len(box) == 0:
         return None, f
-    cells = np.unique((box + np.asarray(start.lo)) // np.array([f, f, f if three else 1]),
-                      axis=0)
+    # the coarse nodes of the frozen ones (a mask over their box: a source ball on constant
+    # speed holds ~33,000 nodes on 2048^2, and np.unique of rows took 38 ms of serial time)
+    cells = (box + np.asarray(start.lo)) // np.array([f, f, f if three else 1])
     lo = cells.min(axis=0)
     bshape = tuple(int(n) for n in cells.max(axis=0) - lo + 1)
-    Tb = np.full(int(np.prod(bshape)), np.inf)
-    sb = np.zeros(Tb.size, dtype=np.uint8)
-    flat = np.ravel_multi_index(tuple((cells - lo).T), bshape)
-    Tb[flat] = 0.0
-    sb[flat] = _kernels.FROZEN
+    frozen = np.zeros(bshape, dtype=bool)
+    frozen[tuple((cells - lo).T)] = True
+    frozen = frozen.reshape(-1)
+    Tb = np.where(frozen, 0.0, np.inf)
+    sb = np.where(frozen, _kernels.FROZEN, 0).astype(np.uint8)
     cstart = _kernels.Start(tuple(int(a) for a in lo), bshape, Tb, sb)
     hc = tuple(h * f for h in h3[:2]) + ((h3[2] * f,) if three else (h3[2],))
     T, _ = _kernels.march(coarse.reshape(-1), cstart, cshape, hc, 1,
@@ -1024,10 +1114,13 @@ def _coarse_histogram(speed, start, shape3, h3):
         return None, f
     rows = np.broadcast_to(np.arange(cshape[0])[:, None], T.shape)[fin]
     # bins of equal node counts in time order, as the windows (~WINDOW_NODES nodes each);
-    # equal times share a bin (a node's bin from the rank of the first of its time)
+    # equal times share a bin: node bin ``rank * SPLIT_BINS // n``, ``rank`` the count of
+    # earlier times, i.e. how many of the sorted times ending each bin's share are earlier
+    # (a search among SPLIT_BINS - 1 edges instead of among all the times: 4 -> 0.5 ms)
     times = T[fin]
-    rank = np.searchsorted(np.sort(times), times, side="left")
-    bins = rank * SPLIT_BINS // times.size
+    n = times.size
+    ends = -(-np.arange(1, SPLIT_BINS) * n // SPLIT_BINS) - 1  # ceil(b n / bins) - 1 >= 0
+    bins = np.searchsorted(np.sort(times)[ends], times, side="left")
     hist = np.bincount(rows * SPLIT_BINS + bins,
                        minlength=cshape[0] * SPLIT_BINS).reshape(cshape[0], SPLIT_BINS)
     return hist, f
@@ -1066,7 +1159,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
         ``slabs``, ``windows``, ``reopened`` (nodes changed after they were frozen),
         ``raised`` (order 2: updates that found a later time than the node had) and
         ``balance``: nodes frozen over the sum of each window's largest slab share, the
-        speed-up the windows allow if every freeze cost the same (``slabs`` at best).
+        speed-up the windows allow if every freeze cost the same (``slabs`` at best), and
+        ``greedy``: the windows whose slabs :func:`_assign` shared longest first.
     """
     import numba
 
@@ -1095,24 +1189,15 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
     else:  # the serial march's kept buffers (huge pages, no page faults on a repeat)
         Tp, Vp = _kernels._work_pair(npad)
     plane = ny * nz
-    lo, bshape = start.lo, start.shape
-    bplane = bshape[1] * bshape[2]
-    for k in range(K):
-        a, b = int(bounds[k]), int(bounds[k + 1])
-        ra, rb, p0 = _padded_rows(a, b, nx, G)
-        i0, i1 = max(lo[0], ra), min(lo[0] + bshape[0], rb)
-        if i1 > i0:
-            Tb = start.T[(i0 - lo[0]) * bplane:(i1 - lo[0]) * bplane]
-            sb = start.state[(i0 - lo[0]) * bplane:(i1 - lo[0]) * bplane]
-            box = (i0 - ra, lo[1], lo[2], i1 - i0, bshape[1], bshape[2])
-        else:
-            Tb, sb = start.T[:0], start.state[:0]
-            box = (0, 0, 0, 0, 0, 0)
-        seg = slice(int(off[k] + p0 * sx), int(off[k] + (p0 + rb - ra + 2) * sx))
-        _kernels.pad_grid(_kernels._readonly(speed[ra * plane:rb * plane]), Tb, sb, *box,
-                          rb - ra, ny, nz, Tp[seg], Vp[seg])
-        if G > 1:
-            _ghost_rows(speed, Tp, Vp, int(off[k]), a, b, shape3, G)
+    boxes = _start_boxes(start, bounds, nx, G)
+    with _threads(nth):
+        _pad_slabs(nth, _kernels._readonly(speed), start.T, start.state, boxes, bounds, off, ny,
+                   nz, G, Tp, Vp)
+    # the start box's own rows in each slab, the only nodes the start reads
+    b0, b1 = bounds[:-1], bounds[1:]
+    i0 = np.clip(start.lo[0], b0, b1)
+    i1 = np.clip(start.lo[0] + start.shape[0], i0, b1)
+    scan = np.stack([(i0 - b0 + G) * sx, (i1 - b0 + G) * sx], axis=1)
     # the nodes frozen on entry (sources, balls) stay as they are, as in the serial march
     fixed = np.packbits(Tp >= 0.0, bitorder="little")
     U, qp = _kernels._plateau(speed, Vp, shape3, npad,
@@ -1123,7 +1208,11 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
     fl = np.zeros((3, npad // 8 + 2 if order == 2 else 1), dtype=np.uint8)
     eidx = np.zeros(0, dtype=np.uint64)
     if order == 2:
-        eidx = np.flatnonzero((Tp < 0.0) & (Tp > -np.inf)).astype(np.uint64)
+        parts = []
+        for k in range(K):  # in the start box's rows: every other node is far or a wall
+            seg = Tp[off[k] + scan[k, 0]:off[k] + scan[k, 1]]
+            parts.append(off[k] + scan[k, 0] + np.flatnonzero((seg < 0.0) & (seg > -np.inf)))
+        eidx = np.concatenate(parts).astype(np.uint64)
     evals = -Tp[eidx]
     # each slab's nodes frozen in its first and last own rows in the last window (the
     # neighbours' exchange reads those); a count over the capacity: read the whole row
@@ -1147,9 +1236,11 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
     ih = np.array([1.0 / (h * h) for h in h3])
     iso = bool(ih[0] == ih[1] and (not three or ih[1] == ih[2]))
     hh = float(1.0 / ih[0])
-    vmax = float(speed.max()) if speed.size else 1.0
+    # the top speed sets the first window's width only (then adapted): from the plateau's
+    # register when there is one (a pass over the speeds is ~2 ms of serial time on 2048^2)
+    vmax = (1.0 / np.sqrt(qp) if qp > 0.0 else float(speed.max())) if speed.size else 1.0
     width = 2.0 * min(h3[:3 if three else 2]) / max(vmax, 1e-300)
-    win = np.array([0.0, width, 0.0, float(WINDOW_NODES), 0.0, 0.0, np.inf, 0.0])
+    win = np.array([0.0, width, 0.0, float(WINDOW_NODES), 0.0, 0.0, np.inf, 0.0, 0.0])
     stop_idx = np.zeros(0, dtype=np.int64)
     if stop_cells is not None and len(stop_cells):
         cells = np.asarray(stop_cells, dtype=np.int64).reshape(-1, 3)
@@ -1159,6 +1250,9 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
             local = local * (nz + 2) + cells[:, 2] + 1
         stop_idx = off[k] + local
     drive = _DRIVES[3 if three else 2, G]
+    slabs = np.empty(K, dtype=np.int64)  # scratch of _assign: each window's slabs per thread
+    lists = np.empty(nth + 1 + K, dtype=np.int64)
+    load = np.empty(nth)
     first = True
     prev = numba.get_num_threads()
     numba.set_num_threads(nth)
@@ -1166,7 +1260,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
         while True:
             status = drive(nth, Tp, Vp, U, qp, fixed, fl, eidx, evals, off, off + sizes, rows,
                            _U(sx), _U(sy), ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl,
-                           sent, ns, win, first, stop_idx)
+                           sent, ns, win, first, stop_idx, slabs, lists, load, SHARE_SLABS, scan)
             first = win[7] == 0.0
             if status == 0:
                 break
@@ -1181,13 +1275,16 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
     # lean: in place, slab after slab, as the serial march: slab k's times go to
     # [a * plane, b * plane), from no later than its padded grid's start to before slab
     # k + 1's, so every node moves to a lower index and is read before it is written
-    T = Tp if lean else np.empty(nx * ny * nz)
-    for k in range(K):  # from the ghost x-slab next to the own ones (unpad_grid's layout)
-        a, b = int(bounds[k]), int(bounds[k + 1])
-        seg = slice(int(off[k] + (G - 1) * sx), int(off[k] + sizes[k] - (G - 1) * sx))
-        _kernels.unpad_grid(Tp[seg], b - a, ny, nz, T[a * plane:b * plane])
     if lean:
-        T = T[:nx * ny * nz]
+        for k in range(K):  # from the ghost x-slab next to the own ones (unpad_grid's layout)
+            a, b = int(bounds[k]), int(bounds[k + 1])
+            seg = slice(int(off[k] + (G - 1) * sx), int(off[k] + sizes[k] - (G - 1) * sx))
+            _kernels.unpad_grid(Tp[seg], b - a, ny, nz, Tp[a * plane:b * plane])
+        T = Tp[:nx * ny * nz]
+    else:  # a new array: the slabs in parallel
+        T = np.empty(nx * ny * nz)
+        with _threads(nth):
+            _unpad_slabs(nth, Tp, bounds, off, ny, nz, T, G)
     if win[6] < np.inf:  # stopped: what the serial march would not have frozen yet
         T[T > win[6]] = np.inf
         sel = tuple(slice(a, a + m) for a, m in zip(start.lo, start.shape))
@@ -1196,37 +1293,113 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
         box[frozen] = start.T.reshape(start.shape)[frozen]
     return T, {"slabs": K, "windows": int(win[2]), "reopened": int(ctl[:, _C_REOPEN].sum()),
                "raised": int(ctl[:, _C_RAISED].sum()),
-               "balance": float(win[4] / max(win[5], 1.0))}
+               "balance": float(win[4] / max(win[5], 1.0)), "greedy": int(win[8])}
 
 
+@contextlib.contextmanager
+def _threads(nth):
+    """Run numba's parallel regions on ``nth`` threads inside the block."""
+    import numba
+
+    prev = numba.get_num_threads()
+    numba.set_num_threads(nth)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(prev)
+
+
+def _start_boxes(start, bounds, nx, G=1):
+    """Each slab's part of the start box, for :func:`_pad_slabs`: rows ``(i0, j0, k0, bx,
+    by, bz, first, last)`` of ints, the box in the node indices of the rows the slab pads
+    (:func:`_padded_rows`: its own rows, and with ``G = 2`` ghost rows ``G - 1`` deep, whose
+    times the ghosts' ``NaN`` then replaces) (``bx = 0``: none) and the range
+    ``[first, last)`` of ``start.T`` / ``start.state`` it takes."""
+    lo, bshape = start.lo, start.shape
+    bplane = bshape[1] * bshape[2]
+    boxes = np.zeros((len(bounds) - 1, 8), dtype=np.int64)
+    for k in range(len(bounds) - 1):
+        ra, rb, _ = _padded_rows(int(bounds[k]), int(bounds[k + 1]), nx, G)
+        i0, i1 = max(lo[0], ra), min(lo[0] + bshape[0], rb)
+        if i1 > i0:
+            boxes[k] = (i0 - ra, lo[1], lo[2], i1 - i0, bshape[1], bshape[2],
+                        (i0 - lo[0]) * bplane, (i1 - lo[0]) * bplane)
+    return boxes
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def _pad_slabs(nth, speed, Tb, sb, boxes, bounds, off, ny, nz, G, Tp, Vp):
+    """Pad every slab (:func:`fm2uav.eikonal._kernels.pad_grid`) into its place in ``Tp`` /
+    ``Vp`` (slab ``k`` from ``off[k]``, ``G`` ghost x-slabs on each side:
+    :func:`_padded_rows`, :func:`_ghost_rows`), thread ``t`` the slabs ``t, t + nth, ...``
+    (on 2048^2 the padding was 7 of the ~60 ms one thread spent alone)."""
+    K = bounds.size - 1
+    nx = bounds[K]
+    plane = ny * nz
+    sx = (ny + 2) if nz == 1 else (ny + 2) * (nz + 2)
+    for t in prange(nth):
+        for k in range(t, K, nth):
+            a, b = bounds[k], bounds[k + 1]
+            ra, rb, p0 = _padded_rows(a, b, nx, G)
+            bx = boxes[k]
+            seg = slice(off[k] + p0 * sx, off[k] + (p0 + rb - ra + 2) * sx)
+            pad_grid(speed[ra * plane:rb * plane], Tb[bx[6]:bx[7]], sb[bx[6]:bx[7]], bx[0],
+                     bx[1], bx[2], bx[3], bx[4], bx[5], rb - ra, ny, nz, Tp[seg], Vp[seg])
+            if G > 1:
+                _ghost_rows(speed, Tp, Vp, off[k], a, b, nx, ny, nz, G)
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def _unpad_slabs(nth, Tp, bounds, off, ny, nz, T, G):
+    """Every slab's times into its rows of ``T`` (a new array; the lean layout compacts in
+    place, slab after slab), thread ``t`` the slabs ``t, t + nth, ...``; each slab's grid
+    read from its ghost x-slab next to its own rows (``G`` ghost x-slabs a side)."""
+    K = bounds.size - 1
+    plane = ny * nz
+    sx = (ny + 2) if nz == 1 else (ny + 2) * (nz + 2)
+    for t in prange(nth):
+        for k in range(t, K, nth):
+            a, b = bounds[k], bounds[k + 1]
+            o = off[k] + (G - 1) * sx
+            unpad_grid(Tp[o:o + (b - a + 2) * sx], b - a, ny, nz, T[a * plane:b * plane])
+
+
+@njit(cache=True, _nrt=False)
 def _padded_rows(a, b, nx, G):
     """The grid rows ``[ra, rb)`` padded into slab ``[a, b)``'s grid and the slab row of the
     padded grid's first x-slab (its ghost), ``p0``: the slab's padded grid has ``G`` ghost
     x-slabs on each side, slab row ``p`` is grid row ``a - G + p``; rows ``a - G + 1`` to
-    ``b + G - 2`` that exist are padded by :func:`~fm2uav.eikonal._kernels.pad_grid`."""
+    ``b + G - 2`` that exist are padded by :func:`~fm2uav.eikonal._kernels.pad_grid`
+    (``G = 1``: the slab's own rows, ``p0 = 0``)."""
     ra, rb = max(a - G + 1, 0), min(b + G - 1, nx)
     return ra, rb, ra - 1 - a + G
 
 
-def _ghost_rows(speed, Tp, Vp, o, a, b, shape3, G):
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _ghost_rows(speed, Tp, Vp, o, a, b, nx, ny, nz, G):
     """Make the ``G`` x-slabs on each side of slab ``[a, b)`` (its grid from ``Tp[o]``)
-    ghosts (``NaN`` until the exchange) with the grid's ``1 / speed^2`` where the grid has
-    the row (the order-2 speed check reads it), as :func:`~fm2uav.eikonal._kernels.pad_grid`
-    rounds it."""
-    nx, ny, nz = (int(n) for n in shape3)
+    ghosts (``NaN`` until the exchange) with the grid's ``1 / speed^2`` [s^2/m^2] where the
+    grid has the row (the order-2 speed check reads it), rounded as
+    :func:`~fm2uav.eikonal._kernels.pad_grid` rounds it."""
     three = nz > 1
-    rows = b - a + 2 * G
     pz = nz + 2 if three else 1
-    Tv = Tp[o:o + rows * (ny + 2) * pz].reshape(rows, ny + 2, pz)
-    Vv = Vp[o:o + rows * (ny + 2) * pz].reshape(rows, ny + 2, pz)
-    inner = (slice(1, ny + 1), slice(1, nz + 1) if three else slice(0, 1))
-    with np.errstate(divide="ignore"):
-        for p in (*range(G), *range(rows - G, rows)):
-            Tv[p] = np.nan
-            i = a - G + p
-            if 0 <= i < nx:
-                v = speed[i * ny * nz:(i + 1) * ny * nz].reshape(ny, nz)
-                Vv[p][inner] = 1.0 / (v * v)
+    sx = (ny + 2) * pz
+    rows = b - a + 2 * G
+    for p in range(rows):
+        if p >= G and p < rows - G:
+            continue
+        base = o + p * sx
+        for j in range(sx):
+            Tp[base + j] = np.nan
+        i = a - G + p
+        if i < 0 or i >= nx:
+            continue
+        for y in range(ny):
+            dst = base + (y + 1) * pz + (1 if three else 0)
+            src = (i * ny + y) * nz
+            for z in range(nz):
+                v = speed[src + z]
+                Vp[dst + z] = 1.0 / (v * v)
 
 
 def _slab_plateau(speed, vmax, bounds, off, shape3, bits, G=1):

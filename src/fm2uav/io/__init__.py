@@ -12,8 +12,9 @@ The mission names of :mod:`fm2uav.autopilot` (``build_mission``,
 are re-exported here so that code written before the autopilot layer keeps working.
 """
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from .._lazy import lazy_names
 
 if TYPE_CHECKING:  # loaded on first attribute access (PEP 562), see __getattr__
     from .exports import (
@@ -112,17 +113,7 @@ _LAZY_NAMES = {
 }
 
 
-def __getattr__(name: str) -> Any:
-    if name in _LAZY_NAMES:
-        value = getattr(importlib.import_module(_LAZY_NAMES[name], __name__), name)
-        globals()[name] = value  # later accesses skip __getattr__
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY_NAMES))
-
+__getattr__, __dir__ = lazy_names(__name__, _LAZY_NAMES)
 
 __all__ = [
     "read_path_csv",

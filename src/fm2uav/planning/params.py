@@ -23,12 +23,13 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, fields
-from typing import Any, Literal
-
-import numpy as np
+from typing import TYPE_CHECKING, Any, Literal
 
 from .. import _validate as v
 from ..errors import InputError
+
+if TYPE_CHECKING:  # numpy only where a speed map is given: the command line checks these
+    import numpy as np  # objects before numpy loads
 
 __all__ = [
     "Shaping",
@@ -282,6 +283,8 @@ class PlanOptions:
         _set(self, "step", v.in_range(self.step, "step", MIN_STEP, 1.0,
                                       where=_where("step"), hint="the geodesic step in cells"))
         if self.speed_map is not None:
+            import numpy as np
+
             try:
                 W = np.asarray(self.speed_map, dtype=float)
             except (TypeError, ValueError):

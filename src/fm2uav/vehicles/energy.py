@@ -35,7 +35,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from .._validate import positive
+from .._validate import non_negative, positive
 from ..errors import InputError
 from .power import FixedWingPower, PowerModel
 
@@ -184,6 +184,8 @@ def fly_legs(
     takeoff_climb: float = 0.0,
     final_descent: float = 0.0,
     hold: Literal["ground", "air"] | None = None,
+    takeoff_time: float | None = None,
+    final_time: float | None = None,
 ) -> Flight:
     """Time, power and energy of each leg between ``points`` flown in ``wind``.
 
@@ -206,6 +208,11 @@ def fly_legs(
     hold : {"ground", "air"}, optional
         What ``speed`` is: a ground speed (default for a multirotor) or an airspeed
         (default for a fixed-wing).
+    takeoff_time, final_time : float, optional
+        Durations [s] of the take-off climb and of the final descent when they are not
+        flown at the climb / descent rate (a fixed-wing's climb-out, its landing pattern:
+        the height spread over the time, at the first leg's airspeed). Default: the
+        height over the rate.
 
     Returns
     -------
@@ -281,9 +288,13 @@ def fly_legs(
     v0 = float(v[0]) if n else 1.0
     climb, desc = max(float(takeoff_climb), 0.0), max(float(final_descent), 0.0)
     air_v = v0 if fixed else 0.0
-    t_up, t_dn = climb / up, desc / down
-    e_up = float(model.power(air_v, up)) * t_up + float(hold_j[0])
-    e_dn = float(model.power(air_v, -down)) * t_dn
+    t_up = climb / up if takeoff_time is None else non_negative(
+        takeoff_time, "takeoff_time", unit="s")
+    t_dn = desc / down if final_time is None else non_negative(final_time, "final_time", unit="s")
+    vz_up = up if takeoff_time is None else (climb / t_up if t_up > 0 else 0.0)
+    vz_dn = down if final_time is None else (desc / t_dn if t_dn > 0 else 0.0)
+    e_up = float(model.power(air_v, vz_up)) * t_up + float(hold_j[0])
+    e_dn = float(model.power(air_v, -vz_dn)) * t_dn
     return Flight(leg_length=np.hypot(horiz, dz), leg_time=t, groundspeed=g,
                   airspeed=air, climb=vz, power=pw, leg_energy_j=energy, flyable=ok,
                   takeoff_s=t_up + float(h[0]), takeoff_j=e_up, landing_s=t_dn, landing_j=e_dn)
