@@ -62,7 +62,8 @@ from numba.extending import intrinsic
 
 from . import _kernels
 from ._heap import sift_down, sift_up
-from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _U, _ZERO, RESERVE_BLOCKS, BLOCK,
+from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _ORDER2_MAX_W_RATIO, _U, _ZERO,
+                       RESERVE_BLOCKS, BLOCK,
                        _at_plateau, _axis_term, _axis_term_u, _bits, _bucket, _prefetch, _combine,
                        _pop, _push, _rhs, _side_min, _solve_iso, pad_grid, unpad_grid)
 
@@ -511,18 +512,99 @@ def _clear_bit(a, c):
     a[i] = np.uint8(a[i] & (np.uint8(255) ^ np.uint8(_ONE << (c & _U(7)))))
 
 
+@njit(cache=True, inline="always", _nrt=False)
+def _known(T, fixed, c, thr):
+    """Node ``c``'s time if the serial march had frozen it when the node of time ``thr``
+    froze (frozen on entry, or frozen no later than ``thr``), else inf."""
+    x = T[c]
+    if x >= 0.0 and (x <= thr or _bit(fixed, c)):
+        return x
+    return _INF
+
+
 @njit(cache=True, inline="always", error_model="numpy", _nrt=False)
-def _update2(T, V, U, use_u, qp, c, sx, sy, ih, three):
-    """The order-2 upwind time of node ``c`` from its frozen neighbours, as the serial
-    order-2 march computes it (the same terms in the same order: the same bits)."""
+def _axis_term_at(T, V, U, use_u, fixed, c, s, ih2, thr):
+    """:func:`~fm2uav.eikonal._kernels._axis_term_u` at order 2 (the same operations, the
+    same bits) reading only the nodes :func:`_known` at ``thr``."""
+    a = _known(T, fixed, c - s, thr)
+    b = _known(T, fixed, c + s, thr)
+    if b < a:
+        best = b
+        c1 = c + s
+        c2 = c1 + s
+    else:
+        best = a
+        c1 = c - s
+        c2 = c1 - s
+    if best == _INF:
+        return _INF, 0.0
+    t2 = _known(T, fixed, c2, thr)
+    if t2 <= best:
+        if use_u and _at_plateau(U, c) and _at_plateau(U, c1) and _at_plateau(U, c2):
+            return (4.0 * best - t2) / 3.0, 2.25 * ih2
+        w0 = V[c]
+        w1 = V[c1]
+        w2 = V[c2]
+        wmax = max(w0, max(w1, w2))
+        wmin = min(w0, min(w1, w2))
+        if wmax <= _ORDER2_MAX_W_RATIO * wmin:
+            return (4.0 * best - t2) / 3.0, 2.25 * ih2
+    return best, ih2
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _update2_at(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three, thr):
+    """The serial march's order-2 update of node ``c`` when the node of time ``thr`` froze:
+    :func:`_update2` reading only the nodes :func:`_known` at ``thr`` (``thr < 0``: the
+    nodes frozen on entry, as the serial march's first updates)."""
     q = _rhs(V, U, use_u, qp, c)
-    ta, aa = _axis_term_u(T, V, U, use_u, c, sx, ih[0], 2)
-    tb, ab = _axis_term_u(T, V, U, use_u, c, sy, ih[1], 2)
+    ta, aa = _axis_term_at(T, V, U, use_u, fixed, c, sx, ih[0], thr)
+    tb, ab = _axis_term_at(T, V, U, use_u, fixed, c, sy, ih[1], thr)
     if three:
-        tc, ac = _axis_term_u(T, V, U, use_u, c, _ONE, ih[2], 2)
+        tc, ac = _axis_term_at(T, V, U, use_u, fixed, c, _ONE, ih[2], thr)
     else:
         tc, ac = _INF, 0.0
     return _combine(ta, aa, tb, ab, tc, ac, q)
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _later_nb(T, fixed, c, sx, sy, three, t):
+    """Whether a neighbour of node ``c`` is frozen later than ``t`` (and not on entry)."""
+    for nb in _nbs(c, sx, sy, three):
+        if T[nb] > t and not _bit(fixed, nb):  # c itself (2D): band, not > t
+            return True
+    return False
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _serial_time2(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three):
+    """The time the serial order-2 march gives node ``c`` from the frozen times around it.
+
+    The serial march updates ``c`` each time a neighbour freezes, from the nodes frozen by
+    then, and keeps the lowest: first from the nodes frozen on entry (if one is a
+    neighbour), then at each neighbour's time in increasing order, until ``c``'s own time
+    (a neighbour later than it freezes after ``c``). Not :func:`_update2` from every
+    frozen node: adding an axis near its causality limit (its time just below the
+    solution) lowers the exact solution by less than the rounding of the two-axis formula,
+    which can then come out *above* the one-axis solution of an earlier update (by
+    ~1e-13 relative on the 2048^2 FM²-shaped map); the serial march keeps that earlier one.
+    """
+    val = _INF
+    for nb in _nbs(c, sx, sy, three):
+        if nb != c and T[nb] >= 0.0 and _bit(fixed, nb):
+            val = _update2_at(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three, -1.0)
+            break
+    prev = -1.0
+    while True:
+        thr = _INF  # the next neighbour's time (frozen, not on entry)
+        for nb in _nbs(c, sx, sy, three):
+            x = T[nb]
+            if nb != c and x >= 0.0 and x > prev and x < thr and not _bit(fixed, nb):
+                thr = x
+        if not thr < val:
+            return val
+        val = min(val, _update2_at(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three, thr))
+        prev = thr
 
 
 @njit(cache=True, inline="always", _nrt=False)
@@ -551,7 +633,8 @@ def _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf, eidx, eval
     x = T[d]
     if x != x or _bit(fixed, d):
         return
-    t = _entry_cap(eidx, evals, base + d, _update2(T, V, U, use_u, qp, d, sx, sy, ih, three))
+    t = _entry_cap(eidx, evals, base + d,
+                   _serial_time2(T, V, U, use_u, qp, fixed, d, sx, sy, ih, three))
     if x < 0.0:
         if t < -x:
             T[d] = -t
@@ -625,7 +708,7 @@ def _slab_kernels2(three):
             if _bit(sf, c):  # suspect: its time may have to go up
                 _clear_bit(sf, c)
                 t2 = _entry_cap(eidx, evals, base + c,
-                                _update2(T, V, U, use_u, qp, c, sx, sy, ih, three))
+                                _serial_time2(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three))
                 if t2 != t:
                     if t2 > t and _bit(rf, c) and not _bit(pf, c):
                         # nodes may still read its old time (>= t): the stop test must not
@@ -657,13 +740,16 @@ def _slab_kernels2(three):
                     continue
                 y = T[nb]
                 if y < 0.0:  # band or far: an own node
-                    if full:
+                    if full or _later_nb(T, fixed, nb, sx, sy, three, t):
+                        # c frozen again, or a neighbour frozen later than c (a ghost ahead
+                        # of this slab, a repair): the updates at the later freezes read
+                        # nodes not frozen then, from scratch now
                         _recheck(T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf,
                                  eidx, evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl)
-                    else:  # the serial march's relaxation, but a band time that read
-                        # nodes out of time order (a ghost ahead of this slab) may be too
-                        # low: a later update marks it suspect
-                        tn = _update2(T, V, U, use_u, qp, nb, sx, sy, ih, three)
+                    else:  # the serial march's update when c froze; a band time that read
+                        # nodes out of time order may be too low: a later update above it
+                        # marks it suspect
+                        tn = _update2_at(T, V, U, use_u, qp, fixed, nb, sx, sy, ih, three, t)
                         if tn < -y:
                             _lower(T, V, nb, tn, fixed, sx, sy, three, pv, pool, nxt, bk, mw,
                                    st, rkey, ritem, ctl)
@@ -706,7 +792,8 @@ def _slab_kernels2(three):
                     return False
                 for nb in _nbs(c, sx, sy, three):
                     if T[nb] < 0.0:
-                        _lower(T, V, nb, _update2(T, V, U, use_u, qp, nb, sx, sy, ih, three),
+                        _lower(T, V, nb, _update2_at(T, V, U, use_u, qp, fixed, nb, sx, sy, ih,
+                                                     three, -1.0),
                                fixed, sx, sy, three, True, pool, nxt, bk, mw, st, rkey, ritem,
                                ctl)
             c += _ONE
@@ -1199,7 +1286,16 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
     i1 = np.clip(start.lo[0] + start.shape[0], i0, b1)
     scan = np.stack([(i0 - b0 + G) * sx, (i1 - b0 + G) * sx], axis=1)
     # the nodes frozen on entry (sources, balls) stay as they are, as in the serial march
-    fixed = np.packbits(Tp >= 0.0, bitorder="little")
+    fixed = Tp >= 0.0
+    if G == 2:  # order 2: the ghosts' too (the neighbours' own), which the serial march's
+        for k in range(K):  # first updates read (:func:`_known`)
+            if k > 0:
+                o = off[k - 1] + rows[k - 1] * sx
+                fixed[off[k]:off[k] + G * sx] = fixed[o:o + G * sx]
+            if k < K - 1:
+                o = off[k] + (rows[k] + G) * sx
+                fixed[o:o + G * sx] = fixed[off[k + 1] + G * sx:off[k + 1] + 2 * G * sx]
+    fixed = np.packbits(fixed, bitorder="little")
     U, qp = _kernels._plateau(speed, Vp, shape3, npad,
                               fill=lambda vmax, bits: _slab_plateau(speed, vmax, bounds, off,
                                                                     shape3, bits, G))
