@@ -465,7 +465,6 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
             return run
 
         _parallel.march = spy
-        _parallel.ORDER2 = True  # the order-2 rows measure the order-2 slabs
         for key in list(_parallel._DRIVES):
             _parallel._DRIVES[key] = spy_drive(_parallel._DRIVES[key])
 

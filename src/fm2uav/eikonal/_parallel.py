@@ -2,12 +2,14 @@
 
 Private module: :func:`fm2uav.eikonal.fast_marching` calls :func:`march` for
 grids of at least :data:`PARALLEL_MIN_NODES` nodes when more than one thread is
-allowed (``threads``, ``FM2UAV_THREADS``), at order 1, and at order 2 when
-:data:`ORDER2` is set (off: see there) (``stop_at`` too).
+allowed (``threads``, ``FM2UAV_THREADS``), at order 1 and 2 (:data:`ORDER2`), ``stop_at``
+too.
 Order 2's stencil reads two nodes upwind: its slabs have two ghost x-slabs per
-side, the exchange copies two rows, and a changed time updates again the nodes one
-*and two* away along each axis; its update is not monotone, so a repair may also
-raise a time (the notes above :func:`_update2`).
+side (:func:`_pad_slabs`), the exchange copies two rows, and a changed time updates
+again the nodes one *and two* away along each axis; its update is not monotone, so a
+repair may also raise a time, and a node takes the time the serial march keeps, the
+lowest of its updates at its neighbours' freezes (:func:`_serial_time2`): the times
+equal the serial march's bit for bit (the notes above :func:`_known`).
 
 Design (Yang & Stern 2017, domain-decomposition FMM)
 ----------------------------------------------------
@@ -53,6 +55,7 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 
 import numpy as np
@@ -78,16 +81,14 @@ __all__ = ["march", "resolve_threads", "PARALLEL_MIN_NODES", "THREADS_ENV"]
 
 #: Environment variable with the default thread count of the march (an integer >= 1).
 THREADS_ENV = "FM2UAV_THREADS"
-#: Whether :func:`fm2uav.eikonal.fast_marching` marches order 2 in parallel too. Off: the
-#: order-2 slabs give the serial times to 1e-12 (relative) on every test case (the
-#: fields of tests/eikonal/test_fmm_parallel.py, 84 random FM²-shaped fields on slabs of 2
-#: to 6 rows), but not on big grids: 3.0e-11 on the 2048² FM²-shaped map, 1.6e-11 on the
-#: 1000 x 1000 x 40 terrain march (2 December 2026). The order-2 stencil
-#: ``(4 T1 - T2) / 3`` amplifies a difference along the wave: on 2048² every node before
-#: T = 600.73 s is equal, the first that differs by 4e-14 (a discrete choice of the update,
-#: likely a tie the serial march decides by the order of its updates), 1.37 M nodes end
-#: over 1e-12 (docs/performance.md, "Both cores").
-ORDER2 = False
+#: Whether :func:`fm2uav.eikonal.fast_marching` marches order 2 on slabs too (False: order 2
+#: marches serially). The order-2 slabs give the serial march's times bit for bit on every
+#: case measured (tests/eikonal/test_fmm_parallel.py; the 2048² FM²-shaped map and the
+#: 1000 x 1000 x 40 terrain march, 25.8 M nodes): a node's time is the one the serial march
+#: keeps, the lowest of its updates at its neighbours' freezes in time order
+#: (:func:`_serial_time2`). Only a tie (two nodes of one stencil frozen at the very same
+#: time) could make them differ, where the serial march's pick depends on its queue.
+ORDER2 = True
 #: Grids of fewer nodes march serially whatever the thread count. Measured
 #: (benchmarks/bench_core.py, "threads" rows, a machine at load 9 on 2 cores):
 #: on 1024^2 the busiest thread takes 0.06 s of the serial 0.099 CPU-s (1.65x on
@@ -469,20 +470,24 @@ def _exchange(three, *args):
 
 
 # ------------------------------------------------------------------ order 2
-# The serial order-2 time of a node is its update from the final times of its neighbours
-# and of the nodes two away (:func:`_update2`): an axis's term takes the earlier of its two
-# neighbours, and the node beyond it (order 2) when that one is frozen no later than it
-# (and the speed ratio is bounded); nodes later than the result do not change it. So the
-# serial times are the one solution of ``T = update(T)`` in which every node depends on
-# earlier nodes only (unique by induction in time order), and the parallel march ends there:
-# whenever a frozen time that an update read changes (a ghost exchanged, a node frozen again
-# at another time) its dependants -- the neighbours and the nodes two away along each axis
-# -- are updated again. Unlike order 1 the update is not monotone (a lower time two away
-# raises the order-2 term), so a dependant may have to go *up*: a band node keeps its
+# The serial order-2 march updates a node each time one of its neighbours freezes, from the
+# nodes frozen by then, and keeps the lowest update (:func:`_serial_time2` computes that
+# from the frozen times around the node: each neighbour's update reads only the nodes
+# :func:`_known` when it froze). That is a function of the final times of the node's
+# neighbours and of the nodes two away along each axis, all earlier than the node; so the
+# serial times are the one solution of ``T = serial_time(T)`` in which every node depends on
+# earlier nodes only (by induction in time order), and the parallel march ends there,
+# bit for bit: whenever a frozen time that an update read changes (a ghost exchanged, a
+# node frozen again at another time) its dependants -- the neighbours and the nodes two
+# away along each axis -- are updated again. The update is not monotone (a lower time two
+# away raises the order-2 term), so a dependant may have to go *up*: a band node keeps its
 # (lower) time and is marked suspect (bit ``sf``), updated again when popped; a frozen one
 # is re-opened at its old time, suspect too (its queue key stays a lower bound of its
 # time, which the windows and the stop test rely on). A re-opened node (bit ``rf``)
 # updates all its dependants again when frozen again, since they may have read its old time.
+# (Taking one update from all the final times instead differed by up to 3e-11 relative on a
+# 2048^2 map: near an axis's causality limit the two-axis formula's rounding can put it
+# above an earlier one-axis update, which the serial march keeps; docs/performance.md.)
 
 @intrinsic
 def _from_bits(typingctx, k):
@@ -554,9 +559,9 @@ def _axis_term_at(T, V, U, use_u, fixed, c, s, ih2, thr):
 
 @njit(cache=True, inline="always", error_model="numpy", _nrt=False)
 def _update2_at(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three, thr):
-    """The serial march's order-2 update of node ``c`` when the node of time ``thr`` froze:
-    :func:`_update2` reading only the nodes :func:`_known` at ``thr`` (``thr < 0``: the
-    nodes frozen on entry, as the serial march's first updates)."""
+    """The serial march's order-2 update of node ``c`` when the node of time ``thr`` froze,
+    from the nodes :func:`_known` at ``thr`` (``thr < 0``: the nodes frozen on entry, as the
+    serial march's first updates): its terms in the serial march's order, the same bits."""
     q = _rhs(V, U, use_u, qp, c)
     ta, aa = _axis_term_at(T, V, U, use_u, fixed, c, sx, ih[0], thr)
     tb, ab = _axis_term_at(T, V, U, use_u, fixed, c, sy, ih[1], thr)
@@ -583,11 +588,12 @@ def _serial_time2(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three):
     The serial march updates ``c`` each time a neighbour freezes, from the nodes frozen by
     then, and keeps the lowest: first from the nodes frozen on entry (if one is a
     neighbour), then at each neighbour's time in increasing order, until ``c``'s own time
-    (a neighbour later than it freezes after ``c``). Not :func:`_update2` from every
-    frozen node: adding an axis near its causality limit (its time just below the
+    (a neighbour later than it freezes after ``c``). Not one update from every frozen
+    node: adding an axis near its causality limit (its time just below the
     solution) lowers the exact solution by less than the rounding of the two-axis formula,
-    which can then come out *above* the one-axis solution of an earlier update (by
-    ~1e-13 relative on the 2048^2 FM²-shaped map); the serial march keeps that earlier one.
+    which can then come out *above* the one-axis solution of an earlier update (by 4e-14
+    relative at the first node that differed on the 2048^2 FM²-shaped map); the serial
+    march keeps that earlier one.
     """
     val = _INF
     for nb in _nbs(c, sx, sy, three):
@@ -739,7 +745,21 @@ def _slab_kernels2(three):
                 if nb == c:
                     continue
                 y = T[nb]
-                if y < 0.0:  # band or far: an own node
+                if y == -_INF and not full:
+                    # far: c is its only frozen neighbour (every frozen node, ghosts too,
+                    # has updated its neighbours), so the update is the one-axis solution
+                    # along c's axis, as the full update gives it (the serial 2D march's
+                    # shortcut): two axes' reads and terms saved on a third of the updates
+                    if nb == c - sx or nb == c + sx:
+                        s_nb, ih_nb = sx, ih[0]
+                    elif nb == c - sy or nb == c + sy:
+                        s_nb, ih_nb = sy, ih[1]
+                    else:
+                        s_nb, ih_nb = _ONE, ih[2]
+                    ta, aa = _axis_term_at(T, V, U, use_u, fixed, nb, s_nb, ih_nb, t)
+                    _lower(T, V, nb, ta + math.sqrt(_rhs(V, U, use_u, qp, nb) / aa), fixed, sx,
+                           sy, three, pv, pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                elif y < 0.0:  # band (or far after c froze again): an own node
                     if full or _later_nb(T, fixed, nb, sx, sy, three, t):
                         # c frozen again, or a neighbour frozen later than c (a ghost ahead
                         # of this slab, a repair): the updates at the later freezes read
@@ -1236,7 +1256,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
     order : {1, 2}, optional
         Order of the upwind stencil, as in the serial march (order 2: two ghost
         x-slabs per side, the dependants two away updated again; see the notes above
-        :func:`_update2`).
+        :func:`_known`).
 
     Returns
     -------

@@ -176,13 +176,11 @@ def fast_marching(
     threads : int, optional
         Threads the march may use (``>= 1``). None (default): the environment
         variable ``FM2UAV_THREADS`` if set, else every core this process may run
-        on. With 2 or more, order 1 on grids of at least ``PARALLEL_MIN_NODES``
-        (1 M) nodes marches slabs of the grid in parallel
-        (:mod:`fm2uav.eikonal._parallel`; times equal to the serial march's to
-        round-off, ``stop_at`` included); order 2 too when
-        ``fm2uav.eikonal._parallel.ORDER2`` is set (off: its times differ from the
-        serial march's by up to 3e-11 relative on big grids); the wind march and
-        smaller grids march on one thread.
+        on. With 2 or more, a grid of at least ``PARALLEL_MIN_NODES`` (1 M) nodes
+        marches slabs of the grid in parallel, order 1 and 2, ``stop_at`` included
+        (:mod:`fm2uav.eikonal._parallel`; order 1's times equal the serial march's
+        to round-off, order 2's bit for bit on every case measured); the wind march
+        and smaller grids march on one thread.
 
     Returns
     -------
@@ -287,8 +285,8 @@ def run_march(
     nodes frozen on entry (state 2) are expanded first, band nodes (state 1)
     carry tentative times. ``stop_at`` as in :func:`fast_marching`; ``threads``
     (resolved, ``>= 1``) as there: the parallel march on grids of at least
-    :data:`~fm2uav.eikonal._parallel.PARALLEL_MIN_NODES` nodes when ``threads > 1``, for
-    order 1 (order 2 if :data:`~fm2uav.eikonal._parallel.ORDER2`), else the serial one.
+    :data:`~fm2uav.eikonal._parallel.PARALLEL_MIN_NODES` nodes when ``threads > 1`` (order 2
+    while :data:`~fm2uav.eikonal._parallel.ORDER2` is set, the default), else the serial one.
 
     Returns
     -------

@@ -264,9 +264,9 @@ class PlanOptions:
         memory and the world allows it, else "full".
     threads : int or None
         Threads of the Fast Marching runs (``>= 1``); None (default): the
-        environment variable ``FM2UAV_THREADS``, else every core. Order 1 on
-        grids of 1 M nodes or more marches in parallel (the same times to
-        round-off); see :func:`fm2uav.eikonal.fast_marching`.
+        environment variable ``FM2UAV_THREADS``, else every core. Grids of 1 M
+        nodes or more march in parallel at order 1 and 2 (order 1: the same times
+        to round-off, order 2: bit for bit); see :func:`fm2uav.eikonal.fast_marching`.
     """
 
     order: Literal[1, 2] = 2

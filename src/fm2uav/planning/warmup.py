@@ -15,7 +15,7 @@ dimension and order), ``descent`` (geodesic extraction), ``surface``
 call their kernels directly: ``edt_parallel`` (the distance map's lines in
 parallel) and ``fmm3d_o{1,2}_lean`` (the 3D march in the lean layout, see
 ``fm2uav.eikonal._kernels.LEAN_NODES``); ``fmm{2,3}d_parallel`` (the march on both cores,
-order 1, and order 2 when ``_parallel.ORDER2`` is set) compile both layouts. Numbers: docs/performance.md.
+order 1 and 2, ``plan()``'s default) compile both layouts. Numbers: docs/performance.md.
 """
 
 from __future__ import annotations
@@ -73,10 +73,10 @@ def _fmm_lean(order: int) -> Callable[[], None]:
 
 
 def _fmm_parallel(ndim: int) -> Callable[[], None]:
-    """The march on both cores (grids of ``PARALLEL_MIN_NODES`` nodes and more), order 1 (and 2
-    when ``_parallel.ORDER2`` is set), in both layouts (float64 ``V``, and the lean float32 ``V`` of grids over
-    ``LEAN_NODES`` padded nodes, e.g. a 1000x1000x40 terrain plan), its size floors lowered
-    for a 16-node-wide grid while it compiles."""
+    """The march on both cores (grids of ``PARALLEL_MIN_NODES`` nodes and more), order 1 and
+    2 (unless ``_parallel.ORDER2`` is off), in both layouts (float64 ``V``, and the lean
+    float32 ``V`` of grids over ``LEAN_NODES`` padded nodes, e.g. a 1000x1000x40 terrain
+    plan), its size floors lowered for a 16-node-wide grid while it compiles."""
     def run() -> None:
         speed = np.ones((16,) * ndim)
         speed[(0,) * ndim] = 0.5  # a plateau with its mask (a uniform grid needs none)
