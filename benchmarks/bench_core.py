@@ -505,7 +505,9 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
             med = {{th: [statistics.median(r[i] for r in runs[th]) for i in range(4)]
                     for th in runs}}
             out.append(dict(case=case, field=field, order=order, nodes=int(v.size),
-                            parallel=v.size >= _parallel.PARALLEL_MIN_NODES,
+                            parallel=bool(v.size >= _parallel.PARALLEL_MIN_NODES and (
+                                order == 1 or len(shape) == 2
+                                or v.size >= _parallel.ORDER2_MIN_NODES_3D)),
                             serial=med[1], threads2=med[2], balance=stats.get("balance", 1.0),
                             setup=stats.get("setup", 0.0)))
         print(json.dumps(out))

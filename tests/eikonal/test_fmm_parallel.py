@@ -200,7 +200,7 @@ def test_order_2_on_random_fm2_fields_and_thin_slabs_equals_the_serial_march(blo
 
 
 @pytest.mark.parametrize("shape", [(1100, 1000), (110, 100, 100)])
-def test_order_2_on_a_big_fm2_field_equals_the_serial_march_bit_for_bit(shape):
+def test_order_2_on_a_big_fm2_field_equals_the_serial_march_bit_for_bit(shape, monkeypatch):
     """A grid over ``PARALLEL_MIN_NODES`` (the slabs, cuts and windows ``fast_marching``
     picks by itself, 2 threads): every time equal to the serial march's, bit for bit.
     (Before the serial march's choice was followed -- the lowest of the updates at the
@@ -208,6 +208,7 @@ def test_order_2_on_a_big_fm2_field_equals_the_serial_march_bit_for_bit(shape):
     FM²-shaped map differed by up to 3e-11 relative.)"""
     v, src = fm2_shaped(shape, seed=3)
     assert v.size >= _parallel.PARALLEL_MIN_NODES
+    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_3D", 0)  # 3D: 16.8 M nodes by default
     stats = {}
     march = _parallel.march
 
@@ -242,12 +243,13 @@ def test_plan_with_two_threads_flies_the_one_thread_path():
         calls.append(kwargs.get("order"))
         return march(*args, **kwargs)
 
-    saved = _parallel.PARALLEL_MIN_NODES
-    _parallel.PARALLEL_MIN_NODES, _parallel.march = 0, spy
+    saved = _parallel.PARALLEL_MIN_NODES, _parallel.ORDER2_MIN_NODES_3D
+    _parallel.PARALLEL_MIN_NODES, _parallel.ORDER2_MIN_NODES_3D, _parallel.march = 0, 0, spy
     try:
         plans = [plan(world, start, goal, options=PlanOptions(threads=t)) for t in (1, 2)]
     finally:
-        _parallel.PARALLEL_MIN_NODES, _parallel.march = saved, march
+        (_parallel.PARALLEL_MIN_NODES, _parallel.ORDER2_MIN_NODES_3D), _parallel.march = (
+            saved, march)
     assert calls == [2]  # the second plan marched order 2 on the slabs
     one, two = plans
     assert abs(one.length - two.length) <= 1e-9 * one.length
@@ -500,6 +502,14 @@ def test_small_grids_and_one_thread_march_serially(monkeypatch):
         fast_marching(np.ones((40, 40)), [(0, 0)], order=1)
     with pytest.raises(AssertionError, match="parallel march ran"):  # order 2 too
         fast_marching(np.ones((40, 40)), [(0, 0)], order=2)
+    v3 = np.ones((40, 40, 40))  # 3D order 2 only from ORDER2_MIN_NODES_3D nodes
+    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_3D", v3.size + 1)
+    fast_marching(v3, [(0, 0, 0)], order=2)
+    with pytest.raises(AssertionError, match="parallel march ran"):
+        fast_marching(v3, [(0, 0, 0)], order=1)
+    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_3D", v3.size)
+    with pytest.raises(AssertionError, match="parallel march ran"):
+        fast_marching(v3, [(0, 0, 0)], order=2)
     monkeypatch.setattr(_parallel, "ORDER2", False)  # the switch back to a serial order 2
     fast_marching(np.ones((40, 40)), [(0, 0)], order=2)
     with pytest.raises(AssertionError, match="parallel march ran"):

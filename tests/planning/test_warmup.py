@@ -87,6 +87,7 @@ _LATER_PARALLEL_RUN = textwrap.dedent(
     from fm2uav.eikonal import _kernels, _parallel, fast_marching
     _kernels.LEAN_NODES = 0          # a big grid's two-thread march (lean layout, float32
     _parallel.PARALLEL_MIN_NODES = 0  # speed), on a small one
+    _parallel.ORDER2_MIN_NODES_3D = 0
     v = np.ones((40, 36, 20))
     v[10:14, :30, :] = 0.0
     T = fast_marching(v, [(30, 5, 3)], spacing=(15.0, 15.0, 10.0), order=ORDER, threads=2)
@@ -115,7 +116,7 @@ def test_parallel_group_caches_the_lean_layout_of_a_big_two_thread_march(tmp_pat
     # march to compile
     float64_only = ("import numpy as np\n"
                     "from fm2uav.eikonal import _parallel, fast_marching\n"
-                    "_parallel.PARALLEL_MIN_NODES = 0\n"
+                    "_parallel.PARALLEL_MIN_NODES = _parallel.ORDER2_MIN_NODES_3D = 0\n"
                     f"fast_marching(np.ones((16, 16, 16)), [(3, 3, 3)], order={order}, "
                     "threads=2)\n")
     res = _run(["-c", float64_only], tmp_path / "small")

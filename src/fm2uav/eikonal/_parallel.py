@@ -95,6 +95,12 @@ ORDER2 = True
 #: an idle machine) and the wall time is equal; below, a window holds fewer nodes
 #: per barrier and the wall time on a busy machine decides: kept serial.
 PARALLEL_MIN_NODES = 1_000_000
+#: 3D order 2 marches on slabs only from this many nodes: its repairs near the ghosts
+#: (a node's time from scratch, :func:`_serial_time2`) cost more on thin slabs. Measured
+#: (3 December 2026, machine at load 4.5-4.8, medians of 2): 160^3 FM²-shaped (20-row
+#: slabs) CPU 0.97 -> 2.31 s, busiest thread 0.98 -> 1.34 s (0.73x: slower); the
+#: 1000 x 1000 x 40 terrain march (125-row slabs) busiest thread 10.4 -> 5.0 s.
+ORDER2_MIN_NODES_3D = 2**24
 #: Each slab gets at least this many x-slabs (rows), else fewer slabs are used.
 MIN_SLAB_ROWS = 16
 #: ... and at least this many nodes (but every thread one slab): thin slabs cost repairs.

@@ -81,7 +81,8 @@ def _fmm_parallel(ndim: int) -> Callable[[], None]:
         speed = np.ones((16,) * ndim)
         speed[(0,) * ndim] = 0.5  # a plateau with its mask (a uniform grid needs none)
         floor, lean = _parallel.PARALLEL_MIN_NODES, _kernels.LEAN_NODES
-        _parallel.PARALLEL_MIN_NODES = 0
+        floor2 = _parallel.ORDER2_MIN_NODES_3D
+        _parallel.PARALLEL_MIN_NODES = _parallel.ORDER2_MIN_NODES_3D = 0
         try:
             for lean_nodes in (lean, 0):
                 _kernels.LEAN_NODES = lean_nodes
@@ -89,6 +90,7 @@ def _fmm_parallel(ndim: int) -> Callable[[], None]:
                     fast_marching(speed, [(3,) * ndim], order=order, threads=2)
         finally:
             _parallel.PARALLEL_MIN_NODES, _kernels.LEAN_NODES = floor, lean
+            _parallel.ORDER2_MIN_NODES_3D = floor2
 
     return run
 
