@@ -18,9 +18,9 @@ _LATER_RUN = textwrap.dedent(
     from fm2uav import _jit
     compiled = []
     _jit.on_first_compile(lambda: compiled.append(1))
-    from fm2uav.eikonal import _kernels, distance_map, fast_marching
+    from fm2uav.eikonal import _edt, _kernels, distance_map, fast_marching
     _kernels.LEAN_NODES = 0          # a big grid's march, on a small one
-    _kernels.EDT_PARALLEL_MIN_NODES = 0
+    _edt.EDT_PARALLEL_MIN_NODES = 0
     rng = np.random.default_rng(0)
     occ = rng.random((30, 20, 10)) < 0.05
     occ[0, 0, 0] = True
