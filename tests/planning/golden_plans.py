@@ -75,6 +75,8 @@ def cases() -> dict:
                                                                exponent=0.5)}),
         "2d_obstacles_walls": (w2, s2, g2, {"shaping": Shaping(walls=True, exponent=1.5)}),
         "2d_obstacles_fmm": (w2, s2, g2, {"shaping": Shaping(method="fmm")}),
+        "2d_obstacles_fmm_dsat": (w2, s2, g2, {"shaping": Shaping(method="fmm", walls=True,
+                                                                   saturation_distance=5.0)}),
         "3d_obstacles": (w3, s3, g3, {}),
         "3d_obstacles_shaped": (w3, s3, g3, {"shaping": Shaping(saturation=0.6,
                                                                  exponent=1.7)}),

@@ -1399,6 +1399,14 @@ def scan_speed(v, min_speed):
         n_tiny += (x > 0.0) & (x < min_speed)
     if not bad:
         return -1, n_tiny
+    n_tiny = 0
+    for c in range(v.size):
+        x = v[c]
+        if not (x >= 0.0 and x < np.inf):
+            return c, n_tiny
+        if 0.0 < x < min_speed:
+            n_tiny += 1
+    return -1, n_tiny
 
 
 @njit(cache=True, error_model="numpy", parallel=True)
@@ -1420,11 +1428,3 @@ def scan_speed_parallel(nth, v, min_speed):
         if bads[t] >= 0:
             return bads[t], count
     return -1, count
-    n_tiny = 0
-    for c in range(v.size):
-        x = v[c]
-        if not (x >= 0.0 and x < np.inf):
-            return c, n_tiny
-        if 0.0 < x < min_speed:
-            n_tiny += 1
-    return -1, n_tiny

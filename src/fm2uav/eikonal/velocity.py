@@ -142,7 +142,8 @@ def normalised_distance(occupancy: Any, *, spacing: float | Sequence[float] = 1.
     dist, top = _distance(occupancy, spacing, method, walls, 2, threads, True)
     if top is not None and 0.0 < top < np.inf:
         return dist, top  # divided by the transform
-    return normalise_distance(dist, overwrite=True), distance_scale(dist)
+    scale = distance_scale(dist)  # before the division in place
+    return normalise_distance(dist, overwrite=True), scale
 
 
 def normalise_distance(dist: np.ndarray, *, overwrite: bool = False) -> np.ndarray:
