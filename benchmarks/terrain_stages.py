@@ -102,6 +102,8 @@ _CHILD = textwrap.dedent(
     for i, k in enumerate(["(checks)", "velocity_map", "fast_marching", "geodesic", "metrics"]):
         stages[k] = [b - a for a, b in zip(m[i], m[i + 1])]
     stages["plan"] = [b - a for a, b in zip(c1, c2)]
+    stages["plan outside the march kernel"] = [
+        a - b for a, b in zip(stages["plan"], PIECES["  march kernel"])]
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024 - base
     print(json.dumps({"stages": stages, "pieces": PIECES, "peak_mb": peak,
                       "digests": [digest(p.W), digest(p.T), digest(p.path)],
@@ -112,7 +114,7 @@ _CHILD = textwrap.dedent(
 ORDER = ["world build", "(checks)", "velocity_map", "fast_marching", "  input scan",
          "  sources and ball", "  padding", "  plateau test", "  march kernel", "  unpadding",
          "  ties at the start", "geodesic", "  obstacles reached?", "  descent", "metrics",
-         "  clearance", "plan"]
+         "  clearance", "plan", "plan outside the march kernel"]
 
 
 def child(src: str, threads: int, n: int) -> dict:

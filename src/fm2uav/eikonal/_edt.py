@@ -11,9 +11,12 @@ grid (stride ``nz``, resp. ``ny * nz``); gathering one line at a time touched a
 whole cache line (and, along x, a page) per value. The passes gather
 ``LANES`` neighbouring lines at once instead — one cache line of each row — into
 a small block that stays in the L1/L2 cache, transform them there and write them
-back the same way. On the 1000 x 1000 x 40 terrain grid the x pass went from
-most of the transform's time to a share like the others' (docs/performance.md,
-"Big maps").
+back the same way. The first pass (along z, on a map of 0 and inf) is two sweeps
+without divisions (:func:`_binary_line`). Measured on the 1000 x 1000 x 40 terrain
+grid (CPU time, with the root and the division): 1.39 -> 1.20 s
+(``benchmarks/terrain_stages.py``, docs/performance.md "Big maps"); what is left is
+the y and x passes' lower envelopes, a division and an unpredictable branch per node,
+not memory.
 
 The last pass can take the square root and the largest value on the way
 (``root=True``): the distance map and its maximum (the normaliser of W) without
