@@ -18,16 +18,20 @@ _LATER_RUN = textwrap.dedent(
     from fm2uav import _jit
     compiled = []
     _jit.on_first_compile(lambda: compiled.append(1))
-    from fm2uav.eikonal import _kernels, distance_map, fast_marching
-    _kernels.LEAN_NODES = 0          # a big grid's march, on a small one
-    _kernels.EDT_PARALLEL_MIN_NODES = 0
+    from fm2uav.eikonal import _edt, _kernels, distance_map, fast_marching
+    from fm2uav.planning.geodesic import drop_ties, reaches_any
+    _kernels.LEAN_NODES = 0          # a big grid's march, on a small one,
+    _edt.EDT_PARALLEL_MIN_NODES = 0  # its distance map and set-up on two threads
+    _kernels.SETUP_PARALLEL_MIN_NODES = 0
     rng = np.random.default_rng(0)
     occ = rng.random((30, 20, 10)) < 0.05
     occ[0, 0, 0] = True
-    W = distance_map(occ, spacing=(15.0, 15.0, 10.0))
+    W = distance_map(occ, spacing=(15.0, 15.0, 10.0), threads=2)
     T = fast_marching(W / W.max() + 0.01, [(29, 19, 9)], spacing=(15.0, 15.0, 10.0),
-                      stop_at=[(0, 0, 1)])
+                      stop_at=[(0, 0, 1)], threads=2)
     assert np.isfinite(T[0, 0, 1])
+    drop_ties(T, (0, 0, 1))          # the plan's scans of T
+    assert not reaches_any(T, occ & ~np.isfinite(T))
     print("compiled" if compiled else "cached")
     """
 )
@@ -44,7 +48,7 @@ def test_big_grid_groups_cache_what_a_big_plan_compiles(tmp_path):
     # the groups a big plan needs beyond the small ones: after them a big-grid
     # march and distance map (forced on a small grid) compile nothing
     small, big = tmp_path / "small", tmp_path / "big"
-    res = _run(["-m", "fm2uav.planning.warmup", "edt", "fmm3d_o2"], small)
+    res = _run(["-m", "fm2uav.planning.warmup", "edt", "fmm3d_o2", "descent"], small)
     assert res.returncode == 0, res.stderr
     # the small groups' cache, copied, is where the big-grid groups start (numba names a
     # cache folder after the source folder, not after NUMBA_CACHE_DIR: the copy loads)
@@ -53,7 +57,7 @@ def test_big_grid_groups_cache_what_a_big_plan_compiles(tmp_path):
     res = _run(["-c", _LATER_RUN], small)
     assert res.returncode == 0, res.stderr
     assert res.stdout.split() == ["compiled"]
-    groups = ["edt", "edt_parallel", "fmm3d_o2", "fmm3d_o2_lean"]
+    groups = ["edt", "edt_parallel", "fmm3d_o2", "fmm3d_o2_lean", "descent"]
     res = _run(["-m", "fm2uav.planning.warmup", *groups], big)
     assert res.returncode == 0, res.stderr
     assert [line.split(":")[0] for line in res.stdout.splitlines()] == groups
@@ -86,7 +90,8 @@ _LATER_PARALLEL_RUN = textwrap.dedent(
     _jit.on_first_compile(lambda: compiled.append(1))
     from fm2uav.eikonal import _kernels, _parallel, fast_marching
     _kernels.LEAN_NODES = 0          # a big grid's two-thread march (lean layout, float32
-    _parallel.PARALLEL_MIN_NODES = 0  # speed), on a small one
+    _parallel.PARALLEL_MIN_NODES = 0  # speed) and its input scan, on a small one
+    _kernels.SETUP_PARALLEL_MIN_NODES = 0
     v = np.ones((40, 36, 20))
     v[10:14, :30, :] = 0.0
     T = fast_marching(v, [(30, 5, 3)], spacing=(15.0, 15.0, 10.0), order=1, threads=2)

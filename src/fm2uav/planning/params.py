@@ -266,7 +266,9 @@ class PlanOptions:
         Threads of the Fast Marching runs (``>= 1``); None (default): the
         environment variable ``FM2UAV_THREADS``, else every core. Order 1 on
         grids of 1 M nodes or more marches in parallel (the same times to
-        round-off); see :func:`fm2uav.eikonal.fast_marching`.
+        round-off); see :func:`fm2uav.eikonal.fast_marching`. The distance
+        transform of W and the march's set-up on grids of 2 M nodes or more run
+        on as many (the same values bit for bit).
     """
 
     order: Literal[1, 2] = 2

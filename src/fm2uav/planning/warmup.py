@@ -26,10 +26,11 @@ from collections.abc import Callable, Iterable
 
 import numpy as np
 
+from ..eikonal import _edt as _edt_kernels
 from ..eikonal import _kernels, _parallel, distance_map, fast_marching
 from ..world import World
 from ..world.clearance import surface_clearance
-from .geodesic import descend
+from .geodesic import descend, drop_ties, reaches_any
 
 __all__ = ["GROUPS", "FIRST_PLAN_MAIN", "FIRST_PLAN_CHILD", "warm"]
 
@@ -44,7 +45,7 @@ def _edt_parallel() -> None:
     """The distance transform of big grids (lines in parallel)."""
     occ = np.zeros((4, 4, 4), dtype=bool)
     occ[0, 0, 0] = True
-    _kernels._squared_edt_parallel(_kernels._readonly(occ), 1.0, 1.0, 1.0)
+    _edt_kernels._edt_parallel(_kernels._readonly(occ), 1.0, 1.0, 1.0, True, True, 1)
 
 
 def _fmm(ndim: int, order: int) -> Callable[[], None]:
@@ -61,13 +62,22 @@ def _fmm(ndim: int, order: int) -> Callable[[], None]:
 
 
 def _fmm_lean(order: int) -> Callable[[], None]:
-    """The 3D march in the lean layout of grids over ``LEAN_NODES`` nodes (float32 V)."""
+    """The 3D march in the lean layout of grids over ``LEAN_NODES`` nodes (float32 V), and
+    the set-up of big grids on two threads (the input scan, the padding)."""
     def run() -> None:
         T = np.full(125, np.inf)
         state = np.zeros(125, dtype=np.uint8)
         T[62], state[62] = 0.0, _kernels.FROZEN
-        _kernels.march(np.ones(125), _kernels.Start.whole(T, state, (5, 5, 5)), (5, 5, 5),
-                       (1.0, 1.0, 1.0), order, np.zeros((0, 3), dtype=np.int64), lean=True)
+        floor = _kernels.SETUP_PARALLEL_MIN_NODES
+        _kernels.SETUP_PARALLEL_MIN_NODES = 0
+        try:
+            for threads in (1, 2):
+                _kernels.march(np.ones(125), _kernels.Start.whole(T, state, (5, 5, 5)),
+                               (5, 5, 5), (1.0, 1.0, 1.0), order,
+                               np.zeros((0, 3), dtype=np.int64), lean=True, threads=threads)
+        finally:
+            _kernels.SETUP_PARALLEL_MIN_NODES = floor
+        _kernels.scan_speed_parallel(2, _kernels._readonly(np.ones(125)), 1e-150)
 
     return run
 
@@ -93,9 +103,12 @@ def _fmm_parallel(ndim: int) -> Callable[[], None]:
 
 
 def _descent() -> None:
+    """The descent and the plan's scans of its field (ties at the start, obstacles reached)."""
     g = np.array([4.0, 4.0, 4.0])
     axes = np.meshgrid(*[np.arange(5.0)] * 3, indexing="ij")
     T = np.sqrt(sum((a - c) ** 2 for a, c in zip(axes, g)))
+    drop_ties(T, (0, 0, 0))
+    reaches_any(T, np.zeros(T.shape, dtype=bool))
     descend(T, (0.0, 0.0, 0.0), tuple(g), spacing=(1.0, 1.0, 1.0))
 
 
