@@ -50,6 +50,7 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 
 import numpy as np
@@ -108,6 +109,10 @@ WINDOW_NODES = 32768
 #: without (2 threads, 4 slabs per thread): FM²-shaped 2048^2 1.654 -> 1.759, 160^3 1.84 ->
 #: 1.90; constant speed the same (1.99, 1.93 -> 1.95).
 SHARE_SLABS = True
+#: 2D: a far neighbour of the node a window freezes gets the one-axis update along their
+#: axis, as in the serial march (valid in a slab: see the window's docstring); False: the
+#: full update (the same times bit for bit; the tests run both).
+FAR_ONE_AXIS = True
 #: Free repair-heap slots kept before each node's pushes (one pop pushes at most 7).
 HEAP_RESERVE = 8
 #: Smallest start of a slab's repair heap (entries; at least 4 boundary rows) and
@@ -267,7 +272,7 @@ def _lower(T, V, c, t, fixed, sx, sy, three, pv, pool, nxt, bk, mw, st, rkey, ri
             if x == -_INF:  # a new band node: fetch the rows its freezing reads (as _relax)
                 _prefetch_rows(T, V, c, sx, sy, three, pv)
             _enq(_bits(t), c, pool, nxt, bk, mw, st, rkey, ritem)
-    elif t < x and (fixed[c >> _U(3)] >> (c & _U(7))) & _ONE == _ZERO:
+    elif t < x and _fixed_at(fixed, c, sy, three) == _ZERO:
         T[c] = -t
         ctl[_C_REOPEN] += 1.0
         _enq(_bits(t), c, pool, nxt, bk, mw, st, rkey, ritem)
@@ -281,10 +286,26 @@ def _room(st, rkey):
 
 @njit(cache=True, inline="always", _nrt=False)
 def _nbs(c, sx, sy, three):
-    """The neighbours of node ``c``: six in 3D; in 2D four, then ``c`` twice (frozen: skipped)."""
+    """The neighbours of node ``c``: six in 3D; in 2D four (``sy`` the y stride: 1, or 2 in
+    the interleaved layout), then ``c`` twice (frozen: skipped)."""
     if three:
         return (c - sx, c + sx, c - sy, c + sy, c - _ONE, c + _ONE)
-    return (c - sx, c + sx, c - _ONE, c + _ONE, c, c)
+    return (c - sx, c + sx, c - sy, c + sy, c, c)
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _unit(sy, three):
+    """The elements between two consecutive nodes of a slab's ``T``: 1, or 2 in the 2D
+    interleaved layout (node ``c``'s time at ``2 c``, its ``1 / speed^2`` at ``2 c + 1``),
+    where it is the y stride ``sy``; 3D slabs are never interleaved."""
+    return _ONE if three else sy
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _fixed_at(fixed, c, sy, three):
+    """Bit of element ``c``'s node in the frozen-on-entry mask ``fixed`` (one bit a node)."""
+    n = c >> (_unit(sy, three) >> _ONE)  # node index: element index / unit (1 or 2)
+    return (fixed[n >> _U(3)] >> (n & _U(7))) & _ONE
 
 
 @njit(cache=True, inline="always", _nrt=False)
@@ -305,20 +326,33 @@ def _slab_kernels(three):
     # closure variables are part of numba's cache key: only ``three`` (a bool) may be
     # one (a dispatcher's pickle differs per process and would defeat the cache)
     def window(T, V, U, qp, fixed, sx, sy, ih, hh, iso, tw, pool, nxt, bk, mw, st, rkey, ritem,
-               ctl, sent, ns):
+               ctl, sent, ns, far):
         """Freeze the slab's queued nodes with a time below ``tw`` (resumable).
 
         ``T`` is the slab's padded grid (ghost x-slabs first and last). Sets
         ``ctl[_C_NEXT]`` to the smallest time left queued (inf if none). The nodes it
         freezes in its first and last own rows go to ``sent[0]`` and ``sent[1]``
         (``ns`` their counts, reset here): the neighbours' exchange reads only those.
+
+        ``far`` (2D): a far neighbour of the node just frozen gets the one-axis update
+        along their axis, as in the serial march. Valid in a slab because no far node has
+        a frozen neighbour other than the node being frozen: every node that becomes
+        frozen updates its band and far own neighbours at once — a pop here, a node
+        frozen on entry in ``start``, a ghost in ``exchange`` (its one own neighbour) —
+        and an update from a frozen neighbour is finite (or ``inf`` on both ways, where
+        ``1 / speed^2`` overflows), so none of them stays far; a re-opened node was
+        frozen before, so its neighbours are not far either, and nothing turns far
+        again. The full update of such a node reads that one finite neighbour and
+        returns bit for bit the one-axis time (tests/eikonal/test_fmm_parallel.py runs
+        both ways and compares the times bit for bit).
         """
         n = _U(T.size)
         lo = sx  # the slab's own nodes: [sx, n - sx)
         hi = n - sx
         lo2 = lo + sx  # the first own row is [lo, lo2), the last [hi2, hi)
         hi2 = hi - sx
-        use_u = qp > 0.0
+        one = _unit(sy, three)
+        use_u = qp > 0.0 and one == _ONE
         kw = _bits(tw)
         pops = 0
         ns[0] = _ZERO
@@ -346,12 +380,29 @@ def _slab_kernels(three):
                 _note(sent, ns, 0, c)
             if c >= hi2:
                 _note(sent, ns, 1, c)
-            pv = not (use_u and _at_plateau(U, c))
-            for nb in _nbs(c, sx, sy, three):
-                y = T[nb]
-                if y < 0.0 or (y > t and nb >= lo and nb < hi):
-                    # band/far, or frozen later than c in this slab: c may lower it
-                    t_nb = _update(T, V, U, use_u, qp, nb, sx, sy, ih, hh, iso, three)
+            # prefetch V apart from T off the plateau (interleaved: the same lines)
+            pv = one == _ONE and not (use_u and _at_plateau(U, c))
+            if three:
+                for nb in _nbs(c, sx, sy, three):
+                    y = T[nb]
+                    if y < 0.0 or (y > t and nb >= lo and nb < hi):
+                        # band/far, or frozen later than c in this slab: c may lower it
+                        t_nb = _update(T, V, U, use_u, qp, nb, sx, sy, ih, hh, iso, three)
+                        _lower(T, V, nb, t_nb, fixed, sx, sy, three, pv, pool, nxt, bk, mw, st,
+                               rkey, ritem, ctl)
+            else:
+                for j in range(4):  # one site for the four neighbours, as the serial march
+                    s = sx if j < 2 else sy
+                    nb = c - s if j & 1 == 0 else c + s
+                    y = T[nb]
+                    if far and y == -_INF:  # c is its only frozen neighbour (docstring)
+                        q = _rhs(V, U, use_u, qp, nb)
+                        t_nb = t + math.sqrt(q * hh) if iso else t + math.sqrt(q / ih[j >> 1])
+                    elif y < 0.0 or (y > t and nb >= lo and nb < hi):
+                        # band/far, or frozen later than c in this slab: c may lower it
+                        t_nb = _update(T, V, U, use_u, qp, nb, sx, sy, ih, hh, iso, three)
+                    else:
+                        continue
                     _lower(T, V, nb, t_nb, fixed, sx, sy, three, pv, pool, nxt, bk, mw, st,
                            rkey, ritem, ctl)
         ctl[_C_POPS] = pops
@@ -360,7 +411,8 @@ def _slab_kernels(three):
               c0, c1):
         """Queue the slab's band nodes given on entry and expand its frozen ones (all in
         its nodes ``[c0, c1)``, the rows of the start box: the others are far or walls)."""
-        use_u = qp > 0.0
+        one = _unit(sy, three)
+        use_u = qp > 0.0 and one == _ONE
         c = c0
         while c < c1:
             x = T[c]
@@ -368,7 +420,7 @@ def _slab_kernels(three):
                 if not _room(st, rkey):
                     return False
                 _enq(_bits(-x), c, pool, nxt, bk, mw, st, rkey, ritem)
-            c += _ONE
+            c += one
         c = c0
         while c < c1:
             if T[c] >= 0.0:
@@ -377,9 +429,9 @@ def _slab_kernels(three):
                 for nb in _nbs(c, sx, sy, three):
                     if T[nb] < 0.0:
                         t_nb = _update(T, V, U, use_u, qp, nb, sx, sy, ih, hh, iso, three)
-                        _lower(T, V, nb, t_nb, fixed, sx, sy, three, True, pool, nxt, bk, mw,
-                               st, rkey, ritem, ctl)
-            c += _ONE
+                        _lower(T, V, nb, t_nb, fixed, sx, sy, three, one == _ONE, pool, nxt, bk,
+                               mw, st, rkey, ritem, ctl)
+            c += one
         return True
 
     def exchange(T, V, U, qp, fixed, src, sent, m, base, g, own, sx, sy, ih, hh, iso, pool, nxt,
@@ -389,13 +441,14 @@ def _slab_kernels(three):
         the start of that row). Only the neighbour's nodes ``sent[:m] - base`` are read
         (those it froze in its last window), the whole row when ``m`` exceeds the list's
         capacity. Resumable: False when a queue is full."""
-        use_u = qp > 0.0
+        one = _unit(sy, three)
+        use_u = qp > 0.0 and one == _ONE
         full = m > _U(sent.size)
-        count = sx if full else m
+        count = sx if full else m  # elements of the row, or listed nodes
         i = _ZERO
         while i < count:
             j = i if full else sent[i] - base
-            i += _ONE
+            i += one if full else _ONE
             v = src[j]
             if v >= 0.0 and not v >= T[g + j]:  # newly frozen or lowered there
                 if not _room(st, rkey):
@@ -404,7 +457,8 @@ def _slab_kernels(three):
                 c = own + j
                 if T[c] == T[c]:  # not a wall
                     _lower(T, V, c, _update(T, V, U, use_u, qp, c, sx, sy, ih, hh, iso, three),
-                           fixed, sx, sy, three, True, pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                           fixed, sx, sy, three, one == _ONE, pool, nxt, bk, mw, st, rkey, ritem,
+                           ctl)
                     if T[c] < 0.0 and -T[c] < ctl[_C_NEXT]:  # queued: the next window knows
                         ctl[_C_NEXT] = -T[c]
         return True
@@ -519,7 +573,7 @@ def _assign(work, nth, slabs, first, load, share=True):
 def _drive_kernel(three):
     """The compiled driver of one dimension (the parallel region runs the slabs)."""
     def drive(nth, Tp, Vp, U, qp, fx, off, end, rows, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st,
-              rkey, ritem, ctl, sent, ns, win, first, stops, slabs, lists, load, share, scan):
+              rkey, ritem, ctl, sent, ns, win, first, stops, slabs, lists, load, share, scan, far):
         """Run windows until every queue is empty; 0 done, 1/2 grow pool/heap and call again.
 
         ``win`` (float64): [0] window end, [1] width, [2] windows run, [3] target pops,
@@ -532,16 +586,21 @@ def _drive_kernel(three):
         each slab's nodes frozen in its boundary rows in the last window (see ``window``).
         ``slabs`` (K), ``lists`` (nth + 1 + K), ``load`` (nth): scratch of :func:`_assign`
         (``share``: :data:`SHARE_SLABS`). ``scan[k]``: the nodes of slab ``k`` the start
-        reads (the start box's rows).
+        reads (the start box's rows). ``far``: the far neighbours' one-axis update (2D).
+
+        ``off``, ``end``, ``sx``, ``sy``, ``scan`` and ``stops`` count elements of ``Tp``:
+        nodes in the separate layout, twice that in the 2D interleaved one (``Tp`` the
+        buffer, ``Vp = Tp[1:]``, ``sy = 2``); ``U`` and ``fx`` have a bit per node.
         """
         K = off.size
         sxi = np.int64(sx)
+        sh = 0 if three or sy == 1 else 1  # node index = element index >> sh
         if first:
             for t in prange(nth):  # thread t runs slabs t, t + nth, ...
                 for k in range(t, K, nth):
                     if not _start(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]],
-                                  U[0 if U.size == 1 else off[k] >> 3:], qp, fx[off[k] >> 3:],
-                                  sx, sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
+                                  U[0 if U.size == 1 else off[k] >> sh >> 3:], qp,
+                                  fx[off[k] >> sh >> 3:], sx, sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
                                   rkey[k], ritem[k], ctl[k], _U(scan[k, 0]), _U(scan[k, 1])):
                         ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < _U(RESERVE_BLOCKS) else 2.0
             for k in range(K):
@@ -559,8 +618,8 @@ def _drive_kernel(three):
                     k = slabs[i]
                     T = Tp[off[k]:end[k]]
                     V = Vp[off[k]:end[k]]
-                    Uk = U[0 if U.size == 1 else off[k] >> 3:]
-                    F = fx[off[k] >> 3:]
+                    Uk = U[0 if U.size == 1 else off[k] >> sh >> 3:]
+                    F = fx[off[k] >> sh >> 3:]
                     ok = True
                     if k > 0:
                         o = end[k - 1] - 2 * sxi  # last own row of the slab below
@@ -615,9 +674,9 @@ def _drive_kernel(three):
                 for i in range(lists[t], lists[t + 1]):
                     k = slabs[i]
                     _window(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]],
-                            U[0 if U.size == 1 else off[k] >> 3:], qp, fx[off[k] >> 3:], sx, sy,
-                            ih, hh, iso, tw, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
-                            ritem[k], ctl[k], sent[k], ns[k])
+                            U[0 if U.size == 1 else off[k] >> sh >> 3:], qp,
+                            fx[off[k] >> sh >> 3:], sx, sy, ih, hh, iso, tw, pool[k], nxt[k],
+                            bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k], sent[k], ns[k], far)
             win[2] += 1.0
             pops = 0.0
             most = 0.0
@@ -761,7 +820,7 @@ def _coarse_histogram(speed, start, shape3, h3):
     return hist, f
 
 
-def march(speed, start, shape3, h3, threads, stop_cells=None):
+def march(speed, start, shape3, h3, threads, stop_cells=None, *, interleave=None):
     """The order-1 Fast Marching from ``start`` on ``threads`` slabs in parallel.
 
     Parameters
@@ -781,6 +840,10 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
     stop_cells : ndarray, int, shape (m, 3), optional
         Stop once these nodes are frozen and final; nodes later than the latest
         of them are then ``inf``, as in the serial march.
+    interleave : bool, optional
+        2D slabs outside the lean layout: ``T`` and ``1 / speed^2`` interleaved in one
+        array, as the serial march (:func:`fm2uav.eikonal._kernels._buffers`); default:
+        unless every passable node has one speed. The times are the same bit for bit.
 
     Returns
     -------
@@ -809,23 +872,26 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
     off = np.concatenate([[0], np.cumsum(-(-sizes // 8) * 8)[:-1]]).astype(np.int64)
     npad = int(off[-1] + sizes[-1])
     lean = (nx + 2) * sx > _kernels.LEAN_NODES  # V in float32 as the serial march
-    if lean:  # plain mappings, as the serial march's (the times compacted in place below)
-        Tp = _kernels._work(8 * npad).view(np.float64)
-        Vp = _kernels._work(4 * npad).view(np.float32)
-    else:  # the serial march's kept buffers (huge pages, no page faults on a repeat)
-        Tp, Vp = _kernels._work_pair(npad)
+    # the serial march's buffers: in the lean layout plain mappings (the times compacted
+    # in place below), else its kept ones (huge pages, no page faults on a repeat); a 2D
+    # map not of one speed interleaved (Tk: node c's time at 2 c, its V at 2 c + 1; Tp and
+    # Vp strided views of it) and without a plateau register, as the serial march
+    Tp, Vp, Tk, Vk, unit, plat = _kernels._buffers(speed, shape3, npad, lean, interleave)
     plane = ny * nz
     boxes = _start_boxes(start, bounds)
     with _threads(nth):
         _pad_slabs(nth, _kernels._readonly(speed), start.T, start.state, boxes, bounds, off, ny,
                    nz, Tp, Vp)
-    # the start box's rows in each slab, the only nodes the start reads
-    scan = np.stack([(boxes[:, 0] + 1) * sx, (boxes[:, 0] + boxes[:, 3] + 1) * sx], axis=1)
+    # the start box's rows in each slab, the only nodes the start reads (elements of Tk)
+    scan = unit * np.stack([(boxes[:, 0] + 1) * sx, (boxes[:, 0] + boxes[:, 3] + 1) * sx],
+                           axis=1)
     # the nodes frozen on entry (sources, balls) stay as they are, as in the serial march
     fixed = np.packbits(Tp >= 0.0, bitorder="little")
-    U, qp = _kernels._plateau(speed, Vp, shape3, npad,
-                              fill=lambda vmax, bits: _slab_plateau(speed, vmax, bounds, off,
-                                                                    shape3, bits))
+    if plat is None:
+        plat = _kernels._plateau(speed, Vp, shape3, npad,
+                                 fill=lambda vmax, bits: _slab_plateau(speed, vmax, bounds, off,
+                                                                       shape3, bits))
+    U, qp = plat
     # each slab's nodes frozen in its first and last own rows in the last window (the
     # neighbours' exchange reads those); a count over the capacity: read the whole row
     # (so the first exchange, after the start)
@@ -859,7 +925,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
         local = ((cells[:, 0] - bounds[k] + 1) * (ny + 2) + cells[:, 1] + 1)
         if three:
             local = local * (nz + 2) + cells[:, 2] + 1
-        stop_idx = off[k] + local
+        stop_idx = unit * (off[k] + local)
     drive = _drive3d if three else _drive2d
     slabs = np.empty(K, dtype=np.int64)  # scratch of _assign: each window's slabs per thread
     lists = np.empty(nth + 1 + K, dtype=np.int64)
@@ -869,9 +935,10 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
     numba.set_num_threads(nth)
     try:
         while True:
-            status = drive(nth, Tp, Vp, U, qp, fixed, off, off + sizes, rows, _U(sx), _U(sy), ih,
-                           hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win, first,
-                           stop_idx, slabs, lists, load, SHARE_SLABS, scan)
+            status = drive(nth, Tk, Vk, U, qp, fixed, unit * off, unit * (off + sizes), rows,
+                           _U(unit * sx), _U(unit * sy), ih, hh, iso, pool, nxt, bk, mw, st, rkey,
+                           ritem, ctl, sent, ns, win, first, stop_idx, slabs, lists, load,
+                           SHARE_SLABS, scan, FAR_ONE_AXIS)
             first = win[7] == 0.0
             if status == 0:
                 break
@@ -882,7 +949,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None):
                 rkey, ritem = _grow_heaps(rkey, ritem)
     finally:
         numba.set_num_threads(prev)
-    del Vp, pool, nxt
+    del Vp, Vk, Tk, pool, nxt
     # lean: in place, slab after slab, as the serial march: slab k's times go to
     # [a * plane, b * plane), from no later than its padded grid's start to before slab
     # k + 1's, so every node moves to a lower index and is read before it is written
