@@ -710,6 +710,13 @@ _drive3d = _drive_kernel(True)
 #: every 8th / 16th / 32nd node / equal slabs, the coarse march 8 / 2 / 0.5 ms.
 COARSE = 16
 COARSE_3D = 4
+#: Whether the cuts are placed for the slabs shared anew before each window (the least
+#: share of a time bin any sharing allows, :func:`slab_bounds`) rather than for the fixed
+#: interleave. Simulated on the bench's FM²-shaped 2048^2 map from the serial times
+#: (windows of 32768 nodes in time order, the slabs shared as :func:`_assign`), 8 slabs:
+#: windows' balance 1.78 -> 1.84 (16 slabs 1.83 -> 1.84). 3D keeps the interleave's cuts
+#: (not measured there).
+SHARED_CUTS = {2: True, 3: False}
 #: Bins of the split estimate, each as many coarse nodes in time order (stand-ins for
 #: the windows).
 SPLIT_BINS = 256
@@ -724,7 +731,13 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarra
     windows' critical path (a source off-centre would otherwise leave one thread idle
     while the wave crosses the other's slabs), by coordinate descent from equal slabs
     (each cut in turn moved to its best row between its neighbours, until none moves;
-    exhaustive for two slabs). Equal slabs when the start is not a few point sources
+    exhaustive for two slabs). Where :data:`SHARED_CUTS` says so (2D) a second descent
+    counts a thread's nodes in a bin not as the fixed interleave gives them but as the least
+    any sharing of the slabs allows, ``max(the bin's busiest slab, the bin's nodes /
+    threads)`` (the slabs are shared anew before each window, :func:`_assign`, and cuts
+    made for the interleave may leave the late wave in one slab), and the cuts of the two
+    descents with the shorter critical path when the bins' slabs are shared as
+    :func:`_assign` shares them (:func:`_shared_cost`) are taken. Equal slabs when the start is not a few point sources
     (its box over a quarter of the grid) or the grid is too thin for a coarse march.
     """
     nx = int(shape3[0])
@@ -741,29 +754,34 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarra
     cum = np.vstack([np.zeros((1, hist.shape[1]), dtype=np.int64), np.cumsum(hist, axis=0)])
     cuts = np.clip(np.linspace(0, rows, k + 1).round().astype(np.int64), 0, rows)
     owner = np.arange(k) % threads
+    floor = cum[-1] / threads  # a bin's nodes over the threads
 
     def loads(c):  # nodes per thread and time bin, shape (threads, bins)
         per_slab = cum[c[1:]] - cum[c[:-1]]
         return np.stack([per_slab[t::threads].sum(axis=0) for t in range(threads)])
 
-    for _ in range(4 * k):
-        moved = False
-        for i in range(1, k):
-            cand = np.arange(cuts[i - 1] + gap, cuts[i + 1] - gap + 1)
-            if cand.size == 0:
-                continue
-            base = loads(cuts)
-            base[owner[i - 1]] -= cum[cuts[i]] - cum[cuts[i - 1]]
-            base[owner[i]] -= cum[cuts[i + 1]] - cum[cuts[i]]
-            trial = np.repeat(base[None], cand.size, axis=0)
-            trial[:, owner[i - 1]] += cum[cand] - cum[cuts[i - 1]]
-            trial[:, owner[i]] += cum[cuts[i + 1]] - cum[cand]
-            best = int(cand[np.argmin(trial.max(axis=1).sum(axis=1))])
-            if best != cuts[i]:
-                cuts[i] = best
-                moved = True
-        if not moved:
-            break
+    def interleaved(i, cand, c):  # the critical path with cut i at each candidate row
+        base = loads(c)
+        base[owner[i - 1]] -= cum[c[i]] - cum[c[i - 1]]
+        base[owner[i]] -= cum[c[i + 1]] - cum[c[i]]
+        trial = np.repeat(base[None], cand.size, axis=0)
+        trial[:, owner[i - 1]] += cum[cand] - cum[c[i - 1]]  # slabs i - 1 and i
+        trial[:, owner[i]] += cum[c[i + 1]] - cum[cand]
+        return trial.max(axis=1).sum(axis=1)
+
+    def shared(i, cand, c):  # the same, the least share any sharing allows
+        rest = np.delete(cum[c[1:]] - cum[c[:-1]], [i - 1, i], axis=0)
+        base = np.maximum(floor, rest.max(axis=0)) if len(rest) else floor
+        most = np.maximum(cum[cand] - cum[c[i - 1]], cum[c[i + 1]] - cum[cand])
+        return np.maximum(most, base).sum(axis=1)
+
+    fixed = _descend_cuts(cuts.copy(), gap, interleaved, strict=False)
+    if SHARED_CUTS[3 if shape3[2] > 1 else 2]:  # the better, by the windows as _assign
+        cuts = _descend_cuts(cuts, gap, shared, strict=True)  # shares the slabs
+        if _shared_cost(cum, fixed, threads) <= _shared_cost(cum, cuts, threads):
+            cuts = fixed
+    else:
+        cuts = fixed
     bounds = np.minimum(cuts * f, nx)
     bounds[-1] = nx
     for i in range(1, k):  # fine rows: at least MIN_SLAB_ROWS per slab where they fit
@@ -771,6 +789,55 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarra
     if np.any(np.diff(bounds) < 1):
         return even
     return bounds.astype(np.int64)
+
+
+def _descend_cuts(cuts, gap, costs, strict):
+    """Coordinate descent of the inner cuts ``cuts[1:-1]`` (coarse rows, at least ``gap``
+    apart): each in turn to the row of least ``costs(i, rows, cuts)`` between its
+    neighbours (the first such row; ``strict``: only where it costs less than the cut's
+    row), until none moves. ``cuts`` is changed and returned."""
+    k = len(cuts) - 1
+    for _ in range(4 * k):
+        moved = False
+        for i in range(1, k):
+            cand = np.arange(cuts[i - 1] + gap, cuts[i + 1] - gap + 1)
+            if cand.size == 0:
+                continue
+            cost = costs(i, np.append(cand, cuts[i]), cuts)
+            best = int(np.argmin(cost[:-1]))
+            if (cost[best] < cost[-1]) if strict else (cand[best] != cuts[i]):
+                cuts[i] = cand[best]
+                moved = True
+        if not moved:
+            break
+    return cuts
+
+
+def _shared_cost(cum, cuts, threads):
+    """The windows' critical path (nodes) of the cuts ``cuts`` over the coarse histogram's
+    time bins (``cum``: cumulated over the rows) with the slabs shared as :func:`_assign`
+    shares them: longest first by the last bin's nodes when that predicts a smaller
+    largest share than the fixed interleave (slab ``k`` to thread ``k % threads``)."""
+    per = (cum[cuts[1:]] - cum[cuts[:-1]]).astype(np.float64)  # (slabs, bins)
+    k, nb = per.shape
+    pred = np.zeros_like(per)
+    pred[:, 1:] = per[:, :-1]
+    cols = np.arange(nb)
+
+    def fixed_max(a):
+        return np.max([a[t::threads].sum(axis=0) for t in range(threads)], axis=0)
+
+    order = np.argsort(-pred, axis=0, kind="stable")
+    load = np.zeros((threads, nb))
+    owner = np.empty((k, nb), dtype=np.int64)
+    for i in range(k):
+        slab = order[i]
+        best = np.argmin(load, axis=0)
+        owner[slab, cols] = best
+        load[best, cols] += pred[slab, cols]
+    greedy = load.max(axis=0) < fixed_max(pred)
+    shared = np.max([np.where(owner == t, per, 0.0).sum(axis=0) for t in range(threads)], axis=0)
+    return float(np.where(greedy, shared, fixed_max(per)).sum())
 
 
 def _coarse_histogram(speed, start, shape3, h3):
@@ -885,8 +952,9 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, *, interleave=None
     # the start box's rows in each slab, the only nodes the start reads (elements of Tk)
     scan = unit * np.stack([(boxes[:, 0] + 1) * sx, (boxes[:, 0] + boxes[:, 3] + 1) * sx],
                            axis=1)
-    # the nodes frozen on entry (sources, balls) stay as they are, as in the serial march
-    fixed = np.packbits(Tp >= 0.0, bitorder="little")
+    # the nodes frozen on entry (sources, balls) stay as they are, as in the serial march:
+    # a bit per node, set from the start box's rows (the only frozen nodes on entry)
+    fixed = _frozen_bits(Tp, off[:, None] + scan // unit, npad)
     if plat is None:
         plat = _kernels._plateau(speed, Vp, shape3, npad,
                                  fill=lambda vmax, bits: _slab_plateau(speed, vmax, bounds, off,
@@ -915,7 +983,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, *, interleave=None
     hh = float(1.0 / ih[0])
     # the top speed sets the first window's width only (then adapted): from the plateau's
     # register when there is one (a pass over the speeds is ~2 ms of serial time on 2048^2)
-    vmax = (1.0 / np.sqrt(qp) if qp > 0.0 else float(speed.max())) if speed.size else 1.0
+    # (else from the plateau's sample of the speeds: a pass over them is ~2 ms of serial time)
+    vmax = 1.0 / np.sqrt(qp) if qp > 0.0 else _top_speed(speed)
     width = 2.0 * min(h3[:3 if three else 2]) / max(vmax, 1e-300)
     win = np.array([0.0, width, 0.0, float(WINDOW_NODES), 0.0, 0.0, np.inf, 0.0, 0.0])
     stop_idx = np.zeros(0, dtype=np.int64)
@@ -984,6 +1053,28 @@ def _threads(nth):
         yield
     finally:
         numba.set_num_threads(prev)
+
+
+def _frozen_bits(Tp, rows, npad):
+    """A bit per node of the padded slabs ``Tp`` (``npad`` nodes), set where ``Tp >= 0``
+    (frozen) in the node ranges ``rows[k, 0] <= c < rows[k, 1]`` (each slab's start box
+    rows), clear elsewhere (no other node is frozen on entry)."""
+    bits = np.zeros(npad // 8 + 1, dtype=np.uint8)
+    for a, b in rows:
+        if b > a:
+            a8 = int(a) & ~7
+            packed = np.packbits(Tp[a8:int(b)] >= 0.0, bitorder="little")
+            bits[a8 >> 3:(a8 >> 3) + packed.size] |= packed
+    return bits
+
+
+def _top_speed(speed):
+    """The largest speed of the plateau's sample (every ``_PLATEAU_STRIDE``-th node), else
+    of all nodes: it sets only the first window's width, which then adapts."""
+    if speed.size == 0:
+        return 1.0
+    top = float(speed[::_kernels._PLATEAU_STRIDE].max())
+    return top if top > 0.0 else float(speed.max())
 
 
 def _start_boxes(start, bounds):
