@@ -753,31 +753,9 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarra
         return even
     cum = np.vstack([np.zeros((1, hist.shape[1]), dtype=np.int64), np.cumsum(hist, axis=0)])
     cuts = np.clip(np.linspace(0, rows, k + 1).round().astype(np.int64), 0, rows)
-    owner = np.arange(k) % threads
-    floor = cum[-1] / threads  # a bin's nodes over the threads
-
-    def loads(c):  # nodes per thread and time bin, shape (threads, bins)
-        per_slab = cum[c[1:]] - cum[c[:-1]]
-        return np.stack([per_slab[t::threads].sum(axis=0) for t in range(threads)])
-
-    def interleaved(i, cand, c):  # the critical path with cut i at each candidate row
-        base = loads(c)
-        base[owner[i - 1]] -= cum[c[i]] - cum[c[i - 1]]
-        base[owner[i]] -= cum[c[i + 1]] - cum[c[i]]
-        trial = np.repeat(base[None], cand.size, axis=0)
-        trial[:, owner[i - 1]] += cum[cand] - cum[c[i - 1]]  # slabs i - 1 and i
-        trial[:, owner[i]] += cum[c[i + 1]] - cum[cand]
-        return trial.max(axis=1).sum(axis=1)
-
-    def shared(i, cand, c):  # the same, the least share any sharing allows
-        rest = np.delete(cum[c[1:]] - cum[c[:-1]], [i - 1, i], axis=0)
-        base = np.maximum(floor, rest.max(axis=0)) if len(rest) else floor
-        most = np.maximum(cum[cand] - cum[c[i - 1]], cum[c[i + 1]] - cum[cand])
-        return np.maximum(most, base).sum(axis=1)
-
-    fixed = _descend_cuts(cuts.copy(), gap, interleaved, strict=False)
+    fixed = _descend_cuts(cum, cuts.copy(), gap, threads, False)
     if SHARED_CUTS[3 if shape3[2] > 1 else 2]:  # the better, by the windows as _assign
-        cuts = _descend_cuts(cuts, gap, shared, strict=True)  # shares the slabs
+        cuts = _descend_cuts(cum, cuts, gap, threads, True)  # shares the slabs
         if _shared_cost(cum, fixed, threads) <= _shared_cost(cum, cuts, threads):
             cuts = fixed
     else:
@@ -791,22 +769,68 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarra
     return bounds.astype(np.int64)
 
 
-def _descend_cuts(cuts, gap, costs, strict):
+@njit(cache=True, error_model="numpy")
+def _descend_cuts(cum, cuts, gap, threads, shared):
     """Coordinate descent of the inner cuts ``cuts[1:-1]`` (coarse rows, at least ``gap``
-    apart): each in turn to the row of least ``costs(i, rows, cuts)`` between its
-    neighbours (the first such row; ``strict``: only where it costs less than the cut's
-    row), until none moves. ``cuts`` is changed and returned."""
-    k = len(cuts) - 1
+    apart; ``cum``: the coarse histogram cumulated over the rows, ``(rows + 1, bins)``):
+    each in turn to the row between its neighbours with the least critical path, ``sum
+    over bins of the largest thread's nodes``, until none moves; ``cuts`` is changed and
+    returned. A thread's nodes in a bin: those of its slabs in the fixed interleave (slab
+    ``j`` to thread ``j % threads``; the first best row taken), or with ``shared`` the
+    least any sharing allows, ``max(busiest slab, all / threads)`` (a move only where
+    strictly better: that bound ties over many rows)."""
+    k = cuts.size - 1
+    nb = cum.shape[1]
+    base = np.empty((threads, nb))
     for _ in range(4 * k):
         moved = False
         for i in range(1, k):
-            cand = np.arange(cuts[i - 1] + gap, cuts[i + 1] - gap + 1)
-            if cand.size == 0:
+            lo = cuts[i - 1] + gap
+            hi = cuts[i + 1] - gap
+            if hi < lo:
                 continue
-            cost = costs(i, np.append(cand, cuts[i]), cuts)
-            best = int(np.argmin(cost[:-1]))
-            if (cost[best] < cost[-1]) if strict else (cand[best] != cuts[i]):
-                cuts[i] = cand[best]
+            # every slab but i - 1 and i: per thread (interleave) or the bound (shared)
+            base[:] = 0.0
+            for b in range(nb):
+                if shared:
+                    base[0, b] = (cum[-1, b] - cum[0, b]) / threads
+            for j in range(k):
+                if j == i - 1 or j == i:
+                    continue
+                for b in range(nb):
+                    x = cum[cuts[j + 1], b] - cum[cuts[j], b]
+                    if shared:
+                        base[0, b] = max(base[0, b], x)
+                    else:
+                        base[j % threads, b] += x
+            best = cuts[i]
+            best_cost = np.inf
+            here = np.inf
+            for c in range(lo, hi + 2):
+                r = cuts[i] if c == hi + 1 else c  # last: the cut's own row
+                cost = 0.0
+                for b in range(nb):
+                    below = cum[r, b] - cum[cuts[i - 1], b]
+                    above = cum[cuts[i + 1], b] - cum[r, b]
+                    if shared:
+                        cost += max(base[0, b], max(below, above))
+                    else:
+                        most = 0.0
+                        for t in range(threads):
+                            x = base[t, b]
+                            if t == (i - 1) % threads:
+                                x += below
+                            if t == i % threads:
+                                x += above
+                            most = max(most, x)
+                        cost += most
+                if c == hi + 1:
+                    here = cost
+                elif cost < best_cost:
+                    best_cost = cost
+                    best = c
+            if (best_cost < here) if shared else (best != cuts[i]):
+                cuts[i] = best
                 moved = True
         if not moved:
             break
