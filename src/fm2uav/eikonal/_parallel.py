@@ -1007,8 +1007,12 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, *, interleave=None
     hh = float(1.0 / ih[0])
     # the top speed sets the first window's width only (then adapted): from the plateau's
     # register when there is one (a pass over the speeds is ~2 ms of serial time on 2048^2)
-    # (else from the plateau's sample of the speeds: a pass over them is ~2 ms of serial time)
-    vmax = 1.0 / np.sqrt(qp) if qp > 0.0 else _top_speed(speed)
+    # (a pass over the speeds, on the threads, else)
+    if qp > 0.0:
+        vmax = 1.0 / np.sqrt(qp)
+    else:
+        with _threads(nth):
+            vmax = _top_speed(nth, _kernels._readonly(speed))
     width = 2.0 * min(h3[:3 if three else 2]) / max(vmax, 1e-300)
     win = np.array([0.0, width, 0.0, float(WINDOW_NODES), 0.0, 0.0, np.inf, 0.0, 0.0])
     stop_idx = np.zeros(0, dtype=np.int64)
@@ -1092,13 +1096,20 @@ def _frozen_bits(Tp, rows, npad):
     return bits
 
 
-def _top_speed(speed):
-    """The largest speed of the plateau's sample (every ``_PLATEAU_STRIDE``-th node), else
-    of all nodes: it sets only the first window's width, which then adapts."""
-    if speed.size == 0:
+@njit(cache=True, parallel=True, error_model="numpy")
+def _top_speed(nth, speed):
+    """The largest speed (1.0 for none), on ``nth`` threads (one pass over 2048^2 speeds is
+    ~2 ms); it sets the first window's width."""
+    n = speed.size
+    if n == 0:
         return 1.0
-    top = float(speed[::_kernels._PLATEAU_STRIDE].max())
-    return top if top > 0.0 else float(speed.max())
+    part = np.zeros(nth)
+    for t in prange(nth):
+        top = 0.0
+        for c in range(t * n // nth, (t + 1) * n // nth):
+            top = max(top, speed[c])
+        part[t] = top
+    return part.max()
 
 
 def _start_boxes(start, bounds):
