@@ -11,19 +11,39 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
 * The grid is cut along x (the slowest-varying axis of the C layout) into
   ``K`` slabs, :data:`SLABS_PER_THREAD` per thread, thread ``t`` marching slabs
   ``t, t + threads, ...`` (interleaved strips keep both threads busy when the
-  wave starts off-centre, and a coarse march places the cuts, :func:`slab_bounds`),
+  wave starts off-centre, and a coarse march places the cuts, :func:`slab_bounds`; in 2D
+  for the slabs shared before each window where that shortens the windows,
+  :data:`SHARED_CUTS`),
   unless sharing them longest first by the last window's freezes promises a shorter
   window (:func:`_assign`, before every window). The set-up pads the slabs in parallel
   (:func:`_pad_slabs`) and the result is unpadded so (:func:`_unpad_slabs`).
   Each slab is a padded grid of its own, laid out exactly as the
   serial march's (:func:`fm2uav.eikonal._kernels.pad_grid`), one after the other
-  in one buffer (the serial march's kept huge-page buffers; in the lean layout of big
-  grids float32 ``V`` and the times compacted in place, as there): its two ghost
-  x-slabs hold, between windows, the *frozen*
-  times of the neighbouring slab's boundary rows (``NaN`` where not frozen), so
-  the serial kernels' update (``_solve_iso``, ``_axis_term``, ``_combine``, the
-  plateau register ``_rhs``) and radix queue (``_push``, ``_pop``) run unchanged on a
+  in one buffer (the serial march's kept huge-page buffers, chosen by its
+  :func:`~fm2uav.eikonal._kernels._buffers`; in the lean layout of big grids float32 ``V``
+  and the times compacted in place, as there): its two ghost x-slabs hold, between
+  windows, the *frozen* times of the neighbouring slab's boundary rows (``NaN`` where not
+  frozen), so the serial kernels' update (``_solve_iso``, ``_axis_term``, ``_combine``,
+  the plateau register ``_rhs``) and radix queue (``_push``, ``_pop``) run unchanged on a
   slab.
+* **2D interleaved**, as the serial march: a 2D map (outside the lean layout) whose
+  passable nodes do not all have one speed keeps each node's time and ``1 / speed^2``
+  side by side in one array (node ``c``'s time at element ``2 c``, its speed term at
+  ``2 c + 1``; the kernels take the buffer and the buffer shifted by one, and every node
+  index in the kernels, the queues, the boundary lists, the start rows and the stop
+  nodes is an element index: strides ``sx = 2 (ny + 2)``, ``sy = 2``); the frozen-on-entry
+  and plateau masks keep a bit per node (element index halved). An update reads a
+  neighbour's time and speed from one cache line. A uniform map keeps the separate arrays
+  and reads no speed (the plateau register). ``march(..., interleave=False)`` forces the
+  separate arrays (the tests: the same times bit for bit).
+* **Far neighbours** (2D): a window freezing a node gives its far neighbours the one-axis
+  update along their axis, as the serial march (:data:`FAR_ONE_AXIS`). Valid in a slab
+  because a far node never has a frozen neighbour: a pop, a node frozen on entry (the
+  start) and a ghost (the exchange, its one own neighbour) each update their band and far
+  own neighbours when they become frozen, and a re-opened node had done so when it was
+  frozen first; so the full update of that node reads one frozen neighbour and gives the
+  same bits (the tests run with the rule on and off, one-row slabs included, and compare
+  the times and statistics bit for bit).
 * Time windows: every slab pops, with its own queue and in parallel, the nodes
   whose time is below ``t_w``, and lists the nodes it froze in its two boundary rows;
   then (barrier) every slab copies those of its neighbours into its ghosts (not the
@@ -600,8 +620,9 @@ def _drive_kernel(three):
                 for k in range(t, K, nth):
                     if not _start(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]],
                                   U[0 if U.size == 1 else off[k] >> sh >> 3:], qp,
-                                  fx[off[k] >> sh >> 3:], sx, sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
-                                  rkey[k], ritem[k], ctl[k], _U(scan[k, 0]), _U(scan[k, 1])):
+                                  fx[off[k] >> sh >> 3:], sx, sy, ih, hh, iso, pool[k], nxt[k],
+                                  bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k],
+                                  _U(scan[k, 0]), _U(scan[k, 1])):
                         ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < _U(RESERVE_BLOCKS) else 2.0
             for k in range(K):
                 if ctl[k, _C_STATUS] != 0.0:
@@ -737,8 +758,9 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarra
     threads)`` (the slabs are shared anew before each window, :func:`_assign`, and cuts
     made for the interleave may leave the late wave in one slab), and the cuts of the two
     descents with the shorter critical path when the bins' slabs are shared as
-    :func:`_assign` shares them (:func:`_shared_cost`) are taken. Equal slabs when the start is not a few point sources
-    (its box over a quarter of the grid) or the grid is too thin for a coarse march.
+    :func:`_assign` shares them (:func:`_shared_cost`) are taken. Equal slabs when the
+    start is not a few point sources (its box over a quarter of the grid) or the grid is
+    too thin for a coarse march.
     """
     nx = int(shape3[0])
     even = np.linspace(0, nx, k + 1).round().astype(np.int64)
