@@ -912,7 +912,8 @@ def _coarse_histogram(speed, start, shape3, h3):
     sb = np.where(frozen, _kernels.FROZEN, 0).astype(np.uint8)
     cstart = _kernels.Start(tuple(int(a) for a in lo), bshape, Tb, sb)
     hc = tuple(h * f for h in h3[:2]) + ((h3[2] * f,) if three else (h3[2],))
-    T, _ = _kernels.march(coarse.reshape(-1), cstart, cshape, hc, 1,
+    # read-only as fast_marching's speeds: the same specialisations (the warm-up's)
+    T, _ = _kernels.march(_kernels._readonly(coarse.reshape(-1)), cstart, cshape, hc, 1,
                           np.zeros((0, 3), dtype=np.int64))
     T = T.reshape(cshape[0], -1)
     fin = np.isfinite(T)
