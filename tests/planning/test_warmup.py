@@ -164,3 +164,43 @@ def test_2d_groups_cache_both_layouts_of_a_2d_plan(tmp_path):
     res = _run(["-c", _LATER_2D_RUN.replace("ORDERS", "(1,)")], tmp_path / "uniform")
     assert res.returncode == 0, res.stderr
     assert res.stdout.split() == ["compiled"]
+
+
+_LATER_2D_PARALLEL_RUN = textwrap.dedent(
+    """
+    import numpy as np
+    from fm2uav import _jit
+    compiled = []
+    _jit.on_first_compile(lambda: compiled.append(1))
+    from fm2uav.eikonal import _kernels, _parallel, fast_marching
+    _parallel.PARALLEL_MIN_NODES = 0  # a big 2D map's two-thread march, on a small one
+    v = np.ones((160, 40))
+    v[50:54, :30] = 0.0
+    for speed in (v * np.linspace(0.5, 1.0, 40), v):  # interleaved slabs; a uniform speed
+        T = fast_marching(speed, [(30, 5)], spacing=15.0, order=1, threads=2)
+        assert np.isfinite(T[0, 0])
+    # the lean layout (float32 speed) on a grid too thin for the cuts' coarse march (a big
+    # map's coarse march is small: never lean)
+    _kernels.LEAN_NODES = 0
+    T = fast_marching(v[:40] * np.linspace(0.5, 1.0, 40), [(30, 5)], order=1, threads=2)
+    assert np.isfinite(T[0, 0])
+    print("compiled" if compiled else "cached")
+    """
+)
+
+
+@pytest.mark.slow
+def test_2d_parallel_group_caches_every_layout_of_a_two_thread_2d_march(tmp_path):
+    # a 2D map not of one speed marches its slabs interleaved, a uniform one in separate
+    # arrays, a big one in the lean layout; the slab cuts run a compiled descent: after the
+    # groups none of it compiles; without the parallel group it does (the check can fail)
+    res = _run(["-m", "fm2uav.planning.warmup", "fmm2d_o1", "fmm2d_parallel"], tmp_path / "all")
+    assert res.returncode == 0, res.stderr
+    res = _run(["-c", _LATER_2D_PARALLEL_RUN], tmp_path / "all")
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.split() == ["cached"]
+    res = _run(["-m", "fm2uav.planning.warmup", "fmm2d_o1"], tmp_path / "serial")
+    assert res.returncode == 0, res.stderr
+    res = _run(["-c", _LATER_2D_PARALLEL_RUN], tmp_path / "serial")
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.split() == ["compiled"]

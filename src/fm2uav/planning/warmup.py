@@ -84,20 +84,27 @@ def _fmm_lean(order: int) -> Callable[[], None]:
 
 def _fmm_parallel(ndim: int) -> Callable[[], None]:
     """The order-1 march on both cores (grids of ``PARALLEL_MIN_NODES`` nodes and more), in
-    both layouts (float64 ``V``, and the lean float32 ``V`` of grids over ``LEAN_NODES``
-    padded nodes, e.g. a 1000x1000x40 terrain plan), its size floors lowered for a
-    16-node-wide grid while it compiles."""
+    every layout (float64 ``V``: in 2D interleaved with ``T`` unless the speed is uniform,
+    whose separate arrays pad and unpad as other specialisations; and the lean float32
+    ``V`` of grids over ``LEAN_NODES`` padded nodes, e.g. a 1000x1000x40 terrain plan), its
+    size floors lowered for a 16-node-wide grid while it compiles; and the descent placing
+    the slab cuts (a 16-node grid is too thin to be cut)."""
     def run() -> None:
         speed = np.ones((16,) * ndim)
         speed[(0,) * ndim] = 0.5  # a plateau with its mask (a uniform grid needs none)
+        speeds = (speed, np.ones((16,) * ndim)) if ndim == 2 else (speed,)
         floor, lean = _parallel.PARALLEL_MIN_NODES, _kernels.LEAN_NODES
         _parallel.PARALLEL_MIN_NODES = 0
         try:
             for lean_nodes in (lean, 0):
                 _kernels.LEAN_NODES = lean_nodes
-                fast_marching(speed, [(3,) * ndim], order=1, threads=2)
+                for v in speeds:
+                    fast_marching(v, [(3,) * ndim], order=1, threads=2)
         finally:
             _parallel.PARALLEL_MIN_NODES, _kernels.LEAN_NODES = floor, lean
+        cum = np.cumsum(np.ones((5, 3), dtype=np.int64), axis=0)
+        for shared in (False, True):
+            _parallel._descend_cuts(cum, np.array([0, 2, 4], dtype=np.int64), 1, 2, shared)
 
     return run
 
