@@ -9,6 +9,9 @@ the machine, whatever the load). Cases:
 * ``fm2uav --help`` and ``fm2uav plan --help`` (the largest help page, 50+ options);
 * ``fm2uav plan --bogus``: a bad flag, refused by the parser;
 * ``fm2uav run missing.yaml``: a one-line input error found by the command itself;
+* ``fm2uav run bad.yaml``: a mission file with one field out of range, refused by its
+  schema (pydantic, yaml and numpy load; the world's builders, the kernels and the geodata
+  libraries do not);
 * ``fm2uav plan --threads 0`` and ``fm2uav plan --start 1,2``: a bad value of a planner flag
   and of a point, found by the command before the library loads.
 
@@ -112,6 +115,8 @@ def run(quick: bool = False) -> list[dict]:
         peer = Path(tmp) / "peer_app.py"
         peer.write_text(PEER_APP)
         peer_cmd = [sys.executable, str(peer)]
+        bad = Path(tmp) / "bad.yaml"
+        bad.write_text("world: {scenario: open-field}\nplanner: {saturation: 1.5}\n")
         cases = [
             ("`fm2uav --help`", ["--help"], peer_cmd + ["--help"], [0]),
             ("`fm2uav plan --help`", ["plan", "--help"], peer_cmd + ["main", "--help"], [0]),
@@ -119,6 +124,8 @@ def run(quick: bool = False) -> list[dict]:
              peer_cmd + ["main", "--bogus"], [2]),
             ("`fm2uav run missing.yaml` (a missing mission file)",
              ["run", str(Path(tmp) / "missing.yaml")], None, [2]),
+            ("`fm2uav run bad.yaml` (one bad field in a mission file)",
+             ["run", str(bad), "--out", str(Path(tmp) / "out")], None, [2]),
             ("`fm2uav plan --threads 0` (a bad flag value)",
              ["plan", "--threads", "0", "--out", str(Path(tmp) / "out")], None, [2]),
             ("`fm2uav plan --start 1,2` (a bad point)",

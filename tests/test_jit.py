@@ -31,10 +31,12 @@ def _python(code: str, cache: Path) -> subprocess.CompletedProcess:
 
 def test_import_fm2uav_loads_no_numba_scipy_or_matplotlib(tmp_path):
     res = _python("import sys, fm2uav; print(sorted(m for m in ('numba', 'scipy', "
-                  "'matplotlib') if m in sys.modules)); fm2uav.World; print('numba' in sys.modules)",
+                  "'matplotlib') if m in sys.modules)); fm2uav.World; print('numba' in sys.modules); "
+                  "fm2uav.plan; print('numba' in sys.modules)",
                   tmp_path)
     assert res.returncode == 0, res.stderr
-    assert res.stdout.split("\n")[:2] == ["[]", "True"]  # lazy, and loaded on first use
+    # lazy, the World light (its builders load on first call), the planner loads the kernels
+    assert res.stdout.split("\n")[:3] == ["[]", "False", "True"]
 
 
 def test_likely_cold_follows_numba_cache_index(tmp_path, monkeypatch):

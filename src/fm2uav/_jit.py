@@ -56,7 +56,7 @@ _PKG = Path(__file__).resolve().parent
 #: ``(file relative to the package, function name)``. If any has no valid cache
 #: index, the plan will compile.
 FIRST_PLAN_KERNELS: tuple[tuple[str, str], ...] = (
-    ("eikonal/_kernels.py", "_squared_edt_serial"),
+    ("eikonal/_edt.py", "_edt_serial"),
     ("eikonal/_sources.py", "init_sources"),
     ("eikonal/_kernels.py", "march3d_o2"),
     ("planning/_geodesic_kernels.py", "descend_kernel"),

@@ -20,7 +20,7 @@ import sys
 from collections.abc import Callable, Iterable, Mapping
 from typing import Any
 
-__all__ = ["lazy_names"]
+__all__ = ["lazy_names", "lazy_function"]
 
 
 def lazy_names(package: str, names: Mapping[str, str], submodules: Iterable[str] = ()
@@ -59,3 +59,33 @@ def lazy_names(package: str, names: Mapping[str, str], submodules: Iterable[str]
         return sorted(set(vars(sys.modules[package])) | set(names) | subs)
 
     return __getattr__, __dir__
+
+
+def lazy_function(package: str, module: str, name: str) -> Callable[..., Any]:
+    """A function that imports ``module`` (relative to ``package``) on its first call.
+
+    For tables of callables (the builders of :class:`fm2uav.world.World`, the factories
+    of the built-in scenarios) that must exist before their heavy modules load.
+
+    Parameters
+    ----------
+    package : str
+        The ``__name__`` of the package ``module`` is relative to.
+    module : str
+        The module defining the function, e.g. ``".dem"``.
+    name : str
+        The function's name in ``module``.
+
+    Returns
+    -------
+    callable
+        Calls ``module.name`` with the same arguments.
+    """
+
+    def call(*args: Any, **kwargs: Any) -> Any:
+        return getattr(importlib.import_module(module, package), name)(*args, **kwargs)
+
+    call.__name__ = call.__qualname__ = name
+    call.__doc__ = f"``{module.lstrip('.')}.{name}`` of :mod:`{package}`, imported on first call."
+    return call
+

@@ -28,6 +28,10 @@ HEAVY = ("numpy", "numba", "llvmlite", "scipy", "matplotlib", "plotly", "rasteri
          "fm2uav.autopilot", "fm2uav.pipeline.run", "fm2uav.pipeline.cover", "fm2uav.app",
          "fastapi", "starlette", "uvicorn", "rio_tiler")
 
+#: Light modules inside a heavy package that help pages may load: the io package (lazy)
+#: and its table of export file names, which the shared output module reads.
+LIGHT = ("fm2uav.io", "fm2uav.io.formats")
+
 #: Top-level imports a ``cli/*.py`` module may have: the standard library, typer, rich,
 #: fm2uav.errors, the light modules of fm2uav.cli (the cmd_* modules among them) and the two
 #: pipeline modules the commands share with the app, light by the same rule (numpy inside
@@ -44,8 +48,9 @@ from typer.testing import CliRunner
 from fm2uav.cli import app
 
 heavy = {heavy!r}
-loaded = lambda: sorted(m for m in heavy if m in sys.modules or
-                        any(k.startswith(m + ".") for k in sys.modules))
+light = {light!r}
+loaded = lambda: sorted(m for m in heavy if any((k == m or k.startswith(m + "."))
+                                                 and k not in light for k in sys.modules))
 report = {{"import": loaded() + (["pydantic"] if "pydantic" in sys.modules else [])}}
 runner = CliRunner()
 cmd = typer.main.get_command(app)
@@ -69,7 +74,7 @@ print(json.dumps(report))
 
 
 def _probe() -> dict:
-    res = subprocess.run([sys.executable, "-c", PROBE.format(heavy=HEAVY)], capture_output=True,
+    res = subprocess.run([sys.executable, "-c", PROBE.format(heavy=HEAVY, light=LIGHT)], capture_output=True,
                          text=True, timeout=300)
     assert res.returncode == 0, res.stderr
     return json.loads(res.stdout.strip().splitlines()[-1])
@@ -220,3 +225,42 @@ def test_value_errors_are_answered_before_the_heavy_libraries_load(tmp_path):
         assert "Traceback" not in report["out"]
         assert set(report["loaded"]) <= (allowed[0] if allowed else set()), (argv, report)
     assert not (tmp_path / "out").exists()  # refused before any output
+
+
+#: Mission files with one bad line, each refused by the schema (exit 2, one line naming the
+#: key) before the world's builders, the kernels or any geodata library load: the schema
+#: needs pydantic, yaml and numpy only. (file text, words the message must hold.)
+W = "world: {scenario: open-field}\n"
+MISSION_ERRORS = [
+    ("world: {bogus: 1}\n", ["world.bogus", "allowed fields"]),
+    (W + "planner: {saturation: 1.5}\n", ["planner.saturation", "1.5"]),
+    (W + "airframe: {firmware: betaflight}\n", ["airframe.firmware", "betaflight"]),
+    (W + "outputs: {formats: [csv, docx]}\n", ["outputs.formats", "docx"]),
+    ("start: [1, 2\n", ["not valid YAML", "line"]),
+    (W + "planner: {order: true}\n", ["planner.order"]),
+]
+
+MISSION_HEAVY = ("numba", "llvmlite", "scipy", "matplotlib", "plotly", "rasterio", "shapely",
+                 "pyproj", "pyogrio", "dask", "PIL", "fm2uav.eikonal", "fm2uav.planning.planner",
+                 "fm2uav.world.clearance", "fm2uav.world.dem", "fm2uav.world.buildings",
+                 "fm2uav.autopilot.build", "fm2uav.io.exports",
+                 "fm2uav.scenarios.city", "fm2uav.scenarios.coverage",
+                 "fm2uav.viz", "fm2uav.experiments", "fm2uav.missions.coverage")
+
+
+def test_mission_file_errors_are_answered_before_the_heavy_libraries_load(tmp_path):
+    for k, (text, words) in enumerate(MISSION_ERRORS):
+        mission = tmp_path / f"m{k}.yaml"
+        mission.write_text(text, encoding="utf-8")
+        argv = ["run", str(mission), "--out", str(tmp_path / "out")]
+        res = subprocess.run(
+            [sys.executable, "-c", VALUE_PROBE.format(heavy=MISSION_HEAVY, argv=argv)],
+            capture_output=True, text=True, timeout=300)
+        assert res.returncode == 0, res.stderr
+        report = json.loads(res.stdout.strip().splitlines()[-1])
+        message = " ".join(report["out"].split())
+        assert report["code"] == 2, (text, report)
+        assert all(w in message for w in words), (text, message)
+        assert "Traceback" not in report["out"]
+        assert report["loaded"] == [], (text, report["loaded"])
+    assert not (tmp_path / "out").exists()

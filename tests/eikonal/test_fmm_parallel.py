@@ -553,3 +553,229 @@ def test_queues_that_run_low_grow_and_the_march_resumes(monkeypatch):
         for order in (1, 2):
             assert_equal_times(fast_marching(v, [src], order=order, threads=1),
                                fast_marching_parallel(v, [src], order=order), exact=order == 2)
+
+
+# ------------------------------------------------ the 2D slabs in the interleaved layout
+def _layouts(monkeypatch):
+    """Record the y stride (2: interleaved, 1: separate arrays), the speeds' dtype and
+    whether times and speeds share one buffer, of every 2D driver call (order 1 and 2)."""
+    seen = []
+    for order in (1, 2):
+        drive = _parallel._DRIVES[2, order]
+
+        def spy(*args, drive=drive):
+            seen.append((int(args[13]), args[2].dtype, np.shares_memory(args[1], args[2])))
+            return drive(*args)
+
+        monkeypatch.setitem(_parallel._DRIVES, (2, order), spy)
+    return seen
+
+
+def _both_ways(flat, start, shape3, h3, monkeypatch, **kwargs):
+    """The slab march interleaved and in separate arrays, far rule on and off: all four
+    must give the same times bit for bit and the same windows and re-opened nodes. On one
+    thread, which runs the slabs one after the other (with two, a slab's exchange may read
+    a neighbour's boundary node while that neighbour's exchange re-opens it: the same
+    fixed point, reached in another order, rounding apart); then on two threads, to the
+    same times to round-off. Returns the one-thread times and statistics. Order 2
+    (``order=2`` in ``kwargs``): bit for bit on two threads too."""
+    if _parallel.MIN_SLAB_NODES:
+        monkeypatch.setattr(_parallel, "MIN_SLAB_NODES", 0)  # several slabs on one thread
+    out = {}
+    for far in (True, False):
+        monkeypatch.setattr(_parallel, "FAR_ONE_AXIS", far)
+        for interleave in (True, False):
+            out[far, interleave] = _parallel.march(flat, start, shape3, h3, 1,
+                                                   interleave=interleave, **kwargs)
+    T, stats = out[True, True]
+    assert stats["slabs"] >= 4
+    for key, (T2, stats2) in out.items():
+        assert np.array_equal(T, T2, equal_nan=True), key
+        assert {k: stats[k] for k in ("windows", "reopened", "slabs")} == \
+            {k: stats2[k] for k in ("windows", "reopened", "slabs")}, key
+    monkeypatch.setattr(_parallel, "FAR_ONE_AXIS", True)
+    T2, _ = _parallel.march(flat, start, shape3, h3, 2, **kwargs)
+    assert_equal_times(T, T2, exact=kwargs.get("order", 1) == 2)
+    return T, stats
+
+
+@pytest.mark.parametrize("h", [(1.0, 1.0, 1.0), (1.0, 0.7, 1.0)])
+def test_2d_slabs_march_interleaved_unless_the_speed_is_uniform(h, monkeypatch):
+    """2D maps not of one speed march their slabs in the serial march's interleaved layout
+    (time and 1 / speed^2 of a node side by side, y stride 2); a uniform map in separate
+    arrays with the plateau register; the times are the serial march's on every field and
+    spacing, bit for bit the same in either layout and with or without the far
+    neighbours' one-axis update."""
+    seen = _layouts(monkeypatch)
+    for name, v, src in _fields((97, 81)):
+        seen.clear()
+        serial = fast_marching(v, [src], order=1, spacing=h[:2], threads=1)
+        par = fast_marching_parallel(v, [src], order=1, spacing=h[:2], threads=2)
+        assert_equal_times(serial, par)
+        uniform = name == "constant"
+        assert seen and all(s == ((1, np.dtype(np.float64), False) if uniform else
+                                  (2, np.dtype(np.float64), True)) for s in seen), name
+        flat, start, shape3 = _start(v, src)
+        T, _ = _both_ways(flat, start, shape3, h, monkeypatch)
+        serial, _ = _kernels.march(flat, start, shape3, h, 1, np.zeros((0, 3), dtype=int))
+        assert_equal_times(serial, T)
+
+
+def test_interleaved_slabs_stop_where_the_serial_march_stops(monkeypatch):
+    v, src = fm2_shaped((120, 90), seed=2)
+    free = np.argwhere(v > 0)
+    stop = [tuple(free[len(free) // 3]), tuple(free[-7])]
+    flat, start, shape3 = _start(v, src)
+    cells = np.array([[*s, 0] for s in stop])
+    T, _ = _both_ways(flat, start, shape3, (1.0,) * 3, monkeypatch, stop_cells=cells)
+    serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 1, cells)
+    last = max(serial.reshape(v.shape)[s] for s in stop)
+    both = np.isfinite(serial) & np.isfinite(T)
+    assert np.all(np.where(np.isfinite(serial), serial, T)[np.isfinite(serial) != np.isfinite(T)]
+                  == last)
+    assert 0.3 * np.isfinite(serial).sum() < both.sum() < 0.9 * v.size
+    np.testing.assert_allclose(T[both], serial[both], rtol=RTOL, atol=0)
+
+
+def test_interleaved_slabs_repair_what_the_other_slab_reaches_first(monkeypatch):
+    """The fast lane across the slab interface (re-opened nodes), with queues so small
+    that they grow in the middle of the start and of windows: the same times either
+    way, and the serial march's."""
+    monkeypatch.setattr(_parallel, "POOL_MIN_BLOCKS", 8)
+    monkeypatch.setattr(_parallel, "HEAP_START", 8)
+    v = np.full((200, 60), 0.2)
+    v[:, 28:32] = 5.0
+    flat, start, shape3 = _start(v, (2, 30))
+    T, stats = _both_ways(flat, start, shape3, (1.0, 1.3, 1.0), monkeypatch)
+    assert stats["reopened"] > 0 and stats["windows"] > 1
+    serial = fast_marching(v, [(2, 30)], order=1, spacing=(1.0, 1.3), threads=1,
+                           source_ball=False)
+    assert_equal_times(serial.reshape(-1), T)
+
+
+@pytest.mark.parametrize("field", ["smooth", "fm2", "plateau"])
+def test_thin_interleaved_slabs_with_ghosts_on_both_sides(field, monkeypatch):
+    """Slabs of one row: every own node lies between two ghost rows, a node frozen
+    there goes to both neighbours, and the far rule must hold with ghosts and repairs on
+    both sides (several sources, some in other slabs than their ball's centre)."""
+    monkeypatch.setattr(_parallel, "MIN_SLAB_ROWS", 1)
+    monkeypatch.setattr(_parallel, "MIN_SLAB_NODES", 0)
+    monkeypatch.setattr(_parallel, "SLABS_PER_THREAD", {2: 97, 3: 4})  # one row each
+    name, v, src = next(f for f in _fields((97, 81)) if f[0] == field)
+    sources = [src, (50, 7), (51, 70)]
+    flat, start, shape3 = _start(v, src)
+    v3 = _as_speed(v)
+    s3 = np.zeros((3, 3), dtype=np.int64)
+    s3[:, :2] = sources
+    start = _source_start(v3, s3, shape3, (1.0,) * 3, 2.0, 2.0)
+    T, stats = _both_ways(flat, start, shape3, (1.0,) * 3, monkeypatch)
+    assert stats["slabs"] == 97 and stats["reopened"] > 0
+    serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 1, np.zeros((0, 3), dtype=int))
+    assert_equal_times(serial, T)
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_lean_2d_slabs_keep_separate_float32_arrays(order, monkeypatch):
+    seen = _layouts(monkeypatch)
+    monkeypatch.setattr(_kernels, "LEAN_NODES", 0)
+    v, src = fm2_shaped((97, 81), seed=1)
+    par = fast_marching_parallel(v, [src], order=order)
+    assert seen and all(s == (1, np.dtype(np.float32), False) for s in seen)
+    assert_equal_times(fast_marching(v, [src], order=order, threads=1), par, exact=order == 2)
+
+
+# ---------------------------------------- order 2 on the 2D slabs in the interleaved layout
+@pytest.mark.parametrize("h", [(1.0, 1.0, 1.0), (1.0, 0.7, 1.0)])
+def test_2d_order_2_slabs_march_interleaved_bit_for_bit(h, monkeypatch):
+    """Order 2 marches the 2D slabs in the serial march's layout too (interleaved unless the
+    speed is uniform: two ghost rows a side, every index an element index, the masks a bit
+    per node): the serial march's times bit for bit on every field and spacing, in either
+    layout, on one thread and on two."""
+    seen = _layouts(monkeypatch)
+    f64 = np.dtype(np.float64)
+    for name, v, src in _fields((97, 81)):
+        seen.clear()
+        serial = fast_marching(v, [src], order=2, spacing=h[:2], threads=1)
+        par = fast_marching_parallel(v, [src], order=2, spacing=h[:2], threads=2)
+        assert_equal_times(serial, par, exact=True)
+        uniform = name == "constant"
+        assert seen and all(s == ((1, f64, False) if uniform else (2, f64, True))
+                            for s in seen), name
+        flat, start, shape3 = _start(v, src)
+        T, _ = _both_ways(flat, start, shape3, h, monkeypatch, order=2)
+        serial, _ = _kernels.march(flat, start, shape3, h, 2, np.zeros((0, 3), dtype=int))
+        assert_equal_times(serial, T, exact=True)
+
+
+def test_interleaved_order_2_slabs_repair_stop_and_grow(monkeypatch):
+    """Order 2, interleaved: the fast lane across the slab interfaces (re-opened and raised
+    nodes), queues so small that they grow in the start and in windows, two-row slabs
+    (ghosts on both sides of every own node's stencil) and stop nodes: the serial march's
+    times bit for bit either layout."""
+    monkeypatch.setattr(_parallel, "POOL_MIN_BLOCKS", 8)
+    monkeypatch.setattr(_parallel, "HEAP_START", 8)
+    v = np.full((200, 60), 0.2)
+    v[:, 28:32] = 5.0
+    v[:, 40] = 0.35
+    flat, start, shape3 = _start(v, (2, 30))
+    T, stats = _both_ways(flat, start, shape3, (1.0, 1.3, 1.0), monkeypatch, order=2)
+    assert stats["reopened"] > 0 and stats["raised"] > 0 and stats["windows"] > 1
+    serial = fast_marching(v, [(2, 30)], order=2, spacing=(1.0, 1.3), threads=1,
+                           source_ball=False)
+    assert_equal_times(serial.reshape(-1), T, exact=True)
+    monkeypatch.setattr(_parallel, "MIN_SLAB_ROWS", 1)
+    monkeypatch.setattr(_parallel, "SLABS_PER_THREAD", {2: 97, 3: 4})
+    v, src = fm2_shaped((97, 81), seed=3)
+    flat, start, shape3 = _start(v, src)
+    T, stats = _both_ways(flat, start, shape3, (1.0,) * 3, monkeypatch, order=2)
+    assert stats["slabs"] == 97 // 2 and stats["reopened"] > 0
+    serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 2, np.zeros((0, 3), dtype=int))
+    assert_equal_times(serial, T, exact=True)
+    free = np.argwhere(v > 0)
+    cells = np.array([[*free[len(free) // 3], 0], [*free[-7], 0]])
+    T, _ = _both_ways(flat, start, shape3, (1.0,) * 3, monkeypatch, order=2, stop_cells=cells)
+    serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 2, cells)
+    last = max(serial.reshape(v.shape)[tuple(s[:2])] for s in cells)
+    differ = np.isfinite(serial) != np.isfinite(T)  # ties with the latest stop node only
+    assert np.all(np.where(np.isfinite(serial), serial, T)[differ] == last)
+    both = np.isfinite(serial) & np.isfinite(T)
+    assert 0.2 * v.size < both.sum() < 0.95 * v.size
+    assert_equal_times(serial[both], T[both], exact=True)
+
+
+def test_frozen_bits_come_from_the_start_rows_only():
+    rng = np.random.default_rng(4)
+    Tp = np.where(rng.random(1000) < 0.3, rng.random(1000), -np.inf)
+    rows = np.array([[13, 130], [400, 401], [700, 700], [993, 1000]])
+    inside = np.zeros(1000, dtype=bool)
+    for a, b in rows:
+        inside[a:b] = True
+    Tp[~inside] = -1.0  # nothing frozen outside the start rows (as on entry)
+    bits = _parallel._frozen_bits(Tp, rows, Tp.size)
+    assert bits.size == Tp.size // 8 + 1
+    assert np.array_equal(np.unpackbits(bits, bitorder="little")[:Tp.size], Tp >= 0.0)
+    assert (Tp >= 0.0).sum() > 30
+
+
+def test_cuts_for_shared_slabs_shorten_the_windows_on_an_fm2_map(monkeypatch):
+    """The cuts of the second descent (for the slabs shared before each window) are taken
+    where the windows' critical path as _assign shares the slabs is shorter: the windows'
+    balance of the march rises over the interleave's cuts; on smooth speed, where they
+    are not shorter, the interleave's cuts stay."""
+    v, src = fm2_shaped((2048, 2048))  # the bench's map (simulated: 1.78 -> 1.84)
+    flat, start, shape3 = _start(v, src)
+    serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 1, np.zeros((0, 3), dtype=int))
+    cuts, stats = {}, {}
+    for shared in (False, True):
+        monkeypatch.setitem(_parallel.SHARED_CUTS, 2, shared)
+        cuts[shared] = _parallel.slab_bounds(flat, start, shape3, (1.0,) * 3, 8, 2)
+        T, stats[shared] = _parallel.march(flat, start, shape3, (1.0,) * 3, 2)
+        assert_equal_times(serial, T)
+    assert not np.array_equal(cuts[False], cuts[True])
+    assert stats[True]["balance"] > 1.02 * stats[False]["balance"]
+    v, src = smooth((1024, 1024))
+    flat, start, shape3 = _start(v, src)
+    for shared in (False, True):
+        monkeypatch.setitem(_parallel.SHARED_CUTS, 2, shared)
+        cuts[shared] = _parallel.slab_bounds(flat, start, shape3, (1.0,) * 3, 8, 2)
+    assert np.array_equal(cuts[False], cuts[True])

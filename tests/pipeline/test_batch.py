@@ -52,6 +52,30 @@ def _leftovers(folder: Path) -> list[str]:
     return [str(p) for p in folder.rglob(".*")]
 
 
+def test_a_worker_removes_the_private_folders_of_dead_workers_only(tmp_path):
+    import subprocess
+    import sys
+
+    from fm2uav.pipeline.batch import _remove_stale_work
+
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True).stdout.strip()
+    alive = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        folders = {name: tmp_path / f"fm2uav-batch-{name}-abc" for name in
+                   (dead, str(alive.pid), str(os.getpid()), "x1")}
+        for d in folders.values():
+            (d / "set").mkdir(parents=True)
+        (tmp_path / "fm2uav-batch-other").mkdir()  # not a worker folder: no pid
+        assert _remove_stale_work(tmp_path) == [folders[dead]]
+        assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+            [f"fm2uav-batch-{alive.pid}-abc", f"fm2uav-batch-{os.getpid()}-abc",
+             "fm2uav-batch-x1-abc", "fm2uav-batch-other"])
+    finally:
+        alive.kill()
+        alive.wait()
+
+
 # ----------------------------------------------------------------- before any work
 def test_mission_files_reads_folders_in_name_order_and_keeps_each_file_once(tmp_path):
     files = write_missions(tmp_path / "m", names=("north", "east"))
@@ -178,6 +202,8 @@ def test_a_worker_killed_mid_mission_costs_one_attempt_and_nothing_else(missions
         same_as_single_run(out / name, single[name])
     assert sorted(p.name for p in out.iterdir()) == ["big", "east", "far", "north"]
     assert _leftovers(out) == [] and pool.pids() == []
+    # the killed worker's private folder was swept by the mission that ran after it
+    assert not list(work_tmp.glob(f"fm2uav-batch-{killed['pid']}-*"))
 
 
 @pytest.mark.slow  # a Dask cluster of two worker processes

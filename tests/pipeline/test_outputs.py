@@ -5,7 +5,7 @@ from fm2uav.pipeline import outputs
 
 
 def test_export_file_names_are_the_exporters():
-    assert outputs.EXPORT_FILES == EXPORT_FILES
+    assert outputs.EXPORT_FILES is EXPORT_FILES  # one table (fm2uav.io.formats)
     assert outputs.output_names(["plan", "html", "json"]) == ["mission.plan", "report.html",
                                                                "summary.json"]
 

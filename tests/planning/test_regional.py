@@ -9,7 +9,7 @@ from scipy import ndimage
 import fm2uav
 from fm2uav import FlightLevel, InputError, PlanOptions, World
 from fm2uav.analysis.safety import safety_summary
-from fm2uav.eikonal import _kernels
+from fm2uav.eikonal import _edt
 from fm2uav.planning import regional
 from fm2uav.planning.planner import max_distance
 from fm2uav.world._columns import column_tops
@@ -40,12 +40,12 @@ def medium():
 
 def test_column_layer_edt_is_the_full_edt_layer(medium):
     sub = medium.occupancy[:70, :50]
-    full = _kernels.squared_edt(np.ascontiguousarray(sub), CELL, CELL, DZ)
+    full = _edt.squared_edt(np.ascontiguousarray(sub), CELL, CELL, DZ)
     top, solid = column_tops(sub)
     assert solid
     for k in (0, 7, sub.shape[2] - 1):
         np.testing.assert_array_equal(
-            _kernels.squared_column_edt_layer(top, k, CELL, CELL, DZ), full[:, :, k])
+            _edt.squared_column_edt_layer(top, k, CELL, CELL, DZ), full[:, :, k])
 
 
 def test_world_max_distance_is_the_full_plans(medium):

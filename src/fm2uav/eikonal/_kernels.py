@@ -860,36 +860,59 @@ def pad_grid(speed, Tb, sb, i0, j0, k0, bx, by, bz, nx, ny, nz, Tp, Vp):
     speed-0 nodes that are not frozen, and the ghosts, are ``NaN``. The ghosts'
     speeds are never read and stay unset.
     """
+    _pad_ghost_slabs(nx, ny, nz, Tp)
+    for i in range(nx):
+        _pad_slab(speed, Tb, sb, i0, j0, k0, bx, by, bz, i, ny, nz, Tp, Vp)
+
+
+@njit(cache=True, error_model="numpy", parallel=True)
+def pad_grid_parallel(nth, speed, Tb, sb, i0, j0, k0, bx, by, bz, nx, ny, nz, Tp, Vp):
+    """:func:`pad_grid` on ``nth`` threads, thread ``t`` the ``t``-th share of the
+    x-slabs (the same values: every node is written once, from its own speed). On a
+    1000 x 1000 x 40 grid most of its time is the first touch of the fresh padded
+    buffers (page faults), which the threads take in parallel too."""
+    _pad_ghost_slabs(nx, ny, nz, Tp)
+    for t in prange(nth):
+        for i in range(t * nx // nth, (t + 1) * nx // nth):
+            _pad_slab(speed, Tb, sb, i0, j0, k0, bx, by, bz, i, ny, nz, Tp, Vp)
+
+
+@njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+def _pad_ghost_slabs(nx, ny, nz, Tp):
+    """The ghost slabs ``i = -1`` and ``i = nx`` of :func:`pad_grid` (NaN)."""
+    row = (ny + 2) * (1 if nz == 1 else nz + 2)  # one padded x-slab
+    for c in range(row):
+        Tp[c] = np.nan
+        Tp[(nx + 1) * row + c] = np.nan
+
+
+@njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+def _pad_slab(speed, Tb, sb, i0, j0, k0, bx, by, bz, i, ny, nz, Tp, Vp):
+    """The x-slab ``i`` of :func:`pad_grid`, its ghost rows included."""
     two = nz == 1
     pz = 1 if two else nz + 2
     py = ny + 2
-    row = py * pz  # one padded x-slab
-    for c in range(row):  # ghost slabs i = -1 and i = nx
-        Tp[c] = np.nan
-        Tp[(nx + 1) * row + c] = np.nan
-    for i in range(nx):
-        slab = (i + 1) * row
-        for c in range(pz):  # ghost rows j = -1 and j = ny
-            Tp[slab + c] = np.nan
-            Tp[slab + (ny + 1) * pz + c] = np.nan
-        in_i = i0 <= i < i0 + bx
-        if two:  # one run of ny nodes per x-slab
-            if in_i:
-                _pad_row(speed, Tb, sb, i * ny, (i - i0) * by, slab + 1, ny, j0, by,
-                         Tp, Vp)
-            else:
-                _far_run(speed, i * ny, slab + 1, ny, Tp, Vp)
-            continue
-        for j in range(ny):
-            src = (i * ny + j) * nz
-            dst = slab + (j + 1) * pz
-            Tp[dst] = np.nan  # ghost nodes k = -1 and k = nz
-            Tp[dst + nz + 1] = np.nan
-            if in_i and j0 <= j < j0 + by:
-                _pad_row(speed, Tb, sb, src, ((i - i0) * by + j - j0) * bz, dst + 1, nz,
-                         k0, bz, Tp, Vp)
-            else:
-                _far_run(speed, src, dst + 1, nz, Tp, Vp)
+    slab = (i + 1) * py * pz
+    for c in range(pz):  # ghost rows j = -1 and j = ny
+        Tp[slab + c] = np.nan
+        Tp[slab + (ny + 1) * pz + c] = np.nan
+    in_i = i0 <= i < i0 + bx
+    if two:  # one run of ny nodes per x-slab
+        if in_i:
+            _pad_row(speed, Tb, sb, i * ny, (i - i0) * by, slab + 1, ny, j0, by, Tp, Vp)
+        else:
+            _far_run(speed, i * ny, slab + 1, ny, Tp, Vp)
+        return
+    for j in range(ny):
+        src = (i * ny + j) * nz
+        dst = slab + (j + 1) * pz
+        Tp[dst] = np.nan  # ghost nodes k = -1 and k = nz
+        Tp[dst + nz + 1] = np.nan
+        if in_i and j0 <= j < j0 + by:
+            _pad_row(speed, Tb, sb, src, ((i - i0) * by + j - j0) * bz, dst + 1, nz,
+                     k0, bz, Tp, Vp)
+        else:
+            _far_run(speed, src, dst + 1, nz, Tp, Vp)
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)
@@ -1017,7 +1040,8 @@ class Start(NamedTuple):
 LEAN_NODES = 2**25
 
 
-def march(speed, start, shape3, h3, order, stop_cells, *, lean=None, interleave=None):
+def march(speed, start, shape3, h3, order, stop_cells, *, lean=None, interleave=None,
+          threads=1):
     """Run the Fast Marching Method from ``start``; returns the arrival times.
 
     Parameters
@@ -1043,6 +1067,10 @@ def march(speed, start, shape3, h3, order, stop_cells, *, lean=None, interleave=
         array (:func:`_work_interleaved`) instead of two, and no plateau register.
         Default: unless every passable node has one speed (:func:`_buffers`). The times
         are the same bit for bit either way. Ignored in 3D and in the lean layout.
+    threads : int
+        Threads of the set-up (``>= 1``): the lean layout of grids of at least
+        :data:`SETUP_PARALLEL_MIN_NODES` padded nodes is padded on that many
+        (:func:`pad_grid_parallel`); the march itself runs on one.
 
     Returns
     -------
@@ -1064,8 +1092,16 @@ def march(speed, start, shape3, h3, order, stop_cells, *, lean=None, interleave=
     if lean is None:
         lean = npad > LEAN_NODES
     Tp, Vp, Tk, Vk, unit, plat = _buffers(speed, shape3, npad, lean, interleave)
-    pad_grid(_readonly(speed), start.T, start.state, *start.lo, *start.shape, nx, ny, nz,
-             Tp, Vp)
+    # the lean layout's buffers are fresh mappings: most of the padding is their page
+    # faults, which the threads take in parallel; the kept buffers of smaller grids take
+    # milliseconds on one
+    nth = setup_threads(threads, npad) if lean else 1
+    if nth > 1:  # prange(nth): nth threads of numba's pool, whatever its size
+        pad_grid_parallel(nth, _readonly(speed), start.T, start.state, *start.lo,
+                          *start.shape, nx, ny, nz, Tp, Vp)
+    else:
+        pad_grid(_readonly(speed), start.T, start.state, *start.lo, *start.shape, nx, ny,
+                 nz, Tp, Vp)
     stop, n_stop = _stop_bits(stop_cells, start, shape3, npad)
     U, qp = _plateau(speed, Vp, shape3, npad) if plat is None else plat
     # the pool starts at ~1/16 of the nodes (the band is a surface) and doubles
@@ -1104,6 +1140,22 @@ def march(speed, start, shape3, h3, order, stop_cells, *, lean=None, interleave=
         T = np.empty(n)
         unpad_grid(Tp, nx, ny, nz, T)
     return T, int(st[_FROZEN])
+
+
+#: Grids of at least this many nodes are set up on the march's threads (the padding,
+#: the input scan): below it one thread takes a few milliseconds, and the parallel
+#: kernels' one-off compilation is spared to small runs.
+SETUP_PARALLEL_MIN_NODES = 2_000_000
+
+
+def setup_threads(threads, nodes):
+    """Threads for the set-up of a march over ``nodes`` nodes: ``threads`` (at most numba's
+    pool) from :data:`SETUP_PARALLEL_MIN_NODES` nodes on, else 1."""
+    if threads <= 1 or nodes < SETUP_PARALLEL_MIN_NODES:
+        return 1
+    import numba
+
+    return int(min(threads, numba.config.NUMBA_NUM_THREADS))
 
 
 def _buffers(speed, shape3, npad, lean, interleave):
@@ -1357,182 +1409,22 @@ def scan_speed(v, min_speed):
     return -1, n_tiny
 
 
-# ------------------------------------------------------- exact distance transform
-@njit(error_model="numpy")
-def _edt_line(f, n, w2, v, z, out):
-    """1D squared distance transform (Felzenszwalb & Huttenlocher 2012).
-
-    ``out[q] = min_p (w2 * (q - p)^2 + f[p])`` over the finite ``f[p]``: the
-    lower envelope of the parabolas rooted at the finite samples. ``w2`` is the
-    squared spacing of the axis; ``v`` (int) and ``z`` (float) are scratch of
-    length ``n`` and ``n + 1``.
-    """
-    k = -1
-    for q in range(n):
-        fq = f[q]
-        if fq == np.inf:
-            continue
-        if k < 0:
-            k = 0
-            v[0] = q
-            z[0] = -np.inf
-            z[1] = np.inf
-            continue
-        while True:
-            p = v[k]
-            s = ((fq + w2 * q * q) - (f[p] + w2 * p * p)) / (2.0 * w2 * (q - p))
-            if s <= z[k] and k > 0:
-                k -= 1
-            else:
-                break
-        if s <= z[k]:  # k == 0 and the new parabola hides the first one everywhere
-            v[0] = q
-            z[0] = -np.inf
-            z[1] = np.inf
-            continue
-        k += 1
-        v[k] = q
-        z[k] = s
-        z[k + 1] = np.inf
-    if k < 0:
-        for q in range(n):
-            out[q] = np.inf
-        return
-    k = 0
-    for q in range(n):
-        while z[k + 1] < q:
-            k += 1
-        d = q - v[k]
-        out[q] = w2 * d * d + f[v[k]]
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def _edt_yz(occ, d, i, wy, wz, f, out, v, z):
-    """Pass 1 of the EDT on the x-slab ``i``: along z, then along y."""
-    _, ny, nz = occ.shape
-    for j in range(ny):
-        for k in range(nz):
-            f[k] = 0.0 if occ[i, j, k] else np.inf
-        _edt_line(f, nz, wz, v, z, out)
-        for k in range(nz):
-            d[i, j, k] = out[k]
-    if ny > 1:
-        for k in range(nz):
-            for j in range(ny):
-                f[j] = d[i, j, k]
-            _edt_line(f, ny, wy, v, z, out)
-            for j in range(ny):
-                d[i, j, k] = out[j]
-
-
-@njit(cache=True, error_model="numpy", inline="always")
-def _edt_x(d, j, wx, f, out, v, z):
-    """Pass 2 of the EDT on the y-slab ``j``: along x."""
-    nx, _, nz = d.shape
-    for k in range(nz):
-        for i in range(nx):
-            f[i] = d[i, j, k]
-        _edt_line(f, nx, wx, v, z, out)
-        for i in range(nx):
-            d[i, j, k] = out[i]
-
-
-@njit(cache=True, error_model="numpy")
-def _squared_edt_serial(occ, hx, hy, hz):
-    nx, ny, nz = occ.shape
-    d = np.empty((nx, ny, nz), dtype=np.float64)
-    nmax = max(nx, max(ny, nz))
-    f = np.empty(nmax)
-    out = np.empty(nmax)
-    v = np.empty(nmax, dtype=np.int64)
-    z = np.empty(nmax + 1)
-    for i in range(nx):
-        _edt_yz(occ, d, i, hy * hy, hz * hz, f, out, v, z)
-    if nx > 1:
-        for j in range(ny):
-            _edt_x(d, j, hx * hx, f, out, v, z)
-    return d
-
-
 @njit(cache=True, error_model="numpy", parallel=True)
-def _squared_edt_parallel(occ, hx, hy, hz):
-    nx, ny, nz = occ.shape
-    d = np.empty((nx, ny, nz), dtype=np.float64)
-    nmax = max(nx, max(ny, nz))
-    for i in prange(nx):
-        f = np.empty(nmax)
-        out = np.empty(nmax)
-        v = np.empty(nmax, dtype=np.int64)
-        z = np.empty(nmax + 1)
-        _edt_yz(occ, d, i, hy * hy, hz * hz, f, out, v, z)
-    if nx > 1:
-        for j in prange(ny):
-            f = np.empty(nmax)
-            out = np.empty(nmax)
-            v = np.empty(nmax, dtype=np.int64)
-            z = np.empty(nmax + 1)
-            _edt_x(d, j, hx * hx, f, out, v, z)
-    return d
-
-
-#: From this many nodes on, the EDT runs its lines in parallel. The parallel
-#: kernel costs ~2.7 s of one-off compilation (parfors) against ~0.4 s serial;
-#: below ~2 M nodes the serial transform takes < 0.3 s anyway.
-EDT_PARALLEL_MIN_NODES = 2_000_000
-
-
-def squared_edt(occ, hx, hy, hz):
-    """Exact squared Euclidean distance [m²] from every node to the nearest True node.
-
-    Separable: one 1D transform per axis (z, then y, then x); lines in parallel
-    on grids of at least ``EDT_PARALLEL_MIN_NODES`` nodes. ``occ`` is a
-    C-contiguous bool array of shape (nx, ny, nz); returns float64 of the same
-    shape (``inf`` everywhere if ``occ`` has no True node).
-    """
-    occ = _readonly(occ)
-    if occ.size >= EDT_PARALLEL_MIN_NODES:
-        return _squared_edt_parallel(occ, hx, hy, hz)
-    return _squared_edt_serial(occ, hx, hy, hz)
-
-
-@njit(cache=True, error_model="numpy")
-def squared_column_edt_layer(top, k, hx, hy, hz):
-    """Exact squared distance [m²] from the nodes of layer ``k`` to a column world's obstacles.
-
-    A column world has obstacle nodes ``(i, j, l)`` for ``l <= top[i, j]`` (``top = -1``:
-    a column without obstacle). The transform is the separable EDT of
-    :func:`squared_edt` restricted to one layer: the pass along z is the closed form
-    ``hz^2 (k - top)^2`` (0 at and below ``top``), then the passes along y and x, in
-    the same order and arithmetic as :func:`squared_edt`, so the values are those of the
-    full 3D transform's layer ``k``. Returns float64 ``(nx, ny)``.
-    """
-    nx, ny = top.shape
-    d = np.empty((nx, ny), dtype=np.float64)
-    nmax = max(nx, ny)
-    f = np.empty(nmax)
-    out = np.empty(nmax)
-    v = np.empty(nmax, dtype=np.int64)
-    z = np.empty(nmax + 1)
-    wz = hz * hz
-    for i in range(nx):
-        for j in range(ny):
-            t = top[i, j]
-            if t < 0:
-                f[j] = np.inf
-            else:
-                m = k - t
-                f[j] = 0.0 if m <= 0 else wz * m * m + 0.0
-        if ny > 1:
-            _edt_line(f, ny, hy * hy, v, z, out)
-            for j in range(ny):
-                d[i, j] = out[j]
-        else:
-            d[i, 0] = f[0]
-    if nx > 1:
-        for j in range(ny):
-            for i in range(nx):
-                f[i] = d[i, j]
-            _edt_line(f, nx, hx * hx, v, z, out)
-            for i in range(nx):
-                d[i, j] = out[i]
-    return d
+def scan_speed_parallel(nth, v, min_speed):
+    """:func:`scan_speed` on ``nth`` threads, thread ``t`` the ``t``-th share of ``v``: the
+    same ``(bad, n_tiny)`` (the first bad index of the first share holding one, and the
+    count of tiny speeds before it)."""
+    n = v.size
+    bads = np.empty(nth, dtype=np.int64)
+    tiny = np.empty(nth, dtype=np.int64)
+    for t in prange(nth):
+        a = t * n // nth
+        bad, cnt = scan_speed(v[a:(t + 1) * n // nth], min_speed)
+        bads[t] = bad if bad < 0 else a + bad
+        tiny[t] = cnt
+    count = 0
+    for t in range(nth):
+        count += tiny[t]
+        if bads[t] >= 0:
+            return bads[t], count
+    return -1, count

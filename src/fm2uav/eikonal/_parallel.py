@@ -9,26 +9,48 @@ side (:func:`_pad_slabs`), the exchange copies two rows, and a changed time upda
 again the nodes one *and two* away along each axis; its update is not monotone, so a
 repair may also raise a time, and a node takes the time the serial march keeps, the
 lowest of its updates at its neighbours' freezes (:func:`_serial_time2`): the times
-equal the serial march's bit for bit (the notes above :func:`_known`).
+equal the serial march's bit for bit (the notes above :func:`_known`). In 2D it takes the
+interleaved layout as order 1 (below): its two ghost rows a side and every index count
+elements, its bit masks (frozen on entry, re-opened, suspect, pending) keep a bit per node.
 
 Design (Yang & Stern 2017, domain-decomposition FMM)
 ----------------------------------------------------
 * The grid is cut along x (the slowest-varying axis of the C layout) into
   ``K`` slabs, :data:`SLABS_PER_THREAD` per thread, thread ``t`` marching slabs
   ``t, t + threads, ...`` (interleaved strips keep both threads busy when the
-  wave starts off-centre, and a coarse march places the cuts, :func:`slab_bounds`),
+  wave starts off-centre, and a coarse march places the cuts, :func:`slab_bounds`; in 2D
+  for the slabs shared before each window where that shortens the windows,
+  :data:`SHARED_CUTS`),
   unless sharing them longest first by the last window's freezes promises a shorter
   window (:func:`_assign`, before every window). The set-up pads the slabs in parallel
   (:func:`_pad_slabs`) and the result is unpadded so (:func:`_unpad_slabs`).
   Each slab is a padded grid of its own, laid out exactly as the
   serial march's (:func:`fm2uav.eikonal._kernels.pad_grid`), one after the other
-  in one buffer (the serial march's kept huge-page buffers; in the lean layout of big
-  grids float32 ``V`` and the times compacted in place, as there): its two ghost
-  x-slabs hold, between windows, the *frozen*
-  times of the neighbouring slab's boundary rows (``NaN`` where not frozen), so
-  the serial kernels' update (``_solve_iso``, ``_axis_term``, ``_combine``, the
-  plateau register ``_rhs``) and radix queue (``_push``, ``_pop``) run unchanged on a
+  in one buffer (the serial march's kept huge-page buffers, chosen by its
+  :func:`~fm2uav.eikonal._kernels._buffers`; in the lean layout of big grids float32 ``V``
+  and the times compacted in place, as there): its two ghost x-slabs hold, between
+  windows, the *frozen* times of the neighbouring slab's boundary rows (``NaN`` where not
+  frozen), so the serial kernels' update (``_solve_iso``, ``_axis_term``, ``_combine``,
+  the plateau register ``_rhs``) and radix queue (``_push``, ``_pop``) run unchanged on a
   slab.
+* **2D interleaved** (order 1 and 2), as the serial march: a 2D map (outside the lean layout) whose
+  passable nodes do not all have one speed keeps each node's time and ``1 / speed^2``
+  side by side in one array (node ``c``'s time at element ``2 c``, its speed term at
+  ``2 c + 1``; the kernels take the buffer and the buffer shifted by one, and every node
+  index in the kernels, the queues, the boundary lists, the start rows and the stop
+  nodes is an element index: strides ``sx = 2 (ny + 2)``, ``sy = 2``); the frozen-on-entry
+  and plateau masks keep a bit per node (element index halved). An update reads a
+  neighbour's time and speed from one cache line. A uniform map keeps the separate arrays
+  and reads no speed (the plateau register). ``march(..., interleave=False)`` forces the
+  separate arrays (the tests: the same times bit for bit).
+* **Far neighbours** (2D): a window freezing a node gives its far neighbours the one-axis
+  update along their axis, as the serial march (:data:`FAR_ONE_AXIS`). Valid in a slab
+  because a far node never has a frozen neighbour: a pop, a node frozen on entry (the
+  start) and a ghost (the exchange, its one own neighbour) each update their band and far
+  own neighbours when they become frozen, and a re-opened node had done so when it was
+  frozen first; so the full update of that node reads one frozen neighbour and gives the
+  same bits (the tests run with the rule on and off, one-row slabs included, and compare
+  the times and statistics bit for bit).
 * Time windows: every slab pops, with its own queue and in parallel, the nodes
   whose time is below ``t_w``, and lists the nodes it froze in its two boundary rows;
   then (barrier) every slab copies those of its neighbours into its ghosts (not the
@@ -131,6 +153,10 @@ WINDOW_NODES = 32768
 #: without (2 threads, 4 slabs per thread): FM²-shaped 2048^2 1.654 -> 1.759, 160^3 1.84 ->
 #: 1.90; constant speed the same (1.99, 1.93 -> 1.95).
 SHARE_SLABS = True
+#: 2D: a far neighbour of the node a window freezes gets the one-axis update along their
+#: axis, as in the serial march (valid in a slab: see the window's docstring); False: the
+#: full update (the same times bit for bit; the tests run both).
+FAR_ONE_AXIS = True
 #: Free repair-heap slots kept before each node's pushes (one pop pushes at most 7).
 HEAP_RESERVE = 8
 #: Order 2: one pop queues at most 13 entries (six neighbours, the six nodes two away, the
@@ -297,7 +323,7 @@ def _lower(T, V, c, t, fixed, sx, sy, three, pv, pool, nxt, bk, mw, st, rkey, ri
             if x == -_INF:  # a new band node: fetch the rows its freezing reads (as _relax)
                 _prefetch_rows(T, V, c, sx, sy, three, pv)
             _enq(_bits(t), c, pool, nxt, bk, mw, st, rkey, ritem)
-    elif t < x and (fixed[c >> _U(3)] >> (c & _U(7))) & _ONE == _ZERO:
+    elif t < x and _fixed_at(fixed, c, sy, three) == _ZERO:
         T[c] = -t
         ctl[_C_REOPEN] += 1.0
         _enq(_bits(t), c, pool, nxt, bk, mw, st, rkey, ritem)
@@ -311,10 +337,26 @@ def _room(st, rkey):
 
 @njit(cache=True, inline="always", _nrt=False)
 def _nbs(c, sx, sy, three):
-    """The neighbours of node ``c``: six in 3D; in 2D four, then ``c`` twice (frozen: skipped)."""
+    """The neighbours of node ``c``: six in 3D; in 2D four (``sy`` the y stride: 1, or 2 in
+    the interleaved layout), then ``c`` twice (frozen: skipped)."""
     if three:
         return (c - sx, c + sx, c - sy, c + sy, c - _ONE, c + _ONE)
-    return (c - sx, c + sx, c - _ONE, c + _ONE, c, c)
+    return (c - sx, c + sx, c - sy, c + sy, c, c)
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _unit(sy, three):
+    """The elements between two consecutive nodes of a slab's ``T``: 1, or 2 in the 2D
+    interleaved layout (node ``c``'s time at ``2 c``, its ``1 / speed^2`` at ``2 c + 1``),
+    where it is the y stride ``sy``; 3D slabs are never interleaved."""
+    return _ONE if three else sy
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _fixed_at(fixed, c, sy, three):
+    """Bit of element ``c``'s node in the frozen-on-entry mask ``fixed`` (one bit a node)."""
+    n = c >> (_unit(sy, three) >> _ONE)  # node index: element index / unit (1 or 2)
+    return (fixed[n >> _U(3)] >> (n & _U(7))) & _ONE
 
 
 @njit(cache=True, inline="always", _nrt=False)
@@ -335,20 +377,33 @@ def _slab_kernels(three):
     # closure variables are part of numba's cache key: only ``three`` (a bool) may be
     # one (a dispatcher's pickle differs per process and would defeat the cache)
     def window(T, V, U, qp, fixed, sx, sy, ih, hh, iso, tw, pool, nxt, bk, mw, st, rkey, ritem,
-               ctl, sent, ns):
+               ctl, sent, ns, far):
         """Freeze the slab's queued nodes with a time below ``tw`` (resumable).
 
         ``T`` is the slab's padded grid (ghost x-slabs first and last). Sets
         ``ctl[_C_NEXT]`` to the smallest time left queued (inf if none). The nodes it
         freezes in its first and last own rows go to ``sent[0]`` and ``sent[1]``
         (``ns`` their counts, reset here): the neighbours' exchange reads only those.
+
+        ``far`` (2D): a far neighbour of the node just frozen gets the one-axis update
+        along their axis, as in the serial march. Valid in a slab because no far node has
+        a frozen neighbour other than the node being frozen: every node that becomes
+        frozen updates its band and far own neighbours at once — a pop here, a node
+        frozen on entry in ``start``, a ghost in ``exchange`` (its one own neighbour) —
+        and an update from a frozen neighbour is finite (or ``inf`` on both ways, where
+        ``1 / speed^2`` overflows), so none of them stays far; a re-opened node was
+        frozen before, so its neighbours are not far either, and nothing turns far
+        again. The full update of such a node reads that one finite neighbour and
+        returns bit for bit the one-axis time (tests/eikonal/test_fmm_parallel.py runs
+        both ways and compares the times bit for bit).
         """
         n = _U(T.size)
         lo = sx  # the slab's own nodes: [sx, n - sx)
         hi = n - sx
         lo2 = lo + sx  # the first own row is [lo, lo2), the last [hi2, hi)
         hi2 = hi - sx
-        use_u = qp > 0.0
+        one = _unit(sy, three)
+        use_u = qp > 0.0 and one == _ONE
         kw = _bits(tw)
         pops = 0
         ns[0] = _ZERO
@@ -376,12 +431,29 @@ def _slab_kernels(three):
                 _note(sent, ns, 0, c)
             if c >= hi2:
                 _note(sent, ns, 1, c)
-            pv = not (use_u and _at_plateau(U, c))
-            for nb in _nbs(c, sx, sy, three):
-                y = T[nb]
-                if y < 0.0 or (y > t and nb >= lo and nb < hi):
-                    # band/far, or frozen later than c in this slab: c may lower it
-                    t_nb = _update(T, V, U, use_u, qp, nb, sx, sy, ih, hh, iso, three)
+            # prefetch V apart from T off the plateau (interleaved: the same lines)
+            pv = one == _ONE and not (use_u and _at_plateau(U, c))
+            if three:
+                for nb in _nbs(c, sx, sy, three):
+                    y = T[nb]
+                    if y < 0.0 or (y > t and nb >= lo and nb < hi):
+                        # band/far, or frozen later than c in this slab: c may lower it
+                        t_nb = _update(T, V, U, use_u, qp, nb, sx, sy, ih, hh, iso, three)
+                        _lower(T, V, nb, t_nb, fixed, sx, sy, three, pv, pool, nxt, bk, mw, st,
+                               rkey, ritem, ctl)
+            else:
+                for j in range(4):  # one site for the four neighbours, as the serial march
+                    s = sx if j < 2 else sy
+                    nb = c - s if j & 1 == 0 else c + s
+                    y = T[nb]
+                    if far and y == -_INF:  # c is its only frozen neighbour (docstring)
+                        q = _rhs(V, U, use_u, qp, nb)
+                        t_nb = t + math.sqrt(q * hh) if iso else t + math.sqrt(q / ih[j >> 1])
+                    elif y < 0.0 or (y > t and nb >= lo and nb < hi):
+                        # band/far, or frozen later than c in this slab: c may lower it
+                        t_nb = _update(T, V, U, use_u, qp, nb, sx, sy, ih, hh, iso, three)
+                    else:
+                        continue
                     _lower(T, V, nb, t_nb, fixed, sx, sy, three, pv, pool, nxt, bk, mw, st,
                            rkey, ritem, ctl)
         ctl[_C_POPS] = pops
@@ -390,7 +462,8 @@ def _slab_kernels(three):
               c0, c1):
         """Queue the slab's band nodes given on entry and expand its frozen ones (all in
         its nodes ``[c0, c1)``, the rows of the start box: the others are far or walls)."""
-        use_u = qp > 0.0
+        one = _unit(sy, three)
+        use_u = qp > 0.0 and one == _ONE
         c = c0
         while c < c1:
             x = T[c]
@@ -398,7 +471,7 @@ def _slab_kernels(three):
                 if not _room(st, rkey):
                     return False
                 _enq(_bits(-x), c, pool, nxt, bk, mw, st, rkey, ritem)
-            c += _ONE
+            c += one
         c = c0
         while c < c1:
             if T[c] >= 0.0:
@@ -407,9 +480,9 @@ def _slab_kernels(three):
                 for nb in _nbs(c, sx, sy, three):
                     if T[nb] < 0.0:
                         t_nb = _update(T, V, U, use_u, qp, nb, sx, sy, ih, hh, iso, three)
-                        _lower(T, V, nb, t_nb, fixed, sx, sy, three, True, pool, nxt, bk, mw,
-                               st, rkey, ritem, ctl)
-            c += _ONE
+                        _lower(T, V, nb, t_nb, fixed, sx, sy, three, one == _ONE, pool, nxt, bk,
+                               mw, st, rkey, ritem, ctl)
+            c += one
         return True
 
     def exchange(T, V, U, qp, fixed, src, sent, m, base, g, own, sx, sy, ih, hh, iso, pool, nxt,
@@ -419,13 +492,14 @@ def _slab_kernels(three):
         the start of that row). Only the neighbour's nodes ``sent[:m] - base`` are read
         (those it froze in its last window), the whole row when ``m`` exceeds the list's
         capacity. Resumable: False when a queue is full."""
-        use_u = qp > 0.0
+        one = _unit(sy, three)
+        use_u = qp > 0.0 and one == _ONE
         full = m > _U(sent.size)
-        count = sx if full else m
+        count = sx if full else m  # elements of the row, or listed nodes
         i = _ZERO
         while i < count:
             j = i if full else sent[i] - base
-            i += _ONE
+            i += one if full else _ONE
             v = src[j]
             if v >= 0.0 and not v >= T[g + j]:  # newly frozen or lowered there
                 if not _room(st, rkey):
@@ -434,7 +508,8 @@ def _slab_kernels(three):
                 c = own + j
                 if T[c] == T[c]:  # not a wall
                     _lower(T, V, c, _update(T, V, U, use_u, qp, c, sx, sy, ih, hh, iso, three),
-                           fixed, sx, sy, three, True, pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                           fixed, sx, sy, three, one == _ONE, pool, nxt, bk, mw, st, rkey, ritem,
+                           ctl)
                     if T[c] < 0.0 and -T[c] < ctl[_C_NEXT]:  # queued: the next window knows
                         ctl[_C_NEXT] = -T[c]
         return True
@@ -524,21 +599,22 @@ def _clear_bit(a, c):
 
 
 @njit(cache=True, inline="always", _nrt=False)
-def _known(T, fixed, c, thr):
+def _known(T, fixed, c, thr, sh):
     """Node ``c``'s time if the serial march had frozen it when the node of time ``thr``
-    froze (frozen on entry, or frozen no later than ``thr``), else inf."""
+    froze (frozen on entry, or frozen no later than ``thr``), else inf (``c >> sh``: its
+    node index, the bit of ``fixed``)."""
     x = T[c]
-    if x >= 0.0 and (x <= thr or _bit(fixed, c)):
+    if x >= 0.0 and (x <= thr or _bit(fixed, c >> sh)):
         return x
     return _INF
 
 
 @njit(cache=True, inline="always", error_model="numpy", _nrt=False)
-def _axis_term_at(T, V, U, use_u, fixed, c, s, ih2, thr):
+def _axis_term_at(T, V, U, use_u, fixed, c, s, ih2, thr, sh):
     """:func:`~fm2uav.eikonal._kernels._axis_term_u` at order 2 (the same operations, the
     same bits) reading only the nodes :func:`_known` at ``thr``."""
-    a = _known(T, fixed, c - s, thr)
-    b = _known(T, fixed, c + s, thr)
+    a = _known(T, fixed, c - s, thr, sh)
+    b = _known(T, fixed, c + s, thr, sh)
     if b < a:
         best = b
         c1 = c + s
@@ -549,7 +625,7 @@ def _axis_term_at(T, V, U, use_u, fixed, c, s, ih2, thr):
         c2 = c1 - s
     if best == _INF:
         return _INF, 0.0
-    t2 = _known(T, fixed, c2, thr)
+    t2 = _known(T, fixed, c2, thr, sh)
     if t2 <= best:
         if use_u and _at_plateau(U, c) and _at_plateau(U, c1) and _at_plateau(U, c2):
             return (4.0 * best - t2) / 3.0, 2.25 * ih2
@@ -568,11 +644,12 @@ def _update2_at(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three, thr):
     """The serial march's order-2 update of node ``c`` when the node of time ``thr`` froze,
     from the nodes :func:`_known` at ``thr`` (``thr < 0``: the nodes frozen on entry, as the
     serial march's first updates): its terms in the serial march's order, the same bits."""
+    sh = _unit(sy, three) >> _ONE
     q = _rhs(V, U, use_u, qp, c)
-    ta, aa = _axis_term_at(T, V, U, use_u, fixed, c, sx, ih[0], thr)
-    tb, ab = _axis_term_at(T, V, U, use_u, fixed, c, sy, ih[1], thr)
+    ta, aa = _axis_term_at(T, V, U, use_u, fixed, c, sx, ih[0], thr, sh)
+    tb, ab = _axis_term_at(T, V, U, use_u, fixed, c, sy, ih[1], thr, sh)
     if three:
-        tc, ac = _axis_term_at(T, V, U, use_u, fixed, c, _ONE, ih[2], thr)
+        tc, ac = _axis_term_at(T, V, U, use_u, fixed, c, _ONE, ih[2], thr, sh)
     else:
         tc, ac = _INF, 0.0
     return _combine(ta, aa, tb, ab, tc, ac, q)
@@ -581,8 +658,9 @@ def _update2_at(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three, thr):
 @njit(cache=True, inline="always", _nrt=False)
 def _later_nb(T, fixed, c, sx, sy, three, t):
     """Whether a neighbour of node ``c`` is frozen later than ``t`` (and not on entry)."""
+    sh = _unit(sy, three) >> _ONE
     for nb in _nbs(c, sx, sy, three):
-        if T[nb] > t and not _bit(fixed, nb):  # c itself (2D): band, not > t
+        if T[nb] > t and not _bit(fixed, nb >> sh):  # c itself (2D): band, not > t
             return True
     return False
 
@@ -601,9 +679,10 @@ def _serial_time2(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three):
     relative at the first node that differed on the 2048^2 FM²-shaped map); the serial
     march keeps that earlier one.
     """
+    sh = _unit(sy, three) >> _ONE
     val = _INF
     for nb in _nbs(c, sx, sy, three):
-        if nb != c and T[nb] >= 0.0 and _bit(fixed, nb):
+        if nb != c and T[nb] >= 0.0 and _bit(fixed, nb >> sh):
             val = _update2_at(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three, -1.0)
             break
     prev = -1.0
@@ -611,7 +690,7 @@ def _serial_time2(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three):
         thr = _INF  # the next neighbour's time (frozen, not on entry)
         for nb in _nbs(c, sx, sy, three):
             x = T[nb]
-            if nb != c and x >= 0.0 and x > prev and x < thr and not _bit(fixed, nb):
+            if nb != c and x >= 0.0 and x > prev and x < thr and not _bit(fixed, nb >> sh):
                 thr = x
         if not thr < val:
             return val
@@ -643,7 +722,8 @@ def _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf, eidx, eval
     by their index in the slabs' buffer, ``base + d`` for ``d``).
     """
     x = T[d]
-    if x != x or _bit(fixed, d):
+    nd = d >> (_unit(sy, three) >> _ONE)  # its node index: its bits in the masks
+    if x != x or _bit(fixed, nd):
         return
     t = _entry_cap(eidx, evals, base + d,
                    _serial_time2(T, V, U, use_u, qp, fixed, d, sx, sy, ih, three))
@@ -652,17 +732,17 @@ def _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf, eidx, eval
             T[d] = -t
             _enq(_bits(t), d, pool, nxt, bk, mw, st, rkey, ritem)
         elif t > -x and x > -_INF:
-            _set_bit(sf, d)
+            _set_bit(sf, nd)
             ctl[_C_RAISED] += 1.0
     elif t != x:
         ctl[_C_REOPEN] += 1.0
-        _set_bit(rf, d)
+        _set_bit(rf, nd)
         if t < x:
             T[d] = -t
             _enq(_bits(t), d, pool, nxt, bk, mw, st, rkey, ritem)
         else:
             T[d] = -x
-            _set_bit(sf, d)
+            _set_bit(sf, nd)
             ctl[_C_RAISED] += 1.0
             _enq(_bits(x), d, pool, nxt, bk, mw, st, rkey, ritem)
 
@@ -691,7 +771,9 @@ def _slab_kernels2(three):
         hi = n - g
         lo2 = lo + g  # the first two own rows are [lo, lo2), the last two [hi2, hi)
         hi2 = hi - g
-        use_u = qp > 0.0
+        one = _unit(sy, three)  # elements a node (2D interleaved: 2)
+        sh = one >> _ONE  # node index = element index >> sh: the bits of the masks
+        use_u = qp > 0.0 and one == _ONE
         kw = _bits(tw)
         pops = 0
         ns[0] = _ZERO
@@ -717,15 +799,15 @@ def _slab_kernels2(three):
                 _enq(k, c, pool, nxt, bk, mw, st, rkey, ritem)
                 ctl[_C_NEXT] = min(t, _from_bits(kb))
                 break
-            if _bit(sf, c):  # suspect: its time may have to go up
-                _clear_bit(sf, c)
+            if _bit(sf, c >> sh):  # suspect: its time may have to go up
+                _clear_bit(sf, c >> sh)
                 t2 = _entry_cap(eidx, evals, base + c,
                                 _serial_time2(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three))
                 if t2 != t:
-                    if t2 > t and _bit(rf, c) and not _bit(pf, c):
+                    if t2 > t and _bit(rf, c >> sh) and not _bit(pf, c >> sh):
                         # nodes may still read its old time (>= t): the stop test must not
                         # pass t before it is frozen again
-                        _set_bit(pf, c)
+                        _set_bit(pf, c >> sh)
                         ctl[_C_PEND] += 1.0
                         ctl[_C_RMIN] = min(ctl[_C_RMIN], t)
                     T[c] = -t2
@@ -738,15 +820,16 @@ def _slab_kernels2(three):
                 _note(sent, ns, 0, c)
             if c >= hi2:
                 _note(sent, ns, 1, c)
-            if _bit(pf, c):
-                _clear_bit(pf, c)
+            if _bit(pf, c >> sh):
+                _clear_bit(pf, c >> sh)
                 ctl[_C_PEND] -= 1.0
                 if ctl[_C_PEND] == 0.0:
                     ctl[_C_RMIN] = _INF
-            full = _bit(rf, c)  # frozen again: every dependant may have read its old time
+            full = _bit(rf, c >> sh)  # frozen again: every dependant may have read its old time
             if full:
-                _clear_bit(rf, c)
-            pv = not (use_u and _at_plateau(U, c))
+                _clear_bit(rf, c >> sh)
+            # prefetch V apart from T off the plateau (interleaved: the same lines)
+            pv = one == _ONE and not (use_u and _at_plateau(U, c))
             for nb in _nbs(c, sx, sy, three):
                 if nb == c:
                     continue
@@ -762,7 +845,7 @@ def _slab_kernels2(three):
                         s_nb, ih_nb = sy, ih[1]
                     else:
                         s_nb, ih_nb = _ONE, ih[2]
-                    ta, aa = _axis_term_at(T, V, U, use_u, fixed, nb, s_nb, ih_nb, t)
+                    ta, aa = _axis_term_at(T, V, U, use_u, fixed, nb, s_nb, ih_nb, t, sh)
                     _lower(T, V, nb, ta + math.sqrt(_rhs(V, U, use_u, qp, nb) / aa), fixed, sx,
                            sy, three, pv, pool, nxt, bk, mw, st, rkey, ritem, ctl)
                 elif y < 0.0:  # band (or far after c froze again): an own node
@@ -781,7 +864,7 @@ def _slab_kernels2(three):
                                    st, rkey, ritem, ctl)
                         elif (tn > -y and y > -_INF
                               and _entry_cap(eidx, evals, base + nb, tn) > -y):
-                            _set_bit(sf, nb)
+                            _set_bit(sf, nb >> sh)
                             ctl[_C_RAISED] += 1.0
                 elif y >= 0.0 and nb >= lo and nb < hi and (full or y > t):
                     # frozen later than c in this slab: c may change it
@@ -802,7 +885,8 @@ def _slab_kernels2(three):
         """Queue the slab's band nodes given on entry and expand its frozen ones (order 2;
         all in its nodes ``[c0, c1)``, the rows of the start box: the others are far or
         walls)."""
-        use_u = qp > 0.0
+        one = _unit(sy, three)
+        use_u = qp > 0.0 and one == _ONE
         c = c0
         while c < c1:
             x = T[c]
@@ -810,7 +894,7 @@ def _slab_kernels2(three):
                 if not _room2(st, rkey):
                     return False
                 _enq(_bits(-x), c, pool, nxt, bk, mw, st, rkey, ritem)
-            c += _ONE
+            c += one
         c = c0
         while c < c1:
             if T[c] >= 0.0:
@@ -820,9 +904,9 @@ def _slab_kernels2(three):
                     if T[nb] < 0.0:
                         _lower(T, V, nb, _update2_at(T, V, U, use_u, qp, fixed, nb, sx, sy, ih,
                                                      three, -1.0),
-                               fixed, sx, sy, three, True, pool, nxt, bk, mw, st, rkey, ritem,
-                               ctl)
-            c += _ONE
+                               fixed, sx, sy, three, one == _ONE, pool, nxt, bk, mw, st, rkey,
+                               ritem, ctl)
+            c += one
         return True
 
     def exchange(T, V, U, qp, fixed, rf, sf, eidx, evals, ebase, src, sent, m, base, g, up, sx,
@@ -832,16 +916,17 @@ def _slab_kernels2(three):
         from each ghost that changed (toward +x if ``up``). Only the neighbour's nodes
         ``sent[:m] - base`` are read (those it froze in its last window), both rows when
         ``m`` exceeds the list's capacity. Resumable: False when a queue is full."""
-        use_u = qp > 0.0
+        one = _unit(sy, three)
+        use_u = qp > 0.0 and one == _ONE
         n = _U(T.size)
         lo = sx + sx
         hi = n - lo
         full = m > _U(sent.size)
-        count = lo if full else m
+        count = lo if full else m  # elements of the two rows, or listed nodes
         i = _ZERO
         while i < count:
             j = i if full else sent[i] - base
-            i += _ONE
+            i += one if full else _ONE
             v = src[j]
             if v >= 0.0 and v != T[g + j]:  # newly frozen, or frozen again at another time
                 if not _room2(st, rkey):
@@ -945,7 +1030,7 @@ def _drive_kernel(three, order=1):
     """The compiled driver of one dimension and order (the parallel region runs the slabs)."""
     def drive(nth, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, rows, sx, sy, ih, hh, iso, pool,
               nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win, first, stops, slabs, lists, load,
-              share, scan):
+              share, scan, far):
         """Run windows until every queue is empty; 0 done, 1/2 grow pool/heap and call again.
 
         ``win`` (float64): [0] window end, [1] width, [2] windows run, [3] target pops,
@@ -956,24 +1041,29 @@ def _drive_kernel(three, order=1):
         shared longest-first. ``U``, ``qp``: the plateau mask over
         ``Tp`` (one byte: every node) and its ``1 / speed^2`` (0: none); ``sent``, ``ns``:
         each slab's nodes frozen in its boundary rows in the last window (see ``window``).
-        ``fl``: order 2's bit masks over ``Tp`` (re-opened, suspect, raised; unused by
-        order 1), ``eidx``, ``evals`` its nodes in the band on entry (indices into ``Tp``,
-        sorted) and their times; each slab has ``order`` ghost x-slabs on each side.
+        ``fl``: order 2's bit masks, a bit per node (re-opened, suspect, pending; unused by
+        order 1), ``eidx``, ``evals`` its nodes in the band on entry (element indices into
+        ``Tp``, sorted) and their times; each slab has ``order`` ghost x-slabs on each side.
         ``slabs`` (K), ``lists`` (nth + 1 + K), ``load`` (nth): scratch of :func:`_assign`
         (``share``: :data:`SHARE_SLABS`). ``scan[k]``: the nodes of slab ``k`` the start
-        reads (the start box's rows).
+        reads (the start box's rows). ``far``: the far neighbours' one-axis update (2D).
+
+        ``off``, ``end``, ``sx``, ``sy``, ``scan`` and ``stops`` count elements of ``Tp``:
+        nodes in the separate layout, twice that in the 2D interleaved one (``Tp`` the
+        buffer, ``Vp = Tp[1:]``, ``sy = 2``); ``U`` and ``fx`` have a bit per node.
         """
         K = off.size
         sxi = np.int64(sx)
         G = np.int64(order)  # ghost rows on each side of a slab
         low = _U(RESERVE_BLOCKS + (POOL_EXTRA_2 if order == 2 else 0))
+        sh = 0 if three or sy == 1 else 1  # node index = element index >> sh
         if first:
             for t in prange(nth):  # thread t runs slabs t, t + nth, ...
                 for k in range(t, K, nth):
                     T = Tp[off[k]:end[k]]
                     V = Vp[off[k]:end[k]]
-                    Uk = U[0 if U.size == 1 else off[k] >> 3:]
-                    F = fx[off[k] >> 3:]
+                    Uk = U[0 if U.size == 1 else off[k] >> sh >> 3:]
+                    F = fx[off[k] >> sh >> 3:]
                     c0 = _U(scan[k, 0])
                     c1 = _U(scan[k, 1])
                     if order == 2 and three:
@@ -1002,10 +1092,10 @@ def _drive_kernel(three, order=1):
                     k = slabs[i]
                     T = Tp[off[k]:end[k]]
                     V = Vp[off[k]:end[k]]
-                    Uk = U[0 if U.size == 1 else off[k] >> 3:]
-                    F = fx[off[k] >> 3:]
-                    R = fl[0, off[k] >> 3:]
-                    S = fl[1, off[k] >> 3:]
+                    Uk = U[0 if U.size == 1 else off[k] >> sh >> 3:]
+                    F = fx[off[k] >> sh >> 3:]
+                    R = fl[0, off[k] >> sh >> 3:]
+                    S = fl[1, off[k] >> sh >> 3:]
                     ok = True
                     r = _U(rows[k])
                     if k > 0:
@@ -1081,20 +1171,22 @@ def _drive_kernel(three, order=1):
                 for i in range(lists[t], lists[t + 1]):
                     k = slabs[i]
                     if order == 2:
+                        o3 = off[k] >> sh >> 3
                         args = (Tp[off[k]:end[k]], Vp[off[k]:end[k]],
-                                U[0 if U.size == 1 else off[k] >> 3:], qp, fx[off[k] >> 3:],
-                                fl[0, off[k] >> 3:], fl[1, off[k] >> 3:], fl[2, off[k] >> 3:],
-                                eidx, evals, _U(off[k]), sx, sy, ih, tw, pool[k], nxt[k], bk[k],
-                                mw[k], st[k], rkey[k], ritem[k], ctl[k], sent[k], ns[k])
+                                U[0 if U.size == 1 else o3:], qp, fx[o3:], fl[0, o3:],
+                                fl[1, o3:], fl[2, o3:], eidx, evals, _U(off[k]), sx, sy, ih, tw,
+                                pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k],
+                                sent[k], ns[k])
                         if three:
                             _window3d_o2(*args)
                         else:
                             _window2d_o2(*args)
                     else:
                         _window(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]],
-                                U[0 if U.size == 1 else off[k] >> 3:], qp, fx[off[k] >> 3:], sx,
-                                sy, ih, hh, iso, tw, pool[k], nxt[k], bk[k], mw[k], st[k],
-                                rkey[k], ritem[k], ctl[k], sent[k], ns[k])
+                                U[0 if U.size == 1 else off[k] >> sh >> 3:], qp,
+                                fx[off[k] >> sh >> 3:], sx, sy, ih, hh, iso, tw, pool[k], nxt[k],
+                                bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k], sent[k], ns[k],
+                                far)
             win[2] += 1.0
             pops = 0.0
             most = 0.0
@@ -1129,6 +1221,13 @@ _DRIVES = {(d, o): _drive_kernel(d == 3, o) for d in (2, 3) for o in (1, 2)}
 #: every 8th / 16th / 32nd node / equal slabs, the coarse march 8 / 2 / 0.5 ms.
 COARSE = 16
 COARSE_3D = 4
+#: Whether the cuts are placed for the slabs shared anew before each window (the least
+#: share of a time bin any sharing allows, :func:`slab_bounds`) rather than for the fixed
+#: interleave. Simulated on the bench's FM²-shaped 2048^2 map from the serial times
+#: (windows of 32768 nodes in time order, the slabs shared as :func:`_assign`), 8 slabs:
+#: windows' balance 1.78 -> 1.84 (16 slabs 1.83 -> 1.84). 3D keeps the interleave's cuts
+#: (not measured there).
+SHARED_CUTS = {2: True, 3: False}
 #: Bins of the split estimate, each as many coarse nodes in time order (stand-ins for
 #: the windows).
 SPLIT_BINS = 256
@@ -1143,8 +1242,15 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarra
     windows' critical path (a source off-centre would otherwise leave one thread idle
     while the wave crosses the other's slabs), by coordinate descent from equal slabs
     (each cut in turn moved to its best row between its neighbours, until none moves;
-    exhaustive for two slabs). Equal slabs when the start is not a few point sources
-    (its box over a quarter of the grid) or the grid is too thin for a coarse march.
+    exhaustive for two slabs). Where :data:`SHARED_CUTS` says so (2D) a second descent
+    counts a thread's nodes in a bin not as the fixed interleave gives them but as the least
+    any sharing of the slabs allows, ``max(the bin's busiest slab, the bin's nodes /
+    threads)`` (the slabs are shared anew before each window, :func:`_assign`, and cuts
+    made for the interleave may leave the late wave in one slab), and the cuts of the two
+    descents with the shorter critical path when the bins' slabs are shared as
+    :func:`_assign` shares them (:func:`_shared_cost`) are taken. Equal slabs when the
+    start is not a few point sources (its box over a quarter of the grid) or the grid is
+    too thin for a coarse march.
     """
     nx = int(shape3[0])
     even = np.linspace(0, nx, k + 1).round().astype(np.int64)
@@ -1159,30 +1265,13 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarra
         return even
     cum = np.vstack([np.zeros((1, hist.shape[1]), dtype=np.int64), np.cumsum(hist, axis=0)])
     cuts = np.clip(np.linspace(0, rows, k + 1).round().astype(np.int64), 0, rows)
-    owner = np.arange(k) % threads
-
-    def loads(c):  # nodes per thread and time bin, shape (threads, bins)
-        per_slab = cum[c[1:]] - cum[c[:-1]]
-        return np.stack([per_slab[t::threads].sum(axis=0) for t in range(threads)])
-
-    for _ in range(4 * k):
-        moved = False
-        for i in range(1, k):
-            cand = np.arange(cuts[i - 1] + gap, cuts[i + 1] - gap + 1)
-            if cand.size == 0:
-                continue
-            base = loads(cuts)
-            base[owner[i - 1]] -= cum[cuts[i]] - cum[cuts[i - 1]]
-            base[owner[i]] -= cum[cuts[i + 1]] - cum[cuts[i]]
-            trial = np.repeat(base[None], cand.size, axis=0)
-            trial[:, owner[i - 1]] += cum[cand] - cum[cuts[i - 1]]
-            trial[:, owner[i]] += cum[cuts[i + 1]] - cum[cand]
-            best = int(cand[np.argmin(trial.max(axis=1).sum(axis=1))])
-            if best != cuts[i]:
-                cuts[i] = best
-                moved = True
-        if not moved:
-            break
+    fixed = _descend_cuts(cum, cuts.copy(), gap, threads, False)
+    if SHARED_CUTS[3 if shape3[2] > 1 else 2]:  # the better, by the windows as _assign
+        cuts = _descend_cuts(cum, cuts, gap, threads, True)  # shares the slabs
+        if _shared_cost(cum, fixed, threads) <= _shared_cost(cum, cuts, threads):
+            cuts = fixed
+    else:
+        cuts = fixed
     bounds = np.minimum(cuts * f, nx)
     bounds[-1] = nx
     for i in range(1, k):  # fine rows: at least MIN_SLAB_ROWS per slab where they fit
@@ -1190,6 +1279,101 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarra
     if np.any(np.diff(bounds) < 1):
         return even
     return bounds.astype(np.int64)
+
+
+@njit(cache=True, error_model="numpy")
+def _descend_cuts(cum, cuts, gap, threads, shared):
+    """Coordinate descent of the inner cuts ``cuts[1:-1]`` (coarse rows, at least ``gap``
+    apart; ``cum``: the coarse histogram cumulated over the rows, ``(rows + 1, bins)``):
+    each in turn to the row between its neighbours with the least critical path, ``sum
+    over bins of the largest thread's nodes``, until none moves; ``cuts`` is changed and
+    returned. A thread's nodes in a bin: those of its slabs in the fixed interleave (slab
+    ``j`` to thread ``j % threads``; the first best row taken), or with ``shared`` the
+    least any sharing allows, ``max(busiest slab, all / threads)`` (a move only where
+    strictly better: that bound ties over many rows)."""
+    k = cuts.size - 1
+    nb = cum.shape[1]
+    base = np.empty((threads, nb))
+    for _ in range(4 * k):
+        moved = False
+        for i in range(1, k):
+            lo = cuts[i - 1] + gap
+            hi = cuts[i + 1] - gap
+            if hi < lo:
+                continue
+            # every slab but i - 1 and i: per thread (interleave) or the bound (shared)
+            base[:] = 0.0
+            for b in range(nb):
+                if shared:
+                    base[0, b] = (cum[-1, b] - cum[0, b]) / threads
+            for j in range(k):
+                if j == i - 1 or j == i:
+                    continue
+                for b in range(nb):
+                    x = cum[cuts[j + 1], b] - cum[cuts[j], b]
+                    if shared:
+                        base[0, b] = max(base[0, b], x)
+                    else:
+                        base[j % threads, b] += x
+            best = cuts[i]
+            best_cost = np.inf
+            here = np.inf
+            for c in range(lo, hi + 2):
+                r = cuts[i] if c == hi + 1 else c  # last: the cut's own row
+                cost = 0.0
+                for b in range(nb):
+                    below = cum[r, b] - cum[cuts[i - 1], b]
+                    above = cum[cuts[i + 1], b] - cum[r, b]
+                    if shared:
+                        cost += max(base[0, b], max(below, above))
+                    else:
+                        most = 0.0
+                        for t in range(threads):
+                            x = base[t, b]
+                            if t == (i - 1) % threads:
+                                x += below
+                            if t == i % threads:
+                                x += above
+                            most = max(most, x)
+                        cost += most
+                if c == hi + 1:
+                    here = cost
+                elif cost < best_cost:
+                    best_cost = cost
+                    best = c
+            if (best_cost < here) if shared else (best != cuts[i]):
+                cuts[i] = best
+                moved = True
+        if not moved:
+            break
+    return cuts
+
+
+def _shared_cost(cum, cuts, threads):
+    """The windows' critical path (nodes) of the cuts ``cuts`` over the coarse histogram's
+    time bins (``cum``: cumulated over the rows) with the slabs shared as :func:`_assign`
+    shares them: longest first by the last bin's nodes when that predicts a smaller
+    largest share than the fixed interleave (slab ``k`` to thread ``k % threads``)."""
+    per = (cum[cuts[1:]] - cum[cuts[:-1]]).astype(np.float64)  # (slabs, bins)
+    k, nb = per.shape
+    pred = np.zeros_like(per)
+    pred[:, 1:] = per[:, :-1]
+    cols = np.arange(nb)
+
+    def fixed_max(a):
+        return np.max([a[t::threads].sum(axis=0) for t in range(threads)], axis=0)
+
+    order = np.argsort(-pred, axis=0, kind="stable")
+    load = np.zeros((threads, nb))
+    owner = np.empty((k, nb), dtype=np.int64)
+    for i in range(k):
+        slab = order[i]
+        best = np.argmin(load, axis=0)
+        owner[slab, cols] = best
+        load[best, cols] += pred[slab, cols]
+    greedy = load.max(axis=0) < fixed_max(pred)
+    shared = np.max([np.where(owner == t, per, 0.0).sum(axis=0) for t in range(threads)], axis=0)
+    return float(np.where(greedy, shared, fixed_max(per)).sum())
 
 
 def _coarse_histogram(speed, start, shape3, h3):
@@ -1218,7 +1402,8 @@ def _coarse_histogram(speed, start, shape3, h3):
     sb = np.where(frozen, _kernels.FROZEN, 0).astype(np.uint8)
     cstart = _kernels.Start(tuple(int(a) for a in lo), bshape, Tb, sb)
     hc = tuple(h * f for h in h3[:2]) + ((h3[2] * f,) if three else (h3[2],))
-    T, _ = _kernels.march(coarse.reshape(-1), cstart, cshape, hc, 1,
+    # read-only as fast_marching's speeds: the same specialisations (the warm-up's)
+    T, _ = _kernels.march(_kernels._readonly(coarse.reshape(-1)), cstart, cshape, hc, 1,
                           np.zeros((0, 3), dtype=np.int64))
     T = T.reshape(cshape[0], -1)
     fin = np.isfinite(T)
@@ -1239,7 +1424,7 @@ def _coarse_histogram(speed, start, shape3, h3):
     return hist, f
 
 
-def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
+def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interleave=None):
     """The Fast Marching from ``start`` on ``threads`` slabs in parallel.
 
     Parameters
@@ -1263,6 +1448,10 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
         Order of the upwind stencil, as in the serial march (order 2: two ghost
         x-slabs per side, the dependants two away updated again; see the notes above
         :func:`_known`).
+    interleave : bool, optional
+        2D slabs outside the lean layout: ``T`` and ``1 / speed^2`` interleaved in one
+        array, as the serial march (:func:`fm2uav.eikonal._kernels._buffers`); default:
+        unless every passable node has one speed. The times are the same bit for bit.
 
     Returns
     -------
@@ -1296,46 +1485,46 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
     off = np.concatenate([[0], np.cumsum(-(-sizes // 8) * 8)[:-1]]).astype(np.int64)
     npad = int(off[-1] + sizes[-1])
     lean = (nx + 2) * sx > _kernels.LEAN_NODES  # V in float32 as the serial march
-    if lean:  # plain mappings, as the serial march's (the times compacted in place below)
-        Tp = _kernels._work(8 * npad).view(np.float64)
-        Vp = _kernels._work(4 * npad).view(np.float32)
-    else:  # the serial march's kept buffers (huge pages, no page faults on a repeat)
-        Tp, Vp = _kernels._work_pair(npad)
+    # the serial march's buffers: in the lean layout plain mappings (the times compacted
+    # in place below), else its kept ones (huge pages, no page faults on a repeat); a 2D
+    # map not of one speed interleaved (Tk: node c's time at 2 c, its V at 2 c + 1; Tp and
+    # Vp strided views of it) and without a plateau register, as the serial march
+    Tp, Vp, Tk, Vk, unit, plat = _kernels._buffers(speed, shape3, npad, lean, interleave)
     plane = ny * nz
     boxes = _start_boxes(start, bounds, nx, G)
     with _threads(nth):
         _pad_slabs(nth, _kernels._readonly(speed), start.T, start.state, boxes, bounds, off, ny,
                    nz, G, Tp, Vp)
-    # the start box's own rows in each slab, the only nodes the start reads
+    # the start box's own rows in each slab, the only nodes the start reads (nodes of Tp;
+    # elements of Tk: times unit)
     b0, b1 = bounds[:-1], bounds[1:]
     i0 = np.clip(start.lo[0], b0, b1)
     i1 = np.clip(start.lo[0] + start.shape[0], i0, b1)
-    scan = np.stack([(i0 - b0 + G) * sx, (i1 - b0 + G) * sx], axis=1)
-    # the nodes frozen on entry (sources, balls) stay as they are, as in the serial march
-    fixed = Tp >= 0.0
+    rows0 = np.stack([(i0 - b0 + G) * sx, (i1 - b0 + G) * sx], axis=1)
+    scan = unit * rows0
+    # the nodes frozen on entry (sources, balls) stay as they are, as in the serial march:
+    # a bit per node, set from the start box's rows (the only frozen nodes on entry)
+    fixed = _frozen_bits(Tp, off[:, None] + rows0, npad)
     if G == 2:  # order 2: the ghosts' too (the neighbours' own), which the serial march's
-        for k in range(K):  # first updates read (:func:`_known`)
-            if k > 0:
-                o = off[k - 1] + rows[k - 1] * sx
-                fixed[off[k]:off[k] + G * sx] = fixed[o:o + G * sx]
-            if k < K - 1:
-                o = off[k] + (rows[k] + G) * sx
-                fixed[o:o + G * sx] = fixed[off[k + 1] + G * sx:off[k + 1] + 2 * G * sx]
-    fixed = np.packbits(fixed, bitorder="little")
-    U, qp = _kernels._plateau(speed, Vp, shape3, npad,
-                              fill=lambda vmax, bits: _slab_plateau(speed, vmax, bounds, off,
-                                                                    shape3, bits, G))
-    # order 2's bit masks: re-opened, suspect, raised (one spare byte: a 2D slice below),
-    # and the nodes in the band on entry with their times (a repair keeps them if lower)
+        _ghost_frozen_bits(fixed, Tp, off, rows, sx, G)  # first updates read (:func:`_known`)
+    if plat is None:
+        plat = _kernels._plateau(speed, Vp, shape3, npad,
+                                 fill=lambda vmax, bits: _slab_plateau(speed, vmax, bounds, off,
+                                                                       shape3, bits, G))
+    U, qp = plat
+    # order 2's bit masks: re-opened, suspect, pending, a bit per node (one spare byte: a 2D
+    # slice below), and the nodes in the band on entry with their times (a repair keeps
+    # them if lower; element indices)
     fl = np.zeros((3, npad // 8 + 2 if order == 2 else 1), dtype=np.uint8)
-    eidx = np.zeros(0, dtype=np.uint64)
+    nodes = np.zeros(0, dtype=np.int64)
     if order == 2:
         parts = []
         for k in range(K):  # in the start box's rows: every other node is far or a wall
-            seg = Tp[off[k] + scan[k, 0]:off[k] + scan[k, 1]]
-            parts.append(off[k] + scan[k, 0] + np.flatnonzero((seg < 0.0) & (seg > -np.inf)))
-        eidx = np.concatenate(parts).astype(np.uint64)
-    evals = -Tp[eidx]
+            seg = Tp[off[k] + rows0[k, 0]:off[k] + rows0[k, 1]]
+            parts.append(off[k] + rows0[k, 0] + np.flatnonzero((seg < 0.0) & (seg > -np.inf)))
+        nodes = np.concatenate(parts)
+    eidx = (unit * nodes).astype(np.uint64)
+    evals = -Tp[nodes]
     # each slab's nodes frozen in its first and last own rows in the last window (the
     # neighbours' exchange reads those); a count over the capacity: read the whole row
     # (so the first exchange, after the start)
@@ -1360,7 +1549,12 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
     hh = float(1.0 / ih[0])
     # the top speed sets the first window's width only (then adapted): from the plateau's
     # register when there is one (a pass over the speeds is ~2 ms of serial time on 2048^2)
-    vmax = (1.0 / np.sqrt(qp) if qp > 0.0 else float(speed.max())) if speed.size else 1.0
+    # (a pass over the speeds, on the threads, else)
+    if qp > 0.0:
+        vmax = 1.0 / np.sqrt(qp)
+    else:
+        with _threads(nth):
+            vmax = _top_speed(nth, _kernels._readonly(speed))
     width = 2.0 * min(h3[:3 if three else 2]) / max(vmax, 1e-300)
     win = np.array([0.0, width, 0.0, float(WINDOW_NODES), 0.0, 0.0, np.inf, 0.0, 0.0])
     stop_idx = np.zeros(0, dtype=np.int64)
@@ -1370,7 +1564,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
         local = ((cells[:, 0] - bounds[k] + G) * (ny + 2) + cells[:, 1] + 1)
         if three:
             local = local * (nz + 2) + cells[:, 2] + 1
-        stop_idx = off[k] + local
+        stop_idx = unit * (off[k] + local)
     drive = _DRIVES[3 if three else 2, G]
     slabs = np.empty(K, dtype=np.int64)  # scratch of _assign: each window's slabs per thread
     lists = np.empty(nth + 1 + K, dtype=np.int64)
@@ -1380,9 +1574,10 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
     numba.set_num_threads(nth)
     try:
         while True:
-            status = drive(nth, Tp, Vp, U, qp, fixed, fl, eidx, evals, off, off + sizes, rows,
-                           _U(sx), _U(sy), ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl,
-                           sent, ns, win, first, stop_idx, slabs, lists, load, SHARE_SLABS, scan)
+            status = drive(nth, Tk, Vk, U, qp, fixed, fl, eidx, evals, unit * off,
+                           unit * (off + sizes), rows, _U(unit * sx), _U(unit * sy), ih, hh, iso,
+                           pool, nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win, first,
+                           stop_idx, slabs, lists, load, SHARE_SLABS, scan, FAR_ONE_AXIS)
             first = win[7] == 0.0
             if status == 0:
                 break
@@ -1393,7 +1588,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1):
                 rkey, ritem = _grow_heaps(rkey, ritem)
     finally:
         numba.set_num_threads(prev)
-    del Vp, pool, nxt
+    del Vp, Vk, Tk, pool, nxt
     # lean: in place, slab after slab, as the serial march: slab k's times go to
     # [a * plane, b * plane), from no later than its padded grid's start to before slab
     # k + 1's, so every node moves to a lower index and is read before it is written
@@ -1429,6 +1624,53 @@ def _threads(nth):
         yield
     finally:
         numba.set_num_threads(prev)
+
+
+def _frozen_bits(Tp, rows, npad):
+    """A bit per node of the padded slabs ``Tp`` (``npad`` nodes), set where ``Tp >= 0``
+    (frozen) in the node ranges ``rows[k, 0] <= c < rows[k, 1]`` (each slab's start box
+    rows), clear elsewhere (no other node is frozen on entry)."""
+    bits = np.zeros(npad // 8 + 1, dtype=np.uint8)
+    for a, b in rows:
+        if b > a:
+            a8 = int(a) & ~7
+            packed = np.packbits(Tp[a8:int(b)] >= 0.0, bitorder="little")
+            bits[a8 >> 3:(a8 >> 3) + packed.size] |= packed
+    return bits
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def _top_speed(nth, speed):
+    """The largest speed (1.0 for none), on ``nth`` threads (one pass over 2048^2 speeds is
+    ~2 ms); it sets the first window's width."""
+    n = speed.size
+    if n == 0:
+        return 1.0
+    part = np.zeros(nth)
+    for t in prange(nth):
+        top = 0.0
+        for c in range(t * n // nth, (t + 1) * n // nth):
+            top = max(top, speed[c])
+        part[t] = top
+    return part.max()
+
+
+def _ghost_frozen_bits(bits, Tp, off, rows, sx, G):
+    """Order 2: set the bits (frozen on entry) of every slab's ``G`` ghost x-slabs on each
+    side from the neighbours' own boundary rows in ``Tp`` (nodes; slab ``k`` from
+    ``off[k]`` with ``rows[k]`` own rows of ``sx`` nodes): the serial march's first updates
+    read those nodes (:func:`_known`)."""
+    K = len(off)
+    m = G * sx
+    for k in range(K):
+        if k > 0:  # the last own rows of the slab below
+            o = int(off[k - 1] + rows[k - 1] * sx)
+            _or_bits_at(bits, np.packbits(Tp[o:o + m] >= 0.0, bitorder="little"), int(off[k]),
+                        m)
+        if k < K - 1:  # the first own rows of the slab above
+            o = int(off[k + 1] + G * sx)
+            _or_bits_at(bits, np.packbits(Tp[o:o + m] >= 0.0, bitorder="little"),
+                        int(off[k] + (rows[k] + G) * sx), m)
 
 
 def _start_boxes(start, bounds, nx, G=1):

@@ -105,10 +105,16 @@ def register_wind_march(is_calm: Any, march: Any) -> None:
     _WIND_MARCH[:] = [(is_calm, march)]
 
 
-def _as_speed(speed: Any) -> np.ndarray:
+def _as_speed(speed: Any, threads: int = 1) -> np.ndarray:
     arr = np.ascontiguousarray(grid(speed, "speed"))
-    # one compiled pass instead of three numpy passes (matters on 40 M-node maps)
-    bad, n_tiny = _kernels.scan_speed(_kernels._readonly(arr.reshape(-1)), MIN_SPEED)
+    # one compiled pass instead of three numpy passes (matters on 40 M-node maps), on the
+    # march's threads for a big grid
+    flat = _kernels._readonly(arr.reshape(-1))
+    nth = _kernels.setup_threads(threads, flat.size)
+    if nth > 1:
+        bad, n_tiny = _kernels.scan_speed_parallel(nth, flat, MIN_SPEED)
+    else:
+        bad, n_tiny = _kernels.scan_speed(flat, MIN_SPEED)
     if bad >= 0:
         where = [int(w) for w in np.unravel_index(bad, arr.shape)]
         value = float(arr[tuple(where)])
@@ -204,9 +210,9 @@ def fast_marching(
     >>> float(T[4, 0])
     4.0
     """
-    v = _as_speed(speed)
-    shape = v.shape
     nthreads = _parallel.resolve_threads(threads)
+    v = _as_speed(speed, nthreads)
+    shape = v.shape
     if wind is not None:
         is_calm, wind_march = _WIND_MARCH[0]
         if not is_calm(wind, shape):
@@ -288,7 +294,8 @@ def run_march(
     (resolved, ``>= 1``) as there: the parallel march on grids of at least
     :data:`~fm2uav.eikonal._parallel.PARALLEL_MIN_NODES` nodes when ``threads > 1`` (order 2
     while :data:`~fm2uav.eikonal._parallel.ORDER2` is set, the default; in 3D from
-    :data:`~fm2uav.eikonal._parallel.ORDER2_MIN_NODES_3D` nodes), else the serial one.
+    :data:`~fm2uav.eikonal._parallel.ORDER2_MIN_NODES_3D` nodes), else the serial one,
+    which sets up on them (:func:`~fm2uav.eikonal._kernels.march`).
 
     Returns
     -------
@@ -310,5 +317,5 @@ def run_march(
         T, _ = _parallel.march(flat_speed, start, shape3, h3, threads,
                                stops[~start.frozen_at(stops)], order=order)
     else:
-        T, _ = _kernels.march(flat_speed, start, shape3, h3, order, stops)
+        T, _ = _kernels.march(flat_speed, start, shape3, h3, order, stops, threads=threads)
     return T.reshape(shape)

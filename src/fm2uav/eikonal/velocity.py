@@ -16,13 +16,14 @@ import numpy as np
 from scipy import ndimage
 
 from ..errors import InputError
-from . import _kernels
+from . import _edt, _parallel
 from .fmm import as_spacing, fast_marching
 
 __all__ = [
     "distance_map",
     "velocity_map",
     "normalise_distance",
+    "normalised_distance",
     "distance_scale",
     "shape_velocity",
 ]
@@ -49,6 +50,7 @@ def distance_map(
     method: Method = "edt",
     walls: bool = False,
     order: int = 2,
+    threads: int | None = None,
 ) -> np.ndarray:
     """Distance from every node to the nearest obstacle node [m].
 
@@ -66,6 +68,10 @@ def distance_map(
         one spacing outside the map).
     order : {1, 2}
         FMM order for ``method="fmm"``.
+    threads : int, optional
+        Threads of the transform (``>= 1``; grids of at least 2 M nodes use more than
+        one); None: ``FM2UAV_THREADS`` if set, else every core. The values do not
+        depend on it.
 
     Returns
     -------
@@ -73,34 +79,71 @@ def distance_map(
         Distance [m]; 0 on obstacles; ``inf`` everywhere if there is no
         obstacle at all (and ``walls`` is False).
     """
+    return _distance(occupancy, spacing, method, walls, order, threads, False)[0]
+
+
+def _distance(occupancy: Any, spacing: float | Sequence[float], method: Method, walls: bool,
+              order: int, threads: int | None, normalise: bool
+              ) -> tuple[np.ndarray, float | None]:
+    """:func:`distance_map` and its largest value [m] (None: not known, ``method="fmm"``);
+    ``normalise``: the EDT's map divided by that value in place (see :func:`_edt.edt`)."""
     occ = _as_occupancy(occupancy)
     h = as_spacing(spacing, occ.ndim)
     if method not in ("edt", "fmm"):
         raise InputError(f"method must be 'edt' or 'fmm', got {method!r}")
+    nth = _parallel.resolve_threads(threads)
     if walls:
         occ = np.pad(occ, 1, mode="constant", constant_values=True)
     if not occ.any():
-        return np.full(occupancy.shape if not walls else occ.shape, np.inf)
+        return np.full(occupancy.shape if not walls else occ.shape, np.inf), np.inf
+    top = None
     if method == "edt":
         # Our separable exact EDT (numba, lines in parallel) instead of
         # scipy.ndimage.distance_transform_edt: identical values (tested), but
         # 12x faster on a 500x500x40 map (0.28 s vs 3.4 s) and without scipy's
         # (ndim, *shape) int feature array, which dominates memory on big maps.
+        # The square root, the maximum and (normalise) the division are in its last
+        # passes: no more passes over the grid, no temporaries.
         occ3 = np.ascontiguousarray(occ.reshape(occ.shape + (1,) * (3 - occ.ndim)))
         h3 = h + (1.0,) * (3 - occ.ndim)
-        dist = _kernels.squared_edt(occ3, *h3).reshape(occ.shape)
-        np.sqrt(dist, out=dist)
+        dist, top = _edt.edt(occ3, *h3, normalise=normalise, threads=nth)
+        dist = dist.reshape(occ.shape)
     else:
         # Only obstacle nodes with a free neighbour can be nearest; interior
         # obstacle nodes are impassable (speed 0) and stay at distance 0.
         interior = ndimage.binary_erosion(occ, border_value=1)
         boundary = occ & ~interior
         speed = (~interior).astype(np.float64)
-        dist = fast_marching(speed, np.argwhere(boundary), spacing=h, order=order)
+        dist = fast_marching(speed, np.argwhere(boundary), spacing=h, order=order,
+                             threads=nth)
         dist[interior] = 0.0
-    if walls:
+    if walls:  # the ring's distances are 0: the largest value is the interior's
         dist = dist[(slice(1, -1),) * occ.ndim]
-    return np.asarray(dist, dtype=np.float64)
+    return np.asarray(dist, dtype=np.float64), top
+
+
+def normalised_distance(occupancy: Any, *, spacing: float | Sequence[float] = 1.0,
+                        method: Method = "edt", walls: bool = False,
+                        threads: int | None = None) -> tuple[np.ndarray, float]:
+    """``d / max d`` and ``max d`` [m]: :func:`normalise_distance` of :func:`distance_map`
+    and its :func:`distance_scale`, the same values, in one map-sized array.
+
+    With the exact transform the maximum and the division come from the transform's
+    last passes, on ``threads`` (as :func:`distance_map`'s). Used by
+    :func:`velocity_map` and the planner's cached base map.
+
+    Returns
+    -------
+    W : ndarray of float64
+        The normalised distance map in [0, 1] (all ones without obstacles).
+    scale : float
+        The distance [m] it was divided by (``inf`` without obstacles).
+    """
+    dist, top = _distance(occupancy, spacing, method, walls, 2, threads, True)
+    if top is not None and 0.0 < top < np.inf:
+        return dist, top  # divided by the transform
+    scale = distance_scale(dist)  # before the division in place
+    return normalise_distance(dist, overwrite=True), scale
 
 
 def normalise_distance(dist: np.ndarray, *, overwrite: bool = False) -> np.ndarray:
@@ -181,13 +224,19 @@ def shape_velocity(
                 "saturation_distance needs max_distance, the distance [m] W was normalised by "
                 "(eikonal.distance_scale of the distance map)")
         if np.isfinite(max_distance) and max_distance > 0.0:
-            out = np.minimum(W * (max_distance / saturation_distance), 1.0)
+            out = np.multiply(W, max_distance / saturation_distance)
+            np.minimum(out, 1.0, out=out)
         else:  # no obstacle (W all 1) or no free space (W all 0): nothing to saturate
             out = W
+    elif saturation == 1.0:
+        out = W
     else:
-        out = W if saturation == 1.0 else np.minimum(W / saturation, 1.0)
+        out = np.divide(W, saturation)
+        np.minimum(out, 1.0, out=out)
+    # one new map at most, each step in place in it (the same values as the expressions
+    # written out; 320 MB per map on a 1000 x 1000 x 40 grid)
     if exponent != 1.0:
-        out = np.power(out, exponent)
+        out = np.power(out, exponent, out=None if out is W else out)
     elif out is W:
         out = W.copy()
     return out
@@ -202,6 +251,7 @@ def velocity_map(
     method: Method = "edt",
     walls: bool = False,
     saturation_distance: float | None = None,
+    threads: int | None = None,
 ) -> np.ndarray:
     """The FM² velocity map ``W`` in [0, 1] (0 on obstacles).
 
@@ -226,6 +276,8 @@ def velocity_map(
     saturation_distance : float, optional
         ``d_sat`` [m]: full speed from this distance to the obstacles on
         (overrides ``saturation``).
+    threads : int, optional
+        Threads of the distance transform, as :func:`distance_map`'s.
 
     Returns
     -------
@@ -239,8 +291,8 @@ def velocity_map(
     >>> velocity_map(occ)[:, 0].tolist()
     [0.0, 0.25, 0.5, 0.75, 1.0]
     """
-    dist = distance_map(occupancy, spacing=spacing, method=method, walls=walls)
-    top = distance_scale(dist) if saturation_distance is not None else None
-    return shape_velocity(normalise_distance(dist, overwrite=True), saturation=saturation,
-                          exponent=exponent,
+    W, scale = normalised_distance(occupancy, spacing=spacing, method=method, walls=walls,
+                                   threads=threads)
+    top = scale if saturation_distance is not None else None
+    return shape_velocity(W, saturation=saturation, exponent=exponent,
                           saturation_distance=saturation_distance, max_distance=top)

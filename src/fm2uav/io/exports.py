@@ -43,6 +43,7 @@ from .geojson import write_geojson
 from .kml import write_kml, write_kmz
 from .paths import write_path_csv
 from .qgc import write_plan
+from .formats import EXPORT_FILES, FORMAT_ALIASES, RETURN_FILES
 from .terrain_dat import terrain_files
 from .wpl import write_wpl
 
@@ -62,25 +63,6 @@ __all__ = [
     "TERRAIN_WITHOUT",
 ]
 
-#: Export format → file name.
-EXPORT_FILES = {
-    "csv": "path.csv",
-    "geojson": "path.geojson",
-    "kml": "path.kml",
-    "kmz": "path.kmz",
-    "plan": "mission.plan",
-    "wpl": "mission.waypoints",
-}
-#: Files written with the exports when the returns are computed (rally files only with
-#: rally points).
-RETURN_FILES = {
-    "param": "mission.param",
-    "returns": "returns.geojson",
-    "rally": "rally.waypoints",
-    "rally_txt": "rally.txt",
-}
-#: Other names of formats.
-FORMAT_ALIASES = {"waypoints": "wpl", "qgc": "plan"}
 _BINARY = frozenset({"kmz"})
 
 

@@ -70,7 +70,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, PrivateAttr, ValidationError
@@ -79,11 +79,13 @@ from pydantic import ValidationInfo, field_validator, model_validator
 from ..errors import InputError
 from ..world.load import WorldSpec as DataWorldSpec
 from ..world.load import check_points, load_world
-from ..autopilot.build import ExportOptions
 from ..autopilot.firmware import FIRMWARES, VEHICLES
-from .exports import EXPORT_FILES
+from .formats import EXPORT_FILES
 from ..world.geo import DEFAULT_ANCHOR, Anchor, from_lonlat, to_lonlat
 from .zone_spec import ZoneSpec, resolve_zones
+
+if TYPE_CHECKING:
+    from ..autopilot.build import ExportOptions
 
 __all__ = [
     "Mission",
@@ -602,6 +604,8 @@ class Mission(BaseModel):
 
     def export_options(self) -> ExportOptions:
         """The :class:`ExportOptions` of this mission."""
+        from ..autopilot.build import ExportOptions  # the autopilot layer: only to build
+
         o, a = self.outputs, self.airframe
         return ExportOptions(
             tolerance=o.thin_tolerance, max_points=o.max_waypoints, frame=o.frame,

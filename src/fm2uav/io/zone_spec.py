@@ -34,7 +34,6 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-import shapely
 from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
 from .. import _validate
@@ -190,6 +189,8 @@ def resolve_zones(no_fly: Any, operating_area: Any, world: Any, anchor: Any = No
             raise InputError(str(exc) if str(exc).startswith("operating_area") else
                              f"operating_area: {exc}") from None
         if len(zs) > 1:  # one area: the union of the file's polygons
+            import shapely  # resolving zones only: the schema loads without it
+
             zs = [replace(zs[0], geometry=shapely.union_all([z.geometry for z in zs]),
                           circle=None)]
         out.extend(z if z.name else replace(z, name="operating area") for z in zs)

@@ -351,6 +351,31 @@ def write_batch_file(out: str | os.PathLike[str], payload: dict[str, Any]) -> Pa
 
 
 # ----------------------------------------------------------------- on a worker
+#: Prefix of a worker's private folder: ``fm2uav-batch-<pid>-XXXX`` in the system's temporary
+#: folder (its process id, so that a folder left by a killed worker is known to be stale).
+WORK_PREFIX = "fm2uav-batch-"
+
+
+def _remove_stale_work(tmpdir: str | os.PathLike[str]) -> list[Path]:
+    """Remove the private folders of workers that no longer run (killed mid-mission: a
+    SIGKILL leaves its folder behind); return them. Folders of live processes stay."""
+    import shutil
+
+    removed = []
+    for d in Path(tmpdir).glob(f"{WORK_PREFIX}*-*"):
+        pid = d.name[len(WORK_PREFIX):].split("-", 1)[0]
+        if not pid.isdigit() or int(pid) == os.getpid():
+            continue
+        try:
+            os.kill(int(pid), 0)
+        except ProcessLookupError:  # gone: nobody writes there any more
+            shutil.rmtree(d, ignore_errors=True)
+            removed.append(d)
+        except OSError:  # alive, or not ours to ask about
+            continue
+    return removed
+
+
 def plan_mission_files(context: dict[str, Any], mission: BatchMission) -> dict[str, Any]:
     """Worker side: run one mission into a private folder, return its files as bytes.
 
@@ -382,7 +407,8 @@ def plan_mission_files(context: dict[str, Any], mission: BatchMission) -> dict[s
         warnings.simplefilter("always")
         try:
             m = load_mission(file)
-            with tempfile.TemporaryDirectory(prefix="fm2uav-batch-") as tmp:
+            _remove_stale_work(tempfile.gettempdir())
+            with tempfile.TemporaryDirectory(prefix=f"{WORK_PREFIX}{os.getpid()}-") as tmp:
                 od = OutputDir(Path(tmp) / "set")
                 try:
                     run = run_mission(m, od, mission_file=file, formats=list(mission.formats))

@@ -15,16 +15,13 @@ from typing import Any
 
 from .. import progress
 from ..errors import InputError
+from ..io.formats import EXPORT_FILES
 from .rows import returns_rows, safety_rows
 
 __all__ = ["OUTPUT_FILES", "EXPORT_FILES", "output_names", "write_exports", "plan_outputs",
            "flown", "to_jsonable", "write_json", "write_text", "write_figure", "export_options",
            "parse_anchor", "wind_options", "with_wind_on"]
 
-#: Export format → file name (:data:`fm2uav.io.exports.EXPORT_FILES`, repeated here so that
-#: importing this module loads no exporter; a test keeps both equal).
-EXPORT_FILES = {"csv": "path.csv", "geojson": "path.geojson", "kml": "path.kml",
-                "kmz": "path.kmz", "plan": "mission.plan", "wpl": "mission.waypoints"}
 #: Output format → file name, for every format a command can write.
 OUTPUT_FILES = {**EXPORT_FILES, "html": "report.html", "png": "plan.png", "json": "summary.json"}
 

@@ -677,3 +677,48 @@ def descend_kernel(T, start, goal, hx, hy, hz, step, max_steps):
             px, py, pz = float(i), float(j), float(k)
             out, n = _push(out, n, px, py, pz)
             n_fallback += 1
+
+
+# ------------------------------------------------------------- whole-field scans
+# One compiled pass each over a field the descent reads, in place of numpy expressions
+# that allocate map-sized temporaries (40 M nodes: a bool array per comparison, or a
+# copy of every obstacle node's time) before reducing them.
+
+
+@njit(cache=True, error_model="numpy")
+def first_invalid_time(T):
+    """Flat index of the first NaN or ``-inf`` of the flat field ``T`` (-1: none)."""
+    bad = False
+    for c in range(T.size):  # no early exit: the loop vectorises
+        x = T[c]
+        bad |= (x != x) | (x == -np.inf)
+    if not bad:
+        return -1
+    for c in range(T.size):
+        x = T[c]
+        if x != x or x == -np.inf:
+            return c
+    return -1
+
+
+@njit(cache=True, error_model="numpy")
+def any_finite_on(T, mask):
+    """Whether a node of the flat ``mask`` has a finite time in the flat ``T``."""
+    for c in range(T.size):
+        if mask[c] and abs(T[c]) < np.inf:
+            return True
+    return False
+
+
+@njit(cache=True, error_model="numpy")
+def drop_equal(T, node, t):
+    """``inf`` on every node of the flat ``T`` whose time is ``t``, except ``node``, if
+    there is another; returns how many nodes had that time."""
+    count = 0
+    for c in range(T.size):
+        count += T[c] == t
+    if count > 1:
+        for c in range(T.size):
+            if T[c] == t and c != node:
+                T[c] = np.inf
+    return count

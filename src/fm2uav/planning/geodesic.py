@@ -74,12 +74,13 @@ from typing import Any
 import numpy as np
 
 from .._validate import grid
+from ..eikonal._kernels import _readonly
 from ..eikonal.fmm import as_spacing
 from ..errors import InputError, PlanningError, PointError, UnreachableError
 from . import _geodesic_kernels as _k
 
-__all__ = ["descend", "descend_batch", "descend_stopped", "drop_ties", "nearest_node",
-           "default_max_steps"]
+__all__ = ["descend", "descend_batch", "descend_stopped", "drop_ties", "reaches_any",
+           "nearest_node", "default_max_steps"]
 
 
 def nearest_node(points: Any) -> np.ndarray:
@@ -115,9 +116,9 @@ def default_max_steps(shape: Sequence[int], spacing: Sequence[float], step: floa
 
 def _as_field(T: Any) -> np.ndarray:
     arr = grid(T, "T", holding=" of arrival times")
-    bad = np.isnan(arr) | (arr == -np.inf)
-    if bad.any():
-        where = np.argwhere(bad)[0].tolist()
+    bad = _k.first_invalid_time(_readonly(np.ascontiguousarray(arr).reshape(-1)))
+    if bad >= 0:
+        where = [int(w) for w in np.unravel_index(bad, arr.shape)]
         raise InputError(
             f"T must hold arrival times (finite, or +inf where unreached); "
             f"found {arr[tuple(where)]} at index {where}"
@@ -413,11 +414,25 @@ def drop_ties(T: np.ndarray, node: tuple[int, ...]) -> np.ndarray:
     """
     t = T[node]
     if np.isfinite(t):
-        ties = T == t
-        if np.count_nonzero(ties) > 1:
-            T[ties] = np.inf
-            T[node] = t
+        if T.flags.c_contiguous:  # one compiled pass, no map-sized mask
+            _k.drop_equal(T.reshape(-1), np.ravel_multi_index(node, T.shape),
+                                         float(t))
+        else:
+            ties = T == t
+            if np.count_nonzero(ties) > 1:
+                T[ties] = np.inf
+                T[node] = t
     return T
+
+
+def reaches_any(T: np.ndarray, mask: np.ndarray) -> bool:
+    """Whether a node where ``mask`` is True has a finite time in ``T`` (same shapes).
+
+    ``np.isfinite(T[mask]).any()`` without the copy of the masked times.
+    """
+    if T.flags.c_contiguous and mask.flags.c_contiguous and T.dtype == np.float64:
+        return bool(_k.any_finite_on(_readonly(T.reshape(-1)), _readonly(mask.reshape(-1))))
+    return bool(np.isfinite(T[mask]).any())
 
 
 def _sorted_nodes(values: np.ndarray, where: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

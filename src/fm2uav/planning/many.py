@@ -36,7 +36,7 @@ from ..eikonal.fmm import fast_marching
 from ..errors import Fm2uavError, InputError, PlanningError, PointError
 from ..world import World
 from ..world.zones import check_points_allowed
-from .geodesic import descend_stopped
+from .geodesic import descend_stopped, reaches_any
 from .params import FlightLevel, PlanOptions, Shaping
 from .planner import (MAX_PATH_STEPS, Plan, _check_free, _check_objects, _check_work,
                       finish_plans, plan_velocity, stuck_error, unreachable_error)
@@ -329,7 +329,7 @@ def plan_many(
             todo.append(k)
     progress.step(f"routes from {len(todo)} starts (descents, heights, figures)", 0.7)
     # as plan(): obstacles are masked only if W gave them a speed
-    blocked = world.occupancy if np.isfinite(T[world.occupancy]).any() else None
+    blocked = world.occupancy if reaches_any(T, world.occupancy) else None
     finish_plans(world, W, T, [np.asarray([world.to_index(goal_m)] * 2)], shaping, None,
                  options, (t_all, t0, t1, t2))  # fills the world's caches before the threads
     marks = (t_all, t0, t1, t2)

@@ -19,7 +19,7 @@ from scipy import ndimage
 from .. import _validate
 from .. import progress
 from ..eikonal.fmm import fast_marching
-from ..eikonal.velocity import distance_map, distance_scale, normalise_distance, shape_velocity
+from ..eikonal.velocity import normalised_distance, shape_velocity
 from ..errors import InputError, PlanningError, PointError, UnreachableError
 from ..geometry import path_length
 from ..world import World
@@ -27,7 +27,7 @@ from ..world.clearance import min_surface_clearances
 from ..world.zones import check_points_allowed, zone_violations
 from .altitude import AltitudeProfile, final_profile, height_figures
 from .flight_level import flight_level_speed
-from .geodesic import descend, drop_ties
+from .geodesic import descend, drop_ties, reaches_any
 from .params import FlightLevel, PlanOptions, Shaping, plan_params
 from .wind import PathTiming, WindOptions, descend_track, path_timing, wind_times
 from .regional import check_full_grid, plan_regional, use_regional
@@ -199,21 +199,23 @@ class Plan:
         return out
 
 
-def base_velocity(world: World, *, method: str = "edt", walls: bool = False) -> np.ndarray:
+def base_velocity(world: World, *, method: str = "edt", walls: bool = False,
+                  threads: int | None = None) -> np.ndarray:
     """Normalised velocity map of a world before shaping, cached on the world.
 
     ``d / max(d)`` with ``d`` the distance to the nearest obstacle; cached in
     ``world._cache`` because it depends only on the (immutable) occupancy, so
     sweeps over saturation/exponent pay the distance transform once. The
     normaliser ``max(d)`` [m] is cached next to it (:func:`max_distance`).
+    ``threads``: of the distance transform (:func:`fm2uav.eikonal.distance_map`; the
+    values do not depend on it).
     """
     key = ("base_velocity", method, bool(walls))
     cached = world._cache.get(key)
     if cached is None:
         check_full_grid(world)  # a clear error rather than running out of memory
-        dist = distance_map(world.occupancy, spacing=world.spacing, method=method, walls=walls)
-        scale = distance_scale(dist)
-        cached = normalise_distance(dist, overwrite=True)  # dist is ours: no second map
+        cached, scale = normalised_distance(world.occupancy, spacing=world.spacing,
+                                            method=method, walls=walls, threads=threads)
         cached.setflags(write=False)
         world._cache[key] = cached
         world._cache[("max_distance", method, bool(walls))] = scale
@@ -229,13 +231,15 @@ def max_distance(world: World, shaping: Shaping = Shaping()) -> float:
     return world._cache[key]
 
 
-def shaped_velocity(world: World, shaping: Shaping = Shaping()) -> np.ndarray:
+def shaped_velocity(world: World, shaping: Shaping = Shaping(),
+                    threads: int | None = None) -> np.ndarray:
     """The FM² velocity map W of a world shaped by ``shaping`` (0 on obstacles).
 
     The cached :func:`base_velocity` itself (read-only) when there is nothing
-    to shape, else a new array: ``min(d / d_sat, 1) ** exponent``.
+    to shape, else a new array: ``min(d / d_sat, 1) ** exponent``. ``threads``: of
+    the distance transform, as :func:`base_velocity`'s.
     """
-    W = base_velocity(world, method=shaping.method, walls=shaping.walls)
+    W = base_velocity(world, method=shaping.method, walls=shaping.walls, threads=threads)
     if not shaping.shapes:
         return W
     top = max_distance(world, shaping) if shaping.saturation_distance is not None else None
@@ -410,7 +414,7 @@ def plan_velocity(world: World, shaping: Shaping, level: FlightLevel | None,
     if options.speed_map is None:
         # 0 on obstacles already (distance 0); the cached base map is read-only
         # and used as is when there is nothing to shape
-        W = shaped_velocity(world, shaping)
+        W = shaped_velocity(world, shaping, threads=options.threads)
         if level is not None:
             W = flight_level_speed(W, world, level)
     else:
@@ -467,7 +471,7 @@ def trace_plan(world: World, W: np.ndarray, T: np.ndarray, start_m: np.ndarray,
     # descend() never enters nodes with T = inf; obstacles have W = 0, hence
     # T = inf, unless a custom speed map gave them a speed: only then pass the
     # mask (it costs a copy of T, ~1 s on a 40M-node map).
-    blocked = world.occupancy if np.isfinite(T[world.occupancy]).any() else None
+    blocked = world.occupancy if reaches_any(T, world.occupancy) else None
     progress.step("path (geodesic descent)", 0.6)
     try:
         if track is not None:

@@ -47,7 +47,7 @@ from typing import Any
 import numpy as np
 from scipy import ndimage
 
-from ..eikonal import _kernels
+from ..eikonal import _edt
 from ..eikonal.fmm import fast_marching
 from ..eikonal.velocity import distance_map, shape_velocity
 from ..errors import InputError, PlanningError
@@ -173,7 +173,7 @@ def world_max_distance(world: World) -> float:
     if key not in world._cache:
         top = column_surface(world)
         hx, hy, hz = world.spacing
-        d2 = _kernels.squared_column_edt_layer(np.ascontiguousarray(top), world.shape[2] - 1,
+        d2 = _edt.squared_column_edt_layer(np.ascontiguousarray(top), world.shape[2] - 1,
                                                hx, hy, hz)
         world._cache[key] = float(np.sqrt(d2.max()))
     return world._cache[key]

@@ -26,10 +26,11 @@ from collections.abc import Callable, Iterable
 
 import numpy as np
 
+from ..eikonal import _edt as _edt_kernels
 from ..eikonal import _kernels, _parallel, distance_map, fast_marching
 from ..world import World
 from ..world.clearance import surface_clearance
-from .geodesic import descend
+from .geodesic import descend, drop_ties, reaches_any
 
 __all__ = ["GROUPS", "FIRST_PLAN_MAIN", "FIRST_PLAN_CHILD", "warm"]
 
@@ -44,7 +45,7 @@ def _edt_parallel() -> None:
     """The distance transform of big grids (lines in parallel)."""
     occ = np.zeros((4, 4, 4), dtype=bool)
     occ[0, 0, 0] = True
-    _kernels._squared_edt_parallel(_kernels._readonly(occ), 1.0, 1.0, 1.0)
+    _edt_kernels._edt_parallel(_kernels._readonly(occ), 1.0, 1.0, 1.0, True, True, 1)
 
 
 def _fmm(ndim: int, order: int) -> Callable[[], None]:
@@ -61,44 +62,64 @@ def _fmm(ndim: int, order: int) -> Callable[[], None]:
 
 
 def _fmm_lean(order: int) -> Callable[[], None]:
-    """The 3D march in the lean layout of grids over ``LEAN_NODES`` nodes (float32 V)."""
+    """The 3D march in the lean layout of grids over ``LEAN_NODES`` nodes (float32 V), and
+    the set-up of big grids on two threads (the input scan, the padding)."""
     def run() -> None:
         T = np.full(125, np.inf)
         state = np.zeros(125, dtype=np.uint8)
         T[62], state[62] = 0.0, _kernels.FROZEN
-        _kernels.march(np.ones(125), _kernels.Start.whole(T, state, (5, 5, 5)), (5, 5, 5),
-                       (1.0, 1.0, 1.0), order, np.zeros((0, 3), dtype=np.int64), lean=True)
+        floor = _kernels.SETUP_PARALLEL_MIN_NODES
+        _kernels.SETUP_PARALLEL_MIN_NODES = 0
+        try:
+            for threads in (1, 2):
+                _kernels.march(np.ones(125), _kernels.Start.whole(T, state, (5, 5, 5)),
+                               (5, 5, 5), (1.0, 1.0, 1.0), order,
+                               np.zeros((0, 3), dtype=np.int64), lean=True, threads=threads)
+        finally:
+            _kernels.SETUP_PARALLEL_MIN_NODES = floor
+        _kernels.scan_speed_parallel(2, _kernels._readonly(np.ones(125)), 1e-150)
 
     return run
 
 
 def _fmm_parallel(ndim: int) -> Callable[[], None]:
     """The march on both cores (grids of ``PARALLEL_MIN_NODES`` nodes and more), order 1 and
-    2 (unless ``_parallel.ORDER2`` is off), in both layouts (float64 ``V``, and the lean
-    float32 ``V`` of grids over ``LEAN_NODES`` padded nodes, e.g. a 1000x1000x40 terrain
-    plan), its size floors lowered for a 16-node-wide grid while it compiles."""
+    2 (unless ``_parallel.ORDER2`` is off), in every layout (float64 ``V``: in 2D interleaved
+    with ``T`` unless the speed is uniform, whose separate arrays pad and unpad as other
+    specialisations; and the lean float32 ``V`` of grids over ``LEAN_NODES`` padded nodes,
+    e.g. a 1000x1000x40 terrain plan), its size floors lowered for a 16-node-wide grid
+    while it compiles; and the descent placing the slab cuts (a 16-node grid is too thin to
+    be cut)."""
     def run() -> None:
         speed = np.ones((16,) * ndim)
         speed[(0,) * ndim] = 0.5  # a plateau with its mask (a uniform grid needs none)
+        speeds = (speed, np.ones((16,) * ndim)) if ndim == 2 else (speed,)
         floor, lean = _parallel.PARALLEL_MIN_NODES, _kernels.LEAN_NODES
         floor2 = _parallel.ORDER2_MIN_NODES_3D
         _parallel.PARALLEL_MIN_NODES = _parallel.ORDER2_MIN_NODES_3D = 0
         try:
             for lean_nodes in (lean, 0):
                 _kernels.LEAN_NODES = lean_nodes
-                for order in (1, 2) if _parallel.ORDER2 else (1,):
-                    fast_marching(speed, [(3,) * ndim], order=order, threads=2)
+                for v in speeds:
+                    for order in (1, 2) if _parallel.ORDER2 else (1,):
+                        fast_marching(v, [(3,) * ndim], order=order, threads=2)
         finally:
             _parallel.PARALLEL_MIN_NODES, _kernels.LEAN_NODES = floor, lean
             _parallel.ORDER2_MIN_NODES_3D = floor2
+        cum = np.cumsum(np.ones((5, 3), dtype=np.int64), axis=0)
+        for shared in (False, True):
+            _parallel._descend_cuts(cum, np.array([0, 2, 4], dtype=np.int64), 1, 2, shared)
 
     return run
 
 
 def _descent() -> None:
+    """The descent and the plan's scans of its field (ties at the start, obstacles reached)."""
     g = np.array([4.0, 4.0, 4.0])
     axes = np.meshgrid(*[np.arange(5.0)] * 3, indexing="ij")
     T = np.sqrt(sum((a - c) ** 2 for a, c in zip(axes, g)))
+    drop_ties(T, (0, 0, 0))
+    reaches_any(T, np.zeros(T.shape, dtype=bool))
     descend(T, (0.0, 0.0, 0.0), tuple(g), spacing=(1.0, 1.0, 1.0))
 
 

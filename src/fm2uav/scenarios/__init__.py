@@ -17,9 +17,8 @@ from typing import Any
 
 import numpy as np
 
+from .._lazy import lazy_function
 from ..errors import WorldError
-from .city import city, city_high
-from .coverage import coverage
 from .open_field import OPEN_FIELD_CELL, OPEN_FIELD_HEIGHT_CELLS, fissure, open_field
 from .scenario import Scenario
 
@@ -33,30 +32,18 @@ __all__ = [
     "OPEN_FIELD_HEIGHT_CELLS",
 ]
 
-
-def _city2d(seed: int | np.random.Generator = 0) -> Scenario:
-    """2D city map of the curvature study (see :mod:`fm2uav.scenarios.city2d`)."""
-    from .city2d import city2d
-
-    return city2d(seed)
-
-
-def _jacksboro(seed: int | np.random.Generator = 0) -> Scenario:
-    """Real DEM of the Jacksboro fault (see :mod:`fm2uav.scenarios.jacksboro`)."""
-    from .jacksboro import jacksboro
-
-    return jacksboro(seed)
-
-
-#: Scenario name → factory ``f(seed=0) -> Scenario``.
+#: Scenario name → factory ``f(seed=0) -> Scenario``. The factories of the worlds that need
+#: the geodata libraries or the coverage kernels (buildings, survey areas, a real DEM) import
+#: their module on their first call, so the names are known (a mission file's
+#: ``world.scenario`` checked) without loading them.
 SCENARIOS: dict[str, Callable[..., Scenario]] = {
     "open-field": open_field,
     "fissure": fissure,
-    "jacksboro": _jacksboro,
-    "city": city,
-    "city-high": city_high,
-    "coverage": coverage,
-    "city2d": _city2d,
+    "jacksboro": lazy_function(__name__, ".jacksboro", "jacksboro"),
+    "city": lazy_function(__name__, ".city", "city"),
+    "city-high": lazy_function(__name__, ".city", "city_high"),
+    "coverage": lazy_function(__name__, ".coverage", "coverage"),
+    "city2d": lazy_function(__name__, ".city2d", "city2d"),
 }
 
 

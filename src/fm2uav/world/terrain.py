@@ -19,7 +19,6 @@ and Gaussian-filtered noise) and deterministic for a given seed.
 from __future__ import annotations
 
 import numpy as np
-from scipy.ndimage import gaussian_filter
 
 __all__ = ["open_field_heights", "OPEN_FIELD_SHAPE", "FISSURE_Y"]
 
@@ -83,6 +82,8 @@ def open_field_heights(
 
     # fissure: a trough along y = FISSURE_Y between the lateral ridges
     trough = 2.0 * _box(x, 28.0, 116.0, 6.0) * np.exp(-0.5 * ((y - FISSURE_Y) / 4.0) ** 2)
+
+    from scipy.ndimage import gaussian_filter  # the scenarios' names load without scipy
 
     rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
     noise = gaussian_filter(

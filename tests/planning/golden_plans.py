@@ -1,0 +1,123 @@
+"""Small plans whose every output is pinned bit for bit (``data/golden_plans.json``).
+
+The digests were written by the code before the velocity map, the march's set-up and
+the descent's checks were made parallel (commit dbf51f4, issue 27): the faster stages
+must give the same bytes. ``CASES`` maps a name to ``(world, start, goal, keyword
+arguments of plan)``; :func:`digest` is what is compared.
+
+Regenerate only when a change of the numbers is intended (e.g. a new march scheme),
+and say so in the commit::
+
+    PYTHONPATH=src python -m tests.planning.golden_plans --write
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+import fm2uav
+from fm2uav import FlightLevel, PlanOptions, Shaping, World
+
+DATA = Path(__file__).resolve().parent / "data" / "golden_plans.json"
+
+
+def _bytes_digest(a: np.ndarray) -> str:
+    a = np.ascontiguousarray(a)
+    return hashlib.sha256(f"{a.dtype.str}{a.shape}".encode() + a.tobytes()).hexdigest()
+
+
+def _obstacles_2d() -> World:
+    rng = np.random.default_rng(7)
+    occ = np.zeros((90, 70), bool)
+    for _ in range(14):  # boxes of random size
+        x, y = rng.integers(0, 80), rng.integers(0, 60)
+        occ[x:x + rng.integers(2, 12), y:y + rng.integers(2, 12)] = True
+    occ[:6, :6] = occ[-6:, -6:] = False
+    return World(occ, spacing=1.0)
+
+
+def _obstacles_3d() -> World:
+    rng = np.random.default_rng(11)
+    occ = np.zeros((48, 40, 18), bool)
+    occ[:, :, 0] = True  # the ground
+    for _ in range(12):  # buildings
+        x, y = rng.integers(4, 40), rng.integers(4, 32)
+        occ[x:x + rng.integers(2, 7), y:y + rng.integers(2, 7), :rng.integers(3, 15)] = True
+    occ[:4, :4, 1:] = occ[-4:, -4:, 1:] = False
+    return World(occ, spacing=(10.0, 10.0, 5.0))
+
+
+def _terrain(nx: int = 56, ny: int = 44, nz: int = 20, cell: float = 15.0) -> World:
+    rng = np.random.default_rng(3)
+    from scipy import ndimage
+
+    relief = ndimage.gaussian_filter(rng.standard_normal((nx, ny)), 4, mode="wrap")
+    heights = (relief - relief.min()) / np.ptp(relief) * 12 * cell + cell
+    return World.from_heightmap(heights, cell, nz)
+
+
+def cases() -> dict:
+    """Name -> ``(world, start [m], goal [m], plan keyword arguments)``."""
+    w2, w3, wt = _obstacles_2d(), _obstacles_3d(), _terrain()
+    s2, g2 = (2.0, 2.0), (87.0, 67.0)
+    s3, g3 = (15.0, 15.0, 30.0), (460.0, 380.0, 30.0)
+    st, gt = (3 * 15.0, 3 * 15.0, 17 * 15.0), (52 * 15.0, 40 * 15.0, 17 * 15.0)
+    return {
+        "2d_obstacles": (w2, s2, g2, {}),
+        "2d_obstacles_order1": (w2, s2, g2, {"options": PlanOptions(order=1)}),
+        "2d_obstacles_shaped": (w2, s2, g2, {"shaping": Shaping(saturation=0.4, exponent=2.0)}),
+        "2d_obstacles_dsat": (w2, s2, g2, {"shaping": Shaping(saturation_distance=6.0,
+                                                               exponent=0.5)}),
+        "2d_obstacles_walls": (w2, s2, g2, {"shaping": Shaping(walls=True, exponent=1.5)}),
+        "2d_obstacles_fmm": (w2, s2, g2, {"shaping": Shaping(method="fmm")}),
+        "2d_obstacles_fmm_dsat": (w2, s2, g2, {"shaping": Shaping(method="fmm", walls=True,
+                                                                   saturation_distance=5.0)}),
+        "3d_obstacles": (w3, s3, g3, {}),
+        "3d_obstacles_shaped": (w3, s3, g3, {"shaping": Shaping(saturation=0.6,
+                                                                 exponent=1.7)}),
+        "3d_terrain": (wt, st, gt, {}),
+        "3d_terrain_order1": (wt, st, gt, {"options": PlanOptions(order=1)}),
+        "3d_terrain_level": (wt, st, gt, {"level": FlightLevel(agl=60.0)}),
+    }
+
+
+def digest(p: fm2uav.Plan) -> dict:
+    """Every output of a plan: digests of W, T, the path and w; the summary's numbers."""
+    summary = p.summary()
+    summary.pop("timings_s")
+    return {
+        "W": _bytes_digest(np.asarray(p.W, dtype=np.float64)),
+        "T": _bytes_digest(np.asarray(p.T, dtype=np.float64)),
+        "path": _bytes_digest(p.path),
+        "w": _bytes_digest(p.w),
+        "length": repr(float(p.length)),
+        "clearance": repr(float(p.clearance)),
+        "speed_share": _bytes_digest(p.speed_share()),
+        "summary": json.loads(json.dumps(summary, default=repr)),
+    }
+
+
+def run(name: str, **extra) -> dict:
+    """The digest of case ``name`` planned now (``extra`` updates its plan keywords)."""
+    world, s, g, kw = cases()[name]
+    world._cache.clear()
+    return digest(fm2uav.plan(world, s, g, **{**kw, **extra}))
+
+
+def main(argv: list[str]) -> int:
+    out = {name: run(name) for name in cases()}
+    if "--write" in argv:
+        DATA.write_text(json.dumps(out, indent=1, sort_keys=True) + "\n")
+        print(f"wrote {DATA}")
+    else:
+        print(json.dumps(out, indent=1, sort_keys=True))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
