@@ -34,10 +34,6 @@ __all__ = [
     "OPEN_FIELD_HEIGHT_CELLS",
 ]
 
-#: Scenario name → factory ``f(seed=0) -> Scenario``. The factories of the worlds that need
-#: the geodata libraries or the coverage kernels (buildings, survey areas, a real DEM) import
-#: their module on their first call, so the names are known (a mission file's
-#: ``world.scenario`` checked) without loading them.
 __getattr__, __dir__ = lazy_names(__name__, {
     "Scenario": ".scenario",
     "open_field": ".field",
@@ -46,6 +42,9 @@ __getattr__, __dir__ = lazy_names(__name__, {
     "OPEN_FIELD_HEIGHT_CELLS": ".field",
 })
 
+#: Scenario name → factory ``f(seed=0) -> Scenario``. Every factory imports its module on
+#: its first call, so the names are known (a mission file's ``world.scenario`` checked)
+#: without loading numpy, the geodata libraries or the coverage kernels.
 SCENARIOS: dict[str, Callable[..., Scenario]] = {
     "open-field": lazy_function(__name__, ".field", "open_field"),
     "fissure": lazy_function(__name__, ".field", "fissure"),
