@@ -46,8 +46,7 @@ Layout of the march (see docs/performance.md for the measurements behind it)
   lie far apart in memory and the lines an expansion reads are cold. The 3D marches pop
   with :func:`_pop_ahead`: the next pop, the smallest other entry of a scanned bucket,
   gets its lines prefetched (:func:`_fetch_around`) while the popped node is expanded, and
-  a split prefetches its blocks' nodes before checking them; order 2 also prefetches the
-  speeds two planes away. Measured -7 to -12 % on the 1000 x 1000 x 40 terrain march and
+  a split prefetches its blocks' nodes before checking them. Measured -7 to -12 % on the 1000 x 1000 x 40 terrain march and
   on 160^3 FM²-shaped, -13 to -21 % on 160^3 smooth (docs/performance.md); on 2D grids it
   cost +4 %, so 2D pops plainly. The queue pops the same nodes: times bit for bit.
   Prefetching around *every* other entry of the bucket (as first built) re-issued the
@@ -569,15 +568,16 @@ def _solve_iso(a, b, c, q):
 
 
 @njit(**_OPT)
-def _relax(T, V, c, t, last, pool, nxt, bk, mw, nfree, fh, cur, pf1, pf2, n, pv=True,
-           pv2=False):
+def _relax(T, V, c, t, last, pool, nxt, bk, mw, nfree, fh, cur, pf1, pf2, n, pv=True):
     """Lower the band/far node ``c`` to ``t`` if that is smaller; queue it.
 
     A lowered band node gets a new entry; its old one (a larger key) stays in
-    the queue and is skipped when popped (the node is frozen by then). ``pv``:
-    prefetch the speeds ``V`` of the nodes ahead too (not on a plateau, whose
-    speeds are not read); ``pv2``: also those two rows (planes) away, which the
-    order-2 stencil's speed check reads.
+    the queue and is skipped when popped (the node is frozen by then). A new band
+    node of a 2D march (``pf2 == 0``) gets the lines its expansion will read
+    prefetched, ``V`` too if ``pv`` (not on a plateau, whose speeds are not read); a
+    3D march (``pf2`` its y stride) prefetches none: its band is wide, the lines
+    were evicted before the node froze (measured 0.98x without them on 160^3
+    FM²-shaped order 1).
     """
     x = T[c]
     if t < -x:
@@ -585,7 +585,7 @@ def _relax(T, V, c, t, last, pool, nxt, bk, mw, nfree, fh, cur, pf1, pf2, n, pv=
         k = _bits(t)
         if x == -_INF and pf2 == _ZERO:
             # a new band node: when it is frozen, the march reads the nodes up to
-            # two rows (planes) away across x (and y); fetch those lines now.
+            # two rows away across x; fetch those lines now.
             # Measured: -10 % (one row), -12 % more (two rows) on 2048^2.
             _prefetch(T, c - pf1)
             _prefetch(T, c + pf1)
@@ -594,20 +594,6 @@ def _relax(T, V, c, t, last, pool, nxt, bk, mw, nfree, fh, cur, pf1, pf2, n, pv=
                 _prefetch(V, c + pf1)
             _prefetch(T, c - pf1 - pf1 if c >= pf1 + pf1 else c)
             _prefetch(T, c + pf1 + pf1 if c + pf1 + pf1 < n else c)
-            if pf2 != _ZERO:
-                _prefetch(T, c - pf2)
-                _prefetch(T, c + pf2)
-                if pv:
-                    _prefetch(V, c - pf2)
-                    _prefetch(V, c + pf2)
-                _prefetch(T, c - pf2 - pf2)
-                _prefetch(T, c + pf2 + pf2)
-            if pv2:
-                _prefetch(V, c - pf1 - pf1 if c >= pf1 + pf1 else c)
-                _prefetch(V, c + pf1 + pf1 if c + pf1 + pf1 < n else c)
-                if pf2 != _ZERO:
-                    _prefetch(V, c - pf2 - pf2)
-                    _prefetch(V, c + pf2 + pf2)
         nfree, fh, cur = _push(_bucket(k, last), k, c, pool, nxt, bk, mw, nfree, fh, cur)
     return nfree, fh, cur
 
@@ -831,8 +817,6 @@ def _march3d_kernel(order):
                     if n_stop == _ZERO:
                         phase = 3
                         break
-            pv = sep and not (use_u and _at_plateau(U, c))
-            pv2 = pv and order == 2  # the order-2 speed check reads V two planes away
             tcur = T[c]
             for k in range(6):
                 s = sx if k < 2 else (sy if k < 4 else one)
@@ -861,7 +845,7 @@ def _march3d_kernel(order):
                         tc, ac = _axis_term_u(T, V, U, use_u, nb, one, ihz2, order)
                         t = _combine(ta, aa, tb, ab, tc, ac, q)
                     nfree, fh, cur = _relax(T, V, nb, t, last, pool, nxt, bk, mw, nfree, fh, cur,
-                                            sx, sy, n, pv, pv2)
+                                            sx, sy, n)
         st[_PHASE] = phase
         st[_SCAN] = scan
         st[_NFREE] = nfree
