@@ -10,8 +10,8 @@ the machine, whatever the load). Cases:
 * ``fm2uav plan --bogus``: a bad flag, refused by the parser;
 * ``fm2uav run missing.yaml``: a one-line input error found by the command itself;
 * ``fm2uav run bad.yaml``: a mission file with one field out of range, refused by its
-  schema (pydantic, yaml and numpy load; the world's builders, the kernels and the geodata
-  libraries do not);
+  schema (pydantic and yaml load; numpy, the world's builders, the kernels and the
+  geodata libraries do not);
 * ``fm2uav plan --threads 0`` and ``fm2uav plan --start 1,2``: a bad value of a planner flag
   and of a point, found by the command before the library loads.
 

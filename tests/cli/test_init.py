@@ -228,8 +228,8 @@ def test_value_errors_are_answered_before_the_heavy_libraries_load(tmp_path):
 
 
 #: Mission files with one bad line, each refused by the schema (exit 2, one line naming the
-#: key) before the world's builders, the kernels or any geodata library load: the schema
-#: needs pydantic, yaml and numpy only. (file text, words the message must hold.)
+#: key) before numpy, the world, its builders, the kernels or any geodata library load: the
+#: schema needs pydantic and yaml only. (file text, words the message must hold.)
 W = "world: {scenario: open-field}\n"
 MISSION_ERRORS = [
     ("world: {bogus: 1}\n", ["world.bogus", "allowed fields"]),
@@ -240,10 +240,11 @@ MISSION_ERRORS = [
     (W + "planner: {order: true}\n", ["planner.order"]),
 ]
 
-MISSION_HEAVY = ("numba", "llvmlite", "scipy", "matplotlib", "plotly", "rasterio", "shapely",
+MISSION_HEAVY = ("numpy", "numba", "llvmlite", "scipy", "matplotlib", "plotly", "rasterio", "shapely",
                  "pyproj", "pyogrio", "dask", "PIL", "fm2uav.eikonal", "fm2uav.planning.planner",
                  "fm2uav.world.clearance", "fm2uav.world.dem", "fm2uav.world.buildings",
                  "fm2uav.autopilot.build", "fm2uav.io.exports",
+                 "fm2uav.world.world", "fm2uav.world.geo", "fm2uav.scenarios.field",
                  "fm2uav.scenarios.city", "fm2uav.scenarios.coverage",
                  "fm2uav.viz", "fm2uav.experiments", "fm2uav.missions.coverage")
 

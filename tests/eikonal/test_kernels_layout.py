@@ -1,9 +1,10 @@
-"""The 2D march's layouts and shortcuts (issue 27, deliverable 2) give the same times, bit
+"""The march's layouts and shortcuts (issue 27, deliverable 2) give the same times, bit
 for bit, as the march before them.
 
 * **Interleaved layout** (``_kernels._buffers``): a 2D map without a plateau marches with
   ``T`` and ``1 / speed^2`` interleaved in one array (``unit = 2``), a uniform one in two
-  separate arrays; ``march(..., interleave=...)`` forces either.
+  separate arrays; a 3D map too, unless it has a plateau mask (then separate arrays);
+  ``march(..., interleave=...)`` forces either.
 * **Far neighbours while popping**: a far node next to the node just frozen has no other
   frozen neighbour, so the kernel takes the one-axis solution along that node's axis
   instead of the full update; the full update gives the same number.
@@ -68,8 +69,8 @@ def layouts(monkeypatch):
     used = []
     original = _kernels._buffers
 
-    def spy(*args):
-        out = original(*args)
+    def spy(*args, **kw):
+        out = original(*args, **kw)
         used.append("interleaved" if out[4] == 2 else "separate")
         return out
 
@@ -77,13 +78,18 @@ def layouts(monkeypatch):
     return used
 
 
-def test_a_2d_map_without_plateau_marches_interleaved_a_uniform_one_separate(layouts):
+def test_a_map_without_plateau_marches_interleaved_a_uniform_one_separate(layouts):
     v = fm2_field((40, 36), 3)
     fast_marching(v, [free_near(v, (0.5, 0.5))], order=1)
     u = np.ones((40, 36))
     fast_marching(u, [(20, 18)], order=1)
-    fast_marching(fm2_field((12, 10, 9), 3), [(6, 5, 4)], order=1)
-    assert layouts == ["interleaved", "separate", "separate"]
+    w = fm2_field((12, 10, 9), 3)
+    fast_marching(w, [free_near(w, (0.5, 0.5, 0.5))], order=1)
+    fast_marching(np.ones((12, 10, 9)), [(6, 5, 4)], order=1)
+    # a 3D map saturated on most nodes keeps its plateau mask (separate arrays)
+    sat = np.minimum(1.0, 3.0 * w)
+    fast_marching(sat, [free_near(sat, (0.5, 0.5, 0.5))], order=1)
+    assert layouts == ["interleaved", "separate", "interleaved", "separate", "separate"]
 
 
 def _start_of(v, src, order, spacing=1.0):
@@ -113,20 +119,28 @@ def _march(v, start, shape3, h3, order, stops=None, **kw):
 
 
 @pytest.mark.parametrize("order", [1, 2])
-@pytest.mark.parametrize("spacing", [1.0, (0.7, 1.1)])
+@pytest.mark.parametrize("spacing", [1.0, "anisotropic"])
 @pytest.mark.parametrize("field", ["fm2", "plateau", "uniform"])
-def test_interleaved_and_separate_layouts_give_the_same_times(field, spacing, order):
-    v = fm2_field((61, 47), 5)
+@pytest.mark.parametrize("shape", [(61, 47), (23, 19, 17)])
+def test_interleaved_and_separate_layouts_give_the_same_times(shape, field, spacing, order):
+    v = fm2_field(shape, 5)
     if field == "plateau":  # a saturated W: the separate layout reads it from the mask
-        v = np.minimum(1.0, 3.0 * v)
+        # (3D: the walls' first layer slower, every other node at the plateau's speed;
+        # 3 v saturates every free node of this small grid, the walls cover a fifth)
+        slow = v[v > 0].min()
+        v = np.minimum(1.0, 3.0 * v) if v.ndim == 2 else np.where(v == slow, slow, 1.0)
     elif field == "uniform":  # the separate layout reads no speed at all
         v = np.where(v > 0, 1.3, 0.0)
-    src = [free_near(v, (0.3, 0.6))]
+    if spacing == "anisotropic":
+        spacing = (0.7, 1.1, 0.9)[: len(shape)]
+    src = [free_near(v, (0.3, 0.6, 0.45)[: len(shape)])]
     start, shape3, h3 = _start_of(v, src, order, spacing)
-    U, qp = _kernels._plateau(v.reshape(-1), np.empty(0), shape3, 63 * 49)
+    npad = int(np.prod([n + 2 for n in shape]))
+    U, qp = _kernels._plateau(v.reshape(-1), np.empty(0), shape3, npad)
     assert (qp > 0, U.size > 1) == {"fm2": (False, False), "plateau": (True, True),
                                     "uniform": (True, False)}[field]
-    stops = np.array([[*free_near(v, (0.9, 0.2)), 0]], dtype=np.int64)
+    far = free_near(v, (0.9, 0.2, 0.8)[: len(shape)])
+    stops = np.array([[*far, 0][:3]], dtype=np.int64)
     for stop in (None, stops):
         a, fa = _march(v, start, shape3, h3, order, stop, interleave=True)
         b, fb = _march(v, start, shape3, h3, order, stop, interleave=False)
@@ -191,10 +205,14 @@ def test_far_neighbour_update_is_the_full_update_with_one_frozen_neighbour(seed)
         hh = 1.0 / ih2
         assert _kernels._solve_iso(tc, INF, INF, q * hh) == tc + math.sqrt(q * hh)
         assert _kernels._solve_iso(INF, tc, INF, q * hh) == tc + math.sqrt(q * hh)
+        assert _kernels._solve_iso(INF, INF, tc, q * hh) == tc + math.sqrt(q * hh)
         short = tc + math.sqrt(q / ih2)
         assert _kernels._combine(tc, ih2, INF, 0.0, INF, 0.0, q) == short
         assert _kernels._combine(INF, 0.0, tc, ih2, INF, 0.0, q) == short
+        assert _kernels._combine(INF, 0.0, INF, 0.0, tc, ih2, q) == short
         # order 2: the axis term along the frozen node's axis, weight 9/4 ih2
         tau = float(rng.uniform(0.0, 100.0))
         assert (_kernels._combine(INF, 0.0, tau, 2.25 * ih2, INF, 0.0, q)
+                == tau + math.sqrt(q / (2.25 * ih2)))
+        assert (_kernels._combine(INF, 0.0, INF, 0.0, tau, 2.25 * ih2, q)
                 == tau + math.sqrt(q / (2.25 * ih2)))

@@ -44,22 +44,31 @@ Layout of the march (see docs/performance.md for the measurements behind it)
 * **Fetching ahead (3D)**: where the speed varies strongly (W rising from ~0 at the
   ground of a terrain map) the front is sheared and its band wide, so consecutive pops
   lie far apart in memory and the lines an expansion reads are cold. The 3D marches pop
-  with :func:`_pop_ahead`: the other entries of a scanned bucket (the next pops) get
-  their lines prefetched (:func:`_fetch_around`) while the popped node is expanded, and
-  a split prefetches its blocks' nodes before checking them; order 2 also prefetches the
-  speeds two planes away. Measured -7 to -12 % on the 1000 x 1000 x 40 terrain march and
+  with :func:`_pop_ahead`: the next pop, the smallest other entry of a scanned bucket,
+  gets its lines prefetched (:func:`_fetch_around`) while the popped node is expanded, and
+  a split prefetches its blocks' nodes before checking them. Measured -7 to -12 % on the 1000 x 1000 x 40 terrain march and
   on 160^3 FM²-shaped, -13 to -21 % on 160^3 smooth (docs/performance.md); on 2D grids it
   cost +4 %, so 2D pops plainly. The queue pops the same nodes: times bit for bit.
+  Prefetching around *every* other entry of the bucket (as first built) re-issued the
+  same ~16 lines per entry at every pop of a bucket; the next pop only, and no prefetch
+  of a new 3D band node's lines in :func:`_relax` (frozen much later, evicted by then),
+  measured together 0.92x the march time on 160^3 FM²-shaped order 1 (see "3D march,
+  round two" in docs/performance.md).
 * **Interleaved 2D layout**: a 2D map (outside the lean layout) whose passable nodes do
   not all have one speed marches with ``T`` and ``V`` in one array, node ``c``'s time at
   ``2 c`` and its ``1 / speed^2`` at ``2 c + 1`` (the kernel's node indices are element
   indices, ``unit = 2``), so an update reads a neighbour's time and speed from one cache
   line: measured -8 % on 2048^2 FM²-shaped order 1, -17 % on the smooth field, and faster
   than the plateau mask on FM² maps saturated on 57-70 % of the nodes (:func:`_buffers`).
-* **Far neighbours while popping** (2D): a far neighbour of the node just frozen has no
-  other frozen neighbour (every frozen node has queued its neighbours), so its time is the
-  one-axis solution along that axis, which the full update would compute from the same
-  numbers (half of the updates; times bit for bit).
+* **Interleaved 3D layout**: a 3D map without a plateau mask marches interleaved too
+  (``unit = 2``); one with a plateau keeps the mask in separate arrays (measured -22 % on
+  160^3 constant speed). Measured -1.3 to -1.7 % on 160^3 FM²-shaped and smooth: the 3D
+  march's cold lines are mostly ``T`` lines of other planes, which the layout does not
+  bring closer.
+* **Far neighbours while popping** (2D and 3D): a far neighbour of the node just frozen
+  has no other frozen neighbour (every frozen node has queued its neighbours), so its time
+  is the one-axis solution along that axis, which the full update would compute from the
+  same numbers (half of the updates in 2D, a third in 3D; times bit for bit).
 * **The start box**: band and frozen nodes on entry lie in the start box, so the seeding
   and the expansion of the frozen nodes scan its span only, not the grid (a 2048^2
   march that freezes almost nothing: 29 ms before, 19 ms with the interleaved layout).
@@ -317,12 +326,17 @@ def _pop_ahead(T, V, pool, nxt, bk, mw, nfree, fh, cur, last, s1, s2, pv):
                     break
                 cnt = _BS
             c = pool[bp + bp + _ONE]
-            if s1 != _ZERO and cur != _ZERO:  # one block: the next pops
+            if s1 != _ZERO and cur != _ZERO:  # one block: the next pop
                 base = hb * _BS
+                m2 = _KEYMAX
+                p2 = bp
                 for p in range(base, base + _U(bk[_NB + cur])):
-                    e = pool[p + p + _ONE]
-                    if p != bp:
-                        _fetch_around(T, V, e, s1, s2, pv)
+                    kk = pool[p + p]
+                    if kk < m2 and p != bp:
+                        m2 = kk
+                        p2 = p
+                if p2 != bp:
+                    _fetch_around(T, V, pool[p2 + p2 + _ONE], s1, s2, pv)
             nfree, fh = _remove(bp, cur, pool, nxt, bk, mw, nfree, fh)
             return c, nfree, fh, cur, last
         # split one digit level down, relative to the bucket's lower bound: every
@@ -554,23 +568,24 @@ def _solve_iso(a, b, c, q):
 
 
 @njit(**_OPT)
-def _relax(T, V, c, t, last, pool, nxt, bk, mw, nfree, fh, cur, pf1, pf2, n, pv=True,
-           pv2=False):
+def _relax(T, V, c, t, last, pool, nxt, bk, mw, nfree, fh, cur, pf1, pf2, n, pv=True):
     """Lower the band/far node ``c`` to ``t`` if that is smaller; queue it.
 
     A lowered band node gets a new entry; its old one (a larger key) stays in
-    the queue and is skipped when popped (the node is frozen by then). ``pv``:
-    prefetch the speeds ``V`` of the nodes ahead too (not on a plateau, whose
-    speeds are not read); ``pv2``: also those two rows (planes) away, which the
-    order-2 stencil's speed check reads.
+    the queue and is skipped when popped (the node is frozen by then). A new band
+    node of a 2D march (``pf2 == 0``) gets the lines its expansion will read
+    prefetched, ``V`` too if ``pv`` (not on a plateau, whose speeds are not read); a
+    3D march (``pf2`` its y stride) prefetches none: its band is wide, the lines
+    were evicted before the node froze (measured 0.98x without them on 160^3
+    FM²-shaped order 1).
     """
     x = T[c]
     if t < -x:
         T[c] = -t
         k = _bits(t)
-        if x == -_INF:
+        if x == -_INF and pf2 == _ZERO:
             # a new band node: when it is frozen, the march reads the nodes up to
-            # two rows (planes) away across x (and y); fetch those lines now.
+            # two rows away across x; fetch those lines now.
             # Measured: -10 % (one row), -12 % more (two rows) on 2048^2.
             _prefetch(T, c - pf1)
             _prefetch(T, c + pf1)
@@ -579,20 +594,6 @@ def _relax(T, V, c, t, last, pool, nxt, bk, mw, nfree, fh, cur, pf1, pf2, n, pv=
                 _prefetch(V, c + pf1)
             _prefetch(T, c - pf1 - pf1 if c >= pf1 + pf1 else c)
             _prefetch(T, c + pf1 + pf1 if c + pf1 + pf1 < n else c)
-            if pf2 != _ZERO:
-                _prefetch(T, c - pf2)
-                _prefetch(T, c + pf2)
-                if pv:
-                    _prefetch(V, c - pf2)
-                    _prefetch(V, c + pf2)
-                _prefetch(T, c - pf2 - pf2)
-                _prefetch(T, c + pf2 + pf2)
-            if pv2:
-                _prefetch(V, c - pf1 - pf1 if c >= pf1 + pf1 else c)
-                _prefetch(V, c + pf1 + pf1 if c + pf1 + pf1 < n else c)
-                if pf2 != _ZERO:
-                    _prefetch(V, c - pf2 - pf2)
-                    _prefetch(V, c + pf2 + pf2)
         nfree, fh, cur = _push(_bucket(k, last), k, c, pool, nxt, bk, mw, nfree, fh, cur)
     return nfree, fh, cur
 
@@ -758,17 +759,22 @@ def _march2d_kernel(order):
 def _march3d_kernel(order):
     """The compiled 3D march of one order (1 or 2); as :func:`_march2d_kernel`."""
 
-    def march(T, V, U, qp, nx, ny, nz, ihx2, ihy2, ihz2, stop, pool, nxt, bk, mw, st):
-        """March a padded 3D grid ``(nx, ny, nz)`` in place; as :func:`_march2d`."""
-        n = _U(nx) * _U(ny) * _U(nz)
-        sx = _U(ny) * _U(nz)
-        sy = _U(nz)
+    def march(T, V, U, qp, nx, ny, nz, unit, ihx2, ihy2, ihz2, stop, pool, nxt, bk, mw, st):
+        """March a padded 3D grid ``(nx, ny, nz)`` in place; as :func:`_march2d`
+        (``unit`` 2: the interleaved layout, node ``c``'s time at ``T[c]`` and its
+        ``1 / speed^2`` at ``V[c] = T[c + 1]``, without a plateau register)."""
+        one = _U(unit)
+        n = _U(nx) * _U(ny) * _U(nz) * one
+        sx = _U(ny) * _U(nz) * one
+        sy = _U(nz) * one
+        node = one >> _ONE  # element index >> node = node index (stop mask)
         end = _U(st[_END]) if st[_END] != _ZERO else n
-        use_u = qp > 0.0
+        use_u = qp > 0.0 and one == _ONE
+        sep = one == _ONE  # prefetch V apart from T (interleaved: the same lines)
         iso = order == 1 and ihx2 == ihy2 and ihy2 == ihz2
         hh = 1.0 / ihx2
         if st[_PHASE] == 0:
-            if not _seed(T, end, _ONE, pool, nxt, bk, mw, st):
+            if not _seed(T, end, one, pool, nxt, bk, mw, st):
                 return 1
             st[_PHASE] = 1
             st[_SCAN] = st[_BEGIN]
@@ -789,7 +795,7 @@ def _march3d_kernel(order):
             if phase == 1:
                 if scan < end:
                     c = scan
-                    scan += _ONE
+                    scan += one
                     if not T[c] >= 0.0:
                         continue
                 else:
@@ -797,7 +803,7 @@ def _march3d_kernel(order):
                     continue
             else:
                 c, nfree, fh, cur, last = _pop_ahead(T, V, pool, nxt, bk, mw, nfree, fh, cur, last,
-                                                     sx, sy, not use_u)
+                                                     sx, sy, sep and not use_u)
                 if c == _NIL:
                     phase = 3
                     break
@@ -805,26 +811,41 @@ def _march3d_kernel(order):
                     continue
                 T[c] = -T[c]
                 frozen += _ONE
-                if use_stop and (stop[c >> _U(3)] >> (c & _U(7))) & _ONE != _ZERO:
+                cs = c >> node
+                if use_stop and (stop[cs >> _U(3)] >> (cs & _U(7))) & _ONE != _ZERO:
                     n_stop -= _ONE
                     if n_stop == _ZERO:
                         phase = 3
                         break
-            pv = not (use_u and _at_plateau(U, c))
-            pv2 = pv and order == 2  # the order-2 speed check reads V two planes away
-            for nb in (c - sx, c + sx, c - sy, c + sy, c - _ONE, c + _ONE):
-                if T[nb] < 0.0:
+            tcur = T[c]
+            for k in range(6):
+                s = sx if k < 2 else (sy if k < 4 else one)
+                nb = c - s if k & 1 == 0 else c + s
+                x = T[nb]
+                if x < 0.0:
                     q = _rhs(V, U, use_u, qp, nb)
-                    if iso:
+                    if x == -_INF and phase == 2:
+                        # a far node while popping: c is its only frozen neighbour, the
+                        # one-axis solution along s (as in 2D; the same numbers)
+                        if iso:
+                            t = tcur + math.sqrt(q * hh)
+                        else:
+                            ih2 = ihx2 if k < 2 else (ihy2 if k < 4 else ihz2)
+                            if order == 1:
+                                t = tcur + math.sqrt(q / ih2)
+                            else:
+                                ta, aa = _axis_term_u(T, V, U, use_u, nb, s, ih2, order)
+                                t = ta + math.sqrt(q / aa)
+                    elif iso:
                         t = _solve_iso(_side_min(T, nb, sx), _side_min(T, nb, sy),
-                                       _side_min(T, nb, _ONE), q * hh)
+                                       _side_min(T, nb, one), q * hh)
                     else:
                         ta, aa = _axis_term_u(T, V, U, use_u, nb, sx, ihx2, order)
                         tb, ab = _axis_term_u(T, V, U, use_u, nb, sy, ihy2, order)
-                        tc, ac = _axis_term_u(T, V, U, use_u, nb, _ONE, ihz2, order)
+                        tc, ac = _axis_term_u(T, V, U, use_u, nb, one, ihz2, order)
                         t = _combine(ta, aa, tb, ab, tc, ac, q)
                     nfree, fh, cur = _relax(T, V, nb, t, last, pool, nxt, bk, mw, nfree, fh, cur,
-                                            sx, sy, n, pv, pv2)
+                                            sx, sy, n)
         st[_PHASE] = phase
         st[_SCAN] = scan
         st[_NFREE] = nfree
@@ -1063,10 +1084,11 @@ def march(speed, start, shape3, h3, order, stop_cells, *, lean=None, interleave=
         Use the lean layout (see :data:`LEAN_NODES`); default: for grids of more
         than ``LEAN_NODES`` padded nodes.
     interleave : bool, optional
-        2D grids outside the lean layout: ``T`` and ``1 / speed^2`` interleaved in one
+        Grids outside the lean layout: ``T`` and ``1 / speed^2`` interleaved in one
         array (:func:`_work_interleaved`) instead of two, and no plateau register.
-        Default: unless every passable node has one speed (:func:`_buffers`). The times
-        are the same bit for bit either way. Ignored in 3D and in the lean layout.
+        Default: in 2D unless every passable node has one speed, in 3D unless the grid
+        has a plateau (:func:`_buffers`). The times are the same bit for bit either way.
+        Ignored in the lean layout.
     threads : int
         Threads of the set-up (``>= 1``): the lean layout of grids of at least
         :data:`SETUP_PARALLEL_MIN_NODES` padded nodes is padded on that many
@@ -1091,7 +1113,8 @@ def march(speed, start, shape3, h3, order, stop_cells, *, lean=None, interleave=
         )
     if lean is None:
         lean = npad > LEAN_NODES
-    Tp, Vp, Tk, Vk, unit, plat = _buffers(speed, shape3, npad, lean, interleave)
+    Tp, Vp, Tk, Vk, unit, plat = _buffers(speed, shape3, npad, lean, interleave,
+                                          interleave_3d=True)
     # the lean layout's buffers are fresh mappings: most of the padding is their page
     # faults, which the threads take in parallel; the kept buffers of smaller grids take
     # milliseconds on one
@@ -1127,7 +1150,7 @@ def march(speed, start, shape3, h3, order, stop_cells, *, lean=None, interleave=
                             pool, nxt, bk, mw, st)
         else:
             kernel = march3d_o1 if order == 1 else march3d_o2
-            status = kernel(Tp, Vp, U, qp, *pshape, *ih, stop, pool, nxt, bk, mw, st)
+            status = kernel(Tk, Vk, U, qp, *pshape, unit, *ih, stop, pool, nxt, bk, mw, st)
         if status == 0:
             break
         pool, nxt = _grow(pool, nxt, st)
@@ -1158,7 +1181,7 @@ def setup_threads(threads, nodes):
     return int(min(threads, numba.config.NUMBA_NUM_THREADS))
 
 
-def _buffers(speed, shape3, npad, lean, interleave):
+def _buffers(speed, shape3, npad, lean, interleave, *, interleave_3d=False):
     """The padded ``T`` and ``V`` of a march (see :func:`march`'s ``lean`` and ``interleave``).
 
     Returns ``(Tp, Vp, Tk, Vk, unit, plateau)``: the arrays :func:`pad_grid` fills and
@@ -1170,6 +1193,10 @@ def _buffers(speed, shape3, npad, lean, interleave):
     line of ``T``). Measured on 2048^2 (docs/performance.md): FM²-shaped order 1 -8 %,
     smooth -17 %; FM² maps saturated (W = 1) on 57 % and 70 % of the nodes -8 % and
     -6 % against the separate arrays with the plateau mask; a uniform speed +10 %.
+    ``interleave_3d`` (the serial march): a 3D map without a plateau (:func:`_plateau`,
+    its mask built) marches interleaved too, one with a plateau keeps the mask in separate
+    arrays (measured on 160^3 FM²-shaped and smooth: -1.3 to -1.7 %); the slab march's
+    3D kernels take separate arrays (default False).
     """
     if lean:  # two plain mappings: V goes as soon as the march is done
         Tp = _work(8 * npad).view(np.float64)
@@ -1177,10 +1204,12 @@ def _buffers(speed, shape3, npad, lean, interleave):
         return Tp, Vp, Tp, Vp, 1, None
     two = shape3[2] == 1
     plat = None
-    if two and interleave is None:
-        plat = _plateau(speed, _F64_TYPE, shape3, npad, None, False)
+    if (two or interleave_3d) and interleave is None:
+        # a 3D map with a plateau mask keeps it (the separate arrays; measured on 160^3
+        # constant speed -22 %), one without marches interleaved
+        plat = _plateau(speed, _F64_TYPE, shape3, npad, None, not two)
         interleave = plat[1] == 0.0
-    if two and interleave:
+    if (two or interleave_3d) and interleave:
         Tk = _work_interleaved(npad)
         return Tk[0::2], Tk[1::2], Tk, Tk[1:], 2, (_NO_BITS, 0.0)
     Tp, Vp = _work_pair(npad)

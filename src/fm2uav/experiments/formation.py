@@ -94,7 +94,7 @@ def case_scenario(seed: int, case: FormationCase) -> Scenario:
 def _deep_fissure(seed: int, top: float) -> Scenario:
     import numpy as np
 
-    from ..scenarios.open_field import OPEN_FIELD_CELL, OPEN_FIELD_HEIGHT_CELLS
+    from ..scenarios.field import OPEN_FIELD_CELL, OPEN_FIELD_HEIGHT_CELLS
     from ..world import World
     from ..world.terrain import OPEN_FIELD_SHAPE, open_field_heights
 

@@ -72,7 +72,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
-import numpy as np
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, PrivateAttr, ValidationError
 from pydantic import ValidationInfo, field_validator, model_validator
 
@@ -81,10 +80,14 @@ from ..world.load import WorldSpec as DataWorldSpec
 from ..world.load import check_points, load_world
 from ..autopilot.firmware import FIRMWARES, VEHICLES
 from .formats import EXPORT_FILES
-from ..world.geo import DEFAULT_ANCHOR, Anchor, from_lonlat, to_lonlat
 from .zone_spec import ZoneSpec, resolve_zones
 
+# numpy and the geo module load with the first world, not with the schema: a mission file's
+# error is reported without them (tests/cli/test_init.py, bench_cli's `run bad.yaml`)
 if TYPE_CHECKING:
+    import numpy as np
+
+    from ..world.geo import Anchor
     from ..autopilot.build import ExportOptions
 
 __all__ = [
@@ -599,6 +602,8 @@ class Mission(BaseModel):
 
     def anchor(self) -> Anchor:
         """The :class:`Anchor` of a world without CRS (default :data:`DEFAULT_ANCHOR`)."""
+        from ..world.geo import DEFAULT_ANCHOR, Anchor
+
         a = self.world.anchor
         return DEFAULT_ANCHOR if a is None else Anchor(lon=a.lon, lat=a.lat, alt=a.alt)
 
@@ -630,6 +635,7 @@ class Mission(BaseModel):
             A rally file that cannot be read (named).
         """
         from ..autopilot.safe_return import ReturnOptions
+        from ..world.geo import from_lonlat
         from .rally import read_rally_sites
 
         r, anchor = self.rally, self.anchor()
@@ -693,6 +699,8 @@ class Mission(BaseModel):
             The world cannot be built (message names ``world.<field>``), or a
             point cannot be placed (names ``start`` / ``goal``).
         """
+        import numpy as np
+
         w = self.world
         start_default = goal_default = None
         if w.scenario is not None:
@@ -736,6 +744,9 @@ class ResolvedMission:
 
 def _resolve_point(p: PointSpec, world: Any, anchor: Anchor, what: str) -> np.ndarray:
     """A start/goal/via point in world metres (see :func:`resolve_point`)."""
+    import numpy as np
+
+    from ..world.geo import from_lonlat
     if p.cell is not None:
         if world.ndim != 3:
             raise InputError(f"{what}.cell needs a 3D world")
@@ -756,7 +767,7 @@ def _resolve_point(p: PointSpec, world: Any, anchor: Anchor, what: str) -> np.nd
         b = world.bounds
         where = ""
         if getattr(world, "crs", None) is not None:
-            from ..world.geo import bounds_lonlat
+            from ..world.geo import bounds_lonlat, to_lonlat
 
             w_, s_, e_, n_ = bounds_lonlat((b[0, 0], b[1, 0], b[0, 1], b[1, 1]), world.crs)
             ll = to_lonlat(world, point[None])[0]
@@ -772,6 +783,8 @@ def _resolve_point(p: PointSpec, world: Any, anchor: Anchor, what: str) -> np.nd
 def _swap_hint(p: PointSpec, world: Any, anchor: Anchor) -> str:
     """``"; lon and lat look swapped ..."`` when the lon/lat point ``p`` lies off the map but
     would lie on it with its two coordinates exchanged, else ``""``."""
+    from ..world.geo import from_lonlat
+
     if p.lon is None or not (abs(p.lat) <= 180 and abs(p.lon) <= 90):
         return ""
     try:
@@ -799,6 +812,8 @@ def resolve_point(p: PointSpec, world: Any, anchor: Anchor | None = None,
     InputError
         The point lies outside the map (names ``what`` and the map's bounds).
     """
+    from ..world.geo import DEFAULT_ANCHOR
+
     return _resolve_point(p, world, DEFAULT_ANCHOR if anchor is None else anchor, what)
 
 

@@ -31,13 +31,15 @@ from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
-import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
 from .. import _validate
 from ..errors import InputError
+
+if TYPE_CHECKING:  # numpy loads with the zones' resolution, not with the schema
+    import numpy as np
 
 __all__ = ["ZoneSpec", "CircleSpec", "resolve_zones", "zones_from_cli"]
 
@@ -121,6 +123,8 @@ class ZoneSpec(BaseModel):
 def _to_metres(pts: np.ndarray, spec: ZoneSpec, world: Any, anchor: Any) -> np.ndarray:
     if not spec.lonlat:
         return pts
+    import numpy as np
+
     from ..world.geo import from_lonlat
 
     if np.any(np.abs(pts[:, 0]) > 180) or np.any(np.abs(pts[:, 1]) > 90):
@@ -137,6 +141,8 @@ def _one(spec: ZoneSpec, world: Any, anchor: Any, *, inclusion: bool, where: str
     opts["reference"] = spec.reference
     if spec.file is not None:
         return read_zones(spec.file, world, crs=spec.crs, defaults=opts, inclusion=inclusion)
+    import numpy as np
+
     from ..world.zones import check_zones_on_map
 
     raw = np.asarray(spec.polygon if spec.polygon is not None else [spec.circle.center],

@@ -1,6 +1,6 @@
 """Built-in scenarios of the source papers: a world with a start and a goal.
 
-* ``"open-field"`` / ``"fissure"`` — :mod:`.open_field` (terrain-following paper,
+* ``"open-field"`` / ``"fissure"`` — :mod:`.field` (terrain-following paper,
   thesis ch. 4 and 6);
 * ``"city"`` / ``"city-high"`` — :mod:`.city` (thesis ch. 3);
 * ``"coverage"`` — :mod:`.coverage` (coverage paper 003, thesis ch. 5, areas S1-S4);
@@ -13,14 +13,16 @@ A new built-in world goes in its own module here and one entry of :data:`SCENARI
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
-from .._lazy import lazy_function
+from .._lazy import lazy_function, lazy_names
 from ..errors import WorldError
-from .open_field import OPEN_FIELD_CELL, OPEN_FIELD_HEIGHT_CELLS, fissure, open_field
-from .scenario import Scenario
+
+if TYPE_CHECKING:  # loaded on first attribute access (PEP 562)
+    import numpy as np
+
+    from .field import OPEN_FIELD_CELL, OPEN_FIELD_HEIGHT_CELLS, fissure, open_field
+    from .scenario import Scenario
 
 __all__ = [
     "Scenario",
@@ -32,13 +34,20 @@ __all__ = [
     "OPEN_FIELD_HEIGHT_CELLS",
 ]
 
-#: Scenario name → factory ``f(seed=0) -> Scenario``. The factories of the worlds that need
-#: the geodata libraries or the coverage kernels (buildings, survey areas, a real DEM) import
-#: their module on their first call, so the names are known (a mission file's
-#: ``world.scenario`` checked) without loading them.
+__getattr__, __dir__ = lazy_names(__name__, {
+    "Scenario": ".scenario",
+    "open_field": ".field",
+    "fissure": ".field",
+    "OPEN_FIELD_CELL": ".field",
+    "OPEN_FIELD_HEIGHT_CELLS": ".field",
+})
+
+#: Scenario name → factory ``f(seed=0) -> Scenario``. Every factory imports its module on
+#: its first call, so the names are known (a mission file's ``world.scenario`` checked)
+#: without loading numpy, the geodata libraries or the coverage kernels.
 SCENARIOS: dict[str, Callable[..., Scenario]] = {
-    "open-field": open_field,
-    "fissure": fissure,
+    "open-field": lazy_function(__name__, ".field", "open_field"),
+    "fissure": lazy_function(__name__, ".field", "fissure"),
     "jacksboro": lazy_function(__name__, ".jacksboro", "jacksboro"),
     "city": lazy_function(__name__, ".city", "city"),
     "city-high": lazy_function(__name__, ".city", "city_high"),
@@ -57,6 +66,8 @@ def get_scenario(name: str, seed: int | np.random.Generator = 0, **kwargs: Any) 
         raise WorldError(
             f"unknown scenario {name!r}; valid names are: {', '.join(sorted(SCENARIOS))}"
         )
+    import numpy as np
+
     if not isinstance(seed, np.random.Generator):
         from .._validate import seed_value
 

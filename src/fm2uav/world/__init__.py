@@ -12,7 +12,7 @@ from functools import partial
 from typing import TYPE_CHECKING
 
 from .._lazy import lazy_function, lazy_names
-from .world import register_builders
+from ._registry import register_builders
 
 if TYPE_CHECKING:  # loaded on first attribute access (PEP 562)
     from .clearance import clearance_profile

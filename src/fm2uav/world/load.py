@@ -44,14 +44,15 @@ from __future__ import annotations
 import math
 import warnings
 from pathlib import Path
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
-import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator
 
 from ..errors import InputError, PointError, WorldError
 from .quiet import GeodataWarning, library_warnings
-from .world import World
+
+if TYPE_CHECKING:  # numpy and the World load with the first world, not with the schema
+    from .world import World
 
 __all__ = [
     "WorldSpec",
@@ -79,7 +80,7 @@ _ROUND = (1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0)
 
 def round_down(v: float) -> float:
     """``v`` rounded down to 1, 1.5, 2, 2.5, 3, 4, 5, 6 or 8 times a power of ten."""
-    if not (np.isfinite(v) and v > 0):
+    if not (math.isfinite(v) and v > 0):
         raise InputError(f"cannot round {v!r}: give a positive number")
     e = math.floor(math.log10(v))
     m = v / 10.0**e
@@ -348,7 +349,7 @@ def _pixel_ground_size(path: str) -> tuple[float, float]:
         shape = (ds.height, ds.width)
         b = ds.bounds
     if crs is None:
-        res = max(float(np.hypot(t.a, t.d)), float(np.hypot(t.b, t.e)))
+        res = max(math.hypot(t.a, t.d), math.hypot(t.b, t.e))
         return res, (b.right - b.left) * (b.top - b.bottom)
     ll = bounds_lonlat((b.left, b.bottom, b.right, b.top), crs)
     from pyproj import Geod
@@ -360,7 +361,7 @@ def _pixel_ground_size(path: str) -> tuple[float, float]:
     if crs.is_geographic:
         # the larger step in degrees, as metres east-west at the centre (the pixel's short
         # side towards the poles: the finer of the two ground spacings of a square-degree grid)
-        res = max(float(np.hypot(t.a, t.d)), float(np.hypot(t.b, t.e)))
+        res = max(math.hypot(t.a, t.d), math.hypot(t.b, t.e))
         return float(res * 111320.0 * max(math.cos(math.radians(lat_c)), 0.05)), \
             float(width * height)
     ex, ey = pixel_sizes(tuple(t)[:6], crs, shape)
@@ -377,6 +378,7 @@ def _bbox_area(bbox: Any) -> float:
 def _relief_of(path: str, spec: WorldSpec) -> tuple[float, float] | None:
     """(lowest, highest) elevation [m] of one DEM file over the area, from a decimated read
     (<= 256²) taken through the same nodata, sentinel and sea-level rules as the real read."""
+    import numpy as np
     import rasterio
     from rasterio.windows import from_bounds
 
@@ -470,6 +472,7 @@ def _auto_cell(spec: WorldSpec, agl: float | None = None) -> tuple[float, str]:
     if spec.bbox is not None:
         area = _bbox_area(spec.bbox)
     elif data.geometries:
+        import numpy as np
         import shapely
 
         x0, y0, x1, y1 = shapely.total_bounds(np.asarray(data.geometries, dtype=object))
@@ -487,7 +490,7 @@ def _requested(v: float | None, what: str) -> float | None:
     if v is None:
         return None
     f = float(v)
-    if not np.isfinite(f) or f <= 0:
+    if not math.isfinite(f) or f <= 0:
         raise InputError(f"{what} must be a positive height in metres, got {v!r}")
     return f
 
@@ -616,6 +619,8 @@ def check_points(world: World, points: dict[str, Any], *, allow_filled: bool = F
         A point whose ground height is filled (invented); the message names
         ``--allow-filled`` / ``world.allow_filled``.
     """
+    import numpy as np
+
     from .ground import has_unknown_ground
 
     if not has_unknown_ground(world):

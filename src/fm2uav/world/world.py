@@ -19,6 +19,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError, PointError, WorldError
+from ._registry import BUILDERS as _BUILDERS
+from ._registry import register_builders  # noqa: F401  (re-exported: was defined here)
 
 __all__ = ["World", "register_builders"]
 
@@ -27,18 +29,6 @@ __all__ = ["World", "register_builders"]
 #: defensive copy (a 3000 x 3000 x 78 DEM world's grid is 0.7 GB: the copy doubled the
 #: peak and took seconds of page faults).
 _BUILT: set[int] = set()
-
-#: The functions behind World's ``from_dem``, ``from_lonlat_grid``, ``from_buildings``,
-#: ``from_image`` and ``from_ros_map``, by name. They live in their own modules (dem.py,
-#: buildings.py, images.py), which import World; ``fm2uav/world/__init__.py`` registers
-#: them, so this module never imports its builders (imports go one way: the acyclic
-#: contract in pyproject.toml).
-_BUILDERS: dict[str, Callable[..., Any]] = {}
-
-
-def register_builders(**builders: Callable[..., Any]) -> None:
-    """Register the functions behind World's ``from_*`` classmethods, by classmethod name."""
-    _BUILDERS.update(builders)
 
 
 def _readonly(arr: np.ndarray) -> np.ndarray:

@@ -51,9 +51,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from ..items import (
     CMD_DO_CHANGE_SPEED,
@@ -68,6 +66,9 @@ from ..items import (
 )
 from .navigation import AirframeNav, FixedWingNav, SpeedCommand
 from .profile import Problem
+
+if TYPE_CHECKING:  # numpy loads with the first check, not with the firmware profiles
+    import numpy as np
 
 __all__ = ["speed_rules", "fixed_wing_rules", "local_xy", "item_amsl", "turn_angles",
            "END_TURN_DEG", "leg_speeds"]
@@ -91,6 +92,8 @@ def item_amsl(item: MissionItem, home_alt: float | None) -> float | None:
 
 def local_xy(items: Sequence[MissionItem], lat0: float, lon0: float) -> np.ndarray:
     """East/north metres of the items' positions from ``lat0, lon0`` (local tangent plane)."""
+    import numpy as np
+
     lat = np.radians([it.lat for it in items])
     lon = np.radians([it.lon for it in items])
     x = (lon - math.radians(lon0)) * math.cos(math.radians(lat0)) * _EARTH
@@ -106,6 +109,8 @@ END_TURN_DEG = 90.0
 
 def turn_angles(xy: np.ndarray) -> np.ndarray:
     """Heading change at each point of a polyline [deg] (0 at both ends)."""
+    import numpy as np
+
     out = np.zeros(len(xy))
     if len(xy) < 3:
         return out
@@ -120,6 +125,8 @@ def leg_speeds(items: Sequence[MissionItem], nav_index: Sequence[int], default: 
                speed_type: int) -> np.ndarray:
     """Speed in force on each leg between consecutive ``nav_index`` items [m/s]: the last
     ``DO_CHANGE_SPEED`` of ``speed_type`` before the leg's end item (``default`` before one)."""
+    import numpy as np
+
     out = np.full(max(len(nav_index) - 1, 0), float(default))
     ends = np.asarray(nav_index[1:], dtype=int)
     for i, it in enumerate(items):
@@ -212,6 +219,8 @@ def _climb_out(items: Sequence[MissionItem], nav_idx: Sequence[int], xy: np.ndar
     """The take-off climbs straight ahead from the launch (home) along the course to the
     take-off item's position (ArduPlane holds the launch heading: the operator points the
     aircraft along the course the item shows)."""
+    import numpy as np
+
     t = items[nav_idx[0]]
     nxt = items[nav_idx[1]]
     h_to = t.alt if t.frame in (FRAME_RELATIVE, 6, 10, 11) else (
@@ -254,6 +263,8 @@ def _climb_out(items: Sequence[MissionItem], nav_idx: Sequence[int], xy: np.ndar
 
 def _loiters(items: Sequence[MissionItem], nav_idx: Sequence[int], xy: np.ndarray,
              speeds: np.ndarray, n: FixedWingNav, label: str) -> list[Problem]:
+    import numpy as np
+
     out: list[Problem] = []
     for k, i in enumerate(nav_idx):
         it = items[i]
@@ -284,6 +295,8 @@ def _loiters(items: Sequence[MissionItem], nav_idx: Sequence[int], xy: np.ndarra
 def _legs(items: Sequence[MissionItem], nav_idx: Sequence[int], xy: np.ndarray,
           speeds: np.ndarray, n: FixedWingNav, label: str) -> list[Problem]:
     """Waypoint after waypoint: skipped waypoints (error) and overshoots (warning)."""
+    import numpy as np
+
     out: list[Problem] = []
     ang = turn_angles(xy)
     ang[-1] = END_TURN_DEG  # no next leg: the firmware assumes a 90° turn
@@ -323,6 +336,8 @@ def _legs(items: Sequence[MissionItem], nav_idx: Sequence[int], xy: np.ndarray,
 def _landings(items: Sequence[MissionItem], nav_idx: Sequence[int], xy: np.ndarray,
               speeds: np.ndarray, n: FixedWingNav, home_alt: float | None,
               label: str) -> list[Problem]:
+    import numpy as np
+
     out: list[Problem] = []
     for k, i in enumerate(nav_idx):
         land = items[i]

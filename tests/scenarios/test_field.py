@@ -8,7 +8,7 @@ import pytest
 from fm2uav.errors import WorldError
 from fm2uav.scenarios import SCENARIOS, Scenario, fissure, get_scenario, open_field
 from fm2uav.world import World
-from fm2uav.scenarios.open_field import _open_field_world_uncached
+from fm2uav.scenarios.field import _open_field_world_uncached
 from fm2uav.world.terrain import FISSURE_Y, open_field_heights
 
 CELL = 15.0
