@@ -35,8 +35,8 @@ def separate(monkeypatch):
     a 2D map that is not uniform marches interleaved and reads every speed
     (``_kernels._buffers``, tests/eikonal/test_kernels_layout.py)."""
     original = _kernels._buffers
-    monkeypatch.setattr(_kernels, "_buffers", lambda speed, shape3, npad, lean, interleave:
-                        original(speed, shape3, npad, lean, False))
+    monkeypatch.setattr(_kernels, "_buffers", lambda speed, shape3, npad, lean, interleave, **kw:
+                        original(speed, shape3, npad, lean, False, **kw))
 
 
 def _without_plateau(fn):
@@ -167,8 +167,8 @@ def test_a_2d_map_with_a_plateau_marches_interleaved_without_the_mask(order, pat
     assert paths == ["none"]
     with pytest.MonkeyPatch.context() as mp:
         original = _kernels._buffers
-        mp.setattr(_kernels, "_buffers", lambda speed, shape3, npad, lean, interleave:
-                   original(speed, shape3, npad, lean, False))
+        mp.setattr(_kernels, "_buffers", lambda speed, shape3, npad, lean, interleave, **kw:
+                   original(speed, shape3, npad, lean, False, **kw))
         ref = fast_marching(v, src, order=order)
     assert paths == ["none", "mask"]
     np.testing.assert_array_equal(T, ref)
