@@ -268,7 +268,7 @@ def plan_rows(quick: bool) -> list[dict]:
         warm = fm2uav.World.from_heightmap(heights[:40, :40], cell, nz)
         fm2uav.plan(warm, [5 * cell, 5 * cell, 35 * cell], [30 * cell, 30 * cell, 35 * cell])
         from fm2uav.planning.warmup import warm as warm_kernels
-        warm_kernels(["edt_parallel", "fmm3d_o2_lean"])
+        warm_kernels(["edt_parallel", "fmm3d_o2_lean", "fmm3d_parallel"])
         base = rss_mb()
         t0 = time.perf_counter()
         world = fm2uav.World.from_heightmap(heights, cell, nz)
@@ -416,7 +416,7 @@ def jit_rows(quick: bool) -> list[dict]:
 
 
 def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
-    """The parallel march (issue 27): ``threads=2`` against ``threads=1``, order 1.
+    """The parallel march (issue 27): ``threads=2`` against ``threads=1``, order 1 and 2.
 
     2048² and 160³ with constant speed (centre source), the smooth field and the
     FM²-shaped field (:mod:`benchmarks.fields`), and the smaller grids around the size
@@ -433,9 +433,11 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
     cost the same and the barriers nothing (on the idle machine it was ~10 % above the
     measured wall ratio). Bar (issue 27): >= 1.6x on 2048² and 160³.
     """
-    cases = ([("256x256", "smooth"), ("32x32x32", "smooth")] if quick else
-             [(s, f) for s in ("2048x2048", "160x160x160") for f in ("constant", "smooth", "fm2")]
-             + [("512x512", "smooth"), ("1024x1024", "smooth")])
+    cases = ([("256x256", "smooth", 1), ("32x32x32", "smooth", 1), ("256x256", "smooth", 2)]
+             if quick else
+             [(s, f, 1) for s in ("2048x2048", "160x160x160") for f in ("constant", "smooth", "fm2")]
+             + [("512x512", "smooth", 1), ("1024x1024", "smooth", 1)]
+             + [(s, f, 2) for s in ("2048x2048", "160x160x160") for f in ("smooth", "fm2")])
     res = _child(
         f"""
         import os
@@ -463,8 +465,8 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
             return run
 
         _parallel.march = spy
-        _parallel._drive2d = spy_drive(_parallel._drive2d)
-        _parallel._drive3d = spy_drive(_parallel._drive3d)
+        for key in list(_parallel._DRIVES):
+            _parallel._DRIVES[key] = spy_drive(_parallel._DRIVES[key])
 
         def task_cpu():
             out = {{}}
@@ -477,7 +479,7 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
             return out
 
         out = []
-        for case, field in {cases!r}:
+        for case, field, order in {cases!r}:
             shape = tuple(int(n) for n in case.split("x"))
             if field == "constant":
                 v, src = np.ones(shape), tuple(n // 2 for n in shape)
@@ -485,13 +487,13 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
                 v, src = getattr(fields, "smooth" if field == "smooth" else "fm2_shaped")(shape)
             stats.clear()
             for th in (1, 2):  # JIT and first-touch warm-up
-                fast_marching(v, [src], order=1, threads=th)
+                fast_marching(v, [src], order=order, threads=th)
             runs = {{1: [], 2: []}}
             for _ in range({repeats}):
                 for th in (1, 2):
                     stats.clear()
                     a = task_cpu(); w = time.perf_counter(); c = time.process_time()
-                    fast_marching(v, [src], order=1, threads=th)
+                    fast_marching(v, [src], order=order, threads=th)
                     w = time.perf_counter() - w; c = time.process_time() - c
                     b = task_cpu()
                     busiest = max(b[t] - a.get(t, 0.0) for t in b)
@@ -502,8 +504,10 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
                     runs[th].append((w, c, busiest, est))
             med = {{th: [statistics.median(r[i] for r in runs[th]) for i in range(4)]
                     for th in runs}}
-            out.append(dict(case=case, field=field, nodes=int(v.size),
-                            parallel=v.size >= _parallel.PARALLEL_MIN_NODES,
+            out.append(dict(case=case, field=field, order=order, nodes=int(v.size),
+                            parallel=bool(v.size >= _parallel.PARALLEL_MIN_NODES and (
+                                order == 1 or len(shape) == 2
+                                or v.size >= _parallel.ORDER2_MIN_NODES_3D)),
                             serial=med[1], threads2=med[2], balance=stats.get("balance", 1.0),
                             setup=stats.get("setup", 0.0)))
         print(json.dumps(out))
@@ -515,7 +519,7 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
         big = r["case"] in ("2048x2048", "160x160x160")
         rows.append({
             "benchmark": "fmm threads",
-            "case": f"{r['case']} {r['field']} order 1, 2 threads",
+            "case": f"{r['case']} {r['field']} order {r['order']}, 2 threads",
             "ours_s": w2, "peer": "fm2uav 1 thread", "peer_s": w1, "ratio": w1 / w2,
             "bar": ">= 1.6x (issue 27)" if big else ("never slower" if r["parallel"] else ""),
             "notes": (f"{'parallel' if r['parallel'] else 'serial (below PARALLEL_MIN_NODES)'}; "

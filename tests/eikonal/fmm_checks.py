@@ -53,16 +53,18 @@ def assert_same_field(actual: np.ndarray, desired: np.ndarray, rtol: float) -> N
 def fast_marching_parallel(*args, threads: int = 2, **kwargs) -> np.ndarray:
     """:func:`fast_marching` with the parallel march on every grid (no size floor, slabs
     of one row or node on): the small exactness cases then run through the slabs, windows and
-    repairs of :mod:`fm2uav.eikonal._parallel` (order 1; order 2 marches serially)."""
+    repairs of :mod:`fm2uav.eikonal._parallel`, at order 1 and 2 (``ORDER2`` set)."""
     from fm2uav.eikonal import _parallel
 
-    saved = _parallel.PARALLEL_MIN_NODES, _parallel.MIN_SLAB_ROWS, _parallel.MIN_SLAB_NODES
-    _parallel.PARALLEL_MIN_NODES, _parallel.MIN_SLAB_ROWS, _parallel.MIN_SLAB_NODES = 0, 1, 0
+    saved = (_parallel.PARALLEL_MIN_NODES, _parallel.MIN_SLAB_ROWS, _parallel.MIN_SLAB_NODES,
+             _parallel.ORDER2, _parallel.ORDER2_MIN_NODES_3D)
+    (_parallel.PARALLEL_MIN_NODES, _parallel.MIN_SLAB_ROWS, _parallel.MIN_SLAB_NODES,
+     _parallel.ORDER2, _parallel.ORDER2_MIN_NODES_3D) = 0, 1, 0, True, 0
     try:
         return fast_marching(*args, threads=threads, **kwargs)
     finally:
         (_parallel.PARALLEL_MIN_NODES, _parallel.MIN_SLAB_ROWS,
-         _parallel.MIN_SLAB_NODES) = saved
+         _parallel.MIN_SLAB_NODES, _parallel.ORDER2, _parallel.ORDER2_MIN_NODES_3D) = saved
 
 
 #: The implementations of the same discretisation; exact-value tests run on each.

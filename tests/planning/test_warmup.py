@@ -38,9 +38,12 @@ _LATER_RUN = textwrap.dedent(
 
 
 def _run(args, cache):
+    # the timeout only guards against a hang: a cold compile of the parallel groups (order 1
+    # and 2 drives in every layout) took over 600 s of wall time on the loaded 2-core machine
+    # (load 6-8, ~a third of a core)
     env = {**os.environ, "NUMBA_CACHE_DIR": str(cache)}
     return subprocess.run([sys.executable, *args], capture_output=True, text=True, env=env,
-                          timeout=600)
+                          timeout=1800)
 
 
 @pytest.mark.slow
@@ -84,44 +87,63 @@ def test_the_command_line_child_compiles_the_first_plan_child_groups():
 
 _LATER_PARALLEL_RUN = textwrap.dedent(
     """
+    import os
     import numpy as np
-    from fm2uav import _jit
-    compiled = []
-    _jit.on_first_compile(lambda: compiled.append(1))
+    from numba.core import event
     from fm2uav.eikonal import _kernels, _parallel, fast_marching
+
+    class FirstCompile(event.Listener):  # the first fm2uav kernel compiled: named, then exit
+        def on_start(self, ev):
+            disp = ev.data.get("dispatcher") if isinstance(ev.data, dict) else None
+            f = getattr(disp, "py_func", None)
+            if getattr(f, "__module__", "").startswith("fm2uav"):
+                print("compiled", f.__module__, flush=True)
+                os._exit(0)
+
+        def on_end(self, ev):
+            pass
+
+    event.register("numba:compile", FirstCompile())
     _kernels.LEAN_NODES = 0          # a big grid's two-thread march (lean layout, float32
     _parallel.PARALLEL_MIN_NODES = 0  # speed) and its input scan, on a small one
+    _parallel.ORDER2_MIN_NODES_3D = 0
     _kernels.SETUP_PARALLEL_MIN_NODES = 0
+    marches, march = [], _parallel.march
+    _parallel.march = lambda *a, **k: marches.append(k["order"]) or march(*a, **k)
     v = np.ones((40, 36, 20))
     v[10:14, :30, :] = 0.0
-    T = fast_marching(v, [(30, 5, 3)], spacing=(15.0, 15.0, 10.0), order=1, threads=2)
-    assert np.isfinite(T[0, 0, 1])
-    print("compiled" if compiled else "cached")
+    for order in (1, 2):
+        T = fast_marching(v, [(30, 5, 3)], spacing=(15.0, 15.0, 10.0), order=order, threads=2)
+        assert np.isfinite(T[0, 0, 1])
+    assert marches == [1, 2], marches  # both on the slabs
+    print("cached")
     """
 )
 
 
 @pytest.mark.slow
 def test_parallel_group_caches_the_lean_layout_of_a_big_two_thread_march(tmp_path):
-    # a 1000x1000x40 terrain plan marches on both cores in the lean layout (float32 speed):
-    # after the install's groups it compiles nothing (it compiled for ~50 s before); its
-    # serial pieces in the lean layout (a slab too small to split marches serially, the
-    # speed range) are the lean group's
-    groups = ["fmm3d_o1", "fmm3d_o1_lean", "fmm3d_parallel"]
-    res = _run(["-m", "fm2uav.planning.warmup", *groups], tmp_path)
+    # a 1000x1000x40 terrain plan (order 2 by default) marches on both cores in the lean
+    # layout (float32 speed): after the install's groups it compiles nothing (it compiled
+    # for ~50 s before), order 1 nor 2; its serial pieces in the lean layout (a slab too
+    # small to split marches serially, the speed range) are the lean groups', the coarse
+    # order-1 march that places the cuts fmm3d_o1's. One cold compile of each group: the
+    # serial groups' cache, copied, is where the parallel group starts
+    serial, full = tmp_path / "serial", tmp_path / "full"
+    res = _run(["-m", "fm2uav.planning.warmup", "fmm3d_o1", "fmm3d_o1_lean", "fmm3d_o2_lean"],
+               serial)
     assert res.returncode == 0, res.stderr
-    res = _run(["-c", _LATER_PARALLEL_RUN], tmp_path)
+    shutil.copytree(serial, full)
+    res = _run(["-m", "fm2uav.planning.warmup", "fmm3d_parallel"], full)
+    assert res.returncode == 0, res.stderr
+    res = _run(["-c", _LATER_PARALLEL_RUN], full)
     assert res.returncode == 0, res.stderr
     assert res.stdout.split() == ["cached"]
-    # the check can fail: the float64 layout alone (the group before) leaves the lean
-    # march to compile
-    float64_only = ("import numpy as np\n"
-                    "from fm2uav.eikonal import _parallel, fast_marching\n"
-                    "_parallel.PARALLEL_MIN_NODES = 0\n"
-                    "fast_marching(np.ones((16, 16, 16)), [(3, 3, 3)], order=1, threads=2)\n")
-    res = _run(["-c", float64_only], tmp_path / "small")
+    # the check can fail: without the parallel group the same run compiles, first a kernel
+    # of the parallel march (the run stops there: no time spent compiling the rest)
+    res = _run(["-c", _LATER_PARALLEL_RUN], serial)
     assert res.returncode == 0, res.stderr
-    assert _run(["-c", _LATER_PARALLEL_RUN], tmp_path / "small").stdout.split() == ["compiled"]
+    assert res.stdout.split() == ["compiled", "fm2uav.eikonal._parallel"]
 
 
 _LATER_2D_RUN = textwrap.dedent(

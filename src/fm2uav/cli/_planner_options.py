@@ -39,9 +39,9 @@ SHAPING = [
 ]
 #: ``--threads`` and ``--storage`` of the march (``march=True``).
 MARCH = [
-    ("threads", _opt(int | None, "Threads of the Fast Marching (>= 1; order 1 on grids of 1 M "
-                     "nodes or more marches in parallel). Default: FM2UAV_THREADS, else every "
-                     "core."), None),
+    ("threads", _opt(int | None, "Threads of the Fast Marching (>= 1; grids of 1 M nodes or "
+                     "more march in parallel, order 1 and 2). Default: FM2UAV_THREADS, else "
+                     "every core."), None),
     ("storage", _opt(str, "Grid storage: 'full' (one 3D grid), 'regional' (coarse plan, then "
                      "full-resolution windows along it; terrain + --agl) or 'auto' (regional "
                      "when the full grid would not fit in a quarter of the memory)."), "auto"),

@@ -1,10 +1,17 @@
-"""The parallel Fast Marching (order 1): slabs, time windows, ghost exchange, repair.
+"""The parallel Fast Marching (order 1 and 2): slabs, time windows, ghost exchange, repair.
 
 Private module: :func:`fm2uav.eikonal.fast_marching` calls :func:`march` for
 grids of at least :data:`PARALLEL_MIN_NODES` nodes when more than one thread is
-allowed (``threads``, ``FM2UAV_THREADS``) and the order is 1 (``stop_at`` too).
-Order 2 marches serially: its stencil reads two nodes upwind, so the ghosts and
-the repairs would have to reach two rows, which is not built (nor tested) yet.
+allowed (``threads``, ``FM2UAV_THREADS``), at order 1 and 2 (:data:`ORDER2`), ``stop_at``
+too.
+Order 2's stencil reads two nodes upwind: its slabs have two ghost x-slabs per
+side (:func:`_pad_slabs`), the exchange copies two rows, and a changed time updates
+again the nodes one *and two* away along each axis; its update is not monotone, so a
+repair may also raise a time, and a node takes the time the serial march keeps, the
+lowest of its updates at its neighbours' freezes (:func:`_serial_time2`): the times
+equal the serial march's bit for bit (the notes above :func:`_known`). In 2D it takes the
+interleaved layout as order 1 (below): its two ghost rows a side and every index count
+elements, its bit masks (frozen on entry, re-opened, suspect, pending) keep a bit per node.
 
 Design (Yang & Stern 2017, domain-decomposition FMM)
 ----------------------------------------------------
@@ -26,7 +33,7 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
   frozen), so the serial kernels' update (``_solve_iso``, ``_axis_term``, ``_combine``,
   the plateau register ``_rhs``) and radix queue (``_push``, ``_pop``) run unchanged on a
   slab.
-* **2D interleaved**, as the serial march: a 2D map (outside the lean layout) whose
+* **2D interleaved** (order 1 and 2), as the serial march: a 2D map (outside the lean layout) whose
   passable nodes do not all have one speed keeps each node's time and ``1 / speed^2``
   side by side in one array (node ``c``'s time at element ``2 c``, its speed term at
   ``2 c + 1``; the kernels take the buffer and the buffer shifted by one, and every node
@@ -74,13 +81,16 @@ import math
 import os
 
 import numpy as np
-from numba import njit, prange
+from llvmlite import ir
+from numba import njit, prange, types
+from numba.extending import intrinsic
 
 from . import _kernels
 from ._heap import sift_down, sift_up
-from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _U, _ZERO, RESERVE_BLOCKS, BLOCK,
-                       _at_plateau, _axis_term, _bits, _bucket, _prefetch, _combine, _pop, _push,
-                       _rhs, _side_min, _solve_iso, pad_grid, unpad_grid)
+from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _ORDER2_MAX_W_RATIO, _U, _ZERO,
+                       RESERVE_BLOCKS, BLOCK,
+                       _at_plateau, _axis_term, _axis_term_u, _bits, _bucket, _prefetch, _combine,
+                       _pop, _push, _rhs, _side_min, _solve_iso, pad_grid, unpad_grid)
 
 #: The windows meet at a barrier several hundred times per march: a thread that waits
 #: there sleeps instead of spinning (OpenMP's default spins), or on a busy machine the
@@ -93,12 +103,26 @@ __all__ = ["march", "resolve_threads", "PARALLEL_MIN_NODES", "THREADS_ENV"]
 
 #: Environment variable with the default thread count of the march (an integer >= 1).
 THREADS_ENV = "FM2UAV_THREADS"
+#: Whether :func:`fm2uav.eikonal.fast_marching` marches order 2 on slabs too (False: order 2
+#: marches serially). The order-2 slabs give the serial march's times bit for bit on every
+#: case measured (tests/eikonal/test_fmm_parallel.py; the 2048² FM²-shaped map and the
+#: 1000 x 1000 x 40 terrain march, 25.8 M nodes): a node's time is the one the serial march
+#: keeps, the lowest of its updates at its neighbours' freezes in time order
+#: (:func:`_serial_time2`). Only a tie (two nodes of one stencil frozen at the very same
+#: time) could make them differ, where the serial march's pick depends on its queue.
+ORDER2 = True
 #: Grids of fewer nodes march serially whatever the thread count. Measured
 #: (benchmarks/bench_core.py, "threads" rows, a machine at load 9 on 2 cores):
 #: on 1024^2 the busiest thread takes 0.06 s of the serial 0.099 CPU-s (1.65x on
 #: an idle machine) and the wall time is equal; below, a window holds fewer nodes
 #: per barrier and the wall time on a busy machine decides: kept serial.
 PARALLEL_MIN_NODES = 1_000_000
+#: 3D order 2 marches on slabs only from this many nodes: its repairs near the ghosts
+#: (a node's time from scratch, :func:`_serial_time2`) cost more on thin slabs. Measured
+#: (3 December 2026, machine at load 4.5-4.8, medians of 2): 160^3 FM²-shaped (20-row
+#: slabs) CPU 0.97 -> 2.31 s, busiest thread 0.98 -> 1.34 s (0.73x: slower); the
+#: 1000 x 1000 x 40 terrain march (125-row slabs) busiest thread 10.4 -> 5.0 s.
+ORDER2_MIN_NODES_3D = 2**24
 #: Each slab gets at least this many x-slabs (rows), else fewer slabs are used.
 MIN_SLAB_ROWS = 16
 #: ... and at least this many nodes (but every thread one slab): thin slabs cost repairs.
@@ -135,6 +159,10 @@ SHARE_SLABS = True
 FAR_ONE_AXIS = True
 #: Free repair-heap slots kept before each node's pushes (one pop pushes at most 7).
 HEAP_RESERVE = 8
+#: Order 2: one pop queues at most 13 entries (six neighbours, the six nodes two away, the
+#: put-back), so more free repair-heap slots and entry-pool blocks are kept than for order 1.
+HEAP_RESERVE_2 = 16
+POOL_EXTRA_2 = 16
 #: Smallest start of a slab's repair heap (entries; at least 4 boundary rows) and
 #: entry pool (blocks); both double when a window runs low.
 HEAP_START = 4096
@@ -145,7 +173,10 @@ _C_NEXT = 0    # smallest queued time after the last window or exchange (inf: no
 _C_POPS = 1    # nodes frozen in the last window
 _C_REOPEN = 2  # nodes re-opened so far
 _C_STATUS = 3  # 0 ok, 1 entry pool low, 2 repair heap full
-_C_SIZE = 4
+_C_PEND = 4    # order 2: re-opened nodes raised above their old time, not frozen again
+_C_RMIN = 5    # order 2: a time no later than the old times of those (inf: none)
+_C_RAISED = 6  # order 2: updates that found a later time than the node had (suspects)
+_C_SIZE = 7
 
 # slots of the march state ``st`` (uint64), shared with the serial layout
 _NFREE = 2
@@ -519,6 +550,411 @@ def _exchange(three, *args):
     return _exchange2d(*args)
 
 
+# ------------------------------------------------------------------ order 2
+# The serial order-2 march updates a node each time one of its neighbours freezes, from the
+# nodes frozen by then, and keeps the lowest update (:func:`_serial_time2` computes that
+# from the frozen times around the node: each neighbour's update reads only the nodes
+# :func:`_known` when it froze). That is a function of the final times of the node's
+# neighbours and of the nodes two away along each axis, all earlier than the node; so the
+# serial times are the one solution of ``T = serial_time(T)`` in which every node depends on
+# earlier nodes only (by induction in time order), and the parallel march ends there,
+# bit for bit: whenever a frozen time that an update read changes (a ghost exchanged, a
+# node frozen again at another time) its dependants -- the neighbours and the nodes two
+# away along each axis -- are updated again. The update is not monotone (a lower time two
+# away raises the order-2 term), so a dependant may have to go *up*: a band node keeps its
+# (lower) time and is marked suspect (bit ``sf``), updated again when popped; a frozen one
+# is re-opened at its old time, suspect too (its queue key stays a lower bound of its
+# time, which the windows and the stop test rely on). A re-opened node (bit ``rf``)
+# updates all its dependants again when frozen again, since they may have read its old time.
+# (Taking one update from all the final times instead differed by up to 3e-11 relative on a
+# 2048^2 map: near an axis's causality limit the two-axis formula's rounding can put it
+# above an earlier one-axis update, which the serial march keeps; docs/performance.md.)
+
+@intrinsic
+def _from_bits(typingctx, k):
+    """The float64 of an IEEE-754 bit pattern (the inverse of ``_bits``)."""
+    sig = types.float64(types.uint64)
+
+    def codegen(context, builder, signature, args):
+        return builder.bitcast(args[0], ir.DoubleType())
+
+    return sig, codegen
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _bit(a, c):
+    """Bit ``c`` of the bit mask ``a`` (uint8)."""
+    return (a[c >> _U(3)] >> (c & _U(7))) & _ONE != _ZERO
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _set_bit(a, c):
+    a[c >> _U(3)] |= np.uint8(_ONE << (c & _U(7)))
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _clear_bit(a, c):
+    i = c >> _U(3)
+    a[i] = np.uint8(a[i] & (np.uint8(255) ^ np.uint8(_ONE << (c & _U(7)))))
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _known(T, fixed, c, thr, sh):
+    """Node ``c``'s time if the serial march had frozen it when the node of time ``thr``
+    froze (frozen on entry, or frozen no later than ``thr``), else inf (``c >> sh``: its
+    node index, the bit of ``fixed``)."""
+    x = T[c]
+    if x >= 0.0 and (x <= thr or _bit(fixed, c >> sh)):
+        return x
+    return _INF
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _axis_term_at(T, V, U, use_u, fixed, c, s, ih2, thr, sh):
+    """:func:`~fm2uav.eikonal._kernels._axis_term_u` at order 2 (the same operations, the
+    same bits) reading only the nodes :func:`_known` at ``thr``."""
+    a = _known(T, fixed, c - s, thr, sh)
+    b = _known(T, fixed, c + s, thr, sh)
+    if b < a:
+        best = b
+        c1 = c + s
+        c2 = c1 + s
+    else:
+        best = a
+        c1 = c - s
+        c2 = c1 - s
+    if best == _INF:
+        return _INF, 0.0
+    t2 = _known(T, fixed, c2, thr, sh)
+    if t2 <= best:
+        if use_u and _at_plateau(U, c) and _at_plateau(U, c1) and _at_plateau(U, c2):
+            return (4.0 * best - t2) / 3.0, 2.25 * ih2
+        w0 = V[c]
+        w1 = V[c1]
+        w2 = V[c2]
+        wmax = max(w0, max(w1, w2))
+        wmin = min(w0, min(w1, w2))
+        if wmax <= _ORDER2_MAX_W_RATIO * wmin:
+            return (4.0 * best - t2) / 3.0, 2.25 * ih2
+    return best, ih2
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _update2_at(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three, thr):
+    """The serial march's order-2 update of node ``c`` when the node of time ``thr`` froze,
+    from the nodes :func:`_known` at ``thr`` (``thr < 0``: the nodes frozen on entry, as the
+    serial march's first updates): its terms in the serial march's order, the same bits."""
+    sh = _unit(sy, three) >> _ONE
+    q = _rhs(V, U, use_u, qp, c)
+    ta, aa = _axis_term_at(T, V, U, use_u, fixed, c, sx, ih[0], thr, sh)
+    tb, ab = _axis_term_at(T, V, U, use_u, fixed, c, sy, ih[1], thr, sh)
+    if three:
+        tc, ac = _axis_term_at(T, V, U, use_u, fixed, c, _ONE, ih[2], thr, sh)
+    else:
+        tc, ac = _INF, 0.0
+    return _combine(ta, aa, tb, ab, tc, ac, q)
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _later_nb(T, fixed, c, sx, sy, three, t):
+    """Whether a neighbour of node ``c`` is frozen later than ``t`` (and not on entry)."""
+    sh = _unit(sy, three) >> _ONE
+    for nb in _nbs(c, sx, sy, three):
+        if T[nb] > t and not _bit(fixed, nb >> sh):  # c itself (2D): band, not > t
+            return True
+    return False
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _serial_time2(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three):
+    """The time the serial order-2 march gives node ``c`` from the frozen times around it.
+
+    The serial march updates ``c`` each time a neighbour freezes, from the nodes frozen by
+    then, and keeps the lowest: first from the nodes frozen on entry (if one is a
+    neighbour), then at each neighbour's time in increasing order, until ``c``'s own time
+    (a neighbour later than it freezes after ``c``). Not one update from every frozen
+    node: adding an axis near its causality limit (its time just below the
+    solution) lowers the exact solution by less than the rounding of the two-axis formula,
+    which can then come out *above* the one-axis solution of an earlier update (by 4e-14
+    relative at the first node that differed on the 2048^2 FM²-shaped map); the serial
+    march keeps that earlier one.
+    """
+    sh = _unit(sy, three) >> _ONE
+    val = _INF
+    for nb in _nbs(c, sx, sy, three):
+        if nb != c and T[nb] >= 0.0 and _bit(fixed, nb >> sh):
+            val = _update2_at(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three, -1.0)
+            break
+    prev = -1.0
+    while True:
+        thr = _INF  # the next neighbour's time (frozen, not on entry)
+        for nb in _nbs(c, sx, sy, three):
+            x = T[nb]
+            if nb != c and x >= 0.0 and x > prev and x < thr and not _bit(fixed, nb >> sh):
+                thr = x
+        if not thr < val:
+            return val
+        val = min(val, _update2_at(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three, thr))
+        prev = thr
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _entry_cap(eidx, evals, g, t):
+    """``t``, or the time node ``g`` (an index into the slabs' buffer) had in the band on
+    entry if lower: the serial march keeps it (sorted ``eidx``, times ``evals``)."""
+    if eidx.size == 0:
+        return t
+    i = np.searchsorted(eidx, g)
+    if i < eidx.size and eidx[i] == g:
+        return min(t, evals[i])
+    return t
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)  # a call (rare): compiles once
+def _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf, eidx, evals, base, pool,
+             nxt, bk, mw, st, rkey, ritem, ctl):
+    """Update the slab's own node ``d`` again after a time it may read changed (order 2).
+
+    Far or band: a lower time is taken and queued; a higher one marks the node suspect
+    (updated again when popped). Frozen: a different time re-opens it (``rf``), at the new
+    time if lower, else at its old time and suspect. Walls and nodes frozen on entry stay;
+    a node in the band on entry keeps that time if lower (``eidx``, ``evals``: those nodes
+    by their index in the slabs' buffer, ``base + d`` for ``d``).
+    """
+    x = T[d]
+    nd = d >> (_unit(sy, three) >> _ONE)  # its node index: its bits in the masks
+    if x != x or _bit(fixed, nd):
+        return
+    t = _entry_cap(eidx, evals, base + d,
+                   _serial_time2(T, V, U, use_u, qp, fixed, d, sx, sy, ih, three))
+    if x < 0.0:
+        if t < -x:
+            T[d] = -t
+            _enq(_bits(t), d, pool, nxt, bk, mw, st, rkey, ritem)
+        elif t > -x and x > -_INF:
+            _set_bit(sf, nd)
+            ctl[_C_RAISED] += 1.0
+    elif t != x:
+        ctl[_C_REOPEN] += 1.0
+        _set_bit(rf, nd)
+        if t < x:
+            T[d] = -t
+            _enq(_bits(t), d, pool, nxt, bk, mw, st, rkey, ritem)
+        else:
+            T[d] = -x
+            _set_bit(sf, nd)
+            ctl[_C_RAISED] += 1.0
+            _enq(_bits(x), d, pool, nxt, bk, mw, st, rkey, ritem)
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _room2(st, rkey):
+    """Whether the pool and the repair heap have room for the pushes of one order-2 pop."""
+    return (st[_NFREE] >= _U(RESERVE_BLOCKS + POOL_EXTRA_2)
+            and st[_RSIZE] + _U(HEAP_RESERVE_2) <= _U(rkey.size))
+
+
+def _slab_kernels2(three):
+    """The compiled order-2 window, start and exchange of one dimension (``three``: 3D);
+    the slab has two ghost x-slabs on each side (the order-2 stencil reads two rows)."""
+
+    def window(T, V, U, qp, fixed, rf, sf, pf, eidx, evals, base, sx, sy, ih, tw, pool, nxt, bk,
+               mw, st, rkey, ritem, ctl, sent, ns):
+        """Freeze the slab's queued nodes with a time below ``tw`` (resumable), order 2.
+
+        As the order-1 window; the boundary lists hold the nodes frozen in the first and
+        last *two* own rows, and a frozen node's dependants include the nodes two away.
+        """
+        n = _U(T.size)
+        g = sx + sx
+        lo = g  # the slab's own nodes: [lo, hi)
+        hi = n - g
+        lo2 = lo + g  # the first two own rows are [lo, lo2), the last two [hi2, hi)
+        hi2 = hi - g
+        one = _unit(sy, three)  # elements a node (2D interleaved: 2)
+        sh = one >> _ONE  # node index = element index >> sh: the bits of the masks
+        use_u = qp > 0.0 and one == _ONE
+        kw = _bits(tw)
+        pops = 0
+        ns[0] = _ZERO
+        ns[1] = _ZERO
+        ctl[_C_NEXT] = _INF
+        while True:
+            if not _room2(st, rkey):
+                ctl[_C_STATUS] = 1.0 if st[_NFREE] < _U(RESERVE_BLOCKS + POOL_EXTRA_2) else 2.0
+                break
+            heap = st[_RSIZE] > _ZERO
+            kb = rkey[0] if heap else _ZERO
+            c = _deq(T, pool, nxt, bk, mw, st, rkey, ritem)
+            if c == _NIL:
+                break
+            if not heap:  # a lower bound of the popped key and of every key left
+                kb = st[_LAST]
+            x = T[c]
+            if not x < 0.0 or x == -_INF:  # outdated entry (frozen, or far again)
+                continue
+            t = -x
+            k = _bits(t)
+            if k >= kw:  # the window is done: put it back
+                _enq(k, c, pool, nxt, bk, mw, st, rkey, ritem)
+                ctl[_C_NEXT] = min(t, _from_bits(kb))
+                break
+            if _bit(sf, c >> sh):  # suspect: its time may have to go up
+                _clear_bit(sf, c >> sh)
+                t2 = _entry_cap(eidx, evals, base + c,
+                                _serial_time2(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three))
+                if t2 != t:
+                    if t2 > t and _bit(rf, c >> sh) and not _bit(pf, c >> sh):
+                        # nodes may still read its old time (>= t): the stop test must not
+                        # pass t before it is frozen again
+                        _set_bit(pf, c >> sh)
+                        ctl[_C_PEND] += 1.0
+                        ctl[_C_RMIN] = min(ctl[_C_RMIN], t)
+                    T[c] = -t2
+                    if t2 < _INF:
+                        _enq(_bits(t2), c, pool, nxt, bk, mw, st, rkey, ritem)
+                    continue
+            T[c] = t
+            pops += 1
+            if c < lo2:
+                _note(sent, ns, 0, c)
+            if c >= hi2:
+                _note(sent, ns, 1, c)
+            if _bit(pf, c >> sh):
+                _clear_bit(pf, c >> sh)
+                ctl[_C_PEND] -= 1.0
+                if ctl[_C_PEND] == 0.0:
+                    ctl[_C_RMIN] = _INF
+            full = _bit(rf, c >> sh)  # frozen again: every dependant may have read its old time
+            if full:
+                _clear_bit(rf, c >> sh)
+            # prefetch V apart from T off the plateau (interleaved: the same lines)
+            pv = one == _ONE and not (use_u and _at_plateau(U, c))
+            for nb in _nbs(c, sx, sy, three):
+                if nb == c:
+                    continue
+                y = T[nb]
+                if y == -_INF and not full:
+                    # far: c is its only frozen neighbour (every frozen node, ghosts too,
+                    # has updated its neighbours), so the update is the one-axis solution
+                    # along c's axis, as the full update gives it (the serial 2D march's
+                    # shortcut): two axes' reads and terms saved on a third of the updates
+                    if nb == c - sx or nb == c + sx:
+                        s_nb, ih_nb = sx, ih[0]
+                    elif nb == c - sy or nb == c + sy:
+                        s_nb, ih_nb = sy, ih[1]
+                    else:
+                        s_nb, ih_nb = _ONE, ih[2]
+                    ta, aa = _axis_term_at(T, V, U, use_u, fixed, nb, s_nb, ih_nb, t, sh)
+                    _lower(T, V, nb, ta + math.sqrt(_rhs(V, U, use_u, qp, nb) / aa), fixed, sx,
+                           sy, three, pv, pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                elif y < 0.0:  # band (or far after c froze again): an own node
+                    if full or _later_nb(T, fixed, nb, sx, sy, three, t):
+                        # c frozen again, or a neighbour frozen later than c (a ghost ahead
+                        # of this slab, a repair): the updates at the later freezes read
+                        # nodes not frozen then, from scratch now
+                        _recheck(T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf,
+                                 eidx, evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                    else:  # the serial march's update when c froze; a band time that read
+                        # nodes out of time order may be too low: a later update above it
+                        # marks it suspect
+                        tn = _update2_at(T, V, U, use_u, qp, fixed, nb, sx, sy, ih, three, t)
+                        if tn < -y:
+                            _lower(T, V, nb, tn, fixed, sx, sy, three, pv, pool, nxt, bk, mw,
+                                   st, rkey, ritem, ctl)
+                        elif (tn > -y and y > -_INF
+                              and _entry_cap(eidx, evals, base + nb, tn) > -y):
+                            _set_bit(sf, nb >> sh)
+                            ctl[_C_RAISED] += 1.0
+                elif y >= 0.0 and nb >= lo and nb < hi and (full or y > t):
+                    # frozen later than c in this slab: c may change it
+                    _recheck(T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf, eidx,
+                             evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                # the node two away reads c beyond nb when nb is frozen no earlier than c
+                y = T[nb]
+                if y >= 0.0 and (full or t <= y):
+                    d2 = nb + nb - c
+                    if d2 >= lo and d2 < hi:
+                        z = T[d2]
+                        if z < 0.0 or (z >= 0.0 and (full or z > t)):
+                            _recheck(T, V, U, use_u, qp, d2, sx, sy, ih, three, fixed, rf, sf,
+                                     eidx, evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl)
+        ctl[_C_POPS] = pops
+
+    def start(T, V, U, qp, fixed, sx, sy, ih, pool, nxt, bk, mw, st, rkey, ritem, ctl, c0, c1):
+        """Queue the slab's band nodes given on entry and expand its frozen ones (order 2;
+        all in its nodes ``[c0, c1)``, the rows of the start box: the others are far or
+        walls)."""
+        one = _unit(sy, three)
+        use_u = qp > 0.0 and one == _ONE
+        c = c0
+        while c < c1:
+            x = T[c]
+            if x < 0.0 and x > -_INF:
+                if not _room2(st, rkey):
+                    return False
+                _enq(_bits(-x), c, pool, nxt, bk, mw, st, rkey, ritem)
+            c += one
+        c = c0
+        while c < c1:
+            if T[c] >= 0.0:
+                if not _room2(st, rkey):
+                    return False
+                for nb in _nbs(c, sx, sy, three):
+                    if T[nb] < 0.0:
+                        _lower(T, V, nb, _update2_at(T, V, U, use_u, qp, fixed, nb, sx, sy, ih,
+                                                     three, -1.0),
+                               fixed, sx, sy, three, one == _ONE, pool, nxt, bk, mw, st, rkey,
+                               ritem, ctl)
+            c += one
+        return True
+
+    def exchange(T, V, U, qp, fixed, rf, sf, eidx, evals, ebase, src, sent, m, base, g, up, sx,
+                 sy, ih, pool, nxt, bk, mw, st, rkey, ritem, ctl):
+        """Copy the neighbour's two boundary rows ``src`` (their frozen times) into the two
+        ghost rows starting at ``g``; update again the own nodes one and two rows away
+        from each ghost that changed (toward +x if ``up``). Only the neighbour's nodes
+        ``sent[:m] - base`` are read (those it froze in its last window), both rows when
+        ``m`` exceeds the list's capacity. Resumable: False when a queue is full."""
+        one = _unit(sy, three)
+        use_u = qp > 0.0 and one == _ONE
+        n = _U(T.size)
+        lo = sx + sx
+        hi = n - lo
+        full = m > _U(sent.size)
+        count = lo if full else m  # elements of the two rows, or listed nodes
+        i = _ZERO
+        while i < count:
+            j = i if full else sent[i] - base
+            i += one if full else _ONE
+            v = src[j]
+            if v >= 0.0 and v != T[g + j]:  # newly frozen, or frozen again at another time
+                if not _room2(st, rkey):
+                    return False
+                gj = g + j
+                T[gj] = v
+                for step in (sx, lo):
+                    d = gj + step if up else gj - step
+                    if d >= lo and d < hi:
+                        _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf,
+                                 eidx, evals, ebase, pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                        x = T[d]
+                        if x < 0.0 and -x < ctl[_C_NEXT]:  # queued: the next window knows
+                            ctl[_C_NEXT] = -x
+        return True
+
+    d = 3 if three else 2
+    out = []
+    for f in (window, start, exchange):
+        f.__name__ = f.__qualname__ = f"{f.__name__}{d}d_o2"
+        out.append(njit(cache=True, error_model="numpy", _nrt=False)(f))
+    return out
+
+
+_window2d_o2, _start2d_o2, _exchange2d_o2 = _slab_kernels2(False)
+_window3d_o2, _start3d_o2, _exchange3d_o2 = _slab_kernels2(True)
+
+
 @njit(cache=True, error_model="numpy", _nrt=False)
 def _heap_next(T, st, ritem, ctl):
     """Lower ``ctl[_C_NEXT]`` to the repair heap's smallest time (a hint for the window)."""
@@ -590,10 +1026,11 @@ def _assign(work, nth, slabs, first, load, share=True):
     return greedy
 
 
-def _drive_kernel(three):
-    """The compiled driver of one dimension (the parallel region runs the slabs)."""
-    def drive(nth, Tp, Vp, U, qp, fx, off, end, rows, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st,
-              rkey, ritem, ctl, sent, ns, win, first, stops, slabs, lists, load, share, scan, far):
+def _drive_kernel(three, order=1):
+    """The compiled driver of one dimension and order (the parallel region runs the slabs)."""
+    def drive(nth, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, rows, sx, sy, ih, hh, iso, pool,
+              nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win, first, stops, slabs, lists, load,
+              share, scan, far):
         """Run windows until every queue is empty; 0 done, 1/2 grow pool/heap and call again.
 
         ``win`` (float64): [0] window end, [1] width, [2] windows run, [3] target pops,
@@ -604,6 +1041,9 @@ def _drive_kernel(three):
         shared longest-first. ``U``, ``qp``: the plateau mask over
         ``Tp`` (one byte: every node) and its ``1 / speed^2`` (0: none); ``sent``, ``ns``:
         each slab's nodes frozen in its boundary rows in the last window (see ``window``).
+        ``fl``: order 2's bit masks, a bit per node (re-opened, suspect, pending; unused by
+        order 1), ``eidx``, ``evals`` its nodes in the band on entry (element indices into
+        ``Tp``, sorted) and their times; each slab has ``order`` ghost x-slabs on each side.
         ``slabs`` (K), ``lists`` (nth + 1 + K), ``load`` (nth): scratch of :func:`_assign`
         (``share``: :data:`SHARE_SLABS`). ``scan[k]``: the nodes of slab ``k`` the start
         reads (the start box's rows). ``far``: the far neighbours' one-axis update (2D).
@@ -614,16 +1054,29 @@ def _drive_kernel(three):
         """
         K = off.size
         sxi = np.int64(sx)
+        G = np.int64(order)  # ghost rows on each side of a slab
+        low = _U(RESERVE_BLOCKS + (POOL_EXTRA_2 if order == 2 else 0))
         sh = 0 if three or sy == 1 else 1  # node index = element index >> sh
         if first:
             for t in prange(nth):  # thread t runs slabs t, t + nth, ...
                 for k in range(t, K, nth):
-                    if not _start(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]],
-                                  U[0 if U.size == 1 else off[k] >> sh >> 3:], qp,
-                                  fx[off[k] >> sh >> 3:], sx, sy, ih, hh, iso, pool[k], nxt[k],
-                                  bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k],
-                                  _U(scan[k, 0]), _U(scan[k, 1])):
-                        ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < _U(RESERVE_BLOCKS) else 2.0
+                    T = Tp[off[k]:end[k]]
+                    V = Vp[off[k]:end[k]]
+                    Uk = U[0 if U.size == 1 else off[k] >> sh >> 3:]
+                    F = fx[off[k] >> sh >> 3:]
+                    c0 = _U(scan[k, 0])
+                    c1 = _U(scan[k, 1])
+                    if order == 2 and three:
+                        ok = _start3d_o2(T, V, Uk, qp, F, sx, sy, ih, pool[k], nxt[k], bk[k],
+                                         mw[k], st[k], rkey[k], ritem[k], ctl[k], c0, c1)
+                    elif order == 2:
+                        ok = _start2d_o2(T, V, Uk, qp, F, sx, sy, ih, pool[k], nxt[k], bk[k],
+                                         mw[k], st[k], rkey[k], ritem[k], ctl[k], c0, c1)
+                    else:
+                        ok = _start(three, T, V, Uk, qp, F, sx, sy, ih, hh, iso, pool[k], nxt[k],
+                                    bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k], c0, c1)
+                    if not ok:
+                        ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < low else 2.0
             for k in range(K):
                 if ctl[k, _C_STATUS] != 0.0:
                     return int(ctl[k, _C_STATUS])  # grown, the start runs again
@@ -641,22 +1094,40 @@ def _drive_kernel(three):
                     V = Vp[off[k]:end[k]]
                     Uk = U[0 if U.size == 1 else off[k] >> sh >> 3:]
                     F = fx[off[k] >> sh >> 3:]
+                    R = fl[0, off[k] >> sh >> 3:]
+                    S = fl[1, off[k] >> sh >> 3:]
                     ok = True
+                    r = _U(rows[k])
                     if k > 0:
-                        o = end[k - 1] - 2 * sxi  # last own row of the slab below
-                        ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k - 1, 1],
-                                       ns[k - 1, 1], _U(rows[k - 1]) * sx, _ZERO, sx, sx, sy, ih,
-                                       hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
-                                       ritem[k], ctl[k])
+                        o = off[k - 1] + rows[k - 1] * sxi  # last own rows of the slab below
+                        if order == 2:
+                            args = (T, V, Uk, qp, F, R, S, eidx, evals, _U(off[k]),
+                                    Tp[o:o + G * sxi], sent[k - 1, 1],
+                                    ns[k - 1, 1], _U(rows[k - 1]) * sx, _ZERO, True, sx, sy, ih,
+                                    pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k],
+                                    ctl[k])
+                            ok = _exchange3d_o2(*args) if three else _exchange2d_o2(*args)
+                        else:
+                            ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k - 1, 1],
+                                           ns[k - 1, 1], _U(rows[k - 1]) * sx, _ZERO, sx, sx,
+                                           sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
+                                           rkey[k], ritem[k], ctl[k])
                     if ok and k < K - 1:
-                        o = off[k + 1] + sxi  # first own row of the slab above
-                        r = _U(rows[k])
-                        ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k + 1, 0],
-                                       ns[k + 1, 0], sx, (r + _ONE) * sx, r * sx, sx, sy, ih, hh,
-                                       iso, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
-                                       ritem[k], ctl[k])
+                        o = off[k + 1] + G * sxi  # first own rows of the slab above
+                        if order == 2:
+                            args = (T, V, Uk, qp, F, R, S, eidx, evals, _U(off[k]),
+                                    Tp[o:o + G * sxi], sent[k + 1, 0],
+                                    ns[k + 1, 0], _U(G) * sx, (r + _U(G)) * sx, False, sx, sy,
+                                    ih, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
+                                    ritem[k], ctl[k])
+                            ok = _exchange3d_o2(*args) if three else _exchange2d_o2(*args)
+                        else:
+                            ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k + 1, 0],
+                                           ns[k + 1, 0], sx, (r + _ONE) * sx, r * sx, sx, sy,
+                                           ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
+                                           rkey[k], ritem[k], ctl[k])
                     if not ok:
-                        ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < _U(RESERVE_BLOCKS) else 2.0
+                        ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < low else 2.0
                     _heap_next(T, st[k], ritem[k], ctl[k])
             for k in range(K):
                 if ctl[k, _C_STATUS] != 0.0:
@@ -672,7 +1143,9 @@ def _drive_kernel(three):
                     if mw[k, w] != _ZERO:
                         empty = False
             # stop nodes: done once all are frozen no later than every queued time
-            # (nothing queued can lower them: an update is later than its inputs)
+            # (nothing queued can lower them: an update is later than its inputs) and, for
+            # order 2, than the old time of every node re-opened and raised (nodes may
+            # still read it)
             if stops.size > 0:
                 smax = 0.0
                 for i in range(stops.size):
@@ -681,7 +1154,10 @@ def _drive_kernel(three):
                         smax = _INF
                         break
                     smax = max(smax, x)
-                if smax <= tmin:
+                tlow = tmin
+                for k in range(K):
+                    tlow = min(tlow, ctl[k, _C_RMIN])
+                if smax <= tlow:
                     win[6] = smax
                     return 0
             if empty:
@@ -694,10 +1170,23 @@ def _drive_kernel(three):
             for t in prange(nth):  # thread t runs slabs[lists[t]:lists[t + 1]]
                 for i in range(lists[t], lists[t + 1]):
                     k = slabs[i]
-                    _window(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]],
-                            U[0 if U.size == 1 else off[k] >> sh >> 3:], qp,
-                            fx[off[k] >> sh >> 3:], sx, sy, ih, hh, iso, tw, pool[k], nxt[k],
-                            bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k], sent[k], ns[k], far)
+                    if order == 2:
+                        o3 = off[k] >> sh >> 3
+                        args = (Tp[off[k]:end[k]], Vp[off[k]:end[k]],
+                                U[0 if U.size == 1 else o3:], qp, fx[o3:], fl[0, o3:],
+                                fl[1, o3:], fl[2, o3:], eidx, evals, _U(off[k]), sx, sy, ih, tw,
+                                pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k],
+                                sent[k], ns[k])
+                        if three:
+                            _window3d_o2(*args)
+                        else:
+                            _window2d_o2(*args)
+                    else:
+                        _window(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]],
+                                U[0 if U.size == 1 else off[k] >> sh >> 3:], qp,
+                                fx[off[k] >> sh >> 3:], sx, sy, ih, hh, iso, tw, pool[k], nxt[k],
+                                bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k], sent[k], ns[k],
+                                far)
             win[2] += 1.0
             pops = 0.0
             most = 0.0
@@ -716,12 +1205,13 @@ def _drive_kernel(three):
             f = win[3] / max(pops, 1.0)
             win[1] *= min(2.0, max(0.5, f))
 
-    drive.__name__ = drive.__qualname__ = f"drive{3 if three else 2}d"
+    drive.__name__ = drive.__qualname__ = f"drive{3 if three else 2}d" + (
+        "_o2" if order == 2 else "")
     return njit(cache=True, parallel=True, error_model="numpy")(drive)
 
 
-_drive2d = _drive_kernel(False)
-_drive3d = _drive_kernel(True)
+#: The drivers by (dimension, order).
+_DRIVES = {(d, o): _drive_kernel(d == 3, o) for d in (2, 3) for o in (1, 2)}
 
 
 #: The split of two slabs is chosen on a march over every ``COARSE``-th node per axis
@@ -934,8 +1424,8 @@ def _coarse_histogram(speed, start, shape3, h3):
     return hist, f
 
 
-def march(speed, start, shape3, h3, threads, stop_cells=None, *, interleave=None):
-    """The order-1 Fast Marching from ``start`` on ``threads`` slabs in parallel.
+def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interleave=None):
+    """The Fast Marching from ``start`` on ``threads`` slabs in parallel.
 
     Parameters
     ----------
@@ -954,6 +1444,10 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, *, interleave=None
     stop_cells : ndarray, int, shape (m, 3), optional
         Stop once these nodes are frozen and final; nodes later than the latest
         of them are then ``inf``, as in the serial march.
+    order : {1, 2}, optional
+        Order of the upwind stencil, as in the serial march (order 2: two ghost
+        x-slabs per side, the dependants two away updated again; see the notes above
+        :func:`_known`).
     interleave : bool, optional
         2D slabs outside the lean layout: ``T`` and ``1 / speed^2`` interleaved in one
         array, as the serial march (:func:`fm2uav.eikonal._kernels._buffers`); default:
@@ -964,7 +1458,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, *, interleave=None
     T : ndarray, float64, shape (nx*ny*nz,)
         Arrival times [s], ``inf`` where unreachable.
     stats : dict
-        ``slabs``, ``windows``, ``reopened`` (nodes lowered after they were frozen) and
+        ``slabs``, ``windows``, ``reopened`` (nodes changed after they were frozen),
+        ``raised`` (order 2: updates that found a later time than the node had) and
         ``balance``: nodes frozen over the sum of each window's largest slab share, the
         speed-up the windows allow if every freeze cost the same (``slabs`` at best), and
         ``greedy``: the windows whose slabs :func:`_assign` shared longest first.
@@ -976,12 +1471,16 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, *, interleave=None
     nth = int(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
     K = int(max(1, min(nth * SLABS_PER_THREAD[3 if three else 2], nx // MIN_SLAB_ROWS,
                        max(nth, nx * ny * nz // max(MIN_SLAB_NODES, 1)))))
+    G = 2 if order == 2 else 1  # ghost x-slabs on each side (the rows the stencil reads)
+    K = max(1, min(K, nx // G))  # a slab at least as thick as its ghosts
     nth = min(nth, K)
     bounds = slab_bounds(speed, start, shape3, h3, K, nth)
+    if np.diff(bounds).min() < G:  # only the neighbours' rows are exchanged
+        bounds = np.linspace(0, nx, K + 1).round().astype(np.int64)
     rows = np.diff(bounds).astype(np.int64)
     sx = (ny + 2) * (nz + 2) if three else ny + 2
     sy = nz + 2 if three else 1
-    sizes = (rows + 2) * sx
+    sizes = (rows + 2 * G) * sx
     # slabs start at multiples of 8 nodes: each slab's bits of ``fixed`` start a byte
     off = np.concatenate([[0], np.cumsum(-(-sizes // 8) * 8)[:-1]]).astype(np.int64)
     npad = int(off[-1] + sizes[-1])
@@ -992,26 +1491,45 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, *, interleave=None
     # Vp strided views of it) and without a plateau register, as the serial march
     Tp, Vp, Tk, Vk, unit, plat = _kernels._buffers(speed, shape3, npad, lean, interleave)
     plane = ny * nz
-    boxes = _start_boxes(start, bounds)
+    boxes = _start_boxes(start, bounds, nx, G)
     with _threads(nth):
         _pad_slabs(nth, _kernels._readonly(speed), start.T, start.state, boxes, bounds, off, ny,
-                   nz, Tp, Vp)
-    # the start box's rows in each slab, the only nodes the start reads (elements of Tk)
-    scan = unit * np.stack([(boxes[:, 0] + 1) * sx, (boxes[:, 0] + boxes[:, 3] + 1) * sx],
-                           axis=1)
+                   nz, G, Tp, Vp)
+    # the start box's own rows in each slab, the only nodes the start reads (nodes of Tp;
+    # elements of Tk: times unit)
+    b0, b1 = bounds[:-1], bounds[1:]
+    i0 = np.clip(start.lo[0], b0, b1)
+    i1 = np.clip(start.lo[0] + start.shape[0], i0, b1)
+    rows0 = np.stack([(i0 - b0 + G) * sx, (i1 - b0 + G) * sx], axis=1)
+    scan = unit * rows0
     # the nodes frozen on entry (sources, balls) stay as they are, as in the serial march:
     # a bit per node, set from the start box's rows (the only frozen nodes on entry)
-    fixed = _frozen_bits(Tp, off[:, None] + scan // unit, npad)
+    fixed = _frozen_bits(Tp, off[:, None] + rows0, npad)
+    if G == 2:  # order 2: the ghosts' too (the neighbours' own), which the serial march's
+        _ghost_frozen_bits(fixed, Tp, off, rows, sx, G)  # first updates read (:func:`_known`)
     if plat is None:
         plat = _kernels._plateau(speed, Vp, shape3, npad,
                                  fill=lambda vmax, bits: _slab_plateau(speed, vmax, bounds, off,
-                                                                       shape3, bits))
+                                                                       shape3, bits, G))
     U, qp = plat
+    # order 2's bit masks: re-opened, suspect, pending, a bit per node (one spare byte: a 2D
+    # slice below), and the nodes in the band on entry with their times (a repair keeps
+    # them if lower; element indices)
+    fl = np.zeros((3, npad // 8 + 2 if order == 2 else 1), dtype=np.uint8)
+    nodes = np.zeros(0, dtype=np.int64)
+    if order == 2:
+        parts = []
+        for k in range(K):  # in the start box's rows: every other node is far or a wall
+            seg = Tp[off[k] + rows0[k, 0]:off[k] + rows0[k, 1]]
+            parts.append(off[k] + rows0[k, 0] + np.flatnonzero((seg < 0.0) & (seg > -np.inf)))
+        nodes = np.concatenate(parts)
+    eidx = (unit * nodes).astype(np.uint64)
+    evals = -Tp[nodes]
     # each slab's nodes frozen in its first and last own rows in the last window (the
     # neighbours' exchange reads those); a count over the capacity: read the whole row
     # (so the first exchange, after the start)
-    sent = np.empty((K, 2, sx), dtype=np.uint64)
-    ns = np.full((K, 2), sx + 1, dtype=np.uint64)
+    sent = np.empty((K, 2, G * sx), dtype=np.uint64)
+    ns = np.full((K, 2), G * sx + 1, dtype=np.uint64)
     # queues: one radix queue and one repair heap per slab
     nblk = max(POOL_MIN_BLOCKS, int(sizes.max()) // (16 * BLOCK))
     pool = np.empty((K, 2 * nblk * BLOCK), dtype=np.uint64)
@@ -1021,10 +1539,11 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, *, interleave=None
     st = np.zeros((K, _ST), dtype=np.uint64)
     for k in range(K):
         _kernels.init_queue(nxt[k], bk[k], mw[k], st[k])
-    rcap = max(HEAP_START, HEAP_RESERVE)
+    rcap = max(HEAP_START, HEAP_RESERVE_2 if order == 2 else HEAP_RESERVE)
     rkey = np.empty((K, rcap), dtype=np.uint64)
     ritem = np.empty((K, rcap), dtype=np.uint64)
     ctl = np.zeros((K, _C_SIZE))
+    ctl[:, _C_RMIN] = np.inf
     ih = np.array([1.0 / (h * h) for h in h3])
     iso = bool(ih[0] == ih[1] and (not three or ih[1] == ih[2]))
     hh = float(1.0 / ih[0])
@@ -1042,11 +1561,11 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, *, interleave=None
     if stop_cells is not None and len(stop_cells):
         cells = np.asarray(stop_cells, dtype=np.int64).reshape(-1, 3)
         k = np.searchsorted(bounds, cells[:, 0], side="right") - 1
-        local = ((cells[:, 0] - bounds[k] + 1) * (ny + 2) + cells[:, 1] + 1)
+        local = ((cells[:, 0] - bounds[k] + G) * (ny + 2) + cells[:, 1] + 1)
         if three:
             local = local * (nz + 2) + cells[:, 2] + 1
         stop_idx = unit * (off[k] + local)
-    drive = _drive3d if three else _drive2d
+    drive = _DRIVES[3 if three else 2, G]
     slabs = np.empty(K, dtype=np.int64)  # scratch of _assign: each window's slabs per thread
     lists = np.empty(nth + 1 + K, dtype=np.int64)
     load = np.empty(nth)
@@ -1055,10 +1574,10 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, *, interleave=None
     numba.set_num_threads(nth)
     try:
         while True:
-            status = drive(nth, Tk, Vk, U, qp, fixed, unit * off, unit * (off + sizes), rows,
-                           _U(unit * sx), _U(unit * sy), ih, hh, iso, pool, nxt, bk, mw, st, rkey,
-                           ritem, ctl, sent, ns, win, first, stop_idx, slabs, lists, load,
-                           SHARE_SLABS, scan, FAR_ONE_AXIS)
+            status = drive(nth, Tk, Vk, U, qp, fixed, fl, eidx, evals, unit * off,
+                           unit * (off + sizes), rows, _U(unit * sx), _U(unit * sy), ih, hh, iso,
+                           pool, nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win, first,
+                           stop_idx, slabs, lists, load, SHARE_SLABS, scan, FAR_ONE_AXIS)
             first = win[7] == 0.0
             if status == 0:
                 break
@@ -1074,15 +1593,15 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, *, interleave=None
     # [a * plane, b * plane), from no later than its padded grid's start to before slab
     # k + 1's, so every node moves to a lower index and is read before it is written
     if lean:
-        for k in range(K):
+        for k in range(K):  # from the ghost x-slab next to the own ones (unpad_grid's layout)
             a, b = int(bounds[k]), int(bounds[k + 1])
-            seg = slice(int(off[k]), int(off[k] + sizes[k]))
+            seg = slice(int(off[k] + (G - 1) * sx), int(off[k] + sizes[k] - (G - 1) * sx))
             _kernels.unpad_grid(Tp[seg], b - a, ny, nz, Tp[a * plane:b * plane])
         T = Tp[:nx * ny * nz]
     else:  # a new array: the slabs in parallel
         T = np.empty(nx * ny * nz)
         with _threads(nth):
-            _unpad_slabs(nth, Tp, bounds, off, ny, nz, T)
+            _unpad_slabs(nth, Tp, bounds, off, ny, nz, T, G)
     if win[6] < np.inf:  # stopped: what the serial march would not have frozen yet
         T[T > win[6]] = np.inf
         sel = tuple(slice(a, a + m) for a, m in zip(start.lo, start.shape))
@@ -1090,6 +1609,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, *, interleave=None
         frozen = (start.state == _kernels.FROZEN).reshape(start.shape)
         box[frozen] = start.T.reshape(start.shape)[frozen]
     return T, {"slabs": K, "windows": int(win[2]), "reopened": int(ctl[:, _C_REOPEN].sum()),
+               "raised": int(ctl[:, _C_RAISED].sum()),
                "balance": float(win[4] / max(win[5], 1.0)), "greedy": int(win[8])}
 
 
@@ -1135,63 +1655,147 @@ def _top_speed(nth, speed):
     return part.max()
 
 
-def _start_boxes(start, bounds):
+def _ghost_frozen_bits(bits, Tp, off, rows, sx, G):
+    """Order 2: set the bits (frozen on entry) of every slab's ``G`` ghost x-slabs on each
+    side from the neighbours' own boundary rows in ``Tp`` (nodes; slab ``k`` from
+    ``off[k]`` with ``rows[k]`` own rows of ``sx`` nodes): the serial march's first updates
+    read those nodes (:func:`_known`)."""
+    K = len(off)
+    m = G * sx
+    for k in range(K):
+        if k > 0:  # the last own rows of the slab below
+            o = int(off[k - 1] + rows[k - 1] * sx)
+            _or_bits_at(bits, np.packbits(Tp[o:o + m] >= 0.0, bitorder="little"), int(off[k]),
+                        m)
+        if k < K - 1:  # the first own rows of the slab above
+            o = int(off[k + 1] + G * sx)
+            _or_bits_at(bits, np.packbits(Tp[o:o + m] >= 0.0, bitorder="little"),
+                        int(off[k] + (rows[k] + G) * sx), m)
+
+
+def _start_boxes(start, bounds, nx, G=1):
     """Each slab's part of the start box, for :func:`_pad_slabs`: rows ``(i0, j0, k0, bx,
-    by, bz, first, last)`` of ints, the box in the slab's own node indices (``bx = 0``:
-    none) and the range ``[first, last)`` of ``start.T`` / ``start.state`` it takes."""
+    by, bz, first, last)`` of ints, the box in the node indices of the rows the slab pads
+    (:func:`_padded_rows`: its own rows, and with ``G = 2`` ghost rows ``G - 1`` deep, whose
+    times the ghosts' ``NaN`` then replaces) (``bx = 0``: none) and the range
+    ``[first, last)`` of ``start.T`` / ``start.state`` it takes."""
     lo, bshape = start.lo, start.shape
     bplane = bshape[1] * bshape[2]
     boxes = np.zeros((len(bounds) - 1, 8), dtype=np.int64)
     for k in range(len(bounds) - 1):
-        a, b = int(bounds[k]), int(bounds[k + 1])
-        i0, i1 = max(lo[0], a), min(lo[0] + bshape[0], b)
+        ra, rb, _ = _padded_rows(int(bounds[k]), int(bounds[k + 1]), nx, G)
+        i0, i1 = max(lo[0], ra), min(lo[0] + bshape[0], rb)
         if i1 > i0:
-            boxes[k] = (i0 - a, lo[1], lo[2], i1 - i0, bshape[1], bshape[2],
+            boxes[k] = (i0 - ra, lo[1], lo[2], i1 - i0, bshape[1], bshape[2],
                         (i0 - lo[0]) * bplane, (i1 - lo[0]) * bplane)
     return boxes
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def _pad_slabs(nth, speed, Tb, sb, boxes, bounds, off, ny, nz, Tp, Vp):
+def _pad_slabs(nth, speed, Tb, sb, boxes, bounds, off, ny, nz, G, Tp, Vp):
     """Pad every slab (:func:`fm2uav.eikonal._kernels.pad_grid`) into its place in ``Tp`` /
-    ``Vp`` (slab ``k`` from ``off[k]``), thread ``t`` the slabs ``t, t + nth, ...`` (on
-    2048^2 the padding was 7 of the ~60 ms one thread spent alone)."""
+    ``Vp`` (slab ``k`` from ``off[k]``, ``G`` ghost x-slabs on each side:
+    :func:`_padded_rows`, :func:`_ghost_rows`), thread ``t`` the slabs ``t, t + nth, ...``
+    (on 2048^2 the padding was 7 of the ~60 ms one thread spent alone)."""
     K = bounds.size - 1
+    nx = bounds[K]
     plane = ny * nz
     sx = (ny + 2) if nz == 1 else (ny + 2) * (nz + 2)
     for t in prange(nth):
         for k in range(t, K, nth):
             a, b = bounds[k], bounds[k + 1]
+            ra, rb, p0 = _padded_rows(a, b, nx, G)
             bx = boxes[k]
-            seg = slice(off[k], off[k] + (b - a + 2) * sx)
-            pad_grid(speed[a * plane:b * plane], Tb[bx[6]:bx[7]], sb[bx[6]:bx[7]], bx[0], bx[1],
-                     bx[2], bx[3], bx[4], bx[5], b - a, ny, nz, Tp[seg], Vp[seg])
+            seg = slice(off[k] + p0 * sx, off[k] + (p0 + rb - ra + 2) * sx)
+            pad_grid(speed[ra * plane:rb * plane], Tb[bx[6]:bx[7]], sb[bx[6]:bx[7]], bx[0],
+                     bx[1], bx[2], bx[3], bx[4], bx[5], rb - ra, ny, nz, Tp[seg], Vp[seg])
+            if G > 1:
+                _ghost_rows(speed, Tp, Vp, off[k], a, b, nx, ny, nz, G)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def _unpad_slabs(nth, Tp, bounds, off, ny, nz, T):
+def _unpad_slabs(nth, Tp, bounds, off, ny, nz, T, G):
     """Every slab's times into its rows of ``T`` (a new array; the lean layout compacts in
-    place, slab after slab), thread ``t`` the slabs ``t, t + nth, ...``."""
+    place, slab after slab), thread ``t`` the slabs ``t, t + nth, ...``; each slab's grid
+    read from its ghost x-slab next to its own rows (``G`` ghost x-slabs a side)."""
     K = bounds.size - 1
     plane = ny * nz
     sx = (ny + 2) if nz == 1 else (ny + 2) * (nz + 2)
     for t in prange(nth):
         for k in range(t, K, nth):
             a, b = bounds[k], bounds[k + 1]
-            unpad_grid(Tp[off[k]:off[k] + (b - a + 2) * sx], b - a, ny, nz, T[a * plane:b * plane])
+            o = off[k] + (G - 1) * sx
+            unpad_grid(Tp[o:o + (b - a + 2) * sx], b - a, ny, nz, T[a * plane:b * plane])
 
 
-def _slab_plateau(speed, vmax, bounds, off, shape3, bits):
+@njit(cache=True, _nrt=False)
+def _padded_rows(a, b, nx, G):
+    """The grid rows ``[ra, rb)`` padded into slab ``[a, b)``'s grid and the slab row of the
+    padded grid's first x-slab (its ghost), ``p0``: the slab's padded grid has ``G`` ghost
+    x-slabs on each side, slab row ``p`` is grid row ``a - G + p``; rows ``a - G + 1`` to
+    ``b + G - 2`` that exist are padded by :func:`~fm2uav.eikonal._kernels.pad_grid`
+    (``G = 1``: the slab's own rows, ``p0 = 0``)."""
+    ra, rb = max(a - G + 1, 0), min(b + G - 1, nx)
+    return ra, rb, ra - 1 - a + G
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _ghost_rows(speed, Tp, Vp, o, a, b, nx, ny, nz, G):
+    """Make the ``G`` x-slabs on each side of slab ``[a, b)`` (its grid from ``Tp[o]``)
+    ghosts (``NaN`` until the exchange) with the grid's ``1 / speed^2`` [s^2/m^2] where the
+    grid has the row (the order-2 speed check reads it), rounded as
+    :func:`~fm2uav.eikonal._kernels.pad_grid` rounds it."""
+    three = nz > 1
+    pz = nz + 2 if three else 1
+    sx = (ny + 2) * pz
+    rows = b - a + 2 * G
+    for p in range(rows):
+        if p >= G and p < rows - G:
+            continue
+        base = o + p * sx
+        for j in range(sx):
+            Tp[base + j] = np.nan
+        i = a - G + p
+        if i < 0 or i >= nx:
+            continue
+        for y in range(ny):
+            dst = base + (y + 1) * pz + (1 if three else 0)
+            src = (i * ny + y) * nz
+            for z in range(nz):
+                v = speed[src + z]
+                Vp[dst + z] = 1.0 / (v * v)
+
+
+def _slab_plateau(speed, vmax, bounds, off, shape3, bits, G=1):
     """Set the plateau bits (speed ``vmax``) of every slab in its own padded layout (slab
-    ``k`` from byte ``off[k] / 8`` of ``bits``); returns how many nodes have ``vmax``."""
-    _, ny, nz = (int(n) for n in shape3)
+    ``k`` from byte ``off[k] / 8`` of ``bits``; the rows that :func:`_padded_rows` pads);
+    returns how many nodes have ``vmax`` (with ``G = 2`` the rows next to a cut twice)."""
+    nx, ny, nz = (int(n) for n in shape3)
     plane = ny * nz
+    sx = (ny + 2) * (nz + 2 if nz > 1 else 1)
     count = 0
     for k in range(len(bounds) - 1):
         a, b = int(bounds[k]), int(bounds[k + 1])
-        count += _kernels.plateau_bits(speed[a * plane:b * plane], vmax, b - a, ny, nz,
-                                       bits[int(off[k]) >> 3:])
+        ra, rb, p0 = _padded_rows(a, b, nx, G)
+        pos = int(off[k]) + p0 * sx
+        if pos % 8 == 0:
+            count += _kernels.plateau_bits(speed[ra * plane:rb * plane], vmax, rb - ra, ny, nz,
+                                           bits[pos >> 3:])
+        else:  # the first slab of order 2: its grid starts one row into its bits
+            part = np.zeros((rb - ra + 2) * sx // 8 + 1, dtype=np.uint8)
+            count += _kernels.plateau_bits(speed[ra * plane:rb * plane], vmax, rb - ra, ny, nz,
+                                           part)
+            _or_bits_at(bits, part, pos, (rb - ra + 2) * sx)
     return count
+
+
+@njit(cache=True, _nrt=False)
+def _or_bits_at(dst, src, pos, m):
+    """Set bit ``pos + i`` of ``dst`` for every set bit ``i < m`` of ``src``."""
+    for i in range(m):
+        if (src[i >> 3] >> (i & 7)) & 1:
+            j = pos + i
+            dst[j >> 3] |= np.uint8(1 << (j & 7))
 
 
 def _grow_pools(pool, nxt, st):

@@ -182,11 +182,12 @@ def fast_marching(
     threads : int, optional
         Threads the march may use (``>= 1``). None (default): the environment
         variable ``FM2UAV_THREADS`` if set, else every core this process may run
-        on. With 2 or more, order 1 without ``stop_at`` on grids of at least
-        ``PARALLEL_MIN_NODES`` (1 M) nodes marches slabs of the grid in parallel
-        (:mod:`fm2uav.eikonal._parallel`; times equal to the serial march's to
-        round-off, ``stop_at`` included); order 2, the wind march and smaller
-        grids march on one thread.
+        on. With 2 or more, a grid of at least ``PARALLEL_MIN_NODES`` (1 M) nodes
+        marches slabs of the grid in parallel, order 1 and 2 (3D order 2 from
+        ``ORDER2_MIN_NODES_3D``, 16.8 M), ``stop_at`` included
+        (:mod:`fm2uav.eikonal._parallel`; order 1's times equal the serial march's
+        to round-off, order 2's bit for bit on every case measured); the wind march
+        and smaller grids march on one thread.
 
     Returns
     -------
@@ -290,9 +291,11 @@ def run_march(
     Shared by :func:`fast_marching` and :func:`fm2uav.eikonal.restart.remarch`:
     nodes frozen on entry (state 2) are expanded first, band nodes (state 1)
     carry tentative times. ``stop_at`` as in :func:`fast_marching`; ``threads``
-    (resolved, ``>= 1``) as there: the parallel march for order 1 on grids of at
-    least :data:`~fm2uav.eikonal._parallel.PARALLEL_MIN_NODES` nodes; the serial march
-    sets up on them (:func:`~fm2uav.eikonal._kernels.march`).
+    (resolved, ``>= 1``) as there: the parallel march on grids of at least
+    :data:`~fm2uav.eikonal._parallel.PARALLEL_MIN_NODES` nodes when ``threads > 1`` (order 2
+    while :data:`~fm2uav.eikonal._parallel.ORDER2` is set, the default; in 3D from
+    :data:`~fm2uav.eikonal._parallel.ORDER2_MIN_NODES_3D` nodes), else the serial one,
+    which sets up on them (:func:`~fm2uav.eikonal._kernels.march`).
 
     Returns
     -------
@@ -307,9 +310,12 @@ def run_march(
         stops[:, : len(shape)] = idx
         if start.frozen_at(stops).all():  # every stop node is a source or in its ball
             return start.frozen_times(shape3).reshape(shape)
-    if threads > 1 and order == 1 and flat_speed.size >= _parallel.PARALLEL_MIN_NODES:
+    if (threads > 1 and (order == 1 or _parallel.ORDER2)
+            and flat_speed.size >= _parallel.PARALLEL_MIN_NODES
+            and (order == 1 or shape3[2] == 1
+                 or flat_speed.size >= _parallel.ORDER2_MIN_NODES_3D)):
         T, _ = _parallel.march(flat_speed, start, shape3, h3, threads,
-                               stops[~start.frozen_at(stops)])
+                               stops[~start.frozen_at(stops)], order=order)
     else:
         T, _ = _kernels.march(flat_speed, start, shape3, h3, order, stops, threads=threads)
     return T.reshape(shape)

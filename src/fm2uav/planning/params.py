@@ -264,11 +264,11 @@ class PlanOptions:
         memory and the world allows it, else "full".
     threads : int or None
         Threads of the Fast Marching runs (``>= 1``); None (default): the
-        environment variable ``FM2UAV_THREADS``, else every core. Order 1 on
-        grids of 1 M nodes or more marches in parallel (the same times to
-        round-off); see :func:`fm2uav.eikonal.fast_marching`. The distance
-        transform of W and the march's set-up on grids of 2 M nodes or more run
-        on as many (the same values bit for bit).
+        environment variable ``FM2UAV_THREADS``, else every core. Grids of 1 M
+        nodes or more march in parallel at order 1 and 2 (order 1: the same times
+        to round-off, order 2: bit for bit); see :func:`fm2uav.eikonal.fast_marching`.
+        The distance transform of W and the march's set-up on grids of 2 M nodes or
+        more run on as many (the same values bit for bit).
     """
 
     order: Literal[1, 2] = 2

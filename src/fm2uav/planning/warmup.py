@@ -14,8 +14,8 @@ dimension and order), ``descent`` (geodesic extraction), ``surface``
 (continuous clearance to a terrain surface), and two of big grids only, which
 call their kernels directly: ``edt_parallel`` (the distance map's lines in
 parallel) and ``fmm3d_o{1,2}_lean`` (the 3D march in the lean layout, see
-``fm2uav.eikonal._kernels.LEAN_NODES``); ``fmm{2,3}d_parallel`` (the order-1 march on
-both cores) compile both layouts. Numbers: docs/performance.md.
+``fm2uav.eikonal._kernels.LEAN_NODES``); ``fmm{2,3}d_parallel`` (the march on both cores,
+order 1 and 2, ``plan()``'s default) compile both layouts. Numbers: docs/performance.md.
 """
 
 from __future__ import annotations
@@ -82,25 +82,29 @@ def _fmm_lean(order: int) -> Callable[[], None]:
 
 
 def _fmm_parallel(ndim: int) -> Callable[[], None]:
-    """The order-1 march on both cores (grids of ``PARALLEL_MIN_NODES`` nodes and more), in
-    every layout (float64 ``V``: in 2D interleaved with ``T`` unless the speed is uniform,
-    whose separate arrays pad and unpad as other specialisations; and the lean float32
-    ``V`` of grids over ``LEAN_NODES`` padded nodes, e.g. a 1000x1000x40 terrain plan), its
-    size floors lowered for a 16-node-wide grid while it compiles; and the descent placing
-    the slab cuts (a 16-node grid is too thin to be cut)."""
+    """The march on both cores (grids of ``PARALLEL_MIN_NODES`` nodes and more), order 1 and
+    2 (unless ``_parallel.ORDER2`` is off), in every layout (float64 ``V``: in 2D interleaved
+    with ``T`` unless the speed is uniform, whose separate arrays pad and unpad as other
+    specialisations; and the lean float32 ``V`` of grids over ``LEAN_NODES`` padded nodes,
+    e.g. a 1000x1000x40 terrain plan), its size floors lowered for a 16-node-wide grid
+    while it compiles; and the descent placing the slab cuts (a 16-node grid is too thin to
+    be cut)."""
     def run() -> None:
         speed = np.ones((16,) * ndim)
         speed[(0,) * ndim] = 0.5  # a plateau with its mask (a uniform grid needs none)
         speeds = (speed, np.ones((16,) * ndim)) if ndim == 2 else (speed,)
         floor, lean = _parallel.PARALLEL_MIN_NODES, _kernels.LEAN_NODES
-        _parallel.PARALLEL_MIN_NODES = 0
+        floor2 = _parallel.ORDER2_MIN_NODES_3D
+        _parallel.PARALLEL_MIN_NODES = _parallel.ORDER2_MIN_NODES_3D = 0
         try:
             for lean_nodes in (lean, 0):
                 _kernels.LEAN_NODES = lean_nodes
                 for v in speeds:
-                    fast_marching(v, [(3,) * ndim], order=1, threads=2)
+                    for order in (1, 2) if _parallel.ORDER2 else (1,):
+                        fast_marching(v, [(3,) * ndim], order=order, threads=2)
         finally:
             _parallel.PARALLEL_MIN_NODES, _kernels.LEAN_NODES = floor, lean
+            _parallel.ORDER2_MIN_NODES_3D = floor2
         cum = np.cumsum(np.ones((5, 3), dtype=np.int64), axis=0)
         for shared in (False, True):
             _parallel._descend_cuts(cum, np.array([0, 2, 4], dtype=np.int64), 1, 2, shared)
