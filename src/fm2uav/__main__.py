@@ -16,11 +16,13 @@ import that takes time:
   without UTF-8, ``PYTHONIOENCODING=ascii``) is replaced instead of ending the
   run; a closed pipe (``fm2uav --help | head -1``) ends it quietly.
 
-Then, for ``fm2uav plan`` / ``fm2uav run`` on a cold numba cache, the notice
-"compiling kernels, first use only, ~N s" (:func:`fm2uav._jit.likely_cold`: a
-few ms, numba not imported), so it is the first thing on screen; the
-compilation itself (in two processes for ``plan``) starts once the arguments
-are parsed (:mod:`fm2uav.cli._first_use`): a bad flag compiles nothing.
+Then, for ``fm2uav plan`` on a cold numba cache, the notice "compiling kernels,
+first use only, ~N s" (:func:`fm2uav._jit.likely_cold`: ~30 ms, numba not
+imported), so it is the first thing on screen; the compilation itself (in two
+processes) starts once the arguments are parsed (:mod:`fm2uav.cli._first_use`):
+a bad flag compiles nothing. ``fm2uav run`` says it once its mission file is read
+and valid (:func:`fm2uav.cli._first_use.announce_compile` in the command): a
+mission-file error answers without the cache check.
 
 The command line proper is :mod:`fm2uav.cli`, which imports only typer and
 rich: ``fm2uav --help``, ``fm2uav plan --help`` and a bad flag answer without
@@ -34,8 +36,9 @@ import os
 import signal
 import sys
 
-#: Commands whose first run compiles kernels (the notice is shown before anything else).
-_COMPILING_COMMANDS = ("plan", "run")
+#: Commands whose first run compiles kernels and whose notice is shown before anything else
+#: (``run`` shows it after reading its mission file: a file's error answers sooner).
+_COMPILING_COMMANDS = ("plan",)
 
 
 def _printable_streams() -> None:

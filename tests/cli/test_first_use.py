@@ -32,3 +32,49 @@ def test_a_cold_cache_says_so_once(monkeypatch, capsys):
     err = capsys.readouterr().err
     assert err.count("compiling kernels, first use only") == 1
     assert _jit.announced()
+
+
+def test_run_checks_the_cache_once_its_mission_file_is_valid(monkeypatch, tmp_path):
+    # `fm2uav run`: the notice (and its cache check) comes after the mission file is read
+    import typer
+    from typer.testing import CliRunner
+
+    from fm2uav.cli import app
+
+    calls = []
+
+    def spy(**kwargs):
+        calls.append(kwargs)
+        raise typer.Exit(0)  # the plan itself is not this test's
+
+    monkeypatch.setattr(_first_use, "announce_compile", spy)
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("world:\n  scenario: city\nplanner:\n  alpha: -3\n", encoding="utf-8")
+    res = CliRunner().invoke(app, ["run", str(bad), "--out", str(tmp_path / "a")])
+    assert res.exit_code == 2 and "planner.alpha" in " ".join(res.output.split())
+    assert calls == []
+    res = CliRunner().invoke(app, ["run", "examples/open_field_tff.yaml", "--quiet",
+                                   "--out", str(tmp_path / "b")])
+    assert res.exit_code == 0, res.output
+    assert calls == [{"quiet": True}]
+    assert not (tmp_path / "a").exists()
+
+
+def test_a_mission_file_error_on_a_cold_cache_prints_no_compile_notice(tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("world:\n  scenario: city\nplanner:\n  alpha: -3\n", encoding="utf-8")
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cold")}
+    res = subprocess.run([sys.executable, "-m", "fm2uav", "run", str(bad)], env=env,
+                         capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    assert res.returncode == 2
+    assert "planner.alpha" in res.stderr and "Traceback" not in res.stderr
+    assert "compiling kernels" not in res.stderr
+    # the cache is cold for that process indeed (the check above can fail)
+    res = subprocess.run([sys.executable, "-c", "from fm2uav import _jit; "
+                          "print(_jit.likely_cold())"], env=env, capture_output=True,
+                         text=True, timeout=120)
+    assert res.stdout.split() == ["True"], res.stderr

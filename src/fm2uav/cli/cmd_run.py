@@ -99,6 +99,7 @@ def run_cmd(
     from ..pipeline.outputs import flown
     from ..pipeline.rows import returns_rows
     from ..pipeline.run import run_mission
+    from ._first_use import announce_compile
 
     returns.check()
     points = point_overrides(start=start, goal=goal, lonlat=lonlat) or {}
@@ -108,6 +109,7 @@ def run_cmd(
         points["return"] = mission.return_to_start
     m = load_mission(mission_file, world_overrides=world.overrides(),
                      point_overrides=points or None)
+    announce_compile(quiet=output.quiet)  # on a cold cache, once the mission file is valid
     options = mission.export_options(m.export_options())
     # outputs.dir is relative to the mission file, like every path in it (io/mission.py)
     target = output.out or m.output_dir() or Path("out") / mission_file.stem
