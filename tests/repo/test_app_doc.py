@@ -30,11 +30,12 @@ def test_the_guide_shows_the_three_steps():
 
 
 def _workspace(path: Path) -> Path:
-    """A folder laid out as the guide's reader has it (``.venv``: the environment running the
-    tests, ``examples/``: the repository's), so the commands write into it and never into the
-    checkout's ``out/``."""
+    """A folder laid out as the guide's reader has it after ``make run`` (``.venv``: the
+    environment running the tests, ``examples/``: the repository's, ``out/``: made by
+    ``make run``), so the commands write into it and never into the checkout's ``out/``."""
     (path / ".venv").symlink_to(Path(sys.prefix))
     (path / "examples").symlink_to(ROOT / "examples")
+    (path / "out").mkdir()
     return path
 
 
