@@ -33,6 +33,15 @@ def data(tmp_path_factory):
             "coast": gd.topo_bathy(d / "coast.tif"), "dir": d}
 
 
+@pytest.fixture(scope="module")
+def plan_4326(data):
+    """The output folder of ``fm2uav plan`` on the lon/lat DEM (BBOX, lon/lat points, 120 m
+    AGL, 200 m cells), run once for the module: the tests that want this plan read it."""
+    out, _ = _ok(["plan", "--dem", str(data["4326"]), "--bbox", BBOX, *PTS, "--agl", "120",
+                  *FAST], data["dir"], "plan_4326")
+    return out
+
+
 def _ok(args, tmp_path, name):
     out = tmp_path / name
     res = runner.invoke(app, [*args, "--out", str(out)])
@@ -49,11 +58,10 @@ def _error(args, tmp_path):
     return lines[0]
 
 
-def test_plan_on_a_lonlat_dem_records_where_it_is(data, tmp_path):
+def test_plan_on_a_lonlat_dem_records_where_it_is(data, plan_4326, tmp_path):
     msg = _error(["plan", "--dem", str(data["4326"]), *PTS, "--agl", "120"], tmp_path)
     assert "--bbox W,S,E,N" in msg and "--nodata fill" in msg  # nodata outside the border
-    out, _ = _ok(["plan", "--dem", str(data["4326"]), "--bbox", BBOX, *PTS, "--agl", "120",
-                  *FAST], tmp_path, "p")
+    out = plan_4326
     s = json.loads((out / "summary.json").read_text())
     g = s["world"]["georef"]
     assert g["epsg"] == 32632 and g["crs"] == "EPSG:32632" and g["vertical_assumed"]
@@ -66,12 +74,11 @@ def test_plan_on_a_lonlat_dem_records_where_it_is(data, tmp_path):
     assert path.shape[1] == 3 and len(path) > 10
 
 
-def test_web_mercator_and_lonlat_dems_plan_the_same_length(data, tmp_path):
-    lengths = {}
-    for k in ("4326", "3857"):
-        out, _ = _ok(["plan", "--dem", str(data[k]), "--bbox", BBOX, *PTS, "--agl", "120",
-                      *FAST], tmp_path, k)
-        lengths[k] = json.loads((out / "summary.json").read_text())["length_m"]
+def test_web_mercator_and_lonlat_dems_plan_the_same_length(data, plan_4326, tmp_path):
+    lengths = {"4326": json.loads((plan_4326 / "summary.json").read_text())["length_m"]}
+    out, _ = _ok(["plan", "--dem", str(data["3857"]), "--bbox", BBOX, *PTS, "--agl", "120",
+                  *FAST], tmp_path, "3857")
+    lengths["3857"] = json.loads((out / "summary.json").read_text())["length_m"]
     assert lengths["3857"] == pytest.approx(lengths["4326"], rel=0.01), lengths
 
 
@@ -169,20 +176,22 @@ def test_mission_file_world_section_and_run_overrides(data, tmp_path):
 
 
 @pytest.mark.slow
-def test_tune_formation_cover_and_check_take_the_world_options(data, tmp_path):
+def test_tune_formation_cover_and_check_take_the_world_options(data, plan_4326, tmp_path):
     dem = ["--dem", str(data["4326"]), "--bbox", BBOX]
     out, res = _ok(["tune", *dem, *PTS, "--agl", "120", *FAST, "--p1", "0.5", "--p2", "1.3"],
                    tmp_path, "tune")
     assert json.loads((out / "tune.json").read_text())["world"]["georef"]["epsg"] == 32632
-    small = ["--dem", str(data["4326"]), "--bbox", "10.05,45.54,10.12,45.60"]
+    # a formation on a 3 x 4 km corner of the DEM (64 x 79 cells of 50 m: what is checked is
+    # that the world options reach it, in lon/lat, and that it completes there)
+    small = ["--dem", str(data["4326"]), "--bbox", "10.05,45.54,10.09,45.575"]
     out, _ = _ok(["formation", *small, "--lonlat", "--start", "10.06,45.55", "--goal",
-                  "10.11,45.59", "--agl", "150", "--cell-size", "50", "--no-gif"],
+                  "10.08,45.565", "--agl", "150", "--cell-size", "50", "--no-gif"],
                  tmp_path, "formation")
     s = json.loads((out / "summary.json").read_text())
     assert s["world"]["crs"] == "EPSG:32632" and s["completed"]
+    assert s["world"]["shape"][:2] == [64, 79]  # the bbox given, not the whole DEM
     # check the planned path against the same world
-    plan_out, _ = _ok(["plan", *dem, *PTS, "--agl", "120", *FAST], tmp_path, "p")
-    out, _ = _ok(["check", str(plan_out / "path.csv"), "--airframe", "disco", *dem, *FAST],
+    out, _ = _ok(["check", str(plan_4326 / "path.csv"), "--airframe", "disco", *dem, *FAST],
                  tmp_path, "check")
     rep = json.loads((out / "report.json").read_text())
     assert rep["world"]["georef"]["epsg"] == 32632

@@ -576,6 +576,21 @@ def run_docs(ws: Workspace, docs: list[Path] = DOCS) -> dict[str, BlockResult]:
     return done
 
 
+def runs_by_out(runs: dict[str, BlockResult], doc: Path) -> dict[str, Result]:
+    """The commands of ``doc``'s bash blocks as :func:`run_docs` made them, by the output folder
+    they name (``--out out/sorties`` -> ``"out/sorties"``; :attr:`Result.out` is that folder in
+    the workspace)."""
+    found = {}
+    for r in runs.values():
+        if r.block.doc != doc or r.block.kind != "bash":
+            continue
+        for res in r.results:
+            out = _option(shlex.split(res.command, comments=True), "--out")
+            if out is not None:
+                found[out] = res
+    return found
+
+
 def _run_block(b: Block, ws: Workspace, namespace: dict, r: BlockResult) -> None:
     if b.marked("skip") and not b.marked("skip")[0].text:
         return

@@ -2,36 +2,24 @@
 (tests/repo/docs_run.py says how each kind of block is run and checked; tests/README.md,
 "Docs that run", says how to mark a block).
 
-The documents run once per session (``doc_runs``), in one workspace; each block is one test
-case, so a failure names the document and line of the block. ``-k operator.md`` runs README.md
-and docs/operator.md only.
+The documents run once per session (``doc_runs``, tests/repo/conftest.py), in one workspace;
+each block is one test case, so a failure names the document and line of the block.
+``-k operator.md`` runs README.md and docs/operator.md only.
 """
 
 from __future__ import annotations
 
+from pathlib import Path
+from types import SimpleNamespace
+
 import pytest
 
-from . import docs_data
-from .docs_run import (DOCS, LANGS, Workspace, _claims, all_blocks, blocks, check_claim,
-                       commands, parse_marker, run_docs, run_python, text_lines_found,
-                       with_markers)
+from .conftest import README, pages_wanted
+from .docs_run import (DOCS, LANGS, BlockResult, Result, _claims, all_blocks, blocks,
+                       check_claim, commands, parse_marker, run_python, runs_by_out,
+                       text_lines_found, with_markers)
 
 BLOCKS = all_blocks()
-
-
-@pytest.fixture(scope="session")
-def doc_runs(request, tmp_path_factory, cli_once):
-    """Every block of the pages this session tests (README.md always: later pages use its
-    outputs), in order, in one workspace."""
-    ws = Workspace(tmp_path_factory.mktemp("docs"), cli_once, docs_data.FILES,
-                   docs_data.PRODUCERS)
-    for name, make in docs_data.OVERRIDES.items():
-        make(ws.path / name)
-    wanted = {b.doc for b in BLOCKS if any(
-        getattr(item, "callspec", None) is not None and item.callspec.params.get("block") is b
-        and item.originalname == "test_the_block_runs_as_written"
-        for item in request.session.items)}
-    return run_docs(ws, [d for d in DOCS if d in wanted or d.name == "README.md"])
 
 
 @pytest.mark.slow
@@ -135,3 +123,36 @@ def test_markers_are_read_and_need_reasons(tmp_path):
         parse_marker('skip "x"', "d.md:1")
     with pytest.raises(ValueError, match="unknown docs-run marker"):
         parse_marker("run it", "d.md:1")
+
+
+# ------------------------------------------------------------------ what the session runs
+def _item(name, *, block=None, fixtures=(), doc=None):
+    return SimpleNamespace(originalname=name, fixturenames=fixtures,
+                           callspec=SimpleNamespace(params={"block": block}) if block else None,
+                           module=SimpleNamespace(DOC=doc) if doc is not None else None)
+
+
+def test_the_session_runs_readme_the_selected_blocks_pages_and_the_pages_read():
+    op = next(b for b in BLOCKS if b.doc.name == "operator.md")
+    energy = next(d for d in DOCS if d.name == "energy.md")
+    wind = next(d for d in DOCS if d.name == "wind.md")
+    assert pages_wanted([]) == {README}
+    assert pages_wanted([_item("test_the_block_runs_as_written", block=op)]) == {README, op.doc}
+    # a module reading doc_runs brings its DOC; one not taking doc_runs, or whose DOC is text, not
+    assert pages_wanted([_item("test_x", fixtures=("doc_runs",), doc=energy),
+                         _item("test_y", fixtures=("tmp_path",), doc=wind),
+                         _item("test_z", fixtures=("doc_runs",), doc="docs/wind.md")]) == {
+        README, energy}
+
+
+def test_a_pages_runs_by_the_output_folder_they_name():
+    energy = next(b for b in BLOCKS if b.doc.name == "energy.md" and b.kind == "bash")
+    other = next(b for b in BLOCKS if b.doc.name == "wind.md" and b.kind == "bash")
+    res = [Result(".venv/bin/fm2uav cover --area S1 --out out/sorties  # why", 0, "", Path("a")),
+           Result(".venv/bin/python examples/make_flight_log.py", 0, ""),
+           Result("fm2uav plan --out=out/energy", 1, "", Path("b"))]
+    runs = {energy.id: BlockResult(energy, results=res),
+            other.id: BlockResult(other, results=[Result("fm2uav plan --out out/wind", 0, "")])}
+    found = runs_by_out(runs, energy.doc)
+    assert set(found) == {"out/sorties", "out/energy"}
+    assert found["out/sorties"].out == Path("a") and found["out/energy"].code == 1

@@ -5,13 +5,12 @@ Print the table with ``.venv/bin/python -m tests.repo.test_energy_doc``.
 
 from __future__ import annotations
 
-import os
 import re
-import shlex
-import subprocess
 from pathlib import Path
 
 import pytest
+
+from .docs_run import runs_by_out
 
 ROOT = Path(__file__).resolve().parents[2]
 DOC = ROOT / "docs" / "energy.md"
@@ -55,24 +54,18 @@ def test_the_python_block_runs():
         exec(compile(block, f"docs/energy.md python block {i + 1}", "exec"), {})
 
 
-def _commands() -> list[str]:
-    blocks = re.findall(r"```bash\n(.*?)```", DOC.read_text(), flags=re.S)
-    return [line.split("  #")[0].strip() for block in blocks for line in block.splitlines()
-            if line.strip()]
-
-
 @pytest.mark.slow
-def test_the_guides_commands_run():
-    env = {**os.environ, "COLUMNS": "200"}
-    for cmd in _commands():
-        args = shlex.split(cmd)
-        if args[0].endswith("fm2uav"):
-            args += ["--force", "--quiet"]
-        subprocess.run(args, cwd=ROOT, check=True, env=env, timeout=300)
-    assert (ROOT / "out" / "calibrate" / "power.yaml").is_file()
-    assert (ROOT / "out" / "sorties" / "sortie-03.waypoints").is_file()
-    assert not (ROOT / "out" / "sorties" / "sortie-04.waypoints").exists()
-    assert (ROOT / "out" / "energy" / "summary.json").is_file()
+def test_the_guides_commands_write_what_it_says(doc_runs):
+    """The guide's commands as the docs' run makes them (tests/repo/conftest.py; each exits 0,
+    test_docs_run.py) leave the files the guide names: the fitted model, three sorties where
+    equal parts need four, the energy plan."""
+    runs = runs_by_out(doc_runs, DOC)
+    assert {"out/calibrate", "out/energy", "out/sorties"} <= set(runs)
+    assert all(r.code == 0 for r in runs.values()), [r.output for r in runs.values()]
+    assert (runs["out/calibrate"].out / "power.yaml").is_file()
+    assert (runs["out/sorties"].out / "sortie-03.waypoints").is_file()
+    assert not (runs["out/sorties"].out / "sortie-04.waypoints").exists()
+    assert (runs["out/energy"].out / "summary.json").is_file()
 
 
 if __name__ == "__main__":

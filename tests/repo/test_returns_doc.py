@@ -7,9 +7,12 @@ Regenerate the table with ``.venv/bin/python -m tests.repo.test_returns_doc``.
 from __future__ import annotations
 
 import re
+import shlex
 from pathlib import Path
 
 import pytest
+
+from .docs_run import _without, commands
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "returns.md"
 BEGIN, END = "<!-- returns-table:begin -->", "<!-- returns-table:end -->"
@@ -81,9 +84,12 @@ OPERATOR = DOC.parent / "operator.md"
 
 
 def _block(doc: Path, after: str) -> list[str]:
+    """The arguments of the first command after the heading ``after``, as the docs' run
+    (tests/repo/docs_run.py) reads them."""
     text = doc.read_text()
     block = re.search(r"```bash\n(.*?)```", text[text.index(after):], re.S).group(1)
-    args = block.replace("\\\n", " ").split()
+    (command,) = commands(block)
+    args = shlex.split(command, comments=True)
     assert args[0] == ".venv/bin/fm2uav"
     return args[1:]
 
@@ -91,19 +97,14 @@ def _block(doc: Path, after: str) -> list[str]:
 @pytest.mark.slow
 @pytest.mark.parametrize("doc, after", [(DOC, "## Try it"),
                                         (OPERATOR, "## 10. Safe returns")])
-def test_the_docs_commands_run(tmp_path, doc, after):
-    from typer.testing import CliRunner
-
-    from fm2uav.cli import app
-
-    out = tmp_path / "returns"
-    args = [str(out) if a.startswith("out/") else a for a in _block(doc, after)]
-    res = CliRunner().invoke(app, args)
-    assert res.exit_code == 0, res.output
+def test_the_docs_commands_run(cli_once, doc, after):
+    # the run the docs' run makes of the same command (cli_once: once per session)
+    run = cli_once(_without(_block(doc, after), "--out"))
+    assert run.result.exit_code == 0, run.result.output
     for f in ("mission.param", "rally.waypoints", "rally.txt", "returns.geojson"):
-        assert (out / f).is_file(), f
+        assert (run.out / f).is_file(), f
     for row in ("longest way back", "rally points", "point of no return", "firmware return"):
-        assert row in res.output
+        assert row in run.result.output
 
 
 @pytest.mark.slow
