@@ -111,6 +111,7 @@ def test_without_its_groups_each_later_run_needs_what_they_compile(later_runs):
     assert {k for k, _ in uniform} & {k for k, _ in fm2 & first["fmm2d_o1"]}, (uniform, fm2)
 
 
+@pytest.mark.slow
 def test_a_later_process_loads_what_the_warm_up_command_wrote(tmp_path):
     # the one cold cache: the cheapest group. Empty, the probe would compile (it stops at
     # the first compile); after `python -m fm2uav.planning.warmup GROUP`, a later process
