@@ -17,6 +17,13 @@ a later process finds each in the cache. It is tested in parts that each can fai
   lowers read inside a kernel (globals are frozen into the compiled code, not keyed);
 * one cold cache (``NUMBA_CACHE_DIR``): ``python -m fm2uav.planning.warmup`` writes, a later
   process loads and compiles nothing.
+
+On the suite's warm cache the probe only loads kernels (seconds); on a fresh checkout its
+first process compiles every group, as the rest of the suite would. It shares the cache with
+the other workers: numba rewrites a kernel's whole index when it adds an entry, so two
+processes compiling two signatures of one kernel at the same moment can drop one entry (a
+later process compiles it again); only a cold cache compiles, so only a fresh checkout's
+first run can meet this.
 """
 
 from __future__ import annotations
