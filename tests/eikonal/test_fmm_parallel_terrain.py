@@ -1,8 +1,7 @@
 """The parallel march on a terrain's FM² map, as a plan marches it (issue 27).
 
 The 1000 x 1000 x 40 terrain plan marches order 2 from the goal with ``stop_at`` the start,
-on two threads in the lean layout (float32 ``1 / speed^2``): its cuts are placed for the
-slabs shared before each window (``_parallel.SHARED_CUTS_3D_O2``), a second thread faults the
+on two threads in the lean layout (float32 ``1 / speed^2``): a second thread faults the
 buffers' pages in while the cuts are placed (``_parallel._PageToucher``) and the nodes after
 the stop are set to inf on the threads (``_parallel._inf_after``). Here the same path on a
 small terrain, its times bit for bit the serial march's. Speed: docs/performance.md "Both
@@ -40,7 +39,7 @@ def lean(monkeypatch):
 
 def test_terrain_march_with_a_stop_equals_the_serial_march_bit_for_bit(lean, monkeypatch):
     W, goal, start = _terrain()
-    calls = {"touched": 0, "inf_after": 0, "shared": []}
+    calls = {"touched": 0, "inf_after": 0, "cuts": 0}
 
     class Toucher(_parallel._PageToucher):
         def __enter__(self):
@@ -52,7 +51,7 @@ def test_terrain_march_with_a_stop_equals_the_serial_march_bit_for_bit(lean, mon
         return real_inf_after(nth, T, t)
 
     def bounds(*args):
-        calls["shared"].append(args[-1])
+        calls["cuts"] += 1
         return real_bounds(*args)
 
     real_inf_after, real_bounds = _parallel._inf_after, _parallel.slab_bounds
@@ -63,31 +62,11 @@ def test_terrain_march_with_a_stop_equals_the_serial_march_bit_for_bit(lean, mon
                            threads=1)
     par = fast_marching_parallel(W, [goal], spacing=(15.0, 15.0, 10.0), order=2,
                                  stop_at=[start])
-    # the plan's path through the slabs: pages touched, cuts for shared slabs, a stop
-    assert calls == {"touched": 1, "inf_after": 1, "shared": [True]}
+    # the plan's path through the slabs: pages touched while the cuts are placed, a stop
+    assert calls == {"touched": 1, "inf_after": 1, "cuts": 1}
     assert np.isfinite(par[start])
     assert np.isinf(par).sum() > (W == 0).sum()  # the stop left air nodes unfrozen
     assert np.array_equal(serial, par)  # bit for bit, inf where the serial march stopped
-
-
-def test_order_1_3d_keeps_the_interleaves_cuts_and_order_2_can_too(lean, monkeypatch):
-    # 3D order 1 (the 160^3 bench fields: shared cuts simulate worse there) passes no choice
-    # (SHARED_CUTS[3]); order 2 passes SHARED_CUTS_3D_O2, whatever it is set to
-    W, goal, start = _terrain(nx=40, ny=24, nz=10)
-    seen = []
-    real = _parallel.slab_bounds
-    monkeypatch.setattr(_parallel, "slab_bounds",
-                        lambda *args: seen.append(args[-1]) or real(*args))
-    for order, flag, want in [(1, True, None), (2, False, False), (2, True, True)]:
-        monkeypatch.setattr(_parallel, "SHARED_CUTS_3D_O2", flag)
-        seen.clear()
-        serial = fast_marching(W, [goal], order=order, threads=1)
-        par = fast_marching_parallel(W, [goal], order=order)
-        assert seen == [want], (order, flag)
-        if order == 2:
-            assert np.array_equal(serial, par)
-        else:
-            np.testing.assert_allclose(par, serial, rtol=1e-12)
 
 
 def test_inf_after_equals_numpys_masked_assignment():

@@ -19,9 +19,9 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
   ``K`` slabs, :data:`SLABS_PER_THREAD` per thread, thread ``t`` marching slabs
   ``t, t + threads, ...`` (interleaved strips keep both threads busy when the
   wave starts off-centre, and a coarse march places the cuts, :func:`slab_bounds`; in 2D
-  and 3D order 2 for the slabs shared before each window where that shortens the windows,
-  :data:`SHARED_CUTS`, :data:`SHARED_CUTS_3D_O2`; in the lean layout a second thread faults
-  the buffers' pages in meanwhile, :class:`_PageToucher`),
+  for the slabs shared before each window where that shortens the windows,
+  :data:`SHARED_CUTS`; in the lean layout a second thread faults the buffers' pages in
+  meanwhile, :class:`_PageToucher`),
   unless sharing them longest first by the last window's freezes promises a shorter
   window (:func:`_assign`, before every window). The set-up pads the slabs in parallel
   (:func:`_pad_slabs`) and the result is unpadded so (:func:`_unpad_slabs`).
@@ -1262,21 +1262,15 @@ COARSE_3D_Z = 4
 #: (windows of 32768 nodes in time order, the slabs shared as :func:`_assign`), 8 slabs:
 #: windows' balance 1.78 -> 1.84 (16 slabs 1.83 -> 1.84). 3D keeps the interleave's cuts
 #: (simulated on the bench's 160^3 fields, order 1: constant and smooth speed the same cuts,
-#: FM²-shaped 1.921 -> 1.910), except order 2 (:data:`SHARED_CUTS_3D_O2`).
+#: FM²-shaped 1.921 -> 1.910; on the terrain plan's order-2 march 1.881 -> 1.922 measured,
+#: not taken yet: docs/performance.md).
 SHARED_CUTS = {2: True, 3: False}
-#: 3D order 2 (grids of :data:`ORDER2_MIN_NODES_3D` nodes and more) places the cuts for the
-#: shared slabs as 2D does: on the 1000 x 1000 x 40 terrain plan's march (the wave from a
-#: corner, sheared by the slow air near the ground) the windows' balance 1.881 -> 1.922
-#: (simulated from its times 1.884 -> 1.925; the same descent on the exact times' histogram
-#: 1.917), 257,000 nodes re-opened instead of 186,000, the two threads' CPU unchanged.
-SHARED_CUTS_3D_O2 = True
 #: Bins of the split estimate, each as many coarse nodes in time order (stand-ins for
 #: the windows).
 SPLIT_BINS = 256
 
 
-def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2,
-                shared: bool | None = None) -> np.ndarray:
+def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarray:
     """Row bounds (``k + 1`` ints) of ``k`` slabs along x, slab ``j`` marched by thread
     ``j % threads``.
 
@@ -1293,8 +1287,7 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2,
     descents with the shorter critical path when the bins' slabs are shared as
     :func:`_assign` shares them (:func:`_shared_cost`) are taken. Equal slabs when the
     start is not a few point sources (its box over a quarter of the grid) or the grid is
-    too thin for a coarse march. ``shared``: whether to try the second descent (default
-    :data:`SHARED_CUTS` of the grid's dimension).
+    too thin for a coarse march.
     """
     nx = int(shape3[0])
     even = np.linspace(0, nx, k + 1).round().astype(np.int64)
@@ -1310,9 +1303,7 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2,
     cum = np.vstack([np.zeros((1, hist.shape[1]), dtype=np.int64), np.cumsum(hist, axis=0)])
     cuts = np.clip(np.linspace(0, rows, k + 1).round().astype(np.int64), 0, rows)
     fixed = _descend_cuts(cum, cuts.copy(), gap, threads, False)
-    if shared is None:
-        shared = SHARED_CUTS[3 if shape3[2] > 1 else 2]
-    if shared:  # the better, by the windows as _assign
+    if SHARED_CUTS[3 if shape3[2] > 1 else 2]:  # the better, by the windows as _assign
         cuts = _descend_cuts(cum, cuts, gap, threads, True)  # shares the slabs
         if _shared_cost(cum, fixed, threads) <= _shared_cost(cum, cuts, threads):
             cuts = fixed
@@ -1533,12 +1524,11 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         # places the cuts (the coarse march: serial), the padding faults in the rest
         early = _kernels._buffers(speed, shape3, (nx + 2 * G * K) * sx + 8 * K, lean,
                                   interleave)
-    shared = SHARED_CUTS_3D_O2 if three and order == 2 else None
     if early is not None:
         with _PageToucher(early[0], early[1]):
-            bounds = slab_bounds(speed, start, shape3, h3, K, nth, shared)
+            bounds = slab_bounds(speed, start, shape3, h3, K, nth)
     else:
-        bounds = slab_bounds(speed, start, shape3, h3, K, nth, shared)
+        bounds = slab_bounds(speed, start, shape3, h3, K, nth)
     if np.diff(bounds).min() < G:  # only the neighbours' rows are exchanged
         bounds = np.linspace(0, nx, K + 1).round().astype(np.int64)
     rows = np.diff(bounds).astype(np.int64)
