@@ -20,7 +20,8 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
   ``t, t + threads, ...`` (interleaved strips keep both threads busy when the
   wave starts off-centre, and a coarse march places the cuts, :func:`slab_bounds`; in 2D
   for the slabs shared before each window where that shortens the windows,
-  :data:`SHARED_CUTS`),
+  :data:`SHARED_CUTS`; in the lean layout a second thread faults the buffers' pages in
+  meanwhile, :class:`_PageToucher`),
   unless sharing them longest first by the last window's freezes promises a shorter
   window (:func:`_assign`, before every window). The set-up pads the slabs in parallel
   (:func:`_pad_slabs`) and the result is unpadded so (:func:`_unpad_slabs`).
@@ -79,6 +80,7 @@ from __future__ import annotations
 import contextlib
 import math
 import os
+import threading
 
 import numpy as np
 from llvmlite import ir
@@ -90,7 +92,8 @@ from ._heap import sift_down, sift_up
 from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _ORDER2_MAX_W_RATIO, _U, _ZERO,
                        RESERVE_BLOCKS, BLOCK,
                        _at_plateau, _axis_term, _axis_term_u, _bits, _bucket, _prefetch, _combine,
-                       _pop, _push, _rhs, _side_min, _solve_iso, pad_grid, unpad_grid)
+                       _pop, _pop_ahead, _push, _rhs, _side_min, _solve_iso, pad_grid,
+                       unpad_grid)
 
 #: The windows meet at a barrier several hundred times per march: a thread that waits
 #: there sleeps instead of spinning (OpenMP's default spins), or on a busy machine the
@@ -271,6 +274,28 @@ def _deq(T, pool, nxt, bk, mw, st, rkey, ritem):
 
 
 @njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _deq_ahead(T, V, pool, nxt, bk, mw, st, rkey, ritem, s1, s2, pv):
+    """:func:`_deq`, fetching ahead the lines that expanding the nodes popped next from the
+    radix queue reads (:func:`~fm2uav.eikonal._kernels._pop_ahead`: ``s1``, ``s2`` the x
+    and y strides of a 3D slab, ``pv`` the speeds too); the same nodes, in the same order."""
+    size = st[_RSIZE]
+    if size > _ZERO:
+        c = ritem[0]
+        size -= _ONE
+        st[_RSIZE] = size
+        if size > _ZERO:
+            sift_down(rkey, ritem, rkey[:0], np.int64(size), rkey[size], ritem[size])
+        return c
+    c, nfree, fh, cur, last = _pop_ahead(T, V, pool, nxt, bk, mw, st[_NFREE], st[_FH],
+                                         st[_CUR], st[_LAST], s1, s2, pv)
+    st[_NFREE] = nfree
+    st[_FH] = fh
+    st[_CUR] = cur
+    st[_LAST] = last
+    return c
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
 def _update(T, V, U, use_u, qp, c, sx, sy, ih, hh, iso, three):  # noqa: PLR0913
     """The order-1 upwind time of node ``c`` from its frozen neighbours (as the serial march;
     ``1 / speed^2`` from the plateau register ``qp`` where the mask ``U`` says so)."""
@@ -309,18 +334,20 @@ def _prefetch_rows(T, V, c, sx, sy, three, pv):
 
 
 @njit(cache=True, inline="always", error_model="numpy", _nrt=False)
-def _lower(T, V, c, t, fixed, sx, sy, three, pv, pool, nxt, bk, mw, st, rkey, ritem, ctl):
+def _lower(T, V, c, t, fixed, sx, sy, three, pv, pool, nxt, bk, mw, st, rkey, ritem, ctl,
+           rows=True):
     """Give node ``c`` the time ``t`` if that is lower than its band or frozen time.
 
     A frozen node lowered is re-opened (band again), unless it was frozen on entry
     (bit ``c`` of ``fixed``: a source or its ball, final as in the serial march).
-    ``pv``: prefetch the speeds of a new band node's neighbours too (off the plateau).
+    ``rows``: prefetch the rows a new band node's freezing reads (``pv``: their speeds
+    too, off the plateau); the 3D order-2 window fetches around its next pops instead.
     """
     x = T[c]
     if x < 0.0:
         if t < -x:
             T[c] = -t
-            if x == -_INF:  # a new band node: fetch the rows its freezing reads (as _relax)
+            if rows and x == -_INF:  # a new band node: fetch the rows its freezing reads
                 _prefetch_rows(T, V, c, sx, sy, three, pv)
             _enq(_bits(t), c, pool, nxt, bk, mw, st, rkey, ritem)
     elif t < x and _fixed_at(fixed, c, sy, three) == _ZERO:
@@ -763,7 +790,10 @@ def _slab_kernels2(three):
         """Freeze the slab's queued nodes with a time below ``tw`` (resumable), order 2.
 
         As the order-1 window; the boundary lists hold the nodes frozen in the first and
-        last *two* own rows, and a frozen node's dependants include the nodes two away.
+        last *two* own rows, and a frozen node's dependants include the nodes two away. In
+        3D it pops as the serial 3D march (:func:`_deq_ahead`: the lines the next pops read
+        fetched ahead) and fetches no rows for new band nodes (on the terrain march the
+        windows' CPU -8 %, docs/performance.md).
         """
         n = _U(T.size)
         g = sx + sx
@@ -785,7 +815,10 @@ def _slab_kernels2(three):
                 break
             heap = st[_RSIZE] > _ZERO
             kb = rkey[0] if heap else _ZERO
-            c = _deq(T, pool, nxt, bk, mw, st, rkey, ritem)
+            if three:  # fetch the lines the next pops read, as the serial 3D march
+                c = _deq_ahead(T, V, pool, nxt, bk, mw, st, rkey, ritem, sx, sy, not use_u)
+            else:
+                c = _deq(T, pool, nxt, bk, mw, st, rkey, ritem)
             if c == _NIL:
                 break
             if not heap:  # a lower bound of the popped key and of every key left
@@ -847,7 +880,7 @@ def _slab_kernels2(three):
                         s_nb, ih_nb = _ONE, ih[2]
                     ta, aa = _axis_term_at(T, V, U, use_u, fixed, nb, s_nb, ih_nb, t, sh)
                     _lower(T, V, nb, ta + math.sqrt(_rhs(V, U, use_u, qp, nb) / aa), fixed, sx,
-                           sy, three, pv, pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                           sy, three, pv, pool, nxt, bk, mw, st, rkey, ritem, ctl, not three)
                 elif y < 0.0:  # band (or far after c froze again): an own node
                     if full or _later_nb(T, fixed, nb, sx, sy, three, t):
                         # c frozen again, or a neighbour frozen later than c (a ghost ahead
@@ -861,7 +894,7 @@ def _slab_kernels2(three):
                         tn = _update2_at(T, V, U, use_u, qp, fixed, nb, sx, sy, ih, three, t)
                         if tn < -y:
                             _lower(T, V, nb, tn, fixed, sx, sy, three, pv, pool, nxt, bk, mw,
-                                   st, rkey, ritem, ctl)
+                                   st, rkey, ritem, ctl, not three)
                         elif (tn > -y and y > -_INF
                               and _entry_cap(eidx, evals, base + nb, tn) > -y):
                             _set_bit(sf, nb >> sh)
@@ -1221,12 +1254,16 @@ _DRIVES = {(d, o): _drive_kernel(d == 3, o) for d in (2, 3) for o in (1, 2)}
 #: every 8th / 16th / 32nd node / equal slabs, the coarse march 8 / 2 / 0.5 ms.
 COARSE = 16
 COARSE_3D = 4
+#: The coarse march's step along z in 3D (a terrain's layers are few: 40).
+COARSE_3D_Z = 4
 #: Whether the cuts are placed for the slabs shared anew before each window (the least
 #: share of a time bin any sharing allows, :func:`slab_bounds`) rather than for the fixed
 #: interleave. Simulated on the bench's FM²-shaped 2048^2 map from the serial times
 #: (windows of 32768 nodes in time order, the slabs shared as :func:`_assign`), 8 slabs:
 #: windows' balance 1.78 -> 1.84 (16 slabs 1.83 -> 1.84). 3D keeps the interleave's cuts
-#: (not measured there).
+#: (simulated on the bench's 160^3 fields, order 1: constant and smooth speed the same cuts,
+#: FM²-shaped 1.921 -> 1.910; on the terrain plan's order-2 march 1.881 -> 1.922 measured,
+#: not taken yet: docs/performance.md).
 SHARED_CUTS = {2: True, 3: False}
 #: Bins of the split estimate, each as many coarse nodes in time order (stand-ins for
 #: the windows).
@@ -1378,12 +1415,14 @@ def _shared_cost(cum, cuts, threads):
 
 def _coarse_histogram(speed, start, shape3, h3):
     """Nodes per coarse x-row and time bin of a march over every ``COARSE``-th node
-    (``COARSE_3D`` in 3D) from the start's frozen nodes: ``(hist, f)``, ``hist`` of shape
-    ``(coarse rows, SPLIT_BINS)`` and ``f`` the coarsening; ``(None, f)`` if no estimate."""
+    (``COARSE_3D`` in 3D, along z ``COARSE_3D_Z``) from the start's frozen nodes: ``(hist,
+    f)``, ``hist`` of shape ``(coarse rows, SPLIT_BINS)`` and ``f`` the x coarsening;
+    ``(None, f)`` if no estimate."""
     three = shape3[2] > 1
     f = COARSE_3D if three else COARSE
     grid = speed.reshape(shape3)
-    coarse = np.ascontiguousarray(grid[::f, ::f, ::f] if three else grid[::f, ::f, :])
+    fz = COARSE_3D_Z if three else 1
+    coarse = np.ascontiguousarray(grid[::f, ::f, ::fz])
     cshape = coarse.shape
     if cshape[0] < 4:
         return None, f
@@ -1392,7 +1431,7 @@ def _coarse_histogram(speed, start, shape3, h3):
         return None, f
     # the coarse nodes of the frozen ones (a mask over their box: a source ball on constant
     # speed holds ~33,000 nodes on 2048^2, and np.unique of rows took 38 ms of serial time)
-    cells = (box + np.asarray(start.lo)) // np.array([f, f, f if three else 1])
+    cells = (box + np.asarray(start.lo)) // np.array([f, f, fz])
     lo = cells.min(axis=0)
     bshape = tuple(int(n) for n in cells.max(axis=0) - lo + 1)
     frozen = np.zeros(bshape, dtype=bool)
@@ -1401,7 +1440,7 @@ def _coarse_histogram(speed, start, shape3, h3):
     Tb = np.where(frozen, 0.0, np.inf)
     sb = np.where(frozen, _kernels.FROZEN, 0).astype(np.uint8)
     cstart = _kernels.Start(tuple(int(a) for a in lo), bshape, Tb, sb)
-    hc = tuple(h * f for h in h3[:2]) + ((h3[2] * f,) if three else (h3[2],))
+    hc = (h3[0] * f, h3[1] * f, h3[2] * fz)
     # read-only as fast_marching's speeds: the same specialisations (the warm-up's)
     T, _ = _kernels.march(_kernels._readonly(coarse.reshape(-1)), cstart, cshape, hc, 1,
                           np.zeros((0, 3), dtype=np.int64))
@@ -1474,22 +1513,39 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     G = 2 if order == 2 else 1  # ghost x-slabs on each side (the rows the stencil reads)
     K = max(1, min(K, nx // G))  # a slab at least as thick as its ghosts
     nth = min(nth, K)
-    bounds = slab_bounds(speed, start, shape3, h3, K, nth)
+    sx = (ny + 2) * (nz + 2) if three else ny + 2
+    sy = nz + 2 if three else 1
+    lean = (nx + 2) * sx > _kernels.LEAN_NODES  # V in float32 as the serial march
+    early = None
+    if lean and nth > 1:
+        # the lean layout's buffers are fresh mappings whose page faults (~0.4 CPU-s for
+        # the 42 M nodes of a 1000 x 1000 x 40 terrain) the padding takes; map them at
+        # their largest size now and fault them in on a second thread while this one
+        # places the cuts (the coarse march: serial), the padding faults in the rest
+        early = _kernels._buffers(speed, shape3, (nx + 2 * G * K) * sx + 8 * K, lean,
+                                  interleave)
+    if early is not None:
+        with _PageToucher(early[0], early[1]):
+            bounds = slab_bounds(speed, start, shape3, h3, K, nth)
+    else:
+        bounds = slab_bounds(speed, start, shape3, h3, K, nth)
     if np.diff(bounds).min() < G:  # only the neighbours' rows are exchanged
         bounds = np.linspace(0, nx, K + 1).round().astype(np.int64)
     rows = np.diff(bounds).astype(np.int64)
-    sx = (ny + 2) * (nz + 2) if three else ny + 2
-    sy = nz + 2 if three else 1
     sizes = (rows + 2 * G) * sx
     # slabs start at multiples of 8 nodes: each slab's bits of ``fixed`` start a byte
     off = np.concatenate([[0], np.cumsum(-(-sizes // 8) * 8)[:-1]]).astype(np.int64)
     npad = int(off[-1] + sizes[-1])
-    lean = (nx + 2) * sx > _kernels.LEAN_NODES  # V in float32 as the serial march
     # the serial march's buffers: in the lean layout plain mappings (the times compacted
     # in place below), else its kept ones (huge pages, no page faults on a repeat); a 2D
     # map not of one speed interleaved (Tk: node c's time at 2 c, its V at 2 c + 1; Tp and
     # Vp strided views of it) and without a plateau register, as the serial march
-    Tp, Vp, Tk, Vk, unit, plat = _kernels._buffers(speed, shape3, npad, lean, interleave)
+    if early is None:
+        Tp, Vp, Tk, Vk, unit, plat = _kernels._buffers(speed, shape3, npad, lean, interleave)
+    else:  # the lean layout: plain arrays, no plateau decided yet
+        Tp, Vp = early[0][:npad], early[1][:npad]
+        Tk, Vk, unit, plat = Tp, Vp, 1, None
+        del early
     plane = ny * nz
     boxes = _start_boxes(start, bounds, nx, G)
     with _threads(nth):
@@ -1603,7 +1659,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         with _threads(nth):
             _unpad_slabs(nth, Tp, bounds, off, ny, nz, T, G)
     if win[6] < np.inf:  # stopped: what the serial march would not have frozen yet
-        T[T > win[6]] = np.inf
+        with _threads(nth):
+            _inf_after(nth, T, win[6])
         sel = tuple(slice(a, a + m) for a, m in zip(start.lo, start.shape))
         box = T.reshape(shape3)[sel]  # nodes frozen on entry stay, whatever their time
         frozen = (start.state == _kernels.FROZEN).reshape(start.shape)
@@ -1637,6 +1694,17 @@ def _frozen_bits(Tp, rows, npad):
             packed = np.packbits(Tp[a8:int(b)] >= 0.0, bitorder="little")
             bits[a8 >> 3:(a8 >> 3) + packed.size] |= packed
     return bits
+
+
+@njit(cache=True, parallel=True, error_model="numpy")
+def _inf_after(nth, T, t):
+    """``T[T > t] = inf`` on ``nth`` threads (a stopped march: 40 M nodes took ~0.05 s on
+    one)."""
+    n = T.size
+    for k in prange(nth):
+        for i in range(k * n // nth, (k + 1) * n // nth):
+            if T[i] > t:
+                T[i] = np.inf
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
@@ -1822,3 +1890,41 @@ def _grow_heaps(rkey, ritem):
     rkey2[:, :cap] = rkey
     ritem2[:, :cap] = ritem
     return rkey2, ritem2
+
+
+@njit(cache=True, nogil=True, _nrt=False)
+def _touch(a, step):
+    """Write a zero every ``step`` bytes of ``a`` (uint8): the pages' faults, without the GIL."""
+    for i in range(0, a.size, step):
+        a[i] = 0
+
+
+class _PageToucher:
+    """Inside the block a second thread faults in the pages of the arrays given (in chunks
+    of :data:`TOUCH_CHUNK` bytes, in turn), stopping at the block's end; whatever it did
+    not reach faults in where it is first written (:func:`_pad_slabs`, on every thread)."""
+
+    def __init__(self, *arrays):
+        self.bufs = [a.view(np.uint8).reshape(-1) for a in arrays]
+        self.stop = threading.Event()
+        self.thread = threading.Thread(target=self._run, daemon=True)
+
+    def _run(self):
+        for buf in self.bufs:
+            for a in range(0, buf.size, TOUCH_CHUNK):
+                if self.stop.is_set():
+                    return
+                _touch(buf[a:a + TOUCH_CHUNK], 4096)
+
+    def __enter__(self):
+        self.thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self.stop.set()
+        self.thread.join()
+        return False
+
+
+#: Bytes faulted in per call of :func:`_touch` by :class:`_PageToucher` (its stop check).
+TOUCH_CHUNK = 16 * 2**20

@@ -86,9 +86,10 @@ def _fmm_parallel(ndim: int) -> Callable[[], None]:
     2 (unless ``_parallel.ORDER2`` is off), in every layout (float64 ``V``: in 2D interleaved
     with ``T`` unless the speed is uniform, whose separate arrays pad and unpad as other
     specialisations; and the lean float32 ``V`` of grids over ``LEAN_NODES`` padded nodes,
-    e.g. a 1000x1000x40 terrain plan), its size floors lowered for a 16-node-wide grid
-    while it compiles; and the descent placing the slab cuts (a 16-node grid is too thin to
-    be cut)."""
+    e.g. a 1000x1000x40 terrain plan, with the page toucher of its buffers), its size floors
+    lowered for a 16-node-wide grid while it compiles, stopped at a node as a plan's march
+    (the times after the stop set to inf on the threads); and the descent placing the slab
+    cuts (a 16-node grid is too thin to be cut)."""
     def run() -> None:
         speed = np.ones((16,) * ndim)
         speed[(0,) * ndim] = 0.5  # a plateau with its mask (a uniform grid needs none)
@@ -101,7 +102,8 @@ def _fmm_parallel(ndim: int) -> Callable[[], None]:
                 _kernels.LEAN_NODES = lean_nodes
                 for v in speeds:
                     for order in (1, 2) if _parallel.ORDER2 else (1,):
-                        fast_marching(v, [(3,) * ndim], order=order, threads=2)
+                        fast_marching(v, [(3,) * ndim], order=order, threads=2,
+                                      stop_at=[(12,) * ndim])
         finally:
             _parallel.PARALLEL_MIN_NODES, _kernels.LEAN_NODES = floor, lean
             _parallel.ORDER2_MIN_NODES_3D = floor2

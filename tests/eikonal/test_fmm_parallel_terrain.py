@@ -1,0 +1,104 @@
+"""The parallel march on a terrain's FM² map, as a plan marches it (issue 27).
+
+The 1000 x 1000 x 40 terrain plan marches order 2 from the goal with ``stop_at`` the start,
+on two threads in the lean layout (float32 ``1 / speed^2``): a second thread faults the
+buffers' pages in while the cuts are placed (``_parallel._PageToucher``) and the nodes after
+the stop are set to inf on the threads (``_parallel._inf_after``). Here the same path on a
+small terrain, its times bit for bit the serial march's. Speed: docs/performance.md "Both
+cores" (never timed here).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy import ndimage
+
+from fm2uav.eikonal import _kernels, _parallel, distance_map, fast_marching
+
+from .fmm_checks import fast_marching_parallel
+
+
+def _terrain(nx=48, ny=40, nz=14, seed=3):
+    """An FM² map over a smooth random relief: W = distance to the ground / its largest
+    (0 in the ground, rising into the air), as a plan's base map; the goal high in one corner,
+    the start in the opposite one."""
+    rng = np.random.default_rng(seed)
+    relief = ndimage.gaussian_filter(rng.standard_normal((nx, ny)), 4, mode="wrap")
+    ground = 1 + np.round((relief - relief.min()) / np.ptp(relief) * (nz // 2)).astype(int)
+    occ = np.arange(nz)[None, None, :] < ground[:, :, None]
+    d = distance_map(occ, spacing=(15.0, 15.0, 10.0))
+    return d / d.max(), (nx - 3, ny - 3, nz - 2), (2, 2, nz - 2)
+
+
+@pytest.fixture
+def lean(monkeypatch):
+    """The lean layout (float32 speeds) of big grids, on a small one."""
+    monkeypatch.setattr(_kernels, "LEAN_NODES", 0)
+
+
+def test_terrain_march_with_a_stop_equals_the_serial_march_bit_for_bit(lean, monkeypatch):
+    W, goal, start = _terrain()
+    calls = {"touched": 0, "inf_after": 0, "cuts": 0}
+
+    class Toucher(_parallel._PageToucher):
+        def __enter__(self):
+            calls["touched"] += 1
+            return super().__enter__()
+
+    def inf_after(nth, T, t):
+        calls["inf_after"] += 1
+        return real_inf_after(nth, T, t)
+
+    def bounds(*args):
+        calls["cuts"] += 1
+        return real_bounds(*args)
+
+    real_inf_after, real_bounds = _parallel._inf_after, _parallel.slab_bounds
+    monkeypatch.setattr(_parallel, "_PageToucher", Toucher)
+    monkeypatch.setattr(_parallel, "_inf_after", inf_after)
+    monkeypatch.setattr(_parallel, "slab_bounds", bounds)
+    serial = fast_marching(W, [goal], spacing=(15.0, 15.0, 10.0), order=2, stop_at=[start],
+                           threads=1)
+    par = fast_marching_parallel(W, [goal], spacing=(15.0, 15.0, 10.0), order=2,
+                                 stop_at=[start])
+    # the plan's path through the slabs: pages touched while the cuts are placed, a stop
+    assert calls == {"touched": 1, "inf_after": 1, "cuts": 1}
+    assert np.isfinite(par[start])
+    assert np.isinf(par).sum() > (W == 0).sum()  # the stop left air nodes unfrozen
+    assert np.array_equal(serial, par)  # bit for bit, inf where the serial march stopped
+
+
+def test_inf_after_equals_numpys_masked_assignment():
+    rng = np.random.default_rng(0)
+    T = rng.random(10_001)
+    T[::7] = np.inf
+    T[3::11] = np.nan  # unreachable nodes are inf; a NaN is left alone as numpy leaves it
+    want = T.copy()
+    want[want > 0.4] = np.inf
+    for nth in (1, 2, 3):
+        got = T.copy()
+        _parallel._inf_after(nth, got, 0.4)
+        np.testing.assert_array_equal(got, want)
+
+
+def test_touch_writes_a_zero_byte_every_step():
+    a = np.full(3 * 4096 + 5, 0xAB, dtype=np.uint8)
+    _parallel._touch(a, 4096)
+    assert np.flatnonzero(a == 0).tolist() == [0, 4096, 8192, 12288]
+    assert np.all(np.delete(a, [0, 4096, 8192, 12288]) == 0xAB)
+
+
+def test_page_toucher_touches_only_page_starts_and_stops_at_the_block_end():
+    # two arrays (the lean layout's float64 times and float32 speeds): wherever the thread
+    # got to before the block ended, it wrote zero bytes at page starts only
+    a = np.full(3 * _parallel.TOUCH_CHUNK + 4096, 0xAB, dtype=np.uint8).view(np.float64)
+    b = np.full(5000, 0xCD, dtype=np.uint8).view(np.float32)
+    with _parallel._PageToucher(a, b) as toucher:
+        pass
+    assert not toucher.thread.is_alive()
+    for arr, byte in ((a, 0xAB), (b, 0xCD)):
+        raw = arr.view(np.uint8)
+        zeros = np.flatnonzero(raw == 0)
+        assert np.all(zeros % 4096 == 0)
+        assert np.all(np.delete(raw, zeros) == byte)
