@@ -23,7 +23,7 @@ first process compiles every group, as the rest of the suite would. It shares th
 the other workers: numba rewrites a kernel's whole index when it adds an entry, so two
 processes compiling two signatures of one kernel at the same moment can drop one entry (a
 later process compiles it again); only a cold cache compiles, so only a fresh checkout's
-first run can meet this.
+first run can meet this, and the probe's runs are then made again (at most twice).
 """
 
 from __future__ import annotations
@@ -73,11 +73,20 @@ def later_runs():
     """The probe's runs on the suite's cache, one process each, one after the other: every
     group then every later run; the groups no later run needs beyond the others (``NEEDS``)
     then the same runs; no group, then a uniform 2D march and the 2D runs."""
-    full = json.loads(_probe([*warmup.GROUPS, "--", "run3d", "par3d", "uniform2d", "run2d",
-                              "par2d"]))
     needed = {g for gs in NEEDS.values() for g in gs}
-    short = json.loads(_probe([*(g for g in warmup.GROUPS if g not in needed), "--", *NEEDS]))
-    bare = json.loads(_probe(["--", "uniform2d", "run2d"]))
+    # a fresh checkout's first run: another worker compiling a signature of the same kernel
+    # at the same moment may drop an entry the probe wrote (module docstring); the runs are
+    # made again then, at most twice — the next run compiles and writes what was dropped,
+    # so a missing entry that is not such a race stays missing and fails the tests below
+    for _ in range(3):
+        full = json.loads(_probe([*warmup.GROUPS, "--", "run3d", "par3d", "uniform2d",
+                                  "run2d", "par2d"]))
+        short = json.loads(_probe([*(g for g in warmup.GROUPS if g not in needed), "--",
+                                   *NEEDS]))
+        bare = json.loads(_probe(["--", "uniform2d", "run2d"]))
+        if not (full["not_on_disk"] or any(r["compiled"] or r["not_on_disk"]
+                                           for r in (short, bare))):
+            break
     return full, short, bare
 
 
