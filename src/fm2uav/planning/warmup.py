@@ -107,6 +107,9 @@ def _fmm_parallel(ndim: int) -> Callable[[], None]:
         finally:
             _parallel.PARALLEL_MIN_NODES, _kernels.LEAN_NODES = floor, lean
             _parallel.ORDER2_MIN_NODES_3D = floor2
+        # the page toucher's kernel: on a grid this small its thread may be stopped before
+        # its first call (the cuts are placed at once), so it is compiled here
+        _parallel._touch(np.zeros(8, dtype=np.uint8), 4096)
         cum = np.cumsum(np.ones((5, 3), dtype=np.int64), axis=0)
         for shared in (False, True):
             _parallel._descend_cuts(cum, np.array([0, 2, 4], dtype=np.int64), 1, 2, shared)
