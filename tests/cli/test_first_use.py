@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from fm2uav import _jit
 from fm2uav.cli import _first_use
 from fm2uav.planning.warmup import GROUPS
@@ -53,7 +55,8 @@ def test_run_checks_the_cache_once_its_mission_file_is_valid(monkeypatch, tmp_pa
     res = CliRunner().invoke(app, ["run", str(bad), "--out", str(tmp_path / "a")])
     assert res.exit_code == 2 and "planner.alpha" in " ".join(res.output.split())
     assert calls == []
-    res = CliRunner().invoke(app, ["run", "examples/open_field_tff.yaml", "--quiet",
+    example = Path(__file__).resolve().parents[2] / "examples" / "open_field_tff.yaml"
+    res = CliRunner().invoke(app, ["run", str(example), "--quiet",
                                    "--out", str(tmp_path / "b")])
     assert res.exit_code == 0, res.output
     assert calls == [{"quiet": True}]
