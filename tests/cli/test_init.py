@@ -244,6 +244,7 @@ MISSION_HEAVY = ("numpy", "numba", "llvmlite", "scipy", "matplotlib", "plotly", 
                  "pyproj", "pyogrio", "dask", "PIL", "fm2uav.eikonal", "fm2uav.planning.planner",
                  "fm2uav.world.clearance", "fm2uav.world.dem", "fm2uav.world.buildings",
                  "fm2uav.autopilot.build", "fm2uav.io.exports",
+                 "fm2uav.autopilot.firmware.profile", "fm2uav.autopilot.firmware.registry",
                  "fm2uav.world.world", "fm2uav.world.geo", "fm2uav.scenarios.field",
                  "fm2uav.scenarios.city", "fm2uav.scenarios.coverage",
                  "fm2uav.viz", "fm2uav.experiments", "fm2uav.missions.coverage")

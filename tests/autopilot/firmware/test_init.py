@@ -22,7 +22,7 @@ from fm2uav.errors import InputError
 
 
 def test_every_profile_knows_every_airframe_and_its_mav_autopilot():
-    assert FIRMWARES == ("px4", "ardupilot", "generic")
+    assert FIRMWARES == ("px4", "ardupilot", "generic") == tuple(PROFILES)
     assert FIRMWARE_TYPES == {"px4": 12, "ardupilot": 3, "generic": 0}
     for p in PROFILES.values():
         assert set(p.commands) == set(VEHICLES) and p.rules

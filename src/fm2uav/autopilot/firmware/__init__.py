@@ -14,16 +14,23 @@ firmware's name (QGroundControl's ``FirmwarePlugin`` / ``MavCmdInfo`` JSON idea)
 * :data:`GENERIC` (``MAV_AUTOPILOT_GENERIC``): what both accept, with both sets
   of rules.
 
-A new firmware is one module here defining its profile, and one entry in
-:data:`PROFILES`.
+A new firmware is one module here defining its profile, its name in
+:data:`~fm2uav.autopilot.firmware.names.FIRMWARES` (read by the mission schema and the
+command line without building a profile) and one entry in :data:`PROFILES`.
 """
 
 from __future__ import annotations
 
-from ...errors import InputError
-from .ardupilot import ARDUPILOT
-from .profile import VEHICLE_TYPES, VEHICLES, FirmwareProfile, Problem, Rule, both
-from .px4 import PX4
+from typing import TYPE_CHECKING
+
+from ..._lazy import lazy_names
+from .names import FIRMWARES, VEHICLE_TYPES, VEHICLES, check_vehicle
+
+if TYPE_CHECKING:  # loaded on first attribute access (PEP 562): the names above build nothing
+    from .ardupilot import ARDUPILOT
+    from .profile import FirmwareProfile, Problem, Rule, both
+    from .px4 import PX4
+    from .registry import FIRMWARE_TYPES, GENERIC, PROFILES, firmware_profile, supported_commands
 
 __all__ = [
     "PROFILES",
@@ -42,45 +49,9 @@ __all__ = [
     "supported_commands",
 ]
 
-#: MAV_AUTOPILOT_GENERIC: a mission both PX4 and ArduPilot accept.
-GENERIC = both("generic", (PX4, ARDUPILOT), mav_autopilot=0)
-#: Firmware name → profile.
-PROFILES: dict[str, FirmwareProfile] = {p.name: p for p in (PX4, ARDUPILOT, GENERIC)}
-#: Firmware names the checkers know.
-FIRMWARES = tuple(PROFILES)
-#: Firmware name → MAV_AUTOPILOT (``.plan`` ``firmwareType``).
-FIRMWARE_TYPES = {name: p.mav_autopilot for name, p in PROFILES.items()}
-
-
-def firmware_profile(firmware: str) -> FirmwareProfile:
-    """The profile of ``firmware``.
-
-    Raises
-    ------
-    InputError
-        An unknown firmware, naming the mission-file key and CLI flag.
-    """
-    if firmware not in PROFILES:
-        raise InputError(f"firmware must be one of {', '.join(FIRMWARES)}, got {firmware!r} "
-                         "(mission file airframe.firmware, CLI --firmware)")
-    return PROFILES[firmware]
-
-
-def check_vehicle(vehicle: str) -> str:
-    """``vehicle`` if it is an airframe kind the profiles know (:data:`VEHICLES`).
-
-    Raises
-    ------
-    InputError
-        An unknown airframe kind, naming the mission-file key and CLI flag.
-    """
-    if vehicle not in VEHICLES:
-        raise InputError(f"vehicle must be one of {', '.join(VEHICLES)}, got {vehicle!r} "
-                         "(mission file airframe.type, CLI --vehicle)")
-    return vehicle
-
-
-def supported_commands(firmware: str, vehicle: str) -> frozenset[int]:
-    """``MAV_CMD`` ids the firmware flies in a mission on that airframe."""
-    profile = firmware_profile(firmware)
-    return profile.commands[check_vehicle(vehicle)]
+__getattr__, __dir__ = lazy_names(__name__, {
+    "PX4": ".px4", "ARDUPILOT": ".ardupilot",
+    "FirmwareProfile": ".profile", "Problem": ".profile", "Rule": ".profile", "both": ".profile",
+    "PROFILES": ".registry", "GENERIC": ".registry", "FIRMWARE_TYPES": ".registry",
+    "firmware_profile": ".registry", "supported_commands": ".registry",
+})

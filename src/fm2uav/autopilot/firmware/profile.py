@@ -13,15 +13,11 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
+from .names import VEHICLE_TYPES, VEHICLES
 from .navigation import FixedWingNav, SpeedCommand, merge_nav, merge_speed
 
 __all__ = ["VEHICLES", "VEHICLE_TYPES", "Problem", "Rule", "Param", "AltitudeParam",
            "ReturnModel", "FirmwareProfile", "both"]
-
-#: Airframe kinds the profiles know (mission file ``airframe.type``, CLI ``--vehicle``).
-VEHICLES = ("multirotor", "fixed_wing", "vtol")
-#: Airframe kind → MAV_TYPE (``.plan`` ``vehicleType``).
-VEHICLE_TYPES = {"fixed_wing": 1, "multirotor": 2, "vtol": 22}
 
 
 @dataclass(frozen=True)
