@@ -38,6 +38,7 @@ __all__ = [
     "formation_profiles_figure",
     "formation_metrics_figure",
     "formation_animation",
+    "gif_frames",
     "formation_report_html",
     "thesis_report_html",
     "MAX_FRAMES",
