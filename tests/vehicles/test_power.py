@@ -27,6 +27,22 @@ def test_induced_velocity_solves_the_momentum_equation():
                                -1.25 + math.sqrt(1.25 ** 2 + 6.3 ** 2), rtol=1e-12)
 
 
+def test_induced_velocity_is_the_same_bits_one_state_at_a_time_or_many():
+    """A few states are bisected with Python floats, more with array operations: each state's
+    result is the same to the last bit either way (and in any batch it comes in)."""
+    rng = np.random.default_rng(4)
+    v, vz = rng.uniform(0.0, 25.0, 300), rng.uniform(-8.0, 8.0, 300)
+    v[:40] = 0.0  # hover and axial climbs/descents
+    many = induced_velocity(v, vz, 6.3)
+    one = np.array([float(induced_velocity(a, c, 6.3)[()]) for a, c in zip(v, vz)])
+    pairs = np.concatenate([induced_velocity(v[k:k + 2], vz[k:k + 2], 6.3)
+                            for k in range(0, 300, 2)])
+    assert np.array_equal(many, one) and np.array_equal(many, pairs)
+    assert induced_velocity(v[:3], vz[:3], 6.3).shape == (3,)
+    assert induced_velocity(np.zeros((2, 3)), 1.0, 6.3).shape == (2, 3)
+    assert induced_velocity(0.0, 0.0, 6.3).shape == ()
+
+
 def test_multirotor_hover_power_is_momentum_theory_by_hand():
     t = QUAD.mass_kg * G
     vh = math.sqrt(t / (2 * QUAD.air_density * QUAD.disk_area_m2))

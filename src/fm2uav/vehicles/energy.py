@@ -281,7 +281,8 @@ def fly_legs(
     wind_at_wp = np.vstack([w[:1], w]) if n else np.zeros((len(p), 2))
     hold_air = (np.broadcast_to(v[:1] if n else [1.0], len(p)) if fixed
                 else np.hypot(wind_at_wp[:, 0], wind_at_wp[:, 1]))
-    hold_j = h * model.power(hold_air, 0.0)
+    # (no holds: no hover power to weigh, the zeros it would give)
+    hold_j = h * model.power(hold_air, 0.0) if np.any(h) else np.zeros(len(p))
     energy = np.where(ok, pw * t, np.inf) + hold_j[1:]
     t = t + h[1:]
     # vertical take-off and final descent

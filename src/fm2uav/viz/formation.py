@@ -38,6 +38,7 @@ __all__ = [
     "formation_profiles_figure",
     "formation_metrics_figure",
     "formation_animation",
+    "gif_frames",
     "formation_report_html",
     "thesis_report_html",
     "MAX_FRAMES",
@@ -282,13 +283,9 @@ def formation_animation(
     max_frames = check_frames(max_frames)
     path = Path(filename)
     suffix = "".join(path.suffixes[-1:]).lower()
-    if suffix == ".gif":
-        writer = animation.PillowWriter(fps=fps)
-    elif suffix == ".mp4":
-        if not animation.FFMpegWriter.isAvailable():
-            raise InputError("writing .mp4 needs ffmpeg, which is not installed; use a .gif name")
-        writer = animation.FFMpegWriter(fps=fps)
-    else:
+    if suffix == ".mp4" and not animation.FFMpegWriter.isAvailable():
+        raise InputError("writing .mp4 needs ffmpeg, which is not installed; use a .gif name")
+    if suffix not in (".gif", ".mp4"):
         raise InputError(f"animation file must end in .gif or .mp4, got {path.name!r}")
     world = result.world
     pos = result.positions
@@ -322,10 +319,57 @@ def formation_animation(
                        f"{result.shape_error[k]:.0f} m")
         return (*trails, goal_line, real_line, dots, label)
 
-    anim = animation.FuncAnimation(fig, draw, frames=frames, blit=False)
     path.parent.mkdir(parents=True, exist_ok=True)
-    anim.save(str(path), writer=writer, dpi=dpi)
+    if suffix == ".gif":
+        _save_gif(fig, draw, frames, path, fps=fps, dpi=dpi)
+        return path
+    anim = animation.FuncAnimation(fig, draw, frames=frames, blit=False)
+    anim.save(str(path), writer=animation.FFMpegWriter(fps=fps), dpi=dpi)
     return path
+
+
+def gif_frames(fig: Figure, draw: Any, frames: Any, *, dpi: int) -> list[Any]:
+    """The frames of an animation as RGBA Pillow images, the figure's still part drawn once.
+
+    ``draw(k)`` updates the figure for frame ``k`` and returns the artists it changed (as
+    for :class:`matplotlib.animation.FuncAnimation`). The figure is drawn once with those
+    artists left out (axes, ticks, labels, the terrain: what every frame shares); each frame
+    is that background with its artists drawn over it, in their order — the same picture as
+    a full redraw wherever no still artist lies above a changing one, at a fraction of the
+    cost (a full redraw lays out every tick label again, ~75 % of a formation GIF's time).
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from PIL import Image
+
+    fig.set_dpi(dpi)
+    canvas = FigureCanvasAgg(fig)
+    frames = list(frames)
+    changing = draw(frames[0]) if frames else ()
+    for a in changing:
+        a.set_animated(True)
+    try:
+        canvas.draw()
+        background = canvas.copy_from_bbox(fig.bbox)
+        size = canvas.get_width_height()
+        images = []
+        for k in frames:
+            artists = draw(k)
+            canvas.restore_region(background)
+            for a in sorted(artists, key=lambda a: a.get_zorder()):
+                fig.draw_artist(a)
+            images.append(Image.frombuffer("RGBA", size, bytes(canvas.buffer_rgba()), "raw",
+                                           "RGBA", 0, 1))
+    finally:
+        for a in changing:
+            a.set_animated(False)
+    return images
+
+
+def _save_gif(fig: Figure, draw: Any, frames: Any, path: Path, *, fps: int, dpi: int) -> None:
+    """Write :func:`gif_frames` as a looping GIF at ``fps`` (as matplotlib's PillowWriter)."""
+    images = gif_frames(fig, draw, frames, dpi=dpi)
+    images[0].save(path, save_all=True, append_images=images[1:], duration=int(1000 / fps),
+                   loop=0)
 
 
 def _duration(seconds: float) -> str:
