@@ -19,8 +19,9 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
   ``K`` slabs, :data:`SLABS_PER_THREAD` per thread, thread ``t`` marching slabs
   ``t, t + threads, ...`` (interleaved strips keep both threads busy when the
   wave starts off-centre, and a coarse march places the cuts, :func:`slab_bounds`; in 2D
-  for the slabs shared before each window where that shortens the windows,
-  :data:`SHARED_CUTS`; in the lean layout a second thread faults the buffers' pages in
+  and on 3D grids of at least :data:`SHARED_CUTS_MIN_NODES_3D` nodes for the slabs shared
+  before each window where that shortens the windows, :data:`SHARED_CUTS`; in the lean
+  layout a second thread faults the buffers' pages in
   meanwhile, :class:`_PageToucher`),
   unless sharing them longest first by the last window's freezes promises a shorter
   window (:func:`_assign`, before every window). The set-up pads the slabs in parallel
