@@ -102,3 +102,44 @@ def test_page_toucher_touches_only_page_starts_and_stops_at_the_block_end():
         zeros = np.flatnonzero(raw == 0)
         assert np.all(zeros % 4096 == 0)
         assert np.all(np.delete(raw, zeros) == byte)
+
+
+def test_big_3d_grids_cut_the_slabs_for_sharing_bit_for_bit(lean, monkeypatch):
+    """From ``SHARED_CUTS_MIN_NODES_3D`` nodes (the terrain plan's 40 M) a 3D march's cuts are
+    those placed for the slabs shared before each window, where the coarse march says their
+    windows are shorter (the terrain plan's order-2 march: balance 1.881 -> 1.922,
+    docs/performance.md); smaller 3D grids keep the interleave's cuts (the bench's 160^3
+    FM²-shaped field: other cuts, simulated worse). The times are the serial march's bit
+    for bit either way."""
+    W, goal, start = _terrain(nx=192, ny=40, nz=14)
+    h = (15.0, 15.0, 10.0)
+    # the coarse march over every node: on a grid this small, a coarser one leaves a few
+    # nodes per time bin, and both descents the same cuts
+    monkeypatch.setattr(_parallel, "COARSE_3D", 1)
+    monkeypatch.setattr(_parallel, "COARSE_3D_Z", 1)
+    seen = []
+    real = _parallel.slab_bounds
+
+    def spy(*args):
+        seen.append((args, real(*args)))
+        return seen[-1][1]
+
+    monkeypatch.setattr(_parallel, "slab_bounds", spy)
+    serial = fast_marching(W, [goal], spacing=h, order=2, stop_at=[start], threads=1)
+    below = fast_marching_parallel(W, [goal], spacing=h, order=2, stop_at=[start])
+    monkeypatch.setattr(_parallel, "SHARED_CUTS_MIN_NODES_3D", W.size)  # this grid: at it
+    at = fast_marching_parallel(W, [goal], spacing=h, order=2, stop_at=[start])
+    assert np.array_equal(serial, below) and np.array_equal(serial, at)
+    (args, cuts_below), (args_at, cuts_at) = seen
+    speed, st, shape3, h3, k, threads = args
+    assert k == 8 and threads == 2 and shape3 == W.shape
+    monkeypatch.setitem(_parallel.SHARED_CUTS, 3, False)
+    fixed = real(*args)  # the interleave's cuts
+    assert np.array_equal(cuts_below, fixed)
+    assert not np.array_equal(cuts_at, fixed)
+    # the shared cuts' windows, as _assign shares the slabs, are shorter on the coarse march
+    hist, f = _parallel._coarse_histogram(speed, st, shape3, h3)
+    cum = np.vstack([np.zeros((1, hist.shape[1]), dtype=np.int64), np.cumsum(hist, axis=0)])
+    assert f == 1
+    assert _parallel._shared_cost(cum, cuts_at, threads) < _parallel._shared_cost(cum, fixed,
+                                                                                 threads)

@@ -19,8 +19,9 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
   ``K`` slabs, :data:`SLABS_PER_THREAD` per thread, thread ``t`` marching slabs
   ``t, t + threads, ...`` (interleaved strips keep both threads busy when the
   wave starts off-centre, and a coarse march places the cuts, :func:`slab_bounds`; in 2D
-  for the slabs shared before each window where that shortens the windows,
-  :data:`SHARED_CUTS`; in the lean layout a second thread faults the buffers' pages in
+  and on 3D grids of at least :data:`SHARED_CUTS_MIN_NODES_3D` nodes for the slabs shared
+  before each window where that shortens the windows, :data:`SHARED_CUTS`; in the lean
+  layout a second thread faults the buffers' pages in
   meanwhile, :class:`_PageToucher`),
   unless sharing them longest first by the last window's freezes promises a shorter
   window (:func:`_assign`, before every window). The set-up pads the slabs in parallel
@@ -1260,11 +1261,16 @@ COARSE_3D_Z = 4
 #: share of a time bin any sharing allows, :func:`slab_bounds`) rather than for the fixed
 #: interleave. Simulated on the bench's FM²-shaped 2048^2 map from the serial times
 #: (windows of 32768 nodes in time order, the slabs shared as :func:`_assign`), 8 slabs:
-#: windows' balance 1.78 -> 1.84 (16 slabs 1.83 -> 1.84). 3D keeps the interleave's cuts
-#: (simulated on the bench's 160^3 fields, order 1: constant and smooth speed the same cuts,
-#: FM²-shaped 1.921 -> 1.910; on the terrain plan's order-2 march 1.881 -> 1.922 measured,
-#: not taken yet: docs/performance.md).
-SHARED_CUTS = {2: True, 3: False}
+#: windows' balance 1.78 -> 1.84 (16 slabs 1.83 -> 1.84). 3D from
+#: :data:`SHARED_CUTS_MIN_NODES_3D` nodes only (below, the interleave's cuts).
+SHARED_CUTS = {2: True, 3: True}
+#: 3D grids of fewer nodes keep the interleave's cuts: on the bench's 160^3 fields (order 1)
+#: constant and smooth speed get the same cuts either way, the FM²-shaped one other cuts
+#: that simulate worse (1.921 -> 1.910); the 1000 x 1000 x 40 terrain plan's order-2 march
+#: (40 M nodes) gets the shared cuts, measured 1.881 -> 1.922 (docs/performance.md). The
+#: size at which 3D order 2 marches on slabs (:data:`ORDER2_MIN_NODES_3D`): every 3D
+#: order-2 march on slabs is above it, the bench's 3D order-1 grids below.
+SHARED_CUTS_MIN_NODES_3D = ORDER2_MIN_NODES_3D
 #: Bins of the split estimate, each as many coarse nodes in time order (stand-ins for
 #: the windows).
 SPLIT_BINS = 256
@@ -1279,7 +1285,8 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarra
     windows' critical path (a source off-centre would otherwise leave one thread idle
     while the wave crosses the other's slabs), by coordinate descent from equal slabs
     (each cut in turn moved to its best row between its neighbours, until none moves;
-    exhaustive for two slabs). Where :data:`SHARED_CUTS` says so (2D) a second descent
+    exhaustive for two slabs). Where :data:`SHARED_CUTS` says so (2D; 3D grids of at least
+    :data:`SHARED_CUTS_MIN_NODES_3D` nodes, the terrain plan's) a second descent
     counts a thread's nodes in a bin not as the fixed interleave gives them but as the least
     any sharing of the slabs allows, ``max(the bin's busiest slab, the bin's nodes /
     threads)`` (the slabs are shared anew before each window, :func:`_assign`, and cuts
@@ -1303,8 +1310,11 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarra
     cum = np.vstack([np.zeros((1, hist.shape[1]), dtype=np.int64), np.cumsum(hist, axis=0)])
     cuts = np.clip(np.linspace(0, rows, k + 1).round().astype(np.int64), 0, rows)
     fixed = _descend_cuts(cum, cuts.copy(), gap, threads, False)
-    if SHARED_CUTS[3 if shape3[2] > 1 else 2]:  # the better, by the windows as _assign
-        cuts = _descend_cuts(cum, cuts, gap, threads, True)  # shares the slabs
+    three = shape3[2] > 1
+    shared = SHARED_CUTS[3 if three else 2] and not (
+        three and int(np.prod(shape3)) < SHARED_CUTS_MIN_NODES_3D)
+    if shared:  # the better, by the windows as _assign shares the slabs
+        cuts = _descend_cuts(cum, cuts, gap, threads, True)
         if _shared_cost(cum, fixed, threads) <= _shared_cost(cum, cuts, threads):
             cuts = fixed
     else:
