@@ -779,3 +779,91 @@ def test_cuts_for_shared_slabs_shorten_the_windows_on_an_fm2_map(monkeypatch):
         monkeypatch.setitem(_parallel.SHARED_CUTS, 2, shared)
         cuts[shared] = _parallel.slab_bounds(flat, start, shape3, (1.0,) * 3, 8, 2)
     assert np.array_equal(cuts[False], cuts[True])
+
+
+def test_slabs_taken_in_turn_are_ordered_by_predicted_work():
+    """``share=2`` (:data:`_parallel.DYNAMIC_2D`): every slab by decreasing predicted work
+    (ties in slab order), the counter the threads take them by at 0, the owners and the
+    returned flag those of the lists (``share=1``) for the statistics."""
+    rng = np.random.default_rng(1)
+    for _ in range(100):
+        nth = int(rng.integers(2, 5))
+        work = (rng.integers(0, 5, size=int(rng.integers(nth, 20))) * 100).astype(float)
+        slabs = np.full(work.size, -1, dtype=np.int64)
+        first = np.full(nth + 1 + work.size, -1, dtype=np.int64)
+        greedy = _parallel._assign(work, nth, slabs, first, np.empty(nth), 2)
+        assert list(slabs) == sorted(range(work.size), key=lambda k: (-work[k], k))
+        assert first[nth] == 0
+        slabs1 = np.full(work.size, -1, dtype=np.int64)
+        first1 = np.full(nth + 1 + work.size, -1, dtype=np.int64)
+        assert greedy == _parallel._assign(work, nth, slabs1, first1, np.empty(nth), 1)
+        assert np.array_equal(first[nth + 1:], first1[nth + 1:])
+
+
+@pytest.mark.parametrize("threads", [2, 3])
+def test_slabs_taken_in_turn_give_the_serial_times(threads, monkeypatch):
+    """2D order 1 takes the slabs in turn (the drive gets ``share=2``; 3D and order 2 keep
+    the lists): on many thin slabs, with repairs, ``stop_at`` and the lists for comparison,
+    the times are the serial march's; every slab is marched whichever thread takes it."""
+    monkeypatch.setattr(_parallel, "MIN_SLAB_NODES", 0)
+    monkeypatch.setattr(_parallel, "MIN_SLAB_ROWS", 4)
+    monkeypatch.setitem(_parallel.SLABS_PER_THREAD, 2, 9)
+    seen = []
+    for key in list(_parallel._DRIVES):
+        def spy(*args, _d=_parallel._DRIVES[key], _key=key):
+            seen.append((_key, args[33]))  # share
+            return _d(*args)
+        monkeypatch.setitem(_parallel._DRIVES, key, spy)
+    for name, v, src in _fields((131, 67)):
+        flat, start, shape3 = _start(v, src)
+        serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 1,
+                                   np.zeros((0, 3), dtype=int))
+        for dynamic in (True, False):
+            monkeypatch.setattr(_parallel, "DYNAMIC_2D", dynamic)
+            seen.clear()
+            T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, threads)
+            assert_equal_times(serial, T)
+            assert stats["slabs"] == 9 * min(threads, numba.config.NUMBA_NUM_THREADS), name
+            assert stats["windows"] > 3, name
+            assert {s for _, s in seen} == {2 if dynamic else 1}
+            assert 1.0 <= stats["balance"] <= threads + 1e-9
+            stop = np.array([[120, 60, 0]])
+            T, _ = _parallel.march(flat, start, shape3, (1.0,) * 3, threads, stop_cells=stop)
+            ref, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 1, stop)
+            # nodes tied with the stop node may be frozen or not, in the serial march too
+            # (as test_parallel_stop_at_freezes_what_the_serial_march_freezes)
+            differ = np.isfinite(ref) != np.isfinite(T)
+            assert np.all(np.where(np.isfinite(ref), ref, T)[differ] == ref[120 * 67 + 60])
+            both = np.isfinite(ref) & np.isfinite(T)
+            assert both.sum() > 0.3 * np.isfinite(ref).sum() > 0, name
+            assert_equal_times(ref[both], T[both])
+    v, src = fm2_shaped((61, 47, 1)[:2], seed=2)
+    flat, start, shape3 = _start(v, src)
+    seen.clear()
+    monkeypatch.setattr(_parallel, "DYNAMIC_2D", True)
+    _parallel.march(flat, start, shape3, (1.0,) * 3, threads, order=2)
+    assert {s for _, s in seen} == {1}  # order 2 keeps the lists
+
+
+def test_profile_accounts_for_every_region(monkeypatch):
+    """``_parallel.PROFILE``: ``stats["profile"]`` sums each region's busiest thread's CPU
+    and its wall time (the start, an exchange before every window and one after the last),
+    each thread's CPU per kind; the times stay the serial march's."""
+    monkeypatch.setattr(_parallel, "MIN_SLAB_NODES", 0)
+    monkeypatch.setattr(_parallel, "PROFILE", True)
+    v, src = fm2_shaped((257, 131), seed=1)
+    flat, start, shape3 = _start(v, src)
+    serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 1, np.zeros((0, 3), dtype=int))
+    T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, 2)
+    assert_equal_times(serial, T)
+    p = stats["profile"]
+    assert p["regions"] == 2 * stats["windows"] + 2
+    for kind in ("start", "exchange", "window"):
+        assert 0.0 < p[f"{kind}_max"] <= p[f"{kind}_wall"] + 1e-3
+    assert p["start_wall"] + p["exchange_wall"] + p["window_wall"] <= p["drive_wall"] + 1e-6
+    for kind in ("exchange", "window"):
+        assert len(p[f"{kind}_cpu"]) == 2
+        assert max(p[f"{kind}_cpu"]) <= p[f"{kind}_max"] + 1e-6
+        assert sum(p[f"{kind}_cpu"]) >= p[f"{kind}_max"] - 1e-6
+    monkeypatch.setattr(_parallel, "PROFILE", False)
+    assert "profile" not in _parallel.march(flat, start, shape3, (1.0,) * 3, 2)[1]
