@@ -208,7 +208,8 @@ def test_order_2_on_a_big_fm2_field_equals_the_serial_march_bit_for_bit(shape, m
     FM²-shaped map differed by up to 3e-11 relative.)"""
     v, src = fm2_shaped(shape, seed=3)
     assert v.size >= _parallel.PARALLEL_MIN_NODES
-    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_3D", 0)  # 3D: 16.8 M nodes by default
+    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_3D", 0)  # 16.8 M nodes by default
+    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_2D", 0)
     stats = {}
     march = _parallel.march
 
@@ -493,6 +494,7 @@ def test_small_grids_and_one_thread_march_serially(monkeypatch):
     fast_marching(np.ones((small, small)), [(0, 0)], order=1, threads=2)
     fast_marching(np.ones((small, small)), [(0, 0)], order=2, threads=2)
     monkeypatch.setattr(_parallel, "PARALLEL_MIN_NODES", 0)
+    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_2D", 0)
     fast_marching(np.ones((40, 40)), [(0, 0)], order=2, threads=1)
     fast_marching(np.ones((40, 40)), [(0, 0)], order=1, threads=1)
     monkeypatch.setenv("FM2UAV_THREADS", "1")
@@ -510,6 +512,13 @@ def test_small_grids_and_one_thread_march_serially(monkeypatch):
     monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_3D", v3.size)
     with pytest.raises(AssertionError, match="parallel march ran"):
         fast_marching(v3, [(0, 0, 0)], order=2)
+    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_2D", 40 * 40 + 1)  # 2D order 2's floor
+    fast_marching(np.ones((40, 40)), [(0, 0)], order=2)
+    with pytest.raises(AssertionError, match="parallel march ran"):
+        fast_marching(np.ones((40, 40)), [(0, 0)], order=1)
+    with pytest.raises(AssertionError, match="parallel march ran"):
+        fast_marching(np.ones((40, 41)), [(0, 0)], order=2)
+    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_2D", 0)
     monkeypatch.setattr(_parallel, "ORDER2", False)  # the switch back to a serial order 2
     fast_marching(np.ones((40, 40)), [(0, 0)], order=2)
     with pytest.raises(AssertionError, match="parallel march ran"):
@@ -827,6 +836,10 @@ def test_slabs_taken_in_turn_give_the_serial_times(threads, monkeypatch):
             assert stats["windows"] > 3, name
             assert {s for _, s in seen} == {2 if dynamic else 1}
             assert 1.0 <= stats["balance"] <= threads + 1e-9
+            # every slab marched once in every exchange and window, whoever took it: a slab
+            # taken twice, skipped, or a window's counter not reset changes these counts
+            assert stats["exchanges"] >= stats["windows"] + 1, name
+            assert np.all(stats["runs"] == stats["exchanges"] + stats["windows"]), name
             stop = np.array([[120, 60, 0]])
             T, _ = _parallel.march(flat, start, shape3, (1.0,) * 3, threads, stop_cells=stop)
             ref, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 1, stop)
@@ -867,3 +880,40 @@ def test_profile_accounts_for_every_region(monkeypatch):
         assert sum(p[f"{kind}_cpu"]) >= p[f"{kind}_max"] - 1e-6
     monkeypatch.setattr(_parallel, "PROFILE", False)
     assert "profile" not in _parallel.march(flat, start, shape3, (1.0,) * 3, 2)[1]
+
+
+def test_slabs_taken_in_turn_one_thread_after_the_other():
+    """:func:`_parallel._take`: in turn, the counter ``lists[nth]`` hands out 0, 1, 2, ...
+    whichever thread asks, until :func:`_parallel._took_all` (all ``K``); with lists, thread
+    ``t`` runs ``lists[t]:lists[t + 1]``. :func:`_parallel._in_turn`: the work each thread
+    gets when they take the slabs in that order, the next one whoever is free first (an
+    event simulation here)."""
+    nth, K = 3, 7
+    lists = np.array([0, 2, 5, 0] + [0] * K, dtype=np.int64)
+    got = {t: [] for t in range(nth)}
+    i = {t: -1 for t in range(nth)}
+    for t in [0, 2, 2, 1, 0, 1, 2, 0, 1, 0]:  # any order of asking
+        i[t] = _parallel._take(lists, nth, t, i[t], True)
+        if not _parallel._took_all(lists, nth, t, i[t], K, True):
+            got[t].append(int(i[t]))
+    assert sorted(sum(got.values(), [])) == list(range(K))
+    assert got == {0: [0, 4], 1: [3, 5], 2: [1, 2, 6]}
+    lists = np.array([0, 2, 5, K] + [0] * K, dtype=np.int64)
+    for t, (a, b) in enumerate([(0, 2), (2, 5), (5, 7)]):
+        j, mine = _parallel._take(lists, nth, t, -1, False), []
+        while not _parallel._took_all(lists, nth, t, j, K, False):
+            mine.append(int(j))
+            j = _parallel._take(lists, nth, t, j, False)
+        assert mine == list(range(a, b)), t
+    rng = np.random.default_rng(4)
+    for _ in range(200):
+        nth = int(rng.integers(2, 5))
+        work = rng.integers(0, 9, size=int(rng.integers(1, 20))).astype(float)
+        slabs = rng.permutation(work.size).astype(np.int64)
+        load = np.full(nth, -1.0)
+        _parallel._in_turn(work, slabs, load)
+        free = [0.0] * nth  # when each thread is free; the lowest first, ties by thread
+        for k in slabs:
+            t = min(range(nth), key=lambda t: (free[t], t))
+            free[t] += work[k]
+        assert list(load) == free

@@ -127,6 +127,18 @@ PARALLEL_MIN_NODES = 1_000_000
 #: slabs) CPU 0.97 -> 2.31 s, busiest thread 0.98 -> 1.34 s (0.73x: slower); the
 #: 1000 x 1000 x 40 terrain march (125-row slabs) busiest thread 10.4 -> 5.0 s.
 ORDER2_MIN_NODES_3D = 2**24
+#: 2D order 2 marches on slabs only from this many nodes (below: one thread, never slower).
+#: Its slab window costs more a node than the serial order-2 march (its neighbours' freeze
+#: order checked, :func:`_serial_time2`'s from-scratch repairs near the ghosts), which a
+#: bigger grid's memory traffic hides. Measured (3 December 2026, load 6-7, medians of 3,
+#: CPU times): 2048^2 (4.2 M) FM²-shaped one slab on one thread 1.25x the serial march's CPU
+#: (smooth 1.32x) before any repair, two threads' CPU 0.388 -> 0.621 s (1.60x; smooth
+#: 0.524 -> 0.751 s), busiest thread 1.20x (smooth 1.32x; `make bench` on the idle machine:
+#: wall 0.97x / 1.16x); 2900^2 (8.4 M) FM²-shaped CPU 0.875 -> 1.199 s (1.37x), busiest
+#: thread 1.43x (smooth 1.69x; load 8.7-9); 4096^2 (16.8 M) FM²-shaped CPU 1.926 -> 2.338 s
+#: (1.21x), busiest thread 1.60x (smooth 1.69x). On the idle machine the 2048^2 wall ratio
+#: was ~0.8x the busiest thread's: from 2^23 (8.4 M) nodes on the slabs.
+ORDER2_MIN_NODES_2D = 2**23
 #: Each slab gets at least this many x-slabs (rows), else fewer slabs are used.
 MIN_SLAB_ROWS = 16
 #: ... and at least this many nodes (but every thread one slab): thin slabs cost repairs.
@@ -165,8 +177,13 @@ SHARE_SLABS = True
 #: machine holds back takes fewer). Simulated from the serial times of the bench's
 #: FM²-shaped 2048^2 maps (seeds 0-3, windows of 32768 nodes, equal slabs), the windows'
 #: balance with 8 / 16 slabs: lists 1.78-1.81 / 1.82-1.88, in turn 1.79-1.86 / 1.91-1.96
-#: (constant speed 2.00 / 2.00 either way). Needs :data:`SHARE_SLABS`.
-DYNAMIC_2D = False
+#: (constant speed 2.00 / 2.00 either way). Needs :data:`SHARE_SLABS`. Measured (3 December
+#: 2026, load 6, the march's own counts: the balance an idle machine gets, :func:`_in_turn`)
+#: on those maps marched, 4 slabs per thread: balance 1.816/1.855/1.880/1.819 with the lists,
+#: 1.847/1.899/1.901/1.852 in turn, the same nodes re-opened (the windows do not depend on
+#: who runs a slab) and the same CPU; 8 slabs per thread 1.895-1.947 for 1.7-2x the
+#: re-opened nodes (two threads' CPU +3 %: no gain). On: 2D order 1, 4 slabs per thread.
+DYNAMIC_2D = True
 #: 2D: a far neighbour of the node a window freezes gets the one-axis update along their
 #: axis, as in the serial march (valid in a slab: see the window's docstring); False: the
 #: full update (the same times bit for bit; the tests run both).
@@ -190,7 +207,8 @@ _C_STATUS = 3  # 0 ok, 1 entry pool low, 2 repair heap full
 _C_PEND = 4    # order 2: re-opened nodes raised above their old time, not frozen again
 _C_RMIN = 5    # order 2: a time no later than the old times of those (inf: none)
 _C_RAISED = 6  # order 2: updates that found a later time than the node had (suspects)
-_C_SIZE = 7
+_C_RUNS = 7    # the slab's runs in the exchanges and windows (once per region: the tests)
+_C_SIZE = 8
 
 # slots of the march state ``st`` (uint64), shared with the serial layout
 _NFREE = 2
@@ -1139,12 +1157,29 @@ def _assign(work, nth, slabs, first, load, share=1):
     return greedy
 
 
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _in_turn(work, slabs, load):
+    """``load[t]``: the ``work`` thread ``t`` gets when ``load.size`` threads take the slabs
+    in the order ``slabs`` (:func:`_take`), each the next one when done with its last, a
+    slab lasting its work (ties: the lowest thread): what the slabs taken in turn give on
+    an idle machine, for the windows' balance (``stats["balance"]``)."""
+    nth = load.size
+    for t in range(nth):
+        load[t] = 0.0
+    for i in range(slabs.size):
+        j = 0
+        for t in range(1, nth):
+            if load[t] < load[j]:
+                j = t
+        load[j] += work[slabs[i]]
+
+
 #: Debug: :func:`march` records where the drive's time goes (``stats["profile"]``, see
 #: :func:`_profile`): each thread's CPU time per parallel region (``clock_gettime``), the
 #: regions' wall time. Off: one branch per region, nothing else.
 PROFILE = False
 #: Slots of the window state ``win`` (the drive's); the profile's follow when it is on.
-_W_SIZE = 9
+_W_SIZE = 10
 _P_EXMAX, _P_WIMAX, _P_EXWALL, _P_WIWALL, _P_STMAX, _P_STWALL, _P_DRIVE, _P_REGIONS = range(8)
 _P_THREADS = 8  # then per thread: exchange CPU, window CPU, scratch (nth each)
 
@@ -1211,18 +1246,21 @@ def _drive_kernel(three, order=1):
         """Run windows until every queue is empty; 0 done, 1/2 grow pool/heap and call again.
 
         ``win`` (float64): [0] window end, [1] width, [2] windows run, [3] target pops,
-        [4] nodes frozen (re-freezes included), [5] sum over windows of the most a slab
-        froze (the critical path: ``[4] / [5]`` bounds the speed-up), [6] the latest
+        [4] nodes frozen (re-freezes included), [5] sum over windows of the most a thread
+        froze (the critical path: ``[4] / [5]`` bounds the speed-up; slabs taken in turn:
+        as an idle machine shares them, :func:`_in_turn`), [6] the latest
         stop node's time when the stop nodes ``stops`` (indices into ``Tp``) ended it,
         [7] 1 once the start (``first``) is done, [8] windows whose slabs :func:`_assign`
-        shared longest-first. ``U``, ``qp``: the plateau mask over
+        shared longest-first, [9] exchanges run (each slab counts its runs in the
+        exchanges and windows, ``ctl[k, _C_RUNS]``). ``U``, ``qp``: the plateau mask over
         ``Tp`` (one byte: every node) and its ``1 / speed^2`` (0: none); ``sent``, ``ns``:
         each slab's nodes frozen in its boundary rows in the last window (see ``window``).
         ``fl``: order 2's bit masks, a bit per node (re-opened, suspect, pending; unused by
         order 1), ``eidx``, ``evals`` its nodes in the band on entry (element indices into
         ``Tp``, sorted) and their times; each slab has ``order`` ghost x-slabs on each side.
         ``slabs`` (K), ``lists`` (nth + 1 + K), ``load`` (nth): scratch of :func:`_assign`
-        (``share``: :data:`SHARE_SLABS`). ``scan[k]``: the nodes of slab ``k`` the start
+        (``share``: 0 the interleave, 1 :data:`SHARE_SLABS`' lists, 2 taken in turn,
+        :data:`DYNAMIC_2D`). ``scan[k]``: the nodes of slab ``k`` the start
         reads (the start box's rows). ``far``: the far neighbours' one-axis update (2D).
 
         ``off``, ``end``, ``sx``, ``sy``, ``scan`` and ``stops`` count elements of ``Tp``:
@@ -1322,13 +1360,13 @@ def _drive_kernel(three, order=1):
                     if not ok:
                         ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < low else 2.0
                     _heap_next(T, st[k], ritem[k], ctl[k])
-                    if dyn:
-                        lists[nth + 1 + k] = t  # the owner, for the statistics
+                    ctl[k, _C_RUNS] += 1.0
                     i = _take(lists, nth, t, i, dyn)
                 if prof:
                     _prof_done(win, nth, t)
             if prof:
                 _prof_region(win, nth, 0, w0)
+            win[9] += 1.0
             for k in range(K):
                 if ctl[k, _C_STATUS] != 0.0:
                     if prof:
@@ -1399,8 +1437,7 @@ def _drive_kernel(three, order=1):
                                 fx[off[k] >> sh >> 3:], sx, sy, ih, hh, iso, tw, pool[k], nxt[k],
                                 bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k], sent[k], ns[k],
                                 far)
-                    if dyn:
-                        lists[nth + 1 + k] = t  # the owner, for the statistics
+                    ctl[k, _C_RUNS] += 1.0
                     i = _take(lists, nth, t, i, dyn)
                 if prof:
                     _prof_done(win, nth, t)
@@ -1409,9 +1446,14 @@ def _drive_kernel(three, order=1):
             win[2] += 1.0
             pops = 0.0
             most = 0.0
-            for t in range(nth):
+            if dyn:  # the idle machine's share: each slab, in the order taken, to the thread
+                _in_turn(ctl[:, _C_POPS], slabs, load)  # free first (as many freezes, as long)
+                for t in range(nth):
+                    pops += load[t]
+                    most = max(most, load[t])
+            for t in range(nth if not dyn else 0):
                 mine = 0.0
-                for k in range(K):  # the owners: of the window (dyn) or of _assign
+                for k in range(K):  # the owners of _assign's lists
                     if lists[nth + 1 + k] == t:
                         mine += ctl[k, _C_POPS]
                 pops += mine
@@ -1688,9 +1730,13 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     stats : dict
         ``slabs``, ``windows``, ``reopened`` (nodes changed after they were frozen),
         ``raised`` (order 2: updates that found a later time than the node had) and
-        ``balance``: nodes frozen over the sum of each window's largest slab share, the
-        speed-up the windows allow if every freeze cost the same (``slabs`` at best), and
-        ``greedy``: the windows whose slabs :func:`_assign` shared longest first.
+        ``balance``: nodes frozen over the sum of each window's largest thread share, the
+        speed-up the windows allow if every freeze cost the same (``threads`` at best; slabs
+        taken in turn, :data:`DYNAMIC_2D`: the shares an idle machine gives, :func:`_in_turn`,
+        whatever this run's threads took), ``greedy``: the windows whose slabs
+        :func:`_assign` shared longest first, ``exchanges``: the exchanges run, ``runs``:
+        how often each slab was marched in the exchanges and windows (every slab once per
+        region: ``exchanges + windows`` each).
     """
     import numba
 
@@ -1802,7 +1848,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
             vmax = _top_speed(nth, _kernels._readonly(speed))
     width = 2.0 * min(h3[:3 if three else 2]) / max(vmax, 1e-300)
     win = np.zeros(_W_SIZE + (_P_THREADS + 3 * nth if PROFILE else 0))
-    win[:_W_SIZE] = [0.0, width, 0.0, float(WINDOW_NODES), 0.0, 0.0, np.inf, 0.0, 0.0]
+    win[:_W_SIZE] = [0.0, width, 0.0, float(WINDOW_NODES), 0.0, 0.0, np.inf, 0.0, 0.0, 0.0]
     stop_idx = np.zeros(0, dtype=np.int64)
     if stop_cells is not None and len(stop_cells):
         cells = np.asarray(stop_cells, dtype=np.int64).reshape(-1, 3)
@@ -1860,7 +1906,34 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     return T, {"slabs": K, "windows": int(win[2]), "reopened": int(ctl[:, _C_REOPEN].sum()),
                "raised": int(ctl[:, _C_RAISED].sum()),
                "balance": float(win[4] / max(win[5], 1.0)), "greedy": int(win[8]),
+               "exchanges": int(win[9]), "runs": ctl[:, _C_RUNS].astype(np.int64),
                **({"profile": _profile(win, nth)} if PROFILE else {})}
+
+
+def on_slabs(nodes: int, three: bool, order: int) -> bool:
+    """Whether a march of ``nodes`` nodes marches on slabs when threads allow it.
+
+    Parameters
+    ----------
+    nodes : int
+        Grid nodes.
+    three : bool
+        A 3D grid (else 2D).
+    order : {1, 2}
+        Order of the stencil.
+
+    Returns
+    -------
+    bool
+        From :data:`PARALLEL_MIN_NODES` nodes, order 1; order 2 while :data:`ORDER2` is
+        set and from :data:`ORDER2_MIN_NODES_3D` (3D) or :data:`ORDER2_MIN_NODES_2D` (2D)
+        nodes too.
+    """
+    if nodes < PARALLEL_MIN_NODES:
+        return False
+    if order == 1:
+        return True
+    return bool(ORDER2) and nodes >= (ORDER2_MIN_NODES_3D if three else ORDER2_MIN_NODES_2D)
 
 
 @contextlib.contextmanager
