@@ -182,7 +182,10 @@ SHARE_SLABS = True
 #: on those maps marched, 4 slabs per thread: balance 1.816/1.855/1.880/1.819 with the lists,
 #: 1.847/1.899/1.901/1.852 in turn, the same nodes re-opened (the windows do not depend on
 #: who runs a slab) and the same CPU; 8 slabs per thread 1.895-1.947 for 1.7-2x the
-#: re-opened nodes (two threads' CPU +3 %: no gain). On: 2D order 1, 4 slabs per thread.
+#: re-opened nodes (two threads' CPU +3 %: no gain). Wall near idle (load 1.0-1.1, 2048^2,
+#: medians of 5-7 interleaved, two threads over one): lists / in turn constant 1.83-1.84x /
+#: 1.87-1.94x, smooth 1.80x / 1.87x, FM²-shaped 1.51x / 1.57-1.59x. On: 2D order 1, 4 slabs
+#: per thread.
 DYNAMIC_2D = True
 #: 2D: a far neighbour of the node a window freezes gets the one-axis update along their
 #: axis, as in the serial march (valid in a slab: see the window's docstring); False: the
