@@ -509,9 +509,7 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
             med = {{th: [statistics.median(r[i] for r in runs[th]) for i in range(4)]
                     for th in runs}}
             out.append(dict(case=case, field=field, order=order, nodes=int(v.size),
-                            parallel=bool(v.size >= _parallel.PARALLEL_MIN_NODES and (
-                                order == 1 or len(shape) == 2
-                                or v.size >= _parallel.ORDER2_MIN_NODES_3D)),
+                            parallel=_parallel.on_slabs(v.size, len(shape) == 3, order),
                             serial=med[1], threads2=med[2], balance=stats.get("balance", 1.0),
                             setup=stats.get("setup", 0.0)))
         print(json.dumps(out))
@@ -526,7 +524,7 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
             "case": f"{r['case']} {r['field']} order {r['order']}, 2 threads",
             "ours_s": w2, "peer": "fm2uav 1 thread", "peer_s": w1, "ratio": w1 / w2,
             "bar": ">= 1.6x (issue 27)" if big else ("never slower" if r["parallel"] else ""),
-            "notes": (f"{'parallel' if r['parallel'] else 'serial (below PARALLEL_MIN_NODES)'}; "
+            "notes": (f"{'parallel' if r['parallel'] else 'serial (below its floor, on_slabs)'}; "
                       f"CPU 1 thread {c1:.3f} s, 2 threads {c2:.3f} s (ratio {c1 / c2:.2f}x); "
                       f"busiest thread {b2:.3f} s ({c1 / max(b2, 1e-9):.2f}x); windows' balance "
                       f"{r['balance']:.2f}, set-up {1e3 * r['setup']:.0f} ms: idle-machine "

@@ -57,14 +57,16 @@ def fast_marching_parallel(*args, threads: int = 2, **kwargs) -> np.ndarray:
     from fm2uav.eikonal import _parallel
 
     saved = (_parallel.PARALLEL_MIN_NODES, _parallel.MIN_SLAB_ROWS, _parallel.MIN_SLAB_NODES,
-             _parallel.ORDER2, _parallel.ORDER2_MIN_NODES_3D)
+             _parallel.ORDER2, _parallel.ORDER2_MIN_NODES_3D, _parallel.ORDER2_MIN_NODES_2D)
     (_parallel.PARALLEL_MIN_NODES, _parallel.MIN_SLAB_ROWS, _parallel.MIN_SLAB_NODES,
-     _parallel.ORDER2, _parallel.ORDER2_MIN_NODES_3D) = 0, 1, 0, True, 0
+     _parallel.ORDER2, _parallel.ORDER2_MIN_NODES_3D, _parallel.ORDER2_MIN_NODES_2D) = (
+        0, 1, 0, True, 0, 0)
     try:
         return fast_marching(*args, threads=threads, **kwargs)
     finally:
         (_parallel.PARALLEL_MIN_NODES, _parallel.MIN_SLAB_ROWS,
-         _parallel.MIN_SLAB_NODES, _parallel.ORDER2, _parallel.ORDER2_MIN_NODES_3D) = saved
+         _parallel.MIN_SLAB_NODES, _parallel.ORDER2, _parallel.ORDER2_MIN_NODES_3D,
+         _parallel.ORDER2_MIN_NODES_2D) = saved
 
 
 #: The implementations of the same discretisation; exact-value tests run on each.

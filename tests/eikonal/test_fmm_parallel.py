@@ -208,7 +208,8 @@ def test_order_2_on_a_big_fm2_field_equals_the_serial_march_bit_for_bit(shape, m
     FM²-shaped map differed by up to 3e-11 relative.)"""
     v, src = fm2_shaped(shape, seed=3)
     assert v.size >= _parallel.PARALLEL_MIN_NODES
-    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_3D", 0)  # 3D: 16.8 M nodes by default
+    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_3D", 0)  # 16.8 M nodes by default
+    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_2D", 0)
     stats = {}
     march = _parallel.march
 
@@ -289,8 +290,11 @@ def test_balanced_cuts_of_many_slabs_shorten_the_windows_critical_path(shape, ga
     window's busiest thread's share, the speed-up they allow) beats equal slabs, and the
     times stay the serial march's. (2D, 4 slabs per thread, slabs shared anew before each
     window: 1.627 against 1.579 for equal slabs; 8 per thread gained more balance but no
-    wall time.)"""
+    wall time.) The cuts are placed for slabs shared by lists (:func:`_parallel._assign`): 2D
+    compares with the lists, then the slabs taken in turn (:data:`_parallel.DYNAMIC_2D`) on
+    the same cuts must beat them (1.709 against 1.627; the equal slabs' 1.719 in turn)."""
     monkeypatch.setattr(_parallel, "MIN_SLAB_NODES", 0)  # slab counts of 2048^2 and 160^3
+    monkeypatch.setattr(_parallel, "DYNAMIC_2D", False)
     v, src = fm2_shaped(shape)
     flat, start, shape3 = _start(v, src)
     k = 2 * _parallel.SLABS_PER_THREAD[len(shape)]
@@ -307,6 +311,13 @@ def test_balanced_cuts_of_many_slabs_shorten_the_windows_critical_path(shape, ga
     assert_equal_times(serial, T)
     assert balanced["slabs"] == equal["slabs"] == k
     assert balanced["balance"] > gain * equal["balance"]
+    if len(shape) == 2:
+        monkeypatch.setattr(_parallel, "slab_bounds", lambda *a: cuts)
+        monkeypatch.setattr(_parallel, "DYNAMIC_2D", True)
+        T, turn = _parallel.march(flat, start, shape3, (1.0,) * 3, 2)
+        assert_equal_times(serial, T)
+        assert turn["reopened"] == balanced["reopened"]  # the same windows, whoever runs them
+        assert turn["balance"] > 1.03 * balanced["balance"]
 
 
 def _fixed_split(work, nth):
@@ -493,6 +504,7 @@ def test_small_grids_and_one_thread_march_serially(monkeypatch):
     fast_marching(np.ones((small, small)), [(0, 0)], order=1, threads=2)
     fast_marching(np.ones((small, small)), [(0, 0)], order=2, threads=2)
     monkeypatch.setattr(_parallel, "PARALLEL_MIN_NODES", 0)
+    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_2D", 0)
     fast_marching(np.ones((40, 40)), [(0, 0)], order=2, threads=1)
     fast_marching(np.ones((40, 40)), [(0, 0)], order=1, threads=1)
     monkeypatch.setenv("FM2UAV_THREADS", "1")
@@ -510,6 +522,13 @@ def test_small_grids_and_one_thread_march_serially(monkeypatch):
     monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_3D", v3.size)
     with pytest.raises(AssertionError, match="parallel march ran"):
         fast_marching(v3, [(0, 0, 0)], order=2)
+    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_2D", 40 * 40 + 1)  # 2D order 2's floor
+    fast_marching(np.ones((40, 40)), [(0, 0)], order=2)
+    with pytest.raises(AssertionError, match="parallel march ran"):
+        fast_marching(np.ones((40, 40)), [(0, 0)], order=1)
+    with pytest.raises(AssertionError, match="parallel march ran"):
+        fast_marching(np.ones((40, 41)), [(0, 0)], order=2)
+    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_2D", 0)
     monkeypatch.setattr(_parallel, "ORDER2", False)  # the switch back to a serial order 2
     fast_marching(np.ones((40, 40)), [(0, 0)], order=2)
     with pytest.raises(AssertionError, match="parallel march ran"):
@@ -779,3 +798,132 @@ def test_cuts_for_shared_slabs_shorten_the_windows_on_an_fm2_map(monkeypatch):
         monkeypatch.setitem(_parallel.SHARED_CUTS, 2, shared)
         cuts[shared] = _parallel.slab_bounds(flat, start, shape3, (1.0,) * 3, 8, 2)
     assert np.array_equal(cuts[False], cuts[True])
+
+
+def test_slabs_taken_in_turn_are_ordered_by_predicted_work():
+    """``share=2`` (:data:`_parallel.DYNAMIC_2D`): every slab by decreasing predicted work
+    (ties in slab order), the counter the threads take them by at 0, the owners and the
+    returned flag those of the lists (``share=1``) for the statistics."""
+    rng = np.random.default_rng(1)
+    for _ in range(100):
+        nth = int(rng.integers(2, 5))
+        work = (rng.integers(0, 5, size=int(rng.integers(nth, 20))) * 100).astype(float)
+        slabs = np.full(work.size, -1, dtype=np.int64)
+        first = np.full(nth + 1 + work.size, -1, dtype=np.int64)
+        greedy = _parallel._assign(work, nth, slabs, first, np.empty(nth), 2)
+        assert list(slabs) == sorted(range(work.size), key=lambda k: (-work[k], k))
+        assert first[nth] == 0
+        slabs1 = np.full(work.size, -1, dtype=np.int64)
+        first1 = np.full(nth + 1 + work.size, -1, dtype=np.int64)
+        assert greedy == _parallel._assign(work, nth, slabs1, first1, np.empty(nth), 1)
+        assert np.array_equal(first[nth + 1:], first1[nth + 1:])
+
+
+@pytest.mark.parametrize("threads", [2, 3])
+def test_slabs_taken_in_turn_give_the_serial_times(threads, monkeypatch):
+    """2D order 1 takes the slabs in turn (the drive gets ``share=2``; 3D and order 2 keep
+    the lists): on many thin slabs, with repairs, ``stop_at`` and the lists for comparison,
+    the times are the serial march's; every slab is marched whichever thread takes it."""
+    monkeypatch.setattr(_parallel, "MIN_SLAB_NODES", 0)
+    monkeypatch.setattr(_parallel, "MIN_SLAB_ROWS", 4)
+    monkeypatch.setitem(_parallel.SLABS_PER_THREAD, 2, 9)
+    seen = []
+    for key in list(_parallel._DRIVES):
+        def spy(*args, _d=_parallel._DRIVES[key], _key=key):
+            seen.append((_key, args[33]))  # share
+            return _d(*args)
+        monkeypatch.setitem(_parallel._DRIVES, key, spy)
+    for name, v, src in _fields((131, 67)):
+        flat, start, shape3 = _start(v, src)
+        serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 1,
+                                   np.zeros((0, 3), dtype=int))
+        for dynamic in (True, False):
+            monkeypatch.setattr(_parallel, "DYNAMIC_2D", dynamic)
+            seen.clear()
+            T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, threads)
+            assert_equal_times(serial, T)
+            assert stats["slabs"] == 9 * min(threads, numba.config.NUMBA_NUM_THREADS), name
+            assert stats["windows"] > 3, name
+            assert {s for _, s in seen} == {2 if dynamic else 1}
+            assert 1.0 <= stats["balance"] <= threads + 1e-9
+            # every slab marched once in every exchange and window, whoever took it: a slab
+            # taken twice, skipped, or a window's counter not reset changes these counts
+            assert stats["exchanges"] >= stats["windows"] + 1, name
+            assert np.all(stats["runs"] == stats["exchanges"] + stats["windows"]), name
+            stop = np.array([[120, 60, 0]])
+            T, _ = _parallel.march(flat, start, shape3, (1.0,) * 3, threads, stop_cells=stop)
+            ref, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 1, stop)
+            # nodes tied with the stop node may be frozen or not, in the serial march too
+            # (as test_parallel_stop_at_freezes_what_the_serial_march_freezes)
+            differ = np.isfinite(ref) != np.isfinite(T)
+            assert np.all(np.where(np.isfinite(ref), ref, T)[differ] == ref[120 * 67 + 60])
+            both = np.isfinite(ref) & np.isfinite(T)
+            assert both.sum() > 0.3 * np.isfinite(ref).sum() > 0, name
+            assert_equal_times(ref[both], T[both])
+    v, src = fm2_shaped((61, 47, 1)[:2], seed=2)
+    flat, start, shape3 = _start(v, src)
+    seen.clear()
+    monkeypatch.setattr(_parallel, "DYNAMIC_2D", True)
+    _parallel.march(flat, start, shape3, (1.0,) * 3, threads, order=2)
+    assert {s for _, s in seen} == {1}  # order 2 keeps the lists
+
+
+def test_profile_accounts_for_every_region(monkeypatch):
+    """``_parallel.PROFILE``: ``stats["profile"]`` sums each region's busiest thread's CPU
+    and its wall time (the start, an exchange before every window and one after the last),
+    each thread's CPU per kind; the times stay the serial march's."""
+    monkeypatch.setattr(_parallel, "MIN_SLAB_NODES", 0)
+    monkeypatch.setattr(_parallel, "PROFILE", True)
+    v, src = fm2_shaped((257, 131), seed=1)
+    flat, start, shape3 = _start(v, src)
+    serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 1, np.zeros((0, 3), dtype=int))
+    T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, 2)
+    assert_equal_times(serial, T)
+    p = stats["profile"]
+    assert p["regions"] == 2 * stats["windows"] + 2
+    for kind in ("start", "exchange", "window"):
+        assert 0.0 < p[f"{kind}_max"] <= p[f"{kind}_wall"] + 1e-3
+    assert p["start_wall"] + p["exchange_wall"] + p["window_wall"] <= p["drive_wall"] + 1e-6
+    for kind in ("exchange", "window"):
+        assert len(p[f"{kind}_cpu"]) == 2
+        assert max(p[f"{kind}_cpu"]) <= p[f"{kind}_max"] + 1e-6
+        assert sum(p[f"{kind}_cpu"]) >= p[f"{kind}_max"] - 1e-6
+    monkeypatch.setattr(_parallel, "PROFILE", False)
+    assert "profile" not in _parallel.march(flat, start, shape3, (1.0,) * 3, 2)[1]
+
+
+def test_slabs_taken_in_turn_one_thread_after_the_other():
+    """:func:`_parallel._take`: in turn, the counter ``lists[nth]`` hands out 0, 1, 2, ...
+    whichever thread asks, until :func:`_parallel._took_all` (all ``K``); with lists, thread
+    ``t`` runs ``lists[t]:lists[t + 1]``. :func:`_parallel._in_turn`: the work each thread
+    gets when they take the slabs in that order, the next one whoever is free first (an
+    event simulation here)."""
+    nth, K = 3, 7
+    lists = np.array([0, 2, 5, 0] + [0] * K, dtype=np.int64)
+    got = {t: [] for t in range(nth)}
+    i = {t: -1 for t in range(nth)}
+    for t in [0, 2, 2, 1, 0, 1, 2, 0, 1, 0]:  # any order of asking
+        i[t] = _parallel._take(lists, nth, t, i[t], True)
+        if not _parallel._took_all(lists, nth, t, i[t], K, True):
+            got[t].append(int(i[t]))
+    assert sorted(sum(got.values(), [])) == list(range(K))
+    assert got == {0: [0, 4], 1: [3, 5], 2: [1, 2, 6]}
+    lists = np.array([0, 2, 5, K] + [0] * K, dtype=np.int64)
+    for t, (a, b) in enumerate([(0, 2), (2, 5), (5, 7)]):
+        j, mine = _parallel._take(lists, nth, t, -1, False), []
+        while not _parallel._took_all(lists, nth, t, j, K, False):
+            mine.append(int(j))
+            j = _parallel._take(lists, nth, t, j, False)
+        assert mine == list(range(a, b)), t
+    rng = np.random.default_rng(4)
+    for _ in range(200):
+        nth = int(rng.integers(2, 5))
+        work = rng.integers(0, 9, size=int(rng.integers(1, 20))).astype(float)
+        slabs = rng.permutation(work.size).astype(np.int64)
+        load = np.full(nth, -1.0)
+        _parallel._in_turn(work, slabs, load)
+        free = [0.0] * nth  # when each thread is free; the lowest first, ties by thread
+        for k in slabs:
+            t = min(range(nth), key=lambda t: (free[t], t))
+            free[t] += work[k]
+        assert list(load) == free

@@ -82,7 +82,8 @@ def _on_slabs(ndim: int, run: Callable[[], None], orders: tuple[int, ...]) -> No
         marches.append(k["order"])
         return march(*a, **k)
 
-    restore = _patched(_parallel, PARALLEL_MIN_NODES=0, ORDER2_MIN_NODES_3D=0, march=spy)
+    restore = _patched(_parallel, PARALLEL_MIN_NODES=0, ORDER2_MIN_NODES_3D=0,
+                       ORDER2_MIN_NODES_2D=0, march=spy)
     try:
         run()
     finally:

@@ -86,6 +86,7 @@ import threading
 import numpy as np
 from llvmlite import ir
 from numba import njit, prange, types
+from numba.core import cgutils
 from numba.extending import intrinsic
 
 from . import _kernels
@@ -127,6 +128,18 @@ PARALLEL_MIN_NODES = 1_000_000
 #: slabs) CPU 0.97 -> 2.31 s, busiest thread 0.98 -> 1.34 s (0.73x: slower); the
 #: 1000 x 1000 x 40 terrain march (125-row slabs) busiest thread 10.4 -> 5.0 s.
 ORDER2_MIN_NODES_3D = 2**24
+#: 2D order 2 marches on slabs only from this many nodes (below: one thread, never slower).
+#: Its slab window costs more a node than the serial order-2 march (its neighbours' freeze
+#: order checked, :func:`_serial_time2`'s from-scratch repairs near the ghosts), which a
+#: bigger grid's memory traffic hides. Measured (3 December 2026, load 6-7, medians of 3,
+#: CPU times): 2048^2 (4.2 M) FM²-shaped one slab on one thread 1.25x the serial march's CPU
+#: (smooth 1.32x) before any repair, two threads' CPU 0.388 -> 0.621 s (1.60x; smooth
+#: 0.524 -> 0.751 s), busiest thread 1.20x (smooth 1.32x; `make bench` on the idle machine:
+#: wall 0.97x / 1.16x); 2900^2 (8.4 M) FM²-shaped CPU 0.875 -> 1.199 s (1.37x), busiest
+#: thread 1.43x (smooth 1.69x; load 8.7-9); 4096^2 (16.8 M) FM²-shaped CPU 1.926 -> 2.338 s
+#: (1.21x), busiest thread 1.60x (smooth 1.69x). On the idle machine the 2048^2 wall ratio
+#: was ~0.8x the busiest thread's: from 2^23 (8.4 M) nodes on the slabs.
+ORDER2_MIN_NODES_2D = 2**23
 #: Each slab gets at least this many x-slabs (rows), else fewer slabs are used.
 MIN_SLAB_ROWS = 16
 #: ... and at least this many nodes (but every thread one slab): thin slabs cost repairs.
@@ -157,6 +170,24 @@ WINDOW_NODES = 32768
 #: without (2 threads, 4 slabs per thread): FM²-shaped 2048^2 1.654 -> 1.759, 160^3 1.84 ->
 #: 1.90; constant speed the same (1.99, 1.93 -> 1.95).
 SHARE_SLABS = True
+#: 2D order 1: the threads take the slabs of a window (and of its exchange) in turn, the
+#: next not taken when done with the last, by decreasing predicted work (:func:`_take`)
+#: instead of lists fixed before the window (:func:`_assign`): the lists predict a window's
+#: work by the last one's, which lags the wave where it enters or leaves slabs; taken in
+#: turn, a window's slabs go to the threads by their actual work (and a thread the
+#: machine holds back takes fewer). Simulated from the serial times of the bench's
+#: FM²-shaped 2048^2 maps (seeds 0-3, windows of 32768 nodes, equal slabs), the windows'
+#: balance with 8 / 16 slabs: lists 1.78-1.81 / 1.82-1.88, in turn 1.79-1.86 / 1.91-1.96
+#: (constant speed 2.00 / 2.00 either way). Needs :data:`SHARE_SLABS`. Measured (3 December
+#: 2026, load 6, the march's own counts: the balance an idle machine gets, :func:`_in_turn`)
+#: on those maps marched, 4 slabs per thread: balance 1.816/1.855/1.880/1.819 with the lists,
+#: 1.847/1.899/1.901/1.852 in turn, the same nodes re-opened (the windows do not depend on
+#: who runs a slab) and the same CPU; 8 slabs per thread 1.895-1.947 for 1.7-2x the
+#: re-opened nodes (two threads' CPU +3 %: no gain). Wall near idle (load 1.0-1.1, 2048^2,
+#: medians of 5-7 interleaved, two threads over one): lists / in turn constant 1.83-1.84x /
+#: 1.87-1.94x, smooth 1.80x / 1.87x, FM²-shaped 1.51x / 1.57-1.59x. On: 2D order 1, 4 slabs
+#: per thread.
+DYNAMIC_2D = True
 #: 2D: a far neighbour of the node a window freezes gets the one-axis update along their
 #: axis, as in the serial march (valid in a slab: see the window's docstring); False: the
 #: full update (the same times bit for bit; the tests run both).
@@ -180,7 +211,8 @@ _C_STATUS = 3  # 0 ok, 1 entry pool low, 2 repair heap full
 _C_PEND = 4    # order 2: re-opened nodes raised above their old time, not frozen again
 _C_RMIN = 5    # order 2: a time no later than the old times of those (inf: none)
 _C_RAISED = 6  # order 2: updates that found a later time than the node had (suspects)
-_C_SIZE = 7
+_C_RUNS = 7    # the slab's runs in the exchanges and windows (once per region: the tests)
+_C_SIZE = 8
 
 # slots of the march state ``st`` (uint64), shared with the serial layout
 _NFREE = 2
@@ -609,6 +641,60 @@ def _from_bits(typingctx, k):
     return sig, codegen
 
 
+@intrinsic
+def _clock_ns(typingctx, clk):
+    """``clock_gettime(clk)`` in nanoseconds (int64): 1 ``CLOCK_MONOTONIC``, 3
+    ``CLOCK_THREAD_CPUTIME_ID`` (the calling thread's CPU time). For the drive's profile
+    (:data:`PROFILE`) only."""
+    sig = types.int64(clk)
+
+    def codegen(context, builder, signature, args):
+        i32, i64 = ir.IntType(32), ir.IntType(64)
+        ts = cgutils.alloca_once(builder, ir.ArrayType(i64, 2))
+        fnty = ir.FunctionType(i32, [i32, ir.IntType(8).as_pointer()])
+        fn = cgutils.get_or_insert_function(builder.module, fnty, "clock_gettime")
+        builder.call(fn, [builder.trunc(args[0], i32),
+                          builder.bitcast(ts, ir.IntType(8).as_pointer())])
+        zero = ir.Constant(i32, 0)
+        sec = builder.load(builder.gep(ts, [zero, zero]))
+        ns = builder.load(builder.gep(ts, [zero, ir.Constant(i32, 1)]))
+        return builder.add(builder.mul(sec, ir.Constant(i64, 1_000_000_000)), ns)
+
+    return sig, codegen
+
+
+@intrinsic
+def _fetch_add(typingctx, a, i):
+    """``a[i] += 1`` atomically (int64 array), returning the old value: the next slab a
+    thread takes in a dynamically shared region (:data:`DYNAMIC_2D`)."""
+    sig = types.int64(a, i)
+
+    def codegen(context, builder, signature, args):
+        aty = signature.args[0]
+        arr = context.make_array(aty)(context, builder, args[0])
+        ptr = cgutils.get_item_pointer(context, builder, aty, arr, [args[1]])
+        return builder.atomic_rmw("add", ptr, ir.Constant(ir.IntType(64), 1), "seq_cst")
+
+    return sig, codegen
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _take(lists, nth, t, i, dyn):
+    """The next position in ``slabs`` thread ``t`` runs after position ``i`` (``-1``: its
+    first): with ``dyn`` the next one no thread has taken (the counter ``lists[nth]``),
+    else the next of its own list ``lists[t]:lists[t + 1]``. Past the end: done
+    (:func:`_took_all`)."""
+    if dyn:
+        return _fetch_add(lists, nth)
+    return lists[t] if i < 0 else i + 1
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _took_all(lists, nth, t, i, K, dyn):
+    """Whether position ``i`` is past thread ``t``'s slabs (all ``K`` with ``dyn``)."""
+    return i >= (K if dyn else lists[t + 1])
+
+
 @njit(cache=True, inline="always", _nrt=False)
 def _bit(a, c):
     """Bit ``c`` of the bit mask ``a`` (uint8)."""
@@ -998,8 +1084,24 @@ def _heap_next(T, st, ritem, ctl):
             ctl[_C_NEXT] = -x
 
 
+@njit(cache=True, inline="always", _nrt=False)
+def _by_work(work, slabs):
+    """``slabs``: the slab numbers by decreasing ``work`` (insertion sort, stable: a few
+    dozen slabs at most)."""
+    K = work.size
+    for i in range(K):
+        slabs[i] = i
+    for i in range(1, K):
+        k = slabs[i]
+        j = i - 1
+        while j >= 0 and work[slabs[j]] < work[k]:
+            slabs[j + 1] = slabs[j]
+            j -= 1
+        slabs[j + 1] = k
+
+
 @njit(cache=True, error_model="numpy", _nrt=False)
-def _assign(work, nth, slabs, first, load, share=True):
+def _assign(work, nth, slabs, first, load, share=1):
     """Share the slabs among the threads for the next window: thread ``t`` runs slabs
     ``slabs[first[t]:first[t + 1]]``.
 
@@ -1010,8 +1112,13 @@ def _assign(work, nth, slabs, first, load, share=True):
     which is kept otherwise (and before the first window, all predictions 0). On the
     FM²-shaped 2048^2 map the windows' balance rises from ~1.65 to ~1.75: while the wave
     crosses few slabs, the fixed interleave may give two busy slabs to one thread.
-    ``load`` (``nth`` floats) and ``first[nth + 1:]`` (``K`` ints) are scratch;
-    ``share=False``: always the fixed interleave. Returns whether the greedy split was taken.
+    ``load`` (``nth`` floats) and ``first[nth + 1:]`` (``K`` ints) are scratch (the owner
+    of each slab after the call); ``share=0``: always the fixed interleave. ``share=2``
+    (:data:`DYNAMIC_2D`): no lists; ``slabs`` holds every slab by decreasing predicted work
+    and each thread takes the next one not taken (:func:`_take`, the counter
+    ``first[nth]``, set to 0) when done with its last, so a window's slabs go to the
+    threads by their actual work. Returns whether the greedy split was (or, ``share=2``,
+    would have been) taken.
     """
     K = work.size
     fixed_max = 0.0
@@ -1020,16 +1127,7 @@ def _assign(work, nth, slabs, first, load, share=True):
         for k in range(t, K, nth):
             mine += work[k]
         fixed_max = max(fixed_max, mine)
-    # slabs by decreasing predicted work (insertion sort: a few dozen slabs at most)
-    for i in range(K):
-        slabs[i] = i
-    for i in range(1, K):
-        k = slabs[i]
-        j = i - 1
-        while j >= 0 and work[slabs[j]] < work[k]:
-            slabs[j + 1] = slabs[j]
-            j -= 1
-        slabs[j + 1] = k
+    _by_work(work, slabs)
     for t in range(nth):
         load[t] = 0.0
     owner = first[nth + 1:]  # scratch: the owner of each slab (K entries)
@@ -1044,7 +1142,7 @@ def _assign(work, nth, slabs, first, load, share=True):
     greedy_max = 0.0
     for t in range(nth):
         greedy_max = max(greedy_max, load[t])
-    greedy = share and greedy_max < fixed_max
+    greedy = share > 0 and greedy_max < fixed_max
     if not greedy:
         for k in range(K):
             owner[k] = k % nth
@@ -1057,7 +1155,91 @@ def _assign(work, nth, slabs, first, load, share=True):
                 slabs[i] = k
                 i += 1
     first[nth] = i
+    if share == 2:  # in turn: every slab by decreasing predicted work, from the first
+        _by_work(work, slabs)
+        first[nth] = 0
     return greedy
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _in_turn(work, slabs, load):
+    """``load[t]``: the ``work`` thread ``t`` gets when ``load.size`` threads take the slabs
+    in the order ``slabs`` (:func:`_take`), each the next one when done with its last, a
+    slab lasting its work (ties: the lowest thread): what the slabs taken in turn give on
+    an idle machine, for the windows' balance (``stats["balance"]``)."""
+    nth = load.size
+    for t in range(nth):
+        load[t] = 0.0
+    for i in range(slabs.size):
+        j = 0
+        for t in range(1, nth):
+            if load[t] < load[j]:
+                j = t
+        load[j] += work[slabs[i]]
+
+
+#: Debug: :func:`march` records where the drive's time goes (``stats["profile"]``, see
+#: :func:`_profile`): each thread's CPU time per parallel region (``clock_gettime``), the
+#: regions' wall time. Off: one branch per region, nothing else.
+PROFILE = False
+#: Slots of the window state ``win`` (the drive's); the profile's follow when it is on.
+_W_SIZE = 10
+_P_EXMAX, _P_WIMAX, _P_EXWALL, _P_WIWALL, _P_STMAX, _P_STWALL, _P_DRIVE, _P_REGIONS = range(8)
+_P_THREADS = 8  # then per thread: exchange CPU, window CPU, scratch (nth each)
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _prof_mark(win, nth, t):
+    """Profile: thread ``t`` starts its share of a region (its CPU clock)."""
+    win[_W_SIZE + _P_THREADS + 2 * nth + t] = _clock_ns(3) * 1e-9
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _prof_done(win, nth, t):
+    """Profile: thread ``t`` ends its share (the scratch slot now holds its CPU time)."""
+    i = _W_SIZE + _P_THREADS + 2 * nth + t
+    win[i] = _clock_ns(3) * 1e-9 - win[i]
+
+
+@njit(cache=True, _nrt=False)
+def _prof_region(win, nth, kind, wall0):
+    """Profile: after a region (``kind`` 0 exchange, 1 window, 2 start) begun at the
+    monotonic time ``wall0``: its busiest thread's CPU and its wall time summed, each
+    thread's CPU too."""
+    P = _W_SIZE
+    most = 0.0
+    for t in range(nth):
+        x = win[P + _P_THREADS + 2 * nth + t]
+        most = max(most, x)
+        if kind < 2:
+            win[P + _P_THREADS + kind * nth + t] += x
+    wall = _clock_ns(1) * 1e-9 - wall0
+    if kind == 0:
+        win[P + _P_EXMAX] += most
+        win[P + _P_EXWALL] += wall
+    elif kind == 1:
+        win[P + _P_WIMAX] += most
+        win[P + _P_WIWALL] += wall
+    else:
+        win[P + _P_STMAX] += most
+        win[P + _P_STWALL] += wall
+    win[P + _P_REGIONS] += 1.0
+
+
+def _profile(win, nth):
+    """The drive's profile from ``win`` (seconds): ``start``/``exchange``/``window``: the
+    regions' summed wall time (``*_wall``) and summed busiest thread's CPU time
+    (``*_max``: the critical path if the barriers cost nothing); ``drive_wall``: the
+    drive's wall time (the serial rest between the regions included); per thread its
+    CPU in the exchanges and in the windows."""
+    P = _W_SIZE
+    w = win[P:]
+    return {"start_max": w[_P_STMAX], "start_wall": w[_P_STWALL],
+            "exchange_max": w[_P_EXMAX], "exchange_wall": w[_P_EXWALL],
+            "window_max": w[_P_WIMAX], "window_wall": w[_P_WIWALL],
+            "drive_wall": w[_P_DRIVE], "regions": int(w[_P_REGIONS]),
+            "exchange_cpu": [float(x) for x in w[_P_THREADS:_P_THREADS + nth]],
+            "window_cpu": [float(x) for x in w[_P_THREADS + nth:_P_THREADS + 2 * nth]]}
 
 
 def _drive_kernel(three, order=1):
@@ -1068,18 +1250,21 @@ def _drive_kernel(three, order=1):
         """Run windows until every queue is empty; 0 done, 1/2 grow pool/heap and call again.
 
         ``win`` (float64): [0] window end, [1] width, [2] windows run, [3] target pops,
-        [4] nodes frozen (re-freezes included), [5] sum over windows of the most a slab
-        froze (the critical path: ``[4] / [5]`` bounds the speed-up), [6] the latest
+        [4] nodes frozen (re-freezes included), [5] sum over windows of the most a thread
+        froze (the critical path: ``[4] / [5]`` bounds the speed-up; slabs taken in turn:
+        as an idle machine shares them, :func:`_in_turn`), [6] the latest
         stop node's time when the stop nodes ``stops`` (indices into ``Tp``) ended it,
         [7] 1 once the start (``first``) is done, [8] windows whose slabs :func:`_assign`
-        shared longest-first. ``U``, ``qp``: the plateau mask over
+        shared longest-first, [9] exchanges run (each slab counts its runs in the
+        exchanges and windows, ``ctl[k, _C_RUNS]``). ``U``, ``qp``: the plateau mask over
         ``Tp`` (one byte: every node) and its ``1 / speed^2`` (0: none); ``sent``, ``ns``:
         each slab's nodes frozen in its boundary rows in the last window (see ``window``).
         ``fl``: order 2's bit masks, a bit per node (re-opened, suspect, pending; unused by
         order 1), ``eidx``, ``evals`` its nodes in the band on entry (element indices into
         ``Tp``, sorted) and their times; each slab has ``order`` ghost x-slabs on each side.
         ``slabs`` (K), ``lists`` (nth + 1 + K), ``load`` (nth): scratch of :func:`_assign`
-        (``share``: :data:`SHARE_SLABS`). ``scan[k]``: the nodes of slab ``k`` the start
+        (``share``: 0 the interleave, 1 :data:`SHARE_SLABS`' lists, 2 taken in turn,
+        :data:`DYNAMIC_2D`). ``scan[k]``: the nodes of slab ``k`` the start
         reads (the start box's rows). ``far``: the far neighbours' one-axis update (2D).
 
         ``off``, ``end``, ``sx``, ``sy``, ``scan`` and ``stops`` count elements of ``Tp``:
@@ -1087,12 +1272,18 @@ def _drive_kernel(three, order=1):
         buffer, ``Vp = Tp[1:]``, ``sy = 2``); ``U`` and ``fx`` have a bit per node.
         """
         K = off.size
+        dyn = share == 2  # the slabs taken in turn by the threads (DYNAMIC_2D)
+        prof = win.size > _W_SIZE  # the profile (PROFILE)
+        d0 = _clock_ns(1) * 1e-9 if prof else 0.0
         sxi = np.int64(sx)
         G = np.int64(order)  # ghost rows on each side of a slab
         low = _U(RESERVE_BLOCKS + (POOL_EXTRA_2 if order == 2 else 0))
         sh = 0 if three or sy == 1 else 1  # node index = element index >> sh
         if first:
+            w0 = _clock_ns(1) * 1e-9 if prof else 0.0
             for t in prange(nth):  # thread t runs slabs t, t + nth, ...
+                if prof:
+                    _prof_mark(win, nth, t)
                 for k in range(t, K, nth):
                     T = Tp[off[k]:end[k]]
                     V = Vp[off[k]:end[k]]
@@ -1111,8 +1302,14 @@ def _drive_kernel(three, order=1):
                                     bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k], c0, c1)
                     if not ok:
                         ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < low else 2.0
+                if prof:
+                    _prof_done(win, nth, t)
+            if prof:
+                _prof_region(win, nth, 2, w0)
             for k in range(K):
                 if ctl[k, _C_STATUS] != 0.0:
+                    if prof:
+                        win[_W_SIZE + _P_DRIVE] += _clock_ns(1) * 1e-9 - d0
                     return int(ctl[k, _C_STATUS])  # grown, the start runs again
             win[7] = 1.0
         while True:
@@ -1121,8 +1318,12 @@ def _drive_kernel(three, order=1):
             if _assign(ctl[:, _C_POPS], nth, slabs, lists, load, share):
                 win[8] += 1.0
             # exchange: each slab refreshes its own ghosts and the rows next to them
-            for t in prange(nth):  # thread t runs slabs[lists[t]:lists[t + 1]]
-                for i in range(lists[t], lists[t + 1]):
+            w0 = _clock_ns(1) * 1e-9 if prof else 0.0
+            for t in prange(nth):  # thread t runs slabs[lists[t]:lists[t + 1]] (dyn: in turn)
+                if prof:
+                    _prof_mark(win, nth, t)
+                i = _take(lists, nth, t, -1, dyn)
+                while not _took_all(lists, nth, t, i, K, dyn):
                     k = slabs[i]
                     T = Tp[off[k]:end[k]]
                     V = Vp[off[k]:end[k]]
@@ -1163,8 +1364,17 @@ def _drive_kernel(three, order=1):
                     if not ok:
                         ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < low else 2.0
                     _heap_next(T, st[k], ritem[k], ctl[k])
+                    ctl[k, _C_RUNS] += 1.0
+                    i = _take(lists, nth, t, i, dyn)
+                if prof:
+                    _prof_done(win, nth, t)
+            if prof:
+                _prof_region(win, nth, 0, w0)
+            win[9] += 1.0
             for k in range(K):
                 if ctl[k, _C_STATUS] != 0.0:
+                    if prof:
+                        win[_W_SIZE + _P_DRIVE] += _clock_ns(1) * 1e-9 - d0
                     return int(ctl[k, _C_STATUS])
             # the next window
             tmin = _INF
@@ -1193,16 +1403,26 @@ def _drive_kernel(three, order=1):
                     tlow = min(tlow, ctl[k, _C_RMIN])
                 if smax <= tlow:
                     win[6] = smax
+                    if prof:
+                        win[_W_SIZE + _P_DRIVE] += _clock_ns(1) * 1e-9 - d0
                     return 0
             if empty:
+                if prof:
+                    win[_W_SIZE + _P_DRIVE] += _clock_ns(1) * 1e-9 - d0
                 return 0
             if tmin < _INF:
                 win[0] = max(win[0], tmin) + win[1]
             else:
                 win[0] = win[0] + win[1]
             tw = win[0]
-            for t in prange(nth):  # thread t runs slabs[lists[t]:lists[t + 1]]
-                for i in range(lists[t], lists[t + 1]):
+            if dyn:
+                lists[nth] = 0  # the window's slabs taken from the first again
+            w0 = _clock_ns(1) * 1e-9 if prof else 0.0
+            for t in prange(nth):  # thread t runs slabs[lists[t]:lists[t + 1]] (dyn: in turn)
+                if prof:
+                    _prof_mark(win, nth, t)
+                i = _take(lists, nth, t, -1, dyn)
+                while not _took_all(lists, nth, t, i, K, dyn):
                     k = slabs[i]
                     if order == 2:
                         o3 = off[k] >> sh >> 3
@@ -1221,19 +1441,33 @@ def _drive_kernel(three, order=1):
                                 fx[off[k] >> sh >> 3:], sx, sy, ih, hh, iso, tw, pool[k], nxt[k],
                                 bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k], sent[k], ns[k],
                                 far)
+                    ctl[k, _C_RUNS] += 1.0
+                    i = _take(lists, nth, t, i, dyn)
+                if prof:
+                    _prof_done(win, nth, t)
+            if prof:
+                _prof_region(win, nth, 1, w0)
             win[2] += 1.0
             pops = 0.0
             most = 0.0
-            for t in range(nth):
+            if dyn:  # the idle machine's share: each slab, in the order taken, to the thread
+                _in_turn(ctl[:, _C_POPS], slabs, load)  # free first (as many freezes, as long)
+                for t in range(nth):
+                    pops += load[t]
+                    most = max(most, load[t])
+            for t in range(nth if not dyn else 0):
                 mine = 0.0
-                for i in range(lists[t], lists[t + 1]):
-                    mine += ctl[slabs[i], _C_POPS]
+                for k in range(K):  # the owners of _assign's lists
+                    if lists[nth + 1 + k] == t:
+                        mine += ctl[k, _C_POPS]
                 pops += mine
                 most = max(most, mine)
             win[4] += pops
             win[5] += most
             for k in range(K):
                 if ctl[k, _C_STATUS] != 0.0:
+                    if prof:
+                        win[_W_SIZE + _P_DRIVE] += _clock_ns(1) * 1e-9 - d0
                     return int(ctl[k, _C_STATUS])
             # adapt the width toward the target pops per window
             f = win[3] / max(pops, 1.0)
@@ -1509,9 +1743,13 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     stats : dict
         ``slabs``, ``windows``, ``reopened`` (nodes changed after they were frozen),
         ``raised`` (order 2: updates that found a later time than the node had) and
-        ``balance``: nodes frozen over the sum of each window's largest slab share, the
-        speed-up the windows allow if every freeze cost the same (``slabs`` at best), and
-        ``greedy``: the windows whose slabs :func:`_assign` shared longest first.
+        ``balance``: nodes frozen over the sum of each window's largest thread share, the
+        speed-up the windows allow if every freeze cost the same (``threads`` at best; slabs
+        taken in turn, :data:`DYNAMIC_2D`: the shares an idle machine gives, :func:`_in_turn`,
+        whatever this run's threads took), ``greedy``: the windows whose slabs
+        :func:`_assign` shared longest first, ``exchanges``: the exchanges run, ``runs``:
+        how often each slab was marched in the exchanges and windows (every slab once per
+        region: ``exchanges + windows`` each).
     """
     import numba
 
@@ -1622,7 +1860,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         with _threads(nth):
             vmax = _top_speed(nth, _kernels._readonly(speed))
     width = 2.0 * min(h3[:3 if three else 2]) / max(vmax, 1e-300)
-    win = np.array([0.0, width, 0.0, float(WINDOW_NODES), 0.0, 0.0, np.inf, 0.0, 0.0])
+    win = np.zeros(_W_SIZE + (_P_THREADS + 3 * nth if PROFILE else 0))
+    win[:_W_SIZE] = [0.0, width, 0.0, float(WINDOW_NODES), 0.0, 0.0, np.inf, 0.0, 0.0, 0.0]
     stop_idx = np.zeros(0, dtype=np.int64)
     if stop_cells is not None and len(stop_cells):
         cells = np.asarray(stop_cells, dtype=np.int64).reshape(-1, 3)
@@ -1632,6 +1871,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
             local = local * (nz + 2) + cells[:, 2] + 1
         stop_idx = unit * (off[k] + local)
     drive = _DRIVES[3 if three else 2, G]
+    # how the slabs go to the threads (_assign): in turn (2), lists (1), the interleave (0)
+    share = (2 if DYNAMIC_2D and not three and G == 1 else 1) if SHARE_SLABS else 0
     slabs = np.empty(K, dtype=np.int64)  # scratch of _assign: each window's slabs per thread
     lists = np.empty(nth + 1 + K, dtype=np.int64)
     load = np.empty(nth)
@@ -1643,7 +1884,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
             status = drive(nth, Tk, Vk, U, qp, fixed, fl, eidx, evals, unit * off,
                            unit * (off + sizes), rows, _U(unit * sx), _U(unit * sy), ih, hh, iso,
                            pool, nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win, first,
-                           stop_idx, slabs, lists, load, SHARE_SLABS, scan, FAR_ONE_AXIS)
+                           stop_idx, slabs, lists, load, share, scan, FAR_ONE_AXIS)
             first = win[7] == 0.0
             if status == 0:
                 break
@@ -1677,7 +1918,35 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         box[frozen] = start.T.reshape(start.shape)[frozen]
     return T, {"slabs": K, "windows": int(win[2]), "reopened": int(ctl[:, _C_REOPEN].sum()),
                "raised": int(ctl[:, _C_RAISED].sum()),
-               "balance": float(win[4] / max(win[5], 1.0)), "greedy": int(win[8])}
+               "balance": float(win[4] / max(win[5], 1.0)), "greedy": int(win[8]),
+               "exchanges": int(win[9]), "runs": ctl[:, _C_RUNS].astype(np.int64),
+               **({"profile": _profile(win, nth)} if PROFILE else {})}
+
+
+def on_slabs(nodes: int, three: bool, order: int) -> bool:
+    """Whether a march of ``nodes`` nodes marches on slabs when threads allow it.
+
+    Parameters
+    ----------
+    nodes : int
+        Grid nodes.
+    three : bool
+        A 3D grid (else 2D).
+    order : {1, 2}
+        Order of the stencil.
+
+    Returns
+    -------
+    bool
+        From :data:`PARALLEL_MIN_NODES` nodes, order 1; order 2 while :data:`ORDER2` is
+        set and from :data:`ORDER2_MIN_NODES_3D` (3D) or :data:`ORDER2_MIN_NODES_2D` (2D)
+        nodes too.
+    """
+    if nodes < PARALLEL_MIN_NODES:
+        return False
+    if order == 1:
+        return True
+    return bool(ORDER2) and nodes >= (ORDER2_MIN_NODES_3D if three else ORDER2_MIN_NODES_2D)
 
 
 @contextlib.contextmanager

@@ -183,8 +183,8 @@ def fast_marching(
         Threads the march may use (``>= 1``). None (default): the environment
         variable ``FM2UAV_THREADS`` if set, else every core this process may run
         on. With 2 or more, a grid of at least ``PARALLEL_MIN_NODES`` (1 M) nodes
-        marches slabs of the grid in parallel, order 1 and 2 (3D order 2 from
-        ``ORDER2_MIN_NODES_3D``, 16.8 M), ``stop_at`` included
+        marches slabs of the grid in parallel, order 1 and 2 (order 2 from
+        ``ORDER2_MIN_NODES_2D``, 8.4 M, and ``_3D``, 16.8 M), ``stop_at`` included
         (:mod:`fm2uav.eikonal._parallel`; order 1's times equal the serial march's
         to round-off, order 2's bit for bit on every case measured); the wind march
         and smaller grids march on one thread.
@@ -293,8 +293,9 @@ def run_march(
     carry tentative times. ``stop_at`` as in :func:`fast_marching`; ``threads``
     (resolved, ``>= 1``) as there: the parallel march on grids of at least
     :data:`~fm2uav.eikonal._parallel.PARALLEL_MIN_NODES` nodes when ``threads > 1`` (order 2
-    while :data:`~fm2uav.eikonal._parallel.ORDER2` is set, the default; in 3D from
-    :data:`~fm2uav.eikonal._parallel.ORDER2_MIN_NODES_3D` nodes), else the serial one,
+    while :data:`~fm2uav.eikonal._parallel.ORDER2` is set, the default; from
+    :data:`~fm2uav.eikonal._parallel.ORDER2_MIN_NODES_2D` / ``_3D`` nodes:
+    :func:`~fm2uav.eikonal._parallel.on_slabs`), else the serial one,
     which sets up on them (:func:`~fm2uav.eikonal._kernels.march`).
 
     Returns
@@ -310,10 +311,7 @@ def run_march(
         stops[:, : len(shape)] = idx
         if start.frozen_at(stops).all():  # every stop node is a source or in its ball
             return start.frozen_times(shape3).reshape(shape)
-    if (threads > 1 and (order == 1 or _parallel.ORDER2)
-            and flat_speed.size >= _parallel.PARALLEL_MIN_NODES
-            and (order == 1 or shape3[2] == 1
-                 or flat_speed.size >= _parallel.ORDER2_MIN_NODES_3D)):
+    if threads > 1 and _parallel.on_slabs(flat_speed.size, shape3[2] > 1, order):
         T, _ = _parallel.march(flat_speed, start, shape3, h3, threads,
                                stops[~start.frozen_at(stops)], order=order)
     else:

@@ -95,8 +95,9 @@ def _fmm_parallel(ndim: int) -> Callable[[], None]:
         speed[(0,) * ndim] = 0.5  # a plateau with its mask (a uniform grid needs none)
         speeds = (speed, np.ones((16,) * ndim)) if ndim == 2 else (speed,)
         floor, lean = _parallel.PARALLEL_MIN_NODES, _kernels.LEAN_NODES
-        floor2 = _parallel.ORDER2_MIN_NODES_3D
+        floor2 = _parallel.ORDER2_MIN_NODES_3D, _parallel.ORDER2_MIN_NODES_2D
         _parallel.PARALLEL_MIN_NODES = _parallel.ORDER2_MIN_NODES_3D = 0
+        _parallel.ORDER2_MIN_NODES_2D = 0
         try:
             for lean_nodes in (lean, 0):
                 _kernels.LEAN_NODES = lean_nodes
@@ -106,7 +107,7 @@ def _fmm_parallel(ndim: int) -> Callable[[], None]:
                                       stop_at=[(12,) * ndim])
         finally:
             _parallel.PARALLEL_MIN_NODES, _kernels.LEAN_NODES = floor, lean
-            _parallel.ORDER2_MIN_NODES_3D = floor2
+            _parallel.ORDER2_MIN_NODES_3D, _parallel.ORDER2_MIN_NODES_2D = floor2
         # the page toucher's kernel: on a grid this small its thread may be stopped before
         # its first call (the cuts are placed at once), so it is compiled here
         _parallel._touch(np.zeros(8, dtype=np.uint8), 4096)
