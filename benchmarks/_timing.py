@@ -22,3 +22,21 @@ def median_time(fn: Callable[[], Any], repeats: int, *, warmup: bool = False) ->
         out = fn()
         times.append(time.perf_counter() - t)
     return statistics.median(times), out
+
+
+def interleaved_runs(repeats: int, threads: list[int], peer_src: str | None, own_src: str,
+                     run: Callable[[str, int], dict]) -> dict[tuple[str, int], list[dict]]:
+    """Each ``run(src, threads)`` of our checkout and an optional peer's, interleaved.
+
+    Rounds of every thread count and every code in turn (a change of the machine's load hits
+    both alike); keys ``("ours" | "peer", threads)``, each with ``repeats`` results.
+    """
+    codes = {"ours": own_src}
+    if peer_src:
+        codes["peer"] = peer_src
+    runs: dict[tuple[str, int], list[dict]] = {}
+    for _ in range(repeats):
+        for th in threads:
+            for name, src in codes.items():
+                runs.setdefault((name, th), []).append(run(src, th))
+    return runs

@@ -27,6 +27,8 @@ import sys
 import textwrap
 from pathlib import Path
 
+from benchmarks._timing import interleaved_runs
+
 ROOT = Path(__file__).resolve().parents[1]
 
 _CHILD = textwrap.dedent(
@@ -118,14 +120,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--peer-src", default=None, help="another checkout's src/ to interleave")
     args = ap.parse_args(argv)
-    codes = {"ours": str(ROOT / "src")}
-    if args.peer_src:
-        codes["peer"] = args.peer_src
-    runs: dict = {}
-    for _ in range(args.repeats):
-        for th in args.threads:
-            for name, src in codes.items():
-                runs.setdefault((name, th), []).append(child(src, th))
+    runs = interleaved_runs(args.repeats, args.threads, args.peer_src, str(ROOT / "src"),
+                            lambda src, th: child(src, th))
     print(f"medians of {args.repeats} (times in s, CPU from /proc/self/task)")
     for (name, th), rs in runs.items():
         cells = [f"{k} {statistics.median(r[k] for r in rs):.4g}" for k in NUMBERS if k in rs[0]]

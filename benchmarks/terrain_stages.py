@@ -25,6 +25,8 @@ import sys
 import textwrap
 from pathlib import Path
 
+from benchmarks._timing import interleaved_runs
+
 ROOT = Path(__file__).resolve().parents[1]
 
 _CHILD = textwrap.dedent(
@@ -132,14 +134,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--n", type=int, default=1000, help="columns a side (bench: 1000)")
     ap.add_argument("--peer-src", default=None, help="another checkout's src/ to interleave")
     args = ap.parse_args(argv)
-    codes = {"ours": str(ROOT / "src")}
-    if args.peer_src:
-        codes["peer"] = args.peer_src
-    runs: dict = {}
-    for _ in range(args.repeats):
-        for th in args.threads:
-            for name, src in codes.items():
-                runs.setdefault((name, th), []).append(child(src, th, args.n))
+    runs = interleaved_runs(args.repeats, args.threads, args.peer_src, str(ROOT / "src"),
+                            lambda src, th: child(src, th, args.n))
     print("stage: wall / process CPU / main-thread CPU [s], medians of "
           f"{args.repeats}; per code and thread count")
     cols = list(runs)
