@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import statistics
 import time
 from collections.abc import Callable
@@ -40,3 +41,13 @@ def interleaved_runs(repeats: int, threads: list[int], peer_src: str | None, own
             for name, src in codes.items():
                 runs.setdefault((name, th), []).append(run(src, th))
     return runs
+
+
+def ab_parser(description: str) -> argparse.ArgumentParser:
+    """The options of an A/B script run by :func:`interleaved_runs`: ``--threads``,
+    ``--repeats`` and ``--peer-src`` (another checkout's ``src/`` to interleave)."""
+    ap = argparse.ArgumentParser(description=description)
+    ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--peer-src", default=None, help="another checkout's src/ to interleave")
+    return ap

@@ -18,7 +18,6 @@ Not part of ``make bench`` (a march per child: minutes); docs/performance.md quo
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import statistics
@@ -27,7 +26,7 @@ import sys
 import textwrap
 from pathlib import Path
 
-from benchmarks._timing import interleaved_runs
+from benchmarks._timing import ab_parser, interleaved_runs
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -115,10 +114,7 @@ def child(src: str, threads: int) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
-    ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--peer-src", default=None, help="another checkout's src/ to interleave")
+    ap = ab_parser(__doc__.splitlines()[0])
     args = ap.parse_args(argv)
     runs = interleaved_runs(args.repeats, args.threads, args.peer_src, str(ROOT / "src"),
                             lambda src, th: child(src, th))

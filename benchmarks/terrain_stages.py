@@ -16,7 +16,6 @@ Not part of ``make bench`` (a plan per child: minutes); docs/performance.md quot
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import statistics
@@ -25,7 +24,7 @@ import sys
 import textwrap
 from pathlib import Path
 
-from benchmarks._timing import interleaved_runs
+from benchmarks._timing import ab_parser, interleaved_runs
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -128,11 +127,8 @@ def child(src: str, threads: int, n: int) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
-    ap.add_argument("--repeats", type=int, default=3)
+    ap = ab_parser(__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=1000, help="columns a side (bench: 1000)")
-    ap.add_argument("--peer-src", default=None, help="another checkout's src/ to interleave")
     args = ap.parse_args(argv)
     runs = interleaved_runs(args.repeats, args.threads, args.peer_src, str(ROOT / "src"),
                             lambda src, th: child(src, th, args.n))
