@@ -287,22 +287,33 @@ def _enq(k, c, pool, nxt, bk, mw, st, rkey, ritem):
 
 
 @njit(cache=True, inline="always", error_model="numpy", _nrt=False)
-def _deq(T, pool, nxt, bk, mw, st, rkey, ritem):
-    """Remove the smallest queued entry (repair heap first); its node or ``_NIL``."""
-    size = st[_RSIZE]
+def _pop_repair(st, rkey, ritem):
+    """Remove the smallest entry of the repair heap (not empty); its node."""
+    c = ritem[0]
+    size = st[_RSIZE] - _ONE
+    st[_RSIZE] = size
     if size > _ZERO:
-        c = ritem[0]
-        size -= _ONE
-        st[_RSIZE] = size
-        if size > _ZERO:
-            sift_down(rkey, ritem, rkey[:0], np.int64(size), rkey[size], ritem[size])
-        return c
-    c, nfree, fh, cur, last = _pop(T, pool, nxt, bk, mw, st[_NFREE], st[_FH], st[_CUR],
-                                   st[_LAST])
+        sift_down(rkey, ritem, rkey[:0], np.int64(size), rkey[size], ritem[size])
+    return c
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _keep_radix(st, nfree, fh, cur, last):
+    """Store the radix queue's state after a pop in ``st``."""
     st[_NFREE] = nfree
     st[_FH] = fh
     st[_CUR] = cur
     st[_LAST] = last
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _deq(T, pool, nxt, bk, mw, st, rkey, ritem):
+    """Remove the smallest queued entry (repair heap first); its node or ``_NIL``."""
+    if st[_RSIZE] > _ZERO:
+        return _pop_repair(st, rkey, ritem)
+    c, nfree, fh, cur, last = _pop(T, pool, nxt, bk, mw, st[_NFREE], st[_FH], st[_CUR],
+                                   st[_LAST])
+    _keep_radix(st, nfree, fh, cur, last)
     return c
 
 
@@ -311,20 +322,11 @@ def _deq_ahead(T, V, pool, nxt, bk, mw, st, rkey, ritem, s1, s2, pv):
     """:func:`_deq`, fetching ahead the lines that expanding the nodes popped next from the
     radix queue reads (:func:`~fm2uav.eikonal._kernels._pop_ahead`: ``s1``, ``s2`` the x
     and y strides of a 3D slab, ``pv`` the speeds too); the same nodes, in the same order."""
-    size = st[_RSIZE]
-    if size > _ZERO:
-        c = ritem[0]
-        size -= _ONE
-        st[_RSIZE] = size
-        if size > _ZERO:
-            sift_down(rkey, ritem, rkey[:0], np.int64(size), rkey[size], ritem[size])
-        return c
+    if st[_RSIZE] > _ZERO:
+        return _pop_repair(st, rkey, ritem)
     c, nfree, fh, cur, last = _pop_ahead(T, V, pool, nxt, bk, mw, st[_NFREE], st[_FH],
                                          st[_CUR], st[_LAST], s1, s2, pv)
-    st[_NFREE] = nfree
-    st[_FH] = fh
-    st[_CUR] = cur
-    st[_LAST] = last
+    _keep_radix(st, nfree, fh, cur, last)
     return c
 
 
