@@ -92,15 +92,15 @@ def describe_error(exc: BaseException) -> tuple[str, int] | None:
     geometries, inputs nested too deeply and memory exhaustion are named with
     exit 2, so no bad input ends in a traceback.
     """
-    import json
-    import zipfile
-
     if isinstance(exc, PointError):
         return str(exc), EXIT_INPUT
     if isinstance(exc, PlanningError):
         return str(exc), EXIT_PLANNING
     if isinstance(exc, Fm2uavError):
         return str(exc), EXIT_INPUT
+    import json  # only for the others: fm2uav's own errors answer without zipfile
+    import zipfile
+
     if isinstance(exc, OSError):
         return _os_message(exc), EXIT_INPUT
     if isinstance(exc, UnicodeDecodeError):

@@ -266,3 +266,41 @@ def test_mission_file_errors_are_answered_before_the_heavy_libraries_load(tmp_pa
         assert "Traceback" not in report["out"]
         assert report["loaded"] == [], (text, report["loaded"])
     assert not (tmp_path / "out").exists()
+
+
+#: What the command line's own answer to a mission file's error must not load beyond
+#: MISSION_HEAVY: importlib.metadata (pydantic's plugin loader, cli/_pydantic_plugins.py;
+#: with email, zipfile, socket), the run's modules (imported once the file is valid) and the
+#: rally reader (only with --rally). Through fm2uav.__main__, whose PYDANTIC_DISABLE_PLUGINS
+#: default the stand-in needs.
+MISSION_RUN_LATER = ("importlib.metadata", "email", "zipfile", "socket", "fm2uav.pipeline.run",
+                     "fm2uav.io.rally", "fm2uav.autopilot.items", "fm2uav.cli._first_use")
+
+MAIN_PROBE = """
+import atexit, json, sys
+heavy = {heavy!r}
+atexit.register(lambda: print(json.dumps(sorted(m for m in heavy if m in sys.modules))))
+sys.argv = ["fm2uav", *{argv!r}]
+from fm2uav.__main__ import main
+main()
+"""
+
+
+def test_a_mission_file_error_through_the_command_line_loads_no_plugin_machinery(tmp_path):
+    import os
+
+    env = {k: v for k, v in os.environ.items() if k != "PYDANTIC_DISABLE_PLUGINS"}
+    for k, (text, words) in enumerate(MISSION_ERRORS):
+        mission = tmp_path / f"m{k}.yaml"
+        mission.write_text(text, encoding="utf-8")
+        argv = ["run", str(mission), "--out", str(tmp_path / "out")]
+        res = subprocess.run(
+            [sys.executable, "-c", MAIN_PROBE.format(heavy=MISSION_HEAVY + MISSION_RUN_LATER,
+                                                     argv=argv)],
+            capture_output=True, text=True, timeout=300, env=env)
+        assert res.returncode == 2, (text, res.stderr)
+        message = " ".join(res.stderr.split())
+        assert all(w in message for w in words), (text, message)
+        assert "Traceback" not in res.stderr
+        assert json.loads(res.stdout.strip().splitlines()[-1]) == [], text
+    assert not (tmp_path / "out").exists()

@@ -56,9 +56,9 @@ class ReturnFlags:
 
     def check(self) -> None:
         """Refuse a malformed ``--rally`` before any work (InputError naming it)."""
-        from ..io.rally import parse_rally_text
+        for text in self.rally or ():  # the rally reader only for a --rally given
+            from ..io.rally import parse_rally_text
 
-        for text in self.rally or ():
             parse_rally_text(text)
         if self.return_min_agl is not None and not self.return_min_agl >= 0:
             from ..errors import InputError

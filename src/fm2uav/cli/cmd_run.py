@@ -95,11 +95,10 @@ def run_cmd(
     from .._validate import input_file
 
     input_file(mission_file, "")  # a missing mission file is refused before the heavy imports
+    from ._pydantic_plugins import import_plugin_loader
+
+    import_plugin_loader()  # before the schema's models: no importlib.metadata
     from ..io.mission import load_mission
-    from ..pipeline.outputs import flown
-    from ..pipeline.rows import returns_rows
-    from ..pipeline.run import run_mission
-    from ._first_use import announce_compile
 
     returns.check()
     points = point_overrides(start=start, goal=goal, lonlat=lonlat) or {}
@@ -109,6 +108,12 @@ def run_cmd(
         points["return"] = mission.return_to_start
     m = load_mission(mission_file, world_overrides=world.overrides(),
                      point_overrides=points or None)
+    # the run's modules once the mission file is valid (its error answers without them)
+    from ..pipeline.outputs import flown
+    from ..pipeline.rows import returns_rows
+    from ..pipeline.run import run_mission
+    from ._first_use import announce_compile
+
     announce_compile(quiet=output.quiet)  # on a cold cache, once the mission file is valid
     options = mission.export_options(m.export_options())
     # outputs.dir is relative to the mission file, like every path in it (io/mission.py)

@@ -541,6 +541,13 @@ class ReturnsSpec(BaseModel):
                                             "return before its end")
 
 
+def _default(model: type[BaseModel]) -> Any:
+    """The default factory of a section left out: ``model()`` (a function, not the class:
+    pydantic reads a class factory's signature, one parameter per field, to see whether it
+    takes the validated data)."""
+    return lambda: model()
+
+
 class Mission(BaseModel):
     """A whole mission file."""
 
@@ -555,17 +562,17 @@ class Mission(BaseModel):
                                  description="points to pass, in order")
     return_to_start: bool = Field(False, alias="return",
                                   description="plan a leg back to the start")
-    planner: PlannerSpec = Field(default_factory=PlannerSpec)
+    planner: PlannerSpec = Field(default_factory=_default(PlannerSpec))
     no_fly_zones: list[ZoneSpec] = Field(default_factory=_empty, max_length=10000,
                                          description="no-fly zones: files or inline zones")
     operating_area: ZoneSpec | None = Field(None, description="area the mission stays in")
-    airframe: AirframeSpec = Field(default_factory=AirframeSpec)
+    airframe: AirframeSpec = Field(default_factory=_default(AirframeSpec))
     wind: WindSpec | None = Field(None, description="the wind: {speed, from[, ref_height, "
                                   "exponent]} or {file}")
-    outputs: OutputSpec = Field(default_factory=OutputSpec)
+    outputs: OutputSpec = Field(default_factory=_default(OutputSpec))
     _base_dir: Path | None = PrivateAttr(None)
     rally: RallySpec | None = Field(None, description="rally points: sites, a file or auto")
-    returns: ReturnsSpec = Field(default_factory=ReturnsSpec)
+    returns: ReturnsSpec = Field(default_factory=_default(ReturnsSpec))
 
     @model_validator(mode="after")
     def _points_needed(self) -> Mission:
