@@ -8,10 +8,12 @@ after a small warm-up march, the thread counts and, with ``--peer-src``, another
     python -m benchmarks.terrain_march --threads 1 2 --repeats 3 [--peer-src /path/to/src]
 
 Prints per code and thread count the medians of the wall time, the process CPU time, the
-busiest thread's CPU time (``/proc/self/task/*/schedstat``), and for two threads the CPU of
-the windows (the parallel driver's calls: both threads, and the busier one) and the march's
-statistics (slabs, windows, balance, nodes re-opened, updates raised), the load average and
-the digest of the times (equal between codes and thread counts when bit for bit). On a
+busiest thread's CPU time (``/proc/self/task/*/schedstat``), the system CPU time and the
+minor page faults (``getrusage``: the first touch of the march's fresh buffers), and for two
+threads the CPU of the windows (the parallel driver's calls: both threads, and the busier
+one) and the march's statistics (slabs, windows, balance, nodes re-opened, updates raised),
+the load average and the digest of the times (equal between codes and thread counts when bit
+for bit). On a
 loaded machine the walls are the queue for a core; the CPU times are what a thread spent.
 Not part of ``make bench`` (a march per child: minutes); docs/performance.md quotes it.
 """
@@ -32,7 +34,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 _CHILD = textwrap.dedent(
     """
-    import glob, hashlib, json, os, sys, time
+    import glob, hashlib, json, os, resource, sys, time
     import numpy as np
     from scipy import ndimage
     import fm2uav
@@ -88,11 +90,14 @@ _CHILD = textwrap.dedent(
     fast_marching(W[:200, :200], [(150, 150, 35)], spacing=cell, order=2, threads=th)
     WIN.update(win_cpu=0.0, win_busiest=0.0)
     STATS.clear()
+    r0 = resource.getrusage(resource.RUSAGE_SELF)
     t0, w0, p0 = tasks(), time.perf_counter(), time.process_time()
     T = fast_marching(W, [goal], spacing=cell, order=2, stop_at=[start], threads=th)
     w1, p1 = time.perf_counter(), time.process_time()
     d = spent(t0, tasks())
+    r1 = resource.getrusage(resource.RUSAGE_SELF)
     out = {"wall": w1 - w0, "cpu": p1 - p0, "busiest": max(d.values()),
+           "system": r1.ru_stime - r0.ru_stime, "faults": r1.ru_minflt - r0.ru_minflt,
            "digest": hashlib.sha256(T.tobytes()).hexdigest()[:12], "load": os.getloadavg()[0]}
     if th > 1:
         out.update(WIN)
@@ -101,8 +106,8 @@ _CHILD = textwrap.dedent(
     """
 )
 
-NUMBERS = ["wall", "cpu", "busiest", "win_cpu", "win_busiest", "balance", "reopened", "raised",
-           "windows", "slabs"]
+NUMBERS = ["wall", "cpu", "busiest", "system", "faults", "win_cpu", "win_busiest", "balance",
+           "reopened", "raised", "windows", "slabs"]
 
 
 def child(src: str, threads: int) -> dict:

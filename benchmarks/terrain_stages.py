@@ -6,11 +6,15 @@ child process (the bench's conditions: first plan after the JIT warm-up), the th
 
     python -m benchmarks.terrain_stages --threads 1 2 --repeats 3 [--peer-src /path/to/src]
 
-Prints per stage the medians of wall time, process CPU time and the main thread's CPU time
-(process minus main thread: the work the other threads did), the plan's peak memory above
-the warmed-up child and the digests of W, T and the path (equal between peers when the
-change is bit for bit). Stages: the plan's own (``Plan.timings``) and the pieces inside
-``fast_marching`` and the geodesic (input scan, padding, march kernel, unpadding, ...).
+Prints per stage the medians of wall time, process CPU time, the main thread's CPU time
+(process minus main thread: the work the other threads did), the process' system CPU time
+and its minor page faults (``getrusage``: the first touch of fresh memory, whose zeroing is
+system time; on this virtual machine slow for huge pages, docs/performance.md), the plan's
+peak memory above the warmed-up child and the digests of W, T and the path (equal between
+peers when the change is bit for bit). Stages: the plan's own (``Plan.timings``) and the
+pieces inside ``fast_marching`` and the geodesic (input scan, padding, march kernel,
+unpadding, ...); on two threads the march kernel is the windows' driver and the cuts'
+coarse march a piece of its own (its padding and march not counted twice).
 Not part of ``make bench`` (a plan per child: minutes); docs/performance.md quotes it.
 """
 
@@ -34,7 +38,7 @@ _CHILD = textwrap.dedent(
     import numpy as np
     from scipy import ndimage
     import fm2uav
-    from fm2uav.eikonal import _kernels, fmm
+    from fm2uav.eikonal import _kernels, _parallel, fmm
     import fm2uav.planning.planner as pl
 
     def rss_mb():
@@ -45,7 +49,9 @@ _CHILD = textwrap.dedent(
         return hashlib.sha256(np.ascontiguousarray(a).tobytes()).hexdigest()[:12]
 
     def clocks():
-        return time.perf_counter(), time.process_time(), time.thread_time()
+        r = resource.getrusage(resource.RUSAGE_SELF)
+        return (time.perf_counter(), time.process_time(), time.thread_time(), r.ru_stime,
+                float(r.ru_minflt))
 
     rng = np.random.default_rng(0)
     n, nz, cell = N, 40, 15.0
@@ -57,19 +63,35 @@ _CHILD = textwrap.dedent(
     warm_kernels(["edt_parallel", "fmm3d_o2_lean"])
     PIECES = {}
 
-    def timed(mod, name, label):
-        f = getattr(mod, name, None)
-        if f is None:
-            return
+    CUTS = "  cuts (coarse march)"
+    ACTIVE = []
+
+    def wrapped(f, label):
         @functools.wraps(f)
         def w(*a, **k):
+            ACTIVE.append(label)
             c0 = clocks()
-            r = f(*a, **k)
-            acc = PIECES.setdefault(label, [0.0, 0.0, 0.0])
-            for i, (x, y) in enumerate(zip(clocks(), c0)):
-                acc[i] += x - y
-            return r
-        setattr(mod, name, w)
+            try:
+                return f(*a, **k)
+            finally:
+                ACTIVE.pop()
+                if label == CUTS or CUTS not in ACTIVE:  # not the coarse march's pieces
+                    acc = PIECES.setdefault(label, [0.0] * 5)
+                    for i, (x, y) in enumerate(zip(clocks(), c0)):
+                        acc[i] += x - y
+        return w
+
+    def timed(mod, name, label):
+        f = getattr(mod, name, None)
+        if f is not None:
+            setattr(mod, name, wrapped(f, label))
+
+    # two threads: the slabs' set-up and the windows' driver (_parallel)
+    for key in list(_parallel._DRIVES):
+        _parallel._DRIVES[key] = wrapped(_parallel._DRIVES[key], "  march kernel")
+    for name, label in [("slab_bounds", CUTS), ("_pad_slabs", "  padding"),
+                        ("_inf_after", "  unpadding")]:
+        timed(_parallel, name, label)
 
     for mod, name, label in [
             (fmm, "_as_speed", "  input scan"), (fmm, "_source_start", "  sources and ball"),
@@ -113,7 +135,8 @@ _CHILD = textwrap.dedent(
 )
 
 ORDER = ["world build", "(checks)", "velocity_map", "fast_marching", "  input scan",
-         "  sources and ball", "  padding", "  plateau test", "  march kernel", "  unpadding",
+         "  sources and ball", "  cuts (coarse march)", "  padding", "  plateau test",
+         "  march kernel", "  unpadding",
          "  ties at the start", "geodesic", "  obstacles reached?", "  descent", "metrics",
          "  clearance", "plan", "plan outside the march kernel"]
 
@@ -132,7 +155,8 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     runs = interleaved_runs(args.repeats, args.threads, args.peer_src, str(ROOT / "src"),
                             lambda src, th: child(src, th, args.n))
-    print("stage: wall / process CPU / main-thread CPU [s], medians of "
+    print("stage: wall / process CPU / main-thread CPU / system CPU [s] / minor page faults, "
+          "medians of "
           f"{args.repeats}; per code and thread count")
     cols = list(runs)
     print("| stage | " + " | ".join(f"{c} {t} thread{'s' * (t > 1)}" for c, t in cols) + " |")
@@ -145,7 +169,8 @@ def main(argv: list[str] | None = None) -> int:
                 cells.append("")
                 continue
             cells.append(" / ".join(f"{statistics.median(v[i] for v in vals):.3f}"
-                                    for i in range(3)))
+                                    for i in range(4))
+                         + f" / {statistics.median(v[4] for v in vals):.0f}")
         print(f"| {key} | " + " | ".join(cells) + " |")
     for col in cols:
         rs = runs[col]
