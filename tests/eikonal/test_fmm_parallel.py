@@ -927,17 +927,3 @@ def test_slabs_taken_in_turn_one_thread_after_the_other():
             t = min(range(nth), key=lambda t: (free[t], t))
             free[t] += work[k]
         assert list(load) == free
-
-
-@pytest.mark.parametrize("shape", [(3, 5_000_000), (1000,), (8, 3)])
-def test_work_arrays_of_the_slabs_start_zeroed(shape):
-    """The slabs' bit masks and queues (``_parallel._zeroed``: a fresh huge-page mapping
-    from 4 MiB on, ``np.zeros`` below) start as ``np.zeros`` would: every bit clear, the
-    shape and type asked for, writable and C-ordered (the kernels' signature)."""
-    for dtype in (np.uint8, np.uint64):
-        a = _parallel._zeroed(shape, dtype)
-        assert a.shape == shape and a.dtype == dtype
-        assert a.flags.c_contiguous and a.flags.writeable
-        assert not a.any()
-        a[...] = 7
-        assert (a == 7).all()

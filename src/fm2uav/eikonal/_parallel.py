@@ -1821,7 +1821,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     # order 2's bit masks: re-opened, suspect, pending, a bit per node (one spare byte: a 2D
     # slice below), and the nodes in the band on entry with their times (a repair keeps
     # them if lower; element indices)
-    fl = _zeroed((3, npad // 8 + 2 if order == 2 else 1), np.uint8)
+    fl = np.zeros((3, npad // 8 + 2 if order == 2 else 1), dtype=np.uint8)
     nodes = np.zeros(0, dtype=np.int64)
     if order == 2:
         parts = []
@@ -1838,8 +1838,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     ns = np.full((K, 2), G * sx + 1, dtype=np.uint64)
     # queues: one radix queue and one repair heap per slab
     nblk = max(POOL_MIN_BLOCKS, int(sizes.max()) // (16 * BLOCK))
-    pool = _zeroed((K, 2 * nblk * BLOCK), np.uint64)
-    nxt = _zeroed((K, nblk), np.uint32)
+    pool = np.empty((K, 2 * nblk * BLOCK), dtype=np.uint64)
+    nxt = np.empty((K, nblk), dtype=np.uint32)
     bk = np.empty((K, 2 * int(_NB)), dtype=np.uint32)
     mw = np.empty((K, _NW), dtype=np.uint64)
     st = np.zeros((K, _ST), dtype=np.uint64)
@@ -1964,26 +1964,11 @@ def _threads(nth):
         numba.set_num_threads(prev)
 
 
-def _zeroed(shape, dtype):
-    """A zeroed work array: from 4 MiB on a fresh mapping advised for huge pages
-    (:func:`fm2uav.eikonal._kernels._work`, as the serial march's buffers), below
-    ``np.zeros``. numpy's own arrays get 4 KiB pages on this machine, and the windows read
-    the bit masks (``fixed``, the re-opened, suspect and pending bits) at every node of
-    the stencils, across x-planes kilobytes apart: with 4 KiB pages each such read may
-    miss the TLB (the terrain march's windows' CPU with these arrays on huge pages: see
-    docs/performance.md, "The terrain plan, round three")."""
-    dt = np.dtype(dtype)
-    nbytes = int(np.prod(shape)) * dt.itemsize
-    if nbytes < _kernels._HUGE_MIN:
-        return np.zeros(shape, dtype=dt)
-    return _kernels._work(nbytes).view(dt).reshape(shape)
-
-
 def _frozen_bits(Tp, rows, npad):
     """A bit per node of the padded slabs ``Tp`` (``npad`` nodes), set where ``Tp >= 0``
     (frozen) in the node ranges ``rows[k, 0] <= c < rows[k, 1]`` (each slab's start box
     rows), clear elsewhere (no other node is frozen on entry)."""
-    bits = _zeroed(npad // 8 + 1, np.uint8)
+    bits = np.zeros(npad // 8 + 1, dtype=np.uint8)
     for a, b in rows:
         if b > a:
             a8 = int(a) & ~7
@@ -2166,9 +2151,9 @@ def _grow_pools(pool, nxt, st):
     """Double every slab's entry pool; the new blocks join each slab's free list."""
     K, old = nxt.shape
     new = 2 * old
-    pool2 = _zeroed((K, 2 * new * BLOCK), np.uint64)
+    pool2 = np.empty((K, 2 * new * BLOCK), dtype=np.uint64)
     pool2[:, :pool.shape[1]] = pool
-    nxt2 = _zeroed((K, new), np.uint32)
+    nxt2 = np.empty((K, new), dtype=np.uint32)
     nxt2[:, :old] = nxt
     for k in range(K):
         nxt2[k, old:-1] = np.arange(old + 1, new, dtype=np.uint32)
