@@ -99,15 +99,18 @@ def _steps(s: np.ndarray) -> np.ndarray:
     return np.diff(s)
 
 
-def _sweeps(s: Any, bound: Any, pick: Any, forward: float, backward: float) -> np.ndarray:
+def _sweeps(s: Any, bound: Any, upper: bool, forward: float, backward: float) -> np.ndarray:
     """``bound`` swept forward then backward: ``z_i = pick(z_i, z_(i-1) + forward * ds)``,
-    then ``z_i = pick(z_i, z_(i+1) + backward * ds)`` (``ds`` the steps of ``s`` [m])."""
+    then ``z_i = pick(z_i, z_(i+1) + backward * ds)`` (``ds`` the steps of ``s`` [m];
+    ``pick`` is ``min`` when ``upper``, else ``max``; compiled:
+    :func:`._envelope_kernels.sweep_pair`)."""
+    from ._envelope_kernels import sweep_pair
+
     d = _steps(s)
     z = np.array(bound, dtype=float)
-    for i in range(1, len(z)):
-        z[i] = pick(z[i], z[i - 1] + forward * d[i - 1])
-    for i in range(len(z) - 2, -1, -1):
-        z[i] = pick(z[i], z[i + 1] + backward * d[i])
+    if z.shape != (len(d) + 1,):
+        raise InputError(f"the bound has shape {z.shape}, the arc lengths {(len(d) + 1,)}")
+    sweep_pair(z, d, bool(upper), float(forward), float(backward))
     return z
 
 
@@ -134,7 +137,7 @@ def envelope_above(s: Any, lower: Any, tan_climb: float, tan_descent: float) -> 
     >>> envelope_above([0, 1, 2, 3, 4], [0, 0, 10, 0, 0], 5.0, 2.0).tolist()
     [0.0, 5.0, 10.0, 8.0, 6.0]
     """
-    return _sweeps(s, lower, max, -tan_descent, -tan_climb)
+    return _sweeps(s, lower, False, -tan_descent, -tan_climb)
 
 
 def envelope_below(s: Any, upper: Any, tan_climb: float, tan_descent: float) -> np.ndarray:
@@ -147,7 +150,7 @@ def envelope_below(s: Any, upper: Any, tan_climb: float, tan_descent: float) -> 
     >>> envelope_below([0, 1, 2, 3, 4], [9, 9, 0, 9, 9], 2.0, 5.0).tolist()
     [9.0, 5.0, 0.0, 2.0, 4.0]
     """
-    return _sweeps(s, upper, min, tan_climb, tan_descent)
+    return _sweeps(s, upper, True, tan_climb, tan_descent)
 
 
 # ---------------------------------------------------------------------- route
