@@ -59,3 +59,90 @@ def test_every_dropped_point_is_within_tolerance(seed, tol, dim):
             d = segment_distances(p[a + 1 : b], p[a], p[b])
             assert d.max() <= tol + 1e-9
     np.testing.assert_array_equal(thin_path(p, tol), p[kept])
+
+
+# ------------------------------------------------------------------ compiled = numpy, bit for bit
+def _thin_in_numpy(p, tol, max_points=None):
+    """The numpy Douglas–Peucker as it was before the compiled splits (worst first, heap)."""
+    import heapq
+
+    n = len(p)
+    if n <= 2:
+        return np.arange(n)
+    keep = np.zeros(n, dtype=bool)
+    keep[0] = keep[-1] = True
+    segs = []
+
+    def worst(i, j):
+        if j - i < 2:
+            return None
+        d = segment_distances(p[i + 1:j], p[i], p[j])
+        k = int(np.argmax(d))
+        return (-float(d[k]), i, j, i + 1 + k)
+
+    first = worst(0, n - 1)
+    if first is not None:
+        heapq.heappush(segs, first)
+    count = 2
+    while segs:
+        neg, i, j, k = heapq.heappop(segs)
+        if -neg <= tol or (max_points is not None and count >= max_points):
+            break
+        keep[k] = True
+        count += 1
+        for seg in (worst(i, k), worst(k, j)):
+            if seg is not None:
+                heapq.heappush(segs, seg)
+    return np.flatnonzero(keep)
+
+
+def _polyline(rng, kind):
+    n = int(rng.integers(3, 300))
+    d = int(rng.choice([2, 3]))
+    if kind == "walk":  # a descent-like path: small steps, smooth turns
+        p = np.cumsum(rng.normal(0, 1, (n, d)) + rng.normal(0, 1, d), axis=0)
+    elif kind == "grid":  # half-cell points: collinear runs, exact ties, duplicates
+        p = np.cumsum(rng.integers(-1, 2, (n, d)), axis=0) * 0.5
+    elif kind == "zigzag":  # symmetric teeth: equal distances everywhere
+        p = np.zeros((n, d))
+        p[:, 0] = np.arange(n)
+        p[:, 1] = np.where(np.arange(n) % 2, 1.0, -1.0) * rng.choice([1.0, 2.0])
+        p[0, 1] = p[-1, 1] = 0.0
+    elif kind == "line":  # collinear points, some repeated, in UTM-sized coordinates
+        t = np.sort(rng.choice(np.linspace(0, 1, 40), n))
+        p = np.array([4.1e6, 6.5e5, 300.0][:d]) + t[:, None] * rng.normal(0, 900, d)
+    else:  # "utm": a walk far from the origin (rounding relative to the coordinates)
+        p = np.array([6.5e5, 4.1e6, 900.0][:d]) + np.cumsum(rng.normal(0, 20, (n, d)), axis=0)
+    return p
+
+
+@pytest.mark.parametrize("kind", ["walk", "grid", "zigzag", "line", "utm"])
+@pytest.mark.parametrize("seed", range(40))
+def test_compiled_splits_keep_exactly_the_numpy_indices(kind, seed):
+    rng = np.random.default_rng(seed)
+    p = _polyline(rng, kind)
+    dists = segment_distances(p[1:-1], p[0], p[-1])
+    tols = [0.0, 0.5, 1.0, 15.0, float(rng.uniform(0, 5)),
+            float(dists.max()) if len(dists) else 1.0,  # a distance exactly at the tolerance
+            float(np.median(dists)) if len(dists) else 1.0]
+    for tol in tols:
+        want = _thin_in_numpy(p, tol)
+        assert np.array_equal(thin_indices(p, tol), want), (kind, seed, tol)
+        cap = max(2, len(want) - int(rng.integers(0, 3)))
+        assert np.array_equal(thin_indices(p, tol, max_points=cap), _thin_in_numpy(p, tol, cap))
+
+
+def test_near_ties_are_decided_by_numpy_and_the_rest_compiled(monkeypatch):
+    """Equal teeth go to numpy (its own rounding picks), a plain walk never does."""
+    from fm2uav.autopilot import thin
+
+    rng = np.random.default_rng(7)
+    p = _polyline(rng, "walk")
+    calls = []
+    real = thin.segment_distances
+    monkeypatch.setattr(thin, "segment_distances", lambda *a: calls.append(1) or real(*a))
+    assert np.array_equal(thin_indices(p, 1.0), _thin_in_numpy(p, 1.0))
+    assert calls == []  # a walk has no near ties: the compiled splits decide everything
+    z = _polyline(np.random.default_rng(1), "zigzag")
+    assert np.array_equal(thin_indices(z, 0.1), _thin_in_numpy(z, 0.1))
+    assert calls  # the zigzag's equal teeth are decided by numpy's own rounding
