@@ -432,25 +432,24 @@ def _surface_envelope(world: Any, xy: np.ndarray) -> tuple[np.ndarray, np.ndarra
     Returns the surface height at the samples, the highest surface and the lowest
     ground over each sample's two chords [m].
     """
+    from ..world.ground import surface_and_ground
+
     fr = np.array([0.25, 0.5, 0.75])
     inner = (xy[:-1, None, :] + fr[None, :, None] * (xy[1:] - xy[:-1])[:, None, :]).reshape(-1, 2)
-
-    def surf(q: np.ndarray) -> np.ndarray:
-        return np.asarray(world.surface_height(q[:, 0], q[:, 1]), dtype=float)
-
-    def grnd(q: np.ndarray) -> np.ndarray:
-        return np.asarray(world.ground_height(q[:, 0], q[:, 1]), dtype=float)
-
-    s_at, g_at = surf(xy), grnd(xy)
     n_ch = len(xy) - 1
+    # samples and chord points in one read (the ground once: a reprojection per point)
+    s_all, g_all = surface_and_ground(world, np.r_[xy[:, 0], inner[:, 0]],
+                                      np.r_[xy[:, 1], inner[:, 1]])
+    s_at, g_at = s_all[:len(xy)], g_all[:len(xy)]
+    s_in, g_in = s_all[len(xy):], g_all[len(xy):]
     # z is linear along a chord, so only the surface's departure from its own chord
     # between two samples matters: bump (above the chord) for the floor, dip (below
     # it) for the ceiling; each sample takes the larger of its two chords
     if n_ch:
         lin_s = s_at[:-1, None] + fr[None, :] * (s_at[1:] - s_at[:-1])[:, None]
         lin_g = g_at[:-1, None] + fr[None, :] * (g_at[1:] - g_at[:-1])[:, None]
-        bump = np.maximum((surf(inner).reshape(n_ch, 3) - lin_s).max(axis=1), 0.0)
-        dip = np.maximum((lin_g - grnd(inner).reshape(n_ch, 3)).max(axis=1), 0.0)
+        bump = np.maximum((s_in.reshape(n_ch, 3) - lin_s).max(axis=1), 0.0)
+        dip = np.maximum((lin_g - g_in.reshape(n_ch, 3)).max(axis=1), 0.0)
     else:
         bump = dip = np.zeros(0)
     smax = s_at + _window(np.zeros(len(xy)), bump, np.maximum)
