@@ -275,8 +275,8 @@ def _with_rotations(prim: dict[str, np.ndarray], th: np.ndarray, xi: float) -> d
 
 def _sweeps(prim: dict[str, np.ndarray], th: np.ndarray) -> tuple[list[Any], ...]:
     """Per primitive: its swept cells (nearest nodes of its samples, start node included) and its
-    sampled points; CSR pointers and parts ``cell_ptr, cell_x, cell_y, pt_ptr, pt_x, pt_y, pt_th``."""
-    cell_ptr, cell_x, cell_y = [0], [], []
+    sampled points; CSR pointers and parts ``cell_ptr, cell_x, cell_y, pt_ptr, pt_x, pt_y, pt_th``.
+    The cells of a primitive are sorted by (x, y), each once."""
     pt_ptr, pt_x, pt_y, pt_th = [0], [], [], []
     for n in range(len(prim["i"])):
         g = prim["geom"][n]
@@ -285,12 +285,23 @@ def _sweeps(prim: dict[str, np.ndarray], th: np.ndarray) -> tuple[list[Any], ...
         pt_y.append(ys)
         pt_th.append(ths)
         pt_ptr.append(pt_ptr[-1] + len(xs))
-        cells = np.unique(np.floor(np.stack([np.append(xs, 0.0), np.append(ys, 0.0)], 1) + 0.5)
-                          .astype(np.int64), axis=0)
-        cell_x.append(cells[:, 0])
-        cell_y.append(cells[:, 1])
-        cell_ptr.append(cell_ptr[-1] + len(cells))
-    return cell_ptr, cell_x, cell_y, pt_ptr, pt_x, pt_y, pt_th
+    n_prim = len(pt_x)
+    if not n_prim:
+        return [0], [], [], pt_ptr, pt_x, pt_y, pt_th
+    # every primitive's samples and its start node (0, 0), their nearest nodes, then the
+    # distinct (primitive, x, y) in one sort
+    counts = np.diff(np.asarray(pt_ptr)) + 1
+    owner = np.repeat(np.arange(n_prim, dtype=np.int64), counts)
+    zero = np.zeros(1)
+    cx = np.floor(np.concatenate([a for xs in pt_x for a in (xs, zero)]) + 0.5).astype(np.int64)
+    cy = np.floor(np.concatenate([a for ys in pt_y for a in (ys, zero)]) + 0.5).astype(np.int64)
+    x0, y0 = int(cx.min()), int(cy.min())
+    wx, wy = int(cx.max()) - x0 + 1, int(cy.max()) - y0 + 1
+    key = np.unique((owner * wx + (cx - x0)) * wy + (cy - y0))
+    cell_x = (key // wy) % wx + x0
+    cell_y = key % wy + y0
+    cell_ptr = np.searchsorted(key // (wx * wy), np.arange(n_prim + 1)).tolist()
+    return cell_ptr, [cell_x], [cell_y], pt_ptr, pt_x, pt_y, pt_th
 
 
 @lru_cache(maxsize=16)
@@ -384,35 +395,29 @@ def _reduce(prim: dict, K: int, r: int) -> np.ndarray:
         return ((ddx + off) * span + (ddy + off)) * K + jj
 
     by_start = [np.flatnonzero(i == h) for h in range(K)]
+    sizes = np.array([len(b) for b in by_start], dtype=np.int64)
     keep = np.ones(len(i), dtype=bool)
     for h in range(K):
         own = by_start[h]
         if len(own) == 0:
             continue
-        comp_keys, comp_cost, comp_n = [], [], []
-        for p1 in own:
-            p2 = by_start[j[p1]]
-            if len(p2) == 0:
-                continue
-            comp_keys.append(key(dx[p1] + dx[p2], dy[p1] + dy[p2], j[p2]))
-            comp_cost.append(c[p1] + c[p2])
-            comp_n.append(np.maximum(n2[p1], n2[p2]))
-        if not comp_keys:
+        # every composite p1 (own) + p2 (starting at p1's end heading), flattened
+        reps = sizes[j[own]]
+        if not reps.sum():
             continue
-        ck = np.concatenate(comp_keys)
-        cc = np.concatenate(comp_cost)
-        cn = np.concatenate(comp_n)
+        p1 = np.repeat(own, reps)
+        p2 = np.concatenate([by_start[j[q]] for q in own])
+        ck = key(dx[p1] + dx[p2], dy[p1] + dy[p2], j[p2])
+        cc = c[p1] + c[p2]
+        cn = np.maximum(n2[p1], n2[p2])
+        # the own primitive with each composite's (displacement, end heading), if any (one
+        # primitive per (start, displacement, end): the keys of own are distinct)
         own_keys = key(dx[own], dy[own], j[own])
-        # for each own primitive: cheapest composite with strictly shorter parts
-        order = np.argsort(ck, kind="stable")
-        ck, cc, cn = ck[order], cc[order], cn[order]
-        lo = np.searchsorted(ck, own_keys, side="left")
-        hi = np.searchsorted(ck, own_keys, side="right")
-        for m, p in enumerate(own):
-            if hi[m] == lo[m]:
-                continue
-            seg = slice(lo[m], hi[m])
-            shorter = cn[seg] < n2[p] if n2[p] > 0 else np.zeros(hi[m] - lo[m], bool)
-            if np.any(shorter & (cc[seg] <= c[p] * (1.0 + 1e-9))):
-                keep[p] = False
+        order = np.argsort(own_keys, kind="stable")
+        pos = np.minimum(np.searchsorted(own_keys[order], ck), len(own) - 1)
+        match = own_keys[order][pos] == ck
+        p = own[order][pos]
+        # dominated: a composite of strictly shorter parts costing no more
+        beat = match & (n2[p] > 0) & (cn < n2[p]) & (cc <= c[p] * (1.0 + 1e-9))
+        keep[p[beat]] = False
     return keep
