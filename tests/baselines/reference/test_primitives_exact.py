@@ -61,3 +61,22 @@ def test_swept_cells_are_each_primitives_distinct_nearest_nodes(model):
         lo, hi = pr.cell_ptr[n], pr.cell_ptr[n + 1]
         got = np.stack([pr.cell_x[lo:hi], pr.cell_y[lo:hi]], 1)
         assert np.array_equal(got, want), n
+
+
+@pytest.mark.parametrize("model", ["dubins", "elastica", "rs"])
+def test_all_primitives_are_sampled_as_one_at_a_time(model):
+    """The vectorised sampling gives :func:`_sample`'s points of every primitive (rotations in
+    place, straight and curved arcs), bit for bit."""
+    th = P.lattice_headings(3)
+    radius = default_radius(4.0, 3, model)
+    prim = P._candidates(model, 4.0, th, radius, int(radius), math.pi / 2, math.radians(70.0))
+    if model == "rs":
+        prim = P._with_rotations(prim, th, 4.0)
+    ptr, xs, ys, ths = P._sample_all(th[prim["i"]], prim["geom"], prim["dx"].astype(float),
+                                     prim["dy"].astype(float))
+    for n in range(len(prim["i"])):
+        want = P._sample(th[prim["i"][n]], *prim["geom"][n], float(prim["dx"][n]),
+                         float(prim["dy"][n]))
+        got = (xs[ptr[n]:ptr[n + 1]], ys[ptr[n]:ptr[n + 1]], ths[ptr[n]:ptr[n + 1]])
+        for g, w in zip(got, want):
+            assert np.array_equal(g, w), n
