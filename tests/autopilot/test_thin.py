@@ -63,37 +63,11 @@ def test_every_dropped_point_is_within_tolerance(seed, tol, dim):
 
 # ------------------------------------------------------------------ compiled = numpy, bit for bit
 def _thin_in_numpy(p, tol, max_points=None):
-    """The numpy Douglas–Peucker as it was before the compiled splits (worst first, heap)."""
-    import heapq
+    """The numpy Douglas–Peucker as it was before the compiled splits (worst segment first,
+    a heap of numpy distances), kept as ``thin._split_in_order`` for the point budget."""
+    from fm2uav.autopilot.thin import _split_in_order
 
-    n = len(p)
-    if n <= 2:
-        return np.arange(n)
-    keep = np.zeros(n, dtype=bool)
-    keep[0] = keep[-1] = True
-    segs = []
-
-    def worst(i, j):
-        if j - i < 2:
-            return None
-        d = segment_distances(p[i + 1:j], p[i], p[j])
-        k = int(np.argmax(d))
-        return (-float(d[k]), i, j, i + 1 + k)
-
-    first = worst(0, n - 1)
-    if first is not None:
-        heapq.heappush(segs, first)
-    count = 2
-    while segs:
-        neg, i, j, k = heapq.heappop(segs)
-        if -neg <= tol or (max_points is not None and count >= max_points):
-            break
-        keep[k] = True
-        count += 1
-        for seg in (worst(i, k), worst(k, j)):
-            if seg is not None:
-                heapq.heappush(segs, seg)
-    return np.flatnonzero(keep)
+    return np.arange(len(p)) if len(p) <= 2 else _split_in_order(p, tol, max_points)
 
 
 def _polyline(rng, kind):
@@ -136,13 +110,13 @@ def test_near_ties_are_decided_by_numpy_and_the_rest_compiled(monkeypatch):
     """Equal teeth go to numpy (its own rounding picks), a plain walk never does."""
     from fm2uav.autopilot import thin
 
-    rng = np.random.default_rng(7)
-    p = _polyline(rng, "walk")
+    p = _polyline(np.random.default_rng(7), "walk")
+    z = _polyline(np.random.default_rng(1), "zigzag")
+    want_p, want_z = _thin_in_numpy(p, 1.0), _thin_in_numpy(z, 0.1)
     calls = []
     real = thin.segment_distances
     monkeypatch.setattr(thin, "segment_distances", lambda *a: calls.append(1) or real(*a))
-    assert np.array_equal(thin_indices(p, 1.0), _thin_in_numpy(p, 1.0))
+    assert np.array_equal(thin_indices(p, 1.0), want_p)
     assert calls == []  # a walk has no near ties: the compiled splits decide everything
-    z = _polyline(np.random.default_rng(1), "zigzag")
-    assert np.array_equal(thin_indices(z, 0.1), _thin_in_numpy(z, 0.1))
+    assert np.array_equal(thin_indices(z, 0.1), want_z)
     assert calls  # the zigzag's equal teeth are decided by numpy's own rounding
