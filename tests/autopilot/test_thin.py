@@ -59,3 +59,64 @@ def test_every_dropped_point_is_within_tolerance(seed, tol, dim):
             d = segment_distances(p[a + 1 : b], p[a], p[b])
             assert d.max() <= tol + 1e-9
     np.testing.assert_array_equal(thin_path(p, tol), p[kept])
+
+
+# ------------------------------------------------------------------ compiled = numpy, bit for bit
+def _thin_in_numpy(p, tol, max_points=None):
+    """The numpy Douglas–Peucker as it was before the compiled splits (worst segment first,
+    a heap of numpy distances), kept as ``thin._split_in_order`` for the point budget."""
+    from fm2uav.autopilot.thin import _split_in_order
+
+    return np.arange(len(p)) if len(p) <= 2 else _split_in_order(p, tol, max_points)
+
+
+def _polyline(rng, kind):
+    n = int(rng.integers(3, 300))
+    d = int(rng.choice([2, 3]))
+    if kind == "walk":  # a descent-like path: small steps, smooth turns
+        p = np.cumsum(rng.normal(0, 1, (n, d)) + rng.normal(0, 1, d), axis=0)
+    elif kind == "grid":  # half-cell points: collinear runs, exact ties, duplicates
+        p = np.cumsum(rng.integers(-1, 2, (n, d)), axis=0) * 0.5
+    elif kind == "zigzag":  # symmetric teeth: equal distances everywhere
+        p = np.zeros((n, d))
+        p[:, 0] = np.arange(n)
+        p[:, 1] = np.where(np.arange(n) % 2, 1.0, -1.0) * rng.choice([1.0, 2.0])
+        p[0, 1] = p[-1, 1] = 0.0
+    elif kind == "line":  # collinear points, some repeated, in UTM-sized coordinates
+        t = np.sort(rng.choice(np.linspace(0, 1, 40), n))
+        p = np.array([4.1e6, 6.5e5, 300.0][:d]) + t[:, None] * rng.normal(0, 900, d)
+    else:  # "utm": a walk far from the origin (rounding relative to the coordinates)
+        p = np.array([6.5e5, 4.1e6, 900.0][:d]) + np.cumsum(rng.normal(0, 20, (n, d)), axis=0)
+    return p
+
+
+@pytest.mark.parametrize("kind", ["walk", "grid", "zigzag", "line", "utm"])
+@pytest.mark.parametrize("seed", range(40))
+def test_compiled_splits_keep_exactly_the_numpy_indices(kind, seed):
+    rng = np.random.default_rng(seed)
+    p = _polyline(rng, kind)
+    dists = segment_distances(p[1:-1], p[0], p[-1])
+    tols = [0.0, 0.5, 1.0, 15.0, float(rng.uniform(0, 5)),
+            float(dists.max()) if len(dists) else 1.0,  # a distance exactly at the tolerance
+            float(np.median(dists)) if len(dists) else 1.0]
+    for tol in tols:
+        want = _thin_in_numpy(p, tol)
+        assert np.array_equal(thin_indices(p, tol), want), (kind, seed, tol)
+        cap = max(2, len(want) - int(rng.integers(0, 3)))
+        assert np.array_equal(thin_indices(p, tol, max_points=cap), _thin_in_numpy(p, tol, cap))
+
+
+def test_near_ties_are_decided_by_numpy_and_the_rest_compiled(monkeypatch):
+    """Equal teeth go to numpy (its own rounding picks), a plain walk never does."""
+    from fm2uav.autopilot import thin
+
+    p = _polyline(np.random.default_rng(7), "walk")
+    z = _polyline(np.random.default_rng(1), "zigzag")
+    want_p, want_z = _thin_in_numpy(p, 1.0), _thin_in_numpy(z, 0.1)
+    calls = []
+    real = thin.segment_distances
+    monkeypatch.setattr(thin, "segment_distances", lambda *a: calls.append(1) or real(*a))
+    assert np.array_equal(thin_indices(p, 1.0), want_p)
+    assert calls == []  # a walk has no near ties: the compiled splits decide everything
+    assert np.array_equal(thin_indices(z, 0.1), want_z)
+    assert calls  # the zigzag's equal teeth are decided by numpy's own rounding

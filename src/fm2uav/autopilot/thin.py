@@ -6,8 +6,9 @@ points such that every dropped point lies within ``tolerance`` metres of the
 straight segment that replaces it (Euclidean distance in x, y and z, so climbs
 are kept as well as turns). Start and goal are always kept.
 
-(The ``simplification`` package's RDP is 2D only; this one is a short
-iterative numpy version that works in any dimension.)
+(The ``simplification`` package's RDP is 2D only; this one works in any dimension:
+compiled splits (:mod:`._thin_kernels`) with numpy deciding the near ties, so the indices
+are those of the numpy algorithm, :func:`_split_in_order`, bit for bit.)
 
 Douglas–Peucker bounds the distance to the dense path, not the height above
 the ground: the legs it keeps are checked against the world by
@@ -66,6 +67,42 @@ def thin_indices(path: Any, tolerance: float, *, max_points: int | None = None) 
     n = len(p)
     if n <= 2:
         return np.arange(n)
+    kept = _split_compiled(p, float(tolerance))
+    if max_points is None or len(kept) <= max_points:
+        return kept  # the budget is never reached: the splits' order does not matter
+    return _split_in_order(p, float(tolerance), max_points)
+
+
+def _split_compiled(p: np.ndarray, tolerance: float) -> np.ndarray:
+    """Douglas–Peucker without a point budget: the compiled splits
+    (:func:`._thin_kernels.split_all`), the segments they leave undecided decided here with
+    :func:`segment_distances` — the indices of :func:`_split_in_order` without a budget."""
+    from ._thin_kernels import split_all
+
+    n = len(p)
+    p = np.ascontiguousarray(p)
+    keep = np.zeros(n, dtype=bool)
+    keep[0] = keep[-1] = True
+    todo = np.zeros((n, 2), dtype=np.int64)
+    todo[0] = (0, n - 1)
+    n_todo = 1
+    undecided = np.zeros((n, 2), dtype=np.int64)
+    while n_todo:
+        m = split_all(p, tolerance, keep, todo, n_todo, undecided)
+        n_todo = 0
+        for i, j in undecided[:m].tolist():
+            d = segment_distances(p[i + 1 : j], p[i], p[j])
+            k = int(np.argmax(d))
+            if float(d[k]) > tolerance:
+                keep[i + 1 + k] = True
+                todo[n_todo], todo[n_todo + 1] = (i, i + 1 + k), (i + 1 + k, j)
+                n_todo += 2
+    return np.flatnonzero(keep)
+
+
+def _split_in_order(p: np.ndarray, tolerance: float, max_points: int | None) -> np.ndarray:
+    """Douglas–Peucker splitting the worst segment first, up to ``max_points`` points."""
+    n = len(p)
     keep = np.zeros(n, dtype=bool)
     keep[0] = keep[-1] = True
     # always split the segment with the largest deviation first (a max-heap),

@@ -99,15 +99,18 @@ def _steps(s: np.ndarray) -> np.ndarray:
     return np.diff(s)
 
 
-def _sweeps(s: Any, bound: Any, pick: Any, forward: float, backward: float) -> np.ndarray:
+def _sweeps(s: Any, bound: Any, upper: bool, forward: float, backward: float) -> np.ndarray:
     """``bound`` swept forward then backward: ``z_i = pick(z_i, z_(i-1) + forward * ds)``,
-    then ``z_i = pick(z_i, z_(i+1) + backward * ds)`` (``ds`` the steps of ``s`` [m])."""
+    then ``z_i = pick(z_i, z_(i+1) + backward * ds)`` (``ds`` the steps of ``s`` [m];
+    ``pick`` is ``min`` when ``upper``, else ``max``; compiled:
+    :func:`._envelope_kernels.sweep_pair`)."""
+    from ._envelope_kernels import sweep_pair
+
     d = _steps(s)
     z = np.array(bound, dtype=float)
-    for i in range(1, len(z)):
-        z[i] = pick(z[i], z[i - 1] + forward * d[i - 1])
-    for i in range(len(z) - 2, -1, -1):
-        z[i] = pick(z[i], z[i + 1] + backward * d[i])
+    if z.shape != (len(d) + 1,):
+        raise InputError(f"the bound has shape {z.shape}, the arc lengths {(len(d) + 1,)}")
+    sweep_pair(z, d, bool(upper), float(forward), float(backward))
     return z
 
 
@@ -134,7 +137,7 @@ def envelope_above(s: Any, lower: Any, tan_climb: float, tan_descent: float) -> 
     >>> envelope_above([0, 1, 2, 3, 4], [0, 0, 10, 0, 0], 5.0, 2.0).tolist()
     [0.0, 5.0, 10.0, 8.0, 6.0]
     """
-    return _sweeps(s, lower, max, -tan_descent, -tan_climb)
+    return _sweeps(s, lower, False, -tan_descent, -tan_climb)
 
 
 def envelope_below(s: Any, upper: Any, tan_climb: float, tan_descent: float) -> np.ndarray:
@@ -147,7 +150,7 @@ def envelope_below(s: Any, upper: Any, tan_climb: float, tan_descent: float) -> 
     >>> envelope_below([0, 1, 2, 3, 4], [9, 9, 0, 9, 9], 2.0, 5.0).tolist()
     [9.0, 5.0, 0.0, 2.0, 4.0]
     """
-    return _sweeps(s, upper, min, tan_climb, tan_descent)
+    return _sweeps(s, upper, True, tan_climb, tan_descent)
 
 
 # ---------------------------------------------------------------------- route
@@ -429,25 +432,24 @@ def _surface_envelope(world: Any, xy: np.ndarray) -> tuple[np.ndarray, np.ndarra
     Returns the surface height at the samples, the highest surface and the lowest
     ground over each sample's two chords [m].
     """
+    from ..world.ground import surface_and_ground
+
     fr = np.array([0.25, 0.5, 0.75])
     inner = (xy[:-1, None, :] + fr[None, :, None] * (xy[1:] - xy[:-1])[:, None, :]).reshape(-1, 2)
-
-    def surf(q: np.ndarray) -> np.ndarray:
-        return np.asarray(world.surface_height(q[:, 0], q[:, 1]), dtype=float)
-
-    def grnd(q: np.ndarray) -> np.ndarray:
-        return np.asarray(world.ground_height(q[:, 0], q[:, 1]), dtype=float)
-
-    s_at, g_at = surf(xy), grnd(xy)
     n_ch = len(xy) - 1
+    # samples and chord points in one read (the ground once: a reprojection per point)
+    s_all, g_all = surface_and_ground(world, np.r_[xy[:, 0], inner[:, 0]],
+                                      np.r_[xy[:, 1], inner[:, 1]])
+    s_at, g_at = s_all[:len(xy)], g_all[:len(xy)]
+    s_in, g_in = s_all[len(xy):], g_all[len(xy):]
     # z is linear along a chord, so only the surface's departure from its own chord
     # between two samples matters: bump (above the chord) for the floor, dip (below
     # it) for the ceiling; each sample takes the larger of its two chords
     if n_ch:
         lin_s = s_at[:-1, None] + fr[None, :] * (s_at[1:] - s_at[:-1])[:, None]
         lin_g = g_at[:-1, None] + fr[None, :] * (g_at[1:] - g_at[:-1])[:, None]
-        bump = np.maximum((surf(inner).reshape(n_ch, 3) - lin_s).max(axis=1), 0.0)
-        dip = np.maximum((lin_g - grnd(inner).reshape(n_ch, 3)).max(axis=1), 0.0)
+        bump = np.maximum((s_in.reshape(n_ch, 3) - lin_s).max(axis=1), 0.0)
+        dip = np.maximum((lin_g - g_in.reshape(n_ch, 3)).max(axis=1), 0.0)
     else:
         bump = dip = np.zeros(0)
     smax = s_at + _window(np.zeros(len(xy)), bump, np.maximum)

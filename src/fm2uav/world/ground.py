@@ -32,7 +32,7 @@ if TYPE_CHECKING:
     from .world import World
 
 __all__ = ["ground_height", "ground_filled", "ground_source", "has_unknown_ground",
-           "surface_height", "roof_heights", "terrain_along"]
+           "surface_height", "surface_and_ground", "roof_heights", "terrain_along"]
 
 
 def _xy(world: World, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray, bool]:
@@ -156,18 +156,32 @@ def surface_height(world: World, x: Any, y: Any) -> np.ndarray | float:
     """
     xa, ya, scalar = _xy(world, x, y)
     ground = np.asarray(ground_height(world, xa, ya), dtype=float)
+    return _out(_surface_over(world, xa, ya, ground), scalar)
+
+
+def surface_and_ground(world: World, x: Any, y: Any) -> tuple[np.ndarray, np.ndarray]:
+    """``(surface_height, ground_height)`` at ``(x, y)`` [m] as arrays, the ground read once
+    (a DEM world's ground costs a reprojection per point)."""
+    xa, ya, _ = _xy(world, x, y)
+    ground = np.asarray(ground_height(world, xa, ya), dtype=float)
+    return np.asarray(_surface_over(world, xa, ya, ground), dtype=float), ground
+
+
+def _surface_over(world: World, xa: np.ndarray, ya: np.ndarray,
+                  ground: np.ndarray) -> np.ndarray:
+    """The surface over ``ground`` (the ground height at ``(xa, ya)`` [m]): roofs added."""
     model = getattr(world, "buildings", None)
     if model is not None:  # the footprints themselves (world/building_model.py)
-        return _out(np.maximum(ground, model.roof_at(xa, ya)), scalar)
+        return np.maximum(ground, model.roof_at(xa, ya))
     roofs = roof_heights(world)
     if world.ndim != 3 or not np.isfinite(roofs).any():
-        return _out(ground, scalar)
+        return ground
     nx, ny = world.shape[:2]
     # floor(i + 0.5): the nearest-node rule of World.to_cell
     i = np.clip(np.floor((xa - world.origin[0]) / world.spacing[0] + 0.5), 0, nx - 1)
     j = np.clip(np.floor((ya - world.origin[1]) / world.spacing[1] + 0.5), 0, ny - 1)
     roof = roofs[i.astype(np.int64), j.astype(np.int64)]
-    return _out(np.maximum(ground, roof), scalar)
+    return np.maximum(ground, roof)
 
 
 def terrain_along(world: World, path: np.ndarray) -> np.ndarray | None:

@@ -273,24 +273,82 @@ def _with_rotations(prim: dict[str, np.ndarray], th: np.ndarray, xi: float) -> d
     }
 
 
+def _sample_all(theta0: np.ndarray, geom: np.ndarray, dx: np.ndarray, dy: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_sample` of every primitive at once, the same values: ``(ptr, x, y, θ)``.
+
+    Each primitive's arc lengths are its ``np.linspace`` (``i * (total / n)``, the last one
+    ``total``); the scalar sines and cosines of the arcs' start headings are ``math``'s,
+    as in :func:`_sample`.
+    """
+    phi1, L1, k1, phi2, L2, k2 = geom.T
+    total = L1 + L2
+    rot = total <= 0
+    n = np.where(rot, 1, np.maximum(1, np.ceil(total / _SAMPLE_STEP))).astype(np.int64)
+    ptr = np.concatenate([[0], np.cumsum(n)])
+    owner = np.repeat(np.arange(len(n)), n)
+    local = (np.arange(ptr[-1]) - ptr[:-1][owner] + 1).astype(float)
+    s = local * (total / n)[owner] + 0.0
+    last = ptr[1:] - 1
+    s[last] = total
+    first = s <= L1[owner]
+
+    def trig(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return (np.array([math.sin(a) for a in v.tolist()]),
+                np.array([math.cos(a) for a in v.tolist()]))
+
+    def along(s_, o, x0, y0, h0, k, sin0, cos0):
+        straight = np.abs(k[o]) < 1e-12
+        kk = np.where(straight, 1.0, k[o])
+        h = h0[o] + k[o] * s_
+        x = np.where(straight, x0[o] + s_ * cos0[o], x0[o] + (np.sin(h) - sin0[o]) / kk)
+        y = np.where(straight, y0[o] + s_ * sin0[o], y0[o] - (np.cos(h) - cos0[o]) / kk)
+        return x, y, np.where(straight, h0[o], h)
+
+    zero = np.zeros(len(n))
+    sin0, cos0 = trig(theta0)
+    xs, ys, th = np.empty(len(s)), np.empty(len(s)), np.empty(len(s))
+    o = owner[first]
+    xs[first], ys[first], th[first] = along(s[first], o, zero, zero, theta0, k1, sin0, cos0)
+    allp = np.arange(len(n))
+    mx, my, mth = along(L1, allp, zero, zero, theta0, k1, sin0, cos0)
+    sin_m, cos_m = trig(mth)
+    rest = ~first
+    o = owner[rest]
+    xs[rest], ys[rest], th[rest] = along(s[rest] - L1[o], o, mx, my, mth, k2, sin_m, cos_m)
+    xs[last], ys[last] = dx, dy  # exact end
+    r = np.flatnonzero(rot)  # rotations in place: one point, the heading after the turn
+    xs[last[r]], ys[last[r]], th[last[r]] = 0.0, 0.0, theta0[r] + phi1[r] + phi2[r]
+    return ptr, xs, ys, th
+
+
 def _sweeps(prim: dict[str, np.ndarray], th: np.ndarray) -> tuple[list[Any], ...]:
     """Per primitive: its swept cells (nearest nodes of its samples, start node included) and its
-    sampled points; CSR pointers and parts ``cell_ptr, cell_x, cell_y, pt_ptr, pt_x, pt_y, pt_th``."""
-    cell_ptr, cell_x, cell_y = [0], [], []
-    pt_ptr, pt_x, pt_y, pt_th = [0], [], [], []
-    for n in range(len(prim["i"])):
-        g = prim["geom"][n]
-        xs, ys, ths = _sample(th[prim["i"][n]], *g, float(prim["dx"][n]), float(prim["dy"][n]))
-        pt_x.append(xs)
-        pt_y.append(ys)
-        pt_th.append(ths)
-        pt_ptr.append(pt_ptr[-1] + len(xs))
-        cells = np.unique(np.floor(np.stack([np.append(xs, 0.0), np.append(ys, 0.0)], 1) + 0.5)
-                          .astype(np.int64), axis=0)
-        cell_x.append(cells[:, 0])
-        cell_y.append(cells[:, 1])
-        cell_ptr.append(cell_ptr[-1] + len(cells))
-    return cell_ptr, cell_x, cell_y, pt_ptr, pt_x, pt_y, pt_th
+    sampled points; CSR pointers and parts ``cell_ptr, cell_x, cell_y, pt_ptr, pt_x, pt_y, pt_th``.
+    The cells of a primitive are sorted by (x, y), each once."""
+    ptr, xs, ys, ths = _sample_all(th[prim["i"]], prim["geom"], prim["dx"].astype(float),
+                                   prim["dy"].astype(float))
+    pt_ptr = ptr.tolist()
+    pt_x = [xs[a:b] for a, b in zip(pt_ptr[:-1], pt_ptr[1:])]
+    pt_y = [ys[a:b] for a, b in zip(pt_ptr[:-1], pt_ptr[1:])]
+    pt_th = [ths]
+    n_prim = len(pt_x)
+    if not n_prim:
+        return [0], [], [], pt_ptr, pt_x, pt_y, pt_th
+    # every primitive's samples and its start node (0, 0), their nearest nodes, then the
+    # distinct (primitive, x, y) in one sort
+    counts = np.diff(np.asarray(pt_ptr)) + 1
+    owner = np.repeat(np.arange(n_prim, dtype=np.int64), counts)
+    zero = np.zeros(1)
+    cx = np.floor(np.concatenate([a for xs in pt_x for a in (xs, zero)]) + 0.5).astype(np.int64)
+    cy = np.floor(np.concatenate([a for ys in pt_y for a in (ys, zero)]) + 0.5).astype(np.int64)
+    x0, y0 = int(cx.min()), int(cy.min())
+    wx, wy = int(cx.max()) - x0 + 1, int(cy.max()) - y0 + 1
+    key = np.unique((owner * wx + (cx - x0)) * wy + (cy - y0))
+    cell_x = (key // wy) % wx + x0
+    cell_y = key % wy + y0
+    cell_ptr = np.searchsorted(key // (wx * wy), np.arange(n_prim + 1)).tolist()
+    return cell_ptr, [cell_x], [cell_y], pt_ptr, pt_x, pt_y, pt_th
 
 
 @lru_cache(maxsize=16)
@@ -384,35 +442,29 @@ def _reduce(prim: dict, K: int, r: int) -> np.ndarray:
         return ((ddx + off) * span + (ddy + off)) * K + jj
 
     by_start = [np.flatnonzero(i == h) for h in range(K)]
+    sizes = np.array([len(b) for b in by_start], dtype=np.int64)
     keep = np.ones(len(i), dtype=bool)
     for h in range(K):
         own = by_start[h]
         if len(own) == 0:
             continue
-        comp_keys, comp_cost, comp_n = [], [], []
-        for p1 in own:
-            p2 = by_start[j[p1]]
-            if len(p2) == 0:
-                continue
-            comp_keys.append(key(dx[p1] + dx[p2], dy[p1] + dy[p2], j[p2]))
-            comp_cost.append(c[p1] + c[p2])
-            comp_n.append(np.maximum(n2[p1], n2[p2]))
-        if not comp_keys:
+        # every composite p1 (own) + p2 (starting at p1's end heading), flattened
+        reps = sizes[j[own]]
+        if not reps.sum():
             continue
-        ck = np.concatenate(comp_keys)
-        cc = np.concatenate(comp_cost)
-        cn = np.concatenate(comp_n)
+        p1 = np.repeat(own, reps)
+        p2 = np.concatenate([by_start[j[q]] for q in own])
+        ck = key(dx[p1] + dx[p2], dy[p1] + dy[p2], j[p2])
+        cc = c[p1] + c[p2]
+        cn = np.maximum(n2[p1], n2[p2])
+        # the own primitive with each composite's (displacement, end heading), if any (one
+        # primitive per (start, displacement, end): the keys of own are distinct)
         own_keys = key(dx[own], dy[own], j[own])
-        # for each own primitive: cheapest composite with strictly shorter parts
-        order = np.argsort(ck, kind="stable")
-        ck, cc, cn = ck[order], cc[order], cn[order]
-        lo = np.searchsorted(ck, own_keys, side="left")
-        hi = np.searchsorted(ck, own_keys, side="right")
-        for m, p in enumerate(own):
-            if hi[m] == lo[m]:
-                continue
-            seg = slice(lo[m], hi[m])
-            shorter = cn[seg] < n2[p] if n2[p] > 0 else np.zeros(hi[m] - lo[m], bool)
-            if np.any(shorter & (cc[seg] <= c[p] * (1.0 + 1e-9))):
-                keep[p] = False
+        order = np.argsort(own_keys, kind="stable")
+        pos = np.minimum(np.searchsorted(own_keys[order], ck), len(own) - 1)
+        match = own_keys[order][pos] == ck
+        p = own[order][pos]
+        # dominated: a composite of strictly shorter parts costing no more
+        beat = match & (n2[p] > 0) & (cn < n2[p]) & (cc <= c[p] * (1.0 + 1e-9))
+        keep[p[beat]] = False
     return keep
