@@ -36,7 +36,7 @@ def _reduce_loop(prim, K, r):
 
 
 @pytest.mark.parametrize("model, xi, max_int", [("dubins", 3.0, 2), ("elastica", 3.0, 2),
-                                                 ("rs", 3.0, 2), ("elastica", 2.0, 3)])
+                                                 ("rs", 3.0, 2), ("dubins", 2.0, 3)])
 def test_reduction_drops_exactly_the_dominated_primitives(model, xi, max_int):
     th = P.lattice_headings(max_int)
     radius = default_radius(xi, max_int, model)
