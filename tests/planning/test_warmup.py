@@ -52,6 +52,7 @@ NEEDS = {
     "par3d": ("fmm3d_parallel",),
     "run2d": ("fmm2d_o1", "fmm2d_o2"),
     "par2d": ("fmm2d_parallel",),
+    "level": ("profile",),
 }
 
 
@@ -80,7 +81,7 @@ def later_runs():
     # so a missing entry that is not such a race stays missing and fails the tests below
     for _ in range(3):
         full = json.loads(_probe([*warmup.GROUPS, "--", "run3d", "par3d", "uniform2d",
-                                  "run2d", "par2d"]))
+                                  "run2d", "par2d", "level"]))
         short = json.loads(_probe([*(g for g in warmup.GROUPS if g not in needed), "--",
                                    *NEEDS]))
         bare = json.loads(_probe(["--", "uniform2d", "run2d"]))

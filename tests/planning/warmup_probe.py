@@ -157,6 +157,17 @@ def _par2d() -> None:
         restore()
 
 
+def _level() -> None:
+    """A small terrain plan at a flight level: its altitude envelopes' slope sweeps."""
+    import fm2uav
+
+    heights = 10.0 + 20.0 * np.add.outer(np.sin(np.arange(12) / 3), np.cos(np.arange(10) / 4))
+    world = fm2uav.World.from_heightmap(heights, 15.0, 8)
+    level = fm2uav.FlightLevel(agl=30.0)
+    p = fm2uav.plan(world, (20.0, 20.0, 60.0), (150.0, 120.0, 60.0), level=level)
+    assert len(p.path) > 1
+
+
 #: Later runs: name -> what it runs (each restores the size floors it lowers).
 WORKLOADS: dict[str, Callable[[], None]] = {
     "run3d": _run3d,
@@ -164,6 +175,7 @@ WORKLOADS: dict[str, Callable[[], None]] = {
     "uniform2d": _uniform2d,
     "run2d": _run2d,
     "par2d": _par2d,
+    "level": _level,
 }
 
 

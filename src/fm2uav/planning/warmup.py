@@ -11,7 +11,8 @@ two processes at once (see :mod:`fm2uav.__main__`)::
 
 Groups: ``edt`` (distance map), ``fmm{2,3}d_o{1,2}`` (Fast Marching, one
 dimension and order), ``descent`` (geodesic extraction), ``surface``
-(continuous clearance to a terrain surface), and two of big grids only, which
+(continuous clearance to a terrain surface), ``profile`` (the slope sweeps of a flight
+level's altitude envelopes), and two of big grids only, which
 call their kernels directly: ``edt_parallel`` (the distance map's lines in
 parallel) and ``fmm3d_o{1,2}_lean`` (the 3D march in the lean layout, see
 ``fm2uav.eikonal._kernels.LEAN_NODES``); ``fmm{2,3}d_parallel`` (the march on both cores,
@@ -30,6 +31,7 @@ from ..eikonal import _edt as _edt_kernels
 from ..eikonal import _kernels, _parallel, distance_map, fast_marching
 from ..world import World
 from ..world.clearance import surface_clearance
+from .altitude import envelope_above
 from .geodesic import descend, drop_ties, reaches_any
 
 __all__ = ["GROUPS", "FIRST_PLAN_MAIN", "FIRST_PLAN_CHILD", "warm"]
@@ -133,6 +135,12 @@ def _surface() -> None:
     surface_clearance(world, np.array([[1.5, 1.5, 2.5]]))
 
 
+def _profile() -> None:
+    """The slope sweeps of a flight level's altitude envelopes (every flight-level plan and
+    route; not the plain first ``fm2uav plan``)."""
+    envelope_above(np.array([0.0, 1.0, 2.0]), np.array([0.0, 2.0, 0.0]), 0.5, 0.5)
+
+
 #: Group name -> what it runs.
 GROUPS: dict[str, Callable[[], None]] = {
     "edt": _edt,
@@ -147,6 +155,7 @@ GROUPS: dict[str, Callable[[], None]] = {
     "fmm3d_parallel": _fmm_parallel(3),
     "descent": _descent,
     "surface": _surface,
+    "profile": _profile,
 }
 
 #: A first ``fm2uav plan`` (3D, order 2) split in two halves of about equal
