@@ -17,6 +17,9 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e '.[test]'
+	@## the package's bytecode, written even where PYTHONDONTWRITEBYTECODE is set (an editable
+	@## install has none, and every command would compile its modules again: +0.1 s a --help)
+	$(PY) -m compileall -q src
 	@echo "compiling the numba kernels once (cached for every later run) ..."
 	$(PY) -m fm2uav.planning.warmup
 	@touch $(STAMP)
