@@ -213,7 +213,12 @@ def test_worker_killed_in_references_phase(tmp_path):
     assert len(killed) == 2
     refs = res.references
     assert len(refs) == 3 and all(not r["error"] for r in refs.values())
-    assert sorted(r["attempts"] for r in refs.values()) == [1, 1, 2]  # the busy one, again
+    attempts = sorted(r["attempts"] for r in refs.values())
+    # the busy one runs again (a second attempt, its worker's death charged) — unless, on a
+    # loaded machine, it finished its reference in the moment between the other's result
+    # and the kill: then its result is in the pipe, read before its end, and nobody is charged
+    assert attempts in ([1, 1, 2], [1, 1, 1])
+    assert res.worker_deaths == attempts.count(2)
     _assert_each_case_once(res, out, 3 * 2 * 12)
 
 
