@@ -156,18 +156,18 @@ def _smoothing(h, hmin):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _bspline_weights(x, n, lam, w):
+def _bspline_weights(x, n, lam, w, o):
     """Uniform cubic B-spline weights of the 4 nodes around ``x`` on an axis of ``n``.
 
-    Fills ``w[0:4]`` (weights of nodes ``i0 - 1 .. i0 + 2``, ``i0 = floor(x)``,
+    Fills ``w[o:o + 4]`` (weights of nodes ``i0 - 1 .. i0 + 2``, ``i0 = floor(x)``,
     summing to 1) and returns ``i0 - 1``. A single-node axis gets weight 1 on
     node 0. Nodes off the grid are skipped by the caller.
     """
     if n == 1:
-        w[0] = 1.0
-        w[1] = 0.0
-        w[2] = 0.0
-        w[3] = 0.0
+        w[o] = 1.0
+        w[o + 1] = 0.0
+        w[o + 2] = 0.0
+        w[o + 3] = 0.0
         return 0
     i0 = int(math.floor(x))
     if i0 > n - 2:
@@ -176,15 +176,22 @@ def _bspline_weights(x, n, lam, w):
         i0 = 0
     f = x - i0
     g = 1.0 - f
-    w[0] = lam * g * g * g / 6.0
-    w[1] = lam * (3.0 * f * f * f - 6.0 * f * f + 4.0) / 6.0 + (1.0 - lam) * g
-    w[2] = lam * (3.0 * g * g * g - 6.0 * g * g + 4.0) / 6.0 + (1.0 - lam) * f
-    w[3] = lam * f * f * f / 6.0
+    w[o] = lam * g * g * g / 6.0
+    w[o + 1] = lam * (3.0 * f * f * f - 6.0 * f * f + 4.0) / 6.0 + (1.0 - lam) * g
+    w[o + 2] = lam * (3.0 * g * g * g - 6.0 * g * g + 4.0) / 6.0 + (1.0 - lam) * f
+    w[o + 3] = lam * f * f * f / 6.0
     return i0 - 1
 
 
+#: Slots of a descent's cache of node directions (``keys``/``vals`` of :func:`_direction`):
+#: node (i, j, k) goes to slot ((i mod 16) * 16 + j mod 16) * 4 + k mod 4, so the
+#: 4 x 4 x 4 nodes of one blend never share a slot, and consecutive steps, whose blends
+#: overlap, find most of their nodes there (T does not change during a descent).
+_CACHE_SLOTS = 1024
+
+
 @njit(cache=True, error_model="numpy")
-def _direction(T, x, y, z, hx, hy, hz, hmin, smooth):
+def _direction(T, x, y, z, hx, hy, hz, hmin, smooth, keys, vals, w):
     """Index-space displacement of one unit-physical-length descent step.
 
     The unit node directions (:func:`_node_direction`) of the free nodes among
@@ -199,37 +206,51 @@ def _direction(T, x, y, z, hx, hy, hz, hmin, smooth):
     step length ``step`` [cells] is ``step * hmin`` metres. Returns
     ``(dx, dy, dz, ok)``; ``ok`` is False when no free node contributes or the
     blend vanishes.
+
+    ``keys`` (int64, :data:`_CACHE_SLOTS`, -1 = empty) and ``vals`` (``(_CACHE_SLOTS,
+    3)``) cache the node directions of the descent (each node's the same numbers,
+    computed once); ``w`` (12) is scratch for the three axes' weights (no allocation
+    per call). The loops are written out here, not in a helper: numba's inlining
+    adds a reference count update of every array argument per call.
     """
     nx, ny, nz = T.shape
-    wx = np.empty(4)
-    wy = np.empty(4)
-    wz = np.empty(4)
-    ia = _bspline_weights(x, nx, smooth * _smoothing(hx, hmin), wx)
-    ja = _bspline_weights(y, ny, smooth * _smoothing(hy, hmin), wy)
-    ka = _bspline_weights(z, nz, smooth * _smoothing(hz, hmin), wz)
+    ia = _bspline_weights(x, nx, smooth * _smoothing(hx, hmin), w, 0)
+    ja = _bspline_weights(y, ny, smooth * _smoothing(hy, hmin), w, 4)
+    ka = _bspline_weights(z, nz, smooth * _smoothing(hz, hmin), w, 8)
     gx = 0.0
     gy = 0.0
     gz = 0.0
     for a in range(4):
         i = ia + a
-        if i < 0 or i >= nx or wx[a] == 0.0:
+        if i < 0 or i >= nx or w[a] == 0.0:
             continue
         for b in range(4):
             j = ja + b
-            if j < 0 or j >= ny or wy[b] == 0.0:
+            if j < 0 or j >= ny or w[4 + b] == 0.0:
                 continue
-            wab = wx[a] * wy[b]
+            wab = w[a] * w[4 + b]
             for c in range(4):
                 k = ka + c
-                if k < 0 or k >= nz or wz[c] == 0.0:
+                if k < 0 or k >= nz or w[8 + c] == 0.0:
                     continue
                 if not math.isfinite(T[i, j, k]):
                     continue
-                w = wab * wz[c]
-                ux, uy, uz = _node_direction(T, i, j, k, hx, hy, hz)
-                gx += w * ux
-                gy += w * uy
-                gz += w * uz
+                wt = wab * w[8 + c]
+                key = (i * ny + j) * nz + k
+                slot = ((i & 15) * 16 + (j & 15)) * 4 + (k & 3)
+                if keys[slot] != key:
+                    ux, uy, uz = _node_direction(T, i, j, k, hx, hy, hz)
+                    keys[slot] = key
+                    vals[slot, 0] = ux
+                    vals[slot, 1] = uy
+                    vals[slot, 2] = uz
+                else:
+                    ux = vals[slot, 0]
+                    uy = vals[slot, 1]
+                    uz = vals[slot, 2]
+                gx += wt * ux
+                gy += wt * uy
+                gz += wt * uz
     g = math.sqrt(gx * gx + gy * gy + gz * gz)
     if not (g > 0.0) or not math.isfinite(g):
         return 0.0, 0.0, 0.0, False
@@ -483,7 +504,7 @@ def _near_goal(T, px, py, pz, gx, gy, gz):
 
 
 @njit(cache=True, error_model="numpy")
-def _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step):
+def _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step, keys, vals, w):
     """One continuous descent step from p; returns ``(qx, qy, qz, phi(q), ok)``.
 
     Midpoint rule (RK2): the direction is taken at p + L/2 * d(p) (or d(p) if
@@ -501,7 +522,7 @@ def _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step):
     # at the local slowness
     slow = _slowness(T, _nearest(px, nx), _nearest(py, ny), _nearest(pz, nz), hx, hy, hz)
     for smooth in (1.0, 0.0):
-        d1x, d1y, d1z, ok = _direction(T, px, py, pz, hx, hy, hz, hmin, smooth)
+        d1x, d1y, d1z, ok = _direction(T, px, py, pz, hx, hy, hz, hmin, smooth, keys, vals, w)
         if not ok:
             continue
         L = step
@@ -509,7 +530,7 @@ def _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step):
             mx = _clamp(px + 0.5 * L * d1x, nx)
             my = _clamp(py + 0.5 * L * d1y, ny)
             mz = _clamp(pz + 0.5 * L * d1z, nz)
-            d2x, d2y, d2z, ok2 = _direction(T, mx, my, mz, hx, hy, hz, hmin, smooth)
+            d2x, d2y, d2z, ok2 = _direction(T, mx, my, mz, hx, hy, hz, hmin, smooth, keys, vals, w)
             if not ok2 or (d1x * d2x + d1y * d2y + d1z * d2z) <= 0.0:
                 d2x, d2y, d2z = d1x, d1y, d1z
             qx = _clamp(px + L * d2x, nx)
@@ -609,6 +630,10 @@ def descend_kernel(T, start, goal, hx, hy, hz, step, max_steps):
     # potential of the current point, and the last _WINDOW accepted ones
     phi = _potential(T, px, py, pz, hx, hy, hz)
     hist = np.empty(_WINDOW)
+    keys = np.empty(_CACHE_SLOTS, dtype=np.int64)
+    _fill(keys, -1)
+    vals = np.empty((_CACHE_SLOTS, 3))
+    wbuf = np.empty(12)
     _fill(hist, phi)
     hpos = 0
     iters = 0
@@ -623,7 +648,7 @@ def descend_kernel(T, start, goal, hx, hy, hz, step, max_steps):
             # ---- continuous step: midpoint (RK2) on the direction field, with
             #      backtracking on the step length; non-monotone acceptance
             ref = _nanmax(hist)
-            qx, qy, qz, tq, ok = _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step)
+            qx, qy, qz, tq, ok = _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step, keys, vals, wbuf)
             if ok:
                 px, py, pz = qx, qy, qz
                 phi = tq
