@@ -704,6 +704,104 @@ def descend_kernel(T, start, goal, hx, hy, hz, step, max_steps):
             n_fallback += 1
 
 
+# --------------------------------------------------------------- many starts
+@njit(cache=True, error_model="numpy", nogil=True)
+def descend_sweep(work, shape, flat, order, vals, hi, ball_idx, ball_vals, times, nodes,
+                  starts, goal, hx, hy, hz, step, max_steps, sweep):
+    """:func:`descend_kernel` from each of ``starts`` on the field a march stopped there
+    sees, rebuilt in ``work`` (see :func:`fm2uav.planning.geodesic.descend_stopped`).
+
+    For each start ``s`` (time ``t``, flat node ``n``), in the order given (latest
+    first): if ``sweep``, the nodes ``order[lo:hi]`` (``vals[lo:]`` >= t) are made
+    ``inf`` in the flat ``work`` (``hi = lo`` after) and ``work[n] = t``; the nodes of
+    the ball ``ball_idx`` (sorted by ``ball_vals``) with time ``t`` other than ``n``
+    are made ``inf`` during the descent and restored from ``flat`` after it; if
+    ``sweep``, ``work[n]`` is ``inf`` again after the descent.
+
+    Parameters
+    ----------
+    work, flat : float64 arrays, flat
+        The field descended (written) and the whole march's times [s] (``inf`` on
+        blocked nodes), C order of ``shape``.
+    shape : tuple of 3 int
+        The field's shape, padded to 3 axes.
+    order, vals, hi
+        The nodes outside the ball sorted by time, their times, and how many of them
+        are finite in ``work`` now.
+    ball_idx, ball_vals
+        The ball's nodes sorted by time, and their times.
+    times : float64 array (m,); nodes : int64 array (m,)
+        Each start's time and flat node.
+    starts : float64 array (m, 3)
+        Index coordinates, padded with 0 to 3 axes.
+    goal : float64 array (3,)
+    hx, hy, hz, step, max_steps
+        As :func:`descend_kernel`.
+    sweep : bool
+        Whether the starts lie outside the ball (the field is swept down to each).
+
+    Returns
+    -------
+    points : float64 array (N, 3)
+        Every path, one after the other, the first point the start and the last the
+        goal exactly when the descent got there.
+    offsets : int64 array (m + 1,)
+    status : int64 array (m,)
+        ``OK`` or ``STUCK`` per start; ``info`` (m, 3) the node where it got stuck.
+    hi : int
+        The sweep's position after the last start.
+    """
+    m = times.shape[0]
+    work3 = work.reshape(shape)
+    pts = np.empty((max(1024, 64 * m), 3))
+    offsets = np.zeros(m + 1, dtype=np.int64)
+    status = np.zeros(m, dtype=np.int64)
+    info = np.zeros((m, 3), dtype=np.int64)
+    n = 0
+    for r in range(m):
+        t = times[r]
+        node = nodes[r]
+        if sweep:
+            lo = np.searchsorted(vals, t, side="left")
+            if lo < hi:
+                for q in range(lo, hi):
+                    work[order[q]] = np.inf
+                hi = lo
+            work[node] = t
+        a = np.searchsorted(ball_vals, t, side="left")
+        b = np.searchsorted(ball_vals, t, side="right")
+        for q in range(a, b):
+            if ball_idx[q] != node:
+                work[ball_idx[q]] = np.inf
+        path, st, where, _ = descend_kernel(work3, starts[r], goal, hx, hy, hz, step,
+                                            max_steps)
+        for q in range(a, b):
+            if ball_idx[q] != node:
+                work[ball_idx[q]] = flat[ball_idx[q]]
+        if sweep:
+            work[node] = np.inf
+        status[r] = st
+        info[r, 0], info[r, 1], info[r, 2] = where[0], where[1], where[2]
+        k = path.shape[0]
+        if n + k > pts.shape[0]:
+            bigger = np.empty((2 * (n + k), 3))
+            for q in range(n):
+                bigger[q, 0] = pts[q, 0]
+                bigger[q, 1] = pts[q, 1]
+                bigger[q, 2] = pts[q, 2]
+            pts = bigger
+        for q in range(k):
+            pts[n + q, 0] = path[q, 0]
+            pts[n + q, 1] = path[q, 1]
+            pts[n + q, 2] = path[q, 2]
+        if st == OK:  # the ends exact (as descend's)
+            pts[n, 0], pts[n, 1], pts[n, 2] = starts[r, 0], starts[r, 1], starts[r, 2]
+            pts[n + k - 1, 0], pts[n + k - 1, 1], pts[n + k - 1, 2] = goal[0], goal[1], goal[2]
+        n += k
+        offsets[r + 1] = n
+    return pts[:n], offsets, status, info, hi
+
+
 # ------------------------------------------------------------- whole-field scans
 # One compiled pass each over a field the descent reads, in place of numpy expressions
 # that allocate map-sized temporaries (40 M nodes: a bool array per comparison, or a

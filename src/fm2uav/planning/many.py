@@ -349,7 +349,8 @@ def plan_many(
         for (k, _), p in zip(traced, plans):
             routes[k] = RouteFailure("altitude", str(p)) if isinstance(p, PlanningError) else p
 
-    descend_stopped(T, [world.to_index(checked[k][0]) for k in todo], world.to_index(goal_m),
+    descend_stopped(T, world.to_index(np.array([checked[k][0] for k in todo]).reshape(-1, world.ndim)),
+                    world.to_index(goal_m),
                     frozen=ball, spacing=world.spacing, blocked=blocked, step=options.step,
                     threads=n_threads, on_done=finish)
     t3 = time.perf_counter()
