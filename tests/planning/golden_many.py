@@ -61,7 +61,8 @@ def cases() -> dict[str, tuple[World, tuple[float, ...], np.ndarray, dict[str, A
     st = _starts(wt, 60, 3)
     st[:, 2] = goal_t[2]
     return {
-        "2d_city": (city, (161.0, 159.0), _starts(city, 300, 1), {"shaping": Shaping(exponent=0.5)}),
+        "2d_city": (city, (161.0, 159.0), _starts(city, 300, 1),
+                    {"shaping": Shaping(exponent=0.5)}),
         "2d_city_order2_walls": (city, (161.0, 159.0), _starts(city, 120, 2),
                                  {"shaping": Shaping(walls=True, exponent=1.5),
                                   "options": PlanOptions(order=2)}),

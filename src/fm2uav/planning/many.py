@@ -349,10 +349,9 @@ def plan_many(
         for (k, _), p in zip(traced, plans):
             routes[k] = RouteFailure("altitude", str(p)) if isinstance(p, PlanningError) else p
 
-    descend_stopped(T, world.to_index(np.array([checked[k][0] for k in todo]).reshape(-1, world.ndim)),
-                    world.to_index(goal_m),
-                    frozen=ball, spacing=world.spacing, blocked=blocked, step=options.step,
-                    threads=n_threads, on_done=finish)
+    todo_idx = world.to_index(np.array([checked[k][0] for k in todo]).reshape(-1, world.ndim))
+    descend_stopped(T, todo_idx, world.to_index(goal_m), frozen=ball, spacing=world.spacing,
+                    blocked=blocked, step=options.step, threads=n_threads, on_done=finish)
     t3 = time.perf_counter()
     timings = {"velocity_map": t1 - t0 - t_checks, "checks": t_checks, "fast_marching": t2 - t1,
                "routes": t3 - t2, "total": t3 - t_all, "cpu": time.process_time() - c_all}

@@ -105,10 +105,11 @@ def min_surface_clearances(world: World, paths: list[Any]) -> np.ndarray:
     that can hold a path's minimum are measured exactly, in one compiled pass over every
     path (:func:`~fm2uav.world._clearance_kernels.min_box_clearances`): with ``d`` the
     distance from a point's nearest node to the nearest rim node (an obstacle node with
-    a free axis neighbour; one cached distance transform) and ``e`` the point's distance to that node, its clearance lies
-    in ``[d - e - r, d + e]`` (``r`` half a cell diagonal). A point whose lower bound
-    exceeds its path's smallest upper bound (or smallest exact distance) cannot be the
-    nearest; the others are measured against the obstacle cells (boxes) around them.
+    a free axis neighbour; one cached distance transform) and ``e`` the point's
+    distance to that node, its clearance lies in ``[d - e - r, d + e]`` (``r`` half a
+    cell diagonal). A point whose lower bound exceeds its path's smallest upper bound
+    (or smallest exact distance) cannot be the nearest; the others are measured against
+    the obstacle cells (boxes) around them.
 
     Parameters
     ----------
