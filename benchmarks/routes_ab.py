@@ -69,13 +69,16 @@ def main(argv: list[str] | None = None) -> int:
         _run(src, args.threads[0], 60)
     runs = interleaved_runs(args.repeats, args.threads, args.peer_src, str(ROOT / "src"),
                             lambda src, th: _run(src, th, args.count))
+    print("| code | threads | wall [s]: median (runs) | CPU [s] | load | routes | digest |")
+    print("| --- | --- | --- | --- | --- | --- | --- |")
     for (name, th), rs in sorted(runs.items()):
-        walls = ", ".join(f"{r['wall']:.2f}" for r in rs)
-        loads = ", ".join(f"{r['load']:.1f}" for r in rs)
-        digests = ", ".join(sorted({r["digest"] for r in rs}))
-        print(f"{name:5s} threads {th}: wall {statistics.median(r['wall'] for r in rs):.2f} s "
-              f"(runs {walls}), CPU {statistics.median(r['cpu'] for r in rs):.2f} s, "
-              f"load {loads}, {rs[0]['routes']} routes, digest {digests}")
+        cells = [name, str(th),
+                 f"{statistics.median(r['wall'] for r in rs):.2f} ("
+                 + ", ".join(f"{r['wall']:.2f}" for r in rs) + ")",
+                 f"{statistics.median(r['cpu'] for r in rs):.2f}",
+                 ", ".join(f"{r['load']:.1f}" for r in rs), str(rs[0]["routes"]),
+                 ", ".join(sorted({r["digest"] for r in rs}))]
+        print("| " + " | ".join(cells) + " |")
     return 0
 
 

@@ -15,7 +15,6 @@ Regenerate only when a change of the numbers is intended, and say so in the comm
 from __future__ import annotations
 
 import hashlib
-import json
 import sys
 from pathlib import Path
 from typing import Any
@@ -25,27 +24,12 @@ import numpy as np
 from fm2uav import FlightLevel, PlanOptions, Shaping, World
 from fm2uav.planning.many import RouteFailure, plan_many
 
+from benchmarks.bench_routes import city_map
+
+from . import golden_plans
 from .golden_plans import _obstacles_3d, _terrain
 
 DATA = Path(__file__).resolve().parent / "data" / "golden_many.json"
-
-
-def _city(n: int = 160, seed: int = 5) -> World:
-    """Seeded blocks with streets between them, 2 m cells, the centre square kept free."""
-    rng = np.random.default_rng(seed)
-    occ = np.zeros((n, n), bool)
-    x = 0
-    while x < n:
-        w = int(rng.integers(5, 15))
-        y = 0
-        while y < n:
-            h = int(rng.integers(5, 15))
-            if rng.random() < 0.8:
-                occ[x:x + w, y:y + h] = True
-            y += h + int(rng.integers(2, 5))
-        x += w + int(rng.integers(2, 5))
-    occ[n // 2 - 6:n // 2 + 6, n // 2 - 6:n // 2 + 6] = False
-    return World(occ, spacing=2.0)
 
 
 def _starts(world: World, count: int, seed: int) -> np.ndarray:
@@ -56,14 +40,14 @@ def _starts(world: World, count: int, seed: int) -> np.ndarray:
 
 def cases() -> dict[str, tuple[World, tuple[float, ...], np.ndarray, dict[str, Any]]]:
     """Name -> ``(world, goal [m], starts [m], plan_many keyword arguments)``."""
-    city, w3, wt = _city(), _obstacles_3d(), _terrain()
+    city, w3, wt = city_map(160, seed=5), _obstacles_3d(), _terrain()
     goal_t = (28 * 15.0, 22 * 15.0, 17 * 15.0)
     st = _starts(wt, 60, 3)
     st[:, 2] = goal_t[2]
     return {
         "2d_city": (city, (161.0, 159.0), _starts(city, 300, 1),
                     {"shaping": Shaping(exponent=0.5)}),
-        "2d_city_order2_walls": (city, (161.0, 159.0), _starts(city, 120, 2),
+        "2d_city_order2_walls": (city, (159.0, 161.0), _starts(city, 120, 2),
                                  {"shaping": Shaping(walls=True, exponent=1.5),
                                   "options": PlanOptions(order=2)}),
         "3d_obstacles": (w3, (240.0, 200.0, 30.0), _starts(w3, 120, 4), {}),
@@ -98,14 +82,8 @@ def run(name: str, **extra: Any) -> list[str]:
 
 
 def main(argv: list[str]) -> int:
-    out = {name: run(name) for name in cases()}
-    if "--write" in argv:
-        DATA.write_text(json.dumps(out, indent=0, sort_keys=True) + "\n")
-        print(f"wrote {DATA}")
-    else:
-        print(json.dumps({k: [sum(not d.startswith("fail") for d in v), len(v)]
-                          for k, v in out.items()}))
-    return 0
+    """Print the digests of every case, or (``--write``) write them."""
+    return golden_plans.main(argv, cases, run, DATA)
 
 
 if __name__ == "__main__":

@@ -350,9 +350,14 @@ def _potential(T, x, y, z, hx, hy, hz):
     i0, i1, _ = _cell(x, nx)
     j0, j1, _ = _cell(y, ny)
     k0, k1, _ = _cell(z, nz)
-    for i in (i0, i1):
-        for j in (j0, j1):
-            for k in (k0, k1):
+    # a single-node axis (2D: z) has i0 == i1: its corner once (a second visit of the
+    # same corner changes nothing)
+    for a in range(1 if i0 == i1 else 2):
+        i = i1 if a else i0
+        for b in range(1 if j0 == j1 else 2):
+            j = j1 if b else j0
+            for c in range(1 if k0 == k1 else 2):
+                k = k1 if c else k0
                 tc = T[i, j, k]
                 if not (tc < t):  # also skips inf
                     continue
@@ -515,7 +520,8 @@ def _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step, keys, vals, w):
     ``_N_BACKTRACK`` tries. If all fail with the smooth (B-spline) direction
     field, they are repeated with the linear blend (``smooth = 0``), which
     follows the node directions tightly around the corner of a blocked cell
-    that the smooth field would cut.
+    that the smooth field would cut. ``keys``, ``vals``, ``w``: the descent's cache
+    and scratch for :func:`_direction`.
     """
     nx, ny, nz = T.shape
     # sufficient decrease: a fraction of what a step of L cells lowers T by
@@ -648,7 +654,8 @@ def descend_kernel(T, start, goal, hx, hy, hz, step, max_steps):
             # ---- continuous step: midpoint (RK2) on the direction field, with
             #      backtracking on the step length; non-monotone acceptance
             ref = _nanmax(hist)
-            qx, qy, qz, tq, ok = _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step, keys, vals, wbuf)
+            qx, qy, qz, tq, ok = _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step, keys, vals,
+                                           wbuf)
             if ok:
                 px, py, pz = qx, qy, qz
                 phi = tq

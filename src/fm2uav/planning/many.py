@@ -220,9 +220,10 @@ def _classify_all(world: World, W: np.ndarray, starts: Sequence[Any], goal_m: np
             good &= (np.linalg.norm(pts - goal_m, axis=1) / (float(options.step) * h)
                      <= MAX_PATH_STEPS)
     out: list[tuple[np.ndarray, tuple[int, ...]] | RouteFailure] = []
+    cell_list = cells.tolist() if good.any() else []  # Python ints, converted at once
     for k in range(n):
         if good[k]:
-            out.append((pts[k].copy(), tuple(int(v) for v in cells[k])))
+            out.append((pts[k].copy(), tuple(cell_list[k])))
         else:
             out.append(_classify(world, W, starts[k], goal_m, goal_cell, options))
     return out
