@@ -561,7 +561,7 @@ def descend_stopped(
     ball_field = np.where(in_ball, field, np.inf).reshape(-1)
     out: list[Any] = [None] * len(starts)
     pts, ok = _plain_starts(starts, shape)
-    ok &= _starts_free(field, mask, pts)
+    ok[ok] = _starts_free(field, mask, pts[ok])
     for k in np.flatnonzero(~ok).tolist():  # one by one, for the error descend raises
         try:
             pts[k] = _as_point(starts[k], shape, "start")
