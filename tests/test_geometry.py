@@ -15,3 +15,14 @@ def test_resample_keeps_ends_and_step():
     np.testing.assert_allclose(np.linalg.norm(np.diff(q, axis=0), axis=1)[:2], 4.0)
     # the third point is 12 m along the polyline: (10, 2, 0)
     np.testing.assert_allclose(q[3], [10, 2, 0])
+
+
+def test_path_lengths_are_path_length_bit_for_bit():
+    from fm2uav.geometry import path_length, path_lengths
+
+    rng = np.random.default_rng(4)
+    for dim in (2, 3):
+        paths = [rng.normal(0, 50, (n, dim)).cumsum(axis=0) for n in (1, 2, 7, 8, 9, 300, 1000)]
+        paths.append(np.zeros((3, dim)))
+        assert path_lengths(paths) == [path_length(p) for p in paths]
+    assert path_lengths([]) == []

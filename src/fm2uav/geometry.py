@@ -19,6 +19,7 @@ __all__ = [
     "as_path3",
     "arc_length",
     "path_length",
+    "path_lengths",
     "resample_path",
     "resample_uniform",
     "densify",
@@ -91,6 +92,27 @@ def arc_length(path: np.ndarray) -> np.ndarray:
 def path_length(path: np.ndarray) -> float:
     """Total length [m] of a polyline ``(N, d)`` (sum of its segment lengths)."""
     return float(np.sum(np.linalg.norm(np.diff(np.asarray(path, dtype=float), axis=0), axis=1)))
+
+
+def path_lengths(paths: list[np.ndarray]) -> list[float]:
+    """:func:`path_length` of each polyline ``(N_k, d)`` [m], the same numbers, the
+    segments of all of them in a few array operations (one per axis).
+
+    Each segment's length is ``sqrt(dx^2 + dy^2 [+ dz^2])`` summed in that order, as
+    ``np.linalg.norm(..., axis=1)`` sums it, and each path's segments are added by
+    ``np.sum`` (pairwise) as :func:`path_length` adds them.
+    """
+    if not paths:
+        return []
+    pts = np.concatenate([np.asarray(p, dtype=float) for p in paths])
+    d = pts[1:] - pts[:-1]
+    sq = d[:, 0] * d[:, 0]
+    for c in range(1, pts.shape[1]):
+        sq = sq + d[:, c] * d[:, c]
+    seg = np.sqrt(sq)
+    ends = np.cumsum([len(p) for p in paths]).tolist()
+    return [float(np.sum(seg[b - n:b - 1])) if n > 1 else 0.0
+            for b, n in zip(ends, (len(p) for p in paths))]
 
 
 def resample_uniform(path: np.ndarray, ds: float) -> tuple[np.ndarray, np.ndarray]:

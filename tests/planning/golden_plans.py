@@ -109,11 +109,12 @@ def run(name: str, **extra) -> dict:
     return digest(fm2uav.plan(world, s, g, **{**kw, **extra}))
 
 
-def main(argv: list[str]) -> int:
+def main(argv: list[str], cases=cases, run=run, data: Path = DATA) -> int:
+    """Print the digest of every case, or (``--write``) write them to ``data``."""
     out = {name: run(name) for name in cases()}
     if "--write" in argv:
-        DATA.write_text(json.dumps(out, indent=1, sort_keys=True) + "\n")
-        print(f"wrote {DATA}")
+        data.write_text(json.dumps(out, indent=1, sort_keys=True) + "\n")
+        print(f"wrote {data}")
     else:
         print(json.dumps(out, indent=1, sort_keys=True))
     return 0

@@ -152,10 +152,11 @@ def test_potential_cone_tolerates_leaving_the_channel():
 
 
 def test_bspline_weights_partition_of_unity():
-    w = np.empty(4)
+    buf = np.empty(12)
     for lam in (0.0, 0.4, 1.0):
         for x in (0.0, 0.3, 2.5, 6.99, 7.0):
-            first = _k._bspline_weights(x, 8, lam, w)
+            first = _k._bspline_weights(x, 8, lam, buf, 4)  # written at buf[4:8]
+            w = buf[4:8]
             assert w.sum() == pytest.approx(1.0)
             # reproduces linear functions: sum w_i * i == x
             nodes = first + np.arange(4)

@@ -46,3 +46,15 @@ def test_a_path_along_a_wall_and_terrain_columns():
     p3 = np.column_stack([np.linspace(100, 1500, 50), np.linspace(200, 1100, 50),
                           np.full(50, 400.0)])
     assert min_surface_clearance(sc.world, p3) == float(surface_clearance(sc.world, p3).min())
+
+
+def test_a_path_through_a_thick_building_keeps_the_nearest_point_outside():
+    # inside a building only its rim counts (the boxes a free point can see); a point deep
+    # inside must not hide the nearer point outside from the search
+    occ = np.zeros((70, 60), bool)
+    occ[10:40, 10:40] = True
+    occ[:, 55] = True
+    world = World(occ, spacing=1.0)
+    path = np.array([[25.0, 25.0], [25.0, 48.0]])
+    assert surface_clearance(world, path).tolist() == [13.5, 6.5]
+    assert min_surface_clearances(world, [path, path[::-1]]).tolist() == [6.5, 6.5]

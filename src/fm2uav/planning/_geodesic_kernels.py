@@ -156,18 +156,18 @@ def _smoothing(h, hmin):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _bspline_weights(x, n, lam, w):
+def _bspline_weights(x, n, lam, w, o):
     """Uniform cubic B-spline weights of the 4 nodes around ``x`` on an axis of ``n``.
 
-    Fills ``w[0:4]`` (weights of nodes ``i0 - 1 .. i0 + 2``, ``i0 = floor(x)``,
+    Fills ``w[o:o + 4]`` (weights of nodes ``i0 - 1 .. i0 + 2``, ``i0 = floor(x)``,
     summing to 1) and returns ``i0 - 1``. A single-node axis gets weight 1 on
     node 0. Nodes off the grid are skipped by the caller.
     """
     if n == 1:
-        w[0] = 1.0
-        w[1] = 0.0
-        w[2] = 0.0
-        w[3] = 0.0
+        w[o] = 1.0
+        w[o + 1] = 0.0
+        w[o + 2] = 0.0
+        w[o + 3] = 0.0
         return 0
     i0 = int(math.floor(x))
     if i0 > n - 2:
@@ -176,15 +176,22 @@ def _bspline_weights(x, n, lam, w):
         i0 = 0
     f = x - i0
     g = 1.0 - f
-    w[0] = lam * g * g * g / 6.0
-    w[1] = lam * (3.0 * f * f * f - 6.0 * f * f + 4.0) / 6.0 + (1.0 - lam) * g
-    w[2] = lam * (3.0 * g * g * g - 6.0 * g * g + 4.0) / 6.0 + (1.0 - lam) * f
-    w[3] = lam * f * f * f / 6.0
+    w[o] = lam * g * g * g / 6.0
+    w[o + 1] = lam * (3.0 * f * f * f - 6.0 * f * f + 4.0) / 6.0 + (1.0 - lam) * g
+    w[o + 2] = lam * (3.0 * g * g * g - 6.0 * g * g + 4.0) / 6.0 + (1.0 - lam) * f
+    w[o + 3] = lam * f * f * f / 6.0
     return i0 - 1
 
 
+#: Slots of a descent's cache of node directions (``keys``/``vals`` of :func:`_direction`):
+#: node (i, j, k) goes to slot ((i mod 16) * 16 + j mod 16) * 4 + k mod 4, so the
+#: 4 x 4 x 4 nodes of one blend never share a slot, and consecutive steps, whose blends
+#: overlap, find most of their nodes there (T does not change during a descent).
+_CACHE_SLOTS = 1024
+
+
 @njit(cache=True, error_model="numpy")
-def _direction(T, x, y, z, hx, hy, hz, hmin, smooth):
+def _direction(T, x, y, z, hx, hy, hz, hmin, smooth, keys, vals, w):
     """Index-space displacement of one unit-physical-length descent step.
 
     The unit node directions (:func:`_node_direction`) of the free nodes among
@@ -199,37 +206,51 @@ def _direction(T, x, y, z, hx, hy, hz, hmin, smooth):
     step length ``step`` [cells] is ``step * hmin`` metres. Returns
     ``(dx, dy, dz, ok)``; ``ok`` is False when no free node contributes or the
     blend vanishes.
+
+    ``keys`` (int64, :data:`_CACHE_SLOTS`, -1 = empty) and ``vals`` (``(_CACHE_SLOTS,
+    3)``) cache the node directions of the descent (each node's the same numbers,
+    computed once); ``w`` (12) is scratch for the three axes' weights (no allocation
+    per call). The loops are written out here, not in a helper: numba's inlining
+    adds a reference count update of every array argument per call.
     """
     nx, ny, nz = T.shape
-    wx = np.empty(4)
-    wy = np.empty(4)
-    wz = np.empty(4)
-    ia = _bspline_weights(x, nx, smooth * _smoothing(hx, hmin), wx)
-    ja = _bspline_weights(y, ny, smooth * _smoothing(hy, hmin), wy)
-    ka = _bspline_weights(z, nz, smooth * _smoothing(hz, hmin), wz)
+    ia = _bspline_weights(x, nx, smooth * _smoothing(hx, hmin), w, 0)
+    ja = _bspline_weights(y, ny, smooth * _smoothing(hy, hmin), w, 4)
+    ka = _bspline_weights(z, nz, smooth * _smoothing(hz, hmin), w, 8)
     gx = 0.0
     gy = 0.0
     gz = 0.0
     for a in range(4):
         i = ia + a
-        if i < 0 or i >= nx or wx[a] == 0.0:
+        if i < 0 or i >= nx or w[a] == 0.0:
             continue
         for b in range(4):
             j = ja + b
-            if j < 0 or j >= ny or wy[b] == 0.0:
+            if j < 0 or j >= ny or w[4 + b] == 0.0:
                 continue
-            wab = wx[a] * wy[b]
+            wab = w[a] * w[4 + b]
             for c in range(4):
                 k = ka + c
-                if k < 0 or k >= nz or wz[c] == 0.0:
+                if k < 0 or k >= nz or w[8 + c] == 0.0:
                     continue
                 if not math.isfinite(T[i, j, k]):
                     continue
-                w = wab * wz[c]
-                ux, uy, uz = _node_direction(T, i, j, k, hx, hy, hz)
-                gx += w * ux
-                gy += w * uy
-                gz += w * uz
+                wt = wab * w[8 + c]
+                key = (i * ny + j) * nz + k
+                slot = ((i & 15) * 16 + (j & 15)) * 4 + (k & 3)
+                if keys[slot] != key:
+                    ux, uy, uz = _node_direction(T, i, j, k, hx, hy, hz)
+                    keys[slot] = key
+                    vals[slot, 0] = ux
+                    vals[slot, 1] = uy
+                    vals[slot, 2] = uz
+                else:
+                    ux = vals[slot, 0]
+                    uy = vals[slot, 1]
+                    uz = vals[slot, 2]
+                gx += wt * ux
+                gy += wt * uy
+                gz += wt * uz
     g = math.sqrt(gx * gx + gy * gy + gz * gz)
     if not (g > 0.0) or not math.isfinite(g):
         return 0.0, 0.0, 0.0, False
@@ -329,9 +350,14 @@ def _potential(T, x, y, z, hx, hy, hz):
     i0, i1, _ = _cell(x, nx)
     j0, j1, _ = _cell(y, ny)
     k0, k1, _ = _cell(z, nz)
-    for i in (i0, i1):
-        for j in (j0, j1):
-            for k in (k0, k1):
+    # a single-node axis (2D: z) has i0 == i1: its corner once (a second visit of the
+    # same corner changes nothing)
+    for a in range(1 if i0 == i1 else 2):
+        i = i1 if a else i0
+        for b in range(1 if j0 == j1 else 2):
+            j = j1 if b else j0
+            for c in range(1 if k0 == k1 else 2):
+                k = k1 if c else k0
                 tc = T[i, j, k]
                 if not (tc < t):  # also skips inf
                     continue
@@ -483,7 +509,7 @@ def _near_goal(T, px, py, pz, gx, gy, gz):
 
 
 @njit(cache=True, error_model="numpy")
-def _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step):
+def _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step, keys, vals, w):
     """One continuous descent step from p; returns ``(qx, qy, qz, phi(q), ok)``.
 
     Midpoint rule (RK2): the direction is taken at p + L/2 * d(p) (or d(p) if
@@ -494,14 +520,15 @@ def _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step):
     ``_N_BACKTRACK`` tries. If all fail with the smooth (B-spline) direction
     field, they are repeated with the linear blend (``smooth = 0``), which
     follows the node directions tightly around the corner of a blocked cell
-    that the smooth field would cut.
+    that the smooth field would cut. ``keys``, ``vals``, ``w``: the descent's cache
+    and scratch for :func:`_direction`.
     """
     nx, ny, nz = T.shape
     # sufficient decrease: a fraction of what a step of L cells lowers T by
     # at the local slowness
     slow = _slowness(T, _nearest(px, nx), _nearest(py, ny), _nearest(pz, nz), hx, hy, hz)
     for smooth in (1.0, 0.0):
-        d1x, d1y, d1z, ok = _direction(T, px, py, pz, hx, hy, hz, hmin, smooth)
+        d1x, d1y, d1z, ok = _direction(T, px, py, pz, hx, hy, hz, hmin, smooth, keys, vals, w)
         if not ok:
             continue
         L = step
@@ -509,7 +536,7 @@ def _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step):
             mx = _clamp(px + 0.5 * L * d1x, nx)
             my = _clamp(py + 0.5 * L * d1y, ny)
             mz = _clamp(pz + 0.5 * L * d1z, nz)
-            d2x, d2y, d2z, ok2 = _direction(T, mx, my, mz, hx, hy, hz, hmin, smooth)
+            d2x, d2y, d2z, ok2 = _direction(T, mx, my, mz, hx, hy, hz, hmin, smooth, keys, vals, w)
             if not ok2 or (d1x * d2x + d1y * d2y + d1z * d2z) <= 0.0:
                 d2x, d2y, d2z = d1x, d1y, d1z
             qx = _clamp(px + L * d2x, nx)
@@ -609,6 +636,10 @@ def descend_kernel(T, start, goal, hx, hy, hz, step, max_steps):
     # potential of the current point, and the last _WINDOW accepted ones
     phi = _potential(T, px, py, pz, hx, hy, hz)
     hist = np.empty(_WINDOW)
+    keys = np.empty(_CACHE_SLOTS, dtype=np.int64)
+    _fill(keys, -1)
+    vals = np.empty((_CACHE_SLOTS, 3))
+    wbuf = np.empty(12)
     _fill(hist, phi)
     hpos = 0
     iters = 0
@@ -623,7 +654,8 @@ def descend_kernel(T, start, goal, hx, hy, hz, step, max_steps):
             # ---- continuous step: midpoint (RK2) on the direction field, with
             #      backtracking on the step length; non-monotone acceptance
             ref = _nanmax(hist)
-            qx, qy, qz, tq, ok = _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step)
+            qx, qy, qz, tq, ok = _try_step(T, px, py, pz, ref, hx, hy, hz, hmin, step, keys, vals,
+                                           wbuf)
             if ok:
                 px, py, pz = qx, qy, qz
                 phi = tq
@@ -677,6 +709,104 @@ def descend_kernel(T, start, goal, hx, hy, hz, step, max_steps):
             px, py, pz = float(i), float(j), float(k)
             out, n = _push(out, n, px, py, pz)
             n_fallback += 1
+
+
+# --------------------------------------------------------------- many starts
+@njit(cache=True, error_model="numpy", nogil=True)
+def descend_sweep(work, shape, flat, order, vals, hi, ball_idx, ball_vals, times, nodes,
+                  starts, goal, hx, hy, hz, step, max_steps, sweep):
+    """:func:`descend_kernel` from each of ``starts`` on the field a march stopped there
+    sees, rebuilt in ``work`` (see :func:`fm2uav.planning.geodesic.descend_stopped`).
+
+    For each start ``s`` (time ``t``, flat node ``n``), in the order given (latest
+    first): if ``sweep``, the nodes ``order[lo:hi]`` (``vals[lo:]`` >= t) are made
+    ``inf`` in the flat ``work`` (``hi = lo`` after) and ``work[n] = t``; the nodes of
+    the ball ``ball_idx`` (sorted by ``ball_vals``) with time ``t`` other than ``n``
+    are made ``inf`` during the descent and restored from ``flat`` after it; if
+    ``sweep``, ``work[n]`` is ``inf`` again after the descent.
+
+    Parameters
+    ----------
+    work, flat : float64 arrays, flat
+        The field descended (written) and the whole march's times [s] (``inf`` on
+        blocked nodes), C order of ``shape``.
+    shape : tuple of 3 int
+        The field's shape, padded to 3 axes.
+    order, vals, hi
+        The nodes outside the ball sorted by time, their times, and how many of them
+        are finite in ``work`` now.
+    ball_idx, ball_vals
+        The ball's nodes sorted by time, and their times.
+    times : float64 array (m,); nodes : int64 array (m,)
+        Each start's time and flat node.
+    starts : float64 array (m, 3)
+        Index coordinates, padded with 0 to 3 axes.
+    goal : float64 array (3,)
+    hx, hy, hz, step, max_steps
+        As :func:`descend_kernel`.
+    sweep : bool
+        Whether the starts lie outside the ball (the field is swept down to each).
+
+    Returns
+    -------
+    points : float64 array (N, 3)
+        Every path, one after the other, the first point the start and the last the
+        goal exactly when the descent got there.
+    offsets : int64 array (m + 1,)
+    status : int64 array (m,)
+        ``OK`` or ``STUCK`` per start; ``info`` (m, 3) the node where it got stuck.
+    hi : int
+        The sweep's position after the last start.
+    """
+    m = times.shape[0]
+    work3 = work.reshape(shape)
+    pts = np.empty((max(1024, 64 * m), 3))
+    offsets = np.zeros(m + 1, dtype=np.int64)
+    status = np.zeros(m, dtype=np.int64)
+    info = np.zeros((m, 3), dtype=np.int64)
+    n = 0
+    for r in range(m):
+        t = times[r]
+        node = nodes[r]
+        if sweep:
+            lo = np.searchsorted(vals, t, side="left")
+            if lo < hi:
+                for q in range(lo, hi):
+                    work[order[q]] = np.inf
+                hi = lo
+            work[node] = t
+        a = np.searchsorted(ball_vals, t, side="left")
+        b = np.searchsorted(ball_vals, t, side="right")
+        for q in range(a, b):
+            if ball_idx[q] != node:
+                work[ball_idx[q]] = np.inf
+        path, st, where, _ = descend_kernel(work3, starts[r], goal, hx, hy, hz, step,
+                                            max_steps)
+        for q in range(a, b):
+            if ball_idx[q] != node:
+                work[ball_idx[q]] = flat[ball_idx[q]]
+        if sweep:
+            work[node] = np.inf
+        status[r] = st
+        info[r, 0], info[r, 1], info[r, 2] = where[0], where[1], where[2]
+        k = path.shape[0]
+        if n + k > pts.shape[0]:
+            bigger = np.empty((2 * (n + k), 3))
+            for q in range(n):
+                bigger[q, 0] = pts[q, 0]
+                bigger[q, 1] = pts[q, 1]
+                bigger[q, 2] = pts[q, 2]
+            pts = bigger
+        for q in range(k):
+            pts[n + q, 0] = path[q, 0]
+            pts[n + q, 1] = path[q, 1]
+            pts[n + q, 2] = path[q, 2]
+        if st == OK:  # the ends exact (as descend's)
+            pts[n, 0], pts[n, 1], pts[n, 2] = starts[r, 0], starts[r, 1], starts[r, 2]
+            pts[n + k - 1, 0], pts[n + k - 1, 1], pts[n + k - 1, 2] = goal[0], goal[1], goal[2]
+        n += k
+        offsets[r + 1] = n
+    return pts[:n], offsets, status, info, hi
 
 
 # ------------------------------------------------------------- whole-field scans

@@ -247,17 +247,49 @@ def _run(field: np.ndarray, field3: np.ndarray, h3: tuple[float, ...], s: np.nda
     g3 = np.concatenate([g, np.zeros(pad)])
     path, status, info, _ = _k.descend_kernel(field3, s3, g3, *h3, step, int(max_steps))
     if status != _k.OK:
-        node = info[:ndim].tolist()
-        raise PlanningError(
-            f"descent from start {s.tolist()} stuck at node {node} (T = {field[tuple(node)]:g}), "
-            f"which has no free neighbour with smaller T and is not next to the goal "
-            f"{g.tolist()}; T must be the arrival times of a wave started at the goal's "
-            f"nearest node {list(gn)} (e.g. fast_marching(speed, [goal_node]))"
-        )
+        raise _stuck_error(field, s, g, gn, info)
     path = np.ascontiguousarray(path[:, :ndim])
     path[0] = s
     path[-1] = g
     return path
+
+
+def _stuck_error(field: np.ndarray, s: np.ndarray, g: np.ndarray, gn: tuple[int, ...],
+                 info: np.ndarray) -> PlanningError:
+    """The error of a descent from ``s`` stuck at node ``info`` (the kernel's ``STUCK``)."""
+    node = info[:field.ndim].tolist()
+    return PlanningError(
+        f"descent from start {s.tolist()} stuck at node {node} (T = {field[tuple(node)]:g}), "
+        f"which has no free neighbour with smaller T and is not next to the goal "
+        f"{g.tolist()}; T must be the arrival times of a wave started at the goal's "
+        f"nearest node {list(gn)} (e.g. fast_marching(speed, [goal_node]))"
+    )
+
+
+def _plain_starts(starts: Sequence[Any], shape: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """``starts`` as an ``(n, ndim)`` array, clipped into the grid as :func:`_as_point`
+    clips one, and a bool per start: True where :func:`_as_point` would accept it (the
+    others, False, are left to it, for its error)."""
+    n, ndim = len(starts), len(shape)
+    try:
+        arr = np.asarray(starts, dtype=float)
+    except (TypeError, ValueError):
+        arr = None
+    if arr is None or arr.shape != (n, ndim):
+        return np.zeros((n, ndim)), np.zeros(n, dtype=bool)
+    upper = np.asarray(shape, dtype=float) - 1.0
+    ok = np.all(np.isfinite(arr) & (arr >= -1e-9) & (arr <= upper + 1e-9), axis=1)
+    return np.clip(arr, 0.0, upper), ok
+
+
+def _starts_free(field: np.ndarray, mask: np.ndarray | None, pts: np.ndarray) -> np.ndarray:
+    """Per start (index coordinates inside the grid): its nearest node is not blocked and
+    was reached (what :func:`_check_start` checks)."""
+    at = tuple(np.clip(nearest_node(pts), 0, np.asarray(field.shape) - 1).T)
+    free = np.isfinite(field[at])
+    if mask is not None:
+        free &= ~mask[at]
+    return free
 
 
 def _padded(field: np.ndarray, h: Sequence[float]) -> tuple[np.ndarray, tuple[float, ...]]:
@@ -528,74 +560,73 @@ def descend_stopped(
     flat = field.reshape(-1)
     ball_field = np.where(in_ball, field, np.inf).reshape(-1)
     out: list[Any] = [None] * len(starts)
-    late: list[tuple[float, int, int, np.ndarray]] = []  # (time, flat node, k, start)
-    near: list[tuple[float, int, int, np.ndarray]] = []
-    for k, start in enumerate(starts):
+    pts, ok = _plain_starts(starts, shape)
+    ok[ok] = _starts_free(field, mask, pts[ok])
+    for k in np.flatnonzero(~ok).tolist():  # one by one, for the error descend raises
         try:
-            s = _as_point(start, shape, "start")
-            _check_start(field, mask, s, g)
+            pts[k] = _as_point(starts[k], shape, "start")
+            _check_start(field, mask, pts[k], g)
         except (PlanningError, InputError) as exc:
             out[k] = exc
             continue
-        sn = tuple(nearest_node(s).tolist())
-        item = (float(field[sn]), int(np.ravel_multi_index(sn, shape)), k, s)
-        (near if in_ball[sn] else late).append(item)
-    late.sort(key=lambda it: -it[0])
+        ok[k] = True
+    idx = np.flatnonzero(ok)
+    nodes = np.ravel_multi_index(tuple(nearest_node(pts[idx]).T), shape)
+    times = flat[nodes]
+    inside = in_ball.reshape(-1)[nodes]
+    starts3 = np.zeros((len(pts), 3))
+    starts3[:, :field.ndim] = pts
+    g3 = np.zeros(3)
+    g3[:field.ndim] = g
+    h3 = _padded(field, h)[1]
+    shape3 = shape + (1,) * (3 - field.ndim)
+    near = idx[inside], nodes[inside], times[inside]
+    later = np.argsort(-times[~inside], kind="stable")  # the latest first
+    late = idx[~inside][later], nodes[~inside][later], times[~inside][later]
     ball_idx, ball_vals = _sorted_nodes(flat, in_ball.reshape(-1))
     # the nodes outside the ball a march stopped at the earliest start has not frozen
     order, vals = _sorted_nodes(flat, np.isfinite(flat) & ~in_ball.reshape(-1)
-                                & (flat >= (late[-1][0] if late else np.inf)))
+                                & (flat >= (late[2][-1] if len(late[2]) else np.inf)))
 
     stop = threading.Event()
 
-    def run(items: list, base: np.ndarray, sweep: bool) -> None:
+    def run(items: tuple[np.ndarray, np.ndarray, np.ndarray], base: np.ndarray,
+            sweep: bool) -> None:
         work = base.copy()
-        work_nd = work.reshape(shape)
-        work3, h3 = _padded(work_nd, h)
         hi = len(vals)  # vals[hi:] are inf in work
-        batch: list[int] = []
-        for t, sflat, k, s in items:
+        ks, nds, ts = items
+        for a in range(0, len(ks), _BATCH):  # a compiled sweep per batch of starts
             if stop.is_set():  # the caller was interrupted: leave at once
                 return
-            if on_done is not None and len(batch) >= _BATCH:
-                on_done(batch, [out[b] for b in batch])
-                batch = []
-            batch.append(k)
-            if sweep:
-                lo = int(np.searchsorted(vals, t, side="left"))
-                if lo < hi:
-                    work[order[lo:hi]] = np.inf
-                    hi = lo
-                work[sflat] = t
-            a = int(np.searchsorted(ball_vals, t, side="left"))
-            b = int(np.searchsorted(ball_vals, t, side="right"))
-            ties = ball_idx[a:b]
-            ties = ties[ties != sflat]
-            work[ties] = np.inf
-            try:
-                out[k] = _run(work_nd, work3, h3, s, g, gn, step, max_steps)
-            except PlanningError as exc:
-                out[k] = exc
-            work[ties] = flat[ties]
-            if sweep:
-                work[sflat] = np.inf
-        if on_done is not None and batch:
-            on_done(batch, [out[b] for b in batch])
+            b = min(a + _BATCH, len(ks))
+            path_pts, offsets, status, info, hi = _k.descend_sweep(
+                work, shape3, flat, order, vals, hi, ball_idx, ball_vals, ts[a:b], nds[a:b],
+                starts3[ks[a:b]], g3, *h3, step, int(max_steps), sweep)
+            path_pts = np.ascontiguousarray(path_pts[:, :field.ndim])
+            for r, k in enumerate(ks[a:b].tolist()):
+                if status[r] == _k.OK:
+                    out[k] = path_pts[offsets[r]:offsets[r + 1]]
+                else:
+                    out[k] = _stuck_error(field, pts[k], g, gn, info[r])
+            if on_done is not None:
+                done = ks[a:b].tolist()
+                on_done(done, [out[k] for k in done])
 
     if on_done is not None:
         bad = [k for k, r in enumerate(out) if r is not None]  # refused before descending
         if bad:
             on_done(bad, [out[b] for b in bad])
-    tasks: list[tuple[list, np.ndarray, bool]] = []
-    if near:
+    tasks: list[tuple[tuple[np.ndarray, np.ndarray, np.ndarray], np.ndarray, bool]] = []
+    if len(near[0]):
         tasks.append((near, ball_field, False))
     # several chunks per thread, taken as threads free up: the latest starts have the
     # longest paths, so equal shares of the starts are not equal work
-    n_chunks = max(1, min(int(threads) * (4 if threads > 1 else 1), len(late)))
+    n_late = len(late[0])
+    n_chunks = max(1, min(int(threads) * (4 if threads > 1 else 1), n_late))
     for c in range(n_chunks):
-        part = late[c * len(late) // n_chunks:(c + 1) * len(late) // n_chunks]
-        if part:
-            tasks.append((part, flat, True))
+        part = slice(c * n_late // n_chunks, (c + 1) * n_late // n_chunks)
+        if part.stop > part.start:
+            tasks.append((tuple(x[part] for x in late), flat, True))
     if threads == 1 or len(tasks) == 1:
         for task in tasks:
             run(*task)

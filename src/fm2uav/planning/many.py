@@ -220,9 +220,10 @@ def _classify_all(world: World, W: np.ndarray, starts: Sequence[Any], goal_m: np
             good &= (np.linalg.norm(pts - goal_m, axis=1) / (float(options.step) * h)
                      <= MAX_PATH_STEPS)
     out: list[tuple[np.ndarray, tuple[int, ...]] | RouteFailure] = []
+    cell_list = cells.tolist() if good.any() else []  # Python ints, converted at once
     for k in range(n):
         if good[k]:
-            out.append((pts[k].copy(), tuple(int(v) for v in cells[k])))
+            out.append((pts[k].copy(), tuple(cell_list[k])))
         else:
             out.append(_classify(world, W, starts[k], goal_m, goal_cell, options))
     return out
@@ -349,9 +350,9 @@ def plan_many(
         for (k, _), p in zip(traced, plans):
             routes[k] = RouteFailure("altitude", str(p)) if isinstance(p, PlanningError) else p
 
-    descend_stopped(T, [world.to_index(checked[k][0]) for k in todo], world.to_index(goal_m),
-                    frozen=ball, spacing=world.spacing, blocked=blocked, step=options.step,
-                    threads=n_threads, on_done=finish)
+    todo_idx = world.to_index(np.array([checked[k][0] for k in todo]).reshape(-1, world.ndim))
+    descend_stopped(T, todo_idx, world.to_index(goal_m), frozen=ball, spacing=world.spacing,
+                    blocked=blocked, step=options.step, threads=n_threads, on_done=finish)
     t3 = time.perf_counter()
     timings = {"velocity_map": t1 - t0 - t_checks, "checks": t_checks, "fast_marching": t2 - t1,
                "routes": t3 - t2, "total": t3 - t_all, "cpu": time.process_time() - c_all}

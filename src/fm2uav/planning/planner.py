@@ -21,7 +21,7 @@ from .. import progress
 from ..eikonal.fmm import fast_marching
 from ..eikonal.velocity import normalised_distance, shape_velocity
 from ..errors import InputError, PlanningError, PointError, UnreachableError
-from ..geometry import path_length
+from ..geometry import path_lengths
 from ..world import World
 from ..world.clearance import min_surface_clearances
 from ..world.zones import check_points_allowed, zone_violations
@@ -543,8 +543,10 @@ def finish_plans(world: World, W: np.ndarray, T: np.ndarray, paths_idx: list[np.
     heights = level is not None and level.heights == "ground" and world.ndim == 3
     if heights:
         progress.step("heights above the ground", 1.0)
-    for path_idx in paths_idx:
-        path = world.to_world(path_idx)
+    lens = [len(q) for q in paths_idx]
+    ends = np.cumsum(lens)[:-1] if lens else []
+    in_world = np.split(world.to_world(np.concatenate(paths_idx)), ends) if lens else []
+    for path, path_idx in zip(in_world, paths_idx):  # world.to_world of each, in one call
         profile = None
         try:
             if heights:
@@ -572,6 +574,7 @@ def finish_plans(world: World, W: np.ndarray, T: np.ndarray, paths_idx: list[np.
         w_all = np.split(ndimage.map_coordinates(
             W, np.concatenate([f[1] for f in done]).T, order=1, mode="nearest"), ends)
         clear_all = min_surface_clearances(world, [f[0] for f in done])
+        lengths = path_lengths([f[0] for f in done])
     t4 = time.perf_counter()
     timings = {
         "velocity_map": t1 - t0,
@@ -588,7 +591,7 @@ def finish_plans(world: World, W: np.ndarray, T: np.ndarray, paths_idx: list[np.
             out.append(f)
             continue
         path, _, profile = f
-        w, clearance = w_all[k], float(clear_all[k])
+        w, clearance, length = w_all[k], float(clear_all[k]), lengths[k]
         k += 1
         params = dict(base_params)
         timing = None
@@ -599,7 +602,7 @@ def finish_plans(world: World, W: np.ndarray, T: np.ndarray, paths_idx: list[np.
         out.append(Plan(
             path=path,
             w=w,
-            length=path_length(path),
+            length=length,
             clearance=clearance,
             timings=dict(timings),
             W=W,

@@ -11,8 +11,9 @@ two processes at once (see :mod:`fm2uav.__main__`)::
 
 Groups: ``edt`` (distance map), ``fmm{2,3}d_o{1,2}`` (Fast Marching, one
 dimension and order), ``descent`` (geodesic extraction), ``surface``
-(continuous clearance to a terrain surface), ``profile`` (the slope sweeps of a flight
-level's altitude envelopes), and two of big grids only, which
+(continuous clearance to a terrain surface), ``many`` (many routes from one wave: the
+descents' sweep; the clearance to obstacle cells), ``profile`` (the slope sweeps of a
+flight level's altitude envelopes), and two of big grids only, which
 call their kernels directly: ``edt_parallel`` (the distance map's lines in
 parallel) and ``fmm3d_o{1,2}_lean`` (the 3D march in the lean layout, see
 ``fm2uav.eikonal._kernels.LEAN_NODES``); ``fmm{2,3}d_parallel`` (the march on both cores,
@@ -30,9 +31,9 @@ import numpy as np
 from ..eikonal import _edt as _edt_kernels
 from ..eikonal import _kernels, _parallel, distance_map, fast_marching
 from ..world import World
-from ..world.clearance import surface_clearance
+from ..world.clearance import min_surface_clearances, surface_clearance
 from .altitude import envelope_above
-from .geodesic import descend, drop_ties, reaches_any
+from .geodesic import descend, descend_stopped, drop_ties, reaches_any
 
 __all__ = ["GROUPS", "FIRST_PLAN_MAIN", "FIRST_PLAN_CHILD", "warm"]
 
@@ -130,6 +131,19 @@ def _descent() -> None:
     descend(T, (0.0, 0.0, 0.0), tuple(g), spacing=(1.0, 1.0, 1.0))
 
 
+def _many() -> None:
+    """Many routes from one wave (``plan_many``): the descents' compiled sweep, and the
+    clearance of paths measured to obstacle cells (2D worlds, also ``plan()``'s)."""
+    g = np.array([4.0, 4.0, 4.0])
+    axes = np.meshgrid(*[np.arange(5.0)] * 3, indexing="ij")
+    T = np.sqrt(sum((a - c) ** 2 for a, c in zip(axes, g)))
+    ball = np.where(T <= 1.0, T, np.inf)
+    descend_stopped(T, [(0.0, 0.0, 0.0), (4.0, 3.0, 4.0)], tuple(g), frozen=ball)
+    occ = np.zeros((4, 4), dtype=bool)
+    occ[0, 0] = True
+    min_surface_clearances(World(occ, spacing=1.0), [np.array([[2.5, 2.5], [3.0, 3.0]])])
+
+
 def _surface() -> None:
     world = World.from_heightmap(np.zeros((4, 4)), 1.0, 4)
     surface_clearance(world, np.array([[1.5, 1.5, 2.5]]))
@@ -155,6 +169,7 @@ GROUPS: dict[str, Callable[[], None]] = {
     "fmm3d_parallel": _fmm_parallel(3),
     "descent": _descent,
     "surface": _surface,
+    "many": _many,
     "profile": _profile,
 }
 

@@ -222,3 +222,107 @@ def surface_distance(points, start, heights, ox, oy, hx, hy, roofs, rox, roy, rh
                         best2 = d2
         out[p] = math.sqrt(best2)
     return out
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def _box_window(px, py, pz, rim, ox, oy, oz, hx, hy, hz, reach, best):
+    """Smallest distance [m] from point p to the boxes of the ``rim`` nodes whose centres
+    lie within ``reach`` [m] of p on every axis (``best`` if none is nearer).
+
+    A box's distance is ``sqrt(gx^2 + gy^2 + gz^2)``, ``g = max(|c - p| - h / 2, 0)`` per
+    axis (``c = o + i h`` its centre): the numbers :func:`clearance._box_distances`
+    computes with numpy, operation for operation.
+    """
+    nx, ny, nz = rim.shape
+    i0 = max(int(math.floor((px - reach - ox) / hx)) - 1, 0)
+    i1 = min(int(math.ceil((px + reach - ox) / hx)) + 1, nx - 1)
+    j0 = max(int(math.floor((py - reach - oy) / hy)) - 1, 0)
+    j1 = min(int(math.ceil((py + reach - oy) / hy)) + 1, ny - 1)
+    k0 = max(int(math.floor((pz - reach - oz) / hz)) - 1, 0)
+    k1 = min(int(math.ceil((pz + reach - oz) / hz)) + 1, nz - 1)
+    for i in range(i0, i1 + 1):
+        gx = max(abs((ox + i * hx) - px) - 0.5 * hx, 0.0)
+        for j in range(j0, j1 + 1):
+            gy = max(abs((oy + j * hy) - py) - 0.5 * hy, 0.0)
+            for k in range(k0, k1 + 1):
+                if not rim[i, j, k]:
+                    continue
+                gz = max(abs((oz + k * hz) - pz) - 0.5 * hz, 0.0)
+                d = math.sqrt(gx * gx + gy * gy + gz * gz)
+                if d < best:
+                    best = d
+    return best
+
+
+@njit(cache=True, error_model="numpy", nogil=True)
+def min_box_clearances(points, offsets, dist, rim, ox, oy, oz, hx, hy, hz, r):
+    """Smallest distance [m] from the points of each path to the obstacle cells (boxes).
+
+    Path ``m`` is ``points[offsets[m]:offsets[m + 1]]``. With ``d`` the distance from a
+    point's nearest node to the nearest ``rim`` node (``dist``, a distance transform)
+    and ``e`` the point's distance to that node, its clearance lies in
+    ``[d - e - r, d + e]`` (``r`` half a cell diagonal); a point whose lower bound
+    exceeds the smallest upper bound (or the smallest exact distance found) cannot hold
+    the path's minimum. The others are measured exactly against the boxes of the rim
+    nodes (obstacle nodes with a free axis neighbour; the nearest box is always one)
+    whose centres lie within that bound plus ``r``: the path's minimum is the minimum of
+    the exact distances, whatever the order.
+
+    Parameters
+    ----------
+    points : ndarray, shape (N, 3)
+        World coordinates [m] (2D worlds padded with z = 0).
+    offsets : ndarray of int64, shape (M + 1,)
+    dist : ndarray, shape (nx, ny, nz)
+        Distance [m] from each node to the nearest rim node's centre.
+    rim : ndarray of bool, shape (nx, ny, nz)
+        The obstacle nodes with a free axis neighbour (at least one).
+    ox, oy, oz, hx, hy, hz : float
+        Origin and spacing [m] (2D: any positive ``hz``).
+    r : float
+        Half the diagonal of a cell [m] (of the map's own axes).
+
+    Returns
+    -------
+    ndarray, shape (M,)
+        ``inf`` for a path without points.
+    """
+    nx, ny, nz = dist.shape
+    m = offsets.shape[0] - 1
+    out = np.full(m, np.inf)
+    for p in range(m):
+        a = offsets[p]
+        b = offsets[p + 1]
+        if b <= a:
+            continue
+        lower = np.empty(b - a)
+        upper = np.inf
+        first = a
+        for q in range(a, b):
+            px = points[q, 0]
+            py = points[q, 1]
+            pz = points[q, 2]
+            i = min(max(int(math.floor((px - ox) / hx + 0.5)), 0), nx - 1)
+            j = min(max(int(math.floor((py - oy) / hy + 0.5)), 0), ny - 1)
+            k = min(max(int(math.floor((pz - oz) / hz + 0.5)), 0), nz - 1)
+            ex = px - (ox + i * hx)
+            ey = py - (oy + j * hy)
+            ez = pz - (oz + k * hz)
+            e = math.sqrt(ex * ex + ey * ey + ez * ez)
+            d = dist[i, j, k]
+            lower[q - a] = d - e - r
+            if d + e < upper:
+                upper = d + e
+                first = q
+        # the point of the smallest upper bound first: its exact distance bounds the others
+        best = _box_window(points[first, 0], points[first, 1], points[first, 2], rim,
+                           ox, oy, oz, hx, hy, hz, upper * (1 + 1e-12) + 1e-12 + r, np.inf)
+        bound = min(best, upper)
+        for q in range(a, b):
+            if q == first or lower[q - a] > bound * (1 + 1e-12) + 1e-12:
+                continue
+            best = _box_window(points[q, 0], points[q, 1], points[q, 2], rim, ox, oy, oz,
+                               hx, hy, hz, bound * (1 + 1e-12) + 1e-12 + r, best)
+            bound = min(best, upper)
+        out[p] = best
+    return out

@@ -28,7 +28,7 @@ from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from .world import World
-from ._clearance_kernels import column_clearance, surface_distance
+from ._clearance_kernels import column_clearance, min_box_clearances, surface_distance
 
 __all__ = ["clearance_profile", "obstacle_tree", "column_surface", "surface_clearance",
            "min_surface_clearance", "min_surface_clearances", "base_occupancy"]
@@ -102,12 +102,14 @@ def min_surface_clearances(world: World, paths: list[Any]) -> np.ndarray:
     """``surface_clearance(world, path).min()`` [m] of each path, the same numbers, faster.
 
     On worlds measured to their obstacle cells (2D, not solid columns) only the points
-    that can hold a path's minimum are measured exactly, all paths at once: with ``d``
-    the distance from a point's nearest node to the nearest obstacle node (one cached
-    distance transform) and ``e`` the point's distance to that node, its clearance lies
-    in ``[d - e - r, d + e]`` (``r`` half a cell diagonal); then, with ``c`` its distance
-    to the nearest obstacle cell centre, in ``[c - r, c]``. A point whose lower bound
-    exceeds its path's smallest upper bound cannot be the nearest.
+    that can hold a path's minimum are measured exactly, in one compiled pass over every
+    path (:func:`~fm2uav.world._clearance_kernels.min_box_clearances`): with ``d`` the
+    distance from a point's nearest node to the nearest rim node (an obstacle node with
+    a free axis neighbour; one cached distance transform) and ``e`` the point's
+    distance to that node, its clearance lies in ``[d - e - r, d + e]`` (``r`` half a
+    cell diagonal). A point whose lower bound exceeds its path's smallest upper bound
+    (or smallest exact distance) cannot be the nearest; the others are measured against
+    the obstacle cells (boxes) around them.
 
     Parameters
     ----------
@@ -130,47 +132,40 @@ def min_surface_clearances(world: World, paths: list[Any]) -> np.ndarray:
     lens = np.array([len(p) for p in pts_list], dtype=np.int64)
     if not occ.any() or lens.sum() == 0:
         return out
-    key = "box_distance"
+    rim = _box_rim(world)
+    if not rim.any():
+        return out
+    key = "rim_distance"
     if key not in world._cache:
-        world._cache[key] = ndimage.distance_transform_edt(~occ, sampling=world.spacing)
-    dist = world._cache[key]
-    pts = np.concatenate([p for p in pts_list if len(p)])
-    owner = np.repeat(np.arange(len(pts_list)), lens)
+        world._cache[key] = ndimage.distance_transform_edt(~rim, sampling=world.spacing)
+    pad = (1,) * (3 - world.ndim)
+    dist = world._cache[key].reshape(world.shape + pad)
+    rim = rim.reshape(world.shape + pad)
+    pts = np.zeros((int(lens.sum()), 3))
+    pts[:, :world.ndim] = np.concatenate([p for p in pts_list if len(p)])
+    offsets = np.concatenate(([0], np.cumsum(lens)))
+    o = tuple(world.origin) + (0.0,) * len(pad)
+    h = tuple(world.spacing) + (1.0,) * len(pad)
     half_diag = 0.5 * float(np.linalg.norm(np.asarray(world.spacing, dtype=float)))
+    return min_box_clearances(pts, offsets, dist, rim, *o, *h, half_diag)
 
-    def within(lower: np.ndarray, upper: np.ndarray, who: np.ndarray) -> np.ndarray:
-        best = np.full(len(pts_list), np.inf)
-        np.minimum.at(best, who, upper)
-        bound = best[who]
-        return lower <= bound * (1 + 1e-12) + 1e-12
 
-    node = np.clip(np.floor(world.to_index(pts) + 0.5).astype(np.int64), 0,
-                   np.asarray(world.shape) - 1)
-    e = np.linalg.norm(pts - world.to_world(node), axis=1)
-    d = dist[tuple(node.T)]
-    keep = within(d - e - half_diag, d + e, owner)
-    pts, owner = pts[keep], owner[keep]
-    c, _ = _box_tree(world)[0].query(pts)  # the nearest centre exactly
-    keep = within(c - half_diag, c, owner)
-    pts, owner, c = pts[keep], owner[keep], c[keep]
-    # measure each path's nearest centre first: its exact distance bounds the others
-    order = np.lexsort((c, owner))
-    first = order[np.r_[True, owner[order][1:] != owner[order][:-1]]]
-    np.minimum.at(out, owner[first], _box_distances(world, pts[first], c[first]))
-    rest = np.ones(len(pts), dtype=bool)
-    rest[first] = False
-    rest &= c - half_diag <= out[owner] * (1 + 1e-12) + 1e-12
-    np.minimum.at(out, owner[rest], _box_distances(world, pts[rest], c[rest]))
-    return out
+def _box_rim(world: World) -> np.ndarray:
+    """The obstacle nodes with a free axis neighbour (cached): the nearest obstacle cell
+    of a free point is always one of them."""
+    key = "box_rim"
+    if key not in world._cache:
+        occ = base_occupancy(world)
+        world._cache[key] = np.ascontiguousarray(occ & ~ndimage.binary_erosion(
+            occ, border_value=1))
+    return world._cache[key]
 
 
 def _box_tree(world: World) -> tuple[cKDTree, np.ndarray]:
     """KD-tree of the obstacle cells' centres on the obstacles' rim (cached), and the centres."""
     key = "box_tree"
     if key not in world._cache:
-        occ = base_occupancy(world)
-        interior = ndimage.binary_erosion(occ, border_value=1)
-        nodes = np.argwhere(occ & ~interior)
+        nodes = np.argwhere(_box_rim(world))
         world._cache[key] = (cKDTree(world.to_world(nodes)), world.to_world(nodes))
     return world._cache[key]
 
