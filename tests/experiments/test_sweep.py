@@ -7,9 +7,11 @@ import pytest
 
 from fm2uav.experiments.sweep import (
     best_parameters,
+    compare_paths,
     curvature_profile,
     distance_matrix,
     parameter_grid,
+    resample_references,
     smooth_dct,
     sweep_alpha_row,
     valley,
@@ -96,3 +98,15 @@ def test_sweep_row_records_each_case():
     bad = np.array([200.0, 150.0])  # inside the Centre Pompidou
     rows = sweep_alpha_row(w, bad, g[0], 0.5, [0.2], {"dubins": ref})
     assert rows[0]["status"] == "error" and "PointError" in rows[0]["error"]
+
+
+def test_references_resampled_once_give_the_same_metrics():
+    rng = np.random.default_rng(11)
+    path = np.cumsum(rng.normal(size=(40, 2)), axis=0)
+    refs = {"dubins": np.cumsum(rng.normal(size=(300, 2)) * 0.2, axis=0),
+            "rs": np.cumsum(rng.normal(size=(7, 2)) * 3, axis=0)}
+    want = compare_paths(path, refs, ds=0.7)
+    again = resample_references(refs, 0.7)
+    assert compare_paths(path, again, ds=0.7, resampled=True) == want
+    # resampling a resampled curve moves its points: the flag is what keeps the numbers
+    assert compare_paths(path, again, ds=0.7) != want

@@ -74,7 +74,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 from pydantic import model_validator
 
 from .. import progress as _progress
-from ..errors import InputError
+from ..errors import Fm2uavError, InputError
 from ..world import World
 from ..baselines.reference import MODELS, reference_path
 from ._executors import (  # noqa: F401  (check_workers, max_workers: re-exported)
@@ -103,7 +103,7 @@ from ._store import (
     write_atomic,
     write_summary,
 )
-from .sweep import METRICS, parameter_grid, sweep_alpha_row
+from .sweep import METRICS, parameter_grid, resample_references, sweep_alpha_row
 
 __all__ = [
     "GridSpec",
@@ -350,7 +350,8 @@ def _reference_case(ctx: dict[str, Any], model: str) -> dict[str, Any]:
 def _fm2_case(ctx: dict[str, Any], beta: float) -> dict[str, Any]:
     world = _world_cached(ctx["scenario"], ctx["cell"])
     row = sweep_alpha_row(world, ctx["start"], ctx["goal"], ctx["alpha"], [beta],
-                          ctx["references"], ds=ctx["ds"], order=ctx["order"])[0]
+                          ctx["references"], ds=ctx["ds"], order=ctx["order"],
+                          resampled=ctx.get("resampled", False))[0]
     row["pair"] = ctx["pair"]
     return row
 
@@ -812,6 +813,7 @@ def _fm2_jobs(config: SweepConfig, refs: dict[tuple[int, str], dict[str, Any]],
     skipped = skipped_failed = 0
     for p in range(len(starts)):
         ref_paths, ref_errors = {}, []
+        resampled = None
         for m in config.models:
             r = refs[(p, m)]
             if r["error"]:
@@ -832,11 +834,22 @@ def _fm2_jobs(config: SweepConfig, refs: dict[tuple[int, str], dict[str, Any]],
             if ref_errors:
                 missing_refs.append((p, float(a), todo, "; ".join(ref_errors)))
             else:
+                if resampled is None:  # once per pair, for all of its cases
+                    resampled = _resampled(ref_paths, float(config.ds))
                 jobs.append(Job({**base_ctx, "pair": p, "start": starts[p],
-                                 "goal": goals[p], "alpha": float(a),
-                                 "references": ref_paths, "ds": float(config.ds),
-                                 "order": int(config.order)}, todo, tag=(p, float(a))))
+                                 "goal": goals[p], "alpha": float(a), **resampled,
+                                 "ds": float(config.ds), "order": int(config.order)},
+                                todo, tag=(p, float(a))))
     return jobs, missing_refs, skipped, skipped_failed
+
+
+def _resampled(ref_paths: dict[str, Any], ds: float) -> dict[str, Any]:
+    """The ``references`` of a pair's FM² jobs: resampled every ``ds`` once (``resampled``
+    True), or as they are if that fails, so each case then fails with the error, as before."""
+    try:
+        return {"references": resample_references(ref_paths, ds), "resampled": True}
+    except (Fm2uavError, ValueError, FloatingPointError):
+        return {"references": ref_paths, "resampled": False}
 
 
 def _fm2_row(o: Any, metric_cols: Any) -> dict[str, Any]:

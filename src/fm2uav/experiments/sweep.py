@@ -61,19 +61,28 @@ def parameter_grid(start: float = 0.02, stop: float = 1.0, step: float = 0.02) -
     return np.round(start + step * np.arange(n), 10)
 
 
+def resample_references(references: Mapping[str, np.ndarray], ds: float) -> dict[str, np.ndarray]:
+    """Each reference resampled every ``ds`` metres (:func:`~fm2uav.geometry.resample_path`),
+    as :func:`compare_paths` compares them: a sweep does it once per pair, not per case."""
+    return {model: resample_path(ref, ds) for model, ref in references.items()}
+
+
 def compare_paths(
-    path: np.ndarray, references: Mapping[str, np.ndarray], *, ds: float = 1.0
+    path: np.ndarray, references: Mapping[str, np.ndarray], *, ds: float = 1.0,
+    resampled: bool = False,
 ) -> dict[str, float]:
     """Fréchet distance [m] and area between curves [m²] to each reference.
 
     Both curves are resampled every ``ds`` metres first, so the discrete
-    Fréchet distance does not depend on how densely each planner samples.
+    Fréchet distance does not depend on how densely each planner samples;
+    ``resampled=True`` says the references already are
+    (:func:`resample_references` with the same ``ds``).
     Keys: ``frechet_<model>``, ``area_<model>``.
     """
     p = resample_path(path, ds)
+    refs = references if resampled else resample_references(references, ds)
     out: dict[str, float] = {}
-    for model, ref in references.items():
-        r = resample_path(ref, ds)
+    for model, r in refs.items():
         out[f"frechet_{model}"] = frechet_distance(p, r)
         out[f"area_{model}"] = area_between_curves(p, r)
     return out
@@ -89,6 +98,7 @@ def sweep_alpha_row(
     *,
     ds: float = 1.0,
     order: int = 2,
+    resampled: bool = False,
 ) -> list[dict[str, Any]]:
     """FM² for one α and every β of a row, compared with the references.
 
@@ -96,6 +106,7 @@ def sweep_alpha_row(
     "error"), ``error`` (message), ``fm2_time_s`` (plan wall time [s]),
     ``length_m``, ``clearance_m`` and the :func:`compare_paths` metrics.
     A failing case is recorded with its error and does not stop the others.
+    ``resampled``: the references are already :func:`resample_references` of ``ds``.
     """
     rows = []
     for beta in betas:
@@ -108,7 +119,7 @@ def sweep_alpha_row(
             row["fm2_time_s"] = time.perf_counter() - t0
             row["length_m"] = p.length
             row["clearance_m"] = p.clearance
-            row.update(compare_paths(p.path, references, ds=ds))
+            row.update(compare_paths(p.path, references, ds=ds, resampled=resampled))
         except (Fm2uavError, ValueError, FloatingPointError) as exc:
             row["status"] = "error"
             row["error"] = f"{type(exc).__name__}: {exc}"

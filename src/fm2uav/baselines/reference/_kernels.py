@@ -2,6 +2,16 @@
 
 State id ``s = (ix * ny + iy) * K + k``. The heap is a binary min-heap over
 arrays with lazy deletion (stale entries are skipped when popped).
+
+Inside the search the states live on the map padded by ``R`` blocked nodes on every
+side (``R``: the longest reach of a primitive or of its swept cells), with the
+cost-to-come ``-inf`` on blocked and padding nodes. One test then rejects every
+primitive the plain loop would skip before its collision check — a target off the map,
+in an obstacle (its end node is one of its swept cells), already settled (for Dijkstra
+its cost is at most the cost being expanded) or not improved — and that test is a
+gather over the primitives of one heading, which the compiler vectorises. The few
+primitives left are taken in their order, as before, so the pushes, the heap and the
+ties come out the same as a state-by-state loop.
 """
 
 from __future__ import annotations
@@ -32,6 +42,23 @@ def _pop(hk, hv, nopos, n):
     return key, val, n
 
 
+@njit(cache=True)
+def _reach(ptr, pdx, pdy, pend, cptr, cx, cy):
+    """The padding ``R`` [nodes] the primitives need: their largest ``|dx|, |dy|`` and
+    swept-cell offset. Checks that every primitive sweeps its end node (the search
+    rejects a primitive ending in an obstacle before its collision check)."""
+    reach = 0
+    for p in range(pdx.shape[0]):
+        reach = max(reach, abs(pdx[p]), abs(pdy[p]))
+        swept = False
+        for q in range(cptr[p], cptr[p + 1]):
+            reach = max(reach, abs(cx[q]), abs(cy[q]))
+            swept = swept or (cx[q] == pdx[p] and cy[q] == pdy[p])
+        if not swept:
+            raise ValueError("a primitive's swept cells must include its end node")
+    return reach
+
+
 # long on purpose: one compiled search loop; helpers would add calls in the hot path
 @njit(cache=True)
 def lattice_search(
@@ -49,7 +76,8 @@ def lattice_search(
     K : int
         Number of headings.
     ptr, pdx, pdy, pend, pcost, cptr, cx, cy : arrays
-        The control set (see ``Primitives``).
+        The control set (see ``Primitives``); costs >= 0, and every primitive's swept
+        cells include its end node (ValueError otherwise).
     sources : int64[:]
         Source state ids (cost 0).
     goal_x, goal_y : int
@@ -72,58 +100,89 @@ def lattice_search(
         States settled.
     """
     nx, ny = free.shape
-    n_states = nx * ny * K
-    cost = np.full(n_states, np.inf)
-    parent = np.full(n_states, -1, np.int64)
-    done = np.zeros(n_states, np.bool_)
+    R = _reach(ptr, pdx, pdy, pend, cptr, cx, cy)
+    nyp = ny + 2 * R
+    n_cells = (nx + 2 * R) * nyp
+    # padded state u = (cell_p) * K + k, cell_p = (ix + R) * nyp + iy + R
+    freep = np.zeros(n_cells, np.bool_)
+    cost = np.full(n_cells * K, -np.inf)  # -inf: never a target (blocked or off the map)
+    for ix in range(nx):
+        for iy in range(ny):
+            if free[ix, iy]:
+                c = (ix + R) * nyp + iy + R
+                freep[c] = True
+                cost[c * K:(c + 1) * K] = np.inf
+    parent = np.full(n_cells * K, -1, np.int64)
+    done = np.zeros(n_cells * K, np.bool_)
+    n_prims = pdx.shape[0]
+    off = np.empty(n_prims, np.int64)  # state offset of each primitive's target
+    for p in range(n_prims):
+        off[p] = (pdx[p] * nyp + pdy[p]) * K + pend[p]
+    coff = np.empty(cx.shape[0], np.int64)  # cell offset of each swept cell
+    for q in range(cx.shape[0]):
+        coff[q] = cx[q] * nyp + cy[q]
+    most = 1
+    for k in range(K):
+        most = max(most, ptr[k + 1] - ptr[k])
+    better = np.empty(most, np.bool_)
     cap = 1 << 20
     hk = np.empty(cap, np.float64)
     hv = np.empty(cap, np.int64)
     nopos = np.empty(0, np.int64)  # no slot index: lazy deletion (stale entries skipped)
     n = 0
     for s in sources:
-        if cost[s] > 0.0:
-            cost[s] = 0.0
-            ix = s // K // ny
-            iy = (s // K) % ny
+        ix = s // K // ny
+        iy = (s // K) % ny
+        u = ((ix + R) * nyp + iy + R) * K + s % K
+        if cost[u] == -np.inf:  # a source in an obstacle: expanded all the same
+            cost[u] = np.inf
+        if cost[u] > 0.0:
+            cost[u] = 0.0
             h = heuristic_weight * np.sqrt((ix - goal_x) ** 2 + (iy - goal_y) ** 2)
             if n >= cap:
                 cap *= 2
                 hk = np.concatenate((hk, np.empty(cap - hk.size, np.float64)))
                 hv = np.concatenate((hv, np.empty(cap - hv.size, np.int64)))
-            n = _push(hk, hv, nopos, n, h, s)
+            n = _push(hk, hv, nopos, n, h, u)
+    astar = heuristic_weight > 0.0
     n_expanded = 0
-    goal_state = -1
+    goal_u = -1
     while n > 0:
-        key, s, n = _pop(hk, hv, nopos, n)
-        if done[s]:
+        key, u, n = _pop(hk, hv, nopos, n)
+        if done[u]:
             continue
-        done[s] = True
+        done[u] = True
         n_expanded += 1
-        k = s % K
-        cell = s // K
-        ix = cell // ny
-        iy = cell % ny
+        k = u % K
+        cp = u // K
+        ix = cp // nyp - R
+        iy = cp % nyp - R
         if ix == goal_x and iy == goal_y and goal_mask[k]:
-            goal_state = s
+            goal_u = u
             break
-        c0 = cost[s]
-        for p in range(ptr[k], ptr[k + 1]):
-            tx = ix + pdx[p]
-            ty = iy + pdy[p]
-            if tx < 0 or ty < 0 or tx >= nx or ty >= ny:
+        c0 = cost[u]
+        base = cp * K
+        first = ptr[k]
+        last = ptr[k + 1]
+        # Dijkstra pops keys in order, so a settled target costs <= c0 <= c0 + pcost: the
+        # cost test alone rejects it; A* keys are not costs, so it checks `done` too
+        if astar:
+            for p in range(first, last):
+                t = base + off[p]
+                better[p - first] = (c0 + pcost[p] < cost[t]) & (not done[t])
+        else:
+            for p in range(first, last):
+                better[p - first] = c0 + pcost[p] < cost[base + off[p]]
+        for p in range(first, last):
+            if not better[p - first]:
                 continue
-            t = (tx * ny + ty) * K + pend[p]
-            if done[t]:
-                continue
+            t = base + off[p]
             nc = c0 + pcost[p]
-            if nc >= cost[t]:
+            if nc >= cost[t]:  # lowered by an earlier primitive of this state
                 continue
             ok = True
             for q in range(cptr[p], cptr[p + 1]):
-                qx = ix + cx[q]
-                qy = iy + cy[q]
-                if qx < 0 or qy < 0 or qx >= nx or qy >= ny or not free[qx, qy]:
+                if not freep[cp + coff[q]]:
                     ok = False
                     break
             if not ok:
@@ -131,8 +190,9 @@ def lattice_search(
             cost[t] = nc
             parent[t] = p
             h = 0.0
-            if heuristic_weight > 0.0:
-                h = heuristic_weight * np.sqrt((tx - goal_x) ** 2 + (ty - goal_y) ** 2)
+            if astar:
+                h = heuristic_weight * np.sqrt((ix + pdx[p] - goal_x) ** 2
+                                               + (iy + pdy[p] - goal_y) ** 2)
             if n >= cap:
                 cap *= 2
                 hk2 = np.empty(cap, np.float64)
@@ -142,4 +202,19 @@ def lattice_search(
                 hk = hk2
                 hv = hv2
             n = _push(hk, hv, nopos, n, nc + h, t)
-    return goal_state, cost, parent, n_expanded
+    # back to the map's state ids (-inf, the padding's mark, is inf: not reached)
+    out_cost = np.empty(nx * ny * K)
+    out_parent = np.empty(nx * ny * K, np.int64)
+    for ix in range(nx):
+        for iy in range(ny):
+            a = (ix * ny + iy) * K
+            b = ((ix + R) * nyp + iy + R) * K
+            for k in range(K):
+                c = cost[b + k]
+                out_cost[a + k] = np.inf if c == -np.inf else c
+                out_parent[a + k] = parent[b + k]
+    goal_state = -1
+    if goal_u >= 0:
+        cp = goal_u // K
+        goal_state = ((cp // nyp - R) * ny + cp % nyp - R) * K + goal_u % K
+    return goal_state, out_cost, out_parent, n_expanded
