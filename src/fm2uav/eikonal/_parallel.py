@@ -85,7 +85,7 @@ import threading
 
 import numpy as np
 from llvmlite import ir
-from numba import njit, prange, types
+from numba import njit, prange, set_num_threads, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
@@ -188,6 +188,13 @@ SHARE_SLABS = True
 #: 1.87-1.94x, smooth 1.80x / 1.87x, FM²-shaped 1.51x / 1.57-1.59x. On: 2D order 1, 4 slabs
 #: per thread.
 DYNAMIC_2D = True
+#: 2D: the exchange before each window runs on the calling thread alone (the parallel
+#: region's iterations in turn), not on every thread: its work is a row per slab side (the
+#: busiest thread's share summed over the 108 exchanges of the bench's FM²-shaped 2048^2
+#: map: ~1 ms) while waking the sleeping threads for it and waiting for the last cost
+#: ~0.1 ms of wall per region on the near-idle machine (the regions' wall summed: 12-18
+#: ms; docs/performance.md). 3D exchanges planes: on the threads. A compile-time constant.
+EXCHANGE_ALONE_2D = True
 #: 2D: a far neighbour of the node a window freezes gets the one-axis update along their
 #: axis, as in the serial march (valid in a slab: see the window's docstring); False: the
 #: full update (the same times bit for bit; the tests run both).
@@ -1275,6 +1282,7 @@ def _drive_kernel(three, order=1):
         """
         K = off.size
         dyn = share == 2  # the slabs taken in turn by the threads (DYNAMIC_2D)
+        alone = not three and EXCHANGE_ALONE_2D  # the 2D exchange on the calling thread
         prof = win.size > _W_SIZE  # the profile (PROFILE)
         d0 = _clock_ns(1) * 1e-9 if prof else 0.0
         sxi = np.int64(sx)
@@ -1319,8 +1327,11 @@ def _drive_kernel(three, order=1):
             # window's freezes)
             if _assign(ctl[:, _C_POPS], nth, slabs, lists, load, share):
                 win[8] += 1.0
-            # exchange: each slab refreshes its own ghosts and the rows next to them
+            # exchange: each slab refreshes its own ghosts and the rows next to them; in 2D
+            # on this thread alone, the iterations in turn (:data:`EXCHANGE_ALONE_2D`)
             w0 = _clock_ns(1) * 1e-9 if prof else 0.0
+            if alone:
+                set_num_threads(1)
             for t in prange(nth):  # thread t runs slabs[lists[t]:lists[t + 1]] (dyn: in turn)
                 if prof:
                     _prof_mark(win, nth, t)
@@ -1370,6 +1381,8 @@ def _drive_kernel(three, order=1):
                     i = _take(lists, nth, t, i, dyn)
                 if prof:
                     _prof_done(win, nth, t)
+            if alone:
+                set_num_threads(nth)
             if prof:
                 _prof_region(win, nth, 0, w0)
             win[9] += 1.0
@@ -1632,31 +1645,32 @@ def _descend_cuts(cum, cuts, gap, threads, shared):
     return cuts
 
 
+@njit(cache=True, error_model="numpy")
 def _shared_cost(cum, cuts, threads):
     """The windows' critical path (nodes) of the cuts ``cuts`` over the coarse histogram's
     time bins (``cum``: cumulated over the rows) with the slabs shared as :func:`_assign`
     shares them: longest first by the last bin's nodes when that predicts a smaller
-    largest share than the fixed interleave (slab ``k`` to thread ``k % threads``)."""
-    per = (cum[cuts[1:]] - cum[cuts[:-1]]).astype(np.float64)  # (slabs, bins)
-    k, nb = per.shape
-    pred = np.zeros_like(per)
-    pred[:, 1:] = per[:, :-1]
-    cols = np.arange(nb)
-
-    def fixed_max(a):
-        return np.max([a[t::threads].sum(axis=0) for t in range(threads)], axis=0)
-
-    order = np.argsort(-pred, axis=0, kind="stable")
-    load = np.zeros((threads, nb))
-    owner = np.empty((k, nb), dtype=np.int64)
-    for i in range(k):
-        slab = order[i]
-        best = np.argmin(load, axis=0)
-        owner[slab, cols] = best
-        load[best, cols] += pred[slab, cols]
-    greedy = load.max(axis=0) < fixed_max(pred)
-    shared = np.max([np.where(owner == t, per, 0.0).sum(axis=0) for t in range(threads)], axis=0)
-    return float(np.where(greedy, shared, fixed_max(per)).sum())
+    largest share than the fixed interleave (slab ``k`` to thread ``k % threads``).
+    Compiled (it was 0.8 ms of numpy per call, twice per march, on the calling thread alone
+    while the other waits)."""
+    k = cuts.size - 1
+    per = np.zeros(k)
+    pred = np.zeros(k)
+    slabs = np.empty(k, dtype=np.int64)
+    first = np.empty(threads + 1 + k, dtype=np.int64)
+    load = np.empty(threads)
+    share = np.empty(threads)
+    total = 0.0
+    for b in range(cum.shape[1]):
+        for j in range(k):
+            pred[j] = per[j]  # the last bin's nodes (0 before the first)
+            per[j] = cum[cuts[j + 1], b] - cum[cuts[j], b]
+        _assign(pred, threads, slabs, first, load, 1)
+        share[:] = 0.0
+        for j in range(k):  # the owners of the lists (greedy or the interleave)
+            share[first[threads + 1 + j]] += per[j]
+        total += share.max()
+    return total
 
 
 def _coarse_histogram(speed, start, shape3, h3):
@@ -1774,8 +1788,15 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         # places the cuts (the coarse march: serial), the padding faults in the rest
         early = _kernels._buffers(speed, shape3, (nx + 2 * G * K) * sx + 8 * K, lean,
                                   interleave)
+    out = side = None  # the result (not lean), and the thread beside the cuts
     if early is not None:
         with _PageToucher(early[0], early[1]):
+            bounds = slab_bounds(speed, start, shape3, h3, K, nth)
+    elif nth > 1:
+        # the cuts' coarse march runs on this thread alone: meanwhile a second one finds the
+        # top speed (the first window's width) and faults in the result's pages
+        out = np.empty(nx * ny * nz)
+        with _Beside(_kernels._readonly(speed), out) as side:
             bounds = slab_bounds(speed, start, shape3, h3, K, nth)
     else:
         bounds = slab_bounds(speed, start, shape3, h3, K, nth)
@@ -1835,20 +1856,21 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     # neighbours' exchange reads those); a count over the capacity: read the whole row
     # (so the first exchange, after the start)
     sent = np.empty((K, 2, G * sx), dtype=np.uint64)
-    ns = np.full((K, 2), G * sx + 1, dtype=np.uint64)
-    # queues: one radix queue and one repair heap per slab
+    ns = _lined(K, 2, np.uint64, G * sx + 1)
+    # queues: one radix queue and one repair heap per slab (each slab's small arrays on
+    # cache lines of its own: the two threads write them at every push and pop)
     nblk = max(POOL_MIN_BLOCKS, int(sizes.max()) // (16 * BLOCK))
     pool = np.empty((K, 2 * nblk * BLOCK), dtype=np.uint64)
     nxt = np.empty((K, nblk), dtype=np.uint32)
-    bk = np.empty((K, 2 * int(_NB)), dtype=np.uint32)
-    mw = np.empty((K, _NW), dtype=np.uint64)
-    st = np.zeros((K, _ST), dtype=np.uint64)
+    bk = _lined(K, 2 * int(_NB), np.uint32)
+    mw = _lined(K, _NW, np.uint64)
+    st = _lined(K, _ST, np.uint64)
     for k in range(K):
         _kernels.init_queue(nxt[k], bk[k], mw[k], st[k])
     rcap = max(HEAP_START, HEAP_RESERVE_2 if order == 2 else HEAP_RESERVE)
     rkey = np.empty((K, rcap), dtype=np.uint64)
     ritem = np.empty((K, rcap), dtype=np.uint64)
-    ctl = np.zeros((K, _C_SIZE))
+    ctl = _lined(K, _C_SIZE, np.float64)
     ctl[:, _C_RMIN] = np.inf
     ih = np.array([1.0 / (h * h) for h in h3])
     iso = bool(ih[0] == ih[1] and (not three or ih[1] == ih[2]))
@@ -1858,6 +1880,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     # (a pass over the speeds, on the threads, else)
     if qp > 0.0:
         vmax = 1.0 / np.sqrt(qp)
+    elif side is not None:
+        vmax = side.top
     else:
         with _threads(nth):
             vmax = _top_speed(nth, _kernels._readonly(speed))
@@ -1907,8 +1931,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
             seg = slice(int(off[k] + (G - 1) * sx), int(off[k] + sizes[k] - (G - 1) * sx))
             _kernels.unpad_grid(Tp[seg], b - a, ny, nz, Tp[a * plane:b * plane])
         T = Tp[:nx * ny * nz]
-    else:  # a new array: the slabs in parallel
-        T = np.empty(nx * ny * nz)
+    else:  # a new array (its pages faulted in beside the cuts, the rest here): in parallel
+        T = np.empty(nx * ny * nz) if out is None else out
         with _threads(nth):
             _unpad_slabs(nth, Tp, bounds, off, ny, nz, T, G)
     if win[6] < np.inf:  # stopped: what the serial march would not have frozen yet
@@ -2065,16 +2089,23 @@ def _pad_slabs(nth, speed, Tb, sb, boxes, bounds, off, ny, nz, G, Tp, Vp):
 @njit(cache=True, parallel=True, error_model="numpy")
 def _unpad_slabs(nth, Tp, bounds, off, ny, nz, T, G):
     """Every slab's times into its rows of ``T`` (a new array; the lean layout compacts in
-    place, slab after slab), thread ``t`` the slabs ``t, t + nth, ...``; each slab's grid
-    read from its ghost x-slab next to its own rows (``G`` ghost x-slabs a side)."""
+    place, slab after slab), thread ``t`` the ``t``-th share of the grid's rows, from
+    whichever slabs hold them (each slab's grid read from its ghost x-slab next to the
+    rows: ``G`` ghost x-slabs a side). By rows, not by slabs: the slabs' rows differ (the
+    cuts follow the wave), and slab by slab one thread took 1136 of 2048 rows on the
+    bench's FM²-shaped map while the other waited (the unpadding's wall 17 ms against its
+    6 ms on the calling thread)."""
     K = bounds.size - 1
+    nx = bounds[K]
     plane = ny * nz
     sx = (ny + 2) if nz == 1 else (ny + 2) * (nz + 2)
     for t in prange(nth):
-        for k in range(t, K, nth):
-            a, b = bounds[k], bounds[k + 1]
-            o = off[k] + (G - 1) * sx
-            unpad_grid(Tp[o:o + (b - a + 2) * sx], b - a, ny, nz, T[a * plane:b * plane])
+        lo, hi = t * nx // nth, (t + 1) * nx // nth
+        for k in range(K):
+            a, b = max(bounds[k], lo), min(bounds[k + 1], hi)
+            if b > a:  # grid rows [a, b) of slab k: its padded rows from a - bounds[k] + G
+                o = off[k] + (G - 1 + a - bounds[k]) * sx
+                unpad_grid(Tp[o:o + (b - a + 2) * sx], b - a, ny, nz, T[a * plane:b * plane])
 
 
 @njit(cache=True, _nrt=False)
@@ -2147,6 +2178,25 @@ def _or_bits_at(dst, src, pos, m):
             dst[j >> 3] |= np.uint8(1 << (j & 7))
 
 
+def _lined(K, n, dtype, fill=0):
+    """``K`` rows of at least ``n`` items of ``dtype`` filled with ``fill``, each row on cache
+    lines of its own (64-byte aligned, a multiple of 64 bytes long; a C-contiguous view).
+
+    Each slab's queue state (``st``, ``bk``, ``mw``) and control slots (``ctl``, ``ns``)
+    are written by the thread marching it at every push and pop; rows sharing a line with
+    the neighbouring slab's would bounce that line between the cores while both march.
+    """
+    item = np.dtype(dtype).itemsize
+    m = -(-n * item // _LINE) * _LINE // item
+    buf = np.full(K * m + _LINE // item, fill, dtype=dtype)
+    a = (-buf.ctypes.data % _LINE) // item
+    return buf[a:a + K * m].reshape(K, m)
+
+
+#: Bytes of a cache line (x86-64, ARMv8 cores but Apple's).
+_LINE = 64
+
+
 def _grow_pools(pool, nxt, st):
     """Double every slab's entry pool; the new blocks join each slab's free list."""
     K, old = nxt.shape
@@ -2209,3 +2259,62 @@ class _PageToucher:
 
 #: Bytes faulted in per call of :func:`_touch` by :class:`_PageToucher` (its stop check).
 TOUCH_CHUNK = 16 * 2**20
+
+
+@intrinsic
+def _load_acquire(typingctx, a, i):
+    """``a[i]`` (int64 array) read atomically, acquire ordering: a flag another thread
+    sets, read afresh on every call (a plain load in a loop may be hoisted out of it)."""
+    sig = types.int64(a, i)
+
+    def codegen(context, builder, signature, args):
+        aty = signature.args[0]
+        arr = context.make_array(aty)(context, builder, args[0])
+        ptr = cgutils.get_item_pointer(context, builder, aty, arr, [args[1]])
+        return builder.load_atomic(ptr, "acquire", 8)
+
+    return sig, codegen
+
+
+@njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _top_then_touch(speed, out, stop):
+    """The largest of ``speed`` (1.0 for none; the first window's width), then a write to
+    every 4 KiB page of ``out`` (its page faults), last page first, until ``stop[0]`` is
+    set: the work of :class:`_Beside`, without the GIL. Returns the top speed."""
+    top = 0.0
+    for c in range(speed.size):
+        top = max(top, speed[c])
+    step = 4096 // 8
+    for i in range(out.size - 1, -1, -step):  # from the end: the rows the other thread
+        if _load_acquire(stop, 0) != 0:  # unpads (:func:`_unpad_slabs`), which it also
+            break  # reaches last (it wakes)
+        out[i] = 0.0
+    return top if speed.size > 0 else 1.0
+
+
+class _Beside:
+    """Inside the block a second thread finds the top speed of ``speed`` (``top`` after the
+    block) and then faults in the pages of ``out`` (the result) until the block ends
+    (:func:`_top_then_touch`): the work :func:`march` would otherwise do on both threads
+    after the cuts (a pass over the speeds, ~2 ms of each thread's time on 2048^2; the
+    faults of a fresh 32 MB result, ~6 ms each in the unpadding) moved to the core that
+    waits while this thread places the cuts (:func:`slab_bounds`, serial). Pages not
+    reached fault in where :func:`_unpad_slabs` writes them."""
+
+    def __init__(self, speed, out):
+        self.speed, self.out = speed, out
+        self.stop = np.zeros(1, dtype=np.int64)
+        self.top = None
+        self.thread = threading.Thread(target=self._run, daemon=True)
+
+    def _run(self):
+        self.top = _top_then_touch(self.speed, self.out, self.stop)
+
+    def __enter__(self):
+        self.thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self.stop[0] = 1
+        self.thread.join()
+        return False
