@@ -85,7 +85,7 @@ import threading
 
 import numpy as np
 from llvmlite import ir
-from numba import njit, prange, set_num_threads, types
+from numba import njit, prange, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
@@ -683,6 +683,27 @@ def _fetch_add(typingctx, a, i):
         arr = context.make_array(aty)(context, builder, args[0])
         ptr = cgutils.get_item_pointer(context, builder, aty, arr, [args[1]])
         return builder.atomic_rmw("add", ptr, ir.Constant(ir.IntType(64), 1), "seq_cst")
+
+    return sig, codegen
+
+
+@intrinsic
+def _set_threads(typingctx, n):
+    """``numba.set_num_threads(n)`` for the parallel regions this thread starts, by the
+    threading layer's symbol as numba's own ``get_num_threads`` calls it (numba's jitted
+    ``set_num_threads`` holds a ctypes pointer, and a function holding one is not cached:
+    the drive would compile again in every process)."""
+    from numba.np.ufunc.parallel import _launch_threads
+
+    _launch_threads()
+    sig = types.void(n)
+
+    def codegen(context, builder, signature, args):
+        i32 = ir.IntType(32)
+        fnty = ir.FunctionType(ir.VoidType(), [i32])
+        fn = cgutils.get_or_insert_function(builder.module, fnty, "set_num_threads")
+        builder.call(fn, [builder.trunc(args[0], i32)])
+        return context.get_dummy_value()
 
     return sig, codegen
 
@@ -1331,7 +1352,7 @@ def _drive_kernel(three, order=1):
             # on this thread alone, the iterations in turn (:data:`EXCHANGE_ALONE_2D`)
             w0 = _clock_ns(1) * 1e-9 if prof else 0.0
             if alone:
-                set_num_threads(1)
+                _set_threads(1)
             for t in prange(nth):  # thread t runs slabs[lists[t]:lists[t + 1]] (dyn: in turn)
                 if prof:
                     _prof_mark(win, nth, t)
@@ -1382,7 +1403,7 @@ def _drive_kernel(three, order=1):
                 if prof:
                     _prof_done(win, nth, t)
             if alone:
-                set_num_threads(nth)
+                _set_threads(nth)
             if prof:
                 _prof_region(win, nth, 0, w0)
             win[9] += 1.0
