@@ -1666,32 +1666,31 @@ def _descend_cuts(cum, cuts, gap, threads, shared):
     return cuts
 
 
-@njit(cache=True, error_model="numpy")
 def _shared_cost(cum, cuts, threads):
     """The windows' critical path (nodes) of the cuts ``cuts`` over the coarse histogram's
     time bins (``cum``: cumulated over the rows) with the slabs shared as :func:`_assign`
     shares them: longest first by the last bin's nodes when that predicts a smaller
-    largest share than the fixed interleave (slab ``k`` to thread ``k % threads``).
-    Compiled (it was 0.8 ms of numpy per call, twice per march, on the calling thread alone
-    while the other waits)."""
-    k = cuts.size - 1
-    per = np.zeros(k)
-    pred = np.zeros(k)
-    slabs = np.empty(k, dtype=np.int64)
-    first = np.empty(threads + 1 + k, dtype=np.int64)
-    load = np.empty(threads)
-    share = np.empty(threads)
-    total = 0.0
-    for b in range(cum.shape[1]):
-        for j in range(k):
-            pred[j] = per[j]  # the last bin's nodes (0 before the first)
-            per[j] = cum[cuts[j + 1], b] - cum[cuts[j], b]
-        _assign(pred, threads, slabs, first, load, 1)
-        share[:] = 0.0
-        for j in range(k):  # the owners of the lists (greedy or the interleave)
-            share[first[threads + 1 + j]] += per[j]
-        total += share.max()
-    return total
+    largest share than the fixed interleave (slab ``k`` to thread ``k % threads``)."""
+    per = (cum[cuts[1:]] - cum[cuts[:-1]]).astype(np.float64)  # (slabs, bins)
+    k, nb = per.shape
+    pred = np.zeros_like(per)
+    pred[:, 1:] = per[:, :-1]
+    cols = np.arange(nb)
+
+    def fixed_max(a):
+        return np.max([a[t::threads].sum(axis=0) for t in range(threads)], axis=0)
+
+    order = np.argsort(-pred, axis=0, kind="stable")
+    load = np.zeros((threads, nb))
+    owner = np.empty((k, nb), dtype=np.int64)
+    for i in range(k):
+        slab = order[i]
+        best = np.argmin(load, axis=0)
+        owner[slab, cols] = best
+        load[best, cols] += pred[slab, cols]
+    greedy = load.max(axis=0) < fixed_max(pred)
+    shared = np.max([np.where(owner == t, per, 0.0).sum(axis=0) for t in range(threads)], axis=0)
+    return float(np.where(greedy, shared, fixed_max(per)).sum())
 
 
 def _coarse_histogram(speed, start, shape3, h3):
@@ -1809,15 +1808,16 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         # places the cuts (the coarse march: serial), the padding faults in the rest
         early = _kernels._buffers(speed, shape3, (nx + 2 * G * K) * sx + 8 * K, lean,
                                   interleave)
-    out = side = None  # the result (not lean), and the thread beside the cuts
+    out = None  # the result (not lean)
     if early is not None:
         with _PageToucher(early[0], early[1]):
             bounds = slab_bounds(speed, start, shape3, h3, K, nth)
     elif nth > 1:
-        # the cuts' coarse march runs on this thread alone: meanwhile a second one finds the
-        # top speed (the first window's width) and faults in the result's pages
+        # the cuts' coarse march runs on this thread alone: meanwhile a second one faults in
+        # the result's pages, the rows the other thread unpads first (_unpad_slabs)
         out = np.empty(nx * ny * nz)
-        with _Beside(_kernels._readonly(speed), out) as side:
+        half = out.size // 2
+        with _PageToucher(out[half:], out[:half]):
             bounds = slab_bounds(speed, start, shape3, h3, K, nth)
     else:
         bounds = slab_bounds(speed, start, shape3, h3, K, nth)
@@ -1901,8 +1901,6 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     # (a pass over the speeds, on the threads, else)
     if qp > 0.0:
         vmax = 1.0 / np.sqrt(qp)
-    elif side is not None:
-        vmax = side.top
     else:
         with _threads(nth):
             vmax = _top_speed(nth, _kernels._readonly(speed))
@@ -2281,61 +2279,3 @@ class _PageToucher:
 #: Bytes faulted in per call of :func:`_touch` by :class:`_PageToucher` (its stop check).
 TOUCH_CHUNK = 16 * 2**20
 
-
-@intrinsic
-def _load_acquire(typingctx, a, i):
-    """``a[i]`` (int64 array) read atomically, acquire ordering: a flag another thread
-    sets, read afresh on every call (a plain load in a loop may be hoisted out of it)."""
-    sig = types.int64(a, i)
-
-    def codegen(context, builder, signature, args):
-        aty = signature.args[0]
-        arr = context.make_array(aty)(context, builder, args[0])
-        ptr = cgutils.get_item_pointer(context, builder, aty, arr, [args[1]])
-        return builder.load_atomic(ptr, "acquire", 8)
-
-    return sig, codegen
-
-
-@njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
-def _top_then_touch(speed, out, stop):
-    """The largest of ``speed`` (1.0 for none; the first window's width), then a write to
-    every 4 KiB page of ``out`` (its page faults), last page first, until ``stop[0]`` is
-    set: the work of :class:`_Beside`, without the GIL. Returns the top speed."""
-    top = 0.0
-    for c in range(speed.size):
-        top = max(top, speed[c])
-    step = 4096 // 8
-    for i in range(out.size - 1, -1, -step):  # from the end: the rows the other thread
-        if _load_acquire(stop, 0) != 0:  # unpads (:func:`_unpad_slabs`), which it also
-            break  # reaches last (it wakes)
-        out[i] = 0.0
-    return top if speed.size > 0 else 1.0
-
-
-class _Beside:
-    """Inside the block a second thread finds the top speed of ``speed`` (``top`` after the
-    block) and then faults in the pages of ``out`` (the result) until the block ends
-    (:func:`_top_then_touch`): the work :func:`march` would otherwise do on both threads
-    after the cuts (a pass over the speeds, ~2 ms of each thread's time on 2048^2; the
-    faults of a fresh 32 MB result, ~6 ms each in the unpadding) moved to the core that
-    waits while this thread places the cuts (:func:`slab_bounds`, serial). Pages not
-    reached fault in where :func:`_unpad_slabs` writes them."""
-
-    def __init__(self, speed, out):
-        self.speed, self.out = speed, out
-        self.stop = np.zeros(1, dtype=np.int64)
-        self.top = None
-        self.thread = threading.Thread(target=self._run, daemon=True)
-
-    def _run(self):
-        self.top = _top_then_touch(self.speed, self.out, self.stop)
-
-    def __enter__(self):
-        self.thread.start()
-        return self
-
-    def __exit__(self, *exc):
-        self.stop[0] = 1
-        self.thread.join()
-        return False
