@@ -448,29 +448,11 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
         from fm2uav import fast_marching
         from fm2uav.eikonal import _parallel
         from benchmarks import fields
+        from benchmarks._march_spy import watch_parallel_march
 
-        stats = {{}}
-        _march = _parallel.march
-
-        def spy(*args, **kwargs):  # the windows' balance of the last parallel march, the
-            stats.update(drive_main=0.0, drive_cpu=0.0)  # calling thread's CPU outside the
-            t = time.thread_time()  # windows (the set-up: serial) and the windows' CPU
-            T, s = _march(*args, **kwargs)
-            stats.update(s, setup=time.thread_time() - t - stats["drive_main"])
-            return T, s
-
-        def spy_drive(drive):
-            def run(*args, **kwargs):
-                t, c = time.thread_time(), time.process_time()
-                out = drive(*args, **kwargs)
-                stats["drive_main"] += time.thread_time() - t
-                stats["drive_cpu"] += time.process_time() - c
-                return out
-            return run
-
-        _parallel.march = spy
-        for key in list(_parallel._DRIVES):
-            _parallel._DRIVES[key] = spy_drive(_parallel._DRIVES[key])
+        # the windows' balance of the last parallel march, the calling thread's CPU outside
+        # the windows (the set-up: serial) and the windows' CPU
+        stats = watch_parallel_march()
 
         def task_cpu():
             out = {{}}

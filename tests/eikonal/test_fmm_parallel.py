@@ -927,3 +927,16 @@ def test_slabs_taken_in_turn_one_thread_after_the_other():
             t = min(range(nth), key=lambda t: (free[t], t))
             free[t] += work[k]
         assert list(load) == free
+
+
+def test_each_slabs_small_arrays_on_cache_lines_of_their_own():
+    """The slabs' queue state and control rows (:func:`_parallel._lined`): every row starts
+    on a 64-byte boundary, spans whole lines, holds at least the items asked, filled, and
+    the array is C-contiguous (the kernels' types unchanged)."""
+    for K, n, dtype, fill in [(8, 9, np.uint64, 0), (5, 516, np.uint32, 3), (3, 8, np.float64, 0),
+                              (6, 2, np.uint64, 77), (1, 5, np.uint64, 0)]:
+        a = _parallel._lined(K, n, dtype, fill)
+        assert a.shape[0] == K and a.shape[1] >= n and a.flags.c_contiguous and a.dtype == dtype
+        assert a.ctypes.data % 64 == 0 and a.strides[0] % 64 == 0
+        assert a.strides[0] - n * a.itemsize < 64
+        assert np.all(a == fill)

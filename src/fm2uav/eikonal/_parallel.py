@@ -188,6 +188,13 @@ SHARE_SLABS = True
 #: 1.87-1.94x, smooth 1.80x / 1.87x, FM²-shaped 1.51x / 1.57-1.59x. On: 2D order 1, 4 slabs
 #: per thread.
 DYNAMIC_2D = True
+#: 2D: the exchange before each window runs on the calling thread alone (the parallel
+#: region's iterations in turn), not on every thread: its work is a row per slab side (the
+#: busiest thread's share summed over the 108 exchanges of the bench's FM²-shaped 2048^2
+#: map: ~1 ms) while waking the sleeping threads for it and waiting for the last cost
+#: ~0.1 ms of wall per region on the near-idle machine (the regions' wall summed: 12-18
+#: ms; docs/performance.md). 3D exchanges planes: on the threads. A compile-time constant.
+EXCHANGE_ALONE_2D = True
 #: 2D: a far neighbour of the node a window freezes gets the one-axis update along their
 #: axis, as in the serial march (valid in a slab: see the window's docstring); False: the
 #: full update (the same times bit for bit; the tests run both).
@@ -676,6 +683,27 @@ def _fetch_add(typingctx, a, i):
         arr = context.make_array(aty)(context, builder, args[0])
         ptr = cgutils.get_item_pointer(context, builder, aty, arr, [args[1]])
         return builder.atomic_rmw("add", ptr, ir.Constant(ir.IntType(64), 1), "seq_cst")
+
+    return sig, codegen
+
+
+@intrinsic
+def _set_threads(typingctx, n):
+    """``numba.set_num_threads(n)`` for the parallel regions this thread starts, by the
+    threading layer's symbol as numba's own ``get_num_threads`` calls it (numba's jitted
+    ``set_num_threads`` holds a ctypes pointer, and a function holding one is not cached:
+    the drive would compile again in every process)."""
+    from numba.np.ufunc.parallel import _launch_threads
+
+    _launch_threads()
+    sig = types.void(n)
+
+    def codegen(context, builder, signature, args):
+        i32 = ir.IntType(32)
+        fnty = ir.FunctionType(ir.VoidType(), [i32])
+        fn = cgutils.get_or_insert_function(builder.module, fnty, "set_num_threads")
+        builder.call(fn, [builder.trunc(args[0], i32)])
+        return context.get_dummy_value()
 
     return sig, codegen
 
@@ -1275,6 +1303,7 @@ def _drive_kernel(three, order=1):
         """
         K = off.size
         dyn = share == 2  # the slabs taken in turn by the threads (DYNAMIC_2D)
+        alone = not three and EXCHANGE_ALONE_2D  # the 2D exchange on the calling thread
         prof = win.size > _W_SIZE  # the profile (PROFILE)
         d0 = _clock_ns(1) * 1e-9 if prof else 0.0
         sxi = np.int64(sx)
@@ -1319,8 +1348,11 @@ def _drive_kernel(three, order=1):
             # window's freezes)
             if _assign(ctl[:, _C_POPS], nth, slabs, lists, load, share):
                 win[8] += 1.0
-            # exchange: each slab refreshes its own ghosts and the rows next to them
+            # exchange: each slab refreshes its own ghosts and the rows next to them; in 2D
+            # on this thread alone, the iterations in turn (:data:`EXCHANGE_ALONE_2D`)
             w0 = _clock_ns(1) * 1e-9 if prof else 0.0
+            if alone:
+                _set_threads(1)
             for t in prange(nth):  # thread t runs slabs[lists[t]:lists[t + 1]] (dyn: in turn)
                 if prof:
                     _prof_mark(win, nth, t)
@@ -1370,6 +1402,8 @@ def _drive_kernel(three, order=1):
                     i = _take(lists, nth, t, i, dyn)
                 if prof:
                     _prof_done(win, nth, t)
+            if alone:
+                _set_threads(nth)
             if prof:
                 _prof_region(win, nth, 0, w0)
             win[9] += 1.0
@@ -1774,8 +1808,16 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         # places the cuts (the coarse march: serial), the padding faults in the rest
         early = _kernels._buffers(speed, shape3, (nx + 2 * G * K) * sx + 8 * K, lean,
                                   interleave)
+    out = None  # the result (not lean)
     if early is not None:
         with _PageToucher(early[0], early[1]):
+            bounds = slab_bounds(speed, start, shape3, h3, K, nth)
+    elif nth > 1:
+        # the cuts' coarse march runs on this thread alone: meanwhile a second one faults in
+        # the result's pages, the rows the other thread unpads first (_unpad_slabs)
+        out = np.empty(nx * ny * nz)
+        half = out.size // 2
+        with _PageToucher(out[half:], out[:half]):
             bounds = slab_bounds(speed, start, shape3, h3, K, nth)
     else:
         bounds = slab_bounds(speed, start, shape3, h3, K, nth)
@@ -1835,20 +1877,21 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     # neighbours' exchange reads those); a count over the capacity: read the whole row
     # (so the first exchange, after the start)
     sent = np.empty((K, 2, G * sx), dtype=np.uint64)
-    ns = np.full((K, 2), G * sx + 1, dtype=np.uint64)
-    # queues: one radix queue and one repair heap per slab
+    ns = _lined(K, 2, np.uint64, G * sx + 1)
+    # queues: one radix queue and one repair heap per slab (each slab's small arrays on
+    # cache lines of its own: the two threads write them at every push and pop)
     nblk = max(POOL_MIN_BLOCKS, int(sizes.max()) // (16 * BLOCK))
     pool = np.empty((K, 2 * nblk * BLOCK), dtype=np.uint64)
     nxt = np.empty((K, nblk), dtype=np.uint32)
-    bk = np.empty((K, 2 * int(_NB)), dtype=np.uint32)
-    mw = np.empty((K, _NW), dtype=np.uint64)
-    st = np.zeros((K, _ST), dtype=np.uint64)
+    bk = _lined(K, 2 * int(_NB), np.uint32)
+    mw = _lined(K, _NW, np.uint64)
+    st = _lined(K, _ST, np.uint64)
     for k in range(K):
         _kernels.init_queue(nxt[k], bk[k], mw[k], st[k])
     rcap = max(HEAP_START, HEAP_RESERVE_2 if order == 2 else HEAP_RESERVE)
     rkey = np.empty((K, rcap), dtype=np.uint64)
     ritem = np.empty((K, rcap), dtype=np.uint64)
-    ctl = np.zeros((K, _C_SIZE))
+    ctl = _lined(K, _C_SIZE, np.float64)
     ctl[:, _C_RMIN] = np.inf
     ih = np.array([1.0 / (h * h) for h in h3])
     iso = bool(ih[0] == ih[1] and (not three or ih[1] == ih[2]))
@@ -1907,8 +1950,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
             seg = slice(int(off[k] + (G - 1) * sx), int(off[k] + sizes[k] - (G - 1) * sx))
             _kernels.unpad_grid(Tp[seg], b - a, ny, nz, Tp[a * plane:b * plane])
         T = Tp[:nx * ny * nz]
-    else:  # a new array: the slabs in parallel
-        T = np.empty(nx * ny * nz)
+    else:  # a new array (its pages faulted in beside the cuts, the rest here): in parallel
+        T = np.empty(nx * ny * nz) if out is None else out
         with _threads(nth):
             _unpad_slabs(nth, Tp, bounds, off, ny, nz, T, G)
     if win[6] < np.inf:  # stopped: what the serial march would not have frozen yet
@@ -2065,16 +2108,23 @@ def _pad_slabs(nth, speed, Tb, sb, boxes, bounds, off, ny, nz, G, Tp, Vp):
 @njit(cache=True, parallel=True, error_model="numpy")
 def _unpad_slabs(nth, Tp, bounds, off, ny, nz, T, G):
     """Every slab's times into its rows of ``T`` (a new array; the lean layout compacts in
-    place, slab after slab), thread ``t`` the slabs ``t, t + nth, ...``; each slab's grid
-    read from its ghost x-slab next to its own rows (``G`` ghost x-slabs a side)."""
+    place, slab after slab), thread ``t`` the ``t``-th share of the grid's rows, from
+    whichever slabs hold them (each slab's grid read from its ghost x-slab next to the
+    rows: ``G`` ghost x-slabs a side). By rows, not by slabs: the slabs' rows differ (the
+    cuts follow the wave), and slab by slab one thread took 1136 of 2048 rows on the
+    bench's FM²-shaped map while the other waited (the unpadding's wall 17 ms against its
+    6 ms on the calling thread)."""
     K = bounds.size - 1
+    nx = bounds[K]
     plane = ny * nz
     sx = (ny + 2) if nz == 1 else (ny + 2) * (nz + 2)
     for t in prange(nth):
-        for k in range(t, K, nth):
-            a, b = bounds[k], bounds[k + 1]
-            o = off[k] + (G - 1) * sx
-            unpad_grid(Tp[o:o + (b - a + 2) * sx], b - a, ny, nz, T[a * plane:b * plane])
+        lo, hi = t * nx // nth, (t + 1) * nx // nth
+        for k in range(K):
+            a, b = max(bounds[k], lo), min(bounds[k + 1], hi)
+            if b > a:  # grid rows [a, b) of slab k: its padded rows from a - bounds[k] + G
+                o = off[k] + (G - 1 + a - bounds[k]) * sx
+                unpad_grid(Tp[o:o + (b - a + 2) * sx], b - a, ny, nz, T[a * plane:b * plane])
 
 
 @njit(cache=True, _nrt=False)
@@ -2147,6 +2197,25 @@ def _or_bits_at(dst, src, pos, m):
             dst[j >> 3] |= np.uint8(1 << (j & 7))
 
 
+def _lined(K, n, dtype, fill=0):
+    """``K`` rows of at least ``n`` items of ``dtype`` filled with ``fill``, each row on cache
+    lines of its own (64-byte aligned, a multiple of 64 bytes long; a C-contiguous view).
+
+    Each slab's queue state (``st``, ``bk``, ``mw``) and control slots (``ctl``, ``ns``)
+    are written by the thread marching it at every push and pop; rows sharing a line with
+    the neighbouring slab's would bounce that line between the cores while both march.
+    """
+    item = np.dtype(dtype).itemsize
+    m = -(-n * item // _LINE) * _LINE // item
+    buf = np.full(K * m + _LINE // item, fill, dtype=dtype)
+    a = (-buf.ctypes.data % _LINE) // item
+    return buf[a:a + K * m].reshape(K, m)
+
+
+#: Bytes of a cache line (x86-64, ARMv8 cores but Apple's).
+_LINE = 64
+
+
 def _grow_pools(pool, nxt, st):
     """Double every slab's entry pool; the new blocks join each slab's free list."""
     K, old = nxt.shape
@@ -2209,3 +2278,4 @@ class _PageToucher:
 
 #: Bytes faulted in per call of :func:`_touch` by :class:`_PageToucher` (its stop check).
 TOUCH_CHUNK = 16 * 2**20
+
