@@ -37,6 +37,7 @@ from typing import Any
 
 __all__ = [
     "FIRST_PLAN_KERNELS",
+    "ROUTES_KERNELS",
     "COLD_FIRST_PLAN_CPU_S",
     "NOTICE",
 
@@ -61,6 +62,13 @@ FIRST_PLAN_KERNELS: tuple[tuple[str, str], ...] = (
     ("eikonal/_kernels.py", "march3d_o2"),
     ("planning/_geodesic_kernels.py", "descend_kernel"),
     ("world/_clearance_kernels.py", "surface_distance"),
+)
+
+#: Kernels a first ``fm2uav routes`` compiles: a first plan's and the batch descent's
+#: (``descend_sweep``) and clearance (``min_box_clearances``) of ``plan_many``.
+ROUTES_KERNELS: tuple[tuple[str, str], ...] = FIRST_PLAN_KERNELS + (
+    ("planning/_geodesic_kernels.py", "descend_sweep"),
+    ("world/_clearance_kernels.py", "min_box_clearances"),
 )
 
 #: What the command line says before the first compilation (``seconds``: :func:`cold_estimate_s`).

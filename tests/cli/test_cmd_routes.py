@@ -7,6 +7,7 @@ import json
 
 import numpy as np
 import pytest
+from pyproj import Geod
 from typer.testing import CliRunner
 
 from fm2uav import Shaping, plan, scenarios
@@ -14,6 +15,7 @@ from fm2uav.cli import app
 from fm2uav.world.geo import to_lonlat
 
 runner = CliRunner()
+GEOD = Geod(ellps="WGS84")
 
 
 @pytest.fixture(scope="module")
@@ -59,11 +61,50 @@ def test_routes_equal_single_plans_and_failures_are_listed(tmp_path, city_starts
         if r["status"] != "ok":
             continue
         single = plan(sc.world, pts[k], goal_m, shaping=Shaping(exponent=0.5))
-        assert float(r["length_m"]) == round(single.length, 3)
-        assert float(r["time_s"]) == round(single.length / 10.0, 3)
+        assert float(r["planned_length_m"]) == round(single.length, 3)
         line = np.asarray(feats[r["id"]]["geometry"]["coordinates"])
+        assert float(r["length_m"]) == pytest.approx(GEOD.line_length(*line.T), abs=6e-4)
+        assert float(r["time_s"]) == pytest.approx(float(r["length_m"]) / 10.0, abs=6e-4)
         assert len(line) == len(single.path)  # --thin 0: every point
         np.testing.assert_allclose(line, np.round(to_lonlat(sc.world, single.path)[:, :2], 7))
+
+
+def test_every_figure_equals_an_independent_check_of_the_written_files(tmp_path, city_starts):
+    """Default thinning (1 m): each route's length_m / time_s are the written line's (WGS84
+    geodesic of its positions, as pyproj measures the file), the summary's lengths those of
+    routes.csv, planned_length_m the planner's; a start off the map is refused in lon/lat."""
+    sc, pts, f, goal = city_starts
+    out = tmp_path / "r"
+    res = runner.invoke(app, ["routes", "--scenario", "city2d", f"--goal={goal}", "--starts",
+                              str(f), "--exponent", "0.5", "--speed", "7", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    rows = {r["id"]: r for r in csv.DictReader(open(out / "routes.csv"))}
+    feats = json.loads((out / "routes.geojson").read_text())["features"]
+    assert len(feats) >= 10
+    shorter = []
+    for ft in feats:
+        line = np.asarray(ft["geometry"]["coordinates"])
+        measured = GEOD.line_length(*line.T)
+        p, row = ft["properties"], rows[ft["properties"]["id"]]
+        assert p["length_m"] == float(row["length_m"]) == pytest.approx(measured, abs=6e-4)
+        assert p["time_s"] == float(row["time_s"]) == pytest.approx(measured / 7.0, abs=6e-4)
+        assert p["points"] == len(line)
+        assert p["planned_length_m"] == float(row["planned_length_m"])
+        shorter.append(measured / p["planned_length_m"])
+    # the thinned line is shorter than the planner's path, never longer (same endpoints)
+    assert 0.98 < min(shorter) and max(shorter) <= 1.0 + 1e-6 and min(shorter) < 0.9995
+    s = json.loads((out / "summary.json").read_text())
+    lengths = sorted(float(r["length_m"]) for r in rows.values() if r["status"] == "ok")
+    assert s["length_m"]["min"] == lengths[0] and s["length_m"]["max"] == lengths[-1]
+    assert s["length_m"]["median"] == pytest.approx(float(np.median(lengths)), abs=6e-4)
+    planned = sorted(float(r["planned_length_m"]) for r in rows.values() if r["status"] == "ok")
+    assert s["planned_length_m"]["min"] == planned[0]
+    assert f"{lengths[0]:.0f} / " in res.output  # the printed row: the written lengths
+    outside = rows["house-14"]
+    assert outside["reason"] == "outside"
+    assert f"lon {outside['lon']}, lat {outside['lat']}" in outside["message"]
+    assert "lies outside the map (lon -3." in outside["message"]
+    assert "m lies outside the map, whose bounds are" in outside["message"]  # then in metres
 
 
 def test_exit_codes_and_one_line_errors(tmp_path, city_starts):

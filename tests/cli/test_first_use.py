@@ -81,3 +81,43 @@ def test_a_mission_file_error_on_a_cold_cache_prints_no_compile_notice(tmp_path)
                           "print(_jit.likely_cold())"], env=env, capture_output=True,
                          text=True, timeout=120)
     assert res.stdout.split() == ["True"], res.stderr
+
+
+def test_routes_checks_and_warms_the_batch_descent_too(monkeypatch, tmp_path):
+    """``fm2uav routes`` on a cache where only plan_many's kernels are missing: cold (the
+    notice), and the child compiles the march's group and ``many`` (descend_sweep,
+    min_box_clearances); a plain plan's check stays warm there."""
+    from fm2uav.planning import warmup
+
+    missing = {("planning/_geodesic_kernels.py", "descend_sweep")}
+    monkeypatch.setattr(_jit, "_cached", lambda rel, func, version: (rel, func) not in missing)
+    monkeypatch.setattr(_jit, "_fired", False)
+    assert not _jit.likely_cold() and _jit.likely_cold(_jit.ROUTES_KERNELS)
+    assert set(_jit.ROUTES_KERNELS) > set(_jit.FIRST_PLAN_KERNELS)
+    for rel, func in set(_jit.ROUTES_KERNELS) - set(_jit.FIRST_PLAN_KERNELS):
+        assert f"def {func}(" in (Path(_jit.__file__).parent / rel).read_text()  # real names
+    spawned = []
+
+    class Done:
+        def wait(self, timeout=None):
+            return 0
+
+        def poll(self):
+            return 0
+
+    monkeypatch.setattr(_first_use, "_spawn", lambda groups: spawned.append(groups) or Done())
+    monkeypatch.setattr(warmup, "warm", lambda groups: {})
+    from typer.testing import CliRunner
+
+    from fm2uav.cli import app
+
+    base = ["routes", "--scenario", "city2d", "--goal=-3.7630,40.3334", "--quiet"]
+    res = CliRunner().invoke(app, [*base, "--starts", str(tmp_path / "missing.csv")])
+    assert res.exit_code == 2 and "missing.csv: no such file" in res.output
+    assert spawned == []  # a wrong path answers before the cache check
+    starts = tmp_path / "s.csv"
+    starts.write_text("lon,lat\n-3.7620,40.3340\n")
+    res = CliRunner().invoke(app, [*base, "--starts", str(starts), "--out", str(tmp_path / "o")])
+    assert res.exit_code in (0, 1), res.output
+    assert spawned == [["fmm2d_o2", "many"]]
+    assert "many" in GROUPS

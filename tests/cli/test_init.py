@@ -184,6 +184,7 @@ VALUE_ERRORS = [
     (["routes", "--goal", "1,2,30", "--starts", "s.csv", "--threads", "0"], ["--threads"]),
     (["routes", "--goal", "1,2,30", "--starts", "s.csv", "--speed", "0"], ["--speed"]),
     (["routes", "--goal", "1", "--starts", "s.csv"], ["--goal", "LON,LAT"]),
+    (["routes", "--goal", "1,2,30", "--starts", "s.csv"], ["--starts s.csv", "no such file"]),
     (["routes", "--goal", "1,2,30", "--starts", "s.csv", "--exponent", "0"], ["--exponent"]),
     (["check", "missing.csv"], ["path file", "missing.csv", "not found"]),
     (["export", "missing.csv", "--scenario", "open-field"], ["path file", "not found"]),

@@ -42,7 +42,8 @@ def _spawn(groups: list[str]) -> subprocess.Popen | None:
 
 
 def announce_compile(*, quiet: bool = False, child_group: str | None = None,
-                     preload: Sequence[str] = ()) -> bool:
+                     preload: Sequence[str] = (), also: Sequence[str] = (),
+                     kernels: Sequence[tuple[str, str]] | None = None) -> bool:
     """On a cold cache: the compile notice, and the two-process warm-up with ``child_group``.
 
     Parameters
@@ -55,6 +56,11 @@ def announce_compile(*, quiet: bool = False, child_group: str | None = None,
         the notice.
     preload : sequence of str
         Modules the command imports next, imported while the child finishes.
+    also : sequence of str
+        More warm-up groups the child compiles after ``child_group`` (e.g. ``many``).
+    kernels : sequence of (str, str), optional
+        The kernels whose cache decides "cold" (default
+        :data:`fm2uav._jit.FIRST_PLAN_KERNELS`; ``fm2uav routes``: ``ROUTES_KERNELS``).
 
     Returns
     -------
@@ -63,7 +69,7 @@ def announce_compile(*, quiet: bool = False, child_group: str | None = None,
     """
     from .. import _jit
 
-    if not _jit.likely_cold():
+    if not _jit.likely_cold(_jit.FIRST_PLAN_KERNELS if kernels is None else kernels):
         return False
     if not quiet and not _jit.announced():  # (fm2uav.__main__ may have said it already)
         from ._common import err_console
@@ -71,7 +77,7 @@ def announce_compile(*, quiet: bool = False, child_group: str | None = None,
         err_console.print(_jit.NOTICE.format(seconds=_jit.cold_estimate_s()), style="yellow",
                           highlight=False)
     _jit.mark_announced()  # the numba-event fallback stays silent
-    child = _spawn([child_group]) if child_group else None
+    child = _spawn([child_group, *also]) if child_group else None
     if child is None:
         return True
     try:

@@ -83,9 +83,14 @@ def routes_cmd(
     shaping, level, options = planner.objects(storage="full")
     check_point_texts({"goal": goal}, scenario=scenario, lonlat=True, cells=False,
                       agl=planner.agl)
+    from ..io.starts_path import check_starts_path
+
+    check_starts_path(starts)  # a wrong path answers before the world and the compile
+    from .._jit import ROUTES_KERNELS
+
     announce_compile(quiet=output.quiet,
                      child_group=fmm_group(order=planner.order, ndim=scenario_ndim(scenario)),
-                     preload=("fm2uav.planning.many",))
+                     also=("many",), kernels=ROUTES_KERNELS, preload=("fm2uav.planning.many",))
     from .. import progress
     from ..io.starts import read_starts
     from ..pipeline.routes import ROUTES_FILES, RouteSettings, routes_rows, run_routes

@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError, WorldError
+from .starts_path import check_starts_path
 
 __all__ = ["CSV_SUFFIXES", "Starts", "read_starts"]
 
@@ -182,10 +183,7 @@ def read_starts(path: str | Path, world: Any, *, agl: float | None = None, crs: 
     """
     from ..world.geo import from_lonlat
 
-    path = Path(path)
-    if not path.is_file():
-        raise InputError(f"--starts {path}: no such file; give a CSV (lon,lat[,id][,agl] with "
-                         "a header) or a GeoJSON/GeoPackage/Shapefile/KML of points")
+    path = check_starts_path(path)
     problems: dict[int, str] = {}
     if path.suffix.lower() in CSV_SUFFIXES:
         ids, lons, lats, agls, bad, where = _read_csv(path)

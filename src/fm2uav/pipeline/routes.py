@@ -6,17 +6,29 @@
 * ``routes.geojson``: a FeatureCollection of one LineString per route, ``[lon, lat]``
   (``[lon, lat, alt]`` on a 3D map, alt in metres above the map's vertical datum),
   thinned by Douglas–Peucker to ``thin`` metres, with the properties ``id``,
-  ``length_m``, ``time_s``, ``lowest_agl_m``, ``clearance_m``, ``points``;
+  ``length_m``, ``planned_length_m``, ``time_s``, ``lowest_agl_m``,
+  ``planned_lowest_agl_m``, ``clearance_m``, ``points`` (the written line's);
 * ``routes.csv``: one row per start, in the file's order — ``id``, ``status`` (``ok`` or
   ``failed``), ``reason`` (:data:`fm2uav.planning.many.FAILURE_REASONS`), ``lon``,
-  ``lat``, ``length_m``, ``time_s``, ``lowest_agl_m``, ``clearance_m``, ``message``;
+  ``lat``, ``length_m``, ``planned_length_m``, ``time_s``, ``lowest_agl_m``,
+  ``planned_lowest_agl_m``, ``clearance_m``, ``message``;
 * ``summary.json``: the goal, the counts (per failure reason), the failed starts with
-  their reason and message, lengths, the settings and the timings.
+  their reason and message, lengths (min/median/max of ``length_m`` and of
+  ``planned_length_m``), the settings and the timings.
 
-``length_m`` is the route's 3D length, ``time_s`` = ``length_m / speed`` (a constant
-ground speed, no wind), ``lowest_agl_m`` the lowest height above the ground along the
-route as ``fm2uav plan`` reports it (``height_above_ground.path.min_m``; empty on a 2D
-map), ``clearance_m`` the plan's clearance to the terrain/building surface.
+The figures of a route are those of the line as written (what a vehicle given the file
+flies, and what an independent check of the file measures): ``length_m`` the written
+line's length — its rounded positions, segment by segment the WGS84 geodesic combined
+with the altitude change (:func:`fm2uav.world.line_length.lonlat_line_lengths`);
+``time_s`` = ``length_m / speed`` (a constant ground speed, no wind); ``lowest_agl_m``
+the lowest height above the continuous ground along its straight legs (3D maps; empty
+on a 2D map). The planner's own figures, before thinning and in the map's metres, beside
+them: ``planned_length_m`` (``Plan.length``, what ``fm2uav plan`` reports; the thinning
+shortens a line by ~0.3 % at 1 m, and a projected map's metres differ from the
+ellipsoid's by its scale factor), ``planned_lowest_agl_m`` (``fm2uav plan``'s
+``height_above_ground.path.min_m``); ``clearance_m`` the plan's clearance to the
+terrain/building surface. A start outside the map is refused with its lon/lat and the
+map's lon/lat extent, then its position in map metres.
 """
 
 from __future__ import annotations
@@ -37,8 +49,8 @@ __all__ = ["ROUTES_FILES", "RoutesRun", "RouteSettings", "run_routes", "routes_r
 #: The files of a ``fm2uav routes`` output set.
 ROUTES_FILES = ("routes.geojson", "routes.csv", "summary.json")
 
-_CSV_COLUMNS = ("id", "status", "reason", "lon", "lat", "length_m", "time_s", "lowest_agl_m",
-                "clearance_m", "message")
+_CSV_COLUMNS = ("id", "status", "reason", "lon", "lat", "length_m", "planned_length_m", "time_s",
+                "lowest_agl_m", "planned_lowest_agl_m", "clearance_m", "message")
 
 
 @dataclass(frozen=True)
@@ -72,6 +84,24 @@ class RoutesRun:
     summary: dict[str, Any]
     #: The starts [m], one row per start in the file's order (NaN where a row had none).
     starts: Any = None
+
+
+def _lowest_line_agl(world: Any, lines: list[np.ndarray]) -> list[float]:
+    """The lowest height above the ground [m] along each written line's straight legs.
+
+    Each line (its points [m], as thinned) sampled as :func:`fm2uav.analysis.safety.
+    leg_figures` samples waypoint legs (every quarter of ``sampling_step``, horizontally),
+    against the continuous ground (:meth:`World.ground_height`), rounded to the mm.
+    """
+    from ..analysis.safety import height_above_ground
+    from ..geometry import densify
+    from ..world.ground_model import sampling_step
+
+    step = 0.25 * sampling_step(world)
+    dense = [densify(p, step, horizontal=True)[0] for p in lines]
+    counts = np.array([len(d) for d in dense])
+    h = height_above_ground(world, np.concatenate(dense))
+    return [round(float(v), 3) for v in np.minimum.reduceat(h, np.cumsum(counts) - counts)]
 
 
 def _lowest_agl(plan: Any) -> float | None:
@@ -109,6 +139,7 @@ def run_routes(outdir: Any, world: Any, goal_m: Any, starts: Any, *, shaping: An
     from ..autopilot.thin import thin_indices
     from ..planning.many import RouteFailure, plan_many
     from ..world.geo import to_lonlat
+    from ..world.line_length import lonlat_line_lengths
 
     progress.step("routes (one wave, every start)", 0.8)
     pts = np.asarray(starts.points, dtype=float)
@@ -123,41 +154,57 @@ def run_routes(outdir: Any, world: Any, goal_m: Any, starts: Any, *, shaping: An
     if known.any():
         start_ll[known] = to_lonlat(world, pts[known], anchor=settings.anchor)[:, :2]
     ok = [k for k, r in enumerate(routes) if not isinstance(r, RouteFailure)]
-    lines: dict[int, np.ndarray] = {}
+    lines: dict[int, np.ndarray] = {}  # each line as written: rounded lon, lat[, alt]
+    lowest: dict[int, float | None] = {k: None for k in ok}
     if ok:
         keep = [routes[k].path[thin_indices(routes[k].path, settings.thin)] for k in ok]
         ends = np.cumsum([len(q) for q in keep])[:-1]
         geo = np.split(to_lonlat(world, np.concatenate(keep), anchor=settings.anchor), ends)
-        lines = dict(zip(ok, geo))
+        lines = {k: _written(g, world.ndim) for k, g in zip(ok, geo)}
+        if world.ndim == 3:
+            lowest = dict(zip(ok, _lowest_line_agl(world, keep)))
+    written = dict(zip(ok, lonlat_line_lengths([lines[k] for k in ok])))
+    extent = _extent_text(world, settings.anchor) if any(
+        isinstance(r, RouteFailure) and r.reason == "outside" for r in routes) else ""
     rows: list[dict[str, Any]] = []
     features: list[dict[str, Any]] = []
     for k, r in enumerate(routes):
         row: dict[str, Any] = {"id": starts.ids[k], "lon": _deg(start_ll[k, 0]),
                                "lat": _deg(start_ll[k, 1])}
         if isinstance(r, RouteFailure):
-            row.update(status="failed", reason=r.reason, length_m=None, time_s=None,
-                       lowest_agl_m=None, clearance_m=None, message=r.message)
+            message = r.message
+            if r.reason == "outside" and row["lon"] is not None:  # in the user's terms first
+                message = (f"the start at lon {row['lon']}, lat {row['lat']} lies outside the "
+                           f"map ({extent}); {message}")
+            row.update(status="failed", reason=r.reason, length_m=None, planned_length_m=None,
+                       time_s=None, lowest_agl_m=None, planned_lowest_agl_m=None,
+                       clearance_m=None, message=message)
         else:
-            length = round(float(r.length), 3)
-            row.update(status="ok", reason="", length_m=length,
-                       time_s=round(float(r.length) / settings.speed, 3),
-                       lowest_agl_m=_lowest_agl(r),
+            length = float(written[k])
+            row.update(status="ok", reason="", length_m=round(length, 3),
+                       planned_length_m=round(float(r.length), 3),
+                       time_s=round(length / settings.speed, 3),
+                       lowest_agl_m=lowest[k], planned_lowest_agl_m=_lowest_agl(r),
                        clearance_m=(round(float(r.clearance), 3)
                                     if np.isfinite(r.clearance) else None), message="")
-            props = {key: row[key] for key in ("id", "length_m", "time_s", "lowest_agl_m",
+            props = {key: row[key] for key in ("id", "length_m", "planned_length_m", "time_s",
+                                               "lowest_agl_m", "planned_lowest_agl_m",
                                                "clearance_m")}
             features.append({"type": "Feature", "properties": {**props,
-                                                               "points": int(len(r.path))},
+                                                               "points": int(len(lines[k]))},
                              "geometry": {"type": "LineString",
-                                          "coordinates": _coords(lines[k], world.ndim)}})
+                                          "coordinates": lines[k].tolist()}})
         rows.append(row)
     with outdir.open("routes.geojson") as fh:
         json.dump({"type": "FeatureCollection", "features": features}, fh,
                   separators=(",", ":"))
     with outdir.open("routes.csv") as fh:
         fh.write(_csv_text(rows))
-    doc = {**(summary or {}), **many.summary(), "goal_lonlat": _goal_lonlat(world, many.goal,
-                                                                             settings.anchor),
+    many_summary = many.summary()
+    doc = {**(summary or {}), **many_summary,
+           "length_m": _stats([row["length_m"] for row in rows if row["status"] == "ok"]),
+           "planned_length_m": many_summary["length_m"],
+           "goal_lonlat": _goal_lonlat(world, many.goal, settings.anchor),
            "speed_m_s": settings.speed, "thin_m": settings.thin,
            "params": many.routes[ok[0]].params if ok else None,
            "failures": [{"id": row["id"], "reason": row["reason"], "message": row["message"]}
@@ -174,11 +221,32 @@ def _deg(v: float) -> float | None:
     return round(float(v), 7) if np.isfinite(v) else None
 
 
-def _coords(geo: np.ndarray, ndim: int) -> list[list[float]]:
-    """GeoJSON positions: lon/lat to 1e-7 degrees (~1 cm), altitude to the millimetre."""
+def _written(geo: np.ndarray, ndim: int) -> np.ndarray:
+    """A line's GeoJSON positions: lon/lat to 1e-7 degrees (~1 cm), altitude to the mm."""
     if ndim == 2:
-        return np.round(geo[:, :2], 7).tolist()
-    return np.column_stack([np.round(geo[:, :2], 7), np.round(geo[:, 2], 3)]).tolist()
+        return np.round(geo[:, :2], 7)
+    return np.column_stack([np.round(geo[:, :2], 7), np.round(geo[:, 2], 3)])
+
+
+def _stats(values: list[float]) -> dict[str, float] | None:
+    """min / median / max [m] of the routes' lengths, None without a route."""
+    if not values:
+        return None
+    return {"min": min(values), "median": round(float(np.median(values)), 3),
+            "max": max(values)}
+
+
+def _extent_text(world: Any, anchor: Any) -> str:
+    """The map's lon/lat extent for a message: ``lon a..b, lat c..d`` (its corners)."""
+    from ..world.geo import to_lonlat
+
+    (x0, x1), (y0, y1) = np.asarray(world.bounds, dtype=float)[:2]  # (ndim, 2): min, max
+    corners = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
+    if world.ndim == 3:
+        corners = np.column_stack([corners, np.zeros(4)])
+    ll = to_lonlat(world, corners, anchor=anchor)
+    return (f"lon {ll[:, 0].min():.5f}..{ll[:, 0].max():.5f}, "
+            f"lat {ll[:, 1].min():.5f}..{ll[:, 1].max():.5f}")
 
 
 def _goal_lonlat(world: Any, goal: np.ndarray, anchor: Any) -> list[float]:
