@@ -159,3 +159,42 @@ def test_report_draws_every_route_and_lists_the_failed_starts(tmp_path, city_sta
     assert len(layers) == 1 and layers[0]["geometry"]["type"] == "MultiPoint"
     np.testing.assert_allclose(layers[0]["geometry"]["coordinates"],
                                [[float(r["lon"]), float(r["lat"])] for r in failed], atol=2e-7)
+
+
+def test_routes_over_filled_ground_say_so_as_an_independent_measurement_finds(tmp_path):
+    """A DEM whose nodata is filled (``--nodata fill``): the metres of each written line over
+    unknown ground (filled_ground_m) equal an independent reading of the GeoTIFF's mask under
+    routes.geojson; the summary and the printed rows say how many routes fly over it."""
+    from pyproj import Transformer
+
+    from tests.world import dem_cases as dc
+
+    tif = dc.country(tmp_path / "country.tif")
+    starts = tmp_path / "starts.csv"
+    starts.write_text("lon,lat,id\n"
+                      f"{dc.BORDER_START[0]},{dc.BORDER_START[1]},border\n"
+                      "10.17,45.62,inland\n")
+    goal = ",".join(f"{v}" for v in dc.BORDER_GOAL)
+    out = tmp_path / "r"
+    res = runner.invoke(app, ["routes", "--dem", str(tif), f"--goal={goal}", "--starts",
+                              str(starts), "--agl", "100", "--cell-size", "150", "--nodata",
+                              "fill", "--out", str(out)])
+    assert res.exit_code == 0, res.output
+    s = json.loads((out / "summary.json").read_text())
+    crs = s["world"]["georef"]["crs"]
+    rows = {r["id"]: r for r in csv.DictReader(open(out / "routes.csv"))}
+    to_map = Transformer.from_crs("EPSG:4326", crs, always_xy=True)
+    measured = {}
+    for ft in json.loads((out / "routes.geojson").read_text())["features"]:
+        ll = np.asarray(ft["geometry"]["coordinates"])
+        pts = np.column_stack([*to_map.transform(ll[:, 0], ll[:, 1]), ll[:, 2]])
+        over, _ = dc.length_over(pts, lambda p: ~dc.measured_mask(tif, crs, p), step=0.25)
+        p = ft["properties"]
+        assert p["filled_ground_m"] == pytest.approx(over, abs=1.0)
+        assert float(rows[p["id"]]["filled_ground_m"]) == p["filled_ground_m"]
+        measured[p["id"]] = over
+    assert measured["border"] > 500.0, measured  # the case needs a route over the fill
+    over_ids = [k for k, v in measured.items() if v > 0]
+    assert s["over_filled_ground"]["routes"] == len(over_ids)
+    assert s["over_filled_ground"]["ids"] == over_ids
+    assert "over FILLED ground" in res.output

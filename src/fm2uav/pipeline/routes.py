@@ -7,14 +7,16 @@
   (``[lon, lat, alt]`` on a 3D map, alt in metres above the map's vertical datum),
   thinned by Douglas–Peucker to ``thin`` metres, with the properties ``id``,
   ``length_m``, ``planned_length_m``, ``time_s``, ``lowest_agl_m``,
-  ``planned_lowest_agl_m``, ``clearance_m``, ``points`` (the written line's);
+  ``planned_lowest_agl_m``, ``filled_ground_m``, ``clearance_m``, ``points`` (the
+  written line's);
 * ``routes.csv``: one row per start, in the file's order — ``id``, ``status`` (``ok`` or
   ``failed``), ``reason`` (:data:`fm2uav.planning.many.FAILURE_REASONS`), ``lon``,
   ``lat``, ``length_m``, ``planned_length_m``, ``time_s``, ``lowest_agl_m``,
-  ``planned_lowest_agl_m``, ``clearance_m``, ``message``;
+  ``planned_lowest_agl_m``, ``filled_ground_m``, ``clearance_m``, ``message``;
 * ``summary.json``: the goal, the counts (per failure reason), the failed starts with
   their reason and message, lengths (min/median/max of ``length_m`` and of
-  ``planned_length_m``), the settings and the timings.
+  ``planned_length_m``), the routes over filled ground (``over_filled_ground``: how
+  many, the first ids, the most metres; None on a 2D map), the settings and the timings.
 
 The figures of a route are those of the line as written (what a vehicle given the file
 flies, and what an independent check of the file measures): ``length_m`` the written
@@ -22,7 +24,10 @@ line's length — its rounded positions, segment by segment the WGS84 geodesic c
 with the altitude change (:func:`fm2uav.world.line_length.lonlat_line_lengths`);
 ``time_s`` = ``length_m / speed`` (a constant ground speed, no wind); ``lowest_agl_m``
 the lowest height above the continuous ground along its straight legs (3D maps; empty
-on a 2D map). The planner's own figures, before thinning and in the map's metres, beside
+on a 2D map); ``filled_ground_m`` the metres of it over filled (unknown) ground — nodata
+the DEM did not measure, classified as ``fm2uav plan`` classifies its path (0 where every
+metre is measured; empty on a 2D map): a height above invented ground is not a measured
+one. The planner's own figures, before thinning and in the map's metres, beside
 them: ``planned_length_m`` (``Plan.length``, what ``fm2uav plan`` reports; the thinning
 shortens a line by ~0.3 % at 1 m, and a projected map's metres differ from the
 ellipsoid's by its scale factor), ``planned_lowest_agl_m`` (``fm2uav plan``'s
@@ -50,7 +55,8 @@ __all__ = ["ROUTES_FILES", "RoutesRun", "RouteSettings", "run_routes", "routes_r
 ROUTES_FILES = ("routes.geojson", "routes.csv", "summary.json")
 
 _CSV_COLUMNS = ("id", "status", "reason", "lon", "lat", "length_m", "planned_length_m", "time_s",
-                "lowest_agl_m", "planned_lowest_agl_m", "clearance_m", "message")
+                "lowest_agl_m", "planned_lowest_agl_m", "filled_ground_m", "clearance_m",
+                "message")
 
 
 @dataclass(frozen=True)
@@ -102,6 +108,22 @@ def _lowest_line_agl(world: Any, lines: list[np.ndarray]) -> list[float]:
     counts = np.array([len(d) for d in dense])
     h = height_above_ground(world, np.concatenate(dense))
     return [round(float(v), 3) for v in np.minimum.reduceat(h, np.cumsum(counts) - counts)]
+
+
+def _filled_ground(world: Any, lines: list[np.ndarray]) -> list[float]:
+    """Metres [m] of each written line (its points [m], as thinned) over filled (unknown)
+    ground, classified as ``fm2uav plan`` classifies its path
+    (:func:`fm2uav.analysis.known_ground.ground_split`); 0 on a map without unknown ground."""
+    from ..analysis.known_ground import ground_split
+    from ..world.ground import has_unknown_ground
+
+    if not has_unknown_ground(world):
+        return [0.0] * len(lines)
+    out = []
+    for p in lines:
+        split = ground_split(world, p, np.zeros(len(p))) if len(p) >= 2 else None
+        out.append(0.0 if split is None else float(split["filled"]["length_m"]))
+    return out
 
 
 def _lowest_agl(plan: Any) -> float | None:
@@ -156,6 +178,7 @@ def run_routes(outdir: Any, world: Any, goal_m: Any, starts: Any, *, shaping: An
     ok = [k for k, r in enumerate(routes) if not isinstance(r, RouteFailure)]
     lines: dict[int, np.ndarray] = {}  # each line as written: rounded lon, lat[, alt]
     lowest: dict[int, float | None] = {k: None for k in ok}
+    filled: dict[int, float | None] = {k: None for k in ok}
     if ok:
         keep = [routes[k].path[thin_indices(routes[k].path, settings.thin)] for k in ok]
         ends = np.cumsum([len(q) for q in keep])[:-1]
@@ -163,6 +186,7 @@ def run_routes(outdir: Any, world: Any, goal_m: Any, starts: Any, *, shaping: An
         lines = {k: _written(g, world.ndim) for k, g in zip(ok, geo)}
         if world.ndim == 3:
             lowest = dict(zip(ok, _lowest_line_agl(world, keep)))
+            filled = dict(zip(ok, _filled_ground(world, keep)))
     written = dict(zip(ok, lonlat_line_lengths([lines[k] for k in ok])))
     extent = _extent_text(world, settings.anchor) if any(
         isinstance(r, RouteFailure) and r.reason == "outside" for r in routes) else ""
@@ -178,18 +202,19 @@ def run_routes(outdir: Any, world: Any, goal_m: Any, starts: Any, *, shaping: An
                            f"map ({extent}); {message}")
             row.update(status="failed", reason=r.reason, length_m=None, planned_length_m=None,
                        time_s=None, lowest_agl_m=None, planned_lowest_agl_m=None,
-                       clearance_m=None, message=message)
+                       filled_ground_m=None, clearance_m=None, message=message)
         else:
             length = float(written[k])
             row.update(status="ok", reason="", length_m=round(length, 3),
                        planned_length_m=round(float(r.length), 3),
                        time_s=round(length / settings.speed, 3),
                        lowest_agl_m=lowest[k], planned_lowest_agl_m=_lowest_agl(r),
+                       filled_ground_m=filled[k],
                        clearance_m=(round(float(r.clearance), 3)
                                     if np.isfinite(r.clearance) else None), message="")
             props = {key: row[key] for key in ("id", "length_m", "planned_length_m", "time_s",
                                                "lowest_agl_m", "planned_lowest_agl_m",
-                                               "clearance_m")}
+                                               "filled_ground_m", "clearance_m")}
             features.append({"type": "Feature", "properties": {**props,
                                                                "points": int(len(lines[k]))},
                              "geometry": {"type": "LineString",
@@ -209,6 +234,11 @@ def run_routes(outdir: Any, world: Any, goal_m: Any, starts: Any, *, shaping: An
            "params": many.routes[ok[0]].params if ok else None,
            "failures": [{"id": row["id"], "reason": row["reason"], "message": row["message"]}
                         for row in rows if row["status"] == "failed"]}
+    over = [row for row in rows if row.get("filled_ground_m")]
+    doc["over_filled_ground"] = {  # unknown ground is said, never counted as known
+        "routes": len(over), "ids": [row["id"] for row in over[:20]],
+        "max_m": max((row["filled_ground_m"] for row in over), default=0.0)} \
+        if world.ndim == 3 else None
     failed = [row["reason"] for row in rows if row["status"] == "failed"]
     doc["failed"] = len(failed)
     doc["routes"] = len(rows) - len(failed)
@@ -271,6 +301,10 @@ def routes_rows(run: RoutesRun) -> dict[str, str]:
     out = {"starts": str(s["starts"]), "routes": str(s["routes"])}
     if s["failed"]:
         out["failed"] = ", ".join(f"{n} {r}" for r, n in s["failed_by_reason"].items())
+    over = s.get("over_filled_ground") or {}
+    if over.get("routes"):
+        out["over FILLED ground"] = (f"{over['routes']} route(s) fly over filled (unknown) "
+                                     f"ground, up to {over['max_m']:.0f} m: filled_ground_m")
     if s["length_m"]:
         L = s["length_m"]
         out["length [m]"] = f"{L['min']:.0f} / {L['median']:.0f} / {L['max']:.0f} (min/median/max)"
