@@ -22,6 +22,10 @@ $(STAMP): pyproject.toml
 	$(PY) -m compileall -q src
 	@echo "compiling the numba kernels once (cached for every later run) ..."
 	$(PY) -m fm2uav.planning.warmup
+	@## every help page rendered once and kept (fm2uav._help_cache): the next `fm2uav <cmd>
+	@## --help` from a script or a pipe copies it without typer or rich (best effort)
+	-@$(PY) -c "from fm2uav.cli import COMMANDS, REPRODUCE; print('', *COMMANDS, 'reproduce', *('reproduce ' + c for c in REPRODUCE), sep='\n')" \
+		| while read -r words; do $(VENV)/bin/fm2uav $$words --help >/dev/null 2>&1 </dev/null || true; done
 	@touch $(STAMP)
 
 ## make install: the venv with the package (editable) and its numba kernels compiled

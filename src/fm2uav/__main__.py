@@ -24,6 +24,10 @@ a bad flag compiles nothing. ``fm2uav run`` says it once its mission file is rea
 and valid (:func:`fm2uav.cli._first_use.announce_compile` in the command): a
 mission-file error answers without the cache check.
 
+A help page (``fm2uav [command ...] --help``) asked before is copied from the pages
+kept between runs (:mod:`fm2uav._help_cache`: keyed on the package's source, the
+renderers and the terminal), without typer or rich.
+
 The command line proper is :mod:`fm2uav.cli`, which imports only typer and
 rich: ``fm2uav --help``, ``fm2uav plan --help`` and a bad flag answer without
 numba, scipy or matplotlib (docs/architecture.md, "The command line stays
@@ -35,6 +39,9 @@ from __future__ import annotations
 import os
 import signal
 import sys
+from typing import Any
+
+from . import _help_cache
 
 #: Commands whose first run compiles kernels and whose notice is shown before anything else
 #: (``run`` shows it after reading its mission file: a file's error answers sooner).
@@ -108,6 +115,21 @@ def _notice_if_cold(argv: list[str]) -> None:
                                        style="yellow", highlight=False)
 
 
+def _render_and_keep(cli_main: Any, page: str) -> None:
+    """Run a help request, keeping its page (stdout) when it exits 0 with nothing on stderr."""
+    out, err = _help_cache.Recorder(sys.stdout), _help_cache.Recorder(sys.stderr)
+    real = sys.stdout, sys.stderr
+    sys.stdout, sys.stderr = out, err
+    try:
+        cli_main()
+    except SystemExit as exc:
+        if exc.code in (0, None) and not err.parts:
+            _help_cache.keep(page, "".join(out.parts))
+        raise
+    finally:
+        sys.stdout, sys.stderr = real
+
+
 def _run() -> int:
     """The command line's exit code (stop signals: 130 with one line, never a traceback)."""
     from .io.outdir import Interrupted, install_stop_signals, raise_if_stopped, unreported_stop
@@ -116,10 +138,16 @@ def _run() -> int:
         install_stop_signals()  # no traceback for a stop signal from here on
         try:
             _printable_streams()
+            served, page = _help_cache.serve(sys.argv[1:])
+            if served:  # a help page kept from an earlier run: no typer, no rich
+                return 0
             _notice_if_cold(sys.argv[1:])
             from .cli import main as cli_main
 
-            cli_main()
+            if page is None:
+                cli_main()
+            else:
+                _render_and_keep(cli_main, page)
         except SystemExit as exc:
             raise_if_stopped()  # a stop Python swallowed (start-up, parsing): 130 all the same
             if exc.code == 130:  # stopped: a command reported it, or typer's parser exited
