@@ -178,3 +178,22 @@ def test_cache_fault_finds_numba_s_cache_loader_and_clear_cache_deletes_its_file
     assert sorted(in_tree.glob("_kernels.*.nb[ic]")) == others  # only where this process caches
 
     assert _python(code, tmp_path).returncode == 0  # compiles and caches again
+
+
+def test_numba_version_is_the_distribution_s_without_importlib_metadata(tmp_path, monkeypatch):
+    """The version the cache check compares with numba's index (its dist-info folder's name:
+    what importlib.metadata reads, without loading it); where there is no such folder, the
+    fallback still answers."""
+    import importlib.metadata
+
+    import numba
+
+    assert _jit._numba_version() == importlib.metadata.version("numba") == numba.__version__
+    res = subprocess.run([sys.executable, "-c", "import sys; from fm2uav import _jit; "
+                          "_jit._numba_version(); print('importlib.metadata' in sys.modules)"],
+                         capture_output=True, text=True, timeout=120)
+    assert res.stdout.split() == ["False"], res.stderr
+    # a numba package without a dist-info folder beside it: importlib.metadata's answer
+    (tmp_path / "numba").mkdir()
+    monkeypatch.setattr(sys, "path", [str(tmp_path), *sys.path])
+    assert _jit._numba_version() == importlib.metadata.version("numba")

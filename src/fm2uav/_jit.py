@@ -147,6 +147,24 @@ class _IndexUnpickler(pickle.Unpickler):
 
 
 def _numba_version() -> str | None:
+    """numba's version as its distribution records it, or None if it cannot tell.
+
+    Read from the name of the ``numba-<version>.dist-info`` folder beside the ``numba``
+    package that imports first on ``sys.path`` (a directory listing: importlib.metadata
+    costs ~50 ms of a bad flag's answer, the email package included); importlib.metadata
+    where there is no such folder.
+    """
+    for entry in sys.path:
+        try:
+            names = os.listdir(entry or os.curdir)
+        except OSError:
+            continue
+        if "numba" not in names:
+            continue
+        for name in names:
+            if name.startswith("numba-") and name.endswith(".dist-info"):
+                return name[len("numba-"):-len(".dist-info")]
+        break
     try:
         from importlib.metadata import version
 
