@@ -23,7 +23,6 @@ This module imports nothing of fm2uav and no third-party library.
 
 from __future__ import annotations
 
-import hashlib
 import os
 import sys
 from collections.abc import Sequence
@@ -127,6 +126,8 @@ def page_key(words: Sequence[str]) -> str:
         d = _package_dir(lib)
         if d is not None:
             _tree(d, parts)
+    import hashlib  # (OpenSSL's: only for a help request)
+
     return hashlib.sha256("\n".join(parts).encode("utf-8", "backslashreplace")).hexdigest()
 
 
