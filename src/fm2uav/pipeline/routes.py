@@ -220,9 +220,9 @@ def run_routes(outdir: Any, world: Any, goal_m: Any, starts: Any, *, shaping: An
                              "geometry": {"type": "LineString",
                                           "coordinates": lines[k].tolist()}})
         rows.append(row)
-    with outdir.open("routes.geojson") as fh:
-        json.dump({"type": "FeatureCollection", "features": features}, fh,
-                  separators=(",", ":"))
+    with outdir.open("routes.geojson") as fh:  # dumps: json's C encoder (dump's is Python's)
+        fh.write(json.dumps({"type": "FeatureCollection", "features": features},
+                            separators=(",", ":"), allow_nan=False))
     with outdir.open("routes.csv") as fh:
         fh.write(_csv_text(rows))
     many_summary = many.summary()
