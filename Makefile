@@ -22,6 +22,9 @@ $(STAMP): pyproject.toml
 	$(PY) -m compileall -q src
 	@echo "compiling the numba kernels once (cached for every later run) ..."
 	$(PY) -m fm2uav.planning.warmup
+	@## the layers above planning warm their own kernels (planning cannot import them)
+	$(PY) -m fm2uav.vehicles.warmup
+	$(PY) -m fm2uav.baselines.warmup
 	@touch $(STAMP)
 
 ## make install: the venv with the package (editable) and its numba kernels compiled
