@@ -29,6 +29,14 @@ def added_after(module: str | None, kernel: str, code: str) -> dict[str, list[st
     return json.loads(res.stdout.splitlines()[-1])  # after the groups' "name: seconds" lines
 
 
+def assert_covers(module: str, kernel: str, code: str) -> None:
+    """After ``module``'s warm-up, ``code`` adds no signature to ``kernel``; without it, the
+    same code adds exactly what the warm-up compiled (the check can fail)."""
+    after = added_after(module, kernel, code)
+    assert after["warm"] and after["added"] == []
+    assert added_after(None, kernel, code)["added"] == after["warm"]
+
+
 def main(argv: list[str]) -> int:
     module, kernel, code = argv
     mod_name, func = kernel.split(":")
