@@ -28,7 +28,7 @@ def test_induced_velocity_solves_the_momentum_equation():
 
 
 def test_induced_velocity_is_the_same_bits_one_state_at_a_time_or_many():
-    """A few states are bisected with Python floats, more with array operations: each state's
+    """A few states are bisected with Python floats, more in a compiled loop: each state's
     result is the same to the last bit either way (and in any batch it comes in)."""
     rng = np.random.default_rng(4)
     v, vz = rng.uniform(0.0, 25.0, 300), rng.uniform(-8.0, 8.0, 300)

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import sys
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 
 import numpy as np
 
@@ -180,13 +180,17 @@ FIRST_PLAN_CHILD: tuple[str, ...] = ("fmm3d_o2",)
 FIRST_PLAN_MAIN: tuple[str, ...] = ("descent", "edt", "surface")
 
 
-def warm(groups: Iterable[str] = tuple(GROUPS)) -> dict[str, float]:
+def warm(groups: Iterable[str] | None = None, *,
+         table: Mapping[str, Callable[[], None]] = GROUPS) -> dict[str, float]:
     """Run the named groups; returns the seconds each took (compile + tiny run).
 
     Parameters
     ----------
-    groups : iterable of str
-        Keys of :data:`GROUPS`.
+    groups : iterable of str, optional
+        Keys of ``table`` (default: all of them).
+    table : mapping of str to callable
+        The groups: :data:`GROUPS`, or the warm-up of a layer above this one
+        (``fm2uav.vehicles.warmup``, ``fm2uav.baselines.warmup``).
 
     Raises
     ------
@@ -194,23 +198,25 @@ def warm(groups: Iterable[str] = tuple(GROUPS)) -> dict[str, float]:
         An unknown group name.
     """
     out = {}
-    for name in groups:
-        fn = GROUPS[name]
+    for name in (table if groups is None else groups):
+        fn = table[name]
         t = time.perf_counter()
         fn()
         out[name] = time.perf_counter() - t
     return out
 
 
-def main(argv: list[str] | None = None) -> int:
-    """``python -m fm2uav.planning.warmup [GROUP ...]``: print each group's time."""
-    names = (sys.argv[1:] if argv is None else argv) or list(GROUPS)
-    unknown = [n for n in names if n not in GROUPS]
+def main(argv: list[str] | None = None, *,
+         table: Mapping[str, Callable[[], None]] = GROUPS) -> int:
+    """``python -m fm2uav.planning.warmup [GROUP ...]``: print each group's time (``table``:
+    the groups, :func:`warm`)."""
+    names = (sys.argv[1:] if argv is None else argv) or list(table)
+    unknown = [n for n in names if n not in table]
     if unknown:
-        print(f"unknown warm-up group(s) {unknown}; choose from {sorted(GROUPS)}",
+        print(f"unknown warm-up group(s) {unknown}; choose from {sorted(table)}",
               file=sys.stderr)
         return 2
-    for name, seconds in warm(names).items():
+    for name, seconds in warm(names, table=table).items():
         print(f"{name}: {seconds:.2f} s")
     return 0
 

@@ -109,9 +109,9 @@ def _check(name: str, value: Any, *, low: float = 0.0, allow_low: bool = False,
 #: Halvings of :func:`induced_velocity`'s bisection (the bracket shrinks to machine precision).
 _HALVINGS = 60
 
-#: Up to this many states, :func:`induced_velocity` bisects each with Python floats: the same
-#: IEEE operations as the array loop (bit for bit), without its per-call overhead of ~10
-#: array operations x 60 halvings (what a take-off, a landing or a hover costs).
+#: Up to this many states, :func:`induced_velocity` bisects each with Python floats (no
+#: numba import for a take-off, a landing or a hover); more go to the compiled loop
+#: (``_power_kernels.bisect_induced``): the same IEEE operations, bit for bit.
 _SCALAR_STATES = 4
 
 
@@ -121,7 +121,7 @@ def induced_velocity(airspeed: Any, climb: Any, hover_induced: float) -> np.ndar
     Solves ``v_i · sqrt(V² + (Vz + v_i)²) = v_h²`` for ``v_i > 0`` by bisection on
     ``[0, v_h + |Vz|]`` (60 halvings, to machine precision). Each state is solved on its own
     (the result of one does not depend on the others it is given with), a few states with
-    Python floats, more with array operations: the same result, bit for bit.
+    Python floats, more in a compiled loop: the same result, bit for bit.
 
     Examples
     --------
@@ -138,23 +138,12 @@ def induced_velocity(airspeed: Any, climb: Any, hover_induced: float) -> np.ndar
     if v.size <= _SCALAR_STATES:
         return np.array([_bisect(a, c, vh) for a, c in zip(v.flat, vz.flat)],
                         dtype=float).reshape(v.shape)
-    vh2 = vh ** 2
-    v2 = v * v
-    lo = np.zeros(v.shape)
-    hi = vh + np.abs(vz)
-    mid = np.empty(v.shape)
-    s = np.empty(v.shape)
-    below = np.empty(v.shape, dtype=bool)
-    for _ in range(_HALVINGS):
-        # mid·sqrt(V² + (Vz + mid)²) < v_h², with a - b < 0 <=> a < b (IEEE, finite)
-        np.multiply(0.5, np.add(lo, hi, out=mid), out=mid)
-        np.add(vz, mid, out=s)
-        np.multiply(s, s, out=s)
-        np.sqrt(np.add(v2, s, out=s), out=s)
-        np.less(np.multiply(mid, s, out=s), vh2, out=below)
-        np.copyto(lo, mid, where=below)
-        np.copyto(hi, mid, where=~below)
-    return 0.5 * (lo + hi)
+    from ._power_kernels import bisect_induced
+
+    out = np.empty(v.size)
+    # copies: writeable and contiguous whatever the input (one compiled specialisation)
+    bisect_induced(np.array(v).ravel(), np.array(vz).ravel(), vh, vh ** 2, _HALVINGS, out)
+    return out.reshape(v.shape)
 
 
 def _bisect(v: float, vz: float, vh: float) -> float:
