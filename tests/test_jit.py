@@ -197,3 +197,23 @@ def test_numba_version_is_the_distribution_s_without_importlib_metadata(tmp_path
     (tmp_path / "numba").mkdir()
     monkeypatch.setattr(sys, "path", [str(tmp_path), *sys.path])
     assert _jit._numba_version() == importlib.metadata.version("numba")
+
+
+def test_clear_kernel_cache_deletes_the_damaged_kernel_s_files_only(tmp_path, monkeypatch):
+    """One kernel's index or data file failed to load: its index and every data file go, the
+    other kernels' (same module, same line, other names) stay; an unknown file: all of them."""
+    names = ["_kernels.march2d_o1-643.py311.nbi", "_kernels.march2d_o1-643.py311.1.nbc",
+             "_kernels.march2d_o1-643.py311.2.nbc", "_kernels.march2d_o2-643.py311.nbi",
+             "_kernels.march2d_o2-643.py311.1.nbc", "_kernels.scan_speed-1416.py311.nbi",
+             "_kernels.cpython-311.pyc"]
+    for n in names:
+        (tmp_path / n).write_bytes(b"x")
+    removed = _jit.clear_kernel_cache(str(tmp_path / names[1]))
+    assert sorted(p.name for p in removed) == sorted(names[:3])
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(names[3:])
+    assert _jit.clear_kernel_cache(str(tmp_path / names[3])) and \
+        sorted(p.name for p in tmp_path.iterdir()) == sorted(names[5:])
+    # not a kernel's cache file: every fm2uav cache file (where this process keeps them)
+    calls = []
+    monkeypatch.setattr(_jit, "clear_cache", lambda: calls.append(1) or [])
+    assert _jit.clear_kernel_cache("numba cache") == [] and calls == [1]

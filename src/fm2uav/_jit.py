@@ -43,6 +43,7 @@ __all__ = [
 
     "cache_fault",
     "clear_cache",
+    "clear_kernel_cache",
     "cold_estimate_s",
     "likely_cold",
     "announced",
@@ -253,6 +254,37 @@ def clear_cache() -> list[Path]:
                 continue
             removed.append(Path(f))
 
+    return removed
+
+
+def clear_kernel_cache(path: str) -> list[Path]:
+    """Delete the numba cache files of the one kernel whose file ``path`` failed to load.
+
+    ``path`` is what :func:`cache_fault` returns: an index (``<module>.<kernel>-<line>.<tag>
+    .nbi``) or data file (``....<n>.nbc``) of a kernel; every file of that kernel in that
+    folder goes (its index and all its data files), the other kernels' caches stay — another
+    process may be using them, and they load. A ``path`` that names no kernel's cache file
+    (``"numba cache"``: the file was not known) falls back to :func:`clear_cache`.
+
+    Returns
+    -------
+    list of Path
+        The files deleted.
+    """
+    import re
+
+    p = Path(path)
+    m = re.match(r"^(.+?-\d+)\.py\d", p.name)
+    if m is None or p.suffix not in (".nbi", ".nbc"):
+        return clear_cache()
+    removed = []
+    for f in glob.glob(str(glob.escape(str(p.parent)) + "/" + glob.escape(m.group(1))
+                           + ".*.nb[ic]")):
+        try:
+            os.unlink(f)
+        except OSError:
+            continue
+        removed.append(Path(f))
     return removed
 
 

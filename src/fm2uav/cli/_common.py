@@ -150,11 +150,12 @@ _RERUN_ENV = "FM2UAV_CACHE_REBUILT"
 
 
 def _cache_fault(path: str) -> None:
-    """A damaged numba cache: delete fm2uav's cache files, then run the command again
-    (once, :data:`RERUN_ALLOWED`) or say how. Never returns."""
+    """A damaged numba cache: delete the damaged kernel's cache files (all of fm2uav's when
+    the file is not known: :func:`fm2uav._jit.clear_kernel_cache`), then run the command
+    again (once, :data:`RERUN_ALLOWED`) or say how. Never returns."""
     from .. import _jit
 
-    removed = _jit.clear_cache()
+    removed = _jit.clear_kernel_cache(path)
     what = f"the numba cache of fm2uav's compiled kernels is damaged ({path})"
     if RERUN_ALLOWED and removed and not os.environ.get(_RERUN_ENV):
         _warning_line(f"{what}; deleted its {len(removed)} files, compiling the kernels "
