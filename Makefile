@@ -25,6 +25,8 @@ $(STAMP): pyproject.toml
 	@## the layers above planning warm their own kernels (planning cannot import them)
 	$(PY) -m fm2uav.vehicles.warmup
 	$(PY) -m fm2uav.baselines.warmup
+	$(PY) -m fm2uav.missions.warmup
+	$(PY) -m fm2uav.autopilot.warmup
 	@## every help page rendered once and kept (fm2uav._help_cache): the next `fm2uav <cmd>
 	@## --help` from a script or a pipe copies it without typer or rich (best effort)
 	-@$(PY) -c "from fm2uav.cli import COMMANDS, REPRODUCE; print('', *COMMANDS, 'reproduce', *('reproduce ' + c for c in REPRODUCE), sep='\n')" \

@@ -80,7 +80,9 @@ def _split_compiled(p: np.ndarray, tolerance: float) -> np.ndarray:
     from ._thin_kernels import split_all
 
     n = len(p)
-    p = np.ascontiguousarray(p)
+    # C order and writeable: one compiled signature for every caller (a plan's read-only
+    # path would compile a second one)
+    p = np.require(p, requirements=("C", "W"))
     keep = np.zeros(n, dtype=bool)
     keep[0] = keep[-1] = True
     todo = np.zeros((n, 2), dtype=np.int64)
