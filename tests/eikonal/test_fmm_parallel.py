@@ -800,6 +800,51 @@ def test_cuts_for_shared_slabs_shorten_the_windows_on_an_fm2_map(monkeypatch):
     assert np.array_equal(cuts[False], cuts[True])
 
 
+def _shared_cost_numpy(cum, cuts, threads):
+    """The windows' critical path of the cuts as _assign shares the slabs, in numpy (the
+    compiled _shared_cost's reference: greedy longest first by the last bin's nodes where
+    that predicts a smaller largest share than the interleave)."""
+    per = (cum[cuts[1:]] - cum[cuts[:-1]]).astype(np.float64)  # (slabs, bins)
+    k, nb = per.shape
+    pred = np.zeros_like(per)
+    pred[:, 1:] = per[:, :-1]
+    cols = np.arange(nb)
+
+    def fixed_max(a):
+        return np.max([a[t::threads].sum(axis=0) for t in range(threads)], axis=0)
+
+    order = np.argsort(-pred, axis=0, kind="stable")
+    load = np.zeros((threads, nb))
+    owner = np.empty((k, nb), dtype=np.int64)
+    for i in range(k):
+        slab = order[i]
+        best = np.argmin(load, axis=0)
+        owner[slab, cols] = best
+        load[best, cols] += pred[slab, cols]
+    greedy = load.max(axis=0) < fixed_max(pred)
+    shared = np.max([np.where(owner == t, per, 0.0).sum(axis=0) for t in range(threads)], axis=0)
+    return float(np.where(greedy, shared, fixed_max(per)).sum())
+
+
+@pytest.mark.parametrize("threads", [2, 3])
+def test_shared_cost_compiled_equals_numpys_sharing(threads):
+    # random histograms with ties (small counts) and empty bins, random cuts
+    rng = np.random.default_rng(threads)
+    for _ in range(30):
+        hist = rng.integers(0, 4, size=(40, 64)) * (rng.random((40, 64)) < 0.5)
+        cum = np.vstack([np.zeros((1, 64), dtype=np.int64), np.cumsum(hist, axis=0)])
+        k = int(rng.integers(threads, 12))
+        cuts = np.concatenate([[0], np.sort(rng.choice(np.arange(1, 40), k - 1, False)), [40]])
+        got = _parallel._shared_cost(cum, cuts.astype(np.int64), threads)
+        assert got == _shared_cost_numpy(cum, cuts, threads)
+    # and the bench's kind of map, its coarse march's histogram, at equal cuts
+    flat, start, shape3 = _start(*fm2_shaped((512, 512)))
+    hist, _ = _parallel._coarse_histogram(flat, start, shape3, (1.0,) * 3)
+    cum = np.vstack([np.zeros((1, hist.shape[1]), dtype=np.int64), np.cumsum(hist, axis=0)])
+    cuts = np.linspace(0, hist.shape[0], 9).round().astype(np.int64)
+    assert _parallel._shared_cost(cum, cuts, threads) == _shared_cost_numpy(cum, cuts, threads)
+
+
 def test_slabs_taken_in_turn_are_ordered_by_predicted_work():
     """``share=2`` (:data:`_parallel.DYNAMIC_2D`): every slab by decreasing predicted work
     (ties in slab order), the counter the threads take them by at 0, the owners and the

@@ -104,6 +104,21 @@ def test_page_toucher_touches_only_page_starts_and_stops_at_the_block_end():
         assert np.all(np.delete(raw, zeros) == byte)
 
 
+def test_page_toucher_finds_the_top_speed_before_it_touches():
+    # the top speed (the first window's width) is found whatever the block's length: the
+    # block ends at once here, the pages then stay untouched but the top is there
+    speed = np.random.default_rng(1).random(100_003) * 7.0
+    a = np.full(3 * _parallel.TOUCH_CHUNK, 0xAB, dtype=np.uint8)
+    with _parallel._PageToucher(a, top_of=speed) as toucher:
+        pass
+    assert toucher.top == speed.max()
+    assert _parallel._top_speed(_kernels._readonly(speed)) == speed.max()
+    assert _parallel._top_speed(_kernels._readonly(np.zeros(0))) == 1.0  # none: 1
+    with _parallel._PageToucher(a) as toucher:  # no speeds, no top
+        pass
+    assert toucher.top is None
+
+
 def test_big_3d_grids_cut_the_slabs_for_sharing_bit_for_bit(lean, monkeypatch):
     """From ``SHARED_CUTS_MIN_NODES_3D`` nodes (the terrain plan's 40 M) a 3D march's cuts are
     those placed for the slabs shared before each window, where the coarse march says their

@@ -1666,31 +1666,32 @@ def _descend_cuts(cum, cuts, gap, threads, shared):
     return cuts
 
 
+@njit(cache=True, error_model="numpy")
 def _shared_cost(cum, cuts, threads):
     """The windows' critical path (nodes) of the cuts ``cuts`` over the coarse histogram's
     time bins (``cum``: cumulated over the rows) with the slabs shared as :func:`_assign`
     shares them: longest first by the last bin's nodes when that predicts a smaller
-    largest share than the fixed interleave (slab ``k`` to thread ``k % threads``)."""
-    per = (cum[cuts[1:]] - cum[cuts[:-1]]).astype(np.float64)  # (slabs, bins)
-    k, nb = per.shape
-    pred = np.zeros_like(per)
-    pred[:, 1:] = per[:, :-1]
-    cols = np.arange(nb)
-
-    def fixed_max(a):
-        return np.max([a[t::threads].sum(axis=0) for t in range(threads)], axis=0)
-
-    order = np.argsort(-pred, axis=0, kind="stable")
-    load = np.zeros((threads, nb))
-    owner = np.empty((k, nb), dtype=np.int64)
-    for i in range(k):
-        slab = order[i]
-        best = np.argmin(load, axis=0)
-        owner[slab, cols] = best
-        load[best, cols] += pred[slab, cols]
-    greedy = load.max(axis=0) < fixed_max(pred)
-    shared = np.max([np.where(owner == t, per, 0.0).sum(axis=0) for t in range(threads)], axis=0)
-    return float(np.where(greedy, shared, fixed_max(per)).sum())
+    largest share than the fixed interleave (slab ``k`` to thread ``k % threads``).
+    Compiled (in numpy it was 0.8 ms per call, twice per march, on the calling thread
+    alone while the other waits)."""
+    k = cuts.size - 1
+    per = np.zeros(k)
+    pred = np.zeros(k)
+    slabs = np.empty(k, dtype=np.int64)
+    first = np.empty(threads + 1 + k, dtype=np.int64)
+    load = np.empty(threads)
+    share = np.empty(threads)
+    total = 0.0
+    for b in range(cum.shape[1]):
+        for j in range(k):
+            pred[j] = per[j]  # the last bin's nodes (0 before the first)
+            per[j] = cum[cuts[j + 1], b] - cum[cuts[j], b]
+        _assign(pred, threads, slabs, first, load, 1)
+        share[:] = 0.0
+        for j in range(k):  # the owners of the lists (greedy or the interleave)
+            share[first[threads + 1 + j]] += per[j]
+        total += share.max()
+    return total
 
 
 def _coarse_histogram(speed, start, shape3, h3):
@@ -1800,7 +1801,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     sx = (ny + 2) * (nz + 2) if three else ny + 2
     sy = nz + 2 if three else 1
     lean = (nx + 2) * sx > _kernels.LEAN_NODES  # V in float32 as the serial march
-    early = None
+    early = toucher = None
     if lean and nth > 1:
         # the lean layout's buffers are fresh mappings whose page faults (~0.4 CPU-s for
         # the 42 M nodes of a 1000 x 1000 x 40 terrain) the padding takes; map them at
@@ -1810,14 +1811,15 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
                                   interleave)
     out = None  # the result (not lean)
     if early is not None:
-        with _PageToucher(early[0], early[1]):
+        with _PageToucher(early[0], early[1], top_of=speed) as toucher:
             bounds = slab_bounds(speed, start, shape3, h3, K, nth)
     elif nth > 1:
-        # the cuts' coarse march runs on this thread alone: meanwhile a second one faults in
-        # the result's pages, the rows the other thread unpads first (_unpad_slabs)
+        # the cuts' coarse march runs on this thread alone: meanwhile a second one finds the
+        # top speed and faults in the result's pages, the rows the other thread unpads
+        # first (_unpad_slabs)
         out = np.empty(nx * ny * nz)
         half = out.size // 2
-        with _PageToucher(out[half:], out[:half]):
+        with _PageToucher(out[half:], out[:half], top_of=speed) as toucher:
             bounds = slab_bounds(speed, start, shape3, h3, K, nth)
     else:
         bounds = slab_bounds(speed, start, shape3, h3, K, nth)
@@ -1897,13 +1899,14 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     iso = bool(ih[0] == ih[1] and (not three or ih[1] == ih[2]))
     hh = float(1.0 / ih[0])
     # the top speed sets the first window's width only (then adapted): from the plateau's
-    # register when there is one (a pass over the speeds is ~2 ms of serial time on 2048^2)
-    # (a pass over the speeds, on the threads, else)
+    # register when there is one, else found beside the cuts (a pass over the speeds is
+    # ~2 ms on 2048^2, on the core that waits while the cuts are placed)
     if qp > 0.0:
         vmax = 1.0 / np.sqrt(qp)
+    elif toucher is not None:
+        vmax = toucher.top
     else:
-        with _threads(nth):
-            vmax = _top_speed(nth, _kernels._readonly(speed))
+        vmax = _top_speed(_kernels._readonly(speed))
     width = 2.0 * min(h3[:3 if three else 2]) / max(vmax, 1e-300)
     win = np.zeros(_W_SIZE + (_P_THREADS + 3 * nth if PROFILE else 0))
     win[:_W_SIZE] = [0.0, width, 0.0, float(WINDOW_NODES), 0.0, 0.0, np.inf, 0.0, 0.0, 0.0]
@@ -2031,20 +2034,14 @@ def _inf_after(nth, T, t):
                 T[i] = np.inf
 
 
-@njit(cache=True, parallel=True, error_model="numpy")
-def _top_speed(nth, speed):
-    """The largest speed (1.0 for none), on ``nth`` threads (one pass over 2048^2 speeds is
-    ~2 ms); it sets the first window's width."""
-    n = speed.size
-    if n == 0:
-        return 1.0
-    part = np.zeros(nth)
-    for t in prange(nth):
-        top = 0.0
-        for c in range(t * n // nth, (t + 1) * n // nth):
-            top = max(top, speed[c])
-        part[t] = top
-    return part.max()
+@njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
+def _top_speed(speed):
+    """The largest speed (1.0 for none), without the GIL (:class:`_PageToucher` finds it
+    beside the cuts); it sets the first window's width."""
+    top = 0.0
+    for c in range(speed.size):
+        top = max(top, speed[c])
+    return top if speed.size > 0 else 1.0
 
 
 def _ghost_frozen_bits(bits, Tp, off, rows, sx, G):
@@ -2252,14 +2249,21 @@ def _touch(a, step):
 class _PageToucher:
     """Inside the block a second thread faults in the pages of the arrays given (in chunks
     of :data:`TOUCH_CHUNK` bytes, in turn), stopping at the block's end; whatever it did
-    not reach faults in where it is first written (:func:`_pad_slabs`, on every thread)."""
+    not reach faults in where it is first written (:func:`_pad_slabs`, on every thread).
+    With ``top_of`` (speeds [m/s]) it first finds their largest (:func:`_top_speed`, not
+    stopped: ``top`` after the block), work :func:`march` would otherwise do after the cuts
+    while the other core waits."""
 
-    def __init__(self, *arrays):
+    def __init__(self, *arrays, top_of=None):
         self.bufs = [a.view(np.uint8).reshape(-1) for a in arrays]
+        self.speed = None if top_of is None else _kernels._readonly(top_of)
+        self.top = None
         self.stop = threading.Event()
         self.thread = threading.Thread(target=self._run, daemon=True)
 
     def _run(self):
+        if self.speed is not None:
+            self.top = _top_speed(self.speed)
         for buf in self.bufs:
             for a in range(0, buf.size, TOUCH_CHUNK):
                 if self.stop.is_set():

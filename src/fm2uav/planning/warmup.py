@@ -92,7 +92,7 @@ def _fmm_parallel(ndim: int) -> Callable[[], None]:
     e.g. a 1000x1000x40 terrain plan, with the page toucher of its buffers), its size floors
     lowered for a 16-node-wide grid while it compiles, stopped at a node as a plan's march
     (the times after the stop set to inf on the threads); and the descent placing the slab
-    cuts (a 16-node grid is too thin to be cut)."""
+    cuts and their comparison (a 16-node grid is too thin to be cut)."""
     def run() -> None:
         speed = np.ones((16,) * ndim)
         speed[(0,) * ndim] = 0.5  # a plateau with its mask (a uniform grid needs none)
@@ -111,12 +111,16 @@ def _fmm_parallel(ndim: int) -> Callable[[], None]:
         finally:
             _parallel.PARALLEL_MIN_NODES, _kernels.LEAN_NODES = floor, lean
             _parallel.ORDER2_MIN_NODES_3D, _parallel.ORDER2_MIN_NODES_2D = floor2
-        # the page toucher's kernel: on a grid this small its thread may be stopped before
-        # its first call (the cuts are placed at once), so it is compiled here
+        # the page toucher's kernels (the top speed first, then the page faults): on a grid
+        # this small its thread may be stopped before its first touch (the cuts are placed
+        # at once), so they are compiled here
         _parallel._touch(np.zeros(8, dtype=np.uint8), 4096)
+        _parallel._top_speed(_kernels._readonly(np.ones(8)))
         cum = np.cumsum(np.ones((5, 3), dtype=np.int64), axis=0)
+        cuts = np.array([0, 2, 4], dtype=np.int64)
         for shared in (False, True):
-            _parallel._descend_cuts(cum, np.array([0, 2, 4], dtype=np.int64), 1, 2, shared)
+            _parallel._descend_cuts(cum, cuts, 1, 2, shared)
+        _parallel._shared_cost(cum, cuts, 2)  # the two descents' cuts compared
 
     return run
 
