@@ -27,6 +27,7 @@ $(STAMP): pyproject.toml
 	$(PY) -m fm2uav.baselines.warmup
 	$(PY) -m fm2uav.missions.warmup
 	$(PY) -m fm2uav.autopilot.warmup
+	$(PY) -m fm2uav.analysis.warmup
 	@## every help page rendered once and kept (fm2uav._help_cache): the next `fm2uav <cmd>
 	@## --help` from a script or a pipe copies it without typer or rich (best effort)
 	-@$(PY) -c "from fm2uav.cli import COMMANDS, REPRODUCE; print('', *COMMANDS, 'reproduce', *('reproduce ' + c for c in REPRODUCE), sep='\n')" \

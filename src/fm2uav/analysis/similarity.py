@@ -57,7 +57,7 @@ def _as_curve(c: Any, what: str) -> np.ndarray:
         raise InputError(f"{what} must be an (N, d) array of points with N >= 1, got shape {arr.shape}")
     if not np.all(np.isfinite(arr)):
         raise InputError(f"{what} has non-finite coordinates")
-    return np.ascontiguousarray(arr)
+    return np.require(arr, requirements=("C", "W"))  # one compiled signature for any caller
 
 
 
