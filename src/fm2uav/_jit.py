@@ -243,17 +243,21 @@ def clear_cache() -> list[Path]:
     """
     removed = []
     for py_file in _fm2uav_sources():
-        stem = glob.escape(py_file.stem)
         d = _cache_dir(py_file)
-        if d is None or not d.is_dir():
-            continue
-        for f in glob.glob(str(glob.escape(str(d)) + f"/{stem}.*.nb[ic]")):
-            try:
-                os.unlink(f)
-            except OSError:
-                continue
-            removed.append(Path(f))
+        if d is not None and d.is_dir():
+            removed += _unlink_cache_files(d, py_file.stem)
+    return removed
 
+
+def _unlink_cache_files(folder: Path, prefix: str) -> list[Path]:
+    """Delete ``folder/<prefix>.*.nbi`` and ``.nbc``; the files deleted (others left)."""
+    removed = []
+    for f in glob.glob(str(glob.escape(str(folder)) + "/" + glob.escape(prefix) + ".*.nb[ic]")):
+        try:
+            os.unlink(f)
+        except OSError:
+            continue
+        removed.append(Path(f))
     return removed
 
 
@@ -277,15 +281,7 @@ def clear_kernel_cache(path: str) -> list[Path]:
     m = re.match(r"^(.+?-\d+)\.py\d", p.name)
     if m is None or p.suffix not in (".nbi", ".nbc"):
         return clear_cache()
-    removed = []
-    for f in glob.glob(str(glob.escape(str(p.parent)) + "/" + glob.escape(m.group(1))
-                           + ".*.nb[ic]")):
-        try:
-            os.unlink(f)
-        except OSError:
-            continue
-        removed.append(Path(f))
-    return removed
+    return _unlink_cache_files(p.parent, m.group(1))
 
 
 def _chain(exc: BaseException) -> Iterable[BaseException]:
