@@ -79,11 +79,12 @@ def test_the_key_follows_words_environment_and_every_source_file(tmp_path, monke
     monkeypatch.setattr(sys, "argv", ["/somewhere/else/fm2uav-dev"])  # "Usage: <name> ..."
     assert _help_cache.page_key(("plan",)) != base
     monkeypatch.undo()
-    monkeypatch.setenv("COLUMNS", "77")
-    assert _help_cache.page_key(("plan",)) != base
-    monkeypatch.delenv("COLUMNS")
-    monkeypatch.setenv("SOMETHING_ELSE", "1")  # not a rendering variable: same page
-    assert _help_cache.page_key(("plan",)) == base
+    with monkeypatch.context() as m:  # (restores a COLUMNS the environment may have set)
+        m.setenv("COLUMNS", "77" if os.environ.get("COLUMNS") != "77" else "78")
+        assert _help_cache.page_key(("plan",)) != base
+    with monkeypatch.context() as m:
+        m.setenv("SOMETHING_ELSE", "1")  # not a rendering variable: same page
+        assert _help_cache.page_key(("plan",)) == base
     # a source file's size or time changes the listing the key is made of
     pkg = tmp_path / "pkg"
     (pkg / "sub").mkdir(parents=True)
