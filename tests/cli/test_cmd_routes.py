@@ -161,6 +161,35 @@ def test_report_draws_every_route_and_lists_the_failed_starts(tmp_path, city_sta
                                [[float(r["lon"]), float(r["lat"])] for r in failed], atol=2e-7)
 
 
+def _lowest_agl_by_ground(tif, crs, to_map, ll, step=1.0):
+    """Independently of fm2uav: min(alt - ground) along the straight legs (in the map's
+    metres, every ``step`` m) of lon/lat/alt positions, over ground the GeoTIFF measures
+    and over its nodata apart (None where there is none); ground = the GeoTIFF bilinear
+    between its pixel centres."""
+    import rasterio
+    from pyproj import Transformer
+    from scipy import ndimage
+
+    from tests.world import dem_cases as dc
+
+    xy = np.column_stack(to_map.transform(ll[:, 0], ll[:, 1]))
+    pts = []
+    for a, b, za, zb in zip(xy[:-1], xy[1:], ll[:-1, 2], ll[1:, 2]):
+        t = np.linspace(0.0, 1.0, max(2, int(np.hypot(*(b - a)) / step) + 1))
+        pts.append(np.column_stack([a + t[:, None] * (b - a), za + t * (zb - za)]))
+    p = np.concatenate(pts)
+    known = dc.measured_mask(tif, crs, p)
+    with rasterio.open(tif) as ds:
+        z, inv, dem_crs = ds.read(1).astype(float), ~ds.transform, ds.crs
+    lon, lat = Transformer.from_crs(crs, dem_crs, always_xy=True).transform(p[:, 0], p[:, 1])
+    col, row = inv * (np.asarray(lon), np.asarray(lat))
+    ground = ndimage.map_coordinates(z, [np.asarray(row) - 0.5, np.asarray(col) - 0.5],
+                                     order=1, mode="nearest")
+    h = p[:, 2] - ground
+    return (float(h[known].min()) if known.any() else None,
+            float(h[~known].min()) if (~known).any() else None)
+
+
 def test_routes_over_filled_ground_say_so_as_an_independent_measurement_finds(tmp_path):
     """A DEM whose nodata is filled (``--nodata fill``): the metres of each written line over
     unknown ground (filled_ground_m) equal an independent reading of the GeoTIFF's mask under
@@ -178,7 +207,7 @@ def test_routes_over_filled_ground_say_so_as_an_independent_measurement_finds(tm
     out = tmp_path / "r"
     res = runner.invoke(app, ["routes", "--dem", str(tif), f"--goal={goal}", "--starts",
                               str(starts), "--agl", "100", "--cell-size", "150", "--nodata",
-                              "fill", "--out", str(out)])
+                              "fill", "--out", str(out), "--report"])
     assert res.exit_code == 0, res.output
     s = json.loads((out / "summary.json").read_text())
     crs = s["world"]["georef"]["crs"]
@@ -194,6 +223,25 @@ def test_routes_over_filled_ground_say_so_as_an_independent_measurement_finds(tm
         assert float(rows[p["id"]]["filled_ground_m"]) == p["filled_ground_m"]
         measured[p["id"]] = over
     assert measured["border"] > 500.0, measured  # the case needs a route over the fill
+    # the lowest height above ground over measured ground only, as the GeoTIFF itself says
+    # (bilinear between its pixel centres); a height above the invented fill apart
+    for ft in json.loads((out / "routes.geojson").read_text())["features"]:
+        p, row = ft["properties"], rows[ft["properties"]["id"]]
+        ll = np.asarray(ft["geometry"]["coordinates"])
+        low_measured, low_filled = _lowest_agl_by_ground(tif, crs, to_map, ll)
+        assert p["lowest_agl_m"] == pytest.approx(low_measured, abs=0.05)
+        assert float(row["lowest_agl_m"]) == p["lowest_agl_m"]
+        if measured[p["id"]] > 0:
+            assert low_filled is not None and p["lowest_agl_filled_m"] is not None
+            assert float(row["lowest_agl_filled_m"]) == p["lowest_agl_filled_m"]
+        else:
+            assert low_filled is None and p["lowest_agl_filled_m"] is None
+            assert row["lowest_agl_filled_m"] == ""
+    assert s["over_filled_ground"]["lowest_agl_m"] == min(
+        float(rows[k]["lowest_agl_filled_m"]) for k in measured if measured[k] > 0)
+    assert "above that invented" in res.output and "lowest_agl_filled_m" in res.output
+    page = (out / "report.html").read_text()  # the starts table says it too
+    assert "<th>filled_ground_m</th>" in page and "<th>lowest_agl_filled_m</th>" in page
     over_ids = [k for k, v in measured.items() if v > 0]
     assert s["over_filled_ground"]["routes"] == len(over_ids)
     assert s["over_filled_ground"]["ids"] == over_ids

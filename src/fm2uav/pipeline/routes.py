@@ -7,27 +7,31 @@
   (``[lon, lat, alt]`` on a 3D map, alt in metres above the map's vertical datum),
   thinned by Douglas–Peucker to ``thin`` metres, with the properties ``id``,
   ``length_m``, ``planned_length_m``, ``time_s``, ``lowest_agl_m``,
-  ``planned_lowest_agl_m``, ``filled_ground_m``, ``clearance_m``, ``points`` (the
-  written line's);
+  ``lowest_agl_filled_m``, ``planned_lowest_agl_m``, ``filled_ground_m``,
+  ``clearance_m``, ``points`` (the written line's);
 * ``routes.csv``: one row per start, in the file's order — ``id``, ``status`` (``ok`` or
   ``failed``), ``reason`` (:data:`fm2uav.planning.many.FAILURE_REASONS`), ``lon``,
   ``lat``, ``length_m``, ``planned_length_m``, ``time_s``, ``lowest_agl_m``,
-  ``planned_lowest_agl_m``, ``filled_ground_m``, ``clearance_m``, ``message``;
+  ``lowest_agl_filled_m``, ``planned_lowest_agl_m``, ``filled_ground_m``,
+  ``clearance_m``, ``message``;
 * ``summary.json``: the goal, the counts (per failure reason), the failed starts with
   their reason and message, lengths (min/median/max of ``length_m`` and of
   ``planned_length_m``), the routes over filled ground (``over_filled_ground``: how
-  many, the first ids, the most metres; None on a 2D map), the settings and the timings.
+  many, the first ids, the most metres, the lowest height above that invented ground; None
+  on a 2D map), the settings and the timings.
 
 The figures of a route are those of the line as written (what a vehicle given the file
 flies, and what an independent check of the file measures): ``length_m`` the written
 line's length — its rounded positions, segment by segment the WGS84 geodesic combined
 with the altitude change (:func:`fm2uav.world.line_length.lonlat_line_lengths`);
 ``time_s`` = ``length_m / speed`` (a constant ground speed, no wind); ``lowest_agl_m``
-the lowest height above the continuous ground along its straight legs (3D maps; empty
-on a 2D map); ``filled_ground_m`` the metres of it over filled (unknown) ground — nodata
-the DEM did not measure, classified as ``fm2uav plan`` classifies its path (0 where every
-metre is measured; empty on a 2D map): a height above invented ground is not a measured
-one. The planner's own figures, before thinning and in the map's metres, beside
+the lowest height above the continuous *measured* ground along its straight legs (3D
+maps; empty on a 2D map or where the whole line is over filled ground);
+``filled_ground_m`` the metres of it over filled (unknown) ground — nodata the DEM did
+not measure, classified as ``fm2uav plan`` classifies its path (0 where every metre is
+measured; empty on a 2D map) — and ``lowest_agl_filled_m`` the lowest height above that
+invented ground (empty where the line has none): a height above invented ground is not a
+measured one, so it is never part of ``lowest_agl_m``. The planner's own figures, before thinning and in the map's metres, beside
 them: ``planned_length_m`` (``Plan.length``, what ``fm2uav plan`` reports; the thinning
 shortens a line by ~0.3 % at 1 m, and a projected map's metres differ from the
 ellipsoid's by its scale factor), ``planned_lowest_agl_m`` (``fm2uav plan``'s
@@ -55,8 +59,8 @@ __all__ = ["ROUTES_FILES", "RoutesRun", "RouteSettings", "run_routes", "routes_r
 ROUTES_FILES = ("routes.geojson", "routes.csv", "summary.json")
 
 _CSV_COLUMNS = ("id", "status", "reason", "lon", "lat", "length_m", "planned_length_m", "time_s",
-                "lowest_agl_m", "planned_lowest_agl_m", "filled_ground_m", "clearance_m",
-                "message")
+                "lowest_agl_m", "lowest_agl_filled_m", "planned_lowest_agl_m", "filled_ground_m",
+                "clearance_m", "message")
 
 
 @dataclass(frozen=True)
@@ -92,22 +96,35 @@ class RoutesRun:
     starts: Any = None
 
 
-def _lowest_line_agl(world: Any, lines: list[np.ndarray]) -> list[float]:
-    """The lowest height above the ground [m] along each written line's straight legs.
+def _lowest_line_agl(world: Any, lines: list[np.ndarray]) -> list[tuple[Any, Any]]:
+    """The lowest height above the ground [m] along each written line's straight legs, over
+    measured and over filled (unknown) ground apart.
 
     Each line (its points [m], as thinned) sampled as :func:`fm2uav.analysis.safety.
     leg_figures` samples waypoint legs (every quarter of ``sampling_step``, horizontally),
-    against the continuous ground (:meth:`World.ground_height`), rounded to the mm.
+    against the continuous ground (:meth:`World.ground_height`), rounded to the mm; a sample
+    is over filled ground as :func:`fm2uav.analysis.known_ground.filled_mask` says. Returns
+    ``(measured, filled)`` per line, None where the line has no sample over that ground (a
+    height above invented ground is never reported as a measured one).
     """
+    from ..analysis.known_ground import filled_mask
     from ..analysis.safety import height_above_ground
     from ..geometry import densify
+    from ..world.ground import has_unknown_ground
     from ..world.ground_model import sampling_step
 
     step = 0.25 * sampling_step(world)
     dense = [densify(p, step, horizontal=True)[0] for p in lines]
     counts = np.array([len(d) for d in dense])
-    h = height_above_ground(world, np.concatenate(dense))
-    return [round(float(v), 3) for v in np.minimum.reduceat(h, np.cumsum(counts) - counts)]
+    pts = np.concatenate(dense)
+    h = height_above_ground(world, pts)
+    filled = filled_mask(world, pts) if has_unknown_ground(world) else np.zeros(len(h), bool)
+    out = []
+    for seg_h, seg_f in zip(np.split(h, np.cumsum(counts)[:-1]),
+                            np.split(filled, np.cumsum(counts)[:-1])):
+        out.append(tuple(round(float(seg_h[sel].min()), 3) if sel.any() else None
+                         for sel in (~seg_f, seg_f)))
+    return out
 
 
 def _filled_ground(world: Any, lines: list[np.ndarray]) -> list[float]:
@@ -177,7 +194,7 @@ def run_routes(outdir: Any, world: Any, goal_m: Any, starts: Any, *, shaping: An
         start_ll[known] = to_lonlat(world, pts[known], anchor=settings.anchor)[:, :2]
     ok = [k for k, r in enumerate(routes) if not isinstance(r, RouteFailure)]
     lines: dict[int, np.ndarray] = {}  # each line as written: rounded lon, lat[, alt]
-    lowest: dict[int, float | None] = {k: None for k in ok}
+    lowest: dict[int, tuple[Any, Any]] = {k: (None, None) for k in ok}
     filled: dict[int, float | None] = {k: None for k in ok}
     if ok:
         keep = [routes[k].path[thin_indices(routes[k].path, settings.thin)] for k in ok]
@@ -201,20 +218,23 @@ def run_routes(outdir: Any, world: Any, goal_m: Any, starts: Any, *, shaping: An
                 message = (f"the start at lon {row['lon']}, lat {row['lat']} lies outside the "
                            f"map ({extent}); {message}")
             row.update(status="failed", reason=r.reason, length_m=None, planned_length_m=None,
-                       time_s=None, lowest_agl_m=None, planned_lowest_agl_m=None,
-                       filled_ground_m=None, clearance_m=None, message=message)
+                       time_s=None, lowest_agl_m=None, lowest_agl_filled_m=None,
+                       planned_lowest_agl_m=None, filled_ground_m=None, clearance_m=None,
+                       message=message)
         else:
             length = float(written[k])
             row.update(status="ok", reason="", length_m=round(length, 3),
                        planned_length_m=round(float(r.length), 3),
                        time_s=round(length / settings.speed, 3),
-                       lowest_agl_m=lowest[k], planned_lowest_agl_m=_lowest_agl(r),
+                       lowest_agl_m=lowest[k][0], lowest_agl_filled_m=lowest[k][1],
+                       planned_lowest_agl_m=_lowest_agl(r),
                        filled_ground_m=filled[k],
                        clearance_m=(round(float(r.clearance), 3)
                                     if np.isfinite(r.clearance) else None), message="")
             props = {key: row[key] for key in ("id", "length_m", "planned_length_m", "time_s",
-                                               "lowest_agl_m", "planned_lowest_agl_m",
-                                               "filled_ground_m", "clearance_m")}
+                                               "lowest_agl_m", "lowest_agl_filled_m",
+                                               "planned_lowest_agl_m", "filled_ground_m",
+                                               "clearance_m")}
             features.append({"type": "Feature", "properties": {**props,
                                                                "points": int(len(lines[k]))},
                              "geometry": {"type": "LineString",
@@ -235,10 +255,11 @@ def run_routes(outdir: Any, world: Any, goal_m: Any, starts: Any, *, shaping: An
            "failures": [{"id": row["id"], "reason": row["reason"], "message": row["message"]}
                         for row in rows if row["status"] == "failed"]}
     over = [row for row in rows if row.get("filled_ground_m")]
+    low = [row["lowest_agl_filled_m"] for row in over if row["lowest_agl_filled_m"] is not None]
     doc["over_filled_ground"] = {  # unknown ground is said, never counted as known
         "routes": len(over), "ids": [row["id"] for row in over[:20]],
-        "max_m": max((row["filled_ground_m"] for row in over), default=0.0)} \
-        if world.ndim == 3 else None
+        "max_m": max((row["filled_ground_m"] for row in over), default=0.0),
+        "lowest_agl_m": min(low, default=None)} if world.ndim == 3 else None
     failed = [row["reason"] for row in rows if row["status"] == "failed"]
     doc["failed"] = len(failed)
     doc["routes"] = len(rows) - len(failed)
@@ -303,8 +324,12 @@ def routes_rows(run: RoutesRun) -> dict[str, str]:
         out["failed"] = ", ".join(f"{n} {r}" for r, n in s["failed_by_reason"].items())
     over = s.get("over_filled_ground") or {}
     if over.get("routes"):
-        out["over FILLED ground"] = (f"{over['routes']} route(s) fly over filled (unknown) "
-                                     f"ground, up to {over['max_m']:.0f} m: filled_ground_m")
+        low = over.get("lowest_agl_m")
+        out["over FILLED ground"] = (
+            f"{over['routes']} route(s) fly over filled (unknown) ground, up to "
+            f"{over['max_m']:.0f} m: filled_ground_m"
+            + ("" if low is None else f"; lowest {low:.1f} m above that invented ground, "
+               "not a measured height: lowest_agl_filled_m"))
     if s["length_m"]:
         L = s["length_m"]
         out["length [m]"] = f"{L['min']:.0f} / {L['median']:.0f} / {L['max']:.0f} (min/median/max)"

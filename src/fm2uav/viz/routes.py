@@ -73,7 +73,8 @@ def routes_report_html(world: Any, run: Any, figures: Mapping[str, Any], *, titl
     failed = [row for row in run.rows if row["status"] != "ok"]
     shown = (failed + [row for row in run.rows if row["status"] == "ok"])[:MAX_ROWS]
     cols = ("id", "status", "reason", "lon", "lat", "length_m", "time_s", "lowest_agl_m",
-            "message")
+            *(("filled_ground_m", "lowest_agl_filled_m")  # unknown ground said where flown
+              if any(row.get("filled_ground_m") for row in run.rows) else ()), "message")
     table = [{c: ("" if row.get(c) is None else row.get(c)) for c in cols} for row in shown]
     head = (f"Starts ({len(run.rows)}; failed first"
             + (f", the first {MAX_ROWS} shown — every row is in routes.csv)"
