@@ -277,50 +277,73 @@ def resolve_threads(threads) -> int:
 
 # ------------------------------------------------------------------ queue glue
 @njit(cache=True, inline="always", error_model="numpy", _nrt=False)
-def _enq(k, c, pool, nxt, bk, mw, st, rkey, ritem):
-    """Queue node ``c`` with key bits ``k``: the radix queue if ``k`` is not below its
-    lower bound, else the repair heap (the caller keeps :data:`HEAP_RESERVE` slots free)."""
-    last = st[_LAST]
-    if k >= last:
-        nfree, fh, cur = _push(_bucket(k, last), k, c, pool, nxt, bk, mw, st[_NFREE],
-                               st[_FH], st[_CUR])
-        st[_NFREE] = nfree
-        st[_FH] = fh
-        st[_CUR] = cur
-        return
-    size = st[_RSIZE]
-    sift_up(rkey, ritem, rkey[:0], np.int64(size), k, c)
-    st[_RSIZE] = size + _ONE
-
-
-@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
-def _pop_repair(st, rkey, ritem):
-    """Remove the smallest entry of the repair heap (not empty); its node."""
-    c = ritem[0]
-    size = st[_RSIZE] - _ONE
-    st[_RSIZE] = size
-    if size > _ZERO:
-        sift_down(rkey, ritem, rkey[:0], np.int64(size), rkey[size], ritem[size])
-    return c
-
-
-@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
-def _keep_radix(st, nfree, fh, cur, last):
-    """Store the radix queue's state after a pop in ``st``."""
+def _keep_queue(st, nfree, fh, cur, last, rsize):
+    """Store the queue's state (radix queue and repair heap's size) in ``st``."""
     st[_NFREE] = nfree
     st[_FH] = fh
     st[_CUR] = cur
     st[_LAST] = last
+    st[_RSIZE] = rsize
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _enq_r(k, c, pool, nxt, bk, mw, rkey, ritem, nfree, fh, cur, last, rsize):
+    """Queue node ``c`` with key bits ``k``: the radix queue if ``k`` is not below its
+    lower bound ``last``, else the repair heap of ``rsize`` entries (the caller keeps
+    :data:`HEAP_RESERVE` slots free). The queue's state in and out as values (a kernel
+    keeps it in registers, :func:`_window`): ``nfree, fh, cur, rsize``."""
+    if k >= last:
+        nfree, fh, cur = _push(_bucket(k, last), k, c, pool, nxt, bk, mw, nfree, fh, cur)
+    else:
+        sift_up(rkey, ritem, rkey[:0], np.int64(rsize), k, c)
+        rsize += _ONE
+    return nfree, fh, cur, rsize
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _enq(k, c, pool, nxt, bk, mw, st, rkey, ritem):
+    """:func:`_enq_r` with the queue's state in ``st``."""
+    nfree, fh, cur, rsize = _enq_r(k, c, pool, nxt, bk, mw, rkey, ritem, st[_NFREE], st[_FH],
+                                   st[_CUR], st[_LAST], st[_RSIZE])
+    _keep_queue(st, nfree, fh, cur, st[_LAST], rsize)
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _pop_repair_r(rkey, ritem, rsize):
+    """Remove the smallest entry of the repair heap of ``rsize`` entries (not empty): its
+    node and the new size."""
+    c = ritem[0]
+    rsize -= _ONE
+    if rsize > _ZERO:
+        sift_down(rkey, ritem, rkey[:0], np.int64(rsize), rkey[rsize], ritem[rsize])
+    return c, rsize
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _pop_repair(st, rkey, ritem):
+    """:func:`_pop_repair_r` with the heap's size in ``st``."""
+    c, rsize = _pop_repair_r(rkey, ritem, st[_RSIZE])
+    st[_RSIZE] = rsize
+    return c
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _deq_r(T, pool, nxt, bk, mw, rkey, ritem, nfree, fh, cur, last, rsize):
+    """Remove the smallest queued entry (repair heap first): its node or ``_NIL``, and the
+    queue's state ``nfree, fh, cur, last, rsize`` (values, as :func:`_enq_r`)."""
+    if rsize > _ZERO:
+        c, rsize = _pop_repair_r(rkey, ritem, rsize)
+        return c, nfree, fh, cur, last, rsize
+    c, nfree, fh, cur, last = _pop(T, pool, nxt, bk, mw, nfree, fh, cur, last)
+    return c, nfree, fh, cur, last, rsize
 
 
 @njit(cache=True, inline="always", error_model="numpy", _nrt=False)
 def _deq(T, pool, nxt, bk, mw, st, rkey, ritem):
-    """Remove the smallest queued entry (repair heap first); its node or ``_NIL``."""
-    if st[_RSIZE] > _ZERO:
-        return _pop_repair(st, rkey, ritem)
-    c, nfree, fh, cur, last = _pop(T, pool, nxt, bk, mw, st[_NFREE], st[_FH], st[_CUR],
-                                   st[_LAST])
-    _keep_radix(st, nfree, fh, cur, last)
+    """:func:`_deq_r` with the queue's state in ``st``."""
+    c, nfree, fh, cur, last, rsize = _deq_r(T, pool, nxt, bk, mw, rkey, ritem, st[_NFREE],
+                                            st[_FH], st[_CUR], st[_LAST], st[_RSIZE])
+    _keep_queue(st, nfree, fh, cur, last, rsize)
     return c
 
 
@@ -333,7 +356,7 @@ def _deq_ahead(T, V, pool, nxt, bk, mw, st, rkey, ritem, s1, s2, pv):
         return _pop_repair(st, rkey, ritem)
     c, nfree, fh, cur, last = _pop_ahead(T, V, pool, nxt, bk, mw, st[_NFREE], st[_FH],
                                          st[_CUR], st[_LAST], s1, s2, pv)
-    _keep_radix(st, nfree, fh, cur, last)
+    _keep_queue(st, nfree, fh, cur, last, st[_RSIZE])
     return c
 
 
@@ -376,14 +399,15 @@ def _prefetch_rows(T, V, c, sx, sy, three, pv):
 
 
 @njit(cache=True, inline="always", error_model="numpy", _nrt=False)
-def _lower(T, V, c, t, fixed, sx, sy, three, pv, pool, nxt, bk, mw, st, rkey, ritem, ctl,
-           rows=True):
+def _lower_r(T, V, c, t, fixed, sx, sy, three, pv, pool, nxt, bk, mw, rkey, ritem, ctl, rows,
+             nfree, fh, cur, last, rsize):
     """Give node ``c`` the time ``t`` if that is lower than its band or frozen time.
 
     A frozen node lowered is re-opened (band again), unless it was frozen on entry
     (bit ``c`` of ``fixed``: a source or its ball, final as in the serial march).
     ``rows``: prefetch the rows a new band node's freezing reads (``pv``: their speeds
     too, off the plateau); the 3D order-2 window fetches around its next pops instead.
+    The queue's state in and out as values (:func:`_enq_r`): ``nfree, fh, cur, rsize``.
     """
     x = T[c]
     if x < 0.0:
@@ -391,17 +415,36 @@ def _lower(T, V, c, t, fixed, sx, sy, three, pv, pool, nxt, bk, mw, st, rkey, ri
             T[c] = -t
             if rows and x == -_INF:  # a new band node: fetch the rows its freezing reads
                 _prefetch_rows(T, V, c, sx, sy, three, pv)
-            _enq(_bits(t), c, pool, nxt, bk, mw, st, rkey, ritem)
+            return _enq_r(_bits(t), c, pool, nxt, bk, mw, rkey, ritem, nfree, fh, cur, last,
+                          rsize)
     elif t < x and _fixed_at(fixed, c, sy, three) == _ZERO:
         T[c] = -t
         ctl[_C_REOPEN] += 1.0
-        _enq(_bits(t), c, pool, nxt, bk, mw, st, rkey, ritem)
+        return _enq_r(_bits(t), c, pool, nxt, bk, mw, rkey, ritem, nfree, fh, cur, last, rsize)
+    return nfree, fh, cur, rsize
 
 
 @njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _lower(T, V, c, t, fixed, sx, sy, three, pv, pool, nxt, bk, mw, st, rkey, ritem, ctl,
+           rows=True):
+    """:func:`_lower_r` with the queue's state in ``st``."""
+    nfree, fh, cur, rsize = _lower_r(T, V, c, t, fixed, sx, sy, three, pv, pool, nxt, bk, mw,
+                                     rkey, ritem, ctl, rows, st[_NFREE], st[_FH], st[_CUR],
+                                     st[_LAST], st[_RSIZE])
+    _keep_queue(st, nfree, fh, cur, st[_LAST], rsize)
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _room_r(nfree, rsize, rkey):
+    """Whether the pool (``nfree`` blocks free) and the repair heap (``rsize`` entries) have
+    room for the pushes of one node."""
+    return nfree >= _U(RESERVE_BLOCKS) and rsize + _U(HEAP_RESERVE) <= _U(rkey.size)
+
+
+@njit(cache=True, inline="always", _nrt=False)
 def _room(st, rkey):
-    """Whether the pool and the repair heap have room for the pushes of one node."""
-    return st[_NFREE] >= _U(RESERVE_BLOCKS) and st[_RSIZE] + _U(HEAP_RESERVE) <= _U(rkey.size)
+    """:func:`_room_r` with the queue's state in ``st``."""
+    return _room_r(st[_NFREE], st[_RSIZE], rkey)
 
 
 @njit(cache=True, inline="always", _nrt=False)
@@ -478,11 +521,19 @@ def _slab_kernels(three):
         ns[0] = _ZERO
         ns[1] = _ZERO
         ctl[_C_NEXT] = _INF
+        # the queue's state in registers (stored back at the end): the stores into T
+        # would otherwise reload it from st at every push and pop
+        nfree = st[_NFREE]
+        fh = st[_FH]
+        cur = st[_CUR]
+        last = st[_LAST]
+        rsize = st[_RSIZE]
         while True:
-            if not _room(st, rkey):
-                ctl[_C_STATUS] = 1.0 if st[_NFREE] < _U(RESERVE_BLOCKS) else 2.0
+            if not _room_r(nfree, rsize, rkey):
+                ctl[_C_STATUS] = 1.0 if nfree < _U(RESERVE_BLOCKS) else 2.0
                 break
-            c = _deq(T, pool, nxt, bk, mw, st, rkey, ritem)
+            c, nfree, fh, cur, last, rsize = _deq_r(T, pool, nxt, bk, mw, rkey, ritem, nfree,
+                                                    fh, cur, last, rsize)
             if c == _NIL:
                 break
             x = T[c]
@@ -491,7 +542,8 @@ def _slab_kernels(three):
             t = -x
             k = _bits(t)
             if k >= kw:  # the window is done: put it back
-                _enq(k, c, pool, nxt, bk, mw, st, rkey, ritem)
+                nfree, fh, cur, rsize = _enq_r(k, c, pool, nxt, bk, mw, rkey, ritem, nfree, fh,
+                                               cur, last, rsize)
                 ctl[_C_NEXT] = t
                 break
             T[c] = t
@@ -508,8 +560,10 @@ def _slab_kernels(three):
                     if y < 0.0 or (y > t and nb >= lo and nb < hi):
                         # band/far, or frozen later than c in this slab: c may lower it
                         t_nb = _update(T, V, U, use_u, qp, nb, sx, sy, ih, hh, iso, three)
-                        _lower(T, V, nb, t_nb, fixed, sx, sy, three, pv, pool, nxt, bk, mw, st,
-                               rkey, ritem, ctl)
+                        nfree, fh, cur, rsize = _lower_r(T, V, nb, t_nb, fixed, sx, sy, three,
+                                                         pv, pool, nxt, bk, mw, rkey, ritem,
+                                                         ctl, True, nfree, fh, cur, last,
+                                                         rsize)
             else:
                 for j in range(4):  # one site for the four neighbours, as the serial march
                     s = sx if j < 2 else sy
@@ -523,8 +577,10 @@ def _slab_kernels(three):
                         t_nb = _update(T, V, U, use_u, qp, nb, sx, sy, ih, hh, iso, three)
                     else:
                         continue
-                    _lower(T, V, nb, t_nb, fixed, sx, sy, three, pv, pool, nxt, bk, mw, st,
-                           rkey, ritem, ctl)
+                    nfree, fh, cur, rsize = _lower_r(T, V, nb, t_nb, fixed, sx, sy, three, pv,
+                                                     pool, nxt, bk, mw, rkey, ritem, ctl, True,
+                                                     nfree, fh, cur, last, rsize)
+        _keep_queue(st, nfree, fh, cur, last, rsize)
         ctl[_C_POPS] = pops
 
     def start(T, V, U, qp, fixed, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl,
