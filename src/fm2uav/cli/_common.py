@@ -210,15 +210,20 @@ def handle_errors(func: F) -> F:
     command accepts (:mod:`fm2uav.cli._flags`: a flag it lacks becomes the
     mission-file key). A damaged numba cache is deleted and the command run again
     once (:func:`fm2uav._jit.cache_fault`). ``FM2UAV_DEBUG=1`` (:func:`debug_enabled`)
-    lets errors through with their traceback.
+    lets errors through with their traceback. The command runs with Python's garbage
+    collector on (the entry point pauses it while the command line starts:
+    :mod:`fm2uav._gc`).
     """
 
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
+        from .._gc import resume
+
+        resume()  # the garbage collector, paused while the command line started
         debug = debug_enabled()
         interrupted: tuple[type[BaseException], ...] = (KeyboardInterrupt,)
         try:
-            from ..io.outdir import Interrupted, abort_all, finish_all, interrupt_signals
+            from ..io._stops import Interrupted, abort_all, finish_all, interrupt_signals
 
             interrupted = (KeyboardInterrupt, Interrupted)
             with interrupt_signals(), warning_lines():
@@ -239,7 +244,7 @@ def handle_errors(func: F) -> F:
         except interrupted as exc:
             import signal
 
-            from ..io.outdir import stop_reported
+            from ..io._stops import stop_reported
 
             stop_reported()  # reported here: not raised again at the end of the command line
 
