@@ -4,9 +4,10 @@ The first instructions make the process safe to stop and to print, before any
 import that takes time:
 
 * **stop signals from the first instruction**: SIGINT (Ctrl-C), SIGTERM and
-  SIGHUP raise at once (:func:`fm2uav.io.outdir.install_stop_signals`: a light
-  module, loaded before anything else); outside a command (start-up, argument
-  parsing) the run ends with one line and exit code 130, never a traceback.
+  SIGHUP raise at once (:func:`fm2uav.io._stops.install_stop_signals`, re-exported
+  by :mod:`fm2uav.io.outdir`: a light module, loaded before anything else); outside
+  a command (start-up, argument parsing) the run ends with one line and exit code
+  130, never a traceback.
   While a command runs the output sets' rules apply
   (:func:`fm2uav.io.outdir.interrupt_signals`: the set is removed, the previous
   one kept, exit 130). A stop that Python swallows (one landing in a weakref
@@ -41,7 +42,7 @@ import signal
 import sys
 from typing import Any
 
-from . import _help_cache
+from . import _gc, _help_cache
 
 #: Commands whose first run compiles kernels and whose notice is shown before anything else
 #: (``run`` shows it after reading its mission file: a file's error answers sooner).
@@ -132,7 +133,7 @@ def _render_and_keep(cli_main: Any, page: str) -> None:
 
 def _run() -> int:
     """The command line's exit code (stop signals: 130 with one line, never a traceback)."""
-    from .io.outdir import Interrupted, install_stop_signals, raise_if_stopped, unreported_stop
+    from .io._stops import Interrupted, install_stop_signals, raise_if_stopped, unreported_stop
 
     try:
         install_stop_signals()  # no traceback for a stop signal from here on
@@ -167,16 +168,21 @@ def _run() -> int:
 def main() -> None:
     """Run the ``fm2uav`` command line.
 
+    The cyclic garbage collector is paused while the command line starts and until the
+    command runs (:mod:`fm2uav._gc`: ~10 % of a help page's or an error's instructions).
     The command line loads no third-party pydantic plugins (``PYDANTIC_DISABLE_PLUGINS``
     defaults to ``__all__`` in this process: pydantic otherwise reads the entry points of
     every installed distribution when the mission schema is built, ~20 ms of a mission-file
     error's answer); a value set in the environment is kept.
     """
+    _gc.pause()  # until the command runs (fm2uav._gc): start-up frees almost nothing
     os.environ.setdefault("PYDANTIC_DISABLE_PLUGINS", "__all__")
     try:
         code = _run()
     except KeyboardInterrupt:  # Ctrl-C before the handlers are in place (Python's own)
         _stopped(signal.SIGINT)
+    finally:
+        _gc.at_exit()  # the exit does not traverse the heap
     sys.exit(code)
 
 

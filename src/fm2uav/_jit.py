@@ -25,7 +25,6 @@ Bottom layer (no fm2uav imports): the kernels are named by file and function.
 
 from __future__ import annotations
 
-import glob
 import hashlib
 import os
 import pickle
@@ -194,12 +193,22 @@ def _cached(rel_file: str, func: str, numba_version: str | None) -> bool:
     except OSError:
         return False
     tag = f"py{sys.version_info[0]}{sys.version_info[1]}{getattr(sys, 'abiflags', '')}"
-    pattern = f"{glob.escape(py_file.stem)}.{glob.escape(func)}-*.{tag}.nbi"
     d = _cache_dir(py_file)
     if d is None:
         return False
-    return any(_fresh_index(Path(index), source_hash, numba_version)
-               for index in glob.glob(str(d / pattern)))
+    return any(_fresh_index(d / name, source_hash, numba_version)
+               for name in _names(d, f"{py_file.stem}.{func}-", f".{tag}.nbi"))
+
+
+def _names(folder: Path, prefix: str, suffix: str) -> list[str]:
+    """The files ``folder/<prefix>*<suffix>`` (what ``glob`` matches, without its regular
+    expressions: the check runs before a plan's arguments are parsed)."""
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return []
+    return sorted(n for n in names if n.startswith(prefix) and n.endswith(suffix)
+                  and len(n) >= len(prefix) + len(suffix))
 
 
 def likely_cold(kernels: Iterable[tuple[str, str]] = FIRST_PLAN_KERNELS) -> bool:
@@ -251,6 +260,8 @@ def clear_cache() -> list[Path]:
 
 def _unlink_cache_files(folder: Path, prefix: str) -> list[Path]:
     """Delete ``folder/<prefix>.*.nbi`` and ``.nbc``; the files deleted (others left)."""
+    import glob
+
     removed = []
     for f in glob.glob(str(glob.escape(str(folder)) + "/" + glob.escape(prefix) + ".*.nb[ic]")):
         try:

@@ -25,6 +25,7 @@ import sys
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
+from ._yaml_light import import_yaml
 from .errors import InputError
 
 if TYPE_CHECKING:  # numpy is imported by the checks that need it: the file checks
@@ -470,7 +471,7 @@ MAX_YAML_VALUES = 1_000_000
 def _expanded_size(root: Any) -> float:
     """How many scalars and collections ``root`` (a composed YAML node) holds with every
     alias expanded, counted in linear time over the node graph (aliases are shared nodes)."""
-    import yaml
+    yaml = import_yaml()
 
     def kids(node: Any) -> list[Any]:
         if isinstance(node, yaml.SequenceNode):
@@ -527,7 +528,7 @@ def _unique_key_loader() -> Any:
         return _YAML_LOADER
     import re
 
-    import yaml
+    yaml = import_yaml()
 
     class Yaml12Loader(yaml.SafeLoader):
         pass
@@ -594,7 +595,7 @@ def load_yaml(text_or_path: Any, what: str, *, where: Where = None, source: str 
     ...
     fm2uav.errors.InputError: config <text>: duplicate key 'a' (lines 1 and 2): the second would silently replace the first; keep one, at line 2, column 1
     """
-    import yaml
+    yaml = import_yaml()  # its reader's slowest pattern compiled fast (fm2uav._yaml_light)
 
     if source is None:
         text = read_text(text_or_path, what, where=where)

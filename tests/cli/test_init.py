@@ -35,9 +35,10 @@ LIGHT = ("fm2uav.io", "fm2uav.io.formats")
 #: Top-level imports a ``cli/*.py`` module may have: the standard library, typer, rich,
 #: fm2uav.errors, the light modules of fm2uav.cli (the cmd_* modules among them) and the two
 #: pipeline modules the commands share with the app, light by the same rule (numpy inside
-#: their functions; the jobs, fm2uav.pipeline.run / .cover, are imported by the commands).
+#: their functions; the jobs, fm2uav.pipeline.run / .cover, are imported by the commands),
+#: and fm2uav._lazy (names re-exported on first use: importlib and sys only).
 ALLOWED_TOP = ("typer", "rich", "fm2uav.errors", "fm2uav.cli", "fm2uav.pipeline.outputs",
-               "fm2uav.pipeline.rows")
+               "fm2uav.pipeline.rows", "fm2uav._lazy")
 
 # In a fresh interpreter: import the app, render every help page and the usage errors,
 # then list what got loaded.
@@ -304,4 +305,53 @@ def test_a_mission_file_error_through_the_command_line_loads_no_plugin_machinery
         assert all(w in message for w in words), (text, message)
         assert "Traceback" not in res.stderr
         assert json.loads(res.stdout.strip().splitlines()[-1]) == [], text
+    assert not (tmp_path / "out").exists()
+
+
+#: What the command line does not load to answer a bad flag or value, a missing or a bad
+#: mission file (issue 27, deliverable 4: every one-line error <= 0.3 s): the output sets'
+#: machinery (the stop signals are fm2uav.io._stops), the shared output writers with the
+#: progress events and json (imported by the commands that write), glob's regular
+#: expressions (the cold-cache check lists the folder) and ``run``'s module for ``plan``.
+ERROR_PATH_LATER = ("fm2uav.io.outdir", "fm2uav.pipeline.outputs", "fm2uav.progress", "json",
+                    "glob")
+
+ERROR_PROBE = """
+import atexit, sys
+heavy = {heavy!r}
+def report():
+    yaml = sys.modules.get("yaml")
+    loaded = sorted(m for m in heavy if m in sys.modules)
+    import json
+    print(json.dumps({{"loaded": loaded,
+                      "gc_frozen": __import__("gc").get_freeze_count() > 0,
+                      "yaml_pattern": yaml and yaml.reader.Reader.NON_PRINTABLE.pattern}}))
+atexit.register(report)
+sys.argv = ["fm2uav", *{argv!r}]
+from fm2uav.__main__ import main
+main()
+"""
+
+
+def test_one_line_errors_through_the_command_line_load_no_output_machinery(tmp_path):
+    from fm2uav._yaml_light import NOT_ALLOWED
+
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(W + "planner: {saturation: 1.5}\n", encoding="utf-8")
+    out = str(tmp_path / "out")
+    cases = [(["plan", "--bogus"], ("cmd_run",)), (["plan", "--threads", "0", "--out", out], ()),
+             (["plan", "--start", "1,2", "--out", out], ("cmd_run",)),
+             (["run", str(tmp_path / "missing.yaml")], ()), (["run", str(bad), "--out", out], ())]
+    for argv, also in cases:
+        heavy = ERROR_PATH_LATER + tuple(f"fm2uav.cli.{m}" for m in also)
+        res = subprocess.run([sys.executable, "-c", ERROR_PROBE.format(heavy=heavy, argv=argv)],
+                             capture_output=True, text=True, timeout=300, cwd=tmp_path)
+        assert res.returncode == 2, (argv, res.stderr)
+        assert "Traceback" not in res.stderr
+        report = json.loads(res.stdout.strip().splitlines()[-1])
+        assert report["loaded"] == [], (argv, report)
+        assert report["gc_frozen"], argv  # fm2uav._gc froze the start-up's objects (at exit)
+        if argv[1] == str(bad):  # yaml's reader compiled the fast form of its pattern
+            assert report["yaml_pattern"] == NOT_ALLOWED
+            assert "planner.saturation" in res.stderr
     assert not (tmp_path / "out").exists()

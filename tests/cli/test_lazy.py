@@ -103,7 +103,10 @@ print(json.dumps({{"code": code, "cmd": mods, "pydantic": "pydantic" in sys.modu
 
 
 def _probe(tmp_path, *args: str) -> dict:
-    env = {**os.environ, "PYTHONPATH": str(ROOT / "src"), "NUMBA_DISABLE_JIT": "1"}
+    # a help cache of the test's own: a page kept by an earlier run would be copied without
+    # building any command (fm2uav._help_cache)
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "src"), "NUMBA_DISABLE_JIT": "1",
+           "FM2UAV_CACHE_DIR": str(tmp_path / "cache")}
     res = subprocess.run([sys.executable, "-c", PROBE.format(args=list(args))], cwd=tmp_path,
                          capture_output=True, text=True, timeout=120, env=env)
     return json.loads(res.stderr.strip().splitlines()[-1])

@@ -23,7 +23,6 @@ Every command follows the same contract (issue "operator workflow"):
 from __future__ import annotations
 
 import functools
-import json
 import os
 import sys
 from collections.abc import Callable, Iterator
@@ -46,12 +45,7 @@ from ..errors import (  # noqa: F401  (exit codes and describe_error: re-exporte
     InputError,
     describe_error,
 )
-from ..pipeline.outputs import (  # noqa: F401  (re-exported; light: numpy inside)
-    to_jsonable,
-    write_figure,
-    write_json,
-    write_text,
-)
+from .._lazy import lazy_names
 from ..pipeline.rows import plan_rows  # noqa: F401  (re-exported; light: numpy inside)
 
 if TYPE_CHECKING:  # imported when a command runs (fm2uav.io loads numpy & co.)
@@ -89,13 +83,12 @@ err_console = Console(stderr=True)
 F = TypeVar("F", bound=Callable[..., Any])
 
 
-def __getattr__(name: str) -> Any:
-    """``OutputDir`` on first use (PEP 562): importing it loads :mod:`fm2uav.io`."""
-    if name == "OutputDir":
-        from ..io.outdir import OutputDir
-
-        return OutputDir
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+#: Names re-exported on first use (PEP 562): ``OutputDir`` (:mod:`fm2uav.io.outdir`) and the
+#: writers of :mod:`fm2uav.pipeline.outputs`, which a parse error does not need.
+__getattr__, __dir__ = lazy_names(__name__, {
+    "OutputDir": "fm2uav.io.outdir", "to_jsonable": "fm2uav.pipeline.outputs",
+    "write_figure": "fm2uav.pipeline.outputs", "write_json": "fm2uav.pipeline.outputs",
+    "write_text": "fm2uav.pipeline.outputs"})
 
 
 def _fail(message: str, code: int) -> None:
@@ -210,15 +203,20 @@ def handle_errors(func: F) -> F:
     command accepts (:mod:`fm2uav.cli._flags`: a flag it lacks becomes the
     mission-file key). A damaged numba cache is deleted and the command run again
     once (:func:`fm2uav._jit.cache_fault`). ``FM2UAV_DEBUG=1`` (:func:`debug_enabled`)
-    lets errors through with their traceback.
+    lets errors through with their traceback. The command runs with Python's garbage
+    collector on (the entry point pauses it while the command line starts:
+    :mod:`fm2uav._gc`).
     """
 
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
+        from .._gc import resume
+
+        resume()  # the garbage collector, paused while the command line started
         debug = debug_enabled()
         interrupted: tuple[type[BaseException], ...] = (KeyboardInterrupt,)
         try:
-            from ..io.outdir import Interrupted, abort_all, finish_all, interrupt_signals
+            from ..io._stops import Interrupted, abort_all, finish_all, interrupt_signals
 
             interrupted = (KeyboardInterrupt, Interrupted)
             with interrupt_signals(), warning_lines():
@@ -239,7 +237,7 @@ def handle_errors(func: F) -> F:
         except interrupted as exc:
             import signal
 
-            from ..io.outdir import stop_reported
+            from ..io._stops import stop_reported
 
             stop_reported()  # reported here: not raised again at the end of the command line
 
@@ -304,6 +302,10 @@ def print_summary(
     if quiet:
         return
     if as_json:
+        import json
+
+        from ..pipeline.outputs import to_jsonable
+
         payload = dict(rows)
         if files is not None:
             payload["files"] = [str(f) for f in files]

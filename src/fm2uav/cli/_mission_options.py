@@ -14,8 +14,12 @@ from typing import Annotated, Any
 
 import typer
 
+from .._lazy import lazy_names
 from ..errors import InputError
-from ..pipeline.outputs import export_options, parse_anchor  # noqa: F401  (re-exported)
+
+# re-exported from fm2uav.pipeline.outputs on first use: a parse error does not load it
+__getattr__, __dir__ = lazy_names(__name__, {"export_options": "fm2uav.pipeline.outputs",
+                                             "parse_anchor": "fm2uav.pipeline.outputs"})
 
 __all__ = [
     "Firmware", "Vehicle", "Frame", "End", "Thin", "AnchorText", "SpeedChanges", "MinSpeed",

@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 
 from ..errors import InputError
-from ._common import Output, handle_errors, plan_rows, write_json
+from ._common import Output, handle_errors, plan_rows
 from .options import (
     SCENARIO_NAMES,
     LonLatOpt,
@@ -22,11 +22,9 @@ from .options import (
     world_options,
     world_rows,
 )
-from ._mission_options import parse_anchor
 from ._planner_options import PlannerFlags, planner_options
 from ._return_options import ReturnFlags, return_options
-from ..pipeline.outputs import wind_options, with_wind_on
-from .cmd_run import mission_rows, output_names, plan_outputs, safety_rows
+from ..pipeline.rows import mission_rows, safety_rows
 
 PLAN_FILES = ("path.csv", "plan.png", "summary.json")
 
@@ -102,6 +100,8 @@ def plan_cmd(
                      preload=("fm2uav.missions.route", "fm2uav.viz", "fm2uav.io"))
     from .. import progress
     from ..missions.route import plan_route
+    from ..pipeline.outputs import (output_names, plan_outputs, wind_options, with_wind_on,
+                                    write_json)
     from ..world.load import world_summary
 
     with output.progress():
@@ -251,6 +251,7 @@ def _export_options(anchor: str | None, thin: float):
     import numpy as np
 
     from ..autopilot import ExportOptions
+    from ..pipeline.outputs import parse_anchor
 
     if not (np.isfinite(thin) and 0 <= thin <= 1000):
         raise InputError(f"--thin must be a tolerance in [0, 1000] m (mission file: "

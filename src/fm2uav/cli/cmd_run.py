@@ -11,12 +11,7 @@ from pathlib import Path
 
 import typer
 
-from ..pipeline.outputs import (  # noqa: F401  (re-exported: were defined here)
-    OUTPUT_FILES,
-    output_names,
-    plan_outputs,
-    write_exports,
-)
+from .._lazy import lazy_names
 from ..pipeline.rows import ground_rows, mission_rows, safety_rows  # noqa: F401  (re-exported)
 from ._common import (
     Output,
@@ -35,6 +30,12 @@ from .options import (
     world_options,
     world_rows,
 )
+
+# re-exported from fm2uav.pipeline.outputs on first use (were defined here): a parse error
+# or a mission file's does not load it
+__getattr__, __dir__ = lazy_names(__name__, dict.fromkeys(
+    ("OUTPUT_FILES", "output_names", "plan_outputs", "write_exports"),
+    "fm2uav.pipeline.outputs"))
 
 RUN_HELP = (
     "Plan the mission described by a YAML file (start, via points, goal, optional "
@@ -109,7 +110,7 @@ def run_cmd(
     m = load_mission(mission_file, world_overrides=world.overrides(),
                      point_overrides=points or None)
     # the run's modules once the mission file is valid (its error answers without them)
-    from ..pipeline.outputs import flown
+    from ..pipeline.outputs import flown, output_names
     from ..pipeline.rows import returns_rows
     from ..pipeline.run import run_mission
     from ._first_use import announce_compile
