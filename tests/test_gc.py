@@ -72,3 +72,28 @@ def test_the_command_line_pauses_and_the_command_runs_with_the_collector(tmp_pat
         assert report["in_command"] and all(report["in_command"])
     else:  # a parse error: no command ran, the collector stayed paused to the end
         assert report == {"in_command": [], "at_exit": False}
+
+
+def test_every_command_runs_through_handle_errors_so_the_collector_is_on():
+    """The entry point pauses the collector; only ``handle_errors`` turns it on again. A
+    command registered without it (a long ``fm2uav app`` server, a sweep) would run with the
+    collector off and never free a reference cycle: every command of both groups must be
+    wrapped by it."""
+    from fm2uav.cli import COMMANDS, REPRODUCE
+    from fm2uav.cli._lazy import registered
+
+    def wrapped(fn):
+        while fn is not None:
+            if getattr(getattr(fn, "__code__", None), "co_qualname", "") == \
+                    "handle_errors.<locals>.wrapper":  # wraps() copies __qualname__
+                return True
+            fn = getattr(fn, "__wrapped__", None)
+        return False
+
+    seen = 0
+    for table, section in ((COMMANDS, "app"), (REPRODUCE, "reproduce")):
+        for name, module in table.items():
+            info = registered("fm2uav.cli", module, section)[name]
+            assert wrapped(info.callback), f"{section} {name}: not wrapped by handle_errors"
+            seen += 1
+    assert seen >= 15
