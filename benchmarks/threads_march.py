@@ -18,7 +18,11 @@ driver), their balance, the nodes re-opened, then the ratios one thread / two th
 windows' CPU / balance)`` of ``benchmarks/bench_core.py``'s threads rows) and the digest
 of the times (equal between codes when bit for bit). ``--peer-cache`` sets the peer's
 ``NUMBA_CACHE_DIR`` (an empty value: unset, numba's default next to its sources).
-``--first`` (root) runs the children in a session of their own at autogroup nice -20 and
+Only the thread counts asked for are warmed up (``--threads 1``: no parallel kernel is
+loaded or compiled). ``--skfmm``: the first code's child also times scikit-fmm on the same
+problem (the FM²-shaped rows of ``benchmarks/bench_core.py``: a half-cell circle around the
+source, the walls masked) once a round, and each code's one-thread CPU time is compared with
+its (CPU time of the calling thread, as those rows' notes). ``--first`` (root) runs the children in a session of their own at autogroup nice -20 and
 nice -20: on a machine shared with other sessions (each its own autogroup, which plain
 ``nice`` does not cross) their processes then wait while a march runs, and the two
 threads run at once as on an idle machine (not quite: the others still run between the
@@ -60,6 +64,7 @@ _CHILD = textwrap.dedent(
         return out
 
     cases = {}
+    warm = set()
     for line in sys.stdin:
         case, th = line.split()
         th = int(th)
@@ -74,9 +79,17 @@ _CHILD = textwrap.dedent(
                 name, _, seed = field.partition("@")
                 v, src = fields.fm2_shaped(shape, seed=int(seed or 0))
             cases[case] = (v, src, int(rest[0]) if rest else 1)
-            for t in (1, 2):  # kernels loaded, buffers kept
-                fast_marching(v, [src], order=cases[case][2], threads=t)
         v, src, order = cases[case]
+        if th == 0:  # scikit-fmm on the same problem, CPU time of this thread
+            import skfmm
+            phi, vs = fields.skfmm_point_source(v, src)
+            c = time.thread_time()
+            skfmm.travel_time(phi, vs, order=order)
+            print(json.dumps({"cpu": time.thread_time() - c}), flush=True)
+            continue
+        if (case, th) not in warm:  # kernels loaded, buffers kept
+            warm.add((case, th))
+            fast_marching(v, [src], order=order, threads=th)
         STATS.clear()
         a = tasks(); w = time.perf_counter(); c = time.process_time()
         T = fast_marching(v, [src], order=order, threads=th)
@@ -131,6 +144,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--cases", nargs="+", default=["2048x2048:fm2"])
     ap.add_argument("--peer-cache", default=None,
                     help="the peer's NUMBA_CACHE_DIR (empty: unset)")
+    ap.add_argument("--skfmm", action="store_true",
+                    help="time scikit-fmm too (one-thread CPU ratios against it)")
     ap.add_argument("--first", action="store_true",
                     help="children at autogroup nice -20 (root): near-idle walls")
     args = ap.parse_args(argv)
@@ -146,10 +161,13 @@ def main(argv: list[str] | None = None) -> int:
     try:
         for case in args.cases:
             runs: dict[tuple[str, int], list[dict]] = {}
+            peer_cpu: list[float] = []
             for _ in range(args.repeats):
                 for th in args.threads:
                     for name, child in codes.items():
                         runs.setdefault((name, th), []).append(child.run(case, th))
+                if args.skfmm:
+                    peer_cpu.append(codes["ours"].run(case, 0)["cpu"])
             med = {key: {k: statistics.median(r[k] for r in rs) for k in NUMBERS if k in rs[0]}
                    for key, rs in runs.items()}
             loads = [r["load"] for rs in runs.values() for r in rs]
@@ -158,6 +176,11 @@ def main(argv: list[str] | None = None) -> int:
                 cells = ", ".join(f"{k} {m[k]:.4g}" for k in NUMBERS if k in m)
                 digests = " ".join(sorted({r["digest"] for r in runs[name, th]}))
                 print(f"  {name} {th} thread{'s' * (th > 1)}: {cells}; digest {digests}")
+            if peer_cpu:
+                sk = statistics.median(peer_cpu)
+                ratios = ", ".join(f"{name} {sk / med[name, 1]['cpu']:.3f}x" for name in codes
+                                   if (name, 1) in med)
+                print(f"  scikit-fmm CPU {sk:.4g} s; its CPU over one thread's: {ratios}")
             for name in codes:
                 one, two = med.get((name, 1)), med.get((name, 2))
                 if one and two and "balance" in two:
