@@ -20,9 +20,10 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
   ``t, t + threads, ...`` (interleaved strips keep both threads busy when the
   wave starts off-centre, and a coarse march places the cuts, :func:`slab_bounds`; in 2D
   and on 3D grids of at least :data:`SHARED_CUTS_MIN_NODES_3D` nodes for the slabs shared
-  before each window where that shortens the windows, :data:`SHARED_CUTS`; in the lean
-  layout a second thread faults the buffers' pages in
-  meanwhile, :class:`_PageToucher`),
+  before each window where that shortens the windows, :data:`SHARED_CUTS`; while this
+  thread places the cuts, a second one finds the top speed and faults pages in — the lean
+  layout's buffers, else the result's rows the other thread unpads first —
+  :class:`_PageToucher`),
   unless sharing them longest first by the last window's freezes promises a shorter
   window (:func:`_assign`, before every window). The set-up pads the slabs in parallel
   (:func:`_pad_slabs`) and the result is unpadded so (:func:`_unpad_slabs`).
