@@ -32,6 +32,11 @@ def _grids():
     occ = np.zeros((5, 6, 19), bool)                                # lanes: 19 = 2 x 8 + 3
     occ[2, 3, [0, 18]] = True
     out.append((occ, (1.0, 2.0, 0.5)))
+    # a terrain: solid ground up to layer 2 at least, so whole y and x lines are obstacle
+    # (zeros at once) beside lines with some; the x pass's blocks: 13 x 9 = 3 x 32 + 21
+    top = np.maximum(rng.integers(-1, 9, (21, 13)), 2)
+    out.append((np.ascontiguousarray(np.arange(9)[None, None, :] <= top[:, :, None]),
+                (15.0, 15.0, 10.0)))
     return out
 
 
