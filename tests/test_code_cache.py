@@ -149,5 +149,13 @@ def test_the_entry_point_keeps_the_table_and_answers_the_same(tmp_path):
     assert len({(a.returncode, a.stdout, a.stderr) for a in answers}) == 1
     assert answers[0].returncode == 2
     files = list((tmp_path / "code").iterdir())
-    assert [f.name for f in files] == [os.path.basename(_code_cache.cache_file())]
+    assert [f.name for f in files] == [os.path.basename(_code_cache.cache_file("plan"))]
     assert len(_code_cache._load(str(files[0]))) > 50
+
+
+def test_each_command_word_has_a_table_and_anything_else_shares_one():
+    names = {w: os.path.basename(_code_cache.cache_file(w))
+             for w in ("plan", "run", "x-y2", "", "--help", "Plan", "../x", "a b")}
+    assert names["plan"].endswith("-plan.marshal") and names["x-y2"].endswith("-x-y2.marshal")
+    assert len({names[w] for w in ("", "--help", "Plan", "../x", "a b")}) == 1
+    assert names[""].endswith("-_.marshal") and sys.implementation.cache_tag in names[""]

@@ -142,7 +142,8 @@ def _run() -> int:
             served, page = _help_cache.serve(sys.argv[1:])
             if served:  # a help page kept from an earlier run: no typer, no rich
                 return 0
-            _code_cache.install()  # generated source compiled once (fm2uav._code_cache)
+            # generated source compiled once (fm2uav._code_cache), a table per command
+            _code_cache.install(sys.argv[1] if len(sys.argv) > 1 else "")
             _notice_if_cold(sys.argv[1:])
             from .cli import main as cli_main
 

@@ -25,9 +25,11 @@ nothing to go stale. Anything else (bytes, a file name other than ``<string>``, 
 flags, another ``optimize``) goes to the built-in unchanged, and so does a text the
 built-in refuses (its own error, raised by the built-in itself).
 
-The table lives in ``$FM2UAV_CACHE_DIR/code``, else ``$XDG_CACHE_HOME/fm2uav/code``
-(``~/.cache``), one :mod:`marshal` file per interpreter, written atomically; at most
-:data:`MAX_ENTRIES` entries (beyond, only the run's own are kept). A table that cannot be
+The tables live in ``$FM2UAV_CACHE_DIR/code``, else ``$XDG_CACHE_HOME/fm2uav/code``
+(``~/.cache``), one :mod:`marshal` file per interpreter and command word (``plan``,
+``run``, ...: a run reads only what its command compiles, ~8 M instructions for
+``run``'s ~1,300 entries), written atomically; at most :data:`MAX_ENTRIES` entries
+(beyond, only the run's own are kept). A table that cannot be
 read or written is ignored (the text is compiled); ``FM2UAV_CODE_CACHE=0`` turns it off.
 Only the entry point installs it: the library, and tests running commands in process,
 compile as usual.
@@ -46,8 +48,9 @@ from typing import Any
 __all__ = ["MAX_ENTRIES", "MODULES", "cache_file", "enabled", "install", "installed",
            "lookup", "save", "stats"]
 
-#: Entries kept at most (each ~0.5 kB); a run that would pass it keeps its own only.
-MAX_ENTRIES = 20_000
+#: Entries kept at most per table (each ~0.2 kB, read by every run of its command); a run
+#: that would pass it keeps its own only.
+MAX_ENTRIES = 5_000
 
 #: The modules given a caching built-in, and which: those that compile generated text.
 MODULES = {"dataclasses": ("exec",), "collections": ("eval",), "typing": ("compile",)}
@@ -82,12 +85,17 @@ def enabled() -> bool:
         "0", "false", "no", "off")
 
 
-def cache_file() -> str:
-    """The table of this interpreter (its bytecode magic number and marshal's format)."""
+def cache_file(command: str = "") -> str:
+    """The table of this interpreter (its bytecode magic number and marshal's format) for
+    ``command`` (a command word: lower-case letters, digits and ``-``; anything else
+    shares one table)."""
     from ._help_cache import cache_dir
 
+    if not (command[:1].isalpha() and command.islower()
+            and all(c.isalnum() or c == "-" for c in command)):
+        command = "_"
     magic = sys.modules["_frozen_importlib_external"].MAGIC_NUMBER.hex()
-    name = f"{sys.implementation.cache_tag}-{magic}-m{marshal.version}.marshal"
+    name = f"{sys.implementation.cache_tag}-{magic}-m{marshal.version}-{command}.marshal"
     return os.path.join(os.path.dirname(cache_dir()), "code", name)
 
 
@@ -185,10 +193,11 @@ def installed() -> bool:
     return _State.table is not None
 
 
-def install() -> bool:
-    """Give :data:`MODULES` their caching built-ins, the table read from :func:`cache_file`
-    (see the module's notes); True when installed. Imports :mod:`dataclasses` (and
-    :mod:`typing`, :mod:`collections`) so their first use finds the stand-ins."""
+def install(command: str = "") -> bool:
+    """Give :data:`MODULES` their caching built-ins, the table of ``command`` read from
+    :func:`cache_file` (see the module's notes); True when installed. Imports
+    :mod:`dataclasses` (and :mod:`typing`, :mod:`collections`) so their first use finds the
+    stand-ins."""
     if _State.table is not None or not enabled():
         return _State.table is not None
     import collections  # noqa: F401
@@ -196,7 +205,7 @@ def install() -> bool:
     import typing  # noqa: F401
 
     _State.mask = _future_mask()
-    _State.path = cache_file()
+    _State.path = cache_file(command)
     _State.table = _load(_State.path)
     for module, names in MODULES.items():
         namespace = vars(sys.modules[module])
