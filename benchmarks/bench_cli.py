@@ -2,9 +2,10 @@
 
 Each case starts the installed ``fm2uav`` console script (``python -m fm2uav`` where there
 is none) as a user's shell does, several times after one untimed run (the ``.pyc`` files
-and the OS file cache warm), and records the median wall time and the median CPU time of
-the process (user + system, from the OS accounting of the child: what the command costs
-the machine, whatever the load). Cases:
+and the OS file cache warm, and the code of the source text the imports generate kept:
+``fm2uav._code_cache``, in the run's own cache folder), and records the median wall time
+and the median CPU time of the process (user + system, from the OS accounting of the
+child: what the command costs the machine, whatever the load). Cases:
 
 * ``fm2uav --help`` and ``fm2uav plan --help`` (the largest help page, 50+ options): the
   page kept from the untimed run (``fm2uav._help_cache``, in a cache of the run's own), and

@@ -42,7 +42,7 @@ import signal
 import sys
 from typing import Any
 
-from . import _gc, _help_cache
+from . import _code_cache, _gc, _help_cache
 
 #: Commands whose first run compiles kernels and whose notice is shown before anything else
 #: (``run`` shows it after reading its mission file: a file's error answers sooner).
@@ -142,6 +142,8 @@ def _run() -> int:
             served, page = _help_cache.serve(sys.argv[1:])
             if served:  # a help page kept from an earlier run: no typer, no rich
                 return 0
+            # generated source compiled once (fm2uav._code_cache), a table per command
+            _code_cache.install(sys.argv[1] if len(sys.argv) > 1 else "")
             _notice_if_cold(sys.argv[1:])
             from .cli import main as cli_main
 
@@ -182,6 +184,7 @@ def main() -> None:
     except KeyboardInterrupt:  # Ctrl-C before the handlers are in place (Python's own)
         _stopped(signal.SIGINT)
     finally:
+        _code_cache.save()  # the code this run compiled first, for the next runs
         _gc.at_exit()  # the exit does not traverse the heap
     sys.exit(code)
 

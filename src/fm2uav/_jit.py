@@ -25,11 +25,8 @@ Bottom layer (no fm2uav imports): the kernels are named by file and function.
 
 from __future__ import annotations
 
-import hashlib
 import os
-import pickle
 import sys
-import tempfile
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
@@ -97,6 +94,8 @@ def cold_estimate_s() -> int:
 def _usable(path: Path) -> bool:
     """Can numba keep its cache in ``path`` (created if missing, writable)? As its locators."""
     try:
+        import tempfile
+
         os.makedirs(path, exist_ok=True)
         with tempfile.TemporaryFile(dir=path):
             pass
@@ -109,6 +108,8 @@ def _cache_candidates(py_file: Path) -> list[Path]:
     """Where numba may keep ``py_file``'s cache, in the order its locators try them:
     ``$NUMBA_CACHE_DIR/<dir>_<sha1(dir)>`` when set, the source's ``__pycache__``,
     the user-wide cache directory (``$XDG_CACHE_HOME/numba/<dir>_<sha1(dir)>``)."""
+    import hashlib
+
     parent = py_file.parent
     sub = f"{parent.name}_{hashlib.sha1(str(parent).encode()).hexdigest()}"
     candidates = []
@@ -139,11 +140,24 @@ class _Stub:
         return _Stub()
 
 
-class _IndexUnpickler(pickle.Unpickler):
-    def find_class(self, module, name):
-        if module.split(".")[0] in ("numba", "llvmlite", "numpy"):
-            return _Stub
-        return super().find_class(module, name)
+_UNPICKLER: list[type] = []
+
+
+def _index_unpickler() -> type:
+    """The unpickler of numba's cache indexes: :class:`_Stub` for every numba object
+    (a class made on first use: :mod:`pickle`, :mod:`hashlib` and :mod:`tempfile` load
+    only when a cache is read, not with every command line that imports this module)."""
+    if not _UNPICKLER:
+        import pickle
+
+        class _IndexUnpickler(pickle.Unpickler):
+            def find_class(self, module: str, name: str) -> Any:
+                if module.split(".")[0] in ("numba", "llvmlite", "numpy"):
+                    return _Stub
+                return super().find_class(module, name)
+
+        _UNPICKLER.append(_IndexUnpickler)
+    return _UNPICKLER[0]
 
 
 def _numba_version() -> str | None:
@@ -175,10 +189,13 @@ def _numba_version() -> str | None:
 
 def _fresh_index(index: Path, source_hash: bytes, numba_version: str | None) -> bool:
     """True if ``index`` is a numba cache index of this source with an entry."""
+    import pickle
+
     try:
         with open(index, "rb") as fh:
             version = pickle.load(fh)
-            stamp, overloads = _IndexUnpickler(fh).load()  # numba: pickle of (stamp, overloads)
+            # numba: pickle of (stamp, overloads)
+            stamp, overloads = _index_unpickler()(fh).load()
     except Exception:  # unreadable, truncated, another format: not usable
         return False
     if numba_version is not None and version != numba_version:
@@ -187,6 +204,8 @@ def _fresh_index(index: Path, source_hash: bytes, numba_version: str | None) -> 
 
 
 def _cached(rel_file: str, func: str, numba_version: str | None) -> bool:
+    import hashlib
+
     py_file = _PKG / rel_file
     try:
         source_hash = hashlib.sha256(py_file.read_bytes()).digest()

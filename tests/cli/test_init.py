@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import ast
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -289,8 +290,6 @@ main()
 
 
 def test_a_mission_file_error_through_the_command_line_loads_no_plugin_machinery(tmp_path):
-    import os
-
     env = {k: v for k, v in os.environ.items() if k != "PYDANTIC_DISABLE_PLUGINS"}
     for k, (text, words) in enumerate(MISSION_ERRORS):
         mission = tmp_path / f"m{k}.yaml"
@@ -355,3 +354,35 @@ def test_one_line_errors_through_the_command_line_load_no_output_machinery(tmp_p
             assert report["yaml_pattern"] == NOT_ALLOWED
             assert "planner.saturation" in res.stderr
     assert not (tmp_path / "out").exists()
+
+
+CODE_PROBE = """
+import atexit, json, sys
+from fm2uav import _code_cache
+heavy = {heavy!r}
+atexit.register(lambda: print(json.dumps({{**_code_cache.stats(),
+                                          "loaded": sorted(m for m in heavy if m in sys.modules)}})))
+sys.argv = ["fm2uav", *{argv!r}]
+from fm2uav.__main__ import main
+main()
+"""
+
+
+def test_one_line_errors_compile_no_generated_source_once_kept(tmp_path):
+    # fm2uav._code_cache: the dataclasses' methods, namedtuples and forward references the
+    # imports compile are kept by the first run of a command and taken by the next; the
+    # numba cache check's hashlib (OpenSSL) waits for a cache to read (fm2uav._jit)
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(W + "planner: {saturation: 1.5}\n", encoding="utf-8")
+    env = {**os.environ, "FM2UAV_CACHE_DIR": str(tmp_path / "cache")}
+    out = str(tmp_path / "out")
+    cases = [(["plan", "--bogus"], ()), (["run", str(bad), "--out", out], ()),
+             (["run", str(tmp_path / "missing.yaml")], ("hashlib", "_hashlib"))]
+    for argv, later in cases:
+        probe = CODE_PROBE.format(heavy=later, argv=argv)
+        runs = [subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                               timeout=300, env=env) for _ in range(2)]
+        assert [r.returncode for r in runs] == [2, 2] and runs[0].stderr == runs[1].stderr
+        first, second = (json.loads(r.stdout.strip().splitlines()[-1]) for r in runs)
+        assert second["new"] == 0 and second["hits"] > 50, (argv, first, second)
+        assert first["loaded"] == second["loaded"] == [], (argv, first)
