@@ -137,38 +137,34 @@ def _caller_flags(depth: int = 2) -> int:
     return sys._getframe(depth).f_code.co_flags & _State.mask
 
 
-def _exec(source: Any, globals: Any = None, locals: Any = None, /, **kw: Any) -> Any:
-    """``exec`` for :mod:`dataclasses`: a text's code from the table, run as exec runs it."""
-    frame = sys._getframe(1)
-    if globals is None:  # exec's defaults: the caller's namespaces
+def _prepared(source: Any, mode: str, globals: Any, locals: Any) -> tuple[Any, Any, Any]:
+    """What the stand-in of ``exec`` / ``eval`` (``mode``) hands the built-in: the text's
+    code from the table (a text the built-in refuses, or not a text, unchanged) and the
+    namespaces the built-in would default to (the stand-in's caller's)."""
+    frame = sys._getframe(2)
+    if globals is None:  # the built-ins' defaults: the caller's namespaces
         globals = frame.f_globals
         if locals is None:
             locals = frame.f_locals
     elif locals is None:
         locals = globals
     if type(source) is str:
+        text = source if mode == "exec" else source.lstrip(" \t")  # eval strips them too
         try:
-            source = lookup(source, "exec", frame.f_code.co_flags & _State.mask)
+            source = lookup(text, mode, frame.f_code.co_flags & _State.mask)
         except (SyntaxError, ValueError):  # the built-in raises its own error
             pass
-    return builtins.exec(source, globals, locals, **kw)
+    return source, globals, locals
+
+
+def _exec(source: Any, globals: Any = None, locals: Any = None, /, **kw: Any) -> Any:
+    """``exec`` for :mod:`dataclasses`: a text's code from the table, run as exec runs it."""
+    return builtins.exec(*_prepared(source, "exec", globals, locals), **kw)
 
 
 def _eval(source: Any, globals: Any = None, locals: Any = None, /) -> Any:
     """``eval`` for :mod:`collections`: a text's code from the table, run as eval runs it."""
-    frame = sys._getframe(1)
-    if globals is None:
-        globals = frame.f_globals
-        if locals is None:
-            locals = frame.f_locals
-    elif locals is None:
-        locals = globals
-    if type(source) is str:
-        try:
-            source = lookup(source.lstrip(" \t"), "eval", frame.f_code.co_flags & _State.mask)
-        except (SyntaxError, ValueError):
-            pass
-    return builtins.eval(source, globals, locals)
+    return builtins.eval(*_prepared(source, "eval", globals, locals))
 
 
 def _compile(source: Any, filename: Any, mode: str, flags: int = 0, dont_inherit: bool = False,
