@@ -8,6 +8,7 @@ import builtins
 import json
 import marshal
 import os
+import re
 import subprocess
 import sys
 import textwrap
@@ -102,6 +103,43 @@ def test_a_table_of_another_interpreter_or_unreadable_is_ignored(tmp_path):
     assert _code_cache._load(str(path)) == {("eval", 0, "1"): code}
 
 
+PATTERNS = [
+    (r"(?P<key>[A-Za-z_][\w.-]*)\s*=\s*(?P<value>.*?)\s*$", 0),
+    (r"^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+][0-9]+)?)$", re.X),
+    (r"(?<=abc)déf|\bG[h-k]+", re.IGNORECASE | re.UNICODE),
+    (rb"\x00(?P<n>[\x01-\x7f]{2,})\Z", 0),
+    (r"(a)(b)?(?(2)c|d)", re.MULTILINE | re.DOTALL),
+    (r"", 0),
+]
+
+
+@pytest.mark.parametrize(("pattern", "flags"), PATTERNS)
+def test_a_kept_pattern_is_exactly_what_re_compiles(table, pattern, flags):
+    flags = int(flags)
+    first = _code_cache._re_compile(pattern, flags)
+    fresh = re._compiler.compile(pattern, flags)  # re's own compiler (not installed here)
+    key = ("re", flags, pattern)
+    kept = marshal.loads(marshal.dumps(table.table[key]))  # as read back from the file
+    table.table[key] = kept
+    again = _code_cache._re_compile(pattern, flags)
+    for p in (first, again):  # Pattern's == compares the text, the flags and the code
+        assert p == fresh and p.groupindex == fresh.groupindex and p.groups == fresh.groups
+    text = "x" * 3 if isinstance(pattern, str) else b"\x00ab"
+    assert [m.span() for m in again.finditer(text)] == [m.span() for m in fresh.finditer(text)]
+    assert _code_cache.stats() == {"entries": 1, "hits": 1, "new": 1}
+
+
+def test_a_pattern_re_refuses_or_that_warns_or_debug_is_not_kept(table, capsys):
+    with pytest.raises(re.error, match="missing \\)"):
+        _code_cache._re_compile("(ab", 0)
+    for _ in range(2):  # said again on every compilation, as by re itself
+        with pytest.warns(FutureWarning, match="Possible nested set"):
+            assert _code_cache._re_compile("[[a]", 0).match("[")
+    _code_cache._re_compile("ab", re.DEBUG)
+    assert "LITERAL 97" in capsys.readouterr().out  # re's own debug listing
+    assert table.table == {} and _code_cache.stats()["new"] == 0
+
+
 PROBE = textwrap.dedent("""
     import json, sys
     from fm2uav import _code_cache
@@ -113,13 +151,18 @@ PROBE = textwrap.dedent("""
         y: "tuple[int, ...]" = dataclasses.field(default_factory=tuple)
     Pair = collections.namedtuple("Pair", "a b")
     ref = typing.ForwardRef("dict[str, int]")
+    import re
+    word = re.compile(r"(?P<w>[a-z]+)-(?P=w)[0-9]{2,}", re.I)
     p = P(1, (2,))
     ok = (repr(p) == "P(x=1, y=(2,))" and p == P(1, (2,)) and P(0) < p
           and hash(p) == hash(P(1, (2,)))
-          and Pair(1, 2).b == 2 and ref.__forward_code__.co_filename == "<string>")
+          and Pair(1, 2).b == 2 and ref.__forward_code__.co_filename == "<string>"
+          and word.fullmatch("Ab-ab42").group("w") == "Ab")
+    ours = re._compiler.compile.__module__ == "fm2uav._code_cache"
     stats = _code_cache.stats()
     saved = _code_cache.save()
-    print(json.dumps({"installed": installed, "ok": ok, "stats": stats, "saved": saved}))
+    print(json.dumps({"installed": installed, "ok": ok, "stats": stats, "saved": saved,
+                      "re": ours}))
 """)
 
 
@@ -132,13 +175,13 @@ def _probe(tmp_path, **env):
 
 def test_a_second_process_takes_every_entry_from_the_table(tmp_path):
     first = _probe(tmp_path)
-    assert first["installed"] and first["ok"] and first["saved"]
-    assert first["stats"]["new"] >= 5  # the dataclass's methods, the namedtuple, the ref
+    assert first["installed"] and first["ok"] and first["saved"] and first["re"]
+    assert first["stats"]["new"] >= 6  # the dataclass's methods, the namedtuple, the ref, re
     second = _probe(tmp_path)
     assert second["ok"] and not second["saved"]
     assert second["stats"]["new"] == 0 and second["stats"]["hits"] == first["stats"]["new"]
     off = _probe(tmp_path, FM2UAV_CODE_CACHE="0")
-    assert off["ok"] and not off["installed"] and off["stats"]["entries"] == 0
+    assert off["ok"] and not off["installed"] and off["stats"]["entries"] == 0 and not off["re"]
 
 
 def test_the_entry_point_keeps_the_table_and_answers_the_same(tmp_path):
@@ -150,7 +193,8 @@ def test_the_entry_point_keeps_the_table_and_answers_the_same(tmp_path):
     assert answers[0].returncode == 2
     files = list((tmp_path / "code").iterdir())
     assert [f.name for f in files] == [os.path.basename(_code_cache.cache_file("plan"))]
-    assert len(_code_cache._load(str(files[0]))) > 50
+    kept = _code_cache._load(str(files[0]))
+    assert len(kept) > 50 and sum(key[0] == "re" for key in kept) > 10  # typer's, rich's...
 
 
 def test_each_command_word_has_a_table_and_anything_else_shares_one():
@@ -159,3 +203,39 @@ def test_each_command_word_has_a_table_and_anything_else_shares_one():
     assert names["plan"].endswith("-plan.marshal") and names["x-y2"].endswith("-x-y2.marshal")
     assert len({names[w] for w in ("", "--help", "Plan", "../x", "a b")}) == 1
     assert names[""].endswith("-_.marshal") and sys.implementation.cache_tag in names[""]
+
+
+def test_a_write_that_fails_leaves_the_kept_table_and_no_partial_file(table, tmp_path,
+                                                                      monkeypatch):
+    path = tmp_path / "code" / "t.marshal"
+    path.parent.mkdir()
+    path.write_bytes(b"kept")
+    monkeypatch.setattr(_code_cache._State, "path", str(path))
+    _code_cache.lookup("1 + 1", "eval", 0)
+    real_dumps = marshal.dumps
+
+    def full_disk(obj):  # the table cannot be written whole
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(marshal, "dumps", full_disk)
+    assert not _code_cache.save()
+    assert sorted(p.name for p in path.parent.iterdir()) == ["t.marshal"]
+    assert path.read_bytes() == b"kept"
+    monkeypatch.setattr(marshal, "dumps", real_dumps)
+    assert _code_cache.save() and _code_cache._load(str(path))
+
+
+def test_a_new_pattern_while_other_threads_run_goes_to_re(table):
+    import threading
+
+    release = threading.Event()
+    other = threading.Thread(target=release.wait)
+    other.start()
+    try:
+        assert _code_cache._re_compile("a+b", 0) == re._compiler.compile("a+b", 0)
+        assert table.table == {}
+    finally:
+        release.set()
+        other.join()
+    _code_cache._re_compile("a+b", 0)
+    assert list(table.table) == [("re", 0, "a+b")]

@@ -8,13 +8,17 @@ and compiled again in every process: each ``@dataclass`` class compiles its ``__
 (``from __future__ import annotations`` in pydantic-core's schema types, pydantic's
 models) becomes a :class:`typing.ForwardRef` that compiles its text (``compile``). On
 ``fm2uav run bad.yaml`` that is ~1,300 compilations, ~190 M instructions (~22 % of the
-answer); on ``fm2uav plan --bogus`` ~100.
+answer); on ``fm2uav plan --bogus`` ~100. Regular expressions are the same kind of work:
+:mod:`re` parses a pattern and compiles it to the matcher's code in Python (~60 patterns
+compiled at import on ``run bad.yaml``: textwrap, logging, yaml's resolver, rich, typer...).
 
 :func:`install` (the entry point, :mod:`fm2uav.__main__`, once a help page is not served
 from :mod:`fm2uav._help_cache`) gives those three modules an ``exec``, ``eval`` and
 ``compile`` of their own (a module global, which the module's code finds before the
 built-in) that look the text up in a table of code objects kept from earlier runs and
-compile it only when it is new. :func:`save` (at exit) adds the new ones to the table.
+compile it only when it is new, and :mod:`re` a compiler (``re._compiler.compile``) that
+takes a pattern's matcher code (the arguments of ``_sre.compile``) from the same table.
+:func:`save` (at exit) adds the new ones to the table.
 
 The key of a code object is everything compiling reads: the exact text, the mode
 (``exec`` / ``eval``), the ``__future__`` flags the built-in would inherit from its
@@ -23,7 +27,11 @@ caller, and the interpreter (the file's name holds its bytecode magic number and
 of those alone, so a kept entry can never differ from a fresh compilation: there is
 nothing to go stale. Anything else (bytes, a file name other than ``<string>``, explicit
 flags, another ``optimize``) goes to the built-in unchanged, and so does a text the
-built-in refuses (its own error, raised by the built-in itself).
+built-in refuses (its own error, raised by the built-in itself). A pattern's key is its
+text (``str`` or ``bytes``) and flags; a pattern the parser refuses raises the parser's
+error, and one whose parsing warns (a possible nested set...) is not kept, so it warns
+again in every run; ``re.DEBUG``, and a new pattern while other threads run (the warnings'
+check is process-wide), go to :mod:`re` unchanged.
 
 The tables live in ``$FM2UAV_CACHE_DIR/code``, else ``$XDG_CACHE_HOME/fm2uav/code``
 (``~/.cache``), one :mod:`marshal` file per interpreter and command word (``plan``,
@@ -71,8 +79,8 @@ def _future_mask() -> int:
 
 
 class _State:
-    table: dict[tuple[str, int, str], Any] | None = None  # None: not installed
-    used: dict[tuple[str, int, str], Any] = {}  # the entries this run looked up or added
+    table: dict[tuple[str, int, Any], Any] | None = None  # None: not installed (key: mode, flags, text)
+    used: dict[tuple[str, int, Any], Any] = {}  # the entries this run looked up or added
     new = 0  # entries compiled in this run
     hits = 0
     path = ""
@@ -208,6 +216,11 @@ def install(command: str = "") -> bool:
         for name in names:
             if name not in namespace:  # a module of its own name: left as it is
                 namespace[name] = _STAND_INS[name]
+    import re._compiler
+
+    if not _RE_COMPILE:
+        _RE_COMPILE.append(re._compiler.compile)
+        re._compiler.compile = _re_compile
     return True
 
 
@@ -219,16 +232,60 @@ def save() -> bool:
         return False
     keep = table if len(table) <= MAX_ENTRIES else dict(_State.used)
     path = _State.path
+    tmp = f"{path}.{os.getpid()}.tmp"
     try:
         os.makedirs(os.path.dirname(path), exist_ok=True)
-        tmp = f"{path}.{os.getpid()}.tmp"
         with open(tmp, "wb") as fh:
             fh.write(marshal.dumps((_HEADER, sys.version, keep)))
         os.replace(tmp, path)
     except (OSError, ValueError):
+        try:  # a write cut short (a full disk...) leaves no partial file behind
+            os.unlink(tmp)
+        except OSError:
+            pass
         return False
     _State.new = 0
     return True
+
+
+def _re_compile(p: Any, flags: int = 0) -> Any:
+    """``re._compiler.compile`` with the matcher's code of a pattern text from the table
+    (see the module's notes): the same ``_sre.compile`` call, its arguments kept."""
+    compiler = sys.modules["re._compiler"]
+    if not (type(p) in (str, bytes) and type(flags) is int) or flags & compiler.SRE_FLAG_DEBUG:
+        return (_RE_COMPILE or [compiler.compile])[0](p, flags)
+    key = ("re", flags, p)
+    table = _State.table
+    args = table.get(key) if table is not None else None
+    if args is None:
+        import threading
+        import warnings
+
+        if threading.active_count() > 1:  # catch_warnings is process-wide: left to re
+            return (_RE_COMPILE or [compiler.compile])[0](p, flags)
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            parsed = compiler._parser.parse(p, flags)
+        for w in said:  # said again where the parser said it; such a pattern is not kept
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        state = parsed.state
+        index = [None] * state.groups
+        for name, i in state.groupdict.items():
+            index[i] = name
+        code = list(map(int, compiler._code(parsed, flags)))  # marshal takes plain ints
+        args = (flags | state.flags, code, state.groups - 1, dict(state.groupdict),
+                tuple(index))
+        if table is not None and not said:
+            table[key] = args
+            _State.new += 1
+    else:
+        _State.hits += 1
+    _State.used[key] = args
+    return compiler._sre.compile(p, *args)
+
+
+#: ``re._compiler.compile`` as :mod:`re` has it (set by :func:`install`).
+_RE_COMPILE: list[Any] = []
 
 
 def stats() -> dict[str, int]:
