@@ -10,6 +10,11 @@ second run without ``--force`` is fine: it is refused and leaves the folder as i
 test folders that mirror different packages, so they live here too; fixtures used by one
 folder only stay in that folder's conftest.py.
 
+The command line's caches between runs (help pages and compiled code: fm2uav._help_cache,
+fm2uav._code_cache) live in a folder of the test session's own (``FM2UAV_CACHE_DIR``, set
+when pytest starts unless the caller set it; the workers of pytest-xdist inherit it, it is
+removed at the end), never in the user's ~/.cache/fm2uav.
+
 Long end-to-end tests are marked ``@pytest.mark.slow``: ``make test`` runs them,
 ``make test-fast`` (``-m "not slow"``) leaves them out.
 """
@@ -18,7 +23,9 @@ from __future__ import annotations
 
 import os
 import re
+import shutil
 import signal
+import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -83,6 +90,10 @@ class XdistScheduling:
 
 
 def pytest_configure(config):
+    if "FM2UAV_CACHE_DIR" not in os.environ:  # this session's own (see the module's notes)
+        cache = tempfile.mkdtemp(prefix="fm2uav-test-cache-")
+        os.environ["FM2UAV_CACHE_DIR"] = cache
+        config.add_cleanup(lambda: shutil.rmtree(cache, ignore_errors=True))
     if config.pluginmanager.hasplugin("xdist"):
         config.pluginmanager.register(XdistScheduling(), "fm2uav-xdist-scheduling")
 
