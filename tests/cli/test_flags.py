@@ -243,13 +243,30 @@ def _methods() -> dict[str, list[Node]]:
     return index
 
 
-def _class_members(key: Node) -> list[Node]:
+@lru_cache(maxsize=1)
+def _by_module() -> dict[str, list[tuple[str, ast.AST]]]:
+    """Module → its nodes ``(qualified name, node)``, in :func:`nodes`' order."""
+    out: dict[str, list[tuple[str, ast.AST]]] = {}
+    for (module, q), n in nodes().items():
+        out.setdefault(module, []).append((q, n))
+    return out
+
+
+@lru_cache(maxsize=None)
+def _class_members(key: Node) -> tuple[Node, ...]:
     """A class reaches its body and its dunder methods (run without being named)."""
     module, q = key
-    return [(m, n) for m, n in nodes() if m == module and n.startswith(q + ".__")]
+    return tuple((module, n) for n, _ in _by_module().get(module, ())
+                 if n.startswith(q + ".__"))
 
 
-def _mentions(key: Node) -> Iterator[Node]:
+@lru_cache(maxsize=None)
+def _mentions(key: Node) -> tuple[Node, ...]:
+    """The nodes the body of ``key`` names (each command's walk reads them: kept)."""
+    return tuple(_mentioned(key))
+
+
+def _mentioned(key: Node) -> Iterator[Node]:
     module = key[0]
     aliases = {k for k, (m, a) in _imports(module).items() if a is None}
     for n in _runtime(nodes()[key]):
@@ -305,7 +322,7 @@ def reach(callback) -> frozenset[Node]:
         if key in seen or key not in nodes() or key[0].startswith(PAGE_PACKAGE):
             continue
         seen.add(key)
-        todo += list(_mentions(key))
+        todo += _mentions(key)
         if isinstance(nodes()[key], ast.ClassDef):
             todo += _class_members(key)
     return frozenset(seen)
@@ -351,12 +368,13 @@ def messages() -> Iterator[tuple[str, str | None, int, str]]:
                 skip.update(id(n) for n in ast.walk(node))
         pieces = {id(v) for p in ast.walk(t) if isinstance(p, ast.JoinedStr) for v in p.values}
         owner: dict[int, str] = {}
-        for (m, q), n in nodes().items():
-            if m == module and not isinstance(n, ast.ClassDef):
+        own = _by_module().get(module, [])
+        for q, n in own:
+            if not isinstance(n, ast.ClassDef):
                 for sub in ast.walk(n):
                     owner.setdefault(id(sub), q)
-        for (m, q), n in nodes().items():  # class bodies (defaults) last: methods win
-            if m == module and isinstance(n, ast.ClassDef):
+        for q, n in own:  # class bodies (defaults) last: methods win
+            if isinstance(n, ast.ClassDef):
                 for sub in ast.walk(n):
                     owner.setdefault(id(sub), q)
         for node in ast.walk(t):
