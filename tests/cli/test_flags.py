@@ -353,31 +353,41 @@ def messages() -> Iterator[tuple[str, str | None, int, str]]:
         if module in NOT_MESSAGES:
             continue
         t = tree(module)
-        parent = {id(c): n for n in ast.walk(t) for c in ast.iter_child_nodes(n)}
+        everything = list(ast.walk(t))
+        kids = {id(n): list(ast.iter_child_nodes(n)) for n in everything}
+
+        def walk(top: ast.AST) -> Iterator[ast.AST]:  # ast.walk on the children listed once
+            todo = [top]
+            while todo:
+                n = todo.pop()
+                yield n
+                todo.extend(kids[id(n)])
+
+        parent = {id(c): n for n in everything for c in kids[id(n)]}
         skip: set[int] = set()
-        for node in ast.walk(t):
-            for child in ast.iter_child_nodes(node):
+        for node in everything:
+            for child in kids[id(node)]:
                 if isinstance(child, ast.Expr) and _is_doc(child, node):
-                    skip.update(id(n) for n in ast.walk(child))
+                    skip.update(id(n) for n in walk(child))
             if isinstance(node, ast.keyword) and node.arg == "help":
-                skip.update(id(n) for n in ast.walk(node.value))
+                skip.update(id(n) for n in walk(node.value))
             if isinstance(node, ast.Assign) and any(getattr(x, "id", "").endswith("_HELP")
                                                     for x in node.targets):
-                skip.update(id(n) for n in ast.walk(node.value))
+                skip.update(id(n) for n in walk(node.value))
             if isinstance(node, ast.FunctionDef) and node.name == "_help":  # a help text
-                skip.update(id(n) for n in ast.walk(node))
-        pieces = {id(v) for p in ast.walk(t) if isinstance(p, ast.JoinedStr) for v in p.values}
+                skip.update(id(n) for n in walk(node))
+        pieces = {id(v) for p in everything if isinstance(p, ast.JoinedStr) for v in p.values}
         owner: dict[int, str] = {}
         own = _by_module().get(module, [])
         for q, n in own:
             if not isinstance(n, ast.ClassDef):
-                for sub in ast.walk(n):
+                for sub in walk(n):
                     owner.setdefault(id(sub), q)
         for q, n in own:  # class bodies (defaults) last: methods win
             if isinstance(n, ast.ClassDef):
-                for sub in ast.walk(n):
+                for sub in walk(n):
                     owner.setdefault(id(sub), q)
-        for node in ast.walk(t):
+        for node in everything:
             if id(node) in skip or id(node) in pieces:
                 continue
             if not (isinstance(node, ast.JoinedStr) or isinstance(node, ast.Constant)
