@@ -56,8 +56,6 @@ def test_every_example_validates(examples, name):
     assert m.version == 1 and m.outputs.formats
 
 
-@pytest.mark.parametrize("name", ["open_field_tff.yaml", "town_buildings.yaml",
-                                  "jacksboro_geotiff.yaml"])
 def _example_run(cli_once, examples: Path, name: str):
     """``fm2uav run examples/NAME --json`` from the folder holding ``examples``: one run per
     example for the session (tests/conftest.py), shared with the docs' run of the same command
@@ -70,6 +68,8 @@ def _example_run(cli_once, examples: Path, name: str):
         os.chdir(old)
 
 
+@pytest.mark.parametrize("name", ["open_field_tff.yaml", "town_buildings.yaml",
+                                  "jacksboro_geotiff.yaml"])
 def test_examples_run_end_to_end(examples, name, cli_once):
     # the default mission's run is shared with
     # test_export_converts_an_existing_path_for_another_firmware
