@@ -12,16 +12,21 @@ from fm2uav.cli import app
 runner = CliRunner()
 
 
-def test_formation_cli_writes_outputs(tmp_path):
-    out = tmp_path / "f"
-    res = runner.invoke(app, ["formation", "--level", "7", "--no-gif", "--json", "--out", str(out)])
+#: the documented formation run (README.md, docs/formation.md), made once per session with
+#: tests/e2e/test_reports.py and the docs' run (tests/conftest.py, cli_once)
+FORMATION = ["formation", "--scenario", "fissure", "--level", "7", "--report", "--json"]
+
+
+def test_formation_cli_writes_outputs(cli_once):
+    run = cli_once(FORMATION)
+    res, out = run.result, run.out
     assert res.exit_code == 0, res.output
     summary = json.loads(res.output)
     assert summary["completed"] and summary["min_separation_m"] >= 30.0
     assert summary["inside_terrain_samples"] == 0
     assert summary["agl_m"] == [105.0, 105.0, 105.0]
     for name in ("trajectories.csv", "metrics.csv", "cycles.csv", "summary.json",
-                 "paths.png", "profiles.png", "metrics.png"):
+                 "paths.png", "profiles.png", "metrics.png", "formation.gif"):
         assert (out / name).stat().st_size > 0, name
     with open(out / "trajectories.csv") as fh:
         rows = list(csv.DictReader(fh))
@@ -29,7 +34,7 @@ def test_formation_cli_writes_outputs(tmp_path):
     last = [r for r in rows if r["uav"] == "leader"][-1]
     np.testing.assert_allclose([float(last[k]) for k in ("x_m", "y_m", "z_m")],
                                [1680, 600, 450], atol=1e-3)
-    # no overwrite without --force
+    # no overwrite without --force (refused: the shared folder is left as it was)
     res = runner.invoke(app, ["formation", "--no-gif", "--out", str(out)])
     assert res.exit_code == 2 and "--force" in res.output
 

@@ -1,7 +1,8 @@
 """Every mission command writes report.html with --report: self-contained, the expected
 traces and tables, --json on stdout, and no overwrite without --force (exit 2, files kept).
 
-Each command runs once on its quickest setting (module fixture); the tests read its outputs.
+Each command runs once on its quickest setting (module fixture; formation: the documented
+run of README.md, shared with the docs' run) and the tests read its outputs.
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ CASES = {
               ["report.html"],
               ["FM² path", "area", "bands", "terrain", "FM² path ideal (100 m AGL)",
                "FM² path start", "FM² path goal"], []),
-    "formation": (["formation", "--level", "7", "--no-gif"],
+    "formation": (["formation", "--scenario", "fissure", "--level", "7"],
                   ["report.html"],
                   ["leader", "follower 1", "follower 2", "leader FM² plan",
                    "leader ideal (105 m AGL)", "terrain"], ["UAVs"]),
@@ -117,7 +118,9 @@ def _cases():
 def runs(tmp_path_factory, cli_once):
     """Every command run once, when a test first asks for it, with --report --json:
     name -> (result, out dir, args). The reproductions go through the session's
-    ``cli_once`` (tests/conftest.py), shared with tests/cli/test_cmd_city.py, test_cmd_tff.py, test_cmd_formation.py."""
+    ``cli_once`` (tests/conftest.py), shared with tests/cli/test_cmd_city.py, test_cmd_tff.py,
+    test_cmd_formation.py; formation's is also the docs' run of ``fm2uav formation --scenario
+    fissure --level 7`` (README.md, with --report --json)."""
     tmp = tmp_path_factory.mktemp("cli_reports")
     bent = str(_bent_path(tmp))
 

@@ -2,6 +2,7 @@
 each gives one specific line (field, bad value, allowed range) and exit code 2."""
 
 import json
+import os
 import shutil
 from pathlib import Path
 
@@ -36,11 +37,12 @@ def _write_dem(path, crs="EPSG:32630", size=(40, 50)):
 
 @pytest.fixture(scope="module")
 def examples(tmp_path_factory):
-    """A copy of examples/ with the generated GeoTIFF (as a user makes it)."""
+    """A copy of examples/ with the generated GeoTIFF (as a user makes it), in a folder of
+    its own named ``examples`` (the docs' commands name ``examples/...``)."""
     import importlib.util
 
-    d = tmp_path_factory.mktemp("examples")
-    shutil.copytree(EXAMPLES, d, dirs_exist_ok=True)
+    d = tmp_path_factory.mktemp("user") / "examples"
+    shutil.copytree(EXAMPLES, d)
     spec = importlib.util.spec_from_file_location("mk", d / "make_jacksboro_geotiff.py")
     mk = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mk)
@@ -54,12 +56,24 @@ def test_every_example_validates(examples, name):
     assert m.version == 1 and m.outputs.formats
 
 
+def _example_run(cli_once, examples: Path, name: str):
+    """``fm2uav run examples/NAME --json`` from the folder holding ``examples``: one run per
+    example for the session (tests/conftest.py), shared with the docs' run of the same command
+    (docs/operator.md runs ``examples/jacksboro_geotiff.yaml`` so)."""
+    old = Path.cwd()
+    os.chdir(examples.parent)
+    try:
+        return cli_once(["run", f"examples/{name}", "--json"])
+    finally:
+        os.chdir(old)
+
+
 @pytest.mark.parametrize("name", ["open_field_tff.yaml", "town_buildings.yaml",
                                   "jacksboro_geotiff.yaml"])
 def test_examples_run_end_to_end(examples, name, cli_once):
-    # one run per example for the session (tests/conftest.py); the default mission's run
-    # is shared with test_export_converts_an_existing_path_for_another_firmware
-    run = cli_once(["run", str(examples / name), "--json"])
+    # the default mission's run is shared with
+    # test_export_converts_an_existing_path_for_another_firmware
+    run = _example_run(cli_once, examples, name)
     res, out = run.result, run.out
     assert res.exit_code == 0, res.output
     summary = json.loads(res.output)
@@ -324,7 +338,7 @@ def test_a_mission_file_with_two_via_points_and_a_return_leg(tmp_path):
 
 def test_export_converts_an_existing_path_for_another_firmware(examples, tmp_path, cli_once):
     # the default mission's run of test_examples_run_end_to_end (one run per session)
-    run = cli_once(["run", str(examples / "open_field_tff.yaml"), "--json"])
+    run = _example_run(cli_once, examples, "open_field_tff.yaml")
     res, out = run.result, run.out
     assert res.exit_code == 0, res.output
     conv = tmp_path / "conv"

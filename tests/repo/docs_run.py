@@ -8,9 +8,11 @@ How a block is run depends on its language (the word after the opening fence):
   and the data files the docs name (``country.tif``, ``osm.geojson``, ...: made on demand by
   :data:`tests.repo.docs_data.FILES`). ``fm2uav ...`` and ``.venv/bin/fm2uav ...`` run in this
   process through the CLI (with ``--out``: once per session, shared with every test asking for
-  the same run, ``cli_once``); ``fm2uav app ...`` is started as a server, asked for its page and
-  session, and stopped with Ctrl-C; ``make run`` runs the Makefile's target with ``OUT`` in the
-  workspace; anything else runs in ``bash`` with the venv first on ``PATH``. Each must exit 0.
+  the same run, ``cli_once``; a ``sweep`` into the folder that another run of the docs filled
+  resumes it, in a copy of that folder, as the reader's does); ``fm2uav app ...`` is started
+  as a server, asked for its page and session, and stopped with Ctrl-C; ``make run`` runs the
+  Makefile's target with ``OUT`` in the workspace; anything else runs in ``bash`` with the venv
+  first on ``PATH``. Each must exit 0.
 * ``python``: the blocks of one document run in order in one namespace, in the workspace. An
   expression statement whose comment starts with ``→`` states its value: the numbers (and
   ``True``/``False``/``None``, quoted strings) after the arrow, up to an opening parenthesis,
@@ -228,6 +230,8 @@ class Workspace:
                         ignore=shutil.ignore_patterns("*.tif", "__pycache__"))
         (path / ".venv").symlink_to(Path(sys.prefix))
         self.bin = Path(sys.prefix) / "bin"
+        #: the output folders linked to a session run, and the arguments of that run
+        self.linked: dict[Path, list[str]] = {}
         self.env = {**os.environ, **WIDE,
                     "PATH": f"{self.bin}{os.pathsep}{os.environ.get('PATH', '')}"}
 
@@ -277,12 +281,20 @@ class Workspace:
         with self.here():
             if out is not None and not wide:
                 key = _without(args, "--out")
-                run = self.cli_once(key)
                 target = self.path / out
-                if not target.exists() and not target.is_symlink():
-                    target.parent.mkdir(parents=True, exist_ok=True)
-                    target.symlink_to(run.out)
-                return Result(command, run.result.exit_code, run.result.output, target)
+                if not (args[:1] == ["sweep"] and self.linked.get(target, key) != key):
+                    run = self.cli_once(key)
+                    if not target.exists() and not target.is_symlink():
+                        target.parent.mkdir(parents=True, exist_ok=True)
+                        target.symlink_to(run.out)
+                        self.linked[target] = key
+                    return Result(command, run.result.exit_code, run.result.output, target)
+                # a sweep into the folder another sweep filled resumes it, as the reader's
+                # does (docs/sweeps.md): in a copy, the shared run's folder stays as it was made
+                shared = target.resolve()
+                target.unlink()
+                shutil.copytree(shared, target)
+                del self.linked[target]
             res = CliRunner(env=WIDE).invoke(app, args)
         text = res.output
         if res.exception is not None and not isinstance(res.exception, SystemExit):

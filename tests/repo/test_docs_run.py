@@ -15,8 +15,8 @@ from types import SimpleNamespace
 import pytest
 
 from .conftest import README, pages_wanted
-from .docs_run import (DOCS, LANGS, BlockResult, Result, _claims, all_blocks, blocks,
-                       check_claim, commands, parse_marker, run_python, runs_by_out,
+from .docs_run import (DOCS, LANGS, BlockResult, Result, Workspace, _claims, all_blocks,
+                       blocks, check_claim, commands, parse_marker, run_python, runs_by_out,
                        text_lines_found, with_markers)
 
 BLOCKS = all_blocks()
@@ -123,6 +123,37 @@ def test_markers_are_read_and_need_reasons(tmp_path):
         parse_marker('skip "x"', "d.md:1")
     with pytest.raises(ValueError, match="unknown docs-run marker"):
         parse_marker("run it", "d.md:1")
+
+
+def test_a_sweep_into_another_sweeps_folder_resumes_a_copy_of_it(tmp_path):
+    """The docs' runs share one run per argument list (cli_once); a sweep into the folder of
+    a different sweep is the reader's resume: it runs in a copy, the shared folder untouched."""
+    made, runs = [], {}
+
+    def cli_once(args):  # as tests/conftest.py's: one run per argument list
+        if tuple(args) not in runs:
+            out = tmp_path / "shared" / str(len(made))
+            out.mkdir(parents=True)
+            (out / "cases.jsonl").write_text("kept\n")
+            made.append(tuple(args))
+            runs[tuple(args)] = SimpleNamespace(
+                result=SimpleNamespace(exit_code=0, output="ran"), out=out)
+        return runs[tuple(args)]
+
+    ws = Workspace(tmp_path / "ws", cli_once, {}, {})
+    (ws.path / "bad.yaml").write_text("xi: -1\n")
+    first = ws.run("fm2uav sweep examples/sweeps/city2d_small.yaml --out out/sweep")
+    again = ws.run("fm2uav sweep examples/sweeps/city2d_small.yaml --out out/sweep  # resumes")
+    assert (first.code, again.code) == (0, 0) and (ws.path / "out/sweep").is_symlink()
+    assert made == [("sweep", "examples/sweeps/city2d_small.yaml")]
+    resumed = ws.run("fm2uav sweep bad.yaml --out out/sweep --keep-failed")
+    assert resumed.code == 2 and "xi" in resumed.output  # the CLI's own answer, not a shared run
+    assert len(made) == 1 and not (ws.path / "out/sweep").is_symlink()
+    assert (ws.path / "out/sweep/cases.jsonl").read_text() == "kept\n"
+    assert sorted(p.name for p in (tmp_path / "shared" / "0").iterdir()) == ["cases.jsonl"]
+    # any other command into a folder already made shares its own run, as before
+    ws.run("fm2uav plan --scenario open-field --out out/sweep")
+    assert made[-1] == ("plan", "--scenario", "open-field")
 
 
 # ------------------------------------------------------------------ what the session runs

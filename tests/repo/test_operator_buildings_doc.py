@@ -5,12 +5,15 @@ mission is written relative to home, with a home altitude that is unknown."""
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import shlex
 from pathlib import Path
 
 import pytest
+
+from .docs_run import _without
 
 ROOT = Path(__file__).resolve().parents[2]
 DOC = ROOT / "docs" / "operator.md"
@@ -25,28 +28,43 @@ def _doc_command() -> list[str]:
     return shlex.split(lines[0])[1:]
 
 
+@contextlib.contextmanager
+def _in_repository():
+    """The guide's paths are relative to the repository."""
+    old = os.getcwd()
+    os.chdir(ROOT)
+    try:
+        yield
+    finally:
+        os.chdir(old)
+
+
+def _read(out: Path) -> tuple[dict, dict]:
+    return (json.loads((out / "summary.json").read_text()),
+            json.loads((out / "mission.plan").read_text()))
+
+
 def _run(args: list[str], out: Path) -> tuple[dict, dict]:
     from typer.testing import CliRunner
 
     from fm2uav.cli import app
 
     args = [*args[:args.index("--out")], "--out", str(out), "--quiet"]
-    old = os.getcwd()
-    os.chdir(ROOT)  # the guide's paths are relative to the repository
-    try:
+    with _in_repository():
         res = CliRunner().invoke(app, args)
-    finally:
-        os.chdir(old)
     assert res.exit_code == 0, res.output
-    return (json.loads((out / "summary.json").read_text()),
-            json.loads((out / "mission.plan").read_text()))
+    return _read(out)
 
 
 @pytest.mark.slow
-def test_buildings_alone_on_a_ground_elevation_and_without_one(tmp_path):
+def test_buildings_alone_on_a_ground_elevation_and_without_one(tmp_path, cli_once):
     args = _doc_command()
     ground = float(args[args.index("--ground-elevation") + 1])
-    s, plan = _run(args, tmp_path / "amsl")
+    # the command as written: the run the docs' run makes of it (cli_once, once per session)
+    with _in_repository():
+        run = cli_once(_without(args, "--out"))
+    assert run.result.exit_code == 0, run.result.output
+    s, plan = _read(run.out)
     wps = [it for it in plan["mission"]["items"] if it["command"] == 16]
     assert {it["frame"] for it in wps} == {0}
     assert s["autopilot"]["home"]["alt_amsl_m"] == ground

@@ -8,9 +8,8 @@ import shlex
 from pathlib import Path
 
 import pytest
-from typer.testing import CliRunner
 
-from fm2uav.cli import app
+from .docs_run import _without, commands
 
 ROOT = Path(__file__).resolve().parents[2]
 DOC = (ROOT / "docs" / "operator.md").read_text()
@@ -21,14 +20,14 @@ def _section() -> str:
 
 
 @pytest.mark.slow
-def test_the_terrain_files_command_writes_what_the_guide_says(tmp_path):
+def test_the_terrain_files_command_writes_what_the_guide_says(cli_once):
     text = _section()
-    block = re.search(r"```bash\n(.*?)```", text, flags=re.S).group(1).replace("\\\n", " ")
-    args = shlex.split(block)
-    assert args[0] == ".venv/bin/fm2uav"
-    out = tmp_path / Path(args[args.index("--out") + 1]).name
-    args[args.index("--out") + 1] = str(out)
-    res = CliRunner().invoke(app, args[1:], env={"COLUMNS": "300"})
+    (command,) = commands(re.search(r"```bash\n(.*?)```", text, flags=re.S).group(1))
+    args = shlex.split(command, comments=True)
+    assert args[0] == ".venv/bin/fm2uav" and "--out" in args
+    # the run the docs' run makes of the same command (cli_once: once per session)
+    run = cli_once(_without(args[1:], "--out"))
+    res, out = run.result, run.out
     assert res.exit_code == 0, res.output
     spacing = int(args[args.index("--terrain-spacing") + 1])
     dat = re.search(r"`terrain/(\w+\.DAT)`", text).group(1)
