@@ -158,9 +158,12 @@ def area_between_curves(P: Any, Q: Any) -> float:
     faces = shapely.get_parts(shapely.polygonize(shapely.get_parts(noded)))
     if len(faces) == 0:
         return 0.0
-    # each face's area and inner point (representative_point) in one call each, then the
-    # faces the polygon winds around summed in their order
-    areas = np.ascontiguousarray(shapely.area(faces), dtype=np.float64)
-    xy = np.ascontiguousarray(shapely.get_coordinates(shapely.point_on_surface(faces)),
-                              dtype=np.float64)
-    return float(_wound_area(ring, areas, xy))
+    # the faces' areas, then the inner points (representative_point) of those with a
+    # positive area, in one call each; the faces the polygon winds around summed in order
+    areas = np.asarray(shapely.area(faces), dtype=np.float64)
+    keep = areas > 0.0
+    if not keep.any():
+        return 0.0
+    pts = shapely.point_on_surface(faces[keep])
+    xy = np.column_stack([shapely.get_x(pts), shapely.get_y(pts)])
+    return float(_wound_area(ring, np.ascontiguousarray(areas[keep]), xy))
