@@ -28,7 +28,7 @@ area_between_curves(S[::-1].copy(), T[::-1])
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("kernel", ["_frechet_kernel", "_winding"])
+@pytest.mark.parametrize("kernel", ["_frechet_kernel", "_wound_area"])
 def test_a_later_comparison_needs_no_signature_the_warm_up_did_not_compile(kernel):
     assert_covers("fm2uav.analysis.warmup", f"fm2uav.analysis.similarity:{kernel}", LATER)
 

@@ -110,6 +110,17 @@ def _winding(ring, x, y):
     return w
 
 
+@njit(cache=True)
+def _wound_area(ring, areas, xy):
+    """Sum, in order, of the ``areas`` [m²] of the faces with a positive area whose inner
+    point ``xy[i]`` the closed polyline ``ring`` winds around."""
+    total = 0.0
+    for i in range(areas.shape[0]):
+        if areas[i] > 0.0 and _winding(ring, xy[i, 0], xy[i, 1]) != 0:
+            total += areas[i]
+    return total
+
+
 def area_between_curves(P: Any, Q: Any) -> float:
     """Area enclosed between two 2D curves with common end points [m²].
 
@@ -145,12 +156,14 @@ def area_between_curves(P: Any, Q: Any) -> float:
         return 0.0
     noded = shapely.node(LineString(ring))
     faces = shapely.get_parts(shapely.polygonize(shapely.get_parts(noded)))
-    total = 0.0
-    for face in faces:
-        a = face.area
-        if a <= 0.0:
-            continue
-        pt = face.representative_point()
-        if _winding(ring, pt.x, pt.y) != 0:
-            total += a
-    return float(total)
+    if len(faces) == 0:
+        return 0.0
+    # the faces' areas, then the inner points (representative_point) of those with a
+    # positive area, in one call each; the faces the polygon winds around summed in order
+    areas = np.asarray(shapely.area(faces), dtype=np.float64)
+    keep = areas > 0.0
+    if not keep.any():
+        return 0.0
+    pts = shapely.point_on_surface(faces[keep])
+    xy = np.column_stack([shapely.get_x(pts), shapely.get_y(pts)])
+    return float(_wound_area(ring, np.ascontiguousarray(areas[keep]), xy))

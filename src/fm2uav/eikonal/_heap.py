@@ -4,8 +4,9 @@ A heap of ``size`` entries lives in two arrays, ``key[i]`` (the priority, e.g. a
 arrival time [s]) and ``item[i]`` (what it orders, e.g. a node index); slot 0 holds
 the smallest key. An indexed heap also keeps ``pos[item] = slot`` up to date (so a
 key can be lowered in place); a heap with lazy deletion passes an empty ``pos``.
-Used by the source boxes of :mod:`._sources` and by the lattice search of
-:mod:`fm2uav.baselines.reference`.
+Used by the source boxes of :mod:`._sources`; the lattice search of
+:mod:`fm2uav.baselines.reference` takes the same steps on one interleaved array, and its
+tests check it against these two.
 """
 
 from __future__ import annotations

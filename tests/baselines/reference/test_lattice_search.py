@@ -3,7 +3,9 @@
 ``_loop_search`` below is the search as it was before the padded, vectorised filter (the
 same binary heap with lazy deletion, each primitive tested in turn), run as plain Python.
 Both are run on seeded random maps and control sets — integer costs, so that many states
-tie — and must return the same goal state, cost-to-come, parents and expansion count.
+tie — and must return the same goal state, cost-to-come, parents and expansion count. The
+kernel's heap (keys and state ids interleaved in one array) must pop what the two-array
+heap of ``fm2uav.eikonal._heap`` pops, in the same order, ties included.
 """
 
 from __future__ import annotations
@@ -159,6 +161,31 @@ def test_a_source_in_an_obstacle_is_expanded_like_any_other():
     args[0] = free
     args[10] = np.array([(2 * 9 + 2) * K + 1], np.int64)
     _same(tuple(args))
+
+
+def test_the_interleaved_heap_pops_like_the_two_array_heap():
+    rng = np.random.default_rng(11)
+    push, pop = _kernels._push.py_func, _kernels._pop.py_func
+    size = 4000
+    hk, hv, nopos = np.empty(size), np.empty(size, np.int64), np.empty(0, np.int64)
+    hh = np.empty(2 * size)
+    n = m = 0
+    got, want = [], []
+    for i in range(3000):  # pushes and pops mixed, few distinct keys: many ties
+        if n > 0 and rng.random() < 0.4:
+            want.append((hk[0], hv[0]))
+            n -= 1
+            if n > 0:
+                _down(hk, hv, nopos, n, hk[n], hv[n])
+            key, val, m = pop(hh, m)
+            got.append((key, int(val)))
+        else:
+            key = float(rng.integers(0, 6))
+            _up(hk, hv, nopos, n, key, i)
+            n += 1
+            m = push(hh, m, key, float(i))
+    assert got == want and m == n
+    assert len(set(want)) == len(want) and len({k for k, _ in want}) < len(want) // 100
 
 
 def test_a_primitive_must_sweep_its_end_node():

@@ -1,17 +1,19 @@
 """Compiled Dijkstra / A* over the (x, y, θ) lattice (numba).
 
-State id ``s = (ix * ny + iy) * K + k``. The heap is a binary min-heap over
-arrays with lazy deletion (stale entries are skipped when popped).
+State id ``s = (ix * ny + iy) * K + k``. The heap is a binary min-heap with lazy
+deletion (stale entries are skipped when popped), its keys and state ids interleaved in
+one array (:func:`_push`): the sifts then touch half as many cache lines as with two
+arrays, and the search takes ~15 % less CPU with the same pops, ties included.
 
 Inside the search the states live on the map padded by ``R`` blocked nodes on every
 side (``R``: the longest reach of a primitive or of its swept cells), with the
-cost-to-come ``-inf`` on blocked and padding nodes. One test then rejects every
+cost-to-come ``-inf`` on blocked and padding nodes. One cost test then rejects every
 primitive the plain loop would skip before its collision check — a target off the map,
 in an obstacle (its end node is one of its swept cells), already settled (for Dijkstra
-its cost is at most the cost being expanded) or not improved — and that test is a
-gather over the primitives of one heading, which the compiler vectorises. The few
-primitives left are taken in their order, as before, so the pushes, the heap and the
-ties come out the same as a state-by-state loop.
+its cost is at most the cost being expanded) or not improved. The primitives are taken
+in their order, as before, so the pushes, the heap and the ties come out the same as a
+state-by-state loop. (A first pass filling a mask of the primitives that pass the test
+was not vectorised by the compiler and cost ~8 % more than this single pass.)
 """
 
 from __future__ import annotations
@@ -19,26 +21,55 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ...eikonal._heap import sift_down, sift_up
 
 __all__ = ["lattice_search"]
 
 
 @njit(cache=True, inline="always")
-def _push(hk, hv, nopos, n, key, val):
-    """Add ``val`` with ``key`` to the heap of ``n`` entries; the new count."""
-    sift_up(hk, hv, nopos, n, key, val)
+def _push(h, n, key, val):
+    """Add ``val`` with ``key`` to the heap of ``n`` entries in ``h``; the new count.
+
+    The heap's slot ``i`` is ``h[2 i]`` (key) and ``h[2 i + 1]`` (the state id, exact as a
+    float below 2**53): a parent's key and its children's keys and values share cache
+    lines. Same steps and comparisons as :func:`fm2uav.eikonal._heap.sift_up`, so the
+    same order of pops, ties included."""
+    p = n
+    while p > 0:
+        q = (p - 1) >> 1
+        if h[2 * q] <= key:
+            break
+        h[2 * p] = h[2 * q]
+        h[2 * p + 1] = h[2 * q + 1]
+        p = q
+    h[2 * p] = key
+    h[2 * p + 1] = val
     return n + 1
 
 
 @njit(cache=True, inline="always")
-def _pop(hk, hv, nopos, n):
-    """The root ``(key, val)`` taken off the heap of ``n`` entries, and the new count."""
-    key = hk[0]
-    val = hv[0]
+def _pop(h, n):
+    """The root ``(key, val)`` taken off the heap of ``n`` entries in ``h`` (see
+    :func:`_push`), and the new count; the steps of :func:`fm2uav.eikonal._heap.sift_down`."""
+    key = h[0]
+    val = h[1]
     n -= 1
     if n > 0:
-        sift_down(hk, hv, nopos, n, hk[n], hv[n])
+        t = h[2 * n]
+        c = h[2 * n + 1]
+        p = 0
+        while True:
+            child = 2 * p + 1
+            if child >= n:
+                break
+            if child + 1 < n and h[2 * child + 2] < h[2 * child]:
+                child += 1
+            if h[2 * child] >= t:
+                break
+            h[2 * p] = h[2 * child]
+            h[2 * p + 1] = h[2 * child + 1]
+            p = child
+        h[2 * p] = t
+        h[2 * p + 1] = c
     return key, val, n
 
 
@@ -121,14 +152,8 @@ def lattice_search(
     coff = np.empty(cx.shape[0], np.int64)  # cell offset of each swept cell
     for q in range(cx.shape[0]):
         coff[q] = cx[q] * nyp + cy[q]
-    most = 1
-    for k in range(K):
-        most = max(most, ptr[k + 1] - ptr[k])
-    better = np.empty(most, np.bool_)
     cap = 1 << 20
-    hk = np.empty(cap, np.float64)
-    hv = np.empty(cap, np.int64)
-    nopos = np.empty(0, np.int64)  # no slot index: lazy deletion (stale entries skipped)
+    hh = np.empty(2 * cap, np.float64)  # lazy deletion: stale entries skipped when popped
     n = 0
     for s in sources:
         ix = s // K // ny
@@ -141,14 +166,14 @@ def lattice_search(
             h = heuristic_weight * np.sqrt((ix - goal_x) ** 2 + (iy - goal_y) ** 2)
             if n >= cap:
                 cap *= 2
-                hk = np.concatenate((hk, np.empty(cap - hk.size, np.float64)))
-                hv = np.concatenate((hv, np.empty(cap - hv.size, np.int64)))
-            n = _push(hk, hv, nopos, n, h, u)
+                hh = np.concatenate((hh, np.empty(2 * cap - hh.size, np.float64)))
+            n = _push(hh, n, h, float(u))
     astar = heuristic_weight > 0.0
     n_expanded = 0
     goal_u = -1
     while n > 0:
-        key, u, n = _pop(hk, hv, nopos, n)
+        key, uf, n = _pop(hh, n)
+        u = np.int64(uf)
         if done[u]:
             continue
         done[u] = True
@@ -166,19 +191,12 @@ def lattice_search(
         last = ptr[k + 1]
         # Dijkstra pops keys in order, so a settled target costs <= c0 <= c0 + pcost: the
         # cost test alone rejects it; A* keys are not costs, so it checks `done` too
-        if astar:
-            for p in range(first, last):
-                t = base + off[p]
-                better[p - first] = (c0 + pcost[p] < cost[t]) & (not done[t])
-        else:
-            for p in range(first, last):
-                better[p - first] = c0 + pcost[p] < cost[base + off[p]]
         for p in range(first, last):
-            if not better[p - first]:
-                continue
             t = base + off[p]
             nc = c0 + pcost[p]
-            if nc >= cost[t]:  # lowered by an earlier primitive of this state
+            if not nc < cost[t]:  # off the map, blocked, settled or not improved
+                continue
+            if astar and done[t]:
                 continue
             ok = True
             for q in range(cptr[p], cptr[p + 1]):
@@ -195,13 +213,10 @@ def lattice_search(
                                                + (iy + pdy[p] - goal_y) ** 2)
             if n >= cap:
                 cap *= 2
-                hk2 = np.empty(cap, np.float64)
-                hv2 = np.empty(cap, np.int64)
-                hk2[:n] = hk[:n]
-                hv2[:n] = hv[:n]
-                hk = hk2
-                hv = hv2
-            n = _push(hk, hv, nopos, n, nc + h, t)
+                hh2 = np.empty(2 * cap, np.float64)
+                hh2[:2 * n] = hh[:2 * n]
+                hh = hh2
+            n = _push(hh, n, nc + h, float(t))
     # back to the map's state ids (-inf, the padding's mark, is inf: not reached)
     out_cost = np.empty(nx * ny * K)
     out_parent = np.empty(nx * ny * K, np.int64)
