@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from fm2uav.baselines.reference import _kernels, build_primitives
+from fm2uav.eikonal import _heap
 from fm2uav.eikonal._heap import sift_down, sift_up
 
 _up, _down = sift_up.py_func, sift_down.py_func
@@ -165,7 +166,7 @@ def test_a_source_in_an_obstacle_is_expanded_like_any_other():
 
 def test_the_interleaved_heap_pops_like_the_two_array_heap():
     rng = np.random.default_rng(11)
-    push, pop = _kernels._push.py_func, _kernels._pop.py_func
+    push, pop = _heap.push_pairs.py_func, _heap.pop_pairs.py_func
     size = 4000
     hk, hv, nopos = np.empty(size), np.empty(size, np.int64), np.empty(0, np.int64)
     hh = np.empty(2 * size)
