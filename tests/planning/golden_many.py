@@ -81,6 +81,17 @@ def run(name: str, **extra: Any) -> list[str]:
     return [_route_digest(r) for r in many.routes]
 
 
+def run_case(name: str, threads: int | None = None, step: float | None = None) -> list[str]:
+    """:func:`run` with arguments a child Python can be given (tests/planning/golden_numpy.py):
+    ``threads`` (``plan_many``'s), ``step`` another descent step [cells] (order 2)."""
+    extra: dict[str, Any] = {}
+    if threads is not None:
+        extra["threads"] = threads
+    if step is not None:
+        extra["options"] = PlanOptions(step=step)
+    return run(name, **extra)
+
+
 def main(argv: list[str]) -> int:
     """Print the digests of every case, or (``--write``) write them."""
     return golden_plans.main(argv, cases, run, DATA)

@@ -109,6 +109,38 @@ def run(name: str, **extra) -> dict:
     return digest(fm2uav.plan(world, s, g, **{**kw, **extra}))
 
 
+def run_case(name: str, threads: int | None = None, force_parallel: bool = False,
+             lean: bool = False, exponent: float | None = None) -> dict:
+    """:func:`run` with arguments a child Python can be given (tests/planning/golden_numpy.py).
+
+    ``threads``: the case's order on that many threads (None: the case's own options);
+    ``force_parallel``: the distance transform's and the march set-up's parallel paths on
+    this small world; ``lean``: the lean layout forced; ``exponent``: another shaping
+    exponent (a changed plan). The thresholds are restored afterwards.
+    """
+    from fm2uav.eikonal import _edt, _kernels
+
+    saved = (_edt.EDT_PARALLEL_MIN_NODES, _kernels.SETUP_PARALLEL_MIN_NODES,
+             _kernels.LEAN_NODES)
+    try:
+        if force_parallel or lean:
+            _kernels.SETUP_PARALLEL_MIN_NODES = 0
+        if force_parallel:
+            _edt.EDT_PARALLEL_MIN_NODES = 0
+        if lean:
+            _kernels.LEAN_NODES = 0
+        extra: dict = {}
+        if threads is not None:
+            opts = cases()[name][3].get("options", PlanOptions())
+            extra["options"] = PlanOptions(order=opts.order, threads=threads)
+        if exponent is not None:
+            extra["shaping"] = Shaping(exponent=exponent)
+        return run(name, **extra)
+    finally:
+        (_edt.EDT_PARALLEL_MIN_NODES, _kernels.SETUP_PARALLEL_MIN_NODES,
+         _kernels.LEAN_NODES) = saved
+
+
 def main(argv: list[str], cases=cases, run=run, data: Path = DATA) -> int:
     """Print the digest of every case, or (``--write``) write them to ``data``."""
     out = {name: run(name) for name in cases()}
