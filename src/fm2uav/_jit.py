@@ -20,7 +20,9 @@ Library code never prints: this module only *detects* and *calls back*.
   kernels are compiled again (the command line does both, see
   :func:`fm2uav.cli._common.handle_errors`).
 
-Bottom layer (no fm2uav imports): the kernels are named by file and function.
+Bottom layer (fm2uav imports only ``_kernel_stamp``: a kernel cache's stamp is its file and
+the modules it imports, as ``fm2uav._numba`` stamps it): the kernels are named by file and
+function.
 """
 
 from __future__ import annotations
@@ -30,6 +32,8 @@ import sys
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
+
+from ._kernel_stamp import kernel_stamp
 
 __all__ = [
     "FIRST_PLAN_KERNELS",
@@ -204,11 +208,9 @@ def _fresh_index(index: Path, source_hash: bytes, numba_version: str | None) -> 
 
 
 def _cached(rel_file: str, func: str, numba_version: str | None) -> bool:
-    import hashlib
-
     py_file = _PKG / rel_file
     try:
-        source_hash = hashlib.sha256(py_file.read_bytes()).digest()
+        source_hash = kernel_stamp(py_file)
     except OSError:
         return False
     tag = f"py{sys.version_info[0]}{sys.version_info[1]}{getattr(sys, 'abiflags', '')}"

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 import shapely
-from numba import njit
+from .._numba import njit
 from shapely.geometry import LineString
 
 from ..errors import InputError

@@ -30,7 +30,7 @@ correctly rounded one, so the values are the same bit for bit.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from .._numba import njit, prange
 
 from ._kernels import _readonly
 

@@ -13,7 +13,7 @@ share cache lines) serves the lattice search of :mod:`fm2uav.baselines.reference
 
 from __future__ import annotations
 
-from numba import njit
+from .._numba import njit
 
 __all__ = ["sift_up", "sift_down", "push_pairs", "pop_pairs"]
 

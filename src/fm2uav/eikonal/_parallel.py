@@ -86,7 +86,7 @@ import threading
 
 import numpy as np
 from llvmlite import ir
-from numba import njit, prange, types
+from .._numba import njit, prange, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 

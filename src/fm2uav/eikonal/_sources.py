@@ -67,7 +67,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from .._numba import njit
 
 from ._heap import sift_down, sift_up
 

@@ -87,7 +87,7 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
+from .._numba import njit
 
 __all__ = ["Stencil", "stencil", "march", "zermelo_time", "ORDER2_MAX_SPEED_RATIO",
            "ORDER2_MAX_WIND_CHANGE", "CONE_TOL", "REOPEN_RTOL", "FIXED", "POPPED", "STOP"]
