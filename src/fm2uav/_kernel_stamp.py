@@ -22,9 +22,7 @@ no fm2uav imports.
 
 from __future__ import annotations
 
-import hashlib
 import os
-import re
 from pathlib import Path
 
 __all__ = ["PACKAGE", "kernel_stamp", "kernel_sources"]
@@ -32,10 +30,23 @@ __all__ = ["PACKAGE", "kernel_stamp", "kernel_sources"]
 #: The fm2uav package folder (absolute imports ``fm2uav.x`` resolve against it).
 PACKAGE = Path(__file__).resolve().parent
 
-_FROM = re.compile(r"^[ \t]*from[ \t]+(\.+[\w.]*|fm2uav(?:\.[\w.]+)?)[ \t]+import[ \t]+(.*)$",
-                   re.MULTILINE)
-_IMPORT = re.compile(r"^[ \t]*import[ \t]+fm2uav\.([\w.]+)", re.MULTILINE)
-_NAME = re.compile(r"\w+")
+_PATTERNS: list = []
+
+
+def _patterns() -> tuple:
+    """The import-line patterns, compiled on first use (the command line imports this
+    module with ``fm2uav._jit`` and reads no cache on its error paths: no ``re`` work, no
+    ``hashlib`` there)."""
+    if not _PATTERNS:
+        import re
+
+        _PATTERNS.extend([
+            re.compile(r"^[ \t]*from[ \t]+(\.+[\w.]*|fm2uav(?:\.[\w.]+)?)[ \t]+import[ \t]+(.*)$",
+                       re.MULTILINE),
+            re.compile(r"^[ \t]*import[ \t]+fm2uav\.([\w.]+)", re.MULTILINE),
+            re.compile(r"\w+"),
+        ])
+    return tuple(_PATTERNS)
 
 
 def _module_file(folder: Path) -> Path | None:
@@ -52,9 +63,10 @@ def _imports(py_file: Path, package: Path) -> set[Path]:
         text = py_file.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError):
         return set()
+    from_, import_, name_ = _patterns()
     found: set[Path] = set()
     targets: list[tuple[Path, str]] = []
-    for m in _FROM.finditer(text):
+    for m in from_.finditer(text):
         mod, names = m.group(1), m.group(2)
         if mod.startswith("."):
             dots = len(mod) - len(mod.lstrip("."))
@@ -66,7 +78,7 @@ def _imports(py_file: Path, package: Path) -> set[Path]:
             base, rest = package, mod[len("fm2uav"):].lstrip(".")
         folder = base.joinpath(*rest.split(".")) if rest else base
         targets.append((folder, names.split("#", 1)[0]))
-    for m in _IMPORT.finditer(text):
+    for m in import_.finditer(text):
         targets.append((package.joinpath(*m.group(1).split(".")), ""))
     for folder, names in targets:
         target = _module_file(folder)
@@ -74,7 +86,7 @@ def _imports(py_file: Path, package: Path) -> set[Path]:
             continue
         found.add(target)
         if target.name == "__init__.py":  # `from . import _heap`: the submodule
-            for name in _NAME.findall(names.replace(" as ", " ")):
+            for name in name_.findall(names.replace(" as ", " ")):
                 sub = _module_file(folder / name)
                 if sub is not None:
                     found.add(sub)
@@ -116,6 +128,8 @@ def kernel_stamp(py_file: str | os.PathLike, package: Path = PACKAGE) -> bytes:
     Equal to numba's own stamp (the SHA-256 of the file's bytes) when the file imports no
     package module. Kept per process while no file involved changes its modification time
     or size (as numba keeps its own)."""
+    import hashlib
+
     path = Path(py_file).resolve()
     key0 = (path, package)
     deps = _SOURCES.get(key0)
