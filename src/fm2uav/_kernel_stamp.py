@@ -130,7 +130,8 @@ def kernel_stamp(py_file: str | os.PathLike, package: Path = PACKAGE) -> bytes:
     or size (as numba keeps its own)."""
     import hashlib
 
-    path = Path(py_file).resolve()
+    path = py_file if isinstance(py_file, Path) and py_file.is_absolute() else \
+        Path(py_file).resolve()
     key0 = (path, package)
     deps = _SOURCES.get(key0)
     if deps is None:

@@ -27,11 +27,18 @@ __all__ = ["KERNEL_ROOTS", "LOCATORS", "njit", "prange", "types"]
 KERNEL_ROOTS: list[Path] = [PACKAGE]
 
 
+_RESOLVED: dict[str, Path | None] = {}
+
+
 def _root(py_file: str) -> Path | None:
-    try:
-        path = Path(py_file).resolve()
-    except (OSError, TypeError, ValueError):
-        return None
+    """The entry of KERNEL_ROOTS holding ``py_file``, None if none does (numba asks for each
+    cached function: the file's real path is resolved once)."""
+    path = _RESOLVED.get(py_file)
+    if path is None:
+        try:
+            path = _RESOLVED[py_file] = Path(py_file).resolve()
+        except (OSError, TypeError, ValueError):
+            return None
     return next((r for r in KERNEL_ROOTS if path.is_relative_to(r)), None)
 
 
@@ -47,7 +54,8 @@ def _stamped(base: type) -> type:
             return super().from_function(py_func, py_file)
 
         def get_source_stamp(self):
-            return kernel_stamp(self._py_file, _root(self._py_file) or PACKAGE)
+            return kernel_stamp(_RESOLVED.get(self._py_file) or self._py_file,
+                                _root(self._py_file) or PACKAGE)
 
     Locator.__name__ = Locator.__qualname__ = f"Fm2uav{base.__name__}"
     return Locator
