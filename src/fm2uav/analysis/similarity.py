@@ -13,9 +13,9 @@ from typing import Any
 
 import numpy as np
 import shapely
-from .._numba import njit
 from shapely.geometry import LineString
 
+from .._numba import njit
 from ..errors import InputError
 
 __all__ = ["frechet_distance", "area_between_curves"]

@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
 from .._numba import njit
 
 __all__ = ["split_all", "REL"]

@@ -30,8 +30,8 @@ correctly rounded one, so the values are the same bit for bit.
 from __future__ import annotations
 
 import numpy as np
-from .._numba import njit, prange
 
+from .._numba import njit, prange
 from ._kernels import _readonly
 
 __all__ = ["squared_edt", "edt", "EDT_PARALLEL_MIN_NODES", "LANES", "XLANES",

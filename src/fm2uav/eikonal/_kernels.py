@@ -97,11 +97,11 @@ from typing import NamedTuple
 
 import numpy as np
 from llvmlite import ir
-from .._numba import njit, prange, types
 from numba.core import cgutils
 from numba.cpython.unsafe.numbers import leading_zeros, trailing_zeros
 from numba.extending import intrinsic
 
+from .._numba import njit, prange, types
 from ..errors import InputError
 
 FAR = np.uint8(0)

@@ -86,10 +86,10 @@ import threading
 
 import numpy as np
 from llvmlite import ir
-from .._numba import njit, prange, types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
+from .._numba import njit, prange, types
 from . import _kernels
 from ._heap import sift_down, sift_up
 from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _ORDER2_MAX_W_RATIO, _U, _ZERO,

@@ -67,8 +67,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from .._numba import njit
 
+from .._numba import njit
 from ._heap import sift_down, sift_up
 
 _INF = np.inf

@@ -87,6 +87,7 @@ import math
 from typing import NamedTuple
 
 import numpy as np
+
 from .._numba import njit
 
 __all__ = ["Stencil", "stencil", "march", "zermelo_time", "ORDER2_MAX_SPEED_RATIO",

@@ -8,6 +8,7 @@ milliseconds of the Python loop (a mission's safe returns compute hundreds of pr
 from __future__ import annotations
 
 import numpy as np
+
 from .._numba import njit
 
 __all__ = ["sweep_pair"]

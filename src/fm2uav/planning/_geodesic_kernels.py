@@ -37,6 +37,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
 from .._numba import njit
 
 OK = 0

@@ -19,8 +19,8 @@ was not vectorised by the compiler and cost ~8 % more than this single pass.)
 from __future__ import annotations
 
 import numpy as np
-from ..._numba import njit
 
+from ..._numba import njit
 from ...eikonal._heap import pop_pairs as _pop
 from ...eikonal._heap import push_pairs as _push
 

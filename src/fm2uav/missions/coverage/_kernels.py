@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
 from ..._numba import njit
 
 __all__ = ["strip_extents", "band_ends", "zigzag_cost"]
