@@ -106,6 +106,19 @@ def pytest_collection_modifyitems(config, items):
         items.sort(key=lambda item: item.get_closest_marker("slow") is None)
 
 
+@pytest.fixture(autouse=True)
+def _each_test_a_fresh_process_for_stops():
+    """A stop signal a test raises and catches itself (``pytest.raises(Interrupted)``) stays
+    recorded as not reported (:mod:`fm2uav.io._stops`: the command line raises it again at its
+    next checkpoint); each test is a process of its own for that record, as each command is."""
+    yield
+    import sys
+
+    stops = sys.modules.get("fm2uav.io._stops")
+    if stops is not None:
+        stops.stop_reported()
+
+
 @dataclass(frozen=True)
 class CliRun:
     """One shared CLI run: its result, its output folder and its arguments (without --out)."""

@@ -115,6 +115,80 @@ def test_a_stop_python_swallows_is_raised_again_at_the_next_checkpoint():
     assert "Exception ignored" not in res.stderr and "Traceback" not in res.stderr
 
 
+# The stop lands during start-up in code that swallows it (a library's ``except
+# BaseException`` without re-raising), or that turns it into an error of its own (numba's
+# dispatcher: "SystemError: ... returned a result with an exception set"): the command line
+# must stop with 130 and one line all the same (a CI run once saw a SIGTERM at 0.2 s lost
+# and the plan written).
+LANDS_IN_START_UP = """
+import os, runpy, signal, sys, time
+from fm2uav import _code_cache
+
+real_install = _code_cache.install
+
+def install(*args):
+    try:
+        os.kill(os.getpid(), signal.{sig})
+        time.sleep(5)  # the handler raises here
+    except BaseException as exc:
+        if {turn_into_error}:
+            raise SystemError("returned a result with an exception set") from exc
+    return real_install(*args)
+
+_code_cache.install = install
+sys.argv = ["fm2uav", *sys.argv[1:]]
+runpy.run_module("fm2uav", run_name="__main__")
+"""
+
+
+@pytest.mark.parametrize("sig", ["SIGTERM", "SIGINT"])
+@pytest.mark.parametrize("turn_into_error", [False, True], ids=["swallowed", "turned-into-error"])
+def test_a_stop_swallowed_or_turned_into_an_error_during_start_up_still_exits_130(
+        tmp_path, sig, turn_into_error):
+    out = tmp_path / "plan"
+    code = LANDS_IN_START_UP.format(sig=sig, turn_into_error=turn_into_error)
+    t0 = time.monotonic()
+    res = subprocess.run([sys.executable, "-c", code, "plan", "--out", str(out)],
+                         capture_output=True, text=True, timeout=120, env=_env())
+    assert res.returncode == 130, res.stderr
+    name = "SIGINT (Ctrl-C)" if sig == "SIGINT" else "SIGTERM"
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"error: interrupted by {name}"), res.stderr
+    assert not out.exists()
+    assert time.monotonic() - t0 < 60  # stopped at the command's start, not after a plan
+
+
+def test_the_command_keeps_a_stop_signal_the_parent_ignores():
+    # nohup ignores SIGHUP, a background job of a shell without job control SIGINT: a command
+    # must not take them back while it runs (closing the terminal would stop a nohup run)
+    code = ("import signal; signal.signal(signal.SIGHUP, signal.SIG_IGN); "
+            "from fm2uav.io.outdir import install_stop_signals, interrupt_signals; "
+            "install_stop_signals()\n"
+            "with interrupt_signals():\n"
+            "    print(signal.getsignal(signal.SIGHUP) is signal.SIG_IGN, "
+            "signal.getsignal(signal.SIGTERM).__name__)\n"
+            "print(signal.getsignal(signal.SIGHUP) is signal.SIG_IGN)")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=60, env=_env())
+    assert res.stdout.split() == ["True", "_on_stop_signal", "True"], res.stderr
+
+
+def test_a_stop_signal_after_the_command_ended_changes_nothing():
+    # the interpreter's shutdown restores the default actions: a SIGTERM landing there once
+    # killed a finished plan (exit status -15, its outputs in place)
+    code = ("import signal, sys\n"
+            "from fm2uav.__main__ import main\n"
+            "sys.argv = ['fm2uav', '--help']\n"
+            "try:\n"
+            "    main()\n"
+            "except SystemExit as exc:\n"
+            "    print(exc.code, *(signal.getsignal(s) is signal.SIG_IGN\n"
+            "                      for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)))")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=60, env=_env())
+    assert res.stdout.split()[-4:] == ["0", "True", "True", "True"], res.stdout + res.stderr
+
+
 @pytest.mark.parametrize("env", [
     {"PYTHONIOENCODING": "ascii"},
     {"LC_ALL": "POSIX", "LANG": "C"},

@@ -10,9 +10,11 @@ import that takes time:
   130, never a traceback.
   While a command runs the output sets' rules apply
   (:func:`fm2uav.io.outdir.interrupt_signals`: the set is removed, the previous
-  one kept, exit 130). A stop that Python swallows (one landing in a weakref
-  callback of the import system, a ``__del__``) is raised again at the next
-  checkpoint (:func:`fm2uav.io.outdir.raise_if_stopped`): never lost;
+  one kept, exit 130). A stop that is swallowed (one landing in a weakref
+  callback of the import system, a ``__del__``, a library's ``except BaseException``)
+  is raised again at the next checkpoint (:func:`fm2uav.io.outdir.raise_if_stopped`):
+  never lost; an error raised while a stop is pending is reported as the stop;
+  once the command has ended, a stop signal is ignored (its outcome is decided);
 * **any output encoding**: text that stdout/stderr cannot encode (``LANG=C``
   without UTF-8, ``PYTHONIOENCODING=ascii``) is replaced instead of ending the
   run; a closed pipe (``fm2uav --help | head -1``) ends it quietly.
@@ -68,17 +70,22 @@ def _stopped(signum: int) -> None:
     when the KeyboardInterrupt passed through code Python evaluated for it (nothing is
     open here: a command removes its output sets before it reports its own stop).
     """
-    for sig_name in ("SIGINT", "SIGTERM", "SIGHUP"):  # a second signal while reporting the
-        try:                                          # first: no traceback
-            signal.signal(getattr(signal, sig_name), signal.SIG_IGN)
-        except (AttributeError, ValueError, OSError):
-            pass
+    _ignore_stops()  # a second signal while reporting the first: no traceback
     what = "SIGINT (Ctrl-C)" if signum == signal.SIGINT else signal.Signals(signum).name
     try:
         sys.stderr.write(f"error: interrupted by {what}; nothing was written\n")
     except (OSError, ValueError):
         pass
     _exit_now(130)
+
+
+def _ignore_stops() -> None:
+    """Ignore SIGINT, SIGTERM and SIGHUP from now on: the run's outcome is decided."""
+    for sig_name in ("SIGINT", "SIGTERM", "SIGHUP"):
+        try:
+            signal.signal(getattr(signal, sig_name), signal.SIG_IGN)
+        except (AttributeError, ValueError, OSError):
+            pass
 
 
 def _exit_now(code: int) -> None:
@@ -164,6 +171,11 @@ def _run() -> int:
         _stopped(getattr(exc, "signum", signal.SIGINT))  # its own: handle_errors)
     except BrokenPipeError:
         return _quiet_broken_pipe()
+    except Exception:  # an error a stop turned into (a library's, while it was raised)
+        signum = unreported_stop()
+        if signum is not None:
+            _stopped(signum)
+        raise
     return 0  # pragma: no cover - cli_main always exits
 
 
@@ -184,6 +196,10 @@ def main() -> None:
     except KeyboardInterrupt:  # Ctrl-C before the handlers are in place (Python's own)
         _stopped(signal.SIGINT)
     finally:
+        # the command has ended, its outputs in place or not written: a stop signal now
+        # changes nothing (and the interpreter's shutdown would give it the default action:
+        # a finished run killed, exit status -15)
+        _ignore_stops()
         _code_cache.save()  # the code this run compiled first, for the next runs
         _gc.at_exit()  # the exit does not traverse the heap
     sys.exit(code)

@@ -239,3 +239,40 @@ def test_a_stop_swallowed_inside_a_command_still_ends_it_with_130(tmp_path):
     outdir.raise_if_stopped()  # reported: not raised again
     res = runner.invoke(mini, ["--out", str(out)])  # the next command is not affected
     assert res.exit_code == 130  # (its own Victim again)
+
+
+@pytest.mark.parametrize("how", ["swallowed", "turned-into-error"])
+def test_a_stop_a_library_swallows_or_turns_into_an_error_ends_the_command_with_130(
+        tmp_path, how):
+    import signal
+
+    import typer
+
+    from fm2uav.cli._common import handle_errors
+    from fm2uav.io import outdir
+
+    mini = typer.Typer()
+
+    @mini.command()
+    @handle_errors
+    def main(out: str = typer.Option(..., "--out")) -> None:
+        od = outdir.OutputDir(out)
+        od.check(["a.txt"])
+        with od.open("a.txt") as fh:
+            fh.write("new")
+        try:  # a library that catches everything (or numba's dispatcher, which answers a
+            outdir._on_stop_signal(signal.SIGTERM, None)  # pending exception with an error)
+        except BaseException as exc:
+            if how == "turned-into-error":
+                raise SystemError("CPUDispatcher(<function f>) returned a result with an "
+                                  "exception set") from exc
+
+    out = tmp_path / "out"
+    res = runner.invoke(mini, ["--out", str(out)])
+    assert res.exit_code == 130, res.output
+    assert res.output.strip().splitlines() == [
+        "error: interrupted by SIGTERM; no partial outputs were left (an earlier output set "
+        "is as it was)"]
+    assert not out.exists()  # nothing put in place
+    assert outdir.unreported_stop() is None  # reported: not raised again
+    outdir.raise_if_stopped()

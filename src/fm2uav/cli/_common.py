@@ -188,6 +188,18 @@ def _for_this_command(message: str) -> str:
     return for_command(message, accepted)
 
 
+def _report_stop(signum: int) -> None:
+    """End the command stopped by ``signum``: one line, exit code 130 (its sets removed)."""
+    import signal
+
+    from ..io._stops import stop_reported
+
+    stop_reported()  # reported here: not raised again at the end of the command line
+    what = "SIGINT (Ctrl-C)" if signum == signal.SIGINT else signal.Signals(signum).name
+    _fail(f"interrupted by {what}; no partial outputs were left (an earlier output set "
+          "is as it was)", EXIT_INTERRUPTED)
+
+
 def handle_errors(func: F) -> F:
     """Run a command: map errors to one-line messages and exit codes, finish its output sets.
 
@@ -237,16 +249,13 @@ def handle_errors(func: F) -> F:
         except interrupted as exc:
             import signal
 
-            from ..io._stops import stop_reported
-
-            stop_reported()  # reported here: not raised again at the end of the command line
-
-            signum = getattr(exc, "signum", signal.SIGINT)
-            what = ("SIGINT (Ctrl-C)" if signum == signal.SIGINT
-                    else signal.Signals(signum).name)
-            _fail(f"interrupted by {what}; no partial outputs were left (an earlier output set "
-                  "is as it was)", EXIT_INTERRUPTED)
+            _report_stop(getattr(exc, "signum", signal.SIGINT))
         except Exception as exc:  # noqa: BLE001 - the one place errors become exit codes
+            from ..io._stops import unreported_stop
+
+            signum = unreported_stop()
+            if signum is not None:  # an error the stop turned into (numba's SystemError "...
+                _report_stop(signum)  # returned a result with an exception set"): the stop
             if debug:
                 raise
             from .._jit import cache_fault

@@ -81,8 +81,10 @@ def app_cmd(
     try:
         serve(doc, folder=folder, mission_path=save_to, port=port,
               open_browser=not no_browser, announce=announce)
-    except KeyboardInterrupt:
-        pass
+    except KeyboardInterrupt:  # Ctrl-C is how the app stops: reported, exit 0
+        from ..io._stops import stop_reported
+
+        stop_reported()
 
 
 def register(app: typer.Typer, reproduce_app: typer.Typer) -> None:

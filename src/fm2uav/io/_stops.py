@@ -22,8 +22,8 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from .outdir import OutputDir
 
-__all__ = ["Interrupted", "abort_all", "active_sets", "finish_all", "interrupt_signals", "install_stop_signals", "raise_if_stopped",
-           "stop_reported", "unreported_stop"]
+__all__ = ["Interrupted", "abort_all", "active_sets", "finish_all", "install_stop_signals",
+           "interrupt_signals", "raise_if_stopped", "stop_reported", "unreported_stop"]
 
 #: The output sets of this process not finished or aborted yet (:class:`~.outdir.OutputDir`
 #: adds and removes itself): a stop signal once they are all in place is too late to undo.
@@ -53,20 +53,23 @@ class _Hold:
 
 
 class _Stop:
-    """A stop signal that was swallowed and not reported yet (:func:`stop_reported`).
+    """A stop signal raised and not reported yet (:func:`stop_reported`).
 
-    Python ignores an exception raised where it cannot propagate — a weakref callback
-    (the import system has some), a ``__del__``, the garbage collector — and hands it to
-    ``sys.unraisablehook`` ("Exception ignored in ..."): a stop signal that lands there
-    would be lost and the command would run on. :func:`_unraisable` records it instead,
-    and :func:`raise_if_stopped` raises it again at the next checkpoint (a command's
-    start, before its sets are put in place, the end of the command line), so a stop is
-    never swallowed. A stop held during the renames of a set that then fail is recorded
-    the same way.
+    Every stop the handler raises is recorded here until whoever reports it to the user
+    calls :func:`stop_reported`, and :func:`raise_if_stopped` raises it again at the next
+    checkpoint (a command's start, before its sets are put in place, the end of the
+    command line): a stop that something swallowed is never lost. Python ignores an
+    exception raised where it cannot propagate — a weakref callback (the import system
+    has some), a ``__del__``, the garbage collector — and hands it to
+    ``sys.unraisablehook`` (:func:`_keep_swallowed_stops` keeps it, without the
+    "Exception ignored in" lines); a library may catch it (``except BaseException``
+    without re-raising), a C function may clear it, or turn it into an error of its own
+    (numba's dispatcher: "SystemError: ... returned a result with an exception set"):
+    :func:`unreported_stop` tells the command line that such an error is the stop. A stop
+    held during the renames of a set that then fail is recorded the same way.
     """
 
     signum: int | None = None
-    delivered: int | None = None  # the last stop raised, until reported
     previous_hook: Any = None
 
 
@@ -77,7 +80,10 @@ def _stop_exception(signum: int) -> BaseException:
 def _deliver(signum: int) -> None:
     if _Commit.done and not _ACTIVE:
         return  # the outputs are in place: the command is ending anyway
-    _Stop.delivered = signum
+    # kept until reported (stop_reported): raised again at the next checkpoint if a library
+    # swallows it (an ``except BaseException`` that does not re-raise, a C function that
+    # clears errors), never lost
+    _Stop.signum = signum
     raise _stop_exception(signum)
 
 
@@ -114,13 +120,14 @@ def raise_if_stopped() -> None:
 
 def stop_reported() -> None:
     """The stop signal was reported to the user (the process ends with 130): forget it."""
-    _Stop.signum = _Stop.delivered = None
+    _Stop.signum = None
 
 
 def unreported_stop() -> int | None:
-    """The last stop signal raised in this process that nobody reported (e.g. one that a
-    library turned into an exit code of its own, as typer's parser does), or None."""
-    return _Stop.delivered if _Stop.signum is None else _Stop.signum
+    """The stop signal raised in this process and not reported yet (:class:`_Stop`), or None:
+    one that a library swallowed, or turned into an exit code (typer's parser) or an error
+    of its own, which is then reported as the stop."""
+    return _Stop.signum
 
 
 def _stop_signals() -> list[int]:
@@ -182,8 +189,10 @@ def interrupt_signals() -> Iterator[None]:
 
     SIGINT raises :class:`KeyboardInterrupt` as usual. Once the command's output
     sets are renamed into place (and no other set is open), both are ignored: the
-    new outputs are complete and the command is ending. Outside the main thread
-    (where handlers cannot be set) this does nothing.
+    new outputs are complete and the command is ending. A signal the parent ignores
+    (``nohup``: SIGHUP; a background job of a shell without job control: SIGINT) stays
+    ignored, as in :func:`install_stop_signals`. Outside the main thread (where
+    handlers cannot be set) this does nothing.
     """
     if threading.current_thread() is not threading.main_thread():
         yield
@@ -193,6 +202,8 @@ def interrupt_signals() -> Iterator[None]:
     _unraisable_stops()
     for sig in _stop_signals():
         try:
+            if signal.getsignal(sig) is signal.SIG_IGN:
+                continue  # ignored by the parent (nohup: SIGHUP; a background job: SIGINT)
             old[sig] = signal.signal(sig, _on_stop_signal)
         except (ValueError, OSError):  # pragma: no cover - exotic platforms
             pass
