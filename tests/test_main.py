@@ -28,6 +28,12 @@ def _fm2uav(*args: str, **env: str) -> subprocess.CompletedProcess:
                           timeout=300, env=_env(**env))
 
 
+def _python(code: str) -> subprocess.CompletedProcess:
+    """``python -c code`` with the checkout's fm2uav (text output)."""
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=60, env=_env())
+
+
 def _catches(pid: int, sig: int) -> bool:
     """Has process ``pid`` a handler for ``sig`` (Linux: SigCgt of /proc/PID/status)?"""
     try:
@@ -82,8 +88,7 @@ def test_install_stop_signals_keeps_what_the_shell_ignores():
             "from fm2uav.io.outdir import install_stop_signals as i; i(); "
             "print(signal.getsignal(signal.SIGHUP) is signal.SIG_IGN, "
             "signal.getsignal(signal.SIGTERM).__name__)")
-    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         timeout=60, env=_env())
+    res = _python(code)
     assert res.stdout.split() == ["True", "_on_stop_signal"], res.stderr  # nohup stays nohup
 
 
@@ -108,8 +113,7 @@ except outdir.Interrupted as exc:
 
 
 def test_a_stop_python_swallows_is_raised_again_at_the_next_checkpoint():
-    res = subprocess.run([sys.executable, "-c", SWALLOWED], capture_output=True, text=True,
-                         timeout=60, env=_env())
+    res = _python(SWALLOWED)
     assert res.returncode == 0, res.stderr
     assert res.stdout.strip() == f"raised {int(signal.SIGTERM)}"
     assert "Exception ignored" not in res.stderr and "Traceback" not in res.stderr
@@ -168,8 +172,7 @@ def test_the_command_keeps_a_stop_signal_the_parent_ignores():
             "    print(signal.getsignal(signal.SIGHUP) is signal.SIG_IGN, "
             "signal.getsignal(signal.SIGTERM).__name__)\n"
             "print(signal.getsignal(signal.SIGHUP) is signal.SIG_IGN)")
-    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         timeout=60, env=_env())
+    res = _python(code)
     assert res.stdout.split() == ["True", "_on_stop_signal", "True"], res.stderr
 
 
@@ -184,8 +187,7 @@ def test_a_stop_signal_after_the_command_ended_changes_nothing():
             "except SystemExit as exc:\n"
             "    print(exc.code, *(signal.getsignal(s) is signal.SIG_IGN\n"
             "                      for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)))")
-    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         timeout=60, env=_env())
+    res = _python(code)
     assert res.stdout.split()[-4:] == ["0", "True", "True", "True"], res.stdout + res.stderr
 
 

@@ -208,17 +208,13 @@ def test_an_error_names_only_the_flags_of_the_command_that_raised_it():
         "planner.agl too")
 
 
-def test_a_stop_swallowed_inside_a_command_still_ends_it_with_130(tmp_path):
-    import signal
-
+def _writing_command(stop):
+    """A one-command app (:func:`handle_errors`) that writes ``a.txt`` in an output set at
+    ``--out``, then calls ``stop()`` (where a stop signal lands)."""
     import typer
 
     from fm2uav.cli._common import handle_errors
     from fm2uav.io import outdir
-
-    class Victim:
-        def __del__(self):  # Python ignores what is raised here ("Exception ignored in")
-            outdir._on_stop_signal(signal.SIGTERM, None)
 
     mini = typer.Typer()
 
@@ -229,8 +225,22 @@ def test_a_stop_swallowed_inside_a_command_still_ends_it_with_130(tmp_path):
         od.check(["a.txt"])
         with od.open("a.txt") as fh:
             fh.write("new")
-        Victim()  # the stop lands in its __del__ and is swallowed; the command runs on
+        stop()
 
+    return mini
+
+
+def test_a_stop_swallowed_inside_a_command_still_ends_it_with_130(tmp_path):
+    import signal
+
+    from fm2uav.io import outdir
+
+    class Victim:
+        def __del__(self):  # Python ignores what is raised here ("Exception ignored in")
+            outdir._on_stop_signal(signal.SIGTERM, None)
+
+    # the stop lands in its __del__ and is swallowed; the command runs on
+    mini = _writing_command(lambda: Victim())
     out = tmp_path / "out"
     res = runner.invoke(mini, ["--out", str(out)])
     assert res.exit_code == 130, res.output
@@ -246,20 +256,9 @@ def test_a_stop_a_library_swallows_or_turns_into_an_error_ends_the_command_with_
         tmp_path, how):
     import signal
 
-    import typer
-
-    from fm2uav.cli._common import handle_errors
     from fm2uav.io import outdir
 
-    mini = typer.Typer()
-
-    @mini.command()
-    @handle_errors
-    def main(out: str = typer.Option(..., "--out")) -> None:
-        od = outdir.OutputDir(out)
-        od.check(["a.txt"])
-        with od.open("a.txt") as fh:
-            fh.write("new")
+    def stop():
         try:  # a library that catches everything (or numba's dispatcher, which answers a
             outdir._on_stop_signal(signal.SIGTERM, None)  # pending exception with an error)
         except BaseException as exc:
@@ -268,7 +267,7 @@ def test_a_stop_a_library_swallows_or_turns_into_an_error_ends_the_command_with_
                                   "exception set") from exc
 
     out = tmp_path / "out"
-    res = runner.invoke(mini, ["--out", str(out)])
+    res = runner.invoke(_writing_command(stop), ["--out", str(out)])
     assert res.exit_code == 130, res.output
     assert res.output.strip().splitlines() == [
         "error: interrupted by SIGTERM; no partial outputs were left (an earlier output set "
