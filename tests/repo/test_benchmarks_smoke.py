@@ -26,3 +26,18 @@ def test_every_benchmark_runs_quick(tmp_path):
         assert r["ours_s"] is None or r["ours_s"] > 0
         if r.get("peer_s"):
             assert abs(r["ratio"] - r["peer_s"] / r["ours_s"]) < 1e-9 * r["ratio"]
+
+
+def test_the_machine_scaling_probe_times_its_five_loops_on_one_and_two_threads():
+    res = subprocess.run([sys.executable, "-m", "benchmarks.machine_scaling", "--mb", "8",
+                          "--repeats", "1"], cwd=ROOT, capture_output=True, text=True,
+                         timeout=300)
+    assert res.returncode == 0, res.stderr[-3000:]
+    rows = [line.split("|")[1:-1] for line in res.stdout.splitlines()
+            if line.startswith("| ") and not line.startswith("| loop")]
+    assert [r[0].strip() for r in rows] == ["compute", "l2", "stream", "lines", "gather"]
+    for _, one, two, ratio in rows:
+        one, two = float(one), float(two)
+        assert one > 0 and two > 0
+        assert float(ratio.strip().removesuffix("x")) == pytest.approx(one / two, rel=0.02,
+                                                                        abs=0.01)
