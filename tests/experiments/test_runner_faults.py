@@ -489,3 +489,23 @@ def test_a_signal_deferred_while_closing_is_raised_when_the_block_ends():
             time.sleep(0.05)  # the handler ran (and deferred it)
             assert signals.pending == signal.SIGINT
     assert exc.value.signum == signal.SIGINT
+
+
+def test_a_signal_the_parent_ignores_stays_ignored_during_a_sweep():
+    """A background job of a shell without job control ignores SIGINT (the terminal's Ctrl-C
+    is the foreground's): the sweep must not take it back; SIGTERM still stops it."""
+    from fm2uav.experiments.runner import SweepInterrupted, raise_on_signals
+
+    before = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        with pytest.raises(SweepInterrupted) as exc:
+            with raise_on_signals():
+                assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+                os.kill(os.getpid(), signal.SIGINT)  # ignored
+                time.sleep(0.05)
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(5)  # the handler raises here
+        assert exc.value.signum == signal.SIGTERM
+        assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGINT, before)

@@ -403,7 +403,9 @@ class SweepInterrupted(KeyboardInterrupt):
 
 
 class _Signals:
-    """SIGINT/SIGTERM raise :class:`SweepInterrupted`, deferred out of log writes."""
+    """SIGINT/SIGTERM raise :class:`SweepInterrupted`, deferred out of log writes; a signal
+    the parent ignores (a background job of a shell without job control: SIGINT) stays
+    ignored, as on the command line (:func:`fm2uav.io.outdir.interrupt_signals`)."""
 
     def __init__(self) -> None:
         self.critical = 0
@@ -414,7 +416,8 @@ class _Signals:
     def __enter__(self) -> _Signals:
         if threading.current_thread() is threading.main_thread():
             for s in (signal.SIGINT, signal.SIGTERM):
-                self._old[s] = signal.signal(s, self._handler)
+                if signal.getsignal(s) is not signal.SIG_IGN:
+                    self._old[s] = signal.signal(s, self._handler)
         return self
 
     def __exit__(self, exc_type: Any, *exc: Any) -> None:
