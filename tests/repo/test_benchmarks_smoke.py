@@ -41,3 +41,38 @@ def test_the_machine_scaling_probe_times_its_five_loops_on_one_and_two_threads()
         assert one > 0 and two > 0
         assert float(ratio.strip().removesuffix("x")) == pytest.approx(one / two, rel=0.02,
                                                                         abs=0.01)
+
+
+def _table(stdout: str, header: str) -> list[list[str]]:
+    """The rows of the markdown table printed below the line starting with ``header``."""
+    return [[c.strip() for c in line.split("|")[1:-1]] for line in stdout.splitlines()
+            if line.startswith("| ") and not line.startswith(header)]
+
+
+def test_the_per_node_probe_marches_every_speed_map_over_the_same_nodes():
+    res = subprocess.run([sys.executable, "-m", "benchmarks.march_per_node", "--sizes", "40",
+                          "--orders", "2"], cwd=ROOT, capture_output=True, text=True,
+                         timeout=300)
+    assert res.returncode == 0, res.stderr[-3000:]
+    rows = _table(res.stdout, "| grid")
+    assert [r[2] for r in rows] == ["terrain", "uniform", "jittered"]
+    assert {r[0] for r in rows} == {"40x40x40"} and {r[1] for r in rows} == {"2"}
+    frozen = {int(r[4]) for r in rows}
+    assert len(frozen) == 1 and 0 < frozen.pop() < 40 * 40 * 40  # the ground is never entered
+    for r in rows:
+        wall, per_node = float(r[3]), float(r[5])
+        assert wall > 0
+        assert per_node == pytest.approx(1e9 * wall / int(r[4]), rel=0.02, abs=1)
+
+
+def test_the_first_touch_probe_maps_huge_and_small_pages_in_fresh_children():
+    res = subprocess.run([sys.executable, "-m", "benchmarks.first_touch", "--mb", "8",
+                          "--repeats", "1", "--pause", "0"], cwd=ROOT, capture_output=True,
+                         text=True, timeout=300)
+    assert res.returncode == 0, res.stderr[-3000:]
+    rows = _table(res.stdout, "| pages")
+    assert [r[0].split()[0] for r in rows] == ["huge", "4"]
+    small = rows[1]
+    assert int(small[3]) >= 8 * 2**20 // 4096  # a fault per 4 KiB page touched
+    for r in rows:
+        assert float(r[1]) >= 0 and float(r[5]) > 0
