@@ -28,19 +28,12 @@ def test_every_benchmark_runs_quick(tmp_path):
             assert abs(r["ratio"] - r["peer_s"] / r["ours_s"]) < 1e-9 * r["ratio"]
 
 
-def test_the_machine_scaling_probe_times_its_five_loops_on_one_and_two_threads():
-    res = subprocess.run([sys.executable, "-m", "benchmarks.machine_scaling", "--mb", "8",
-                          "--repeats", "1"], cwd=ROOT, capture_output=True, text=True,
-                         timeout=300)
+def _probe(module: str, *args: str) -> str:
+    """The standard output of ``python -m benchmarks.<module> <args>`` (exit status 0)."""
+    res = subprocess.run([sys.executable, "-m", f"benchmarks.{module}", *args], cwd=ROOT,
+                         capture_output=True, text=True, timeout=300)
     assert res.returncode == 0, res.stderr[-3000:]
-    rows = [line.split("|")[1:-1] for line in res.stdout.splitlines()
-            if line.startswith("| ") and not line.startswith("| loop")]
-    assert [r[0].strip() for r in rows] == ["compute", "l2", "stream", "lines", "gather"]
-    for _, one, two, ratio in rows:
-        one, two = float(one), float(two)
-        assert one > 0 and two > 0
-        assert float(ratio.strip().removesuffix("x")) == pytest.approx(one / two, rel=0.02,
-                                                                        abs=0.01)
+    return res.stdout
 
 
 def _table(stdout: str, header: str) -> list[list[str]]:
@@ -49,12 +42,17 @@ def _table(stdout: str, header: str) -> list[list[str]]:
             if line.startswith("| ") and not line.startswith(header)]
 
 
+def test_the_machine_scaling_probe_times_its_five_loops_on_one_and_two_threads():
+    rows = _table(_probe("machine_scaling", "--mb", "8", "--repeats", "1"), "| loop")
+    assert [r[0] for r in rows] == ["compute", "l2", "stream", "lines", "gather"]
+    for _, one, two, ratio in rows:
+        one, two = float(one), float(two)
+        assert one > 0 and two > 0
+        assert float(ratio.removesuffix("x")) == pytest.approx(one / two, rel=0.02, abs=0.01)
+
+
 def test_the_per_node_probe_marches_every_speed_map_over_the_same_nodes():
-    res = subprocess.run([sys.executable, "-m", "benchmarks.march_per_node", "--sizes", "40",
-                          "--orders", "2"], cwd=ROOT, capture_output=True, text=True,
-                         timeout=300)
-    assert res.returncode == 0, res.stderr[-3000:]
-    rows = _table(res.stdout, "| grid")
+    rows = _table(_probe("march_per_node", "--sizes", "40", "--orders", "2"), "| grid")
     assert [r[2] for r in rows] == ["terrain", "uniform", "jittered"]
     assert {r[0] for r in rows} == {"40x40x40"} and {r[1] for r in rows} == {"2"}
     frozen = {int(r[4]) for r in rows}
@@ -66,11 +64,8 @@ def test_the_per_node_probe_marches_every_speed_map_over_the_same_nodes():
 
 
 def test_the_first_touch_probe_maps_huge_and_small_pages_in_fresh_children():
-    res = subprocess.run([sys.executable, "-m", "benchmarks.first_touch", "--mb", "8",
-                          "--repeats", "1", "--pause", "0"], cwd=ROOT, capture_output=True,
-                         text=True, timeout=300)
-    assert res.returncode == 0, res.stderr[-3000:]
-    rows = _table(res.stdout, "| pages")
+    rows = _table(_probe("first_touch", "--mb", "8", "--repeats", "1", "--pause", "0"),
+                  "| pages")
     assert [r[0].split()[0] for r in rows] == ["huge", "4"]
     small = rows[1]
     assert int(small[3]) >= 8 * 2**20 // 4096  # a fault per 4 KiB page touched
