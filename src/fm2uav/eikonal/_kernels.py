@@ -68,7 +68,9 @@ Layout of the march (see docs/performance.md for the measurements behind it)
 * **Far neighbours while popping** (2D and 3D): a far neighbour of the node just frozen
   has no other frozen neighbour (every frozen node has queued its neighbours), so its time
   is the one-axis solution along that axis, which the full update would compute from the
-  same numbers (half of the updates in 2D, a third in 3D; times bit for bit).
+  same numbers (half of the updates in 2D, a third in 3D; times bit for bit). At order 2
+  its term reads only the node beyond the one just frozen (:func:`_upwind_term`), not the
+  far node's other side: measured 0.89x the march time on 2048^2 FM²-shaped order 2.
 * **The start box**: band and frozen nodes on entry lie in the start box, so the seeding
   and the expansion of the frozen nodes scan its span only, not the grid (a 2048^2
   march that freezes almost nothing: 29 ms before, 19 ms with the interleaved layout).
@@ -468,6 +470,17 @@ def _axis_term_u(T, V, U, use_u, c, s, ih2, order):
         c2 = c1 - s
     if best == _INF:
         return _INF, 0.0
+    return _upwind_term(T, V, U, use_u, c, best, c1, c2, ih2, order)
+
+
+@njit(**_OPT)
+def _upwind_term(T, V, U, use_u, c, best, c1, c2, ih2, order):
+    """The term of node ``c``'s axis whose frozen upwind neighbour ``c1`` has the time
+    ``best``, ``c2`` the next node beyond it: ``(tau, a)`` as :func:`_axis_term_u`.
+
+    The march's far-neighbour shortcut calls it directly: a far node's only frozen
+    neighbour is the node just frozen, so the axis's other side needs no read.
+    """
     if order == 2:
         t2 = T[c2]  # c1 is a frozen (inner) node, so c2 is at worst a ghost
         if t2 >= 0.0 and t2 <= best:
@@ -732,8 +745,9 @@ def _march2d_kernel(order, pairs=False):
                             t = tc + math.sqrt(q * hh)
                         elif order == 1:
                             t = tc + math.sqrt(q / ih2)
-                        else:
-                            ta, aa = _axis_term_u(T, V, U, use_u, nb, s, ih2, order)
+                        else:  # c2: the node beyond c (nb's other side is not frozen)
+                            c2 = c + s if k & 1 == 0 else c - s
+                            ta, aa = _upwind_term(T, V, U, use_u, nb, tc, c, c2, ih2, order)
                             t = ta + math.sqrt(q / aa)
                     elif iso:
                         t = _solve_iso(_side_min(T, nb, sx), _side_min(T, nb, one), _INF,
@@ -834,8 +848,10 @@ def _march3d_kernel(order):
                             ih2 = ihx2 if k < 2 else (ihy2 if k < 4 else ihz2)
                             if order == 1:
                                 t = tcur + math.sqrt(q / ih2)
-                            else:
-                                ta, aa = _axis_term_u(T, V, U, use_u, nb, s, ih2, order)
+                            else:  # c2: the node beyond c (as in 2D)
+                                c2 = c + s if k & 1 == 0 else c - s
+                                ta, aa = _upwind_term(T, V, U, use_u, nb, tcur, c, c2, ih2,
+                                                      order)
                                 t = ta + math.sqrt(q / aa)
                     elif iso:
                         t = _solve_iso(_side_min(T, nb, sx), _side_min(T, nb, sy),

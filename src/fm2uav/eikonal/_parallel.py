@@ -826,6 +826,14 @@ def _axis_term_at(T, V, U, use_u, fixed, c, s, ih2, thr, sh):
         c2 = c1 - s
     if best == _INF:
         return _INF, 0.0
+    return _upwind_term_at(T, V, U, use_u, fixed, c, best, c1, c2, ih2, thr, sh)
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _upwind_term_at(T, V, U, use_u, fixed, c, best, c1, c2, ih2, thr, sh):
+    """:func:`~fm2uav.eikonal._kernels._upwind_term` reading ``c2`` only if
+    :func:`_known` at ``thr``: the term of ``c``'s axis whose upwind neighbour ``c1`` has
+    the time ``best`` (the far-neighbour shortcut's call: no read of the other side)."""
     t2 = _known(T, fixed, c2, thr, sh)
     if t2 <= best:
         if use_u and _at_plateau(U, c) and _at_plateau(U, c1) and _at_plateau(U, c2):
@@ -1047,12 +1055,14 @@ def _slab_kernels2(three):
                     # along c's axis, as the full update gives it (the serial 2D march's
                     # shortcut): two axes' reads and terms saved on a third of the updates
                     if nb == c - sx or nb == c + sx:
-                        s_nb, ih_nb = sx, ih[0]
+                        ih_nb = ih[0]
                     elif nb == c - sy or nb == c + sy:
-                        s_nb, ih_nb = sy, ih[1]
+                        ih_nb = ih[1]
                     else:
-                        s_nb, ih_nb = _ONE, ih[2]
-                    ta, aa = _axis_term_at(T, V, U, use_u, fixed, nb, s_nb, ih_nb, t, sh)
+                        ih_nb = ih[2]
+                    # c2: the node beyond c on that axis (nb's other side is not frozen)
+                    ta, aa = _upwind_term_at(T, V, U, use_u, fixed, nb, t, c, c + c - nb,
+                                             ih_nb, t, sh)
                     _lower(T, V, nb, ta + math.sqrt(_rhs(V, U, use_u, qp, nb) / aa), fixed, sx,
                            sy, three, pv, pool, nxt, bk, mw, st, rkey, ritem, ctl, not three)
                 elif y < 0.0:  # band (or far after c froze again): an own node
