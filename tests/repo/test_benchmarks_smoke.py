@@ -71,3 +71,16 @@ def test_the_first_touch_probe_maps_huge_and_small_pages_in_fresh_children():
     assert int(small[3]) >= 8 * 2**20 // 4096  # a fault per 4 KiB page touched
     for r in rows:
         assert float(r[1]) >= 0 and float(r[5]) > 0
+
+
+def test_the_wait_policy_probe_marches_every_spin_count_on_one_and_two_threads():
+    out = _probe("wait_policy", "--cases", "1100x1000:fm2", "--spins", "0", "2000",
+                 "--repeats", "1")
+    rows = _table(out.split("\n", 1)[1], "| case")
+    assert [(r[0], r[1]) for r in rows] == [("1100x1000:fm2", "0"), ("1100x1000:fm2", "2000")]
+    for r in rows:
+        one, two = float(r[2]), float(r[3])
+        assert one > 0 and two > 0 and float(r[4]) > 0
+        assert float(r[6].removesuffix("x")) == pytest.approx(one / two, rel=0.02, abs=0.01)
+    # the same code under both spin counts: the same times (one digest per thread count)
+    assert rows[0][7] == rows[1][7]

@@ -99,11 +99,18 @@ from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _ORDER2_MAX_W_RATIO, _U, _ZER
                        unpad_grid)
 
 #: The windows meet at a barrier several hundred times per march: a thread that waits
-#: there sleeps instead of spinning (OpenMP's default spins), or on a busy machine the
-#: spinning thread takes the core its partner needs (measured on 2048^2 with 10 runnable
-#: processes on 2 cores: 3.4 CPU-s spinning, 0.56 s passive, serial 0.53 s). Read by
-#: libgomp when numba first starts its thread pool; a value set by the user stays.
-os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+#: there spins only briefly and then sleeps (OpenMP's default spins ~300,000 times), or on
+#: a busy machine the spinning thread takes the core its partner needs (measured on 2048^2
+#: with 10 runnable processes on 2 cores: 3.4 CPU-s spinning, 0.56 s passive, serial
+#: 0.53 s). The brief spin (:data:`SPIN_COUNT`) spares most wake-ups from sleep: on the
+#: idle machine two threads' wall 0.88x passive's on 2048^2 FM²-shaped order 1, 0.92x on
+#: 160^3, with the same CPU under load (docs/performance.md, "Spinning briefly"). Read by
+#: libgomp when numba first starts its thread pool; values set by the user stay (a user's
+#: ``OMP_WAIT_POLICY`` keeps libgomp's own spin count for it).
+SPIN_COUNT = 2000
+if "OMP_WAIT_POLICY" not in os.environ:
+    os.environ["OMP_WAIT_POLICY"] = "PASSIVE"
+    os.environ.setdefault("GOMP_SPINCOUNT", str(SPIN_COUNT))
 
 __all__ = ["march", "resolve_threads", "PARALLEL_MIN_NODES", "THREADS_ENV"]
 
