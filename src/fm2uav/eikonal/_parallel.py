@@ -102,9 +102,10 @@ from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _ORDER2_MAX_W_RATIO, _U, _ZER
 #: there spins only briefly and then sleeps (OpenMP's default spins ~300,000 times), or on
 #: a busy machine the spinning thread takes the core its partner needs (measured on 2048^2
 #: with 10 runnable processes on 2 cores: 3.4 CPU-s spinning, 0.56 s passive, serial
-#: 0.53 s). The brief spin (:data:`SPIN_COUNT`) spares most wake-ups from sleep: on the
-#: idle machine two threads' wall 0.88x passive's on 2048^2 FM²-shaped order 1, 0.92x on
-#: 160^3, with the same CPU under load (docs/performance.md, "Spinning briefly"). Read by
+#: 0.53 s). The brief spin (:data:`SPIN_COUNT`) spares most wake-ups from sleep: near
+#: idle, two threads' wall 0.93x passive's on 2048^2 FM²-shaped order 1, 0.92x at a
+#: constant speed, 0.98x on 160^3 FM²-shaped (``benchmarks/wait_policy.py``, medians of 11),
+#: the CPU +2-5 % near idle and under load (docs/performance.md, "Spinning briefly"). Read by
 #: libgomp when numba first starts its thread pool; values set by the user stay (a user's
 #: ``OMP_WAIT_POLICY`` keeps libgomp's own spin count for it).
 SPIN_COUNT = 2000
