@@ -102,13 +102,16 @@ from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _ORDER2_MAX_W_RATIO, _U, _ZER
 #: there spins only briefly and then sleeps (OpenMP's default spins ~300,000 times), or on
 #: a busy machine the spinning thread takes the core its partner needs (measured on 2048^2
 #: with 10 runnable processes on 2 cores: 3.4 CPU-s spinning, 0.56 s passive, serial
-#: 0.53 s). The brief spin (:data:`SPIN_COUNT`) spares most wake-ups from sleep: near
-#: idle, two threads' wall 0.93x passive's on 2048^2 FM²-shaped order 1, 0.92x at a
-#: constant speed, 0.98x on 160^3 FM²-shaped (``benchmarks/wait_policy.py``, medians of 11),
-#: the CPU +2-5 % near idle and under load (docs/performance.md, "Spinning briefly"). Read by
-#: libgomp when numba first starts its thread pool; values set by the user stay (a user's
-#: ``OMP_WAIT_POLICY`` keeps libgomp's own spin count for it).
-SPIN_COUNT = 2000
+#: 0.53 s). The brief spin (:data:`SPIN_COUNT`, ~0.1 ms by libgomp's estimate) spares most
+#: wake-ups from sleep: near idle (``benchmarks/wait_policy.py``, medians of 9), two threads'
+#: wall on 2048^2 FM²-shaped order 1 145.1 / 133.3 / 132.4 ms at 2000 / 5000 / 10000 spins,
+#: at a constant speed 139.1 / 127.3 / 125.0 ms, the CPU 253 -> 249 and 261 -> 244 ms (a
+#: sleep and its wake-up cost more than the spin); 160^3 FM²-shaped 278.6 / 279.0 / 267.3
+#: ms. Under load (two busy loops beside, load ~3) 10000 spins cost the CPU +10 % and the
+#: wall 0-8 % (docs/performance.md, "Spinning briefly"). Read by libgomp when numba first
+#: starts its thread pool; values set by the user stay (a user's ``OMP_WAIT_POLICY`` keeps
+#: libgomp's own spin count for it).
+SPIN_COUNT = 10000
 if "OMP_WAIT_POLICY" not in os.environ:
     os.environ["OMP_WAIT_POLICY"] = "PASSIVE"
     os.environ.setdefault("GOMP_SPINCOUNT", str(SPIN_COUNT))
@@ -2355,6 +2358,9 @@ class _PageToucher:
         return False
 
 
-#: Bytes faulted in per call of :func:`_touch` by :class:`_PageToucher` (its stop check).
-TOUCH_CHUNK = 16 * 2**20
+#: Bytes faulted in per call of :func:`_touch` by :class:`_PageToucher` (its stop check):
+#: one huge page, so the block's end waits for at most one fault. With 16 MiB the cuts of
+#: 2048^2 at a constant speed (3.6 ms) waited 13.8 ms for the toucher to end its chunk, with
+#: 2 MiB 0.09 ms (medians of 9; FM²-shaped and smooth 0.1-0.5 ms either way).
+TOUCH_CHUNK = 2 * 2**20
 
