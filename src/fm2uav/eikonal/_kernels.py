@@ -95,6 +95,7 @@ from __future__ import annotations
 import math
 import mmap
 import threading
+import weakref
 from typing import NamedTuple
 
 import numpy as np
@@ -1185,7 +1186,7 @@ def march(speed, start, shape3, h3, order, stop_cells, *, lean=None, interleave=
         unpad_grid(Tp, nx, ny, nz, Tp)
         T = Tp[:n]
     else:
-        T = np.empty(n)
+        T = result_array(n)
         unpad_grid(Tp, nx, ny, nz, T)
     return T, int(st[_FROZEN])
 
@@ -1364,6 +1365,12 @@ def _work(nbytes):
     """
     if nbytes < _HUGE_MIN:
         return np.empty(nbytes, dtype=np.uint8)
+    return np.frombuffer(_map(nbytes), dtype=np.uint8)[:nbytes]
+
+
+def _map(nbytes):
+    """A fresh anonymous mapping of at least ``nbytes`` (whole huge pages), advised for
+    transparent huge pages."""
     size = -(-nbytes // _HUGE) * _HUGE
     mm = mmap.mmap(-1, size, flags=mmap.MAP_PRIVATE | mmap.MAP_ANONYMOUS)
     if hasattr(mmap, "MADV_HUGEPAGE"):
@@ -1371,7 +1378,7 @@ def _work(nbytes):
             mm.madvise(mmap.MADV_HUGEPAGE)
         except OSError:  # THP unavailable: plain pages
             pass
-    return np.frombuffer(mm, dtype=np.uint8)[:nbytes]
+    return mm
 
 
 _HUGE = 2 * 1024 * 1024
@@ -1420,6 +1427,58 @@ def _work_kept(slot, nbytes):
         buf = _work(nbytes)
         kept[slot] = buf
     return buf[:nbytes]
+
+
+#: Result arrays (a march's times) of at least 4 MiB and at most :data:`WORK_KEEP_MAX`
+#: bytes come from a pool of at most this many mappings; a mapping goes back to the pool
+#: when its array and every view of it are gone, so the next march writes its times into
+#: pages that are already there. A fresh array's first touch is the kernel's page faults:
+#: on this virtual machine, after a few seconds idle (its free memory handed back to the
+#: host), 68 ms of system time for the 32 MB of 2048^2 times, a third of the march
+#: (docs/performance.md, "The result's pages"). Four: a caller keeping the last result of
+#: each of a few marches (one and two threads, orders 1 and 2) still gets pooled pages.
+RESULT_KEEP = 4
+_RESULTS_FREE: list = []
+_RESULTS_LOCK = threading.RLock()
+_RESULTS_LIVE = [0]
+
+
+def result_array(n):
+    """An uninitialised float64 array of ``n`` elements for a march's times.
+
+    From the pool of :data:`RESULT_KEEP` mappings when its size allows (the smallest free
+    one that fits; a new one while the pool has room; the smallest free one replaced when
+    none fits), else a plain ``np.empty(n)`` (small or huge arrays, or every pooled mapping
+    still in use). The caller writes every element.
+    """
+    nbytes = 8 * n
+    if nbytes < _HUGE_MIN or nbytes > WORK_KEEP_MAX:
+        return np.empty(n)
+    with _RESULTS_LOCK:
+        free = _RESULTS_FREE
+        fits = [mm for mm in free if len(mm) >= nbytes]
+        if fits:
+            mm = min(fits, key=len)
+            free.remove(mm)
+        elif _RESULTS_LIVE[0] + len(free) < RESULT_KEEP:
+            mm = _map(nbytes)
+        elif free:  # none fits: the smallest free mapping makes room for one that does
+            free.remove(min(free, key=len))
+            mm = _map(nbytes)
+        else:
+            return np.empty(n)
+        _RESULTS_LIVE[0] += 1
+    out = np.frombuffer(mm, dtype=np.float64, count=n)
+    # views of ``out`` keep ``out`` (and its buffer) alive: the mapping is free once it goes
+    weakref.finalize(out.base, _give_back, mm)
+    return out
+
+
+def _give_back(mm):
+    """A pooled result mapping is free again (its array and every view of it are gone)."""
+    with _RESULTS_LOCK:
+        _RESULTS_LIVE[0] -= 1
+        _RESULTS_FREE.append(mm)
 
 
 def _grow(pool, nxt, st):

@@ -1893,9 +1893,9 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
             bounds = slab_bounds(speed, start, shape3, h3, K, nth)
     elif nth > 1:
         # the cuts' coarse march runs on this thread alone: meanwhile a second one finds the
-        # top speed and faults in the result's pages, the rows the other thread unpads
-        # first (_unpad_slabs)
-        out = np.empty(nx * ny * nz)
+        # top speed and faults in the result's pages (a fresh array's; a pooled one's are
+        # there), the rows the other thread unpads first (_unpad_slabs)
+        out = _kernels.result_array(nx * ny * nz)
         half = out.size // 2
         with _PageToucher(out[half:], out[:half], top_of=speed) as toucher:
             bounds = slab_bounds(speed, start, shape3, h3, K, nth)
@@ -2031,8 +2031,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
             seg = slice(int(off[k] + (G - 1) * sx), int(off[k] + sizes[k] - (G - 1) * sx))
             _kernels.unpad_grid(Tp[seg], b - a, ny, nz, Tp[a * plane:b * plane])
         T = Tp[:nx * ny * nz]
-    else:  # a new array (its pages faulted in beside the cuts, the rest here): in parallel
-        T = np.empty(nx * ny * nz) if out is None else out
+    else:  # the result array (its pages faulted in beside the cuts, the rest here): in parallel
+        T = _kernels.result_array(nx * ny * nz) if out is None else out
         with _threads(nth):
             _unpad_slabs(nth, Tp, bounds, off, ny, nz, T, G)
     if win[6] < np.inf:  # stopped: what the serial march would not have frozen yet

@@ -193,6 +193,10 @@ def fast_marching(
     -------
     ndarray of float64, same shape as ``speed``
         Arrival time [s]; ``inf`` where unreachable (or not reached before stop).
+        Results of 4 MiB to 256 MiB are written into pages that an earlier result,
+        no longer referenced (nor any view of it), left behind: up to four such
+        buffers stay with the process (``_kernels.result_array``; a fresh array's
+        page faults cost up to a third of a 2048^2 march, docs/performance.md).
 
     Raises
     ------
