@@ -84,3 +84,13 @@ def test_the_wait_policy_probe_marches_every_spin_count_on_one_and_two_threads()
         assert float(r[6].removesuffix("x")) == pytest.approx(one / two, rel=0.02, abs=0.01)
     # the same code under both spin counts: the same times (one digest per thread count)
     assert rows[0][7] == rows[1][7]
+
+
+def test_the_result_pages_probe_times_the_pool_and_a_fresh_array():
+    out = _probe("result_pages", "--case", "fm2", "--shape", "1100x1000", "--threads", "2",
+                 "--pause", "0", "--repeats", "2")
+    assert "same times: True" in out.splitlines()[0]
+    rows = _table(out.split("\n", 1)[1], "| result")
+    assert [r[0] for r in rows] == ["pool", "fresh"]
+    for r in rows:
+        assert float(r[1]) > 0 and float(r[2]) >= 0 and float(r[3]) >= 0
