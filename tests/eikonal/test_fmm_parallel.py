@@ -184,7 +184,8 @@ def test_order_2_on_random_fm2_fields_and_thin_slabs_equals_the_serial_march(blo
         rows = 2 + seed % 5
         nth = min(threads, numba.config.NUMBA_NUM_THREADS)  # the march's thread count
         per = max(1, v.shape[0] // rows // nth)
-        monkeypatch.setattr(_parallel, "SLABS_PER_THREAD", {2: per, 3: per})
+        monkeypatch.setattr(_parallel, "SLABS_PER_THREAD",
+                            {(d, o): per for d in (2, 3) for o in (1, 2)})
         monkeypatch.setattr(_parallel, "slab_bounds",  # equal slabs of ``rows`` rows
                             lambda speed, start, shape3, h3, k, t=2: np.linspace(
                                 0, shape3[0], k + 1).round().astype(np.int64))
@@ -297,7 +298,7 @@ def test_balanced_cuts_of_many_slabs_shorten_the_windows_critical_path(shape, ga
     monkeypatch.setattr(_parallel, "DYNAMIC_2D", False)
     v, src = fm2_shaped(shape)
     flat, start, shape3 = _start(v, src)
-    k = 2 * _parallel.SLABS_PER_THREAD[len(shape)]
+    k = 2 * _parallel.SLABS_PER_THREAD[len(shape), 1]
     cuts = _parallel.slab_bounds(flat, start, shape3, (1.0,) * 3, k, 2)
     assert cuts[0] == 0 and cuts[-1] == shape[0] and len(cuts) == k + 1
     assert np.all(np.diff(cuts) >= _parallel.MIN_SLAB_ROWS)
@@ -679,7 +680,8 @@ def test_thin_interleaved_slabs_with_ghosts_on_both_sides(field, monkeypatch):
     both sides (several sources, some in other slabs than their ball's centre)."""
     monkeypatch.setattr(_parallel, "MIN_SLAB_ROWS", 1)
     monkeypatch.setattr(_parallel, "MIN_SLAB_NODES", 0)
-    monkeypatch.setattr(_parallel, "SLABS_PER_THREAD", {2: 97, 3: 4})  # one row each
+    monkeypatch.setattr(_parallel, "SLABS_PER_THREAD",  # one row each
+                        {(2, 1): 97, (2, 2): 97, (3, 1): 4, (3, 2): 4})
     name, v, src = next(f for f in _fields((97, 81)) if f[0] == field)
     sources = [src, (50, 7), (51, 70)]
     flat, start, shape3 = _start(v, src)
@@ -743,7 +745,8 @@ def test_interleaved_order_2_slabs_repair_stop_and_grow(monkeypatch):
                            source_ball=False)
     assert_equal_times(serial.reshape(-1), T, exact=True)
     monkeypatch.setattr(_parallel, "MIN_SLAB_ROWS", 1)
-    monkeypatch.setattr(_parallel, "SLABS_PER_THREAD", {2: 97, 3: 4})
+    monkeypatch.setattr(_parallel, "SLABS_PER_THREAD",
+                        {(2, 1): 97, (2, 2): 97, (3, 1): 4, (3, 2): 4})
     v, src = fm2_shaped((97, 81), seed=3)
     flat, start, shape3 = _start(v, src)
     T, stats = _both_ways(flat, start, shape3, (1.0,) * 3, monkeypatch, order=2)
@@ -866,12 +869,13 @@ def test_slabs_taken_in_turn_are_ordered_by_predicted_work():
 
 @pytest.mark.parametrize("threads", [2, 3])
 def test_slabs_taken_in_turn_give_the_serial_times(threads, monkeypatch):
-    """2D order 1 takes the slabs in turn (the drive gets ``share=2``; 3D and order 2 keep
-    the lists): on many thin slabs, with repairs, ``stop_at`` and the lists for comparison,
-    the times are the serial march's; every slab is marched whichever thread takes it."""
+    """2D takes the slabs in turn (the drive gets ``share=2``; 3D keeps the lists): on many
+    thin slabs, with repairs, ``stop_at`` and the lists for comparison, the times are the
+    serial march's (order 2: bit for bit); every slab is marched whichever thread takes it."""
     monkeypatch.setattr(_parallel, "MIN_SLAB_NODES", 0)
     monkeypatch.setattr(_parallel, "MIN_SLAB_ROWS", 4)
-    monkeypatch.setitem(_parallel.SLABS_PER_THREAD, 2, 9)
+    monkeypatch.setitem(_parallel.SLABS_PER_THREAD, (2, 1), 9)
+    monkeypatch.setitem(_parallel.SLABS_PER_THREAD, (2, 2), 9)
     seen = []
     for key in list(_parallel._DRIVES):
         def spy(*args, _d=_parallel._DRIVES[key], _key=key):
@@ -905,12 +909,22 @@ def test_slabs_taken_in_turn_give_the_serial_times(threads, monkeypatch):
             both = np.isfinite(ref) & np.isfinite(T)
             assert both.sum() > 0.3 * np.isfinite(ref).sum() > 0, name
             assert_equal_times(ref[both], T[both])
-    v, src = fm2_shaped((61, 47, 1)[:2], seed=2)
+    v, src = fm2_shaped((131, 67), seed=2)
     flat, start, shape3 = _start(v, src)
+    serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 2, np.zeros((0, 3), dtype=int))
+    for dynamic in (True, False):
+        monkeypatch.setattr(_parallel, "DYNAMIC_2D", dynamic)
+        seen.clear()
+        T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, threads, order=2)
+        assert_equal_times(serial, T, exact=True)
+        assert {s for _, s in seen} == {2 if dynamic else 1}
+        assert stats["reopened"] > 0 and stats["windows"] > 3
+        assert np.all(stats["runs"] == stats["exchanges"] + stats["windows"])
+    v3, src3 = fm2_shaped((41, 23, 19), seed=2)
+    flat, start, shape3 = _start(v3, src3)
     seen.clear()
-    monkeypatch.setattr(_parallel, "DYNAMIC_2D", True)
     _parallel.march(flat, start, shape3, (1.0,) * 3, threads, order=2)
-    assert {s for _, s in seen} == {1}  # order 2 keeps the lists
+    assert {s for _, s in seen} == {1}  # 3D keeps the lists
 
 
 def test_profile_accounts_for_every_region(monkeypatch):

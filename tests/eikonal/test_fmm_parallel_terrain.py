@@ -132,6 +132,7 @@ def test_big_3d_grids_cut_the_slabs_for_sharing_bit_for_bit(lean, monkeypatch):
     # nodes per time bin, and both descents the same cuts
     monkeypatch.setattr(_parallel, "COARSE_3D", 1)
     monkeypatch.setattr(_parallel, "COARSE_3D_Z", 1)
+    monkeypatch.setitem(_parallel.SLABS_PER_THREAD, (3, 2), 4)  # 8 slabs to place
     seen = []
     real = _parallel.slab_bounds
 

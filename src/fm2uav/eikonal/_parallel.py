@@ -138,8 +138,12 @@ PARALLEL_MIN_NODES = 1_000_000
 #: (a node's time from scratch, :func:`_serial_time2`) cost more on thin slabs. Measured
 #: (3 December 2026, machine at load 4.5-4.8, medians of 2): 160^3 FM²-shaped (20-row
 #: slabs) CPU 0.97 -> 2.31 s, busiest thread 0.98 -> 1.34 s (0.73x: slower); the
-#: 1000 x 1000 x 40 terrain march (125-row slabs) busiest thread 10.4 -> 5.0 s.
-ORDER2_MIN_NODES_3D = 2**24
+#: 1000 x 1000 x 40 terrain march (125-row slabs) busiest thread 10.4 -> 5.0 s. Since
+#: (5 December 2026: the window's flags on one line and its queue in registers, 2 slabs
+#: per thread, windows of 16384 nodes; idle machine, wall, 2 threads over 1, medians of 5):
+#: 160^3 (4.1 M) FM²-shaped 1.06-1.28x, constant 1.14-1.17x, smooth 1.11-1.21x; 128^3
+#: (2.1 M) 0.87-0.88x, 100^3 0.38-0.69x: from 4 M nodes.
+ORDER2_MIN_NODES_3D = 4_000_000
 #: 2D order 2 marches on slabs only from this many nodes (below: one thread, never slower).
 #: Its slab window costs more a node than the serial order-2 march (its neighbours' freeze
 #: order checked, :func:`_serial_time2`'s from-scratch repairs near the ghosts), which a
@@ -150,8 +154,11 @@ ORDER2_MIN_NODES_3D = 2**24
 #: wall 0.97x / 1.16x); 2900^2 (8.4 M) FM²-shaped CPU 0.875 -> 1.199 s (1.37x), busiest
 #: thread 1.43x (smooth 1.69x; load 8.7-9); 4096^2 (16.8 M) FM²-shaped CPU 1.926 -> 2.338 s
 #: (1.21x), busiest thread 1.60x (smooth 1.69x). On the idle machine the 2048^2 wall ratio
-#: was ~0.8x the busiest thread's: from 2^23 (8.4 M) nodes on the slabs.
-ORDER2_MIN_NODES_2D = 2**23
+#: was ~0.8x the busiest thread's: from 2^23 (8.4 M) nodes on the slabs. Since (5 December
+#: 2026, as the 3D floor's; windows of 8192 nodes, the slabs taken in turn): 2048^2 (4.2 M)
+#: FM²-shaped 1.16-1.22x, constant 1.06-1.18x, smooth 1.14x; 1448^2 (2.1 M) 0.89-1.04x,
+#: 1024^2 0.83-0.85x: from 2^22 nodes (2048^2).
+ORDER2_MIN_NODES_2D = 2**22
 #: Each slab gets at least this many x-slabs (rows), else fewer slabs are used.
 MIN_SLAB_ROWS = 16
 #: ... and at least this many nodes (but every thread one slab): thin slabs cost repairs.
@@ -168,21 +175,31 @@ MIN_SLAB_NODES = 2**17
 #: balance of 8 did not show in wall time on the idle machine (2048², 2 threads, medians
 #: of 5 interleaved: constant 0.257/0.261 s, smooth 0.292/0.302 s, FM²-shaped
 #: 0.234/0.248 s with 4/8 slabs per thread): 2D keeps 4. (With :data:`SHARE_SLABS`, 2D
-#: FM²-shaped 4/8: balance 1.76/1.81 for 2.2x the re-opened nodes.)
-SLABS_PER_THREAD = {2: 4, 3: 4}
+#: FM²-shaped 4/8: balance 1.76/1.81 for 2.2x the re-opened nodes.) Keyed by (dimension,
+#: order): order 2's ghosts, two rows deep, re-open more nodes on thinner slabs, and its
+#: repairs (a node's time from scratch, :func:`_serial_time2`) cost more; in 3D it takes
+#: 2 (5 December 2026, idle machine, 2 threads over 1, medians of 3, windows of 16384 nodes:
+#: 160^3 FM²-shaped 0.61x / 1.28x with 3 / 2 slabs per thread, 467,000 / 43,000 nodes
+#: re-opened; the terrain march 3.91 / 3.72 s; docs/performance.md).
+SLABS_PER_THREAD = {(2, 1): 4, (3, 1): 4, (2, 2): 4, (3, 2): 2}
 #: Target number of nodes frozen per window (all slabs together); the window
 #: width adapts to it. Fewer, wider windows cost fewer barriers and more repairs:
 #: measured on 160^3 (2 threads, CPU over the serial march's, loaded machine) constant
 #: speed 8192/16384/32768 nodes 1.15x/0.97x/0.85x; FM²-shaped 32768/65536 0.92x/2.4x
-#: (wider windows than the wave's crossing of a slab re-open nodes in cascades).
-WINDOW_NODES = 32768
+#: (wider windows than the wave's crossing of a slab re-open nodes in cascades). Keyed by
+#: (dimension, order): order 2 re-opens more a window (5 December 2026, idle machine, 2
+#: threads over 1, medians of 5, the slabs taken in turn: 2048^2 FM²-shaped 1.13x / 1.16x
+#: with 16384 / 8192 nodes, 95,000 / 52,000 re-opened, 4096 0.90x; 160^3 FM²-shaped, 2 slabs
+#: per thread, 32768 / 16384 / 8192 / 4096 1.03x / 1.28x / 1.25x / 1.10x; the terrain march
+#: 16384 / 32768 nodes 3.72 / 3.57-3.75 s; docs/performance.md).
+WINDOW_NODES = {(2, 1): 32768, (3, 1): 32768, (2, 2): 8192, (3, 2): 16384}
 #: Share the slabs among the threads anew before every window, longest first by the
 #: freezes of the last window, when that predicts a shorter window than the fixed
 #: interleave (:func:`_assign`); False: always the interleave. Windows' balance with /
 #: without (2 threads, 4 slabs per thread): FM²-shaped 2048^2 1.654 -> 1.759, 160^3 1.84 ->
 #: 1.90; constant speed the same (1.99, 1.93 -> 1.95).
 SHARE_SLABS = True
-#: 2D order 1: the threads take the slabs of a window (and of its exchange) in turn, the
+#: 2D: the threads take the slabs of a window (and of its exchange) in turn, the
 #: next not taken when done with the last, by decreasing predicted work (:func:`_take`)
 #: instead of lists fixed before the window (:func:`_assign`): the lists predict a window's
 #: work by the last one's, which lags the wave where it enters or leaves slabs; taken in
@@ -198,7 +215,9 @@ SHARE_SLABS = True
 #: re-opened nodes (two threads' CPU +3 %: no gain). Wall near idle (load 1.0-1.1, 2048^2,
 #: medians of 5-7 interleaved, two threads over one): lists / in turn constant 1.83-1.84x /
 #: 1.87-1.94x, smooth 1.80x / 1.87x, FM²-shaped 1.51x / 1.57-1.59x. On: 2D order 1, 4 slabs
-#: per thread.
+#: per thread. Order 2 too (5 December 2026, 2048^2, 4 slabs per thread, windows of 8192
+#: nodes, 2 threads over 1, medians of 5: lists / in turn FM²-shaped 1.08x / 1.16x, smooth
+#: 1.03x / 1.14x, constant 1.02x / 1.17x).
 DYNAMIC_2D = True
 #: 2D: the exchange before each window runs on the calling thread alone (the parallel
 #: region's iterations in turn), not on every thread: its work is a row per slab side (the
@@ -231,7 +250,10 @@ _C_PEND = 4    # order 2: re-opened nodes raised above their old time, not froze
 _C_RMIN = 5    # order 2: a time no later than the old times of those (inf: none)
 _C_RAISED = 6  # order 2: updates that found a later time than the node had (suspects)
 _C_RUNS = 7    # the slab's runs in the exchanges and windows (once per region: the tests)
-_C_SIZE = 8
+_C_RLIVE = 8   # order 2: the slab's re-opened bits set (0: none, its pops read no bit)
+_C_SLIVE = 9   # order 2: the slab's suspect bits set (likewise)
+_C_FMAX = 10   # order 2: no node of the slab (ghosts too) frozen later, but on entry
+_C_SIZE = 11
 
 # slots of the march state ``st`` (uint64), shared with the serial layout
 _NFREE = 2
@@ -356,19 +378,6 @@ def _deq(T, pool, nxt, bk, mw, st, rkey, ritem):
     c, nfree, fh, cur, last, rsize = _deq_r(T, pool, nxt, bk, mw, rkey, ritem, st[_NFREE],
                                             st[_FH], st[_CUR], st[_LAST], st[_RSIZE])
     _keep_queue(st, nfree, fh, cur, last, rsize)
-    return c
-
-
-@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
-def _deq_ahead(T, V, pool, nxt, bk, mw, st, rkey, ritem, s1, s2, pv):
-    """:func:`_deq`, fetching ahead the lines that expanding the nodes popped next from the
-    radix queue reads (:func:`~fm2uav.eikonal._kernels._pop_ahead`: ``s1``, ``s2`` the x
-    and y strides of a 3D slab, ``pv`` the speeds too); the same nodes, in the same order."""
-    if st[_RSIZE] > _ZERO:
-        return _pop_repair(st, rkey, ritem)
-    c, nfree, fh, cur, last = _pop_ahead(T, V, pool, nxt, bk, mw, st[_NFREE], st[_FH],
-                                         st[_CUR], st[_LAST], s1, s2, pv)
-    _keep_queue(st, nfree, fh, cur, last, st[_RSIZE])
     return c
 
 
@@ -811,6 +820,44 @@ def _clear_bit(a, c):
 
 
 @njit(cache=True, inline="always", _nrt=False)
+def _fbit(a, c):
+    """Bit ``c`` of one of order 2's flag masks: the three masks interleaved a byte each in
+    every 4 bytes (a node's three flags on one cache line; ``a`` starts at the mask's byte)."""
+    return a[(c >> _U(3)) << _U(2)] & np.uint8(_ONE << (c & _U(7)))
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _set_fbit(a, c):
+    a[(c >> _U(3)) << _U(2)] |= np.uint8(_ONE << (c & _U(7)))
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _clear_fbit(a, c):
+    i = (c >> _U(3)) << _U(2)
+    a[i] = np.uint8(a[i] & (np.uint8(255) ^ np.uint8(_ONE << (c & _U(7)))))
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _mark(a, c, ctl, slot):
+    """Set flag bit ``c`` of ``a`` (:func:`_set_fbit`), counting it in ``ctl[slot]`` if it was
+    clear: while the count is 0 the pops read no bit of that mask."""
+    if not _fbit(a, c):
+        _set_fbit(a, c)
+        ctl[slot] += 1.0
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _take_flag(a, c, ctl, slot):
+    """Whether flag bit ``c`` of ``a`` is set, clearing it (and its count) if so; no read
+    while no bit of the mask is set (``ctl[slot] == 0``)."""
+    if ctl[slot] > 0.0 and _fbit(a, c):
+        _clear_fbit(a, c)
+        ctl[slot] -= 1.0
+        return True
+    return False
+
+
+@njit(cache=True, inline="always", _nrt=False)
 def _known(T, fixed, c, thr, sh):
     """Node ``c``'s time if the serial march had frozen it when the node of time ``thr``
     froze (frozen on entry, or frozen no later than ``thr``), else inf (``c >> sh``: its
@@ -922,7 +969,7 @@ def _serial_time2(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three):
 def _entry_cap(eidx, evals, g, t):
     """``t``, or the time node ``g`` (an index into the slabs' buffer) had in the band on
     entry if lower: the serial march keeps it (sorted ``eidx``, times ``evals``)."""
-    if eidx.size == 0:
+    if eidx.size == 0 or g < eidx[0] or g > eidx[eidx.size - 1]:
         return t
     i = np.searchsorted(eidx, g)
     if i < eidx.size and eidx[i] == g:
@@ -952,26 +999,43 @@ def _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf, eidx, eval
             T[d] = -t
             _enq(_bits(t), d, pool, nxt, bk, mw, st, rkey, ritem)
         elif t > -x and x > -_INF:
-            _set_bit(sf, nd)
+            _mark(sf, nd, ctl, _C_SLIVE)
             ctl[_C_RAISED] += 1.0
     elif t != x:
         ctl[_C_REOPEN] += 1.0
-        _set_bit(rf, nd)
+        _mark(rf, nd, ctl, _C_RLIVE)
         if t < x:
             T[d] = -t
             _enq(_bits(t), d, pool, nxt, bk, mw, st, rkey, ritem)
         else:
             T[d] = -x
-            _set_bit(sf, nd)
+            _mark(sf, nd, ctl, _C_SLIVE)
             ctl[_C_RAISED] += 1.0
             _enq(_bits(x), d, pool, nxt, bk, mw, st, rkey, ritem)
+
+
+@njit(cache=True, inline="always", error_model="numpy", _nrt=False)
+def _recheck_r(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf, eidx, evals, base,
+               pool, nxt, bk, mw, st, rkey, ritem, ctl, nfree, fh, cur, last, rsize):
+    """:func:`_recheck` from a kernel keeping the queue's state in registers: stored in
+    ``st`` for the call and read back (``nfree, fh, cur, rsize``; a repair is rare)."""
+    _keep_queue(st, nfree, fh, cur, last, rsize)
+    _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf, eidx, evals, base, pool,
+             nxt, bk, mw, st, rkey, ritem, ctl)
+    return st[_NFREE], st[_FH], st[_CUR], st[_RSIZE]
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _room2_r(nfree, rsize, rkey):
+    """:func:`_room2` with the queue's state in registers."""
+    return (nfree >= _U(RESERVE_BLOCKS + POOL_EXTRA_2)
+            and rsize + _U(HEAP_RESERVE_2) <= _U(rkey.size))
 
 
 @njit(cache=True, inline="always", _nrt=False)
 def _room2(st, rkey):
     """Whether the pool and the repair heap have room for the pushes of one order-2 pop."""
-    return (st[_NFREE] >= _U(RESERVE_BLOCKS + POOL_EXTRA_2)
-            and st[_RSIZE] + _U(HEAP_RESERVE_2) <= _U(rkey.size))
+    return _room2_r(st[_NFREE], st[_RSIZE], rkey)
 
 
 def _slab_kernels2(three):
@@ -984,7 +1048,8 @@ def _slab_kernels2(three):
 
         As the order-1 window; the boundary lists hold the nodes frozen in the first and
         last *two* own rows, and a frozen node's dependants include the nodes two away. In
-        3D it pops as the serial 3D march (:func:`_deq_ahead`: the lines the next pops read
+        3D it pops as the serial 3D march (:func:`~fm2uav.eikonal._kernels._pop_ahead`: the
+        lines the next pops read
         fetched ahead) and fetches no rows for new band nodes (on the terrain march the
         windows' CPU -8 %, docs/performance.md).
         """
@@ -1002,58 +1067,74 @@ def _slab_kernels2(three):
         ns[0] = _ZERO
         ns[1] = _ZERO
         ctl[_C_NEXT] = _INF
+        # the queue's state in registers (stored back at the end, and around a repair's
+        # call): the stores into T would otherwise reload it from st at every push and pop
+        nfree = st[_NFREE]
+        fh = st[_FH]
+        cur = st[_CUR]
+        last = st[_LAST]
+        rsize = st[_RSIZE]
         while True:
-            if not _room2(st, rkey):
-                ctl[_C_STATUS] = 1.0 if st[_NFREE] < _U(RESERVE_BLOCKS + POOL_EXTRA_2) else 2.0
+            if not _room2_r(nfree, rsize, rkey):
+                ctl[_C_STATUS] = 1.0 if nfree < _U(RESERVE_BLOCKS + POOL_EXTRA_2) else 2.0
                 break
-            heap = st[_RSIZE] > _ZERO
+            heap = rsize > _ZERO
             kb = rkey[0] if heap else _ZERO
-            if three:  # fetch the lines the next pops read, as the serial 3D march
-                c = _deq_ahead(T, V, pool, nxt, bk, mw, st, rkey, ritem, sx, sy, not use_u)
+            if heap:
+                c, rsize = _pop_repair_r(rkey, ritem, rsize)
+            elif three:  # fetch the lines the next pops read, as the serial 3D march
+                c, nfree, fh, cur, last = _pop_ahead(T, V, pool, nxt, bk, mw, nfree, fh, cur,
+                                                     last, sx, sy, not use_u)
             else:
-                c = _deq(T, pool, nxt, bk, mw, st, rkey, ritem)
+                c, nfree, fh, cur, last = _pop(T, pool, nxt, bk, mw, nfree, fh, cur, last)
             if c == _NIL:
                 break
             if not heap:  # a lower bound of the popped key and of every key left
-                kb = st[_LAST]
+                kb = last
             x = T[c]
             if not x < 0.0 or x == -_INF:  # outdated entry (frozen, or far again)
                 continue
             t = -x
             k = _bits(t)
             if k >= kw:  # the window is done: put it back
-                _enq(k, c, pool, nxt, bk, mw, st, rkey, ritem)
+                nfree, fh, cur, rsize = _enq_r(k, c, pool, nxt, bk, mw, rkey, ritem, nfree, fh,
+                                               cur, last, rsize)
                 ctl[_C_NEXT] = min(t, _from_bits(kb))
                 break
-            if _bit(sf, c >> sh):  # suspect: its time may have to go up
-                _clear_bit(sf, c >> sh)
+            if _take_flag(sf, c >> sh, ctl, _C_SLIVE):  # suspect: its time may have to go up
                 t2 = _entry_cap(eidx, evals, base + c,
                                 _serial_time2(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three))
                 if t2 != t:
-                    if t2 > t and _bit(rf, c >> sh) and not _bit(pf, c >> sh):
+                    if t2 > t and _fbit(rf, c >> sh) and not _fbit(pf, c >> sh):
                         # nodes may still read its old time (>= t): the stop test must not
                         # pass t before it is frozen again
-                        _set_bit(pf, c >> sh)
+                        _set_fbit(pf, c >> sh)
                         ctl[_C_PEND] += 1.0
                         ctl[_C_RMIN] = min(ctl[_C_RMIN], t)
                     T[c] = -t2
                     if t2 < _INF:
-                        _enq(_bits(t2), c, pool, nxt, bk, mw, st, rkey, ritem)
+                        nfree, fh, cur, rsize = _enq_r(_bits(t2), c, pool, nxt, bk, mw, rkey,
+                                                       ritem, nfree, fh, cur, last, rsize)
                     continue
             T[c] = t
             pops += 1
+            # in time order (no node frozen later than c, but on entry): no neighbour of a
+            # band node is frozen later than c (:func:`_later_nb` False), as in the serial
+            # march; a repair's pop below an earlier freeze is not
+            inorder = t >= ctl[_C_FMAX]
+            if inorder:
+                ctl[_C_FMAX] = t
             if c < lo2:
                 _note(sent, ns, 0, c)
             if c >= hi2:
                 _note(sent, ns, 1, c)
-            if _bit(pf, c >> sh):
-                _clear_bit(pf, c >> sh)
+            if ctl[_C_PEND] > 0.0 and _fbit(pf, c >> sh):
+                _clear_fbit(pf, c >> sh)
                 ctl[_C_PEND] -= 1.0
                 if ctl[_C_PEND] == 0.0:
                     ctl[_C_RMIN] = _INF
-            full = _bit(rf, c >> sh)  # frozen again: every dependant may have read its old time
-            if full:
-                _clear_bit(rf, c >> sh)
+            # frozen again: every dependant may have read its old time
+            full = _take_flag(rf, c >> sh, ctl, _C_RLIVE)
             # prefetch V apart from T off the plateau (interleaved: the same lines)
             pv = one == _ONE and not (use_u and _at_plateau(U, c))
             for nb in _nbs(c, sx, sy, three):
@@ -1074,30 +1155,37 @@ def _slab_kernels2(three):
                     # c2: the node beyond c on that axis (nb's other side is not frozen)
                     ta, aa = _upwind_term_at(T, V, U, use_u, fixed, nb, t, c, c + c - nb,
                                              ih_nb, t, sh)
-                    _lower(T, V, nb, ta + math.sqrt(_rhs(V, U, use_u, qp, nb) / aa), fixed, sx,
-                           sy, three, pv, pool, nxt, bk, mw, st, rkey, ritem, ctl, not three)
+                    nfree, fh, cur, rsize = _lower_r(
+                        T, V, nb, ta + math.sqrt(_rhs(V, U, use_u, qp, nb) / aa), fixed, sx, sy,
+                        three, pv, pool, nxt, bk, mw, rkey, ritem, ctl, not three, nfree, fh,
+                        cur, last, rsize)
                 elif y < 0.0:  # band (or far after c froze again): an own node
-                    if full or _later_nb(T, fixed, nb, sx, sy, three, t):
+                    if full or (not inorder and _later_nb(T, fixed, nb, sx, sy, three, t)):
                         # c frozen again, or a neighbour frozen later than c (a ghost ahead
                         # of this slab, a repair): the updates at the later freezes read
                         # nodes not frozen then, from scratch now
-                        _recheck(T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf,
-                                 eidx, evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                        nfree, fh, cur, rsize = _recheck_r(
+                            T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf, eidx,
+                            evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl, nfree, fh, cur,
+                            last, rsize)
                     else:  # the serial march's update when c froze; a band time that read
                         # nodes out of time order may be too low: a later update above it
                         # marks it suspect
                         tn = _update2_at(T, V, U, use_u, qp, fixed, nb, sx, sy, ih, three, t)
                         if tn < -y:
-                            _lower(T, V, nb, tn, fixed, sx, sy, three, pv, pool, nxt, bk, mw,
-                                   st, rkey, ritem, ctl, not three)
+                            nfree, fh, cur, rsize = _lower_r(
+                                T, V, nb, tn, fixed, sx, sy, three, pv, pool, nxt, bk, mw, rkey,
+                                ritem, ctl, not three, nfree, fh, cur, last, rsize)
                         elif (tn > -y and y > -_INF
                               and _entry_cap(eidx, evals, base + nb, tn) > -y):
-                            _set_bit(sf, nb >> sh)
+                            _mark(sf, nb >> sh, ctl, _C_SLIVE)
                             ctl[_C_RAISED] += 1.0
                 elif y >= 0.0 and nb >= lo and nb < hi and (full or y > t):
                     # frozen later than c in this slab: c may change it
-                    _recheck(T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf, eidx,
-                             evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                    nfree, fh, cur, rsize = _recheck_r(
+                        T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf, eidx, evals,
+                        base, pool, nxt, bk, mw, st, rkey, ritem, ctl, nfree, fh, cur, last,
+                        rsize)
                 # the node two away reads c beyond nb when nb is frozen no earlier than c
                 y = T[nb]
                 if y >= 0.0 and (full or t <= y):
@@ -1105,8 +1193,11 @@ def _slab_kernels2(three):
                     if d2 >= lo and d2 < hi:
                         z = T[d2]
                         if z < 0.0 or (z >= 0.0 and (full or z > t)):
-                            _recheck(T, V, U, use_u, qp, d2, sx, sy, ih, three, fixed, rf, sf,
-                                     eidx, evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                            nfree, fh, cur, rsize = _recheck_r(
+                                T, V, U, use_u, qp, d2, sx, sy, ih, three, fixed, rf, sf, eidx,
+                                evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl, nfree, fh,
+                                cur, last, rsize)
+        _keep_queue(st, nfree, fh, cur, last, rsize)
         ctl[_C_POPS] = pops
 
     def start(T, V, U, qp, fixed, sx, sy, ih, pool, nxt, bk, mw, st, rkey, ritem, ctl, c0, c1):
@@ -1161,6 +1252,8 @@ def _slab_kernels2(three):
                     return False
                 gj = g + j
                 T[gj] = v
+                if v > ctl[_C_FMAX]:  # a ghost frozen later than the slab's nodes
+                    ctl[_C_FMAX] = v
                 for step in (sx, lo):
                     d = gj + step if up else gj - step
                     if d >= lo and d < hi:
@@ -1441,8 +1534,8 @@ def _drive_kernel(three, order=1):
                     V = Vp[off[k]:end[k]]
                     Uk = U[0 if U.size == 1 else off[k] >> sh >> 3:]
                     F = fx[off[k] >> sh >> 3:]
-                    R = fl[0, off[k] >> sh >> 3:]
-                    S = fl[1, off[k] >> sh >> 3:]
+                    R = fl[(off[k] >> sh >> 3) * 4:]
+                    S = fl[(off[k] >> sh >> 3) * 4 + 1:]
                     ok = True
                     r = _U(rows[k])
                     if k > 0:
@@ -1541,8 +1634,8 @@ def _drive_kernel(three, order=1):
                     if order == 2:
                         o3 = off[k] >> sh >> 3
                         args = (Tp[off[k]:end[k]], Vp[off[k]:end[k]],
-                                U[0 if U.size == 1 else o3:], qp, fx[o3:], fl[0, o3:],
-                                fl[1, o3:], fl[2, o3:], eidx, evals, _U(off[k]), sx, sy, ih, tw,
+                                U[0 if U.size == 1 else o3:], qp, fx[o3:], fl[4 * o3:],
+                                fl[4 * o3 + 1:], fl[4 * o3 + 2:], eidx, evals, _U(off[k]), sx, sy, ih, tw,
                                 pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k],
                                 sent[k], ns[k])
                         if three:
@@ -1615,10 +1708,9 @@ SHARED_CUTS = {2: True, 3: True}
 #: 3D grids of fewer nodes keep the interleave's cuts: on the bench's 160^3 fields (order 1)
 #: constant and smooth speed get the same cuts either way, the FM²-shaped one other cuts
 #: that simulate worse (1.921 -> 1.910); the 1000 x 1000 x 40 terrain plan's order-2 march
-#: (40 M nodes) gets the shared cuts, measured 1.881 -> 1.922 (docs/performance.md). The
-#: size at which 3D order 2 marches on slabs (:data:`ORDER2_MIN_NODES_3D`): every 3D
-#: order-2 march on slabs is above it, the bench's 3D order-1 grids below.
-SHARED_CUTS_MIN_NODES_3D = ORDER2_MIN_NODES_3D
+#: (40 M nodes) gets the shared cuts, measured 1.881 -> 1.922 (docs/performance.md): from
+#: 2^24 nodes, the bench's 160^3 grids (both orders) below.
+SHARED_CUTS_MIN_NODES_3D = 2**24
 #: Bins of the split estimate, each as many coarse nodes in time order (stand-ins for
 #: the windows).
 SPLIT_BINS = 256
@@ -1871,7 +1963,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     nx, ny, nz = (int(n) for n in shape3)
     three = nz > 1
     nth = int(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
-    K = int(max(1, min(nth * SLABS_PER_THREAD[3 if three else 2], nx // MIN_SLAB_ROWS,
+    spt = SLABS_PER_THREAD[3 if three else 2, order]
+    K = int(max(1, min(nth * spt, nx // MIN_SLAB_ROWS,
                        max(nth, nx * ny * nz // max(MIN_SLAB_NODES, 1)))))
     G = 2 if order == 2 else 1  # ghost x-slabs on each side (the rows the stencil reads)
     K = max(1, min(K, nx // G))  # a slab at least as thick as its ghosts
@@ -1943,7 +2036,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     # order 2's bit masks: re-opened, suspect, pending, a bit per node (one spare byte: a 2D
     # slice below), and the nodes in the band on entry with their times (a repair keeps
     # them if lower; element indices)
-    fl = np.zeros((3, npad // 8 + 2 if order == 2 else 1), dtype=np.uint8)
+    fl = np.zeros(4 * (npad // 8 + 2) if order == 2 else 4, dtype=np.uint8)
     nodes = np.zeros(0, dtype=np.int64)
     if order == 2:
         parts = []
@@ -1987,7 +2080,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         vmax = _top_speed(_kernels._readonly(speed))
     width = 2.0 * min(h3[:3 if three else 2]) / max(vmax, 1e-300)
     win = np.zeros(_W_SIZE + (_P_THREADS + 3 * nth if PROFILE else 0))
-    win[:_W_SIZE] = [0.0, width, 0.0, float(WINDOW_NODES), 0.0, 0.0, np.inf, 0.0, 0.0, 0.0]
+    wn = WINDOW_NODES[3 if three else 2, order]
+    win[:_W_SIZE] = [0.0, width, 0.0, float(wn), 0.0, 0.0, np.inf, 0.0, 0.0, 0.0]
     stop_idx = np.zeros(0, dtype=np.int64)
     if stop_cells is not None and len(stop_cells):
         cells = np.asarray(stop_cells, dtype=np.int64).reshape(-1, 3)
@@ -1998,7 +2092,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         stop_idx = unit * (off[k] + local)
     drive = _DRIVES[3 if three else 2, G]
     # how the slabs go to the threads (_assign): in turn (2), lists (1), the interleave (0)
-    share = (2 if DYNAMIC_2D and not three and G == 1 else 1) if SHARE_SLABS else 0
+    share = (2 if DYNAMIC_2D and not three else 1) if SHARE_SLABS else 0
     slabs = np.empty(K, dtype=np.int64)  # scratch of _assign: each window's slabs per thread
     lists = np.empty(nth + 1 + K, dtype=np.int64)
     load = np.empty(nth)
