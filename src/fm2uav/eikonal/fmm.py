@@ -184,7 +184,7 @@ def fast_marching(
         variable ``FM2UAV_THREADS`` if set, else every core this process may run
         on. With 2 or more, a grid of at least ``PARALLEL_MIN_NODES`` (1 M) nodes
         marches slabs of the grid in parallel, order 1 and 2 (order 2 from
-        ``ORDER2_MIN_NODES_2D``, 8.4 M, and ``_3D``, 16.8 M), ``stop_at`` included
+        ``ORDER2_MIN_NODES_2D``, 4.2 M, and ``_3D``, 4 M), ``stop_at`` included
         (:mod:`fm2uav.eikonal._parallel`; order 1's times equal the serial march's
         to round-off, order 2's bit for bit on every case measured); the wind march
         and smaller grids march on one thread.
