@@ -1635,9 +1635,9 @@ def _drive_kernel(three, order=1):
                         o3 = off[k] >> sh >> 3
                         args = (Tp[off[k]:end[k]], Vp[off[k]:end[k]],
                                 U[0 if U.size == 1 else o3:], qp, fx[o3:], fl[4 * o3:],
-                                fl[4 * o3 + 1:], fl[4 * o3 + 2:], eidx, evals, _U(off[k]), sx, sy, ih, tw,
-                                pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k],
-                                sent[k], ns[k])
+                                fl[4 * o3 + 1:], fl[4 * o3 + 2:], eidx, evals, _U(off[k]), sx,
+                                sy, ih, tw, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
+                                ritem[k], ctl[k], sent[k], ns[k])
                         if three:
                             _window3d_o2(*args)
                         else:
