@@ -2,7 +2,7 @@
 
 The parallel march's windows end at a parallel region's barrier twice per window; how long
 the thread that arrives first spins before it sleeps is libgomp's ``GOMP_SPINCOUNT``
-(``fm2uav.eikonal._parallel.SPIN_COUNT`` unless the user sets it). One child per spin count
+(``fm2uav.eikonal._tuning.SPIN_COUNT`` unless the user sets it). One child per spin count
 (``benchmarks/threads_march.py``'s child: the same code, kernels loaded once), the children's
 marches alternating one by one, each case on 1 and 2 threads::
 

@@ -54,19 +54,19 @@ def fast_marching_parallel(*args, threads: int = 2, **kwargs) -> np.ndarray:
     """:func:`fast_marching` with the parallel march on every grid (no size floor, slabs
     of one row or node on): the small exactness cases then run through the slabs, windows and
     repairs of :mod:`fm2uav.eikonal._parallel`, at order 1 and 2 (``ORDER2`` set)."""
-    from fm2uav.eikonal import _parallel
+    from fm2uav.eikonal import _tuning
 
-    saved = (_parallel.PARALLEL_MIN_NODES, _parallel.MIN_SLAB_ROWS, _parallel.MIN_SLAB_NODES,
-             _parallel.ORDER2, _parallel.ORDER2_MIN_NODES_3D, _parallel.ORDER2_MIN_NODES_2D)
-    (_parallel.PARALLEL_MIN_NODES, _parallel.MIN_SLAB_ROWS, _parallel.MIN_SLAB_NODES,
-     _parallel.ORDER2, _parallel.ORDER2_MIN_NODES_3D, _parallel.ORDER2_MIN_NODES_2D) = (
+    saved = (_tuning.PARALLEL_MIN_NODES, _tuning.MIN_SLAB_ROWS, _tuning.MIN_SLAB_NODES,
+             _tuning.ORDER2, _tuning.ORDER2_MIN_NODES_3D, _tuning.ORDER2_MIN_NODES_2D)
+    (_tuning.PARALLEL_MIN_NODES, _tuning.MIN_SLAB_ROWS, _tuning.MIN_SLAB_NODES,
+     _tuning.ORDER2, _tuning.ORDER2_MIN_NODES_3D, _tuning.ORDER2_MIN_NODES_2D) = (
         0, 1, 0, True, 0, 0)
     try:
         return fast_marching(*args, threads=threads, **kwargs)
     finally:
-        (_parallel.PARALLEL_MIN_NODES, _parallel.MIN_SLAB_ROWS,
-         _parallel.MIN_SLAB_NODES, _parallel.ORDER2, _parallel.ORDER2_MIN_NODES_3D,
-         _parallel.ORDER2_MIN_NODES_2D) = saved
+        (_tuning.PARALLEL_MIN_NODES, _tuning.MIN_SLAB_ROWS,
+         _tuning.MIN_SLAB_NODES, _tuning.ORDER2, _tuning.ORDER2_MIN_NODES_3D,
+         _tuning.ORDER2_MIN_NODES_2D) = saved
 
 
 #: The implementations of the same discretisation; exact-value tests run on each.

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from fm2uav.errors import InputError
-from fm2uav.eikonal import _kernels, _parallel, fast_marching
+from fm2uav.eikonal import _kernels, _parallel, _tuning, fast_marching
 from fm2uav.eikonal.fmm import _as_speed, _source_start
 
 from .fmm_checks import fast_marching_parallel
@@ -176,15 +176,15 @@ def test_order_2_on_random_fm2_fields_and_thin_slabs_equals_the_serial_march(blo
     FM²-shaped fields, 2 or 3 threads, slabs of 2 to 6 rows (every node near a ghost, the
     order-2 stencil reading two slabs' rows); the repairs re-open nodes and raise some
     (the update is not monotone: a lower time two away raises the order-2 term)."""
-    monkeypatch.setattr(_parallel, "MIN_SLAB_ROWS", 2)
-    monkeypatch.setattr(_parallel, "MIN_SLAB_NODES", 0)
+    monkeypatch.setattr(_tuning, "MIN_SLAB_ROWS", 2)
+    monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)
     reopened = raised = 0
     for seed in range(6 * block, 6 * block + 6):
         v, src, h, threads = _random_case(seed)
         rows = 2 + seed % 5
         nth = min(threads, numba.config.NUMBA_NUM_THREADS)  # the march's thread count
         per = max(1, v.shape[0] // rows // nth)
-        monkeypatch.setattr(_parallel, "SLABS_PER_THREAD",
+        monkeypatch.setattr(_tuning, "SLABS_PER_THREAD",
                             {(d, o): per for d in (2, 3) for o in (1, 2)})
         monkeypatch.setattr(_parallel, "slab_bounds",  # equal slabs of ``rows`` rows
                             lambda speed, start, shape3, h3, k, t=2: np.linspace(
@@ -208,9 +208,9 @@ def test_order_2_on_a_big_fm2_field_equals_the_serial_march_bit_for_bit(shape, m
     neighbours' freezes, :func:`fm2uav.eikonal._parallel._serial_time2` -- the 2048²
     FM²-shaped map differed by up to 3e-11 relative.)"""
     v, src = fm2_shaped(shape, seed=3)
-    assert v.size >= _parallel.PARALLEL_MIN_NODES
-    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_3D", 0)  # 16.8 M nodes by default
-    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_2D", 0)
+    assert v.size >= _tuning.PARALLEL_MIN_NODES
+    monkeypatch.setattr(_tuning, "ORDER2_MIN_NODES_3D", 0)  # 16.8 M nodes by default
+    monkeypatch.setattr(_tuning, "ORDER2_MIN_NODES_2D", 0)
     stats = {}
     march = _parallel.march
 
@@ -245,12 +245,12 @@ def test_plan_with_two_threads_flies_the_one_thread_path():
         calls.append(kwargs.get("order"))
         return march(*args, **kwargs)
 
-    saved = _parallel.PARALLEL_MIN_NODES, _parallel.ORDER2_MIN_NODES_3D
-    _parallel.PARALLEL_MIN_NODES, _parallel.ORDER2_MIN_NODES_3D, _parallel.march = 0, 0, spy
+    saved = _tuning.PARALLEL_MIN_NODES, _tuning.ORDER2_MIN_NODES_3D
+    _tuning.PARALLEL_MIN_NODES, _tuning.ORDER2_MIN_NODES_3D, _parallel.march = 0, 0, spy
     try:
         plans = [plan(world, start, goal, options=PlanOptions(threads=t)) for t in (1, 2)]
     finally:
-        (_parallel.PARALLEL_MIN_NODES, _parallel.ORDER2_MIN_NODES_3D), _parallel.march = (
+        (_tuning.PARALLEL_MIN_NODES, _tuning.ORDER2_MIN_NODES_3D), _parallel.march = (
             saved, march)
     assert calls == [2]  # the second plan marched order 2 on the slabs
     one, two = plans
@@ -292,16 +292,16 @@ def test_balanced_cuts_of_many_slabs_shorten_the_windows_critical_path(shape, ga
     times stay the serial march's. (2D, 4 slabs per thread, slabs shared anew before each
     window: 1.627 against 1.579 for equal slabs; 8 per thread gained more balance but no
     wall time.) The cuts are placed for slabs shared by lists (:func:`_parallel._assign`): 2D
-    compares with the lists, then the slabs taken in turn (:data:`_parallel.DYNAMIC_2D`) on
+    compares with the lists, then the slabs taken in turn (:data:`_tuning.DYNAMIC_2D`) on
     the same cuts must beat them (1.709 against 1.627; the equal slabs' 1.719 in turn)."""
-    monkeypatch.setattr(_parallel, "MIN_SLAB_NODES", 0)  # slab counts of 2048^2 and 160^3
-    monkeypatch.setattr(_parallel, "DYNAMIC_2D", False)
+    monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)  # slab counts of 2048^2 and 160^3
+    monkeypatch.setattr(_tuning, "DYNAMIC_2D", False)
     v, src = fm2_shaped(shape)
     flat, start, shape3 = _start(v, src)
-    k = 2 * _parallel.SLABS_PER_THREAD[len(shape), 1]
+    k = 2 * _tuning.SLABS_PER_THREAD[len(shape), 1]
     cuts = _parallel.slab_bounds(flat, start, shape3, (1.0,) * 3, k, 2)
     assert cuts[0] == 0 and cuts[-1] == shape[0] and len(cuts) == k + 1
-    assert np.all(np.diff(cuts) >= _parallel.MIN_SLAB_ROWS)
+    assert np.all(np.diff(cuts) >= _tuning.MIN_SLAB_ROWS)
     T, balanced = _parallel.march(flat, start, shape3, (1.0,) * 3, 2)
     serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 1, np.zeros((0, 3), dtype=int))
     assert_equal_times(serial, T)
@@ -314,7 +314,7 @@ def test_balanced_cuts_of_many_slabs_shorten_the_windows_critical_path(shape, ga
     assert balanced["balance"] > gain * equal["balance"]
     if len(shape) == 2:
         monkeypatch.setattr(_parallel, "slab_bounds", lambda *a: cuts)
-        monkeypatch.setattr(_parallel, "DYNAMIC_2D", True)
+        monkeypatch.setattr(_tuning, "DYNAMIC_2D", True)
         T, turn = _parallel.march(flat, start, shape3, (1.0,) * 3, 2)
         assert_equal_times(serial, T)
         assert turn["reopened"] == balanced["reopened"]  # the same windows, whoever runs them
@@ -361,13 +361,13 @@ def test_sharing_the_slabs_anew_raises_the_windows_balance(shape, monkeypatch):
     """On the bench's FM²-shaped map (source at 0.3 of x) the windows' balance with the
     slabs shared before each window beats the fixed interleave (1448^2: 1.733 against
     1.661; 96^3: 1.804 against 1.726), at the same times."""
-    monkeypatch.setattr(_parallel, "MIN_SLAB_NODES", 0)
+    monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)
     v, src = fm2_shaped(shape)
     flat, start, shape3 = _start(v, src)
     serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 1, np.zeros((0, 3), dtype=int))
     stats = {}
     for share in (False, True):
-        monkeypatch.setattr(_parallel, "SHARE_SLABS", share)
+        monkeypatch.setattr(_tuning, "SHARE_SLABS", share)
         T, stats[share] = _parallel.march(flat, start, shape3, (1.0,) * 3, 2)
         assert_equal_times(serial, T)
     assert stats[False]["greedy"] == 0 < stats[True]["greedy"] < stats[True]["windows"]
@@ -501,11 +501,11 @@ def _no_parallel(*args, **kwargs):
 
 def test_small_grids_and_one_thread_march_serially(monkeypatch):
     monkeypatch.setattr(_parallel, "march", _no_parallel)
-    small = int(np.sqrt(_parallel.PARALLEL_MIN_NODES)) - 1
+    small = int(np.sqrt(_tuning.PARALLEL_MIN_NODES)) - 1
     fast_marching(np.ones((small, small)), [(0, 0)], order=1, threads=2)
     fast_marching(np.ones((small, small)), [(0, 0)], order=2, threads=2)
-    monkeypatch.setattr(_parallel, "PARALLEL_MIN_NODES", 0)
-    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_2D", 0)
+    monkeypatch.setattr(_tuning, "PARALLEL_MIN_NODES", 0)
+    monkeypatch.setattr(_tuning, "ORDER2_MIN_NODES_2D", 0)
     fast_marching(np.ones((40, 40)), [(0, 0)], order=2, threads=1)
     fast_marching(np.ones((40, 40)), [(0, 0)], order=1, threads=1)
     monkeypatch.setenv("FM2UAV_THREADS", "1")
@@ -516,21 +516,21 @@ def test_small_grids_and_one_thread_march_serially(monkeypatch):
     with pytest.raises(AssertionError, match="parallel march ran"):  # order 2 too
         fast_marching(np.ones((40, 40)), [(0, 0)], order=2)
     v3 = np.ones((40, 40, 40))  # 3D order 2 only from ORDER2_MIN_NODES_3D nodes
-    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_3D", v3.size + 1)
+    monkeypatch.setattr(_tuning, "ORDER2_MIN_NODES_3D", v3.size + 1)
     fast_marching(v3, [(0, 0, 0)], order=2)
     with pytest.raises(AssertionError, match="parallel march ran"):
         fast_marching(v3, [(0, 0, 0)], order=1)
-    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_3D", v3.size)
+    monkeypatch.setattr(_tuning, "ORDER2_MIN_NODES_3D", v3.size)
     with pytest.raises(AssertionError, match="parallel march ran"):
         fast_marching(v3, [(0, 0, 0)], order=2)
-    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_2D", 40 * 40 + 1)  # 2D order 2's floor
+    monkeypatch.setattr(_tuning, "ORDER2_MIN_NODES_2D", 40 * 40 + 1)  # 2D order 2's floor
     fast_marching(np.ones((40, 40)), [(0, 0)], order=2)
     with pytest.raises(AssertionError, match="parallel march ran"):
         fast_marching(np.ones((40, 40)), [(0, 0)], order=1)
     with pytest.raises(AssertionError, match="parallel march ran"):
         fast_marching(np.ones((40, 41)), [(0, 0)], order=2)
-    monkeypatch.setattr(_parallel, "ORDER2_MIN_NODES_2D", 0)
-    monkeypatch.setattr(_parallel, "ORDER2", False)  # the switch back to a serial order 2
+    monkeypatch.setattr(_tuning, "ORDER2_MIN_NODES_2D", 0)
+    monkeypatch.setattr(_tuning, "ORDER2", False)  # the switch back to a serial order 2
     fast_marching(np.ones((40, 40)), [(0, 0)], order=2)
     with pytest.raises(AssertionError, match="parallel march ran"):
         fast_marching(np.ones((40, 40)), [(0, 0)], order=1)
@@ -549,7 +549,7 @@ def test_slab_count_keeps_slabs_of_a_minimum_size():
     v = np.ones((1024, 1024))
     flat, start, shape3 = _start(v, (300, 500))
     _, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, 2)
-    assert stats["slabs"] == v.size // _parallel.MIN_SLAB_NODES == 8  # not 2 * 8
+    assert stats["slabs"] == v.size // _tuning.MIN_SLAB_NODES == 8  # not 2 * 8
     v = np.ones((96, 40))
     flat, start, shape3 = _start(v, (30, 20))
     _, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, 2)
@@ -599,8 +599,8 @@ def _both_ways(flat, start, shape3, h3, monkeypatch, **kwargs):
     fixed point, reached in another order, rounding apart); then on two threads, to the
     same times to round-off. Returns the one-thread times and statistics. Order 2
     (``order=2`` in ``kwargs``): bit for bit on two threads too."""
-    if _parallel.MIN_SLAB_NODES:
-        monkeypatch.setattr(_parallel, "MIN_SLAB_NODES", 0)  # several slabs on one thread
+    if _tuning.MIN_SLAB_NODES:
+        monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)  # several slabs on one thread
     out = {}
     for far in (True, False):
         monkeypatch.setattr(_parallel, "FAR_ONE_AXIS", far)
@@ -678,9 +678,9 @@ def test_thin_interleaved_slabs_with_ghosts_on_both_sides(field, monkeypatch):
     """Slabs of one row: every own node lies between two ghost rows, a node frozen
     there goes to both neighbours, and the far rule must hold with ghosts and repairs on
     both sides (several sources, some in other slabs than their ball's centre)."""
-    monkeypatch.setattr(_parallel, "MIN_SLAB_ROWS", 1)
-    monkeypatch.setattr(_parallel, "MIN_SLAB_NODES", 0)
-    monkeypatch.setattr(_parallel, "SLABS_PER_THREAD",  # one row each
+    monkeypatch.setattr(_tuning, "MIN_SLAB_ROWS", 1)
+    monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)
+    monkeypatch.setattr(_tuning, "SLABS_PER_THREAD",  # one row each
                         {(2, 1): 97, (2, 2): 97, (3, 1): 4, (3, 2): 4})
     name, v, src = next(f for f in _fields((97, 81)) if f[0] == field)
     sources = [src, (50, 7), (51, 70)]
@@ -744,8 +744,8 @@ def test_interleaved_order_2_slabs_repair_stop_and_grow(monkeypatch):
     serial = fast_marching(v, [(2, 30)], order=2, spacing=(1.0, 1.3), threads=1,
                            source_ball=False)
     assert_equal_times(serial.reshape(-1), T, exact=True)
-    monkeypatch.setattr(_parallel, "MIN_SLAB_ROWS", 1)
-    monkeypatch.setattr(_parallel, "SLABS_PER_THREAD",
+    monkeypatch.setattr(_tuning, "MIN_SLAB_ROWS", 1)
+    monkeypatch.setattr(_tuning, "SLABS_PER_THREAD",
                         {(2, 1): 97, (2, 2): 97, (3, 1): 4, (3, 2): 4})
     v, src = fm2_shaped((97, 81), seed=3)
     flat, start, shape3 = _start(v, src)
@@ -789,7 +789,7 @@ def test_cuts_for_shared_slabs_shorten_the_windows_on_an_fm2_map(monkeypatch):
     serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 1, np.zeros((0, 3), dtype=int))
     cuts, stats = {}, {}
     for shared in (False, True):
-        monkeypatch.setitem(_parallel.SHARED_CUTS, 2, shared)
+        monkeypatch.setitem(_tuning.SHARED_CUTS, 2, shared)
         cuts[shared] = _parallel.slab_bounds(flat, start, shape3, (1.0,) * 3, 8, 2)
         T, stats[shared] = _parallel.march(flat, start, shape3, (1.0,) * 3, 2)
         assert_equal_times(serial, T)
@@ -798,7 +798,7 @@ def test_cuts_for_shared_slabs_shorten_the_windows_on_an_fm2_map(monkeypatch):
     v, src = smooth((1024, 1024))
     flat, start, shape3 = _start(v, src)
     for shared in (False, True):
-        monkeypatch.setitem(_parallel.SHARED_CUTS, 2, shared)
+        monkeypatch.setitem(_tuning.SHARED_CUTS, 2, shared)
         cuts[shared] = _parallel.slab_bounds(flat, start, shape3, (1.0,) * 3, 8, 2)
     assert np.array_equal(cuts[False], cuts[True])
 
@@ -849,7 +849,7 @@ def test_shared_cost_compiled_equals_numpys_sharing(threads):
 
 
 def test_slabs_taken_in_turn_are_ordered_by_predicted_work():
-    """``share=2`` (:data:`_parallel.DYNAMIC_2D`): every slab by decreasing predicted work
+    """``share=2`` (:data:`_tuning.DYNAMIC_2D`): every slab by decreasing predicted work
     (ties in slab order), the counter the threads take them by at 0, the owners and the
     returned flag those of the lists (``share=1``) for the statistics."""
     rng = np.random.default_rng(1)
@@ -872,10 +872,10 @@ def test_slabs_taken_in_turn_give_the_serial_times(threads, monkeypatch):
     """2D takes the slabs in turn (the drive gets ``share=2``; 3D keeps the lists): on many
     thin slabs, with repairs, ``stop_at`` and the lists for comparison, the times are the
     serial march's (order 2: bit for bit); every slab is marched whichever thread takes it."""
-    monkeypatch.setattr(_parallel, "MIN_SLAB_NODES", 0)
-    monkeypatch.setattr(_parallel, "MIN_SLAB_ROWS", 4)
-    monkeypatch.setitem(_parallel.SLABS_PER_THREAD, (2, 1), 9)
-    monkeypatch.setitem(_parallel.SLABS_PER_THREAD, (2, 2), 9)
+    monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)
+    monkeypatch.setattr(_tuning, "MIN_SLAB_ROWS", 4)
+    monkeypatch.setitem(_tuning.SLABS_PER_THREAD, (2, 1), 9)
+    monkeypatch.setitem(_tuning.SLABS_PER_THREAD, (2, 2), 9)
     seen = []
     for key in list(_parallel._DRIVES):
         def spy(*args, _d=_parallel._DRIVES[key], _key=key):
@@ -887,7 +887,7 @@ def test_slabs_taken_in_turn_give_the_serial_times(threads, monkeypatch):
         serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 1,
                                    np.zeros((0, 3), dtype=int))
         for dynamic in (True, False):
-            monkeypatch.setattr(_parallel, "DYNAMIC_2D", dynamic)
+            monkeypatch.setattr(_tuning, "DYNAMIC_2D", dynamic)
             seen.clear()
             T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, threads)
             assert_equal_times(serial, T)
@@ -913,7 +913,7 @@ def test_slabs_taken_in_turn_give_the_serial_times(threads, monkeypatch):
     flat, start, shape3 = _start(v, src)
     serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 2, np.zeros((0, 3), dtype=int))
     for dynamic in (True, False):
-        monkeypatch.setattr(_parallel, "DYNAMIC_2D", dynamic)
+        monkeypatch.setattr(_tuning, "DYNAMIC_2D", dynamic)
         seen.clear()
         T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, threads, order=2)
         assert_equal_times(serial, T, exact=True)
@@ -931,7 +931,7 @@ def test_profile_accounts_for_every_region(monkeypatch):
     """``_parallel.PROFILE``: ``stats["profile"]`` sums each region's busiest thread's CPU
     and its wall time (the start, an exchange before every window and one after the last),
     each thread's CPU per kind; the times stay the serial march's."""
-    monkeypatch.setattr(_parallel, "MIN_SLAB_NODES", 0)
+    monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)
     monkeypatch.setattr(_parallel, "PROFILE", True)
     v, src = fm2_shaped((257, 131), seed=1)
     flat, start, shape3 = _start(v, src)

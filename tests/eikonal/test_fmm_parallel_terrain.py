@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
-from fm2uav.eikonal import _kernels, _parallel, distance_map, fast_marching
+from fm2uav.eikonal import _kernels, _parallel, _tuning, distance_map, fast_marching
 
 from .fmm_checks import fast_marching_parallel
 
@@ -92,7 +92,7 @@ def test_touch_writes_a_zero_byte_every_step():
 def test_page_toucher_touches_only_page_starts_and_stops_at_the_block_end():
     # two arrays (the lean layout's float64 times and float32 speeds): wherever the thread
     # got to before the block ended, it wrote zero bytes at page starts only
-    a = np.full(3 * _parallel.TOUCH_CHUNK + 4096, 0xAB, dtype=np.uint8).view(np.float64)
+    a = np.full(3 * _tuning.TOUCH_CHUNK + 4096, 0xAB, dtype=np.uint8).view(np.float64)
     b = np.full(5000, 0xCD, dtype=np.uint8).view(np.float32)
     with _parallel._PageToucher(a, b) as toucher:
         pass
@@ -108,7 +108,7 @@ def test_page_toucher_finds_the_top_speed_before_it_touches():
     # the top speed (the first window's width) is found whatever the block's length: the
     # block ends at once here, the pages then stay untouched but the top is there
     speed = np.random.default_rng(1).random(100_003) * 7.0
-    a = np.full(3 * _parallel.TOUCH_CHUNK, 0xAB, dtype=np.uint8)
+    a = np.full(3 * _tuning.TOUCH_CHUNK, 0xAB, dtype=np.uint8)
     with _parallel._PageToucher(a, top_of=speed) as toucher:
         pass
     assert toucher.top == speed.max()
@@ -130,9 +130,9 @@ def test_big_3d_grids_cut_the_slabs_for_sharing_bit_for_bit(lean, monkeypatch):
     h = (15.0, 15.0, 10.0)
     # the coarse march over every node: on a grid this small, a coarser one leaves a few
     # nodes per time bin, and both descents the same cuts
-    monkeypatch.setattr(_parallel, "COARSE_3D", 1)
-    monkeypatch.setattr(_parallel, "COARSE_3D_Z", 1)
-    monkeypatch.setitem(_parallel.SLABS_PER_THREAD, (3, 2), 4)  # 8 slabs to place
+    monkeypatch.setattr(_tuning, "COARSE_3D", 1)
+    monkeypatch.setattr(_tuning, "COARSE_3D_Z", 1)
+    monkeypatch.setitem(_tuning.SLABS_PER_THREAD, (3, 2), 4)  # 8 slabs to place
     seen = []
     real = _parallel.slab_bounds
 
@@ -143,13 +143,13 @@ def test_big_3d_grids_cut_the_slabs_for_sharing_bit_for_bit(lean, monkeypatch):
     monkeypatch.setattr(_parallel, "slab_bounds", spy)
     serial = fast_marching(W, [goal], spacing=h, order=2, stop_at=[start], threads=1)
     below = fast_marching_parallel(W, [goal], spacing=h, order=2, stop_at=[start])
-    monkeypatch.setattr(_parallel, "SHARED_CUTS_MIN_NODES_3D", W.size)  # this grid: at it
+    monkeypatch.setattr(_tuning, "SHARED_CUTS_MIN_NODES_3D", W.size)  # this grid: at it
     at = fast_marching_parallel(W, [goal], spacing=h, order=2, stop_at=[start])
     assert np.array_equal(serial, below) and np.array_equal(serial, at)
     (args, cuts_below), (args_at, cuts_at) = seen
     speed, st, shape3, h3, k, threads = args
     assert k == 8 and threads == 2 and shape3 == W.shape
-    monkeypatch.setitem(_parallel.SHARED_CUTS, 3, False)
+    monkeypatch.setitem(_tuning.SHARED_CUTS, 3, False)
     fixed = real(*args)  # the interleave's cuts
     assert np.array_equal(cuts_below, fixed)
     assert not np.array_equal(cuts_at, fixed)

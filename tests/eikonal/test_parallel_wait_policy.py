@@ -1,5 +1,5 @@
 """How the parallel march sets up numba's OpenMP pool: sleep after a brief spin, the user's
-settings kept (``fm2uav.eikonal._parallel``, issue 27)."""
+settings kept (``fm2uav.eikonal._parallel``, its spin count in ``_tuning``, issue 27)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import sys
 
 import pytest
 
-from fm2uav.eikonal import _parallel
+from fm2uav.eikonal import _tuning
 
 _KEYS = ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT")
 _PROBE = ("import json, os, fm2uav.eikonal; "
@@ -30,7 +30,7 @@ def _after_import(**given: str) -> dict:
     ("given", "expected"),
     [
         # nothing set: sleep at the barriers after a brief spin
-        ({}, {"OMP_WAIT_POLICY": "PASSIVE", "GOMP_SPINCOUNT": str(_parallel.SPIN_COUNT)}),
+        ({}, {"OMP_WAIT_POLICY": "PASSIVE", "GOMP_SPINCOUNT": str(_tuning.SPIN_COUNT)}),
         # the user's policy stays, with libgomp's own spin count for it
         ({"OMP_WAIT_POLICY": "ACTIVE"}, {"OMP_WAIT_POLICY": "ACTIVE", "GOMP_SPINCOUNT": None}),
         ({"OMP_WAIT_POLICY": "PASSIVE"},
@@ -46,4 +46,4 @@ def test_wait_policy_defaults_and_the_users_settings(given, expected):
 def test_spin_count_is_brief():
     """libgomp spins ~100,000 times a millisecond (its own estimate): the spin stays well
     under a millisecond, short against a busy machine's time slice."""
-    assert 0 < _parallel.SPIN_COUNT <= 20_000
+    assert 0 < _tuning.SPIN_COUNT <= 20_000

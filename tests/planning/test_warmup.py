@@ -254,6 +254,24 @@ def test_no_kernel_reads_a_global_the_groups_lower():
     assert "_C_NEXT" in _names(kernels["fm2uav.eikonal._parallel:drive3d_o2"].py_func.__code__)
 
 
+def test_no_kernel_reads_the_tuning_numbers():
+    # eikonal/_tuning.py holds the parallel march's measured numbers so that they can be
+    # changed without recompiling: a kernel reading one would freeze it into its cache entry
+    from fm2uav.eikonal import _tuning
+
+    tunables = {n for n in vars(_tuning) if n.isupper()}
+    assert {"ORDER2_MIN_NODES_2D", "WINDOW_NODES", "SLABS_PER_THREAD"} <= tunables
+    read = tunables | {"_tuning"}
+    readers = sorted(f"{name} reads {sorted(_names(d.py_func.__code__) & read)}"
+                     for name, d in _dispatchers().items() if _names(d.py_func.__code__) & read)
+    assert readers == []
+    # and the module itself is numbers only: it imports nothing (no kernel to compile)
+    tree = ast.parse(inspect.getsource(_tuning))
+    imports = {n.module if isinstance(n, ast.ImportFrom) else n.names[0].name
+               for n in ast.walk(tree) if isinstance(n, (ast.Import, ast.ImportFrom))}
+    assert imports == {"__future__"}
+
+
 def test_unknown_group_is_refused_with_the_known_names(capsys):
     assert warmup.main(["fmm9d"]) == 2
     err = capsys.readouterr().err

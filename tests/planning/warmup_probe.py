@@ -38,7 +38,7 @@ from numba.core import event
 from numba.core.caching import NullCache
 from numba.core.registry import CPUDispatcher
 
-from fm2uav.eikonal import _edt, _kernels, _parallel, distance_map, fast_marching
+from fm2uav.eikonal import _edt, _kernels, _parallel, _tuning, distance_map, fast_marching
 from fm2uav.planning import warmup
 from fm2uav.planning.geodesic import drop_ties, reaches_any
 
@@ -82,12 +82,13 @@ def _on_slabs(ndim: int, run: Callable[[], None], orders: tuple[int, ...]) -> No
         marches.append(k["order"])
         return march(*a, **k)
 
-    restore = _patched(_parallel, PARALLEL_MIN_NODES=0, ORDER2_MIN_NODES_3D=0,
-                       ORDER2_MIN_NODES_2D=0, march=spy)
+    restore = [_patched(_tuning, PARALLEL_MIN_NODES=0, ORDER2_MIN_NODES_3D=0,
+                        ORDER2_MIN_NODES_2D=0), _patched(_parallel, march=spy)]
     try:
         run()
     finally:
-        restore()
+        for undo in restore:
+            undo()
     assert marches == list(orders), (ndim, marches)
 
 

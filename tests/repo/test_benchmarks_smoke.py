@@ -26,6 +26,10 @@ def test_every_benchmark_runs_quick(tmp_path):
         assert r["ours_s"] is None or r["ours_s"] > 0
         if r.get("peer_s"):
             assert abs(r["ratio"] - r["peer_s"] / r["ours_s"]) < 1e-9 * r["ratio"]
+    # the two-thread rows come with the machine's own scaling, probed before and after them
+    probe = [r for r in rows if r["case"].startswith("the machine: equal loops")]
+    assert len(probe) == 1 and probe[0]["benchmark"] == "fmm threads" and probe[0]["ratio"] > 0
+    assert all(f"{k} " in probe[0]["notes"] for k in ("compute", "l2", "stream", "lines", "gather"))
 
 
 def _probe(module: str, *args: str) -> str:

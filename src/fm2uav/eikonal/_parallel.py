@@ -1,8 +1,8 @@
 """The parallel Fast Marching (order 1 and 2): slabs, time windows, ghost exchange, repair.
 
 Private module: :func:`fm2uav.eikonal.fast_marching` calls :func:`march` for
-grids of at least :data:`PARALLEL_MIN_NODES` nodes when more than one thread is
-allowed (``threads``, ``FM2UAV_THREADS``), at order 1 and 2 (:data:`ORDER2`), ``stop_at``
+grids of at least :data:`_tuning.PARALLEL_MIN_NODES` nodes when more than one thread is
+allowed (``threads``, ``FM2UAV_THREADS``), at order 1 and 2 (:data:`_tuning.ORDER2`), ``stop_at``
 too.
 Order 2's stencil reads two nodes upwind: its slabs have two ghost x-slabs per
 side (:func:`_pad_slabs`), the exchange copies two rows, and a changed time updates
@@ -16,11 +16,11 @@ elements, its bit masks (frozen on entry, re-opened, suspect, pending) keep a bi
 Design (Yang & Stern 2017, domain-decomposition FMM)
 ----------------------------------------------------
 * The grid is cut along x (the slowest-varying axis of the C layout) into
-  ``K`` slabs, :data:`SLABS_PER_THREAD` per thread, thread ``t`` marching slabs
+  ``K`` slabs, :data:`_tuning.SLABS_PER_THREAD` per thread, thread ``t`` marching slabs
   ``t, t + threads, ...`` (interleaved strips keep both threads busy when the
   wave starts off-centre, and a coarse march places the cuts, :func:`slab_bounds`; in 2D
-  and on 3D grids of at least :data:`SHARED_CUTS_MIN_NODES_3D` nodes for the slabs shared
-  before each window where that shortens the windows, :data:`SHARED_CUTS`; while this
+  and on 3D grids of at least :data:`_tuning.SHARED_CUTS_MIN_NODES_3D` nodes for the slabs shared
+  before each window where that shortens the windows, :data:`_tuning.SHARED_CUTS`; while this
   thread places the cuts, a second one finds the top speed and faults pages in — the lean
   layout's buffers, else the result's rows the other thread unpads first —
   :class:`_PageToucher`),
@@ -90,7 +90,7 @@ from numba.core import cgutils
 from numba.extending import intrinsic
 
 from .._numba import njit, prange, types
-from . import _kernels
+from . import _kernels, _tuning
 from ._heap import sift_down, sift_up
 from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _ORDER2_MAX_W_RATIO, _U, _ZERO,
                        RESERVE_BLOCKS, BLOCK,
@@ -98,127 +98,14 @@ from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _ORDER2_MAX_W_RATIO, _U, _ZER
                        _pop, _pop_ahead, _push, _rhs, _side_min, _solve_iso, pad_grid,
                        unpad_grid)
 
-#: The windows meet at a barrier several hundred times per march: a thread that waits
-#: there spins only briefly and then sleeps (OpenMP's default spins ~300,000 times), or on
-#: a busy machine the spinning thread takes the core its partner needs (measured on 2048^2
-#: with 10 runnable processes on 2 cores: 3.4 CPU-s spinning, 0.56 s passive, serial
-#: 0.53 s). The brief spin (:data:`SPIN_COUNT`, ~0.1 ms by libgomp's estimate) spares most
-#: wake-ups from sleep: near idle (``benchmarks/wait_policy.py``, medians of 9), two threads'
-#: wall on 2048^2 FM²-shaped order 1 145.1 / 133.3 / 132.4 ms at 2000 / 5000 / 10000 spins,
-#: at a constant speed 139.1 / 127.3 / 125.0 ms, the CPU 253 -> 249 and 261 -> 244 ms (a
-#: sleep and its wake-up cost more than the spin); 160^3 FM²-shaped 278.6 / 279.0 / 267.3
-#: ms. Under load (two busy loops beside, load ~3) 10000 spins cost the CPU +10 % and the
-#: wall 0-8 % (docs/performance.md, "Spinning briefly"). Read by libgomp when numba first
-#: starts its thread pool; values set by the user stay (a user's ``OMP_WAIT_POLICY`` keeps
-#: libgomp's own spin count for it).
-SPIN_COUNT = 10000
+# threads waiting at a barrier spin briefly, then sleep (:data:`_tuning.SPIN_COUNT`); read
+# by libgomp when numba first starts its thread pool, values the user set stay
 if "OMP_WAIT_POLICY" not in os.environ:
     os.environ["OMP_WAIT_POLICY"] = "PASSIVE"
-    os.environ.setdefault("GOMP_SPINCOUNT", str(SPIN_COUNT))
+    os.environ.setdefault("GOMP_SPINCOUNT", str(_tuning.SPIN_COUNT))
 
-__all__ = ["march", "resolve_threads", "PARALLEL_MIN_NODES", "THREADS_ENV"]
+__all__ = ["march", "on_slabs", "resolve_threads"]
 
-#: Environment variable with the default thread count of the march (an integer >= 1).
-THREADS_ENV = "FM2UAV_THREADS"
-#: Whether :func:`fm2uav.eikonal.fast_marching` marches order 2 on slabs too (False: order 2
-#: marches serially). The order-2 slabs give the serial march's times bit for bit on every
-#: case measured (tests/eikonal/test_fmm_parallel.py; the 2048² FM²-shaped map and the
-#: 1000 x 1000 x 40 terrain march, 25.8 M nodes): a node's time is the one the serial march
-#: keeps, the lowest of its updates at its neighbours' freezes in time order
-#: (:func:`_serial_time2`). Only a tie (two nodes of one stencil frozen at the very same
-#: time) could make them differ, where the serial march's pick depends on its queue.
-ORDER2 = True
-#: Grids of fewer nodes march serially whatever the thread count. Measured
-#: (benchmarks/bench_core.py, "threads" rows, a machine at load 9 on 2 cores):
-#: on 1024^2 the busiest thread takes 0.06 s of the serial 0.099 CPU-s (1.65x on
-#: an idle machine) and the wall time is equal; below, a window holds fewer nodes
-#: per barrier and the wall time on a busy machine decides: kept serial.
-PARALLEL_MIN_NODES = 1_000_000
-#: 3D order 2 marches on slabs only from this many nodes: its repairs near the ghosts
-#: (a node's time from scratch, :func:`_serial_time2`) cost more on thin slabs. Measured
-#: (3 December 2026, machine at load 4.5-4.8, medians of 2): 160^3 FM²-shaped (20-row
-#: slabs) CPU 0.97 -> 2.31 s, busiest thread 0.98 -> 1.34 s (0.73x: slower); the
-#: 1000 x 1000 x 40 terrain march (125-row slabs) busiest thread 10.4 -> 5.0 s. Since
-#: (5 December 2026: the window's flags on one line and its queue in registers, 2 slabs
-#: per thread, windows of 16384 nodes; idle machine, wall, 2 threads over 1, medians of 5):
-#: 160^3 (4.1 M) FM²-shaped 1.06-1.28x, constant 1.14-1.17x, smooth 1.11-1.21x; 128^3
-#: (2.1 M) 0.87-0.88x, 100^3 0.38-0.69x: from 4 M nodes.
-ORDER2_MIN_NODES_3D = 4_000_000
-#: 2D order 2 marches on slabs only from this many nodes (below: one thread, never slower).
-#: Its slab window costs more a node than the serial order-2 march (its neighbours' freeze
-#: order checked, :func:`_serial_time2`'s from-scratch repairs near the ghosts), which a
-#: bigger grid's memory traffic hides. Measured (3 December 2026, load 6-7, medians of 3,
-#: CPU times): 2048^2 (4.2 M) FM²-shaped one slab on one thread 1.25x the serial march's CPU
-#: (smooth 1.32x) before any repair, two threads' CPU 0.388 -> 0.621 s (1.60x; smooth
-#: 0.524 -> 0.751 s), busiest thread 1.20x (smooth 1.32x; `make bench` on the idle machine:
-#: wall 0.97x / 1.16x); 2900^2 (8.4 M) FM²-shaped CPU 0.875 -> 1.199 s (1.37x), busiest
-#: thread 1.43x (smooth 1.69x; load 8.7-9); 4096^2 (16.8 M) FM²-shaped CPU 1.926 -> 2.338 s
-#: (1.21x), busiest thread 1.60x (smooth 1.69x). On the idle machine the 2048^2 wall ratio
-#: was ~0.8x the busiest thread's: from 2^23 (8.4 M) nodes on the slabs. Since (5 December
-#: 2026, as the 3D floor's; windows of 8192 nodes, the slabs taken in turn): 2048^2 (4.2 M)
-#: FM²-shaped 1.16-1.22x, constant 1.06-1.18x, smooth 1.14x; 1448^2 (2.1 M) 0.89-1.04x,
-#: 1024^2 0.83-0.85x: from 2^22 nodes (2048^2).
-ORDER2_MIN_NODES_2D = 2**22
-#: Each slab gets at least this many x-slabs (rows), else fewer slabs are used.
-MIN_SLAB_ROWS = 16
-#: ... and at least this many nodes (but every thread one slab): thin slabs cost repairs.
-#: Measured on 1024^2 smooth (2 threads, CPU over the serial march's, loaded machine):
-#: 2/4/8 slabs per thread 1.05x/1.08x/1.24x at the same windows' balance (1.94-1.96).
-MIN_SLAB_NODES = 2**17
-#: Slabs per thread, thread ``t`` marching slabs ``t, t + threads, ...``: strips
-#: interleaved across the grid keep both threads busy when the wave starts off-centre
-#: (and :func:`slab_bounds` places the cuts). Measured on the FM²-shaped fields (source
-#: at 0.3 of x), 2 threads, windows of 32768 nodes, balanced cuts: the windows' balance
-#: (``stats["balance"]``, the speed-up they allow) 2D 4/8 slabs per thread 1.69/1.76,
-#: 3D 2/4 1.65/1.84, process CPU the same within noise (0.88-0.96x the serial march's;
-#: the exchange reads only the nodes frozen in the boundary rows). In 2D the better
-#: balance of 8 did not show in wall time on the idle machine (2048², 2 threads, medians
-#: of 5 interleaved: constant 0.257/0.261 s, smooth 0.292/0.302 s, FM²-shaped
-#: 0.234/0.248 s with 4/8 slabs per thread): 2D keeps 4. (With :data:`SHARE_SLABS`, 2D
-#: FM²-shaped 4/8: balance 1.76/1.81 for 2.2x the re-opened nodes.) Keyed by (dimension,
-#: order): order 2's ghosts, two rows deep, re-open more nodes on thinner slabs, and its
-#: repairs (a node's time from scratch, :func:`_serial_time2`) cost more; in 3D it takes
-#: 2 (5 December 2026, idle machine, 2 threads over 1, medians of 3, windows of 16384 nodes:
-#: 160^3 FM²-shaped 0.61x / 1.28x with 3 / 2 slabs per thread, 467,000 / 43,000 nodes
-#: re-opened; the terrain march 3.91 / 3.72 s; docs/performance.md).
-SLABS_PER_THREAD = {(2, 1): 4, (3, 1): 4, (2, 2): 4, (3, 2): 2}
-#: Target number of nodes frozen per window (all slabs together); the window
-#: width adapts to it. Fewer, wider windows cost fewer barriers and more repairs:
-#: measured on 160^3 (2 threads, CPU over the serial march's, loaded machine) constant
-#: speed 8192/16384/32768 nodes 1.15x/0.97x/0.85x; FM²-shaped 32768/65536 0.92x/2.4x
-#: (wider windows than the wave's crossing of a slab re-open nodes in cascades). Keyed by
-#: (dimension, order): order 2 re-opens more a window (5 December 2026, idle machine, 2
-#: threads over 1, medians of 5, the slabs taken in turn: 2048^2 FM²-shaped 1.13x / 1.16x
-#: with 16384 / 8192 nodes, 95,000 / 52,000 re-opened, 4096 0.90x; 160^3 FM²-shaped, 2 slabs
-#: per thread, 32768 / 16384 / 8192 / 4096 1.03x / 1.28x / 1.25x / 1.10x; the terrain march
-#: 16384 / 32768 nodes 3.72 / 3.57-3.75 s; docs/performance.md).
-WINDOW_NODES = {(2, 1): 32768, (3, 1): 32768, (2, 2): 8192, (3, 2): 16384}
-#: Share the slabs among the threads anew before every window, longest first by the
-#: freezes of the last window, when that predicts a shorter window than the fixed
-#: interleave (:func:`_assign`); False: always the interleave. Windows' balance with /
-#: without (2 threads, 4 slabs per thread): FM²-shaped 2048^2 1.654 -> 1.759, 160^3 1.84 ->
-#: 1.90; constant speed the same (1.99, 1.93 -> 1.95).
-SHARE_SLABS = True
-#: 2D: the threads take the slabs of a window (and of its exchange) in turn, the
-#: next not taken when done with the last, by decreasing predicted work (:func:`_take`)
-#: instead of lists fixed before the window (:func:`_assign`): the lists predict a window's
-#: work by the last one's, which lags the wave where it enters or leaves slabs; taken in
-#: turn, a window's slabs go to the threads by their actual work (and a thread the
-#: machine holds back takes fewer). Simulated from the serial times of the bench's
-#: FM²-shaped 2048^2 maps (seeds 0-3, windows of 32768 nodes, equal slabs), the windows'
-#: balance with 8 / 16 slabs: lists 1.78-1.81 / 1.82-1.88, in turn 1.79-1.86 / 1.91-1.96
-#: (constant speed 2.00 / 2.00 either way). Needs :data:`SHARE_SLABS`. Measured (3 December
-#: 2026, load 6, the march's own counts: the balance an idle machine gets, :func:`_in_turn`)
-#: on those maps marched, 4 slabs per thread: balance 1.816/1.855/1.880/1.819 with the lists,
-#: 1.847/1.899/1.901/1.852 in turn, the same nodes re-opened (the windows do not depend on
-#: who runs a slab) and the same CPU; 8 slabs per thread 1.895-1.947 for 1.7-2x the
-#: re-opened nodes (two threads' CPU +3 %: no gain). Wall near idle (load 1.0-1.1, 2048^2,
-#: medians of 5-7 interleaved, two threads over one): lists / in turn constant 1.83-1.84x /
-#: 1.87-1.94x, smooth 1.80x / 1.87x, FM²-shaped 1.51x / 1.57-1.59x. On: 2D order 1, 4 slabs
-#: per thread. Order 2 too (5 December 2026, 2048^2, 4 slabs per thread, windows of 8192
-#: nodes, 2 threads over 1, medians of 5: lists / in turn FM²-shaped 1.08x / 1.16x, smooth
-#: 1.03x / 1.14x, constant 1.02x / 1.17x).
-DYNAMIC_2D = True
 #: 2D: the exchange before each window runs on the calling thread alone (the parallel
 #: region's iterations in turn), not on every thread: its work is a row per slab side (the
 #: busiest thread's share summed over the 108 exchanges of the bench's FM²-shaped 2048^2
@@ -287,17 +174,18 @@ def resolve_threads(threads) -> int:
     from ..errors import InputError
 
     if threads is None:
-        env = os.environ.get(THREADS_ENV, "").strip()
+        var = _tuning.THREADS_ENV
+        env = os.environ.get(var, "").strip()
         if env:
             try:
                 threads = int(env)
             except ValueError:
                 raise InputError(
-                    f"{THREADS_ENV} must be an integer >= 1 (threads of the Fast Marching), "
+                    f"{var} must be an integer >= 1 (threads of the Fast Marching), "
                     f"got {env!r}") from None
             if threads < 1:
                 raise InputError(
-                    f"{THREADS_ENV} must be an integer >= 1 (threads of the Fast Marching), "
+                    f"{var} must be an integer >= 1 (threads of the Fast Marching), "
                     f"got {env!r}")
             return threads
         try:
@@ -752,7 +640,7 @@ def _clock_ns(typingctx, clk):
 @intrinsic
 def _fetch_add(typingctx, a, i):
     """``a[i] += 1`` atomically (int64 array), returning the old value: the next slab a
-    thread takes in a dynamically shared region (:data:`DYNAMIC_2D`)."""
+    thread takes in a dynamically shared region (:data:`_tuning.DYNAMIC_2D`)."""
     sig = types.int64(a, i)
 
     def codegen(context, builder, signature, args):
@@ -1315,7 +1203,7 @@ def _assign(work, nth, slabs, first, load, share=1):
     crosses few slabs, the fixed interleave may give two busy slabs to one thread.
     ``load`` (``nth`` floats) and ``first[nth + 1:]`` (``K`` ints) are scratch (the owner
     of each slab after the call); ``share=0``: always the fixed interleave. ``share=2``
-    (:data:`DYNAMIC_2D`): no lists; ``slabs`` holds every slab by decreasing predicted work
+    (:data:`_tuning.DYNAMIC_2D`): no lists; ``slabs`` holds every slab by decreasing predicted work
     and each thread takes the next one not taken (:func:`_take`, the counter
     ``first[nth]``, set to 0) when done with its last, so a window's slabs go to the
     threads by their actual work. Returns whether the greedy split was (or, ``share=2``,
@@ -1464,8 +1352,8 @@ def _drive_kernel(three, order=1):
         order 1), ``eidx``, ``evals`` its nodes in the band on entry (element indices into
         ``Tp``, sorted) and their times; each slab has ``order`` ghost x-slabs on each side.
         ``slabs`` (K), ``lists`` (nth + 1 + K), ``load`` (nth): scratch of :func:`_assign`
-        (``share``: 0 the interleave, 1 :data:`SHARE_SLABS`' lists, 2 taken in turn,
-        :data:`DYNAMIC_2D`). ``scan[k]``: the nodes of slab ``k`` the start
+        (``share``: 0 the interleave, 1 :data:`_tuning.SHARE_SLABS`' lists, 2 taken in turn,
+        :data:`_tuning.DYNAMIC_2D`). ``scan[k]``: the nodes of slab ``k`` the start
         reads (the start box's rows). ``far``: the far neighbours' one-axis update (2D).
 
         ``off``, ``end``, ``sx``, ``sy``, ``scan`` and ``stops`` count elements of ``Tp``:
@@ -1689,31 +1577,6 @@ def _drive_kernel(three, order=1):
 _DRIVES = {(d, o): _drive_kernel(d == 3, o) for d in (2, 3) for o in (1, 2)}
 
 
-#: The split of two slabs is chosen on a march over every ``COARSE``-th node per axis
-#: (2D; 3D: ``COARSE_3D``), ~0.5 % (2D) and ~1.5 % (3D) of the work of the full march
-#: (serial time: the second thread waits). 2D: the windows' balance on FM²-shaped 2048^2
-#: maps (seeds 0-3, with :func:`_assign`) averaged 1.827 / 1.823 / 1.813 / 1.768 with
-#: every 8th / 16th / 32nd node / equal slabs, the coarse march 8 / 2 / 0.5 ms.
-COARSE = 16
-COARSE_3D = 4
-#: The coarse march's step along z in 3D (a terrain's layers are few: 40).
-COARSE_3D_Z = 4
-#: Whether the cuts are placed for the slabs shared anew before each window (the least
-#: share of a time bin any sharing allows, :func:`slab_bounds`) rather than for the fixed
-#: interleave. Simulated on the bench's FM²-shaped 2048^2 map from the serial times
-#: (windows of 32768 nodes in time order, the slabs shared as :func:`_assign`), 8 slabs:
-#: windows' balance 1.78 -> 1.84 (16 slabs 1.83 -> 1.84). 3D from
-#: :data:`SHARED_CUTS_MIN_NODES_3D` nodes only (below, the interleave's cuts).
-SHARED_CUTS = {2: True, 3: True}
-#: 3D grids of fewer nodes keep the interleave's cuts: on the bench's 160^3 fields (order 1)
-#: constant and smooth speed get the same cuts either way, the FM²-shaped one other cuts
-#: that simulate worse (1.921 -> 1.910); the 1000 x 1000 x 40 terrain plan's order-2 march
-#: (40 M nodes) gets the shared cuts, measured 1.881 -> 1.922 (docs/performance.md): from
-#: 2^24 nodes, the bench's 160^3 grids (both orders) below.
-SHARED_CUTS_MIN_NODES_3D = 2**24
-#: Bins of the split estimate, each as many coarse nodes in time order (stand-ins for
-#: the windows).
-SPLIT_BINS = 256
 
 
 def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarray:
@@ -1725,8 +1588,8 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarra
     windows' critical path (a source off-centre would otherwise leave one thread idle
     while the wave crosses the other's slabs), by coordinate descent from equal slabs
     (each cut in turn moved to its best row between its neighbours, until none moves;
-    exhaustive for two slabs). Where :data:`SHARED_CUTS` says so (2D; 3D grids of at least
-    :data:`SHARED_CUTS_MIN_NODES_3D` nodes, the terrain plan's) a second descent
+    exhaustive for two slabs). Where :data:`_tuning.SHARED_CUTS` says so (2D; 3D grids of at least
+    :data:`_tuning.SHARED_CUTS_MIN_NODES_3D` nodes, the terrain plan's) a second descent
     counts a thread's nodes in a bin not as the fixed interleave gives them but as the least
     any sharing of the slabs allows, ``max(the bin's busiest slab, the bin's nodes /
     threads)`` (the slabs are shared anew before each window, :func:`_assign`, and cuts
@@ -1744,15 +1607,15 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarra
     if hist is None:
         return even
     rows = hist.shape[0]
-    gap = max(1, -(-MIN_SLAB_ROWS // f))  # coarse rows per slab at least
+    gap = max(1, -(-_tuning.MIN_SLAB_ROWS // f))  # coarse rows per slab at least
     if rows < k * gap:
         return even
     cum = np.vstack([np.zeros((1, hist.shape[1]), dtype=np.int64), np.cumsum(hist, axis=0)])
     cuts = np.clip(np.linspace(0, rows, k + 1).round().astype(np.int64), 0, rows)
     fixed = _descend_cuts(cum, cuts.copy(), gap, threads, False)
     three = shape3[2] > 1
-    shared = SHARED_CUTS[3 if three else 2] and not (
-        three and int(np.prod(shape3)) < SHARED_CUTS_MIN_NODES_3D)
+    shared = _tuning.SHARED_CUTS[3 if three else 2] and not (
+        three and int(np.prod(shape3)) < _tuning.SHARED_CUTS_MIN_NODES_3D)
     if shared:  # the better, by the windows as _assign shares the slabs
         cuts = _descend_cuts(cum, cuts, gap, threads, True)
         if _shared_cost(cum, fixed, threads) <= _shared_cost(cum, cuts, threads):
@@ -1761,8 +1624,9 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarra
         cuts = fixed
     bounds = np.minimum(cuts * f, nx)
     bounds[-1] = nx
+    least = _tuning.MIN_SLAB_ROWS
     for i in range(1, k):  # fine rows: at least MIN_SLAB_ROWS per slab where they fit
-        bounds[i] = min(max(bounds[i], bounds[i - 1] + MIN_SLAB_ROWS), nx - (k - i) * MIN_SLAB_ROWS)
+        bounds[i] = min(max(bounds[i], bounds[i - 1] + least), nx - (k - i) * least)
     if np.any(np.diff(bounds) < 1):
         return even
     return bounds.astype(np.int64)
@@ -1870,9 +1734,9 @@ def _coarse_histogram(speed, start, shape3, h3):
     f)``, ``hist`` of shape ``(coarse rows, SPLIT_BINS)`` and ``f`` the x coarsening;
     ``(None, f)`` if no estimate."""
     three = shape3[2] > 1
-    f = COARSE_3D if three else COARSE
+    f = _tuning.COARSE_3D if three else _tuning.COARSE
     grid = speed.reshape(shape3)
-    fz = COARSE_3D_Z if three else 1
+    fz = _tuning.COARSE_3D_Z if three else 1
     coarse = np.ascontiguousarray(grid[::f, ::f, ::fz])
     cshape = coarse.shape
     if cshape[0] < 4:
@@ -1907,10 +1771,10 @@ def _coarse_histogram(speed, start, shape3, h3):
     # (a search among SPLIT_BINS - 1 edges instead of among all the times: 4 -> 0.5 ms)
     times = T[fin]
     n = times.size
-    ends = -(-np.arange(1, SPLIT_BINS) * n // SPLIT_BINS) - 1  # ceil(b n / bins) - 1 >= 0
+    nb = _tuning.SPLIT_BINS
+    ends = -(-np.arange(1, nb) * n // nb) - 1  # ceil(b n / bins) - 1 >= 0
     bins = np.searchsorted(np.sort(times)[ends], times, side="left")
-    hist = np.bincount(rows * SPLIT_BINS + bins,
-                       minlength=cshape[0] * SPLIT_BINS).reshape(cshape[0], SPLIT_BINS)
+    hist = np.bincount(rows * nb + bins, minlength=cshape[0] * nb).reshape(cshape[0], nb)
     return hist, f
 
 
@@ -1928,9 +1792,9 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     h3 : tuple of 3 float
         Spacing per axis [m].
     threads : int
-        Threads, ``>= 2`` (each marches :data:`SLABS_PER_THREAD` slabs, fewer
-        where a slab would get fewer than :data:`MIN_SLAB_ROWS` rows or
-        :data:`MIN_SLAB_NODES` nodes).
+        Threads, ``>= 2`` (each marches :data:`_tuning.SLABS_PER_THREAD` slabs, fewer
+        where a slab would get fewer than :data:`_tuning.MIN_SLAB_ROWS` rows or
+        :data:`_tuning.MIN_SLAB_NODES` nodes).
     stop_cells : ndarray, int, shape (m, 3), optional
         Stop once these nodes are frozen and final; nodes later than the latest
         of them are then ``inf``, as in the serial march.
@@ -1952,8 +1816,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         ``raised`` (order 2: updates that found a later time than the node had) and
         ``balance``: nodes frozen over the sum of each window's largest thread share, the
         speed-up the windows allow if every freeze cost the same (``threads`` at best; slabs
-        taken in turn, :data:`DYNAMIC_2D`: the shares an idle machine gives, :func:`_in_turn`,
-        whatever this run's threads took), ``greedy``: the windows whose slabs
+        taken in turn, :data:`_tuning.DYNAMIC_2D`: the shares an idle machine gives,
+        :func:`_in_turn`, whatever this run's threads took), ``greedy``: the windows whose slabs
         :func:`_assign` shared longest first, ``exchanges``: the exchanges run, ``runs``:
         how often each slab was marched in the exchanges and windows (every slab once per
         region: ``exchanges + windows`` each).
@@ -1963,9 +1827,9 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     nx, ny, nz = (int(n) for n in shape3)
     three = nz > 1
     nth = int(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
-    spt = SLABS_PER_THREAD[3 if three else 2, order]
-    K = int(max(1, min(nth * spt, nx // MIN_SLAB_ROWS,
-                       max(nth, nx * ny * nz // max(MIN_SLAB_NODES, 1)))))
+    spt = _tuning.SLABS_PER_THREAD[3 if three else 2, order]
+    K = int(max(1, min(nth * spt, nx // _tuning.MIN_SLAB_ROWS,
+                       max(nth, nx * ny * nz // max(_tuning.MIN_SLAB_NODES, 1)))))
     G = 2 if order == 2 else 1  # ghost x-slabs on each side (the rows the stencil reads)
     K = max(1, min(K, nx // G))  # a slab at least as thick as its ghosts
     nth = min(nth, K)
@@ -2080,7 +1944,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         vmax = _top_speed(_kernels._readonly(speed))
     width = 2.0 * min(h3[:3 if three else 2]) / max(vmax, 1e-300)
     win = np.zeros(_W_SIZE + (_P_THREADS + 3 * nth if PROFILE else 0))
-    wn = WINDOW_NODES[3 if three else 2, order]
+    wn = _tuning.WINDOW_NODES[3 if three else 2, order]
     win[:_W_SIZE] = [0.0, width, 0.0, float(wn), 0.0, 0.0, np.inf, 0.0, 0.0, 0.0]
     stop_idx = np.zeros(0, dtype=np.int64)
     if stop_cells is not None and len(stop_cells):
@@ -2092,7 +1956,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         stop_idx = unit * (off[k] + local)
     drive = _DRIVES[3 if three else 2, G]
     # how the slabs go to the threads (_assign): in turn (2), lists (1), the interleave (0)
-    share = (2 if DYNAMIC_2D and not three else 1) if SHARE_SLABS else 0
+    share = (2 if _tuning.DYNAMIC_2D and not three else 1) if _tuning.SHARE_SLABS else 0
     slabs = np.empty(K, dtype=np.int64)  # scratch of _assign: each window's slabs per thread
     lists = np.empty(nth + 1 + K, dtype=np.int64)
     load = np.empty(nth)
@@ -2158,15 +2022,16 @@ def on_slabs(nodes: int, three: bool, order: int) -> bool:
     Returns
     -------
     bool
-        From :data:`PARALLEL_MIN_NODES` nodes, order 1; order 2 while :data:`ORDER2` is
-        set and from :data:`ORDER2_MIN_NODES_3D` (3D) or :data:`ORDER2_MIN_NODES_2D` (2D)
-        nodes too.
+        From :data:`_tuning.PARALLEL_MIN_NODES` nodes, order 1; order 2 while
+        :data:`_tuning.ORDER2` is set and from :data:`_tuning.ORDER2_MIN_NODES_3D` (3D) or
+        :data:`_tuning.ORDER2_MIN_NODES_2D` (2D) nodes too.
     """
-    if nodes < PARALLEL_MIN_NODES:
+    if nodes < _tuning.PARALLEL_MIN_NODES:
         return False
     if order == 1:
         return True
-    return bool(ORDER2) and nodes >= (ORDER2_MIN_NODES_3D if three else ORDER2_MIN_NODES_2D)
+    floor = _tuning.ORDER2_MIN_NODES_3D if three else _tuning.ORDER2_MIN_NODES_2D
+    return bool(_tuning.ORDER2) and nodes >= floor
 
 
 @contextlib.contextmanager
@@ -2420,7 +2285,7 @@ def _touch(a, step):
 
 class _PageToucher:
     """Inside the block a second thread faults in the pages of the arrays given (in chunks
-    of :data:`TOUCH_CHUNK` bytes, in turn), stopping at the block's end; whatever it did
+    of :data:`_tuning.TOUCH_CHUNK` bytes, in turn), stopping at the block's end; whatever it did
     not reach faults in where it is first written (:func:`_pad_slabs`, on every thread).
     With ``top_of`` (speeds [m/s]) it first finds their largest (:func:`_top_speed`, not
     stopped: ``top`` after the block), work :func:`march` would otherwise do after the cuts
@@ -2437,10 +2302,10 @@ class _PageToucher:
         if self.speed is not None:
             self.top = _top_speed(self.speed)
         for buf in self.bufs:
-            for a in range(0, buf.size, TOUCH_CHUNK):
+            for a in range(0, buf.size, _tuning.TOUCH_CHUNK):
                 if self.stop.is_set():
                     return
-                _touch(buf[a:a + TOUCH_CHUNK], 4096)
+                _touch(buf[a:a + _tuning.TOUCH_CHUNK], 4096)
 
     def __enter__(self):
         self.thread.start()
@@ -2452,9 +2317,4 @@ class _PageToucher:
         return False
 
 
-#: Bytes faulted in per call of :func:`_touch` by :class:`_PageToucher` (its stop check):
-#: one huge page, so the block's end waits for at most one fault. With 16 MiB the cuts of
-#: 2048^2 at a constant speed (3.6 ms) waited 13.8 ms for the toucher to end its chunk, with
-#: 2 MiB 0.09 ms (medians of 9; FM²-shaped and smooth 0.1-0.5 ms either way).
-TOUCH_CHUNK = 2 * 2**20
 

@@ -296,9 +296,9 @@ def run_march(
     nodes frozen on entry (state 2) are expanded first, band nodes (state 1)
     carry tentative times. ``stop_at`` as in :func:`fast_marching`; ``threads``
     (resolved, ``>= 1``) as there: the parallel march on grids of at least
-    :data:`~fm2uav.eikonal._parallel.PARALLEL_MIN_NODES` nodes when ``threads > 1`` (order 2
-    while :data:`~fm2uav.eikonal._parallel.ORDER2` is set, the default; from
-    :data:`~fm2uav.eikonal._parallel.ORDER2_MIN_NODES_2D` / ``_3D`` nodes:
+    :data:`~fm2uav.eikonal._tuning.PARALLEL_MIN_NODES` nodes when ``threads > 1`` (order 2
+    while :data:`~fm2uav.eikonal._tuning.ORDER2` is set, the default; from
+    :data:`~fm2uav.eikonal._tuning.ORDER2_MIN_NODES_2D` / ``_3D`` nodes:
     :func:`~fm2uav.eikonal._parallel.on_slabs`), else the serial one,
     which sets up on them (:func:`~fm2uav.eikonal._kernels.march`).
 

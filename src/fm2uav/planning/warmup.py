@@ -29,7 +29,7 @@ from collections.abc import Callable, Iterable, Mapping
 import numpy as np
 
 from ..eikonal import _edt as _edt_kernels
-from ..eikonal import _kernels, _parallel, distance_map, fast_marching
+from ..eikonal import _kernels, _parallel, _tuning, distance_map, fast_marching
 from ..world import World
 from ..world.clearance import min_surface_clearances, surface_clearance
 from .altitude import envelope_above
@@ -86,7 +86,7 @@ def _fmm_lean(order: int) -> Callable[[], None]:
 
 def _fmm_parallel(ndim: int) -> Callable[[], None]:
     """The march on both cores (grids of ``PARALLEL_MIN_NODES`` nodes and more), order 1 and
-    2 (unless ``_parallel.ORDER2`` is off), in every layout (float64 ``V``: in 2D interleaved
+    2 (unless ``_tuning.ORDER2`` is off), in every layout (float64 ``V``: in 2D interleaved
     with ``T`` unless the speed is uniform, whose separate arrays pad and unpad as other
     specialisations; and the lean float32 ``V`` of grids over ``LEAN_NODES`` padded nodes,
     e.g. a 1000x1000x40 terrain plan, with the page toucher of its buffers), its size floors
@@ -97,20 +97,20 @@ def _fmm_parallel(ndim: int) -> Callable[[], None]:
         speed = np.ones((16,) * ndim)
         speed[(0,) * ndim] = 0.5  # a plateau with its mask (a uniform grid needs none)
         speeds = (speed, np.ones((16,) * ndim)) if ndim == 2 else (speed,)
-        floor, lean = _parallel.PARALLEL_MIN_NODES, _kernels.LEAN_NODES
-        floor2 = _parallel.ORDER2_MIN_NODES_3D, _parallel.ORDER2_MIN_NODES_2D
-        _parallel.PARALLEL_MIN_NODES = _parallel.ORDER2_MIN_NODES_3D = 0
-        _parallel.ORDER2_MIN_NODES_2D = 0
+        floor, lean = _tuning.PARALLEL_MIN_NODES, _kernels.LEAN_NODES
+        floor2 = _tuning.ORDER2_MIN_NODES_3D, _tuning.ORDER2_MIN_NODES_2D
+        _tuning.PARALLEL_MIN_NODES = _tuning.ORDER2_MIN_NODES_3D = 0
+        _tuning.ORDER2_MIN_NODES_2D = 0
         try:
             for lean_nodes in (lean, 0):
                 _kernels.LEAN_NODES = lean_nodes
                 for v in speeds:
-                    for order in (1, 2) if _parallel.ORDER2 else (1,):
+                    for order in (1, 2) if _tuning.ORDER2 else (1,):
                         fast_marching(v, [(3,) * ndim], order=order, threads=2,
                                       stop_at=[(12,) * ndim])
         finally:
-            _parallel.PARALLEL_MIN_NODES, _kernels.LEAN_NODES = floor, lean
-            _parallel.ORDER2_MIN_NODES_3D, _parallel.ORDER2_MIN_NODES_2D = floor2
+            _tuning.PARALLEL_MIN_NODES, _kernels.LEAN_NODES = floor, lean
+            _tuning.ORDER2_MIN_NODES_3D, _tuning.ORDER2_MIN_NODES_2D = floor2
         # the page toucher's kernels (the top speed first, then the page faults): on a grid
         # this small its thread may be stopped before its first touch (the cuts are placed
         # at once), so they are compiled here

@@ -1,0 +1,152 @@
+"""The parallel march's tunable numbers: when it runs, how it cuts the grid, how wide its
+windows are (issue 27).
+
+Read by :mod:`fm2uav.eikonal._parallel` at call time, never by a compiled kernel, so a
+number here can be changed (or patched by a test or a sweep, ``monkeypatch.setattr(_tuning,
+"WINDOW_NODES", ...)``) without recompiling the kernels: an edit of ``_parallel.py`` itself,
+even of a constant, invalidates numba's cache of all its kernels (~10 minutes to rebuild).
+The numbers the kernels read (``EXCHANGE_ALONE_2D``, ``FAR_ONE_AXIS``, the heap and pool
+reserves) stay there. Each number says what was measured to choose it
+(docs/performance.md, "Both cores").
+"""
+
+from __future__ import annotations
+
+#: The windows meet at a barrier several hundred times per march: a thread that waits there spins
+#: only briefly and then sleeps (OpenMP's default spins ~300,000 times), or on a busy machine the
+#: spinning thread takes the core its partner needs (measured on 2048^2 with 10 runnable processes
+#: on 2 cores: 3.4 CPU-s spinning, 0.56 s passive, serial 0.53 s). The brief spin
+#: (:data:`SPIN_COUNT`, ~0.1 ms by libgomp's estimate) spares most wake-ups from sleep: near idle
+#: (``benchmarks/wait_policy.py``, medians of 9), two threads' wall on 2048^2 FM²-shaped order 1
+#: 145.1 / 133.3 / 132.4 ms at 2000 / 5000 / 10000 spins, at a constant speed 139.1 / 127.3 / 125.0
+#: ms, the CPU 253 -> 249 and 261 -> 244 ms (a sleep and its wake-up cost more than the spin);
+#: 160^3 FM²-shaped 278.6 / 279.0 / 267.3 ms. Under load (two busy loops beside, load ~3) 10000
+#: spins cost the CPU +10 % and the wall 0-8 % (docs/performance.md, "Spinning briefly"). Read by
+#: libgomp when numba first starts its thread pool; values set by the user stay (a user's
+#: ``OMP_WAIT_POLICY`` keeps libgomp's own spin count for it).
+SPIN_COUNT = 10000
+#: Environment variable with the default thread count of the march (an integer >= 1).
+THREADS_ENV = "FM2UAV_THREADS"
+#: Whether :func:`fm2uav.eikonal.fast_marching` marches order 2 on slabs too (False: order 2
+#: marches serially). The order-2 slabs give the serial march's times bit for bit on every case
+#: measured (tests/eikonal/test_fmm_parallel.py; the 2048² FM²-shaped map and the 1000 x 1000 x 40
+#: terrain march, 25.8 M nodes): a node's time is the one the serial march keeps, the lowest of its
+#: updates at its neighbours' freezes in time order (:func:`_parallel._serial_time2`). Only a tie
+#: (two nodes of one stencil frozen at the very same time) could make them differ, where the serial
+#: march's pick depends on its queue.
+ORDER2 = True
+#: Grids of fewer nodes march serially whatever the thread count. Measured
+#: (benchmarks/bench_core.py, "threads" rows, a machine at load 9 on 2 cores): on 1024^2 the
+#: busiest thread takes 0.06 s of the serial 0.099 CPU-s (1.65x on an idle machine) and the wall
+#: time is equal; below, a window holds fewer nodes per barrier and the wall time on a busy machine
+#: decides: kept serial.
+PARALLEL_MIN_NODES = 1_000_000
+#: 3D order 2 marches on slabs only from this many nodes: its repairs near the ghosts (a node's
+#: time from scratch, :func:`_parallel._serial_time2`) cost more on thin slabs. Measured (3
+#: December 2026, machine at load 4.5-4.8, medians of 2): 160^3 FM²-shaped (20-row slabs) CPU 0.97
+#: -> 2.31 s, busiest thread 0.98 -> 1.34 s (0.73x: slower); the 1000 x 1000 x 40 terrain march
+#: (125-row slabs) busiest thread 10.4 -> 5.0 s. Since (5 December 2026: the window's flags on one
+#: line and its queue in registers, 2 slabs per thread, windows of 16384 nodes; idle machine, wall,
+#: 2 threads over 1, medians of 5): 160^3 (4.1 M) FM²-shaped 1.06-1.28x, constant 1.14-1.17x,
+#: smooth 1.11-1.21x; 128^3 (2.1 M) 0.87-0.88x, 100^3 0.38-0.69x: from 4 M nodes.
+ORDER2_MIN_NODES_3D = 4_000_000
+#: 2D order 2 marches on slabs only from this many nodes (below: one thread, never slower). Its
+#: slab window costs more a node than the serial order-2 march (its neighbours' freeze order
+#: checked, :func:`_parallel._serial_time2`'s from-scratch repairs near the ghosts), which a bigger
+#: grid's memory traffic hides. Measured (3 December 2026, load 6-7, medians of 3, CPU times):
+#: 2048^2 (4.2 M) FM²-shaped one slab on one thread 1.25x the serial march's CPU (smooth 1.32x)
+#: before any repair, two threads' CPU 0.388 -> 0.621 s (1.60x; smooth 0.524 -> 0.751 s), busiest
+#: thread 1.20x (smooth 1.32x; `make bench` on the idle machine: wall 0.97x / 1.16x); 2900^2 (8.4
+#: M) FM²-shaped CPU 0.875 -> 1.199 s (1.37x), busiest thread 1.43x (smooth 1.69x; load 8.7-9);
+#: 4096^2 (16.8 M) FM²-shaped CPU 1.926 -> 2.338 s (1.21x), busiest thread 1.60x (smooth 1.69x). On
+#: the idle machine the 2048^2 wall ratio was ~0.8x the busiest thread's: from 2^23 (8.4 M) nodes
+#: on the slabs. Since (5 December 2026, as the 3D floor's; windows of 8192 nodes, the slabs taken
+#: in turn): 2048^2 (4.2 M) FM²-shaped 1.16-1.22x, constant 1.06-1.18x, smooth 1.14x; 1448^2 (2.1
+#: M) 0.89-1.04x, 1024^2 0.83-0.85x: from 2^22 nodes (2048^2).
+ORDER2_MIN_NODES_2D = 2**22
+#: Each slab gets at least this many x-slabs (rows), else fewer slabs are used.
+MIN_SLAB_ROWS = 16
+#: ... and at least this many nodes (but every thread one slab): thin slabs cost repairs. Measured
+#: on 1024^2 smooth (2 threads, CPU over the serial march's, loaded machine): 2/4/8 slabs per
+#: thread 1.05x/1.08x/1.24x at the same windows' balance (1.94-1.96).
+MIN_SLAB_NODES = 2**17
+#: Slabs per thread, thread ``t`` marching slabs ``t, t + threads, ...``: strips interleaved across
+#: the grid keep both threads busy when the wave starts off-centre (and
+#: :func:`_parallel.slab_bounds` places the cuts). Measured on the FM²-shaped fields (source at 0.3
+#: of x), 2 threads, windows of 32768 nodes, balanced cuts: the windows' balance
+#: (``stats["balance"]``, the speed-up they allow) 2D 4/8 slabs per thread 1.69/1.76, 3D 2/4
+#: 1.65/1.84, process CPU the same within noise (0.88-0.96x the serial march's; the exchange reads
+#: only the nodes frozen in the boundary rows). In 2D the better balance of 8 did not show in wall
+#: time on the idle machine (2048², 2 threads, medians of 5 interleaved: constant 0.257/0.261 s,
+#: smooth 0.292/0.302 s, FM²-shaped 0.234/0.248 s with 4/8 slabs per thread): 2D keeps 4. (With
+#: :data:`SHARE_SLABS`, 2D FM²-shaped 4/8: balance 1.76/1.81 for 2.2x the re-opened nodes.) Keyed
+#: by (dimension, order): order 2's ghosts, two rows deep, re-open more nodes on thinner slabs, and
+#: its repairs (a node's time from scratch, :func:`_parallel._serial_time2`) cost more; in 3D it
+#: takes 2 (5 December 2026, idle machine, 2 threads over 1, medians of 3, windows of 16384 nodes:
+#: 160^3 FM²-shaped 0.61x / 1.28x with 3 / 2 slabs per thread, 467,000 / 43,000 nodes re-opened;
+#: the terrain march 3.91 / 3.72 s; docs/performance.md).
+SLABS_PER_THREAD = {(2, 1): 4, (3, 1): 4, (2, 2): 4, (3, 2): 2}
+#: Target number of nodes frozen per window (all slabs together); the window width adapts to it.
+#: Fewer, wider windows cost fewer barriers and more repairs: measured on 160^3 (2 threads, CPU
+#: over the serial march's, loaded machine) constant speed 8192/16384/32768 nodes
+#: 1.15x/0.97x/0.85x; FM²-shaped 32768/65536 0.92x/2.4x (wider windows than the wave's crossing of
+#: a slab re-open nodes in cascades). Keyed by (dimension, order): order 2 re-opens more a window
+#: (5 December 2026, idle machine, 2 threads over 1, medians of 5, the slabs taken in turn: 2048^2
+#: FM²-shaped 1.13x / 1.16x with 16384 / 8192 nodes, 95,000 / 52,000 re-opened, 4096 0.90x; 160^3
+#: FM²-shaped, 2 slabs per thread, 32768 / 16384 / 8192 / 4096 1.03x / 1.28x / 1.25x / 1.10x; the
+#: terrain march 16384 / 32768 nodes 3.72 / 3.57-3.75 s; docs/performance.md).
+WINDOW_NODES = {(2, 1): 32768, (3, 1): 32768, (2, 2): 8192, (3, 2): 16384}
+#: Share the slabs among the threads anew before every window, longest first by the freezes of the
+#: last window, when that predicts a shorter window than the fixed interleave
+#: (:func:`_parallel._assign`); False: always the interleave. Windows' balance with / without (2
+#: threads, 4 slabs per thread): FM²-shaped 2048^2 1.654 -> 1.759, 160^3 1.84 -> 1.90; constant
+#: speed the same (1.99, 1.93 -> 1.95).
+SHARE_SLABS = True
+#: 2D: the threads take the slabs of a window (and of its exchange) in turn, the next not taken
+#: when done with the last, by decreasing predicted work (:func:`_parallel._take`) instead of lists
+#: fixed before the window (:func:`_parallel._assign`): the lists predict a window's work by the
+#: last one's, which lags the wave where it enters or leaves slabs; taken in turn, a window's slabs
+#: go to the threads by their actual work (and a thread the machine holds back takes fewer).
+#: Simulated from the serial times of the bench's FM²-shaped 2048^2 maps (seeds 0-3, windows of
+#: 32768 nodes, equal slabs), the windows' balance with 8 / 16 slabs: lists 1.78-1.81 / 1.82-1.88,
+#: in turn 1.79-1.86 / 1.91-1.96 (constant speed 2.00 / 2.00 either way). Needs
+#: :data:`SHARE_SLABS`. Measured (3 December 2026, load 6, the march's own counts: the balance an
+#: idle machine gets, :func:`_parallel._in_turn`) on those maps marched, 4 slabs per thread:
+#: balance 1.816/1.855/1.880/1.819 with the lists, 1.847/1.899/1.901/1.852 in turn, the same nodes
+#: re-opened (the windows do not depend on who runs a slab) and the same CPU; 8 slabs per thread
+#: 1.895-1.947 for 1.7-2x the re-opened nodes (two threads' CPU +3 %: no gain). Wall near idle
+#: (load 1.0-1.1, 2048^2, medians of 5-7 interleaved, two threads over one): lists / in turn
+#: constant 1.83-1.84x / 1.87-1.94x, smooth 1.80x / 1.87x, FM²-shaped 1.51x / 1.57-1.59x. On: 2D
+#: order 1, 4 slabs per thread. Order 2 too (5 December 2026, 2048^2, 4 slabs per thread, windows
+#: of 8192 nodes, 2 threads over 1, medians of 5: lists / in turn FM²-shaped 1.08x / 1.16x, smooth
+#: 1.03x / 1.14x, constant 1.02x / 1.17x).
+DYNAMIC_2D = True
+#: The split of two slabs is chosen on a march over every ``COARSE``-th node per axis (2D; 3D:
+#: ``COARSE_3D``), ~0.5 % (2D) and ~1.5 % (3D) of the work of the full march (serial time: the
+#: second thread waits). 2D: the windows' balance on FM²-shaped 2048^2 maps (seeds 0-3, with
+#: :func:`_parallel._assign`) averaged 1.827 / 1.823 / 1.813 / 1.768 with every 8th / 16th / 32nd
+#: node / equal slabs, the coarse march 8 / 2 / 0.5 ms.
+COARSE = 16
+COARSE_3D = 4
+#: The coarse march's step along z in 3D (a terrain's layers are few: 40).
+COARSE_3D_Z = 4
+#: Whether the cuts are placed for the slabs shared anew before each window (the least share of a
+#: time bin any sharing allows, :func:`_parallel.slab_bounds`) rather than for the fixed
+#: interleave. Simulated on the bench's FM²-shaped 2048^2 map from the serial times (windows of
+#: 32768 nodes in time order, the slabs shared as :func:`_parallel._assign`), 8 slabs: windows'
+#: balance 1.78 -> 1.84 (16 slabs 1.83 -> 1.84). 3D from :data:`SHARED_CUTS_MIN_NODES_3D` nodes
+#: only (below, the interleave's cuts).
+SHARED_CUTS = {2: True, 3: True}
+#: 3D grids of fewer nodes keep the interleave's cuts: on the bench's 160^3 fields (order 1)
+#: constant and smooth speed get the same cuts either way, the FM²-shaped one other cuts that
+#: simulate worse (1.921 -> 1.910); the 1000 x 1000 x 40 terrain plan's order-2 march (40 M nodes)
+#: gets the shared cuts, measured 1.881 -> 1.922 (docs/performance.md): from 2^24 nodes, the
+#: bench's 160^3 grids (both orders) below.
+SHARED_CUTS_MIN_NODES_3D = 2**24
+#: Bins of the split estimate, each as many coarse nodes in time order (stand-ins for the windows).
+SPLIT_BINS = 256
+#: Bytes faulted in per call of :func:`_parallel._touch` by :class:`_parallel._PageToucher` (its
+#: stop check): one huge page, so the block's end waits for at most one fault. With 16 MiB the cuts
+#: of 2048^2 at a constant speed (3.6 ms) waited 13.8 ms for the toucher to end its chunk, with 2
+#: MiB 0.09 ms (medians of 9; FM²-shaped and smooth 0.1-0.5 ms either way).
+TOUCH_CHUNK = 2 * 2**20
