@@ -437,18 +437,24 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
     cost the same and the barriers nothing (on the idle machine it was ~10 % above the
     measured wall ratio). Bar (issue 27): >= 1.6x on 2048² and 160³.
 
-    A first row gives the machine's own scaling, in the same child just before and after the
-    marches (:mod:`benchmarks.machine_scaling`: equal loops on one and two threads, medians
-    of 3): on this virtual machine the host lets the two vCPUs' memory traffic double in
-    some minutes and not in others (``lines`` 1.08-2.00x), so a two-thread ratio of the
-    march is read beside it.
+    First rows give the machine's ceiling for these ratios, measured in a child of their own
+    just before (:mod:`benchmarks.march_pair`): two serial marches at once, in two
+    processes, against one alone (1.00x: two full cores for this work; at 1.30x no
+    two-thread march could pass 2 / 1.30 = 1.54x).
     """
     cases = ([("256x256", "smooth", 1), ("32x32x32", "smooth", 1), ("256x256", "smooth", 2)]
              if quick else
              [(s, f, 1) for s in ("2048x2048", "160x160x160") for f in ("constant", "smooth", "fm2")]
              + [("512x512", "smooth", 1), ("1024x1024", "smooth", 1)]
              + [(s, f, 2) for s in ("2048x2048", "160x160x160") for f in ("smooth", "fm2")])
-    probe_mb, probe_repeats = (16, 1) if quick else (256, 3)
+    pair_cases = ["256x256:fm2"] if quick else ["2048x2048:fm2", "160x160x160:fm2"]
+    pair_repeats = 1 if quick else 3
+    pairs = _child(
+        f"""
+        from benchmarks import march_pair
+        print(json.dumps([march_pair.measure(c, 1, {pair_repeats}) for c in {pair_cases!r}]))
+        """
+    )
     res = _child(
         f"""
         import os
@@ -471,13 +477,6 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
                 out[tid] = (int(f[11]) + int(f[12])) / os.sysconf("SC_CLK_TCK")
             return out
 
-        from benchmarks import machine_scaling
-
-        def probe():
-            return {{k: one / two for k, (one, two)
-                     in machine_scaling.measure({probe_mb}, {probe_repeats}).items()}}
-
-        probes = [probe()]
         out = []
         for case, field, order in {cases!r}:
             shape = tuple(int(n) for n in case.split("x"))
@@ -508,12 +507,11 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
                             parallel=_parallel.on_slabs(v.size, len(shape) == 3, order),
                             serial=med[1], threads2=med[2], balance=stats.get("balance", 1.0),
                             setup=stats.get("setup", 0.0)))
-        probes.append(probe())
-        print(json.dumps(dict(marches=out, probes=probes)))
+        print(json.dumps(out))
         """
     )
-    rows = [_probe_row(res["probes"], probe_mb)]
-    for r in res["marches"]:
+    rows = [_pair_row(p, pair_repeats) for p in pairs]
+    for r in res:
         (w1, c1, _, _), (w2, c2, b2, e2) = r["serial"], r["threads2"]
         big = r["case"] in ("2048x2048", "160x160x160")
         rows.append({
@@ -530,19 +528,18 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
     return rows
 
 
-def _probe_row(probes: list[dict], mb: float) -> dict:
-    """The machine probe's row: ``lines`` (one read a cache line, memory-bound) before the
-    marches as its ratio, every loop before and after in the notes."""
-    before, after = probes[0], probes[-1]
-    loops = ", ".join(f"{k} {before[k]:.2f}x / {after[k]:.2f}x" for k in before)
+def _pair_row(pair: dict, repeats: int) -> dict:
+    """The row of :func:`benchmarks.march_pair.measure`: two serial marches at once."""
+    case = pair["case"].replace(":fm2", " FM²-shaped")
     return {
         "benchmark": "fmm threads",
-        "case": "the machine: equal loops on 1 and 2 threads (memory-bound `lines`)",
-        "ours_s": None, "peer": "", "peer_s": None, "ratio": before["lines"],
-        "bar": "2.00x: the memory doubles",
-        "notes": (f"benchmarks.machine_scaling, {mb:g} MiB, before / after the rows below: "
-                  f"{loops}; at ~1.1x the host gives both vCPUs one core's memory line rate "
-                  "and a march's two-thread ratio falls with it"),
+        "case": f"the machine: two serial marches at once, {case} order {pair['order']}",
+        "ours_s": pair["pair_s"], "peer": "one alone", "peer_s": pair["alone_s"],
+        "ratio": pair["alone_s"] / pair["pair_s"],
+        "bar": "1.00x: two full cores",
+        "notes": (f"benchmarks.march_pair, two processes, medians of {repeats}: each march "
+                  f"{pair['ratio']:.2f}x as long as alone, so a two-thread march's ceiling "
+                  f"on this machine now is {2 / pair['ratio']:.2f}x"),
     }
 
 

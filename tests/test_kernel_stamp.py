@@ -69,6 +69,27 @@ def test_the_package_kernels_stamps_include_their_helpers():
     assert "eikonal/_heap.py" in {p.relative_to(PACKAGE).as_posix() for p in kernel_sources(ref)}
 
 
+def test_the_parallel_marchs_tuned_numbers_are_not_in_its_stamp():
+    """``eikonal/_tuning.py`` is read at call time only (no kernel names it: test_warmup.py):
+    a tuned number changes no stamp, so no kernel of ``_parallel.py`` recompiles for it."""
+    parallel = PACKAGE / "eikonal" / "_parallel.py"
+    assert "from . import _kernels, _tuning" in parallel.read_text(encoding="utf-8")
+    deps = {p.relative_to(PACKAGE).as_posix() for p in kernel_sources(parallel)}
+    assert "eikonal/_tuning.py" not in deps and "eikonal/_kernels.py" in deps
+    assert _kernel_stamp.CALL_TIME_ONLY == {"eikonal/_tuning.py"}  # a new one is a choice
+
+
+def test_a_call_time_only_module_is_left_out_of_the_stamp(tmp_path, monkeypatch):
+    pkg = _package(tmp_path)
+    monkeypatch.setattr(_kernel_stamp, "CALL_TIME_ONLY", frozenset({"c.py"}))
+    _kernel_stamp._SOURCES.clear()
+    assert [p.name for p in kernel_sources(pkg / "a.py", pkg)] == ["b.py"]
+    before = kernel_stamp(pkg / "a.py", pkg)
+    (pkg / "c.py").write_text((pkg / "c.py").read_text() + "K = 2\n")
+    assert kernel_stamp(pkg / "a.py", pkg) == before
+    _kernel_stamp._SOURCES.clear()
+
+
 def test_an_unreadable_import_is_skipped_not_fatal(tmp_path):
     pkg = _package(tmp_path)
     (pkg / "c.py").unlink()  # imported by b, gone: b's stamp is its own bytes and nothing

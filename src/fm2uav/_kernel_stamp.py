@@ -25,10 +25,17 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-__all__ = ["PACKAGE", "kernel_stamp", "kernel_sources"]
+__all__ = ["CALL_TIME_ONLY", "PACKAGE", "kernel_stamp", "kernel_sources"]
 
 #: The fm2uav package folder (absolute imports ``fm2uav.x`` resolve against it).
 PACKAGE = Path(__file__).resolve().parent
+
+#: Package modules (paths relative to the package) that a kernel file imports but no kernel
+#: compiles in: numbers its Python code reads at call time, never a kernel (a test of
+#: ``tests/planning/test_warmup.py`` checks that no compiled function names one). They are
+#: left out of the stamps, so that changing one (e.g. a tuned window size of the parallel
+#: march, ``eikonal/_tuning.py``) keeps every cached kernel instead of recompiling them all.
+CALL_TIME_ONLY = frozenset({"eikonal/_tuning.py"})
 
 _PATTERNS: list = []
 
@@ -107,7 +114,7 @@ def kernel_sources(py_file: str | os.PathLike, package: Path = PACKAGE) -> list[
     while todo:
         f = todo.pop()
         for dep in _imports(f, package):
-            if dep in seen or dep == start:
+            if dep in seen or dep == start or _call_time_only(dep, package):
                 continue
             seen.add(dep)
             try:
@@ -116,6 +123,15 @@ def kernel_sources(py_file: str | os.PathLike, package: Path = PACKAGE) -> list[
             except (OSError, UnicodeDecodeError):
                 continue
     return sorted(seen)
+
+
+def _call_time_only(path: Path, package: Path) -> bool:
+    """Whether ``path`` is one of :data:`CALL_TIME_ONLY` of ``package``."""
+    try:
+        rel = path.resolve().relative_to(package).as_posix()
+    except (OSError, ValueError):
+        return False
+    return rel in CALL_TIME_ONLY
 
 
 _STAMPS: dict[tuple, bytes] = {}

@@ -9,18 +9,35 @@ callee or constant in another module changed then misses its cache and compiles 
 an edited kernel does. Files outside the package keep numba's locators. Every kernel module
 takes its ``njit`` from here (``from .._numba import njit``), so the locators are in place
 before the first kernel is decorated.
+
+It also puts OpenMP first among numba's threading layers (:data:`THREADING_LAYERS`), unless
+the user chose one (``NUMBA_THREADING_LAYER`` or ``NUMBA_THREADING_LAYER_PRIORITY``): numba
+prefers TBB whenever a TBB library is on the machine (Debian's ``libtbb12`` comes with
+OpenCV, VTK and other packages), and the parallel march starts a parallel region in every
+time window (hundreds a march), where TBB's second thread joined each region ~130 µs late
+and OpenMP's ~1 µs (docs/performance.md, "Where two threads lose").
 """
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
+import numba
 from numba import njit, prange, types
 from numba.core import caching
 
 from ._kernel_stamp import PACKAGE, kernel_stamp
 
-__all__ = ["KERNEL_ROOTS", "LOCATORS", "njit", "prange", "types"]
+__all__ = ["KERNEL_ROOTS", "LOCATORS", "THREADING_LAYERS", "njit", "prange", "types"]
+
+#: numba's threading layers in the order fm2uav tries them (numba's own: TBB first). Measured
+#: on the 2-core machine (5 December 2026, medians of 5, two threads): 2048^2 constant speed
+#: order 1 137.2 ms with TBB, 124.9 ms with OpenMP (the serial march 208 ms); the FM²-shaped
+#: map order 2 216.2 / 193.4 ms. Read by numba when it starts its first parallel region.
+THREADING_LAYERS = ["omp", "tbb", "workqueue"]
+if not ({"NUMBA_THREADING_LAYER", "NUMBA_THREADING_LAYER_PRIORITY"} & set(os.environ)):
+    numba.config.THREADING_LAYER_PRIORITY = list(THREADING_LAYERS)
 
 #: Folders whose Python files are stamped with their imports (each is its own package root
 #: for ``fm2uav.x`` imports only when it is the fm2uav package).
