@@ -15,8 +15,9 @@ of the data, no sharing, no synchronisation inside), interleaved, medians::
 * ``gather``: reads at random indices of the whole array (latency-bound misses).
 
 Prints per loop the wall times on one and two threads and their ratio (2.0: the loop
-doubles). The march's windows sit between ``l2`` and ``gather``: a 2D band of a few
-thousand nodes fits the caches, the speeds and times it reads around it do not.
+doubles). The march itself is not bound by ``lines``: two serial marches at once ran at
+1.01-1.03x the time of one while ``lines`` doubled 1.06-1.09x (:mod:`benchmarks.march_pair`,
+the probe to read beside a two-thread ratio of the march).
 """
 
 from __future__ import annotations
