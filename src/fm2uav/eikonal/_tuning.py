@@ -95,7 +95,19 @@ SLABS_PER_THREAD = {(2, 1): 4, (3, 1): 4, (2, 2): 4, (3, 2): 2}
 #: FM²-shaped 1.13x / 1.16x with 16384 / 8192 nodes, 95,000 / 52,000 re-opened, 4096 0.90x; 160^3
 #: FM²-shaped, 2 slabs per thread, 32768 / 16384 / 8192 / 4096 1.03x / 1.28x / 1.25x / 1.10x; the
 #: terrain march 16384 / 32768 nodes 3.72 / 3.57-3.75 s; docs/performance.md).
-WINDOW_NODES = {(2, 1): 32768, (3, 1): 32768, (2, 2): 8192, (3, 2): 16384}
+#: On OpenMP (session 26, 5 December 2026; before, numba had run the regions on TBB, whose
+#: second thread joined each region ~130 us late, docs/performance.md "Where two threads
+#: lose") narrower windows won, their barriers now cheap (two threads over one, wall, medians
+#: of 5-9 interleaved in one process): 2D order 1 32768 / 16384 nodes 2048^2 FM²-shaped
+#: 1.50-1.53x / 1.55-1.60x, smooth 1.49-1.57x / 1.48-1.64x, constant 1.33-1.69x /
+#: 1.32-1.71x, 1448^2 FM²-shaped 1.41x / 1.50x, 1024^2 FM²-shaped 1.20x / 1.26x, smooth
+#: 1.36x / 1.42x (8192 as 16384 on 2048^2); 3D order 1 32768 / 16384 / 8192 160^3
+#: FM²-shaped 1.69x / 1.78x / 1.83x, constant 1.90x / 2.11x / 2.08x, smooth (16384 / 8192)
+#: 1.70x / 1.86x (4096: 1.59x, 1.75x); 3D order 2, 2 slabs per thread, 16384 / 8192 160^3
+#: FM²-shaped 1.32x / 1.44x, constant 1.09x / 1.37x, smooth 1.18x / 1.27x (4 slabs of
+#: 4096: 1.33x / 1.28x / 0.94x; 3 of 8192: 1.10x / 1.07x), the terrain march 3.86 / 3.29-3.68
+#: s (4 of 4096 3.08-3.22 s, 3 of 8192 3.14 s, 4 of 8192 3.39-3.42 s).
+WINDOW_NODES = {(2, 1): 16384, (3, 1): 8192, (2, 2): 8192, (3, 2): 8192}
 #: Share the slabs among the threads anew before every window, longest first by the freezes of the
 #: last window, when that predicts a shorter window than the fixed interleave
 #: (:func:`_parallel._assign`); False: always the interleave. Windows' balance with / without (2
