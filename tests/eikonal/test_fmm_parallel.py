@@ -879,10 +879,11 @@ def test_slabs_taken_in_turn_give_the_serial_times(threads, monkeypatch):
     monkeypatch.setattr(_tuning, "MIN_SLAB_ROWS", 4)
     monkeypatch.setitem(_tuning.SLABS_PER_THREAD, (2, 1), 9)
     monkeypatch.setitem(_tuning.SLABS_PER_THREAD, (2, 2), 9)
-    seen = []
+    seen, alone = [], []
     for key in list(_parallel._DRIVES):
         def spy(*args, _d=_parallel._DRIVES[key], _key=key):
             seen.append((_key, args[33]))  # share
+            alone.append(args[36])  # the exchanges on the calling thread only
             return _d(*args)
         monkeypatch.setitem(_parallel._DRIVES, key, spy)
     for name, v, src in _fields((131, 67)):
@@ -917,17 +918,22 @@ def test_slabs_taken_in_turn_give_the_serial_times(threads, monkeypatch):
     serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 2, np.zeros((0, 3), dtype=int))
     for dynamic in (True, False):
         monkeypatch.setattr(_tuning, "DYNAMIC_2D", dynamic)
-        seen.clear()
-        T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, threads, order=2)
-        assert_equal_times(serial, T, exact=True)
-        assert {s for _, s in seen} == {2 if dynamic else 1}
-        assert stats["reopened"] > 0 and stats["windows"] > 3
-        assert np.all(stats["runs"] == stats["exchanges"] + stats["windows"])
+        for one in (True, False):  # the exchanges on the calling thread, or on every thread
+            monkeypatch.setitem(_tuning.EXCHANGE_ALONE_2D, 2, one)
+            seen.clear()
+            alone.clear()
+            T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, threads, order=2)
+            assert_equal_times(serial, T, exact=True)
+            assert {s for _, s in seen} == {2 if dynamic else 1} and set(alone) == {one}
+            assert stats["reopened"] > 0 and stats["windows"] > 3
+            assert np.all(stats["runs"] == stats["exchanges"] + stats["windows"])
     v3, src3 = fm2_shaped((41, 23, 19), seed=2)
     flat, start, shape3 = _start(v3, src3)
     seen.clear()
+    alone.clear()
     _parallel.march(flat, start, shape3, (1.0,) * 3, threads, order=2)
     assert {s for _, s in seen} == {1}  # 3D keeps the lists
+    assert set(alone) == {False}  # and exchanges its planes on every thread
 
 
 def test_profile_accounts_for_every_region(monkeypatch):

@@ -106,13 +106,6 @@ if "OMP_WAIT_POLICY" not in os.environ:
 
 __all__ = ["march", "on_slabs", "resolve_threads"]
 
-#: 2D: the exchange before each window runs on the calling thread alone (the parallel
-#: region's iterations in turn), not on every thread: its work is a row per slab side (the
-#: busiest thread's share summed over the 108 exchanges of the bench's FM²-shaped 2048^2
-#: map: ~1 ms) while waking the sleeping threads for it and waiting for the last cost
-#: ~0.1 ms of wall per region on the near-idle machine (the regions' wall summed: 12-18
-#: ms; docs/performance.md). 3D exchanges planes: on the threads. A compile-time constant.
-EXCHANGE_ALONE_2D = True
 #: 2D: a far neighbour of the node a window freezes gets the one-axis update along their
 #: axis, as in the serial march (valid in a slab: see the window's docstring); False: the
 #: full update (the same times bit for bit; the tests run both).
@@ -1335,7 +1328,7 @@ def _drive_kernel(three, order=1):
     """The compiled driver of one dimension and order (the parallel region runs the slabs)."""
     def drive(nth, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, rows, sx, sy, ih, hh, iso, pool,
               nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win, first, stops, slabs, lists, load,
-              share, scan, far):
+              share, scan, far, alone):
         """Run windows until every queue is empty; 0 done, 1/2 grow pool/heap and call again.
 
         ``win`` (float64): [0] window end, [1] width, [2] windows run, [3] target pops,
@@ -1355,6 +1348,7 @@ def _drive_kernel(three, order=1):
         (``share``: 0 the interleave, 1 :data:`_tuning.SHARE_SLABS`' lists, 2 taken in turn,
         :data:`_tuning.DYNAMIC_2D`). ``scan[k]``: the nodes of slab ``k`` the start
         reads (the start box's rows). ``far``: the far neighbours' one-axis update (2D).
+        ``alone``: the exchanges on this thread only, the slabs in turn (2D).
 
         ``off``, ``end``, ``sx``, ``sy``, ``scan`` and ``stops`` count elements of ``Tp``:
         nodes in the separate layout, twice that in the 2D interleaved one (``Tp`` the
@@ -1362,7 +1356,6 @@ def _drive_kernel(three, order=1):
         """
         K = off.size
         dyn = share == 2  # the slabs taken in turn by the threads (DYNAMIC_2D)
-        alone = not three and EXCHANGE_ALONE_2D  # the 2D exchange on the calling thread
         prof = win.size > _W_SIZE  # the profile (PROFILE)
         d0 = _clock_ns(1) * 1e-9 if prof else 0.0
         sxi = np.int64(sx)
@@ -1408,7 +1401,8 @@ def _drive_kernel(three, order=1):
             if _assign(ctl[:, _C_POPS], nth, slabs, lists, load, share):
                 win[8] += 1.0
             # exchange: each slab refreshes its own ghosts and the rows next to them; in 2D
-            # on this thread alone, the iterations in turn (:data:`EXCHANGE_ALONE_2D`)
+            # on this thread alone if ``alone``, the iterations in turn
+            # (:data:`_tuning.EXCHANGE_ALONE_2D`)
             w0 = _clock_ns(1) * 1e-9 if prof else 0.0
             if alone:
                 _set_threads(1)
@@ -1968,7 +1962,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
             status = drive(nth, Tk, Vk, U, qp, fixed, fl, eidx, evals, unit * off,
                            unit * (off + sizes), rows, _U(unit * sx), _U(unit * sy), ih, hh, iso,
                            pool, nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win, first,
-                           stop_idx, slabs, lists, load, share, scan, FAR_ONE_AXIS)
+                           stop_idx, slabs, lists, load, share, scan, FAR_ONE_AXIS,
+                           not three and _tuning.EXCHANGE_ALONE_2D[order])
             first = win[7] == 0.0
             if status == 0:
                 break

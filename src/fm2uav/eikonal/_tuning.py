@@ -5,7 +5,7 @@ Read by :mod:`fm2uav.eikonal._parallel` at call time, never by a compiled kernel
 number here can be changed (or patched by a test or a sweep, ``monkeypatch.setattr(_tuning,
 "WINDOW_NODES", ...)``) without recompiling the kernels: an edit of ``_parallel.py`` itself,
 even of a constant, invalidates numba's cache of all its kernels (~10 minutes to rebuild).
-The numbers the kernels read (``EXCHANGE_ALONE_2D``, ``FAR_ONE_AXIS``, the heap and pool
+The numbers the kernels read (``FAR_ONE_AXIS``, the heap and pool
 reserves) stay there. Each number says what was measured to choose it
 (docs/performance.md, "Both cores").
 """
@@ -162,3 +162,14 @@ SPLIT_BINS = 256
 #: of 2048^2 at a constant speed (3.6 ms) waited 13.8 ms for the toucher to end its chunk, with 2
 #: MiB 0.09 ms (medians of 9; FM²-shaped and smooth 0.1-0.5 ms either way).
 TOUCH_CHUNK = 2 * 2**20
+#: 2D: the exchange before each window runs on the calling thread alone (the parallel
+#: region's iterations in turn), not on every thread, keyed by order: an order-1 exchange is a
+#: row per slab side (the busiest thread's share summed over the 108 exchanges of the bench's
+#: FM²-shaped 2048^2 map: ~1 ms), while waking the other thread for it cost ~0.1 ms of wall a
+#: region (3 December 2026; docs/performance.md). Order 2's exchanges are ten times order 1's
+#: (2048^2 FM²-shaped: 10.7 ms on one thread) and, on OpenMP, a region costs ~1 us: on every
+#: thread they gained 2-4 % (5 December 2026, 2048^2, two threads over one, alone / on every
+#: thread, medians of 7 and 9 in two runs: FM²-shaped 1.28x / 1.32x and 1.27x / 1.29x, smooth
+#: 1.22x / 1.24x and 1.21x / 1.25x, constant 1.30x / 1.27x and 1.27x / 1.32x). Order 1: the
+#: same either way (1.61x / 1.62x, 1.65x / 1.66x). Passed to the drive (not compiled in).
+EXCHANGE_ALONE_2D = {1: True, 2: False}
