@@ -440,7 +440,9 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
     First rows give the machine's ceiling for these ratios, measured in a child of their own
     just before (:mod:`benchmarks.march_pair`): two serial marches at once, in two
     processes, against one alone (1.00x: two full cores for this work; at 1.30x no
-    two-thread march could pass 2 / 1.30 = 1.54x).
+    two-thread march could pass 2 / 1.30 = 1.54x). Each row names the threading layer numba
+    ran the regions on (OpenMP unless the user chose another: ``fm2uav._numba``; TBB's late
+    second thread cost 10-20 % of these ratios, docs/performance.md).
     """
     cases = ([("256x256", "smooth", 1), ("32x32x32", "smooth", 1), ("256x256", "smooth", 2)]
              if quick else
@@ -507,11 +509,16 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
                             parallel=_parallel.on_slabs(v.size, len(shape) == 3, order),
                             serial=med[1], threads2=med[2], balance=stats.get("balance", 1.0),
                             setup=stats.get("setup", 0.0)))
-        print(json.dumps(out))
+        import numba
+        try:  # the layer numba ran the parallel regions on (none if every case was serial)
+            layer = numba.threading_layer()
+        except ValueError:
+            layer = "none started"
+        print(json.dumps(dict(marches=out, layer=layer)))
         """
     )
     rows = [_pair_row(p, pair_repeats) for p in pairs]
-    for r in res:
+    for r in res["marches"]:
         (w1, c1, _, _), (w2, c2, b2, e2) = r["serial"], r["threads2"]
         big = r["case"] in ("2048x2048", "160x160x160")
         rows.append({
@@ -523,8 +530,8 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
                       f"CPU 1 thread {c1:.3f} s, 2 threads {c2:.3f} s (ratio {c1 / c2:.2f}x); "
                       f"busiest thread {b2:.3f} s ({c1 / max(b2, 1e-9):.2f}x); windows' balance "
                       f"{r['balance']:.2f}, set-up {1e3 * r['setup']:.0f} ms: idle-machine "
-                      f"estimate {c1 / max(e2, 1e-9):.2f}x; "
-                      f"load average {os.getloadavg()[0]:.1f}")})
+                      f"estimate {c1 / max(e2, 1e-9):.2f}x; numba threading layer "
+                      f"{res['layer']}; load average {os.getloadavg()[0]:.1f}")})
     return rows
 
 

@@ -30,6 +30,9 @@ def test_every_benchmark_runs_quick(tmp_path):
     pair = [r for r in rows if r["case"].startswith("the machine: two serial marches at once")]
     assert len(pair) == 1 and pair[0]["benchmark"] == "fmm threads"
     assert 0.2 < pair[0]["ratio"] < 5 and "ceiling" in pair[0]["notes"]
+    # and name the threading layer the marches ran on
+    threads = [r for r in rows if r["benchmark"] == "fmm threads" and r not in pair]
+    assert threads and all("numba threading layer " in r["notes"] for r in threads)
 
 
 def _probe(module: str, *args: str) -> str:
