@@ -159,3 +159,34 @@ def test_big_3d_grids_cut_the_slabs_for_sharing_bit_for_bit(lean, monkeypatch):
     assert f == 1
     assert _parallel._shared_cost(cum, cuts_at, threads) < _parallel._shared_cost(cum, fixed,
                                                                                  threads)
+
+
+def test_big_3d_grids_take_their_own_slabs_and_windows_bit_for_bit(lean, monkeypatch):
+    """From ``BIG_3D_NODES`` nodes (the terrain plan's march) a 3D march takes
+    ``BIG_3D_SLABS_PER_THREAD`` slabs a thread and windows of ``BIG_3D_WINDOW_NODES`` nodes
+    (keyed by order), smaller grids ``SLABS_PER_THREAD`` and ``WINDOW_NODES``; the times are the
+    serial march's bit for bit either way."""
+    W, goal, start = _terrain(nx=192, ny=40, nz=14)
+    h = (15.0, 15.0, 10.0)
+    monkeypatch.setitem(_tuning.SLABS_PER_THREAD, (3, 2), 2)
+    monkeypatch.setitem(_tuning.WINDOW_NODES, (3, 2), 4000)
+    monkeypatch.setitem(_tuning.BIG_3D_SLABS_PER_THREAD, 2, 3)
+    monkeypatch.setitem(_tuning.BIG_3D_WINDOW_NODES, 2, 1000)
+    seen = []
+    real = _parallel.march
+
+    def spy(*args, **kwargs):
+        T, stats = real(*args, **kwargs)
+        seen.append(stats)
+        return T, stats
+
+    monkeypatch.setattr(_parallel, "march", spy)
+    serial = fast_marching(W, [goal], spacing=h, order=2, stop_at=[start], threads=1)
+    below = fast_marching_parallel(W, [goal], spacing=h, order=2, stop_at=[start])
+    monkeypatch.setattr(_tuning, "BIG_3D_NODES", W.size)  # this grid: at it
+    at = fast_marching_parallel(W, [goal], spacing=h, order=2, stop_at=[start])
+    assert np.array_equal(serial, below) and np.array_equal(serial, at)
+    small, big = seen
+    assert small["slabs"] == 4 and big["slabs"] == 6
+    # a window freezes ~its target: a quarter of the target, four times the windows
+    assert big["windows"] > 2.5 * small["windows"]

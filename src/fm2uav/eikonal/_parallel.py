@@ -907,6 +907,27 @@ def _recheck_r(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf, eidx, ev
 
 
 @njit(cache=True, inline="always", _nrt=False)
+def _unread2(T, fixed, d, g, v, one, sx, sy, three):
+    """Whether the own node ``d`` (one row from the ghost ``g`` if ``one``, else two) keeps
+    its time now that ``g``, never frozen before, froze at ``v``: ``d`` is frozen, every
+    neighbour of ``d`` (``g`` aside) frozen but on entry is earlier than ``v``, and with
+    ``one`` so is ``d`` (no later than ``v``). Then no update :func:`_serial_time2` makes for
+    ``d`` reads ``g`` (each runs at a neighbour's time, below ``v``, where
+    :func:`_known` hides ``g``), and with ``one`` the new candidate ``v`` comes no earlier than
+    ``d``'s time, which ends its loop: the recheck would find the same time."""
+    x = T[d]
+    if not x >= 0.0 or (one and x > v):
+        return False
+    sh = _unit(sy, three) >> _ONE
+    for nb in _nbs(d, sx, sy, three):
+        if nb != d and nb != g:
+            y = T[nb]
+            if y >= v and not _bit(fixed, nb >> sh):
+                return False
+    return True
+
+
+@njit(cache=True, inline="always", _nrt=False)
 def _room2_r(nfree, rsize, rkey):
     """:func:`_room2` with the queue's state in registers."""
     return (nfree >= _U(RESERVE_BLOCKS + POOL_EXTRA_2)
@@ -1132,12 +1153,18 @@ def _slab_kernels2(three):
                 if not _room2(st, rkey):
                     return False
                 gj = g + j
+                was = T[gj]  # NaN (never frozen) or an earlier freeze's time
                 T[gj] = v
                 if v > ctl[_C_FMAX]:  # a ghost frozen later than the slab's nodes
                     ctl[_C_FMAX] = v
                 for step in (sx, lo):
                     d = gj + step if up else gj - step
                     if d >= lo and d < hi:
+                        # not the nodes the wave left before it reached the ghost (the
+                        # exchange back across a cut): their time stands (:func:`_unread2`)
+                        if not was >= 0.0 and _unread2(T, fixed, d, gj, v, step == sx, sx, sy,
+                                                       three):
+                            continue
                         _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf,
                                  eidx, evals, ebase, pool, nxt, bk, mw, st, rkey, ritem, ctl)
                         x = T[d]
@@ -1821,7 +1848,10 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     nx, ny, nz = (int(n) for n in shape3)
     three = nz > 1
     nth = int(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
-    spt = _tuning.SLABS_PER_THREAD[3 if three else 2, order]
+    # big 3D grids (the terrain plan's march) take their own slabs and windows
+    big = three and nx * ny * nz >= _tuning.BIG_3D_NODES
+    spt = (_tuning.BIG_3D_SLABS_PER_THREAD[order] if big
+           else _tuning.SLABS_PER_THREAD[3 if three else 2, order])
     K = int(max(1, min(nth * spt, nx // _tuning.MIN_SLAB_ROWS,
                        max(nth, nx * ny * nz // max(_tuning.MIN_SLAB_NODES, 1)))))
     G = 2 if order == 2 else 1  # ghost x-slabs on each side (the rows the stencil reads)
@@ -1938,7 +1968,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         vmax = _top_speed(_kernels._readonly(speed))
     width = 2.0 * min(h3[:3 if three else 2]) / max(vmax, 1e-300)
     win = np.zeros(_W_SIZE + (_P_THREADS + 3 * nth if PROFILE else 0))
-    wn = _tuning.WINDOW_NODES[3 if three else 2, order]
+    wn = (_tuning.BIG_3D_WINDOW_NODES[order] if big
+          else _tuning.WINDOW_NODES[3 if three else 2, order])
     win[:_W_SIZE] = [0.0, width, 0.0, float(wn), 0.0, 0.0, np.inf, 0.0, 0.0, 0.0]
     stop_idx = np.zeros(0, dtype=np.int64)
     if stop_cells is not None and len(stop_cells):

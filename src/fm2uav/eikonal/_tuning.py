@@ -173,3 +173,17 @@ TOUCH_CHUNK = 2 * 2**20
 #: 1.22x / 1.24x and 1.21x / 1.25x, constant 1.30x / 1.27x and 1.27x / 1.32x). Order 1: the
 #: same either way (1.61x / 1.62x, 1.65x / 1.66x). Passed to the drive (not compiled in).
 EXCHANGE_ALONE_2D = {1: True, 2: False}
+#: 3D grids of at least this many nodes (the terrain plan's march: 1000 x 1000 x 40, 42 M with
+#: its padding) take :data:`BIG_3D_SLABS_PER_THREAD` and :data:`BIG_3D_WINDOW_NODES` (keyed by
+#: order) instead of :data:`SLABS_PER_THREAD` and :data:`WINDOW_NODES`: slabs of ~125 rows are
+#: thick enough that four per thread re-open few nodes, and balance the windows better than two.
+#: Measured on that march (5 December 2026, session 27, idle machine, 2 threads, the settings
+#: interleaved in one process, medians of 3 / 5 in two runs, the second in a slower minute):
+#: 2 slabs per thread with windows of 8192 nodes 3.567 / 4.548 s (windows' balance 1.694,
+#: 10,946 nodes re-opened), 4 with 4096 3.137 / 3.645 s (balance 1.917, 15,456 re-opened), 4 with
+#: 8192 3.594 s in the slower run (42,119 re-opened), 5 with 4096 3.692 s (1.908); the times the
+#: same bit for bit. The bench's 160^3 grids (4.1 M, slabs of 40 rows) stay below: with 4 slabs
+#: per thread of 4096 nodes (session 26) FM²-shaped 1.33x, smooth 0.94x on two threads.
+BIG_3D_NODES = 2**24
+BIG_3D_SLABS_PER_THREAD = {1: 4, 2: 4}
+BIG_3D_WINDOW_NODES = {1: 8192, 2: 4096}
