@@ -1008,3 +1008,47 @@ def test_each_slabs_small_arrays_on_cache_lines_of_their_own():
         assert a.ctypes.data % 64 == 0 and a.strides[0] % 64 == 0
         assert a.strides[0] - n * a.itemsize < 64
         assert np.all(a == fill)
+
+
+@pytest.mark.parametrize("one", [True, False], ids=["one-away", "two-away"])
+def test_order_2_skips_only_rechecks_that_would_find_the_same_time(one):
+    """``_parallel._unread2`` lets the order-2 exchange skip the recheck of a node next to a
+    ghost just frozen (one or two rows away): wherever it says so, the serial march's time of
+    that node (``_serial_time2``) is the same with the ghost's time as without it (a frozen
+    node one away holding its serial time before, as in the march). Random frozen, band and
+    far times on a small 2D and 3D grid, thousands of cases."""
+    rng = np.random.default_rng(11 if one else 12)
+    hits = {2: 0, 3: 0}
+    for three in (False, True):
+        ny, nz = 5, (5 if three else 1)
+        sy = (nz + 2) if three else 1
+        sx = (ny + 2) * sy
+        n = 7 * sx
+        V = rng.uniform(0.5, 2.0, n)
+        U = np.zeros(1, dtype=np.uint8)
+        fixed = np.zeros(n // 8 + 1, dtype=np.uint8)
+        ih = np.ones(3 if three else 2)
+        g = sx + 2 * sy + (2 if three else 0)  # row 1; the node checked 1 or 2 rows on
+        d = g + (sx if one else 2 * sx)
+        for _ in range(3000):
+            T = rng.uniform(0.0, 1.0, n)
+            state = rng.random(n)
+            T[state < 0.15] = -np.inf  # far
+            band = (state >= 0.15) & (state < 0.3)
+            T[band] = -T[band]
+            v = rng.uniform(0.0, 2.5)  # the changed time: often after all the others
+            before = T.copy()
+            before[g] = np.nan  # the ghost, never frozen before
+            idx = [np.uint64(i) for i in (d, g, sx, sy)]  # the kernels' index type
+            args = (V, U, False, 0.0, fixed, idx[0], idx[2], idx[3], ih, three)
+            if one:  # a frozen node holds the serial march's time (the march's invariant)
+                before[d] = _parallel._serial_time2(before, *args)
+            after = before.copy()
+            after[g] = v
+            if not _parallel._unread2(after, fixed, idx[0], idx[1], v, one, idx[2], idx[3],
+                                      three):
+                continue
+            hits[3 if three else 2] += 1
+            assert (_parallel._serial_time2(before, *args)
+                    == _parallel._serial_time2(after, *args))
+    assert min(hits.values()) > 100  # the test checks something in 2D and 3D

@@ -1165,6 +1165,8 @@ def _slab_kernels2(three):
                         if not was >= 0.0 and _unread2(T, fixed, d, gj, v, step == sx, sx, sy,
                                                        three):
                             continue
+                        if step != sx and T[d] == -_INF:  # far: no frozen neighbour
+                            continue
                         _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf,
                                  eidx, evals, ebase, pool, nxt, bk, mw, st, rkey, ritem, ctl)
                         x = T[d]
