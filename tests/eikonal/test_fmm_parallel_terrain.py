@@ -31,6 +31,17 @@ def _terrain(nx=48, ny=40, nz=14, seed=3):
     return d / d.max(), (nx - 3, ny - 3, nz - 2), (2, 2, nz - 2)
 
 
+
+def _below_and_at(monkeypatch, threshold, W, goal, start, h):
+    """March ``W`` order 2 from ``goal`` to ``start`` on the slabs with the grid below the
+    ``_tuning`` size ``threshold``, then at it (set to this grid's size): both the serial
+    march's times bit for bit."""
+    serial = fast_marching(W, [goal], spacing=h, order=2, stop_at=[start], threads=1)
+    below = fast_marching_parallel(W, [goal], spacing=h, order=2, stop_at=[start])
+    monkeypatch.setattr(_tuning, threshold, W.size)  # this grid: at it
+    at = fast_marching_parallel(W, [goal], spacing=h, order=2, stop_at=[start])
+    assert np.array_equal(serial, below) and np.array_equal(serial, at)
+
 @pytest.fixture
 def lean(monkeypatch):
     """The lean layout (float32 speeds) of big grids, on a small one."""
@@ -141,11 +152,7 @@ def test_big_3d_grids_cut_the_slabs_for_sharing_bit_for_bit(lean, monkeypatch):
         return seen[-1][1]
 
     monkeypatch.setattr(_parallel, "slab_bounds", spy)
-    serial = fast_marching(W, [goal], spacing=h, order=2, stop_at=[start], threads=1)
-    below = fast_marching_parallel(W, [goal], spacing=h, order=2, stop_at=[start])
-    monkeypatch.setattr(_tuning, "SHARED_CUTS_MIN_NODES_3D", W.size)  # this grid: at it
-    at = fast_marching_parallel(W, [goal], spacing=h, order=2, stop_at=[start])
-    assert np.array_equal(serial, below) and np.array_equal(serial, at)
+    _below_and_at(monkeypatch, "SHARED_CUTS_MIN_NODES_3D", W, goal, start, h)
     (args, cuts_below), (args_at, cuts_at) = seen
     speed, st, shape3, h3, k, threads = args
     assert k == 8 and threads == 2 and shape3 == W.shape
@@ -181,11 +188,7 @@ def test_big_3d_grids_take_their_own_slabs_and_windows_bit_for_bit(lean, monkeyp
         return T, stats
 
     monkeypatch.setattr(_parallel, "march", spy)
-    serial = fast_marching(W, [goal], spacing=h, order=2, stop_at=[start], threads=1)
-    below = fast_marching_parallel(W, [goal], spacing=h, order=2, stop_at=[start])
-    monkeypatch.setattr(_tuning, "BIG_3D_NODES", W.size)  # this grid: at it
-    at = fast_marching_parallel(W, [goal], spacing=h, order=2, stop_at=[start])
-    assert np.array_equal(serial, below) and np.array_equal(serial, at)
+    _below_and_at(monkeypatch, "BIG_3D_NODES", W, goal, start, h)
     small, big = seen
     assert small["slabs"] == 4 and big["slabs"] == 6
     # a window freezes ~its target: a quarter of the target, four times the windows
