@@ -299,6 +299,8 @@ def test_balanced_cuts_of_many_slabs_shorten_the_windows_critical_path(shape, ga
     monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)  # slab counts of 2048^2 and 160^3
     monkeypatch.setattr(_tuning, "WINDOW_NODES", {k: 32768 for k in _tuning.WINDOW_NODES})
     monkeypatch.setattr(_tuning, "DYNAMIC_2D", False)
+    # the cuts as slab_bounds places them (not moved off the source: clear_of_sources)
+    monkeypatch.setattr(_tuning, "SOURCE_CUT_ROWS", {2: 0, 3: 0})
     v, src = fm2_shaped(shape)
     flat, start, shape3 = _start(v, src)
     k = 2 * _tuning.SLABS_PER_THREAD[len(shape), 1]
@@ -1052,3 +1054,50 @@ def test_order_2_skips_only_rechecks_that_would_find_the_same_time(one):
             assert (_parallel._serial_time2(before, *args)
                     == _parallel._serial_time2(after, *args))
     assert min(hits.values()) > 100  # the test checks something in 2D and 3D
+
+
+def test_cuts_keep_clear_of_a_point_source():
+    """``_parallel.clear_of_sources``: an inner cut closer than ``rows`` rows to the source's
+    row (the start box's middle row) moves to the nearer row ``rows`` from it that lies
+    between its neighbours (the lower on a tie), else stays; cuts already clear, a start box
+    over a quarter of the grid and ``rows = 0`` leave the cuts as they are."""
+    from types import SimpleNamespace
+
+    shape3 = (160, 160, 160)
+    cuts = np.arange(0, 161, 20)
+    box = SimpleNamespace(lo=(75, 75, 75), shape=(11, 11, 11))  # rows [75, 86): source at 80
+    assert _parallel.clear_of_sources(cuts, box, shape3, 8).tolist() == [
+        0, 20, 40, 60, 72, 100, 120, 140, 160]  # 80 -> 72 (a tie with 88: down)
+    near = np.array([0, 60, 83, 100, 160])
+    assert _parallel.clear_of_sources(near, box, shape3, 8).tolist() == [0, 60, 88, 100, 160]
+    assert _parallel.clear_of_sources(cuts, box, shape3, 0).tolist() == cuts.tolist()
+    big = SimpleNamespace(lo=(0, 0, 0), shape=(100, 160, 160))
+    assert _parallel.clear_of_sources(cuts, big, shape3, 8).tolist() == cuts.tolist()
+    tight = np.array([0, 72, 80, 88, 160])  # 80 has no room: 72 and 88 are taken
+    assert _parallel.clear_of_sources(tight, box, shape3, 8).tolist() == tight.tolist()
+
+
+def test_a_3d_march_moves_the_cut_off_its_centred_source_bit_for_bit(monkeypatch):
+    """A 3D march from a centred point source marches with its cuts ``SOURCE_CUT_ROWS`` rows
+    clear of the source's row (:func:`~fm2uav.eikonal._parallel.clear_of_sources`), its times the
+    serial march's bit for bit."""
+    v, src = smooth((48, 40, 36))  # the source at the centre
+    monkeypatch.setitem(_tuning.SOURCE_CUT_ROWS, 3, 5)
+    seen = []
+    real = _parallel.clear_of_sources
+
+    def spy(bounds, start, shape3, rows):
+        seen.append((np.array(bounds), real(bounds, start, shape3, rows), start.lo[0],
+                     start.lo[0] + start.shape[0]))
+        return seen[-1][1]
+
+    monkeypatch.setattr(_parallel, "clear_of_sources", spy)
+    for order in (1, 2):
+        serial = fast_marching(v, [src], order=order, threads=1)
+        assert np.array_equal(fast_marching_parallel(v, [src], order=order), serial)
+    assert len(seen) == 2  # both orders marched on slabs
+    for before, after, lo, hi in seen:
+        inner = after[1:-1]
+        mid = (lo + hi) // 2  # the source's row: the box's middle
+        assert mid == src[0] and np.all(np.abs(inner - mid) >= 5)  # every cut clear of it
+        assert not np.array_equal(before, after)  # the even cuts had one through the source

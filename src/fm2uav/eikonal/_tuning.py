@@ -187,3 +187,14 @@ EXCHANGE_ALONE_2D = {1: True, 2: False}
 BIG_3D_NODES = 2**24
 BIG_3D_SLABS_PER_THREAD = {1: 4, 2: 4}
 BIG_3D_WINDOW_NODES = {1: 8192, 2: 4096}
+#: The cuts between slabs keep this many rows from a point source's row (keyed by dimension;
+#: :func:`_parallel.clear_of_sources`): a cut through the source runs along the wave, and the nodes
+#: beside its ghosts are re-opened all the way out. Measured (5 December 2026, session 27, 2
+#: threads, the cut through the centre moved, medians of 5 interleaved in one process): 160^3
+#: smooth speed (source at the centre) order 1, 0 / 4 / 8 rows above / 8 below: 352.2 / 376.6 /
+#: 319.5 / 297.4 ms (1.56x / 1.46x / 1.72x / 1.85x over one thread), 54,663 / 30,029 / 12,631 /
+#: 8,894 nodes re-opened, windows' balance 1.966 / 1.953 / 1.928 / 1.928; order 2, 0 / 4 / 8 rows
+#: above: 1.25x / 1.49x / 1.61x, 58,329 / 36,760 / 14,882 re-opened. 2048^2 smooth: 8 rows changed
+#: nothing (order 2: 66,232 / 67,295 re-opened; the other six cuts re-open as many), 32 rows
+#: 43,184, the wall within the spread: 2D keeps its cuts.
+SOURCE_CUT_ROWS = {2: 0, 3: 8}
