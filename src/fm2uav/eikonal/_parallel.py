@@ -385,11 +385,12 @@ def _note(sent, ns, side, c):
         ns[side] = _U(sent.shape[1]) + _ONE
 
 
-def _slab_kernels(three):
-    """The compiled window, start and exchange of one dimension (``three``: 3D)."""
+def _slab_kernels(three, pairs=False):
+    """The compiled window, start and exchange of one dimension (``three``: 3D); ``pairs``:
+    the 2D window of the interleaved layout only (``sy`` 2, a constant of the kernel)."""
 
-    # closure variables are part of numba's cache key: only ``three`` (a bool) may be
-    # one (a dispatcher's pickle differs per process and would defeat the cache)
+    # closure variables are part of numba's cache key: only ``three`` and ``pairs`` (bools)
+    # may be ones (a dispatcher's pickle differs per process and would defeat the cache)
     def window(T, V, U, qp, fixed, sx, sy, ih, hh, iso, tw, pool, nxt, bk, mw, st, rkey, ritem,
                ctl, sent, ns, far):
         """Freeze the slab's queued nodes with a time below ``tw`` (resumable).
@@ -416,6 +417,8 @@ def _slab_kernels(three):
         hi = n - sx
         lo2 = lo + sx  # the first own row is [lo, lo2), the last [hi2, hi)
         hi2 = hi - sx
+        if pairs:  # the interleaved layout: the y stride a constant (every helper's too)
+            sy = _U(2)
         one = _unit(sy, three)
         use_u = qp > 0.0 and one == _ONE
         kw = _bits(tw)
@@ -544,12 +547,13 @@ def _slab_kernels(three):
     d = 3 if three else 2
     out = []
     for f in (window, start, exchange):
-        f.__name__ = f.__qualname__ = f"{f.__name__}{d}d"
+        f.__name__ = f.__qualname__ = f"{f.__name__}{d}d" + ("_pairs" if pairs else "")
         out.append(njit(cache=True, error_model="numpy", _nrt=False)(f))
     return out
 
 
 _window2d, _start2d, _exchange2d = _slab_kernels(False)
+_window2d_pairs = _slab_kernels(False, True)[0]
 _window3d, _start3d, _exchange3d = _slab_kernels(True)
 
 
@@ -940,9 +944,10 @@ def _room2(st, rkey):
     return _room2_r(st[_NFREE], st[_RSIZE], rkey)
 
 
-def _slab_kernels2(three):
+def _slab_kernels2(three, pairs=False):
     """The compiled order-2 window, start and exchange of one dimension (``three``: 3D);
-    the slab has two ghost x-slabs on each side (the order-2 stencil reads two rows)."""
+    the slab has two ghost x-slabs on each side (the order-2 stencil reads two rows).
+    ``pairs``: the 2D window of the interleaved layout only (``sy`` 2, a constant)."""
 
     def window(T, V, U, qp, fixed, rf, sf, pf, eidx, evals, base, sx, sy, ih, tw, pool, nxt, bk,
                mw, st, rkey, ritem, ctl, sent, ns):
@@ -961,6 +966,8 @@ def _slab_kernels2(three):
         hi = n - g
         lo2 = lo + g  # the first two own rows are [lo, lo2), the last two [hi2, hi)
         hi2 = hi - g
+        if pairs:  # the interleaved layout: the y stride a constant (every helper's too)
+            sy = _U(2)
         one = _unit(sy, three)  # elements a node (2D interleaved: 2)
         sh = one >> _ONE  # node index = element index >> sh: the bits of the masks
         use_u = qp > 0.0 and one == _ONE
@@ -1177,12 +1184,13 @@ def _slab_kernels2(three):
     d = 3 if three else 2
     out = []
     for f in (window, start, exchange):
-        f.__name__ = f.__qualname__ = f"{f.__name__}{d}d_o2"
+        f.__name__ = f.__qualname__ = f"{f.__name__}{d}d_o2" + ("_pairs" if pairs else "")
         out.append(njit(cache=True, error_model="numpy", _nrt=False)(f))
     return out
 
 
 _window2d_o2, _start2d_o2, _exchange2d_o2 = _slab_kernels2(False)
+_window2d_o2_pairs = _slab_kernels2(False, True)[0]
 _window3d_o2, _start3d_o2, _exchange3d_o2 = _slab_kernels2(True)
 
 
@@ -1551,8 +1559,16 @@ def _drive_kernel(three, order=1):
                                 ritem[k], ctl[k], sent[k], ns[k])
                         if three:
                             _window3d_o2(*args)
+                        elif sy == 2:
+                            _window2d_o2_pairs(*args)
                         else:
                             _window2d_o2(*args)
+                    elif not three and sy == 2:
+                        _window2d_pairs(Tp[off[k]:end[k]], Vp[off[k]:end[k]],
+                                        U[0 if U.size == 1 else off[k] >> sh >> 3:], qp,
+                                        fx[off[k] >> sh >> 3:], sx, sy, ih, hh, iso, tw, pool[k],
+                                        nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k],
+                                        sent[k], ns[k], far)
                     else:
                         _window(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]],
                                 U[0 if U.size == 1 else off[k] >> sh >> 3:], qp,
