@@ -1207,7 +1207,7 @@ def setup_threads(threads, nodes):
     return int(min(threads, numba.config.NUMBA_NUM_THREADS))
 
 
-def _buffers(speed, shape3, npad, lean, interleave, *, interleave_3d=False):
+def _buffers(speed, shape3, npad, lean, interleave, *, interleave_3d=False, huge_times=True):
     """The padded ``T`` and ``V`` of a march (see :func:`march`'s ``lean`` and ``interleave``).
 
     Returns ``(Tp, Vp, Tk, Vk, unit, plateau)``: the arrays :func:`pad_grid` fills and
@@ -1222,10 +1222,11 @@ def _buffers(speed, shape3, npad, lean, interleave, *, interleave_3d=False):
     ``interleave_3d`` (the serial march): a 3D map without a plateau (:func:`_plateau`,
     its mask built) marches interleaved too, one with a plateau keeps the mask in separate
     arrays (measured on 160^3 FM²-shaped and smooth: -1.3 to -1.7 %); the slab march's
-    3D kernels take separate arrays (default False).
+    3D kernels take separate arrays (default False). ``huge_times``: the lean layout's
+    times on huge pages (False: small pages, :func:`_map`).
     """
     if lean:  # two plain mappings: V goes as soon as the march is done
-        Tp = _work(8 * npad).view(np.float64)
+        Tp = _work(8 * npad, huge=huge_times).view(np.float64)
         Vp = _work(4 * npad).view(np.float32)
         return Tp, Vp, Tp, Vp, 1, None
     two = shape3[2] == 1
@@ -1355,27 +1356,33 @@ def _stop_bits(stop_cells, start, shape3, npad):
     return bits, len(c)
 
 
-def _work(nbytes):
+def _work(nbytes, huge=True):
     """Uninitialised work memory of ``nbytes`` (uint8 view).
 
     From 4 MiB on, a fresh anonymous mapping advised for transparent huge pages
     (numpy advises its large arrays too, but malloc may hand back recycled
     small pages): the march reads T and V at scattered rows, and with
     4 KiB pages the TLB misses cost ~15 % on 2048^2 (measured 327 -> 382 ms).
+    ``huge=False``: advised against them (:func:`_map`).
     """
     if nbytes < _HUGE_MIN:
         return np.empty(nbytes, dtype=np.uint8)
-    return np.frombuffer(_map(nbytes), dtype=np.uint8)[:nbytes]
+    return np.frombuffer(_map(nbytes, huge), dtype=np.uint8)[:nbytes]
 
 
-def _map(nbytes):
+def _map(nbytes, huge=True):
     """A fresh anonymous mapping of at least ``nbytes`` (whole huge pages), advised for
-    transparent huge pages."""
+    transparent huge pages, or (``huge=False``) against them: small pages, whose first
+    touch on a virtual machine that hands its free memory back to the host can cost far
+    less (the free memory it reports is whole huge pages; recently freed small pages are
+    still backed). Measured on the parallel terrain march's times (336 MB,
+    docs/performance.md "The terrain march's times on small pages")."""
     size = -(-nbytes // _HUGE) * _HUGE
     mm = mmap.mmap(-1, size, flags=mmap.MAP_PRIVATE | mmap.MAP_ANONYMOUS)
-    if hasattr(mmap, "MADV_HUGEPAGE"):
+    advice = "MADV_HUGEPAGE" if huge else "MADV_NOHUGEPAGE"
+    if hasattr(mmap, advice):
         try:
-            mm.madvise(mmap.MADV_HUGEPAGE)
+            mm.madvise(getattr(mmap, advice))
         except OSError:  # THP unavailable: plain pages
             pass
     return mm

@@ -1910,9 +1910,10 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         # the lean layout's buffers are fresh mappings whose page faults (~0.4 CPU-s for
         # the 42 M nodes of a 1000 x 1000 x 40 terrain) the padding takes; map them at
         # their largest size now and fault them in on a second thread while this one
-        # places the cuts (the coarse march: serial), the padding faults in the rest
+        # places the cuts (the coarse march: serial), the padding faults in the rest; the
+        # times on huge pages or not (_tuning.LEAN_TIMES_HUGE)
         early = _kernels._buffers(speed, shape3, (nx + 2 * G * K) * sx + 8 * K, lean,
-                                  interleave)
+                                  interleave, huge_times=_tuning.LEAN_TIMES_HUGE)
     out = None  # the result (not lean)
     if early is not None:
         with _PageToucher(early[0], early[1], top_of=speed) as toucher:

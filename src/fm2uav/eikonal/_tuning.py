@@ -198,3 +198,15 @@ BIG_3D_WINDOW_NODES = {1: 8192, 2: 4096}
 #: nothing (order 2: 66,232 / 67,295 re-opened; the other six cuts re-open as many), 32 rows
 #: 43,184, the wall within the spread: 2D keeps its cuts.
 SOURCE_CUT_ROWS = {2: 0, 3: 8}
+#: Whether the parallel march's lean-layout times (the terrain plan's march: 42 M nodes, 336
+#: MB; :func:`fm2uav.eikonal._kernels._buffers`) are mapped on huge pages, as every other work
+#: buffer. False: small pages. On this virtual machine a fresh huge page's first touch took
+#: ~4.5 ms (the padding's system CPU 0.93-1.0 s for ~210 of them): the free memory it hands
+#: back to the host is whole huge pages, while recently freed small pages are still backed.
+#: Measured (5 December 2026, session 28, ``benchmarks/terrain_stages`` conditions, 2 threads,
+#: the two settings in alternating fresh processes, medians of 3 / 5 in two runs; huge / small):
+#: padding 0.600 / 0.334 s and 0.632 / 0.248 s, march kernel 2.920 / 2.989 s and 2.874 / 2.955
+#: s (the TLB misses), plan 4.437 / 4.202 s and 4.364 / 4.032 s. V too on small pages: plan
+#: 4.408 / 4.277 s (the kernel +0.136 s). The serial march keeps huge pages: on one thread its
+#: kernel lost more (5.712 / 6.193 s) than the padding gained (1.016 / 0.694 s).
+LEAN_TIMES_HUGE = False
