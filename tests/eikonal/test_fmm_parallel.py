@@ -187,7 +187,7 @@ def test_order_2_on_random_fm2_fields_and_thin_slabs_equals_the_serial_march(blo
         monkeypatch.setattr(_tuning, "SLABS_PER_THREAD",
                             {(d, o): per for d in (2, 3) for o in (1, 2)})
         monkeypatch.setattr(_parallel, "slab_bounds",  # equal slabs of ``rows`` rows
-                            lambda speed, start, shape3, h3, k, t=2: np.linspace(
+                            lambda speed, start, shape3, h3, k, t=2, more=0: np.linspace(
                                 0, shape3[0], k + 1).round().astype(np.int64))
         flat, start, shape3 = _start_h(v, src, h)
         T, stats = _parallel.march(flat, start, shape3, h + (1.0,) * (3 - v.ndim), threads,
@@ -324,6 +324,72 @@ def test_balanced_cuts_of_many_slabs_shorten_the_windows_critical_path(shape, ga
         assert_equal_times(serial, T)
         assert turn["reopened"] == balanced["reopened"]  # the same windows, whoever runs them
         assert turn["balance"] > 1.03 * balanced["balance"]
+
+
+def _cost_ratio(flat, start, shape3, k, more):
+    """The coarse march's windows' critical path with ``k`` slabs over that with ``more``
+    (the slabs shared as :func:`_parallel._assign` shares them), computed here."""
+    hist, f = _parallel._coarse_histogram(flat, start, shape3, (1.0,) * 3)
+    cum = np.vstack([np.zeros((1, hist.shape[1]), dtype=np.int64), np.cumsum(hist, axis=0)])
+    gap = max(1, -(-_tuning.MIN_SLAB_ROWS // f))
+    cost = [_parallel._shared_cost(cum, _parallel._place_cuts(cum, m, gap, 2, shape3), 2)
+            for m in (k, more)]
+    return cost[0] / cost[1]
+
+
+@pytest.mark.parametrize("gain", [0.9, 1.0, 1.02, 2.0])
+def test_more_slabs_only_where_the_coarse_march_predicts_the_gain(gain, monkeypatch):
+    """``slab_bounds(..., k, threads, more)`` returns ``more`` slabs exactly where the coarse
+    march's critical path with ``k`` is at least ``MORE_SLABS_GAIN`` times that with
+    ``more``, else the ``k`` slabs it gives without ``more``."""
+    monkeypatch.setattr(_tuning, "MORE_SLABS_GAIN", gain)
+    for v, src in (fm2_shaped((96, 64, 64)), fm2_shaped((96, 48, 48), 1),
+                   smooth((96, 64, 64))):
+        flat, start, shape3 = _start(v, src)
+        ratio = _cost_ratio(flat, start, shape3, 4, 6)
+        cuts = _parallel.slab_bounds(flat, start, shape3, (1.0,) * 3, 4, 2, 6)
+        assert cuts[0] == 0 and cuts[-1] == shape3[0]
+        assert np.all(np.diff(cuts) >= _tuning.MIN_SLAB_ROWS)
+        if ratio >= gain:
+            assert len(cuts) == 7
+        else:
+            assert np.array_equal(cuts, _parallel.slab_bounds(flat, start, shape3,
+                                                              (1.0,) * 3, 4, 2))
+    # fewer asked for than k, or none: k
+    assert len(_parallel.slab_bounds(flat, start, shape3, (1.0,) * 3, 4, 2, 3)) == 5
+
+
+def test_the_bench_s_3d_fields_get_more_slabs_only_off_centre():
+    """The rule on the fields it was measured on (160^3, order 2, two threads): the
+    FM²-shaped one (source at 0.3 of x, 2 slabs a thread balance its windows 1.705) gets
+    :data:`_tuning.MORE_SLABS_3D`'s 3 slabs a thread, the smooth one (source at the centre)
+    keeps 2."""
+    more = 2 * _tuning.MORE_SLABS_3D[2][0]
+    k = 2 * _tuning.SLABS_PER_THREAD[3, 2]
+    got = {}
+    for name, (v, src) in {"fm2": fm2_shaped((160,) * 3), "smooth": smooth((160,) * 3)}.items():
+        flat, start, shape3 = _start(v, src)
+        got[name] = len(_parallel.slab_bounds(flat, start, shape3, (1.0,) * 3, k, 2, more)) - 1
+    assert got == {"fm2": more, "smooth": k}
+
+
+def test_a_3d_order_2_march_on_more_slabs_takes_their_windows_bit_for_bit(monkeypatch):
+    """Where ``slab_bounds`` takes more slabs the march runs them with
+    ``MORE_SLABS_3D``'s windows, and the times are the serial march's bit for bit."""
+    monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)
+    monkeypatch.setattr(_tuning, "ORDER2_MIN_NODES_3D", 0)
+    monkeypatch.setattr(_tuning, "MORE_SLABS_3D", {2: (3, 1000)})
+    v, src = fm2_shaped((96, 64, 64))
+    flat, start, shape3 = _start(v, src)
+    serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 2, np.zeros((0, 3), dtype=int))
+    stats = {}
+    for gain in (0.0, np.inf):  # always more, never
+        monkeypatch.setattr(_tuning, "MORE_SLABS_GAIN", gain)
+        T, stats[gain] = _parallel.march(flat, start, shape3, (1.0,) * 3, 2, order=2)
+        assert_equal_times(serial, T, exact=True)
+    assert stats[0.0]["slabs"] == 6 and stats[np.inf]["slabs"] == 4
+    # windows of 1000 nodes against 8192: several times as many
+    assert stats[0.0]["windows"] > 4 * stats[np.inf]["windows"]
 
 
 def _fixed_split(work, nth):

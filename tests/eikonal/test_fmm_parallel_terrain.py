@@ -154,7 +154,8 @@ def test_big_3d_grids_cut_the_slabs_for_sharing_bit_for_bit(lean, monkeypatch):
     monkeypatch.setattr(_parallel, "slab_bounds", spy)
     _below_and_at(monkeypatch, "SHARED_CUTS_MIN_NODES_3D", W, goal, start, h)
     (args, cuts_below), (args_at, cuts_at) = seen
-    speed, st, shape3, h3, k, threads = args
+    speed, st, shape3, h3, k, threads, more = args
+    assert more < k  # more slabs only where asked for more than k
     assert k == 8 and threads == 2 and shape3 == W.shape
     monkeypatch.setitem(_tuning.SHARED_CUTS, 3, False)
     fixed = real(*args)  # the interleave's cuts
@@ -179,6 +180,7 @@ def test_big_3d_grids_take_their_own_slabs_and_windows_bit_for_bit(lean, monkeyp
     monkeypatch.setitem(_tuning.WINDOW_NODES, (3, 2), 4000)
     monkeypatch.setitem(_tuning.BIG_3D_SLABS_PER_THREAD, 2, 3)
     monkeypatch.setitem(_tuning.BIG_3D_WINDOW_NODES, 2, 1000)
+    monkeypatch.setattr(_tuning, "MORE_SLABS_3D", {})  # the slabs asked for, no more
     seen = []
     real = _parallel.march
 

@@ -1645,9 +1645,23 @@ def clear_of_sources(bounds, start, shape3, rows: int) -> np.ndarray:
     return out
 
 
-def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarray:
+def _slab_count(most: int, shape3, G: int, nth: int) -> int:
+    """Slabs of a march on ``nth`` threads asking for ``most``: fewer where a slab would get
+    fewer than :data:`_tuning.MIN_SLAB_ROWS` rows or :data:`_tuning.MIN_SLAB_NODES` nodes
+    (but every thread one) or be thinner than its ``G`` ghost rows."""
+    nx, ny, nz = (int(n) for n in shape3)
+    K = int(max(1, min(most, nx // _tuning.MIN_SLAB_ROWS,
+                       max(nth, nx * ny * nz // max(_tuning.MIN_SLAB_NODES, 1)))))
+    return max(1, min(K, nx // G))
+
+
+def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2,
+                more: int = 0) -> np.ndarray:
     """Row bounds (``k + 1`` ints) of ``k`` slabs along x, slab ``j`` marched by thread
-    ``j % threads``.
+    ``j % threads``; or of ``more`` slabs (``more + 1`` ints) where the coarse march
+    predicts for them a windows' critical path shorter by the factor
+    :data:`_tuning.MORE_SLABS_GAIN` (both with the slabs shared as :func:`_assign` shares
+    them, :func:`_shared_cost`).
 
     The cuts are placed where a coarse march predicts the best balance: they minimise
     ``sum over time bins of max over threads of the nodes it marches in that bin``, the
@@ -1677,6 +1691,27 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarra
     if rows < k * gap:
         return even
     cum = np.vstack([np.zeros((1, hist.shape[1]), dtype=np.int64), np.cumsum(hist, axis=0)])
+    cuts = _place_cuts(cum, k, gap, threads, shape3)
+    if more > k and rows >= more * gap:
+        alt = _place_cuts(cum, more, gap, threads, shape3)
+        if _shared_cost(cum, cuts, threads) >= (_tuning.MORE_SLABS_GAIN
+                                                * _shared_cost(cum, alt, threads)):
+            cuts, k = alt, more
+            even = np.linspace(0, nx, k + 1).round().astype(np.int64)
+    bounds = np.minimum(cuts * f, nx)
+    bounds[-1] = nx
+    least = _tuning.MIN_SLAB_ROWS
+    for i in range(1, k):  # fine rows: at least MIN_SLAB_ROWS per slab where they fit
+        bounds[i] = min(max(bounds[i], bounds[i - 1] + least), nx - (k - i) * least)
+    if np.any(np.diff(bounds) < 1):
+        return even
+    return bounds.astype(np.int64)
+
+
+def _place_cuts(cum, k, gap, threads, shape3):
+    """The ``k + 1`` coarse rows of :func:`slab_bounds`' cuts over the cumulated coarse
+    histogram ``cum`` (at least ``gap`` rows apart): the descents from equal slabs."""
+    rows = cum.shape[0] - 1
     cuts = np.clip(np.linspace(0, rows, k + 1).round().astype(np.int64), 0, rows)
     fixed = _descend_cuts(cum, cuts.copy(), gap, threads, False)
     three = shape3[2] > 1
@@ -1688,14 +1723,7 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2) -> np.ndarra
             cuts = fixed
     else:
         cuts = fixed
-    bounds = np.minimum(cuts * f, nx)
-    bounds[-1] = nx
-    least = _tuning.MIN_SLAB_ROWS
-    for i in range(1, k):  # fine rows: at least MIN_SLAB_ROWS per slab where they fit
-        bounds[i] = min(max(bounds[i], bounds[i - 1] + least), nx - (k - i) * least)
-    if np.any(np.diff(bounds) < 1):
-        return even
-    return bounds.astype(np.int64)
+    return cuts
 
 
 @njit(cache=True, error_model="numpy")
@@ -1897,14 +1925,20 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     big = three and nx * ny * nz >= _tuning.BIG_3D_NODES
     spt = (_tuning.BIG_3D_SLABS_PER_THREAD[order] if big
            else _tuning.SLABS_PER_THREAD[3 if three else 2, order])
-    K = int(max(1, min(nth * spt, nx // _tuning.MIN_SLAB_ROWS,
-                       max(nth, nx * ny * nz // max(_tuning.MIN_SLAB_NODES, 1)))))
     G = 2 if order == 2 else 1  # ghost x-slabs on each side (the rows the stencil reads)
-    K = max(1, min(K, nx // G))  # a slab at least as thick as its ghosts
+    K = _slab_count(nth * spt, shape3, G, nth)
+    wn = (_tuning.BIG_3D_WINDOW_NODES[order] if big
+          else _tuning.WINDOW_NODES[3 if three else 2, order])
     nth = min(nth, K)
     sx = (ny + 2) * (nz + 2) if three else ny + 2
     sy = nz + 2 if three else 1
     lean = (nx + 2) * sx > _kernels.LEAN_NODES  # V in float32 as the serial march
+    # more slabs where the coarse march predicts a better balance (slab_bounds decides;
+    # not in the lean layout, whose buffers are sized for K before the cuts)
+    more, more_wn = 0, wn
+    if three and not big and not lean and nth > 1 and order in _tuning.MORE_SLABS_3D:
+        spt2, more_wn = _tuning.MORE_SLABS_3D[order]
+        more = _slab_count(nth * spt2, shape3, G, nth)
     early = toucher = None
     if lean and nth > 1:
         # the lean layout's buffers are fresh mappings whose page faults (~0.4 CPU-s for
@@ -1917,7 +1951,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     out = None  # the result (not lean)
     if early is not None:
         with _PageToucher(early[0], early[1], top_of=speed) as toucher:
-            bounds = slab_bounds(speed, start, shape3, h3, K, nth)
+            bounds = slab_bounds(speed, start, shape3, h3, K, nth, more)
     elif nth > 1:
         # the cuts' coarse march runs on this thread alone: meanwhile a second one finds the
         # top speed and faults in the result's pages (a fresh array's; a pooled one's are
@@ -1925,9 +1959,11 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         out = _kernels.result_array(nx * ny * nz)
         half = out.size // 2
         with _PageToucher(out[half:], out[:half], top_of=speed) as toucher:
-            bounds = slab_bounds(speed, start, shape3, h3, K, nth)
+            bounds = slab_bounds(speed, start, shape3, h3, K, nth, more)
     else:
-        bounds = slab_bounds(speed, start, shape3, h3, K, nth)
+        bounds = slab_bounds(speed, start, shape3, h3, K, nth, more)
+    if bounds.size - 1 != K:  # the more slabs taken, with their windows
+        K, wn = bounds.size - 1, more_wn
     bounds = clear_of_sources(bounds, start, shape3,
                               _tuning.SOURCE_CUT_ROWS[3 if three else 2])
     if np.diff(bounds).min() < G:  # only the neighbours' rows are exchanged
@@ -2016,8 +2052,6 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         vmax = _top_speed(_kernels._readonly(speed))
     width = 2.0 * min(h3[:3 if three else 2]) / max(vmax, 1e-300)
     win = np.zeros(_W_SIZE + (_P_THREADS + 3 * nth if PROFILE else 0))
-    wn = (_tuning.BIG_3D_WINDOW_NODES[order] if big
-          else _tuning.WINDOW_NODES[3 if three else 2, order])
     win[:_W_SIZE] = [0.0, width, 0.0, float(wn), 0.0, 0.0, np.inf, 0.0, 0.0, 0.0]
     stop_idx = np.zeros(0, dtype=np.int64)
     if stop_cells is not None and len(stop_cells):

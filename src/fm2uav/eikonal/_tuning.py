@@ -210,3 +210,16 @@ SOURCE_CUT_ROWS = {2: 0, 3: 8}
 #: 4.408 / 4.277 s (the kernel +0.136 s). The serial march keeps huge pages: on one thread its
 #: kernel lost more (5.712 / 6.193 s) than the padding gained (1.016 / 0.694 s).
 LEAN_TIMES_HUGE = False
+#: 3D grids below :data:`BIG_3D_NODES`, keyed by order: (slabs per thread, window nodes) taken
+#: instead of :data:`SLABS_PER_THREAD` and :data:`WINDOW_NODES` where the coarse march of
+#: :func:`_parallel.slab_bounds` predicts for them a windows' critical path shorter by the
+#: factor :data:`MORE_SLABS_GAIN` (the slabs shared as :func:`_parallel._assign` shares them).
+#: A source off-centre leaves 2 slabs per thread unbalanced; thinner slabs re-open more nodes,
+#: which pays only there. Measured (5 December 2026, session 28, 160^3, 2 threads, the settings
+#: interleaved in one process, medians of 5; two threads over one, 2 : 8192 / 3 : 4096):
+#: FM²-shaped seeds 0 / 1 / 2 1.50x / 1.61x, 1.48x / 1.57x, 1.47x / 1.56x (windows' balance
+#: 1.705 / 1.885, 1.699 / 1.854, 1.605 / 1.881), the coarse march's prediction 1.681 / 1.819,
+#: 1.678 / 1.801, 1.593 / 1.818 (+7 to +14 %); smooth speed (centred source) 1.76x / 1.70x,
+#: constant 1.68x / 1.55x, predicted +0.2 % and -0.4 %. Order 1 (1.84-1.98x) keeps its slabs.
+MORE_SLABS_3D = {2: (3, 4096)}
+MORE_SLABS_GAIN = 1.05
