@@ -95,11 +95,29 @@ def _seconds(x) -> str:
     return f"{x * 1e3:.3g} ms" if x < 0.1 else f"{fmt(x)} s"
 
 
+def cpu_model() -> str:
+    """The processor's model name (``/proc/cpuinfo``; else ``platform.processor()``, maybe
+    empty): ratios against the peers move with it (session 28: 13-33 % between an AMD EPYC
+    and an Intel Xeon host)."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor()
+
+
+def _cpu(m: dict) -> str:
+    """`` (the CPU model)`` for a run's header, empty when the report has none."""
+    return f" ({m['cpu']})" if m.get("cpu") else ""
+
+
 def markdown_table(rows: list[dict], report: dict) -> str:
     """The whole run as one markdown table, with the machine and its load."""
     m = report["machine"]
     lines = [
-        f"Run of {m['date']}: Python {m['python']}, {m['cpus']} CPUs, load average "
+        f"Run of {m['date']}: Python {m['python']}, {m['cpus']} CPUs{_cpu(m)}, load average "
         f"{m['load_before']:.1f} before / {m['load_after']:.1f} after the run "
         f"({'machine otherwise idle' if max(m['load_before'], m['load_after']) < 1.5 else 'machine shared with other jobs: wall times are inflated'}).",
         "",
@@ -126,7 +144,7 @@ def _span(values: list[float]) -> str:
 def summary(rows: list[dict], report: dict) -> str:
     """The README's performance paragraph, from the rows of a full run."""
     m = report["machine"]
-    parts = [f"`make bench` of {m['date']} on this {m['cpus']}-core machine (load average "
+    parts = [f"`make bench` of {m['date']} on this {m['cpus']}-core machine{_cpu(m)} (load average "
              f"{max(m['load_before'], m['load_after']):.1f}; table and method in "
              "`docs/performance.md`):"]
     fmm = [r for r in rows if r["benchmark"] == "fmm" and r.get("ratio")
@@ -207,7 +225,8 @@ def main(argv: list[str] | None = None) -> int:
     args.out.parent.mkdir(parents=True, exist_ok=True)
     report = {
         "machine": {"python": sys.version.split()[0], "platform": platform.platform(),
-                    "processor": platform.processor(), "cpus": os.cpu_count(),
+                    "processor": platform.processor(), "cpu": cpu_model(),
+                    "cpus": os.cpu_count(),
                     "date": datetime.date.today().isoformat(),
                     "load_before": load_before, "load_after": os.getloadavg()[0]},
         "quick": args.quick,

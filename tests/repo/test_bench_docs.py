@@ -58,6 +58,7 @@ def test_write_docs_replaces_the_blocks_only(tmp_path):
     assert "takes 11 s" in readme and "every later one 1.5 s" in readme
     assert ("`fm2uav --help` answers in 0.21 s, `fm2uav plan --bogus` in 0.26 s (warm, CPU "
             "0.19/0.24 s)") in readme
+    assert "2 CPUs, load average" in table and "2-core machine (load" in readme  # no model
     assert "| cli | `fm2uav --help` | 0.21 s | one-command typer app (framework floor) |" in table
 
     # the prose around the blocks is kept, and a second run gives the same pages
@@ -86,3 +87,20 @@ def test_fm2_shaped_field_is_an_fm2_map():
     assert abs(src[0] / 120 - 0.3) < 0.15 and abs(src[1] / 90 - 0.6) < 0.15  # off-centre
     phi, v = fields.skfmm_point_source(W, src)
     assert phi.mask.sum() == walls.sum() and (v > 0).all()
+
+
+def test_the_run_names_the_cpu_model(tmp_path):
+    """The header and the README's sentence name the processor: the peers' ratios move with
+    it. The model read here is the machine's own (``/proc/cpuinfo`` on Linux)."""
+    (tmp_path / "docs").mkdir()
+    for page in PAGES.values():
+        shutil.copy(page, tmp_path / page.relative_to(ROOT))
+    model = bench.cpu_model()
+    assert isinstance(model, str)
+    if Path("/proc/cpuinfo").exists():
+        assert model and model in Path("/proc/cpuinfo").read_text()
+    report = {"machine": dict(REPORT["machine"], cpu="Test CPU 9000")}
+    bench.write_docs(ROWS, report, root=tmp_path)
+    table = (tmp_path / "docs" / "performance.md").read_text()
+    assert "2 CPUs (Test CPU 9000), load average" in table
+    assert "2-core machine (Test CPU 9000) (load" in (tmp_path / "README.md").read_text()
