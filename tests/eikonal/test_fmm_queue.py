@@ -40,12 +40,13 @@ def test_checkerboard_sources_overflow_the_initial_pool(grow_calls, order):
     # axes, so its update is the two-axis one from T1 = T2 = 0:
     # 2 T^2 = (h/v)^2 -> T = 1 / (2 sqrt 2); order 2 cannot apply (the nodes two
     # steps away are not frozen before it). The band holds half the grid,
-    # far more than the initial pool (1/16 of the nodes): the march must grow
-    # the pool and resume.
-    n = 600
+    # far more than the initial pool (1/16 of the nodes, at least two reserves
+    # of RESERVE_BLOCKS): the march must grow the pool and resume.
+    n = 1100
+    assert n * n // 2 > 2 * 2 * _kernels.RESERVE_BLOCKS * _kernels.BLOCK  # two doublings
     i, j = np.indices((n, n))
     src = np.argwhere((i + j) % 2 == 0)
-    T = fast_marching(np.full((n, n), 2.0), src, order=order)
+    T = fast_marching(np.full((n, n), 2.0), src, order=order, threads=1)  # the serial queue
     expected = np.where((i + j) % 2 == 0, 0.0, 1.0 / (2.0 * math.sqrt(2.0)))
     assert_same_field(T, expected, RTOL)
     assert len(grow_calls) >= 2
@@ -136,8 +137,8 @@ def _drain(ahead, T, V, nodes, seed, s1, s2, steps):
     nblk = 8 * nodes.size // _kernels.BLOCK + 2 * _kernels.RESERVE_BLOCKS
     pool = np.empty(2 * nblk * _kernels.BLOCK, dtype=np.uint64)
     nxt = np.empty(nblk, dtype=np.uint32)
-    bk = np.empty(2 * 258, dtype=np.uint32)
-    mw = np.empty(5, dtype=np.uint64)
+    bk = np.empty(2 * int(_kernels._NB), dtype=np.uint32)
+    mw = np.empty(_kernels._NW, dtype=np.uint64)
     st = np.zeros(_kernels.ST_SIZE, dtype=np.uint64)
     _kernels.init_queue(nxt, bk, mw, st)
     nfree, fh, cur, last = np.uint64(st[2]), np.uint64(st[3]), np.uint64(st[4]), np.uint64(0)

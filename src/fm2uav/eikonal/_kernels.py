@@ -14,10 +14,10 @@ Layout of the march (see docs/performance.md for the measurements behind it)
   ``T >= 0`` frozen (final time), ``-t`` narrow band with tentative time ``t``,
   ``-inf`` far, ``NaN`` impassable (speed 0) or ghost. ``T >= 0`` and
   ``T < 0`` are false for NaN, so walls and ghosts need no separate test.
-* **Monotone radix queue** (Ahuja et al. 1990, with 4-bit digits): FMM pops
+* **Monotone radix queue** (Ahuja et al. 1990, with 8-bit digits): FMM pops
   non-decreasing keys, and for non-negative IEEE doubles the order of the bit
   patterns is the order of the values. A key goes into the bucket given by the
-  highest 4-bit digit in which it differs from ``last`` (a lower bound of
+  highest 8-bit digit in which it differs from ``last`` (a lower bound of
   every key in the queue) and that digit's value; buckets are ordered, so the
   smallest key is in the lowest non-empty bucket. A level-0 bucket holds one
   key value (``last`` itself has a level-0 bucket of its own), so its last
@@ -127,13 +127,19 @@ _CALL = dict(cache=True, error_model="numpy", _nrt=False)
 _U = np.uint64
 _ZERO = _U(0)
 _ONE = _U(1)
-#: Queue geometry: 4-bit digits; bucket 0 for keys below ``last`` (rounding),
-#: then 16 levels of 16 buckets, one sentinel bucket.
-_DIGIT = _U(4)
-_NVAL = _U(16)
-_NOB = _U(257)  # sentinel "no bucket"
-_NB = _U(258)
-_NW = 5  # 64-bit words of the bucket occupancy mask
+#: Queue geometry: 8-bit digits; bucket 0 for keys below ``last`` (rounding),
+#: then 8 levels of 256 buckets, one sentinel bucket. Against 4-bit digits (16
+#: levels of 16), a split sorts its entries 8 bits down at once, so an entry is
+#: moved by fewer splits: the one-thread march 4-8 % faster on 2048^2 and 160^3
+#: (docs/performance.md, "The radix queue's digits"); the windows of the parallel
+#: march, whose queues hold a slab's band only, gain ~0-3 %.
+_DIGIT = _U(8)
+_NVAL = _U(1) << _DIGIT
+_NOB = _U(64) // _DIGIT * _NVAL + _ONE  # sentinel "no bucket"
+_NB = _NOB + _ONE
+_NW = (int(_NB) + 63) // 64  # 64-bit words of the bucket occupancy mask
+_LOW = _NVAL - _ONE  # a digit's bits
+_LEV = _U(int(_DIGIT).bit_length() - 1)  # bit index >> _LEV = the bit's level
 #: Slots per block of the entry pool.
 BLOCK = 64
 _BS = _U(BLOCK)
@@ -145,7 +151,7 @@ _NIL = _U(0xFFFFFFFF)
 _KEYMAX = _U(0x7FFFFFFFFFFFFFFF)
 #: Free blocks the march keeps in reserve: one split may open a head block in
 #: every bucket, and one pop pushes at most 6 entries.
-RESERVE_BLOCKS = 258 + 8
+RESERVE_BLOCKS = int(_NB) + 8
 #: Largest padded grid the uint32 node indices of the queue can address.
 MAX_NODES = 2**32 - 2
 #: The plateau mask of a march without one (see :func:`_plateau`).
@@ -187,51 +193,51 @@ def _prefetch(typingctx, arr, idx):
 # ----------------------------------------------------------------------- queue
 # pool[2 s] = key bits, pool[2 s + 1] = node, slot s = block * BLOCK + i
 # nxt[b] = next block after block b in its bucket's list, or in the free list
-# bk[b] = head block of bucket b (_NIL: empty); bk[_NB + b] = entries in that head
-#   block (the other blocks of a bucket are full)
+# bk[2 b] = head block of bucket b (_NIL: empty); bk[2 b + 1] = entries in that head
+#   block (the other blocks of a bucket are full); side by side, one line per push
 # mw[w] = occupancy bits of buckets 64 w .. 64 w + 63
 
 @njit(**_OPT)
 def _bucket(k, last):
     """Bucket of key bits ``k`` relative to ``last``.
 
-    ``1 + 16 * level + digit value`` of the highest 4-bit digit in which ``k``
+    ``1 + 256 * level + digit value`` of the highest 8-bit digit in which ``k``
     differs from ``last``; ``k == last`` goes to level 0 under ``last``'s own
     lowest digit (which no larger key of level 0 has), so every level-0 bucket
     holds a single key value. Keys below ``last`` (rounding) go to bucket 0.
     """
     if k <= last:
-        return _ONE + (last & _U(15)) if k == last else _ZERO
-    lev = (_U(63) - leading_zeros(k ^ last)) >> _U(2)
-    return _ONE + lev * _NVAL + ((k >> (lev * _DIGIT)) & _U(15))
+        return _ONE + (last & _LOW) if k == last else _ZERO
+    lev = (_U(63) - leading_zeros(k ^ last)) >> _LEV
+    return _ONE + lev * _NVAL + ((k >> (lev * _DIGIT)) & _LOW)
 
 
 @njit(**_OPT)
 def _push(b, k, c, pool, nxt, bk, mw, nfree, fh, cur):
     """Add the entry (key bits ``k``, node ``c``) to bucket ``b``."""
-    cnt = bk[_NB + b]
+    cnt = bk[b + b + _ONE]
     if cnt == _BS:  # head block full (or bucket empty): take a free block
         nb = fh
         fh = _U(nxt[nb])
         nfree -= _ONE
-        nxt[nb] = bk[b]
-        bk[b] = nb
+        nxt[nb] = bk[b + b]
+        bk[b + b] = nb
         cnt = _ZERO
         mw[b >> _U(6)] |= _ONE << (b & _U(63))
         if b < cur:
             cur = b
-    slot = _U(bk[b]) * _BS + cnt
+    slot = _U(bk[b + b]) * _BS + cnt
     pool[slot + slot] = k
     pool[slot + slot + _ONE] = c
-    bk[_NB + b] = cnt + _ONE
+    bk[b + b + _ONE] = cnt + _ONE
     return nfree, fh, cur
 
 
 @njit(**_OPT)
 def _remove(p, b, pool, nxt, bk, mw, nfree, fh):
     """Remove slot ``p`` of bucket ``b``: the head block's last entry fills the hole."""
-    hb = _U(bk[b])
-    cnt = _U(bk[_NB + b])
+    hb = _U(bk[b + b])
+    cnt = _U(bk[b + b + _ONE])
     q = hb * _BS + cnt - _ONE
     pool[p + p] = pool[q + q]
     pool[p + p + _ONE] = pool[q + q + _ONE]
@@ -240,12 +246,12 @@ def _remove(p, b, pool, nxt, bk, mw, nfree, fh):
         nxt[hb] = fh
         fh = hb
         nfree += _ONE
-        bk[b] = nx
-        bk[_NB + b] = _BS
+        bk[b + b] = nx
+        bk[b + b + _ONE] = _BS
         if nx == _NIL:
             mw[b >> _U(6)] &= ~(_ONE << (b & _U(63)))
     else:
-        bk[_NB + b] = cnt - _ONE
+        bk[b + b + _ONE] = cnt - _ONE
     return nfree, fh
 
 
@@ -298,15 +304,15 @@ def _pop_ahead(T, V, pool, nxt, bk, mw, nfree, fh, cur, last, s1, s2, pv):
     and these lines are cold. The queue and the popped nodes are those of :func:`_pop`.
     """
     while True:
-        if bk[cur] == _NIL:  # also for the sentinel cur == _NOB
-            w = 0
-            while w < _NW and mw[w] == _ZERO:
-                w += 1
-            if w == _NW:
+        if bk[cur + cur] == _NIL:  # also for the sentinel cur == _NOB
+            w = _ZERO if cur == _NOB else cur >> _U(6)
+            while w < _U(_NW) and mw[w] == _ZERO:
+                w += _ONE
+            if w == _U(_NW):
                 return _NIL, nfree, fh, _NOB, last
             cur = _U(w) * _U(64) + trailing_zeros(mw[w])
-        hb = _U(bk[cur])
-        cnt = _U(bk[_NB + cur])
+        hb = _U(bk[cur + cur])
+        cnt = _U(bk[cur + cur + _ONE])
         if cur - _ONE < _NVAL:  # level 0: one key value, take the last entry (LIFO)
             bp = hb * _BS + cnt - _ONE
             c = pool[bp + bp + _ONE]
@@ -333,7 +339,7 @@ def _pop_ahead(T, V, pool, nxt, bk, mw, nfree, fh, cur, last, s1, s2, pv):
                 base = hb * _BS
                 m2 = _KEYMAX
                 p2 = bp
-                for p in range(base, base + _U(bk[_NB + cur])):
+                for p in range(base, base + _U(bk[cur + cur + _ONE])):
                     kk = pool[p + p]
                     if kk < m2 and p != bp:
                         m2 = kk
@@ -350,8 +356,8 @@ def _pop_ahead(T, V, pool, nxt, bk, mw, nfree, fh, cur, last, s1, s2, pv):
         hsh = (lev + _ONE) * _DIGIT
         hi = _ZERO if hsh >= _U(64) else (last >> hsh) << hsh
         last = hi | (dig << (lev * _DIGIT))
-        bk[cur] = _NIL
-        bk[_NB + cur] = _BS
+        bk[cur + cur] = _NIL
+        bk[cur + cur + _ONE] = _BS
         mw[cur >> _U(6)] &= ~(_ONE << (cur & _U(63)))
         cur = _NOB
         b = hb
@@ -398,8 +404,8 @@ def init_queue(nxt, bk, mw, st):
         nxt[b] = b + 1
     nxt[nblk - 1] = _NIL
     for b in range(_NB):
-        bk[b] = _NIL
-        bk[_NB + _U(b)] = _BS
+        bk[b + b] = _NIL
+        bk[_U(b) + _U(b) + _ONE] = _BS
     for w in range(_NW):
         mw[w] = _ZERO
     st[_PHASE] = 0
