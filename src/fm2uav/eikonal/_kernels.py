@@ -130,9 +130,10 @@ _ONE = _U(1)
 #: Queue geometry: 8-bit digits; bucket 0 for keys below ``last`` (rounding),
 #: then 8 levels of 256 buckets, one sentinel bucket. Against 4-bit digits (16
 #: levels of 16), a split sorts its entries 8 bits down at once, so an entry is
-#: moved by fewer splits: the one-thread march 4-8 % faster on 2048^2 and 160^3
-#: (docs/performance.md, "The radix queue's digits"); the windows of the parallel
-#: march, whose queues hold a slab's band only, gain ~0-3 %.
+#: moved by fewer splits: the one-thread march 4.5-12 % faster on 2048^2 and 160^3,
+#: the two-thread march 1-8 % (its windows' queues hold a slab's band only; see
+#: docs/performance.md, "The radix queue's digits"). _DIGIT must divide 64 and be
+#: a power of two (_LEV).
 _DIGIT = _U(8)
 _NVAL = _U(1) << _DIGIT
 _NOB = _U(64) // _DIGIT * _NVAL + _ONE  # sentinel "no bucket"
