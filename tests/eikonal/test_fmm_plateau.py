@@ -20,8 +20,8 @@ def paths(monkeypatch):
     used = []
     original = _kernels._plateau
 
-    def spy(*args):
-        U, qp = original(*args)
+    def spy(*args, **kwargs):
+        U, qp = original(*args, **kwargs)
         used.append("none" if qp == 0.0 else "uniform" if U.size == 1 else "mask")
         return U, qp
 
@@ -42,7 +42,7 @@ def separate(monkeypatch):
 def _without_plateau(fn):
     """``fn()`` with the plateau switched off (every speed read from the grid)."""
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(_kernels, "_plateau", lambda *args: (_kernels._NO_BITS, 0.0))
+        mp.setattr(_kernels, "_plateau", lambda *args, **kwargs: (_kernels._NO_BITS, 0.0))
         return fn()
 
 

@@ -66,8 +66,14 @@ def test_parallel_scan_answers_as_the_serial_scan(nth):
                 v[bad_at] = bad
                 v[min(bad_at + 7, n - 1)] = -3.0  # a second bad value later: not reported
             ro = _kernels._readonly(v)
-            assert _kernels.scan_speed_parallel(nth, ro, MIN_SPEED) == \
-                _kernels.scan_speed(ro, MIN_SPEED), (bad_at, bad)
+            answer = _kernels.scan_speed(ro, MIN_SPEED)
+            assert _kernels.scan_speed_parallel(nth, ro, MIN_SPEED) == answer, (bad_at, bad)
+            if bad_at is None:  # the speeds' span with it (speed_range's, bit for bit)
+                assert answer == (-1, int(((v > 0) & (v < MIN_SPEED)).sum()),
+                                  *_kernels.speed_range(ro))
+                assert answer[2:] == (v[v > 0].min(), v.max())
+            else:
+                assert answer[0] == bad_at
 
 
 def test_fast_marching_names_the_same_bad_node_on_two_threads(monkeypatch):
@@ -88,3 +94,95 @@ def test_fast_marching_names_the_same_bad_node_on_two_threads(monkeypatch):
     b = fast_marching(v, [(0, 0, 0)], order=1, threads=2)
     np.testing.assert_array_equal(a, b)
     assert np.isfinite(a[20, 0, 0])
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+@pytest.mark.parametrize("field", ["uniform", "plateau", "tiny"])
+def test_the_input_scan_spares_the_march_its_passes_over_the_speeds(monkeypatch, field,
+                                                                    threads):
+    """``fast_marching`` hands its input scan's speed span to the march: the plateau test
+    and the parallel march's first window take no pass of their own over the speeds, a
+    pooled result's resident pages no toucher thread, and the times are those of a march
+    that finds the span itself, bit for bit."""
+    from fm2uav.eikonal import _parallel, _tuning, fmm
+
+    monkeypatch.setattr(_tuning, "PARALLEL_MIN_NODES", 0)
+    monkeypatch.setattr(_tuning, "ORDER2_MIN_NODES_2D", 0)
+    rng = np.random.default_rng(3)
+    v = np.full((90, 70), 2.0)
+    if field == "plateau":  # the top speed on most nodes, a slow wall: the mask is built
+        v[rng.random(v.shape) < 0.3] = 1.25
+        v[40:43, 10:60] = 0.0
+    elif field == "tiny":  # speeds under the floor raised to it: the span follows
+        v = rng.random(v.shape) + 0.5
+        v[:, 30] = 1e-200
+    flat, span = fmm._as_speed_span(v)
+    assert span == _kernels.speed_range(flat.reshape(-1))
+    src = [(5, 6)]
+    shape3 = (90, 70, 1)
+    expect = {}
+    for order in (1, 2):  # the march finding the span itself
+        start = fmm._source_start(flat, np.array([[5, 6, 0]]), shape3, (1.0,) * 3, 4.0, 2.0)
+        expect[order] = fmm.run_march(flat.reshape(-1), start, (90, 70), (1.0,) * 3, order,
+                                      None, threads=threads)
+
+    def forbidding(f):  # the grid's speeds (the cuts' coarse march scans its own)
+        def check(speed):
+            assert speed.size != v.size, "a pass over the speeds the input scan made already"
+            return f(speed)
+        return check
+
+    monkeypatch.setattr(_kernels, "speed_range", forbidding(_kernels.speed_range))
+    monkeypatch.setattr(_parallel, "_top_speed", forbidding(_parallel._top_speed))
+    monkeypatch.setattr(fmm, "SOURCE_INIT_FRACTION", 0.0)  # the ball of 4 cells above
+    monkeypatch.setattr(fmm, "SOURCE_INIT_CELLS", 4.0)
+    for order in (1, 2):
+        T = fast_marching(v, src, order=order, threads=threads)
+        np.testing.assert_array_equal(T, expect[order])
+
+
+def test_a_pooled_result_takes_no_page_toucher_thread(monkeypatch):
+    """The parallel march starts a thread to fault in a fresh result's pages beside the cuts'
+    coarse march; a result from the pool has its pages (and the scan gave the top speed):
+    no thread, the same times."""
+    from fm2uav.eikonal import _parallel
+
+    made = []
+
+    class Spy(_parallel._PageToucher):
+        def __init__(self, *arrays, top_of=None):
+            made.append((len(arrays), top_of is not None))
+            super().__init__(*arrays, top_of=top_of)
+
+    monkeypatch.setattr(_parallel, "_PageToucher", Spy)
+    v = np.ones((1100, 1000))  # 8.8 MB of times: from the pool
+    v[500:520, 100:900] = 0.0
+    a = fast_marching(v, [(3, 4)], order=1, threads=2).copy()  # its mapping back to the pool
+    made.clear()
+    b = fast_marching(v, [(3, 4)], order=1, threads=2)  # in a's pages
+    np.testing.assert_array_equal(b, a)
+    assert made == []
+    made.clear()
+    monkeypatch.setattr(_kernels, "pooled_result_array",  # a fresh array: its pages faulted
+                        lambda n: (np.empty(n), False))   # beside the cuts
+    c = fast_marching(v, [(3, 4)], order=1, threads=2)
+    np.testing.assert_array_equal(c, a)
+    assert made == [(2, False)]  # the top speed from the scan
+
+
+@pytest.mark.parametrize("values", [
+    [], [0.0], [-0.0, 0.0], [0.0, 3.0, -0.0, 2.5], [5e-324, 1.0], [1e-200, 1e300, 7.0],
+    [2.0] * 9, [np.nextafter(1.0, 2.0), 1.0, 0.0],
+])
+def test_the_speed_span_on_the_bits_is_the_float_span(values):
+    """The span of :func:`speed_range` (and the scan's) found on the bits as integers: the
+    smallest positive and the largest speed as floats give them, -0.0 not positive,
+    subnormals positive, (inf, 0) with none positive."""
+    v = np.array(values, dtype=float)
+    pos = v[v > 0]
+    expect = (pos.min() if pos.size else np.inf, max(v.max(), 0.0) if v.size else 0.0)
+    ro = _kernels._readonly(v)
+    assert _kernels.speed_range(ro) == expect
+    assert _kernels.scan_speed(ro, MIN_SPEED)[2:] == expect
+    assert _kernels.scan_speed_parallel(2, ro, MIN_SPEED)[2:] == expect
+    assert str(_kernels.speed_range(ro)[1]) != "-0.0"

@@ -96,7 +96,7 @@ from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _ORDER2_MAX_W_RATIO, _U, _ZER
                        RESERVE_BLOCKS, BLOCK,
                        _at_plateau, _axis_term, _axis_term_u, _bits, _bucket, _prefetch, _combine,
                        _pop, _pop_ahead, _push, _rhs, _side_min, _solve_iso, pad_grid,
-                       unpad_grid)
+                       speed_range, unpad_grid)
 
 # threads waiting at a barrier spin briefly, then sleep (:data:`_tuning.SPIN_COUNT`); read
 # by libgomp when numba first starts its thread pool, values the user set stay
@@ -1872,7 +1872,8 @@ def _coarse_histogram(speed, start, shape3, h3):
     return hist, f
 
 
-def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interleave=None):
+def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interleave=None,
+          span=None):
     """The Fast Marching from ``start`` on ``threads`` slabs in parallel.
 
     Parameters
@@ -1900,6 +1901,11 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         2D slabs outside the lean layout: ``T`` and ``1 / speed^2`` interleaved in one
         array, as the serial march (:func:`fm2uav.eikonal._kernels._buffers`); default:
         unless every passable node has one speed. The times are the same bit for bit.
+    span : tuple of 2 float, optional
+        The smallest positive and the largest speed [m/s], if the caller knows them
+        (:func:`fm2uav.eikonal.fast_marching` finds them in its input scan): the plateau
+        test needs no pass over the speeds, nor the first window's width (the largest).
+        None: found here.
 
     Returns
     -------
@@ -1947,18 +1953,24 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         # places the cuts (the coarse march: serial), the padding faults in the rest; the
         # times on huge pages or not (_tuning.LEAN_TIMES_HUGE)
         early = _kernels._buffers(speed, shape3, (nx + 2 * G * K) * sx + 8 * K, lean,
-                                  interleave, huge_times=_tuning.LEAN_TIMES_HUGE)
+                                  interleave, huge_times=_tuning.LEAN_TIMES_HUGE, span=span)
     out = None  # the result (not lean)
+    top_of = speed if span is None else None
     if early is not None:
-        with _PageToucher(early[0], early[1], top_of=speed) as toucher:
+        with _PageToucher(early[0], early[1], top_of=top_of) as toucher:
             bounds = slab_bounds(speed, start, shape3, h3, K, nth, more)
     elif nth > 1:
         # the cuts' coarse march runs on this thread alone: meanwhile a second one finds the
-        # top speed and faults in the result's pages (a fresh array's; a pooled one's are
-        # there), the rows the other thread unpads first (_unpad_slabs)
-        out = _kernels.result_array(nx * ny * nz)
+        # top speed (unless given) and faults in the result's pages (a fresh array's: a
+        # pooled one's are there, and a thread for nothing cost the wall 1.4 % on 2048^2),
+        # the rows the other thread unpads first (_unpad_slabs)
+        out, resident = _kernels.pooled_result_array(nx * ny * nz)
         half = out.size // 2
-        with _PageToucher(out[half:], out[:half], top_of=speed) as toucher:
+        touch = () if resident else (out[half:], out[:half])
+        if touch or top_of is not None:
+            with _PageToucher(*touch, top_of=top_of) as toucher:
+                bounds = slab_bounds(speed, start, shape3, h3, K, nth, more)
+        else:
             bounds = slab_bounds(speed, start, shape3, h3, K, nth, more)
     else:
         bounds = slab_bounds(speed, start, shape3, h3, K, nth, more)
@@ -1978,7 +1990,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     # map not of one speed interleaved (Tk: node c's time at 2 c, its V at 2 c + 1; Tp and
     # Vp strided views of it) and without a plateau register, as the serial march
     if early is None:
-        Tp, Vp, Tk, Vk, unit, plat = _kernels._buffers(speed, shape3, npad, lean, interleave)
+        Tp, Vp, Tk, Vk, unit, plat = _kernels._buffers(speed, shape3, npad, lean, interleave,
+                                                       span=span)
     else:  # the lean layout: plain arrays, no plateau decided yet
         Tp, Vp = early[0][:npad], early[1][:npad]
         Tk, Vk, unit, plat = Tp, Vp, 1, None
@@ -2003,7 +2016,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     if plat is None:
         plat = _kernels._plateau(speed, Vp, shape3, npad,
                                  fill=lambda vmax, bits: _slab_plateau(speed, vmax, bounds, off,
-                                                                       shape3, bits, G))
+                                                                       shape3, bits, G),
+                                 span=span)
     U, qp = plat
     # order 2's bit masks: re-opened, suspect, pending, a bit per node (one spare byte: a 2D
     # slice below), and the nodes in the band on entry with their times (a repair keeps
@@ -2046,6 +2060,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     # ~2 ms on 2048^2, on the core that waits while the cuts are placed)
     if qp > 0.0:
         vmax = 1.0 / np.sqrt(qp)
+    elif span is not None:
+        vmax = span[1]
     elif toucher is not None:
         vmax = toucher.top
     else:
@@ -2182,11 +2198,8 @@ def _inf_after(nth, T, t):
 @njit(cache=True, nogil=True, error_model="numpy", _nrt=False)
 def _top_speed(speed):
     """The largest speed (1.0 for none), without the GIL (:class:`_PageToucher` finds it
-    beside the cuts); it sets the first window's width."""
-    top = 0.0
-    for c in range(speed.size):
-        top = max(top, speed[c])
-    return top if speed.size > 0 else 1.0
+    beside the cuts where the caller did not give it); it sets the first window's width."""
+    return speed_range(speed)[1] if speed.size > 0 else 1.0
 
 
 def _ghost_frozen_bits(bits, Tp, off, rows, sx, G):

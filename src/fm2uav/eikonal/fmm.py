@@ -106,15 +106,29 @@ def register_wind_march(is_calm: Any, march: Any) -> None:
 
 
 def _as_speed(speed: Any, threads: int = 1) -> np.ndarray:
+    """The speed array of the march (read-only, float64, C order), checked: see
+    :func:`_as_speed_span`."""
+    return _as_speed_span(speed, threads)[0]
+
+
+def _as_speed_span(speed: Any, threads: int = 1) -> tuple[np.ndarray, tuple[float, float]]:
+    """The speed array of the march, checked in one compiled pass, and the smallest
+    positive and the largest speed [m/s] found in the same pass (``(inf, 0)``: none
+    positive), which the march's plateau test and the parallel march's first window
+    would otherwise take a pass each to find.
+
+    Raises :class:`~fm2uav.InputError` naming the first non-finite or negative speed;
+    positive speeds below :data:`MIN_SPEED` are raised to it.
+    """
     arr = np.ascontiguousarray(grid(speed, "speed"))
     # one compiled pass instead of three numpy passes (matters on 40 M-node maps), on the
     # march's threads for a big grid
     flat = _kernels._readonly(arr.reshape(-1))
     nth = _kernels.setup_threads(threads, flat.size)
     if nth > 1:
-        bad, n_tiny = _kernels.scan_speed_parallel(nth, flat, MIN_SPEED)
+        bad, n_tiny, low, top = _kernels.scan_speed_parallel(nth, flat, MIN_SPEED)
     else:
-        bad, n_tiny = _kernels.scan_speed(flat, MIN_SPEED)
+        bad, n_tiny, low, top = _kernels.scan_speed(flat, MIN_SPEED)
     if bad >= 0:
         where = [int(w) for w in np.unravel_index(bad, arr.shape)]
         value = float(arr[tuple(where)])
@@ -125,7 +139,9 @@ def _as_speed(speed: Any, threads: int = 1) -> np.ndarray:
         )
     if n_tiny:
         arr = np.where((arr > 0) & (arr < MIN_SPEED), MIN_SPEED, arr)
-    return _kernels._readonly(arr)  # one compiled flavour of the kernels (see _readonly)
+        low, top = max(low, MIN_SPEED), max(top, MIN_SPEED)
+    # one compiled flavour of the kernels (see _readonly)
+    return _kernels._readonly(arr), (float(low), float(top))
 
 
 def fast_marching(
@@ -215,7 +231,7 @@ def fast_marching(
     4.0
     """
     nthreads = _parallel.resolve_threads(threads)
-    v = _as_speed(speed, nthreads)
+    v, span = _as_speed_span(speed, nthreads)
     shape = v.shape
     if wind is not None:
         is_calm, wind_march = _WIND_MARCH[0]
@@ -245,7 +261,7 @@ def fast_marching(
     if src.shape[0] > MAX_BALL_SOURCES or not source_ball:
         radius = 0.0
     start = _source_start(v, src3, shape3, h3, radius, SOURCE_INIT_CELLS * max(h))
-    return run_march(flat_speed, start, shape, h3, order, stop_at, threads=nthreads)
+    return run_march(flat_speed, start, shape, h3, order, stop_at, threads=nthreads, span=span)
 
 
 def _source_start(v: np.ndarray, src3: np.ndarray, shape3: tuple[int, ...],
@@ -289,6 +305,7 @@ def run_march(
     order: int,
     stop_at: Any,
     threads: int = 1,
+    span: tuple[float, float] | None = None,
 ) -> np.ndarray:
     """March from the frozen/band nodes of ``start`` (a :class:`~fm2uav.eikonal._kernels.Start`).
 
@@ -300,7 +317,9 @@ def run_march(
     while :data:`~fm2uav.eikonal._tuning.ORDER2` is set, the default; from
     :data:`~fm2uav.eikonal._tuning.ORDER2_MIN_NODES_2D` / ``_3D`` nodes:
     :func:`~fm2uav.eikonal._parallel.on_slabs`), else the serial one,
-    which sets up on them (:func:`~fm2uav.eikonal._kernels.march`).
+    which sets up on them (:func:`~fm2uav.eikonal._kernels.march`). ``span``: the
+    smallest positive and the largest speed [m/s] if the caller knows them (the plateau
+    test and the parallel march's first window then need no pass over the speeds).
 
     Returns
     -------
@@ -317,7 +336,8 @@ def run_march(
             return start.frozen_times(shape3).reshape(shape)
     if threads > 1 and _parallel.on_slabs(flat_speed.size, shape3[2] > 1, order):
         T, _ = _parallel.march(flat_speed, start, shape3, h3, threads,
-                               stops[~start.frozen_at(stops)], order=order)
+                               stops[~start.frozen_at(stops)], order=order, span=span)
     else:
-        T, _ = _kernels.march(flat_speed, start, shape3, h3, order, stops, threads=threads)
+        T, _ = _kernels.march(flat_speed, start, shape3, h3, order, stops, threads=threads,
+                              span=span)
     return T.reshape(shape)

@@ -116,6 +116,9 @@ def _fmm_parallel(ndim: int) -> Callable[[], None]:
         # at once), so they are compiled here
         _parallel._touch(np.zeros(8, dtype=np.uint8), 4096)
         _parallel._top_speed(_kernels._readonly(np.ones(8)))
+        # the plateau test's pass over the speeds of a march not given their span: the
+        # cuts' coarse march (fast_marching gives its own march the span of its input scan)
+        _kernels.speed_range(_kernels._readonly(np.ones(8)))
         cum = np.cumsum(np.ones((5, 3), dtype=np.int64), axis=0)
         cuts = np.array([0, 2, 4], dtype=np.int64)
         for shared in (False, True):
