@@ -95,6 +95,7 @@ from ._heap import sift_down, sift_up
 from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _ORDER2_MAX_W_RATIO, _U, _ZERO,
                        RESERVE_BLOCKS, BLOCK,
                        _at_plateau, _axis_term, _axis_term_u, _bits, _bucket, _prefetch, _combine,
+                       _from_bits,
                        _pop, _pop_ahead, _push, _rhs, _side_min, _solve_iso, pad_grid,
                        speed_range, unpad_grid)
 
@@ -600,17 +601,6 @@ def _exchange(three, *args):
 # (Taking one update from all the final times instead differed by up to 3e-11 relative on a
 # 2048^2 map: near an axis's causality limit the two-axis formula's rounding can put it
 # above an earlier one-axis update, which the serial march keeps; docs/performance.md.)
-
-@intrinsic
-def _from_bits(typingctx, k):
-    """The float64 of an IEEE-754 bit pattern (the inverse of ``_bits``)."""
-    sig = types.float64(types.uint64)
-
-    def codegen(context, builder, signature, args):
-        return builder.bitcast(args[0], ir.DoubleType())
-
-    return sig, codegen
-
 
 @intrinsic
 def _clock_ns(typingctx, clk):
