@@ -132,3 +132,37 @@ def test_marches_into_a_recycled_mapping_give_the_same_times(threads):
     held = fast_marching(speed, [(10, 10)], order=1, threads=threads)  # `again` still alive
     assert not np.shares_memory(held, again)
     np.testing.assert_array_equal(again, keep)
+
+
+def test_the_pool_says_whether_a_result_s_pages_are_there():
+    a, resident = _kernels.pooled_result_array(N)
+    assert not resident  # a new mapping (the fixture freed none): its pages fault in
+    del a
+    b, resident = _kernels.pooled_result_array(N)
+    assert resident  # a's mapping, whose pages a's writes faulted in
+    small, resident = _kernels.pooled_result_array(1000)  # not pooled
+    assert not resident and small.size == 1000
+
+
+def test_a_pooled_result_takes_no_page_toucher_thread(monkeypatch):
+    """The parallel march starts a thread to fault in a fresh result's pages beside the cuts'
+    coarse march; a result from the pool has its pages (and the scan gave the top speed):
+    no thread, the same times."""
+    from fm2uav.eikonal import _parallel
+
+    made = []
+
+    class Spy(_parallel._PageToucher):
+        def __init__(self, *arrays, top_of=None):
+            made.append((len(arrays), top_of is not None))
+            super().__init__(*arrays, top_of=top_of)
+
+    monkeypatch.setattr(_parallel, "_PageToucher", Spy)
+    v = np.ones((1100, 1000))  # 8.8 MB of times: from the pool
+    v[500:520, 100:900] = 0.0
+    a = fast_marching(v, [(3, 4)], order=1, threads=2).copy()  # its mapping back to the pool
+    assert made == [(2, False)]  # a new mapping's pages; the top speed from the scan
+    made.clear()
+    b = fast_marching(v, [(3, 4)], order=1, threads=2)  # in a's pages
+    np.testing.assert_array_equal(b, a)
+    assert made == []

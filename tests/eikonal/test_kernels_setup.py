@@ -141,35 +141,6 @@ def test_the_input_scan_spares_the_march_its_passes_over_the_speeds(monkeypatch,
         np.testing.assert_array_equal(T, expect[order])
 
 
-def test_a_pooled_result_takes_no_page_toucher_thread(monkeypatch):
-    """The parallel march starts a thread to fault in a fresh result's pages beside the cuts'
-    coarse march; a result from the pool has its pages (and the scan gave the top speed):
-    no thread, the same times."""
-    from fm2uav.eikonal import _parallel
-
-    made = []
-
-    class Spy(_parallel._PageToucher):
-        def __init__(self, *arrays, top_of=None):
-            made.append((len(arrays), top_of is not None))
-            super().__init__(*arrays, top_of=top_of)
-
-    monkeypatch.setattr(_parallel, "_PageToucher", Spy)
-    v = np.ones((1100, 1000))  # 8.8 MB of times: from the pool
-    v[500:520, 100:900] = 0.0
-    a = fast_marching(v, [(3, 4)], order=1, threads=2).copy()  # its mapping back to the pool
-    made.clear()
-    b = fast_marching(v, [(3, 4)], order=1, threads=2)  # in a's pages
-    np.testing.assert_array_equal(b, a)
-    assert made == []
-    made.clear()
-    monkeypatch.setattr(_kernels, "pooled_result_array",  # a fresh array: its pages faulted
-                        lambda n: (np.empty(n), False))   # beside the cuts
-    c = fast_marching(v, [(3, 4)], order=1, threads=2)
-    np.testing.assert_array_equal(c, a)
-    assert made == [(2, False)]  # the top speed from the scan
-
-
 @pytest.mark.parametrize("values", [
     [], [0.0], [-0.0, 0.0], [0.0, 3.0, -0.0, 2.5], [5e-324, 1.0], [1e-200, 1e300, 7.0],
     [2.0] * 9, [np.nextafter(1.0, 2.0), 1.0, 0.0],
