@@ -1348,8 +1348,8 @@ def _span_step(u, low, top):
 
     On the bits, as unsigned integers: they order non-negative floats as the floats do,
     and an integer minimum and maximum vectorise where a float one does not (it must
-    keep NaN's order: measured on 2048^2, 11.7 ms as floats, 2.0 ms with the input
-    checks of :func:`scan_speed` beside). ``low`` holds the smallest positive speed's
+    keep NaN's order: measured on 2048^2 (cached), :func:`speed_range` 11.7 ms as floats,
+    1.14 ms on the bits). ``low`` holds the smallest positive speed's
     bits minus one (0 wraps to the largest integer: not positive)."""
     w = u & _NO_SIGN
     return min(low, w - _ONE), max(top, w)
@@ -1568,7 +1568,7 @@ def scan_speed(v, min_speed):
     negative speed (-1 if none), the number of speeds in ``(0, min_speed)``
     (``min_speed > 0``), and the smallest positive and the largest speed (as
     :func:`speed_range`; only meaningful when ``bad == -1``). Measured on 2048^2
-    (cached): 1.65 ms for the checks alone before, 1.72 ms with the span.
+    (cached): 1.65 ms for the checks alone before, 1.63-1.71 ms with the span.
     """
     tiny = _bits(min_speed) - _ONE
     n_tiny = _ZERO
