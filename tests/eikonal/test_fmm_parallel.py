@@ -670,10 +670,13 @@ def _both_ways(flat, start, shape3, h3, monkeypatch, **kwargs):
     thread, which runs the slabs one after the other (with two, a slab's exchange may read
     a neighbour's boundary node while that neighbour's exchange re-opens it: the same
     fixed point, reached in another order, rounding apart); then on two threads, to the
-    same times to round-off. Returns the one-thread times and statistics. Order 2
-    (``order=2`` in ``kwargs``): bit for bit on two threads too."""
+    same times to round-off. The four without the deferred entries (``DEFER``): with them
+    the same times to round-off, on one thread and on two. Returns the one-thread times and
+    statistics (without deferral). Order 2 (``order=2`` in ``kwargs``, which defers
+    nothing): bit for bit on two threads too."""
     if _tuning.MIN_SLAB_NODES:
         monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)  # several slabs on one thread
+    monkeypatch.setattr(_parallel, "DEFER", False)
     out = {}
     for far in (True, False):
         monkeypatch.setattr(_parallel, "FAR_ONE_AXIS", far)
@@ -687,8 +690,10 @@ def _both_ways(flat, start, shape3, h3, monkeypatch, **kwargs):
         assert {k: stats[k] for k in ("windows", "reopened", "slabs")} == \
             {k: stats2[k] for k in ("windows", "reopened", "slabs")}, key
     monkeypatch.setattr(_parallel, "FAR_ONE_AXIS", True)
-    T2, _ = _parallel.march(flat, start, shape3, h3, 2, **kwargs)
-    assert_equal_times(T, T2, exact=kwargs.get("order", 1) == 2)
+    monkeypatch.setattr(_parallel, "DEFER", True)
+    for nth in (1, 2):
+        T2, _ = _parallel.march(flat, start, shape3, h3, nth, **kwargs)
+        assert_equal_times(T, T2, exact=kwargs.get("order", 1) == 2)
     return T, stats
 
 

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from numba import njit
 
-from .fmm_checks import assert_same_field
+from .fmm_checks import assert_same_field, fast_marching_parallel
 from fm2uav.eikonal import _kernels, fast_marching
 from fm2uav.eikonal._reference import fast_marching_reference
 
@@ -94,6 +94,27 @@ def test_keys_spanning_many_binary_orders_match_the_reference(order):
     T = fast_marching(speed, [(0, 0), (13, 12)], order=order)
     R = fast_marching_reference(speed, [(0, 0), (13, 12)], order=order)
     assert_same_field(T, R, 1e-9)
+
+
+@pytest.mark.parametrize("order", [1, 2])
+@pytest.mark.parametrize("shape, sources", [((31, 31), [(5, 5), (25, 20)]),
+                                            ((9, 8, 7), [(1, 1, 1), (7, 6, 2)])])
+def test_deferred_nodes_are_frozen_once_their_neighbour_does_not_lower_them(shape, sources,
+                                                                            order):
+    # A far node reached while a band neighbour across another axis is earlier gets its
+    # time but no queue entry (deferred): that neighbour, frozen first, updates it again.
+    # At order 2 that update can come out above the deferred time (the order-2 term is
+    # not monotone), two fronts meet here, and the speeds vary: the node must then be
+    # queued at the time it has, or it is never frozen (inf). Every node is reached, at
+    # the reference march's times, in the serial march and on slabs (two threads).
+    rng = np.random.default_rng(11)
+    for speed in (np.ones(shape), 0.5 + rng.random(shape)):
+        R = fast_marching_reference(speed, sources, order=order)
+        assert np.isfinite(R).all()
+        for T in (fast_marching(speed, sources, order=order),
+                  fast_marching_parallel(speed, sources, order=order, threads=2)):
+            assert np.isfinite(T).all()
+            assert_same_field(T, R, RTOL)
 
 
 def test_stop_at_after_pool_growth(grow_calls):

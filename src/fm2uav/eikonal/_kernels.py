@@ -32,8 +32,8 @@ Layout of the march (see docs/performance.md for the measurements behind it)
   decrease-key**: a lowered band node gets a new entry and its old one (a
   larger key) stays behind; a split drops the entries whose key is no longer
   the node's band time, and a popped entry of a node frozen already is
-  skipped. In 2D every node gets two entries (one per relaxation), and the
-  march needs no node-sized position array. Measured on 2048^2 order 1 (march
+  skipped. The march needs no node-sized position array, and with the deferred
+  entries (below) a node is queued about once. Measured on 2048^2 order 1 (march
   only, interleaved): 0.91x the time of the position-array queue with lazy
   entries, 0.70x with the splits dropping the outdated ones.
 * **Plateau**: where the grid's largest speed covers at least half of the nodes (or
@@ -71,6 +71,21 @@ Layout of the march (see docs/performance.md for the measurements behind it)
   same numbers (half of the updates in 2D, a third in 3D; times bit for bit). At order 2
   its term reads only the node beyond the one just frozen (:func:`_upwind_term`), not the
   far node's other side: measured 0.89x the march time on 2048^2 FM²-shaped order 2.
+* **Deferred entries** (2D and 3D): a far neighbour ``nb`` of the node just frozen gets its
+  time ``t`` (the one-axis solution above) but no queue entry when a neighbour of ``nb``
+  across another axis is in the band earlier than ``t`` (:func:`_earlier_band`): that
+  neighbour is frozen first (the queue pops in time order) and updates ``nb`` again, which
+  almost always lowers it (the two-axis solution) and queues it then; where that update does
+  not lower it, :func:`_relax` queues ``nb`` at the time it has (a band node not lowered is
+  queued again: a second entry at the same key is skipped as outdated). So a node is queued
+  about once instead of twice (2048^2 FM²-shaped order 1: 3,100,435 of 3,142,765 frozen
+  nodes deferred, 6,412 updates that did not lower a band node, each queued again), and the
+  splits no longer sort the outdated first entries. The 2D deferral fetches the lines of
+  the node's rows as :func:`_relax` does for a new band node. The times are the same bit
+  for bit but where tied times pop in another order (the queue holds other entries) and an
+  order-2 update depends on which tied neighbour froze first; measured in
+  docs/performance.md ("Deferred entries": 0.87x the one-thread time on 2048^2 FM²-shaped
+  order 1, 0.91x order 2, 0.89x on 160^3 at a constant speed, 1.00x 160^3 FM²-shaped).
 * **The start box**: band and frozen nodes on entry lie in the start box, so the seeding
   and the expansion of the frozen nodes scan its span only, not the grid (a 2048^2
   march that freezes almost nothing: 29 ms before, 19 ms with the interleaved layout).
@@ -600,14 +615,56 @@ def _solve_iso(a, b, c, q):
 
 
 @njit(**_OPT)
+def _fetch_rows(T, V, c, s, n, pv):
+    """Prefetch the lines of ``T`` (and ``V`` if ``pv``) one row away from node ``c`` across
+    the x stride ``s``, and of ``T`` two rows away (clamped to ``c`` at the ends of the
+    ``n`` elements): what freezing ``c`` will read in a 2D march."""
+    _prefetch(T, c - s)
+    _prefetch(T, c + s)
+    if pv:
+        _prefetch(V, c - s)
+        _prefetch(V, c + s)
+    _prefetch(T, c - s - s if c >= s + s else c)
+    _prefetch(T, c + s + s if c + s + s < n else c)
+
+
+@njit(**_OPT)
+def _earlier_band(T, c, s, t):
+    """Whether a neighbour of node ``c`` across the stride ``s`` is in the band with a
+    time below ``t`` (far nodes, ``-inf``, and walls or ghosts, NaN, are not)."""
+    a = T[c - s]
+    b = T[c + s]
+    return (a < 0.0 and -a < t) or (b < 0.0 and -b < t)
+
+
+@njit(**_OPT)
+def _earlier_band3(T, c, k, sx, sy, sz, t):
+    """Whether a neighbour of node ``c`` of a 3D grid (strides ``sx``, ``sy``, ``sz``) across
+    the two axes other than neighbour ``k``'s (0, 1: x; 2, 3: y; 4, 5: z) is in the band
+    with a time below ``t`` (:func:`_earlier_band`)."""
+    if k < 2:
+        return _earlier_band(T, c, sy, t) or _earlier_band(T, c, sz, t)
+    if k < 4:
+        return _earlier_band(T, c, sx, t) or _earlier_band(T, c, sz, t)
+    return _earlier_band(T, c, sx, t) or _earlier_band(T, c, sy, t)
+
+
+@njit(**_OPT)
 def _relax(T, V, c, t, last, pool, nxt, bk, mw, nfree, fh, cur, pf1, pf2, n, pv=True):
-    """Lower the band/far node ``c`` to ``t`` if that is smaller; queue it.
+    """Lower the band/far node ``c`` to ``t`` if that is smaller and queue it; a band node
+    that ``t`` does not lower is queued again at its time.
 
     A lowered band node gets a new entry; its old one (a larger key) stays in
-    the queue and is skipped when popped (the node is frozen by then). A new band
-    node of a 2D march (``pf2 == 0``) gets the lines its expansion will read
-    prefetched, ``V`` too if ``pv`` (not on a plateau, whose speeds are not read); a
-    3D march (``pf2`` its y stride) prefetches none: its band is wide, the lines
+    the queue and is skipped when popped (the node is frozen by then). A band node
+    not lowered is queued again because it may have no entry: a far node reached
+    first while a band neighbour across another axis is earlier gets its time but no
+    entry (**deferred**, see the march kernels); that neighbour is frozen first and
+    updates it, and this is where the node is queued then if the update did not lower
+    it (rare: 0.2 % of the updates on 2048^2 FM²-shaped order 1; an entry that turns out
+    to be a second one at the same key is skipped as outdated).
+    A new band node of a 2D march (``pf2 == 0``) gets the lines its expansion will read
+    prefetched (:func:`_fetch_rows`), ``V`` too if ``pv`` (not on a plateau, whose speeds are
+    not read); a 3D march (``pf2`` its y stride) prefetches none: its band is wide, the lines
     were evicted before the node froze (measured 0.98x without them on 160^3
     FM²-shaped order 1).
     """
@@ -619,15 +676,12 @@ def _relax(T, V, c, t, last, pool, nxt, bk, mw, nfree, fh, cur, pf1, pf2, n, pv=
             # a new band node: when it is frozen, the march reads the nodes up to
             # two rows away across x; fetch those lines now.
             # Measured: -10 % (one row), -12 % more (two rows) on 2048^2.
-            _prefetch(T, c - pf1)
-            _prefetch(T, c + pf1)
-            if pv:
-                _prefetch(V, c - pf1)
-                _prefetch(V, c + pf1)
-            _prefetch(T, c - pf1 - pf1 if c >= pf1 + pf1 else c)
-            _prefetch(T, c + pf1 + pf1 if c + pf1 + pf1 < n else c)
-        nfree, fh, cur = _push(_bucket(k, last), k, c, pool, nxt, bk, mw, nfree, fh, cur)
-    return nfree, fh, cur
+            _fetch_rows(T, V, c, pf1, n, pv)
+    elif x > -_INF:
+        k = _bits(-x)
+    else:  # a far node that t does not reach (t = inf: 1 / speed^2 overflows)
+        return nfree, fh, cur
+    return _push(_bucket(k, last), k, c, pool, nxt, bk, mw, nfree, fh, cur)
 
 
 @njit(**_CALL)
@@ -768,6 +822,12 @@ def _march2d_kernel(order, pairs=False):
                             c2 = c + s if k & 1 == 0 else c - s
                             ta, aa = _upwind_term(T, V, U, use_u, nb, tc, c, c2, ih2, order)
                             t = ta + math.sqrt(q / aa)
+                        if _earlier_band(T, nb, one if k < 2 else sx, t):
+                            # deferred: that neighbour is frozen first and queues nb
+                            # (_relax); fetch the lines as for a new band node
+                            T[nb] = -t
+                            _fetch_rows(T, V, nb, sx, n, pvc)
+                            continue
                     elif iso:
                         t = _solve_iso(_side_min(T, nb, sx), _side_min(T, nb, one), _INF,
                                        q * hh)
@@ -872,6 +932,9 @@ def _march3d_kernel(order):
                                 ta, aa = _upwind_term(T, V, U, use_u, nb, tcur, c, c2, ih2,
                                                       order)
                                 t = ta + math.sqrt(q / aa)
+                        if _earlier_band3(T, nb, k, sx, sy, one, t):  # deferred (as in 2D)
+                            T[nb] = -t
+                            continue
                     elif iso:
                         t = _solve_iso(_side_min(T, nb, sx), _side_min(T, nb, sy),
                                        _side_min(T, nb, one), q * hh)

@@ -53,7 +53,12 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
   own neighbours when they become frozen, and a re-opened node had done so when it was
   frozen first; so the full update of that node reads one frozen neighbour and gives the
   same bits (the tests run with the rule on and off, one-row slabs included, and compare
-  the times and statistics bit for bit).
+  the times and statistics bit for bit). Such a node is **deferred** as in the serial march
+  (no queue entry while a band neighbour across the other axis is earlier: an own node of
+  the slab, since ghosts hold frozen times or NaN, so this slab freezes it first and updates
+  the node again; :func:`_lower_r` queues a band node that an update does not lower). The 3D
+  windows defer nothing: their loop over the six neighbours with the deferral, with or
+  without the one-axis rule, measured 3-9 % slower on 160^3.
 * Time windows: every slab pops, with its own queue and in parallel, the nodes
   whose time is below ``t_w``, and lists the nodes it froze in its two boundary rows;
   then (barrier) every slab copies those of its neighbours into its ghosts (not the
@@ -94,8 +99,8 @@ from . import _kernels, _tuning
 from ._heap import sift_down, sift_up
 from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _ORDER2_MAX_W_RATIO, _U, _ZERO,
                        RESERVE_BLOCKS, BLOCK,
-                       _at_plateau, _axis_term, _axis_term_u, _bits, _bucket, _prefetch, _combine,
-                       _from_bits,
+                       _at_plateau, _axis_term, _axis_term_u, _bits, _bucket, _combine,
+                       _earlier_band, _from_bits, _prefetch,
                        _pop, _pop_ahead, _push, _rhs, _side_min, _solve_iso, pad_grid,
                        speed_range, unpad_grid)
 
@@ -111,6 +116,12 @@ __all__ = ["march", "on_slabs", "resolve_threads"]
 #: axis, as in the serial march (valid in a slab: see the window's docstring); False: the
 #: full update (the same times bit for bit; the tests run both).
 FAR_ONE_AXIS = True
+#: 2D, with :data:`FAR_ONE_AXIS`: a far neighbour so updated gets no queue entry while a band
+#: neighbour across the other axis is earlier (**deferred**, as in the serial march; see the
+#: window's docstring). False: queued at once. Both end at the serial march's times (order 1,
+#: to round-off); on a map with exact ties and repairs the windows may differ in round-off
+#: (the order in which the same times pop), so the far rule's bit-for-bit tests run without it.
+DEFER = True
 #: Free repair-heap slots kept before each node's pushes (one pop pushes at most 7).
 HEAP_RESERVE = 8
 #: Order 2: one pop queues at most 13 entries (six neighbours, the six nodes two away, the
@@ -307,7 +318,9 @@ def _lower_r(T, V, c, t, fixed, sx, sy, three, pv, pool, nxt, bk, mw, rkey, rite
     """Give node ``c`` the time ``t`` if that is lower than its band or frozen time.
 
     A frozen node lowered is re-opened (band again), unless it was frozen on entry
-    (bit ``c`` of ``fixed``: a source or its ball, final as in the serial march).
+    (bit ``c`` of ``fixed``: a source or its ball, final as in the serial march). A band node
+    not lowered is queued again at its time: it may be a deferred one without an entry (the
+    2D window; a second entry at the same key is skipped as outdated).
     ``rows``: prefetch the rows a new band node's freezing reads (``pv``: their speeds
     too, off the plateau); the 3D order-2 window fetches around its next pops instead.
     The queue's state in and out as values (:func:`_enq_r`): ``nfree, fh, cur, rsize``.
@@ -319,6 +332,9 @@ def _lower_r(T, V, c, t, fixed, sx, sy, three, pv, pool, nxt, bk, mw, rkey, rite
             if rows and x == -_INF:  # a new band node: fetch the rows its freezing reads
                 _prefetch_rows(T, V, c, sx, sy, three, pv)
             return _enq_r(_bits(t), c, pool, nxt, bk, mw, rkey, ritem, nfree, fh, cur, last,
+                          rsize)
+        if x > -_INF and not t < -x:  # a band node not lowered: it may be deferred
+            return _enq_r(_bits(-x), c, pool, nxt, bk, mw, rkey, ritem, nfree, fh, cur, last,
                           rsize)
     elif t < x and _fixed_at(fixed, c, sy, three) == _ZERO:
         T[c] = -t
@@ -401,8 +417,12 @@ def _slab_kernels(three, pairs=False):
         freezes in its first and last own rows go to ``sent[0]`` and ``sent[1]``
         (``ns`` their counts, reset here): the neighbours' exchange reads only those.
 
-        ``far`` (2D): a far neighbour of the node just frozen gets the one-axis update
-        along their axis, as in the serial march. Valid in a slab because no far node has
+        ``far`` (2D): 1 or 2, a far neighbour of the node just frozen gets the one-axis
+        update along their axis, as in the serial march (0: the full update); 2, and no queue
+        entry while a neighbour across the other axis is in the band earlier (deferred, as in
+        the serial march: that neighbour is an own node, ghosts hold frozen times or NaN, so
+        this slab freezes it first and updates the node again, and :func:`_lower_r` queues a
+        band node that an update does not lower). Valid in a slab because no far node has
         a frozen neighbour other than the node being frozen: every node that becomes
         frozen updates its band and far own neighbours at once — a pop here, a node
         frozen on entry in ``start``, a ghost in ``exchange`` (its one own neighbour) —
@@ -475,9 +495,13 @@ def _slab_kernels(three, pairs=False):
                     s = sx if j < 2 else sy
                     nb = c - s if j & 1 == 0 else c + s
                     y = T[nb]
-                    if far and y == -_INF:  # c is its only frozen neighbour (docstring)
+                    if far != 0 and y == -_INF:  # c is its only frozen neighbour (docstring)
                         q = _rhs(V, U, use_u, qp, nb)
                         t_nb = t + math.sqrt(q * hh) if iso else t + math.sqrt(q / ih[j >> 1])
+                        if far == 2 and _earlier_band(T, nb, sy if j < 2 else sx, t_nb):
+                            T[nb] = -t_nb  # deferred, as in the serial march
+                            _prefetch_rows(T, V, nb, sx, sy, three, pv)
+                            continue
                     elif y < 0.0 or (y > t and nb >= lo and nb < hi):
                         # band/far, or frozen later than c in this slab: c may lower it
                         t_nb = _update(T, V, U, use_u, qp, nb, sx, sy, ih, hh, iso, three)
@@ -1374,7 +1398,8 @@ def _drive_kernel(three, order=1):
         ``slabs`` (K), ``lists`` (nth + 1 + K), ``load`` (nth): scratch of :func:`_assign`
         (``share``: 0 the interleave, 1 :data:`_tuning.SHARE_SLABS`' lists, 2 taken in turn,
         :data:`_tuning.DYNAMIC_2D`). ``scan[k]``: the nodes of slab ``k`` the start
-        reads (the start box's rows). ``far``: the far neighbours' one-axis update (2D).
+        reads (the start box's rows). ``far``: the far neighbours' one-axis update (2D), with
+        their deferral (2; :func:`_slab_kernels`' window).
         ``alone``: the exchanges on this thread only, the slabs in turn (2D).
 
         ``off``, ``end``, ``sx``, ``sy``, ``scan`` and ``stops`` count elements of ``Tp``:
@@ -2081,7 +2106,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
             status = drive(nth, Tk, Vk, U, qp, fixed, fl, eidx, evals, unit * off,
                            unit * (off + sizes), rows, _U(unit * sx), _U(unit * sy), ih, hh, iso,
                            pool, nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win, first,
-                           stop_idx, slabs, lists, load, share, scan, FAR_ONE_AXIS,
+                           stop_idx, slabs, lists, load, share, scan,
+                           (1 + int(DEFER)) if FAR_ONE_AXIS else 0,
                            not three and _tuning.EXCHANGE_ALONE_2D[order])
             first = win[7] == 0.0
             if status == 0:
