@@ -618,7 +618,7 @@ def _solve_iso(a, b, c, q):
 def _fetch_rows(T, V, c, s, n, pv):
     """Prefetch the lines of ``T`` (and ``V`` if ``pv``) one row away from node ``c`` across
     the x stride ``s``, and of ``T`` two rows away (clamped to ``c`` at the ends of the
-    ``n`` elements): what freezing ``c`` will read in a 2D march."""
+    ``n`` elements): what freezing ``c`` will read in a 2D march (across x in 3D)."""
     _prefetch(T, c - s)
     _prefetch(T, c + s)
     if pv:

@@ -100,7 +100,7 @@ from ._heap import sift_down, sift_up
 from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _ORDER2_MAX_W_RATIO, _U, _ZERO,
                        RESERVE_BLOCKS, BLOCK,
                        _at_plateau, _axis_term, _axis_term_u, _bits, _bucket, _combine,
-                       _earlier_band, _from_bits, _prefetch,
+                       _earlier_band, _fetch_rows, _from_bits, _prefetch,
                        _pop, _pop_ahead, _push, _rhs, _side_min, _solve_iso, pad_grid,
                        speed_range, unpad_grid)
 
@@ -294,14 +294,7 @@ def _update(T, V, U, use_u, qp, c, sx, sy, ih, hh, iso, three):  # noqa: PLR0913
 @njit(cache=True, inline="always", error_model="numpy", _nrt=False)
 def _prefetch_rows(T, V, c, sx, sy, three, pv):
     """Prefetch ``T`` (and ``V`` if ``pv``) one and two rows (planes) away across x (and y)."""
-    n = _U(T.size)
-    _prefetch(T, c - sx)
-    _prefetch(T, c + sx)
-    if pv:
-        _prefetch(V, c - sx)
-        _prefetch(V, c + sx)
-    _prefetch(T, c - sx - sx if c >= sx + sx else c)
-    _prefetch(T, c + sx + sx if c + sx + sx < n else c)
+    _fetch_rows(T, V, c, sx, _U(T.size), pv)
     if three:
         _prefetch(T, c - sy)
         _prefetch(T, c + sy)
