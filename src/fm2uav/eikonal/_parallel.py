@@ -57,8 +57,8 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
   (no queue entry while a band neighbour across the other axis is earlier: an own node of
   the slab, since ghosts hold frozen times or NaN, so this slab freezes it first and updates
   the node again; :func:`_lower_r` queues a band node that an update does not lower). The 3D
-  windows defer nothing: their loop over the six neighbours with the deferral, with or
-  without the one-axis rule, measured 3-9 % slower on 160^3.
+  windows defer nothing: with the deferral (after the full update, or with the one-axis
+  rule) they measured up to 14 % slower on 160^3 (docs/performance.md, "Deferred entries").
 * Time windows: every slab pops, with its own queue and in parallel, the nodes
   whose time is below ``t_w``, and lists the nodes it froze in its two boundary rows;
   then (barrier) every slab copies those of its neighbours into its ghosts (not the
@@ -326,7 +326,7 @@ def _lower_r(T, V, c, t, fixed, sx, sy, three, pv, pool, nxt, bk, mw, rkey, rite
                 _prefetch_rows(T, V, c, sx, sy, three, pv)
             return _enq_r(_bits(t), c, pool, nxt, bk, mw, rkey, ritem, nfree, fh, cur, last,
                           rsize)
-        if x > -_INF and not t < -x:  # a band node not lowered: it may be deferred
+        if x > -_INF:  # a band node not lowered: it may be deferred
             return _enq_r(_bits(-x), c, pool, nxt, bk, mw, rkey, ritem, nfree, fh, cur, last,
                           rsize)
     elif t < x and _fixed_at(fixed, c, sy, three) == _ZERO:
