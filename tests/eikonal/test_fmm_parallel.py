@@ -672,8 +672,8 @@ def _both_ways(flat, start, shape3, h3, monkeypatch, **kwargs):
     fixed point, reached in another order, rounding apart); then on two threads, to the
     same times to round-off. The four without the deferred entries (``DEFER``): with them
     the same times to round-off, on one thread and on two. Returns the one-thread times and
-    statistics (without deferral). Order 2 (``order=2`` in ``kwargs``, which defers
-    nothing): bit for bit on two threads too."""
+    statistics (without deferral). Order 2 (``order=2`` in ``kwargs``): with the deferral
+    bit for bit, on one thread and on two."""
     if _tuning.MIN_SLAB_NODES:
         monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)  # several slabs on one thread
     monkeypatch.setattr(_parallel, "DEFER", False)
@@ -1174,3 +1174,23 @@ def test_a_3d_march_moves_the_cut_off_its_centred_source_bit_for_bit(monkeypatch
         mid = (lo + hi) // 2  # the source's row: the box's middle
         assert mid == src[0] and np.all(np.abs(inner - mid) >= 5)  # every cut clear of it
         assert not np.array_equal(before, after)  # the even cuts had one through the source
+
+
+def test_slab_march_reuses_its_kept_pools_and_masks_without_a_trace():
+    # The slab march takes its entry pools and order-2 bit masks from the calling thread's
+    # kept buffers (the serial march's "pool", and "flags"), not fresh memory whose page
+    # faults the windows would take: after a larger march of the other order on another
+    # field (stale entries and masks left in them), the same times bit for bit as on
+    # fresh buffers, in the same memory as the last call's.
+    v, src = fm2_shaped((90, 70))
+    _kernels._KEPT.bufs = {}  # fresh buffers
+    first = fast_marching_parallel(v, [src], order=2)
+    assert {"pool", "flags"} <= set(_kernels._KEPT.bufs)
+    big, bsrc = smooth((120, 96))
+    fast_marching_parallel(big, [bsrc], order=1)
+    fast_marching_parallel(big, [bsrc], order=2)
+    stale = dict(_kernels._KEPT.bufs)
+    again = fast_marching_parallel(v, [src], order=2)
+    np.testing.assert_array_equal(again, first)
+    for slot in ("pool", "flags"):  # the smaller march took the larger buffers left
+        assert _kernels._KEPT.bufs[slot] is stale[slot], slot

@@ -56,8 +56,11 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
   the times and statistics bit for bit). Such a node is **deferred** as in the serial march
   (no queue entry while a band neighbour across the other axis is earlier: an own node of
   the slab, since ghosts hold frozen times or NaN, so this slab freezes it first and updates
-  the node again; :func:`_lower_r` queues a band node that an update does not lower). The 3D
-  windows defer nothing: with the deferral (after the full update, or with the one-axis
+  the node again; :func:`_lower_r` queues a band node that an update does not lower). The
+  order-2 window defers so too (its far rule is its own, below): there a suspect node's time
+  can go *up* when it pops, so the band neighbours it no longer precedes are queued then, and
+  its update and repair paths queue a band node they do not lower; still the serial times
+  bit for bit. The 3D windows defer nothing: with the deferral (after the full update, or with the one-axis
   rule) they measured up to 14 % slower on 160^3 (docs/performance.md, "Deferred entries").
 * Time windows: every slab pops, with its own queue and in parallel, the nodes
   whose time is below ``t_w``, and lists the nodes it froze in its two boundary rows;
@@ -118,9 +121,10 @@ __all__ = ["march", "on_slabs", "resolve_threads"]
 FAR_ONE_AXIS = True
 #: 2D, with :data:`FAR_ONE_AXIS`: a far neighbour so updated gets no queue entry while a band
 #: neighbour across the other axis is earlier (**deferred**, as in the serial march; see the
-#: window's docstring). False: queued at once. Both end at the serial march's times (order 1,
-#: to round-off); on a map with exact ties and repairs the windows may differ in round-off
-#: (the order in which the same times pop), so the far rule's bit-for-bit tests run without it.
+#: window's docstring; order 2 too). False: queued at once. Both end at the serial march's
+#: times (order 1 to round-off, order 2 bit for bit); on a map with exact ties and repairs the
+#: order-1 windows may differ in round-off (the order in which the same times pop), so the far
+#: rule's bit-for-bit tests run without it.
 DEFER = True
 #: Free repair-heap slots kept before each node's pushes (one pop pushes at most 7).
 HEAP_RESERVE = 8
@@ -871,14 +875,16 @@ def _entry_cap(eidx, evals, g, t):
 
 @njit(cache=True, error_model="numpy", _nrt=False)  # a call (rare): compiles once
 def _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf, eidx, evals, base, pool,
-             nxt, bk, mw, st, rkey, ritem, ctl):
+             nxt, bk, mw, st, rkey, ritem, ctl, requeue):
     """Update the slab's own node ``d`` again after a time it may read changed (order 2).
 
     Far or band: a lower time is taken and queued; a higher one marks the node suspect
     (updated again when popped). Frozen: a different time re-opens it (``rf``), at the new
     time if lower, else at its old time and suspect. Walls and nodes frozen on entry stay;
     a node in the band on entry keeps that time if lower (``eidx``, ``evals``: those nodes
-    by their index in the slabs' buffer, ``base + d`` for ``d``).
+    by their index in the slabs' buffer, ``base + d`` for ``d``). ``requeue``: a band node
+    not lowered is queued again at its time (it may be a deferred one without an entry: the
+    2D window's far rule).
     """
     x = T[d]
     nd = d >> (_unit(sy, three) >> _ONE)  # its node index: its bits in the masks
@@ -890,9 +896,12 @@ def _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf, eidx, eval
         if t < -x:
             T[d] = -t
             _enq(_bits(t), d, pool, nxt, bk, mw, st, rkey, ritem)
-        elif t > -x and x > -_INF:
-            _mark(sf, nd, ctl, _C_SLIVE)
-            ctl[_C_RAISED] += 1.0
+        elif x > -_INF:
+            if t > -x:
+                _mark(sf, nd, ctl, _C_SLIVE)
+                ctl[_C_RAISED] += 1.0
+            if requeue:
+                _enq(_bits(-x), d, pool, nxt, bk, mw, st, rkey, ritem)
     elif t != x:
         ctl[_C_REOPEN] += 1.0
         _mark(rf, nd, ctl, _C_RLIVE)
@@ -908,12 +917,12 @@ def _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf, eidx, eval
 
 @njit(cache=True, inline="always", error_model="numpy", _nrt=False)
 def _recheck_r(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf, eidx, evals, base,
-               pool, nxt, bk, mw, st, rkey, ritem, ctl, nfree, fh, cur, last, rsize):
+               pool, nxt, bk, mw, st, rkey, ritem, ctl, requeue, nfree, fh, cur, last, rsize):
     """:func:`_recheck` from a kernel keeping the queue's state in registers: stored in
     ``st`` for the call and read back (``nfree, fh, cur, rsize``; a repair is rare)."""
     _keep_queue(st, nfree, fh, cur, last, rsize)
     _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf, eidx, evals, base, pool,
-             nxt, bk, mw, st, rkey, ritem, ctl)
+             nxt, bk, mw, st, rkey, ritem, ctl, requeue)
     return st[_NFREE], st[_FH], st[_CUR], st[_RSIZE]
 
 
@@ -957,7 +966,7 @@ def _slab_kernels2(three, pairs=False):
     ``pairs``: the 2D window of the interleaved layout only (``sy`` 2, a constant)."""
 
     def window(T, V, U, qp, fixed, rf, sf, pf, eidx, evals, base, sx, sy, ih, tw, pool, nxt, bk,
-               mw, st, rkey, ritem, ctl, sent, ns):
+               mw, st, rkey, ritem, ctl, sent, ns, far):
         """Freeze the slab's queued nodes with a time below ``tw`` (resumable), order 2.
 
         As the order-1 window; the boundary lists hold the nodes frozen in the first and
@@ -966,6 +975,13 @@ def _slab_kernels2(three, pairs=False):
         lines the next pops read
         fetched ahead) and fetches no rows for new band nodes (on the terrain march the
         windows' CPU -8 %, docs/performance.md).
+
+        ``far`` 2 (2D): a far node's one-axis time comes without a queue entry while a band
+        neighbour across the other axis is earlier (**deferred**, as the order-1 window and
+        the serial march): that neighbour freezes first and updates it. So a band node an
+        update or a repair does not lower is queued again at its time, and a suspect whose
+        time goes up when popped queues its band neighbours earlier than its new time (they
+        may have been deferred on its old one: the only way a band time rises).
         """
         n = _U(T.size)
         g = sx + sx
@@ -978,6 +994,7 @@ def _slab_kernels2(three, pairs=False):
         one = _unit(sy, three)  # elements a node (2D interleaved: 2)
         sh = one >> _ONE  # node index = element index >> sh: the bits of the masks
         use_u = qp > 0.0 and one == _ONE
+        dfr = far == 2 and not three  # far nodes deferred (2D)
         kw = _bits(tw)
         pops = 0
         ns[0] = _ZERO
@@ -1031,6 +1048,13 @@ def _slab_kernels2(three, pairs=False):
                     if t2 < _INF:
                         nfree, fh, cur, rsize = _enq_r(_bits(t2), c, pool, nxt, bk, mw, rkey,
                                                        ritem, nfree, fh, cur, last, rsize)
+                    if dfr and t2 > t:  # band neighbours deferred on c's old time: queued
+                        for nb in _nbs(c, sx, sy, three):
+                            y = T[nb]
+                            if nb != c and y < 0.0 and y > -_INF and -y < t2:
+                                nfree, fh, cur, rsize = _enq_r(_bits(-y), nb, pool, nxt, bk, mw,
+                                                               rkey, ritem, nfree, fh, cur,
+                                                               last, rsize)
                     continue
             T[c] = t
             pops += 1
@@ -1064,17 +1088,24 @@ def _slab_kernels2(three, pairs=False):
                     # shortcut): two axes' reads and terms saved on a third of the updates
                     if nb == c - sx or nb == c + sx:
                         ih_nb = ih[0]
+                        s_o = sy  # (2D) the other axis' stride
                     elif nb == c - sy or nb == c + sy:
                         ih_nb = ih[1]
+                        s_o = sx
                     else:
                         ih_nb = ih[2]
+                        s_o = sx
                     # c2: the node beyond c on that axis (nb's other side is not frozen)
                     ta, aa = _upwind_term_at(T, V, U, use_u, fixed, nb, t, c, c + c - nb,
                                              ih_nb, t, sh)
+                    t_nb = ta + math.sqrt(_rhs(V, U, use_u, qp, nb) / aa)
+                    if dfr and _earlier_band(T, nb, s_o, t_nb):
+                        T[nb] = -t_nb  # deferred, as in the order-1 window
+                        _prefetch_rows(T, V, nb, sx, sy, three, pv)
+                        continue
                     nfree, fh, cur, rsize = _lower_r(
-                        T, V, nb, ta + math.sqrt(_rhs(V, U, use_u, qp, nb) / aa), fixed, sx, sy,
-                        three, pv, pool, nxt, bk, mw, rkey, ritem, ctl, not three, nfree, fh,
-                        cur, last, rsize)
+                        T, V, nb, t_nb, fixed, sx, sy, three, pv, pool, nxt, bk, mw, rkey,
+                        ritem, ctl, not three, nfree, fh, cur, last, rsize)
                 elif y < 0.0:  # band (or far after c froze again): an own node
                     if full or (not inorder and _later_nb(T, fixed, nb, sx, sy, three, t)):
                         # c frozen again, or a neighbour frozen later than c (a ghost ahead
@@ -1082,8 +1113,8 @@ def _slab_kernels2(three, pairs=False):
                         # nodes not frozen then, from scratch now
                         nfree, fh, cur, rsize = _recheck_r(
                             T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf, eidx,
-                            evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl, nfree, fh, cur,
-                            last, rsize)
+                            evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl, dfr, nfree, fh,
+                            cur, last, rsize)
                     else:  # the serial march's update when c froze; a band time that read
                         # nodes out of time order may be too low: a later update above it
                         # marks it suspect
@@ -1092,16 +1123,20 @@ def _slab_kernels2(three, pairs=False):
                             nfree, fh, cur, rsize = _lower_r(
                                 T, V, nb, tn, fixed, sx, sy, three, pv, pool, nxt, bk, mw, rkey,
                                 ritem, ctl, not three, nfree, fh, cur, last, rsize)
-                        elif (tn > -y and y > -_INF
-                              and _entry_cap(eidx, evals, base + nb, tn) > -y):
-                            _mark(sf, nb >> sh, ctl, _C_SLIVE)
-                            ctl[_C_RAISED] += 1.0
+                        elif y > -_INF:
+                            if tn > -y and _entry_cap(eidx, evals, base + nb, tn) > -y:
+                                _mark(sf, nb >> sh, ctl, _C_SLIVE)
+                                ctl[_C_RAISED] += 1.0
+                            if dfr:  # it may be deferred: queued again at its time
+                                nfree, fh, cur, rsize = _enq_r(_bits(-y), nb, pool, nxt, bk, mw,
+                                                               rkey, ritem, nfree, fh, cur, last,
+                                                               rsize)
                 elif y >= 0.0 and nb >= lo and nb < hi and (full or y > t):
                     # frozen later than c in this slab: c may change it
                     nfree, fh, cur, rsize = _recheck_r(
                         T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf, eidx, evals,
-                        base, pool, nxt, bk, mw, st, rkey, ritem, ctl, nfree, fh, cur, last,
-                        rsize)
+                        base, pool, nxt, bk, mw, st, rkey, ritem, ctl, dfr, nfree, fh, cur,
+                        last, rsize)
                 # the node two away reads c beyond nb when nb is frozen no earlier than c
                 y = T[nb]
                 if y >= 0.0 and (full or t <= y):
@@ -1111,8 +1146,8 @@ def _slab_kernels2(three, pairs=False):
                         if z < 0.0 or (z >= 0.0 and (full or z > t)):
                             nfree, fh, cur, rsize = _recheck_r(
                                 T, V, U, use_u, qp, d2, sx, sy, ih, three, fixed, rf, sf, eidx,
-                                evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl, nfree, fh,
-                                cur, last, rsize)
+                                evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl, dfr, nfree,
+                                fh, cur, last, rsize)
         _keep_queue(st, nfree, fh, cur, last, rsize)
         ctl[_C_POPS] = pops
 
@@ -1145,14 +1180,16 @@ def _slab_kernels2(three, pairs=False):
         return True
 
     def exchange(T, V, U, qp, fixed, rf, sf, eidx, evals, ebase, src, sent, m, base, g, up, sx,
-                 sy, ih, pool, nxt, bk, mw, st, rkey, ritem, ctl):
+                 sy, ih, pool, nxt, bk, mw, st, rkey, ritem, ctl, far):
         """Copy the neighbour's two boundary rows ``src`` (their frozen times) into the two
         ghost rows starting at ``g``; update again the own nodes one and two rows away
         from each ghost that changed (toward +x if ``up``). Only the neighbour's nodes
         ``sent[:m] - base`` are read (those it froze in its last window), both rows when
-        ``m`` exceeds the list's capacity. Resumable: False when a queue is full."""
+        ``m`` exceeds the list's capacity. Resumable: False when a queue is full. ``far``: the
+        window's (2: a band node not lowered is queued again, it may be deferred)."""
         one = _unit(sy, three)
         use_u = qp > 0.0 and one == _ONE
+        dfr = far == 2 and not three
         n = _U(T.size)
         lo = sx + sx
         hi = n - lo
@@ -1182,7 +1219,7 @@ def _slab_kernels2(three, pairs=False):
                         if step != sx and T[d] == -_INF:  # far: no frozen neighbour
                             continue
                         _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf,
-                                 eidx, evals, ebase, pool, nxt, bk, mw, st, rkey, ritem, ctl)
+                                 eidx, evals, ebase, pool, nxt, bk, mw, st, rkey, ritem, ctl, dfr)
                         x = T[d]
                         if x < 0.0 and -x < ctl[_C_NEXT]:  # queued: the next window knows
                             ctl[_C_NEXT] = -x
@@ -1472,7 +1509,7 @@ def _drive_kernel(three, order=1):
                                     Tp[o:o + G * sxi], sent[k - 1, 1],
                                     ns[k - 1, 1], _U(rows[k - 1]) * sx, _ZERO, True, sx, sy, ih,
                                     pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k],
-                                    ctl[k])
+                                    ctl[k], far)
                             ok = _exchange3d_o2(*args) if three else _exchange2d_o2(*args)
                         else:
                             ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k - 1, 1],
@@ -1486,7 +1523,7 @@ def _drive_kernel(three, order=1):
                                     Tp[o:o + G * sxi], sent[k + 1, 0],
                                     ns[k + 1, 0], _U(G) * sx, (r + _U(G)) * sx, False, sx, sy,
                                     ih, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
-                                    ritem[k], ctl[k])
+                                    ritem[k], ctl[k], far)
                             ok = _exchange3d_o2(*args) if three else _exchange2d_o2(*args)
                         else:
                             ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k + 1, 0],
@@ -1564,7 +1601,7 @@ def _drive_kernel(three, order=1):
                                 U[0 if U.size == 1 else o3:], qp, fx[o3:], fl[4 * o3:],
                                 fl[4 * o3 + 1:], fl[4 * o3 + 2:], eidx, evals, _U(off[k]), sx,
                                 sy, ih, tw, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
-                                ritem[k], ctl[k], sent[k], ns[k])
+                                ritem[k], ctl[k], sent[k], ns[k], far)
                         if three:
                             _window3d_o2(*args)
                         elif sy == 2:
@@ -2030,7 +2067,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     # order 2's bit masks: re-opened, suspect, pending, a bit per node (one spare byte: a 2D
     # slice below), and the nodes in the band on entry with their times (a repair keeps
     # them if lower; element indices)
-    fl = np.zeros(4 * (npad // 8 + 2) if order == 2 else 4, dtype=np.uint8)
+    fl = _kernels._work_kept("flags", 4 * (npad // 8 + 2) if order == 2 else 4)
+    fl[:] = 0
     nodes = np.zeros(0, dtype=np.int64)
     if order == 2:
         parts = []
@@ -2048,7 +2086,10 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     # queues: one radix queue and one repair heap per slab (each slab's small arrays on
     # cache lines of its own: the two threads write them at every push and pop)
     nblk = max(POOL_MIN_BLOCKS, int(sizes.max()) // (16 * BLOCK))
-    pool = np.empty((K, 2 * nblk * BLOCK), dtype=np.uint64)
+    # the entry pools in this thread's kept buffer (the serial march's): a fresh one's
+    # page faults (34 MB on 2048^2) would be taken by the windows
+    pool = _kernels._work_kept("pool", K * 16 * nblk * BLOCK).view(np.uint64).reshape(
+        K, 2 * nblk * BLOCK)
     nxt = np.empty((K, nblk), dtype=np.uint32)
     bk = _lined(K, 2 * int(_NB), np.uint32)
     mw = _lined(K, _NW, np.uint64)
