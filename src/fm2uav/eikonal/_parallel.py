@@ -91,6 +91,7 @@ import contextlib
 import math
 import os
 import threading
+from functools import partial
 
 import numpy as np
 from llvmlite import ir
@@ -2067,7 +2068,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     # order 2's bit masks: re-opened, suspect, pending, a bit per node (one spare byte: a 2D
     # slice below), and the nodes in the band on entry with their times (a repair keeps
     # them if lower; element indices)
-    fl = _kernels._work_kept("flags", 4 * (npad // 8 + 2) if order == 2 else 4)
+    fl = (_kernels._work if lean else partial(_kernels._work_kept, "flags"))(
+        4 * (npad // 8 + 2) if order == 2 else 4)
     fl[:] = 0
     nodes = np.zeros(0, dtype=np.int64)
     if order == 2:
@@ -2086,10 +2088,11 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     # queues: one radix queue and one repair heap per slab (each slab's small arrays on
     # cache lines of its own: the two threads write them at every push and pop)
     nblk = max(POOL_MIN_BLOCKS, int(sizes.max()) // (16 * BLOCK))
-    # the entry pools in this thread's kept buffer (the serial march's): a fresh one's
-    # page faults (34 MB on 2048^2) would be taken by the windows
-    pool = _kernels._work_kept("pool", K * 16 * nblk * BLOCK).view(np.uint64).reshape(
-        K, 2 * nblk * BLOCK)
+    # the entry pools in this thread's kept buffer (the serial march's; not in the lean
+    # layout, whose buffers are not kept either): a fresh one's page faults (34 MB on
+    # 2048^2, ~20 ms of system time) would be taken by the windows
+    pool = (_kernels._work if lean else partial(_kernels._work_kept, "pool"))(
+        K * 16 * nblk * BLOCK).view(np.uint64).reshape(K, 2 * nblk * BLOCK)
     nxt = np.empty((K, nblk), dtype=np.uint32)
     bk = _lined(K, 2 * int(_NB), np.uint32)
     mw = _lined(K, _NW, np.uint64)
