@@ -94,7 +94,7 @@ def run_case(name: str, threads: int | None = None, step: float | None = None) -
 
 def main(argv: list[str]) -> int:
     """Print the digests of every case, or (``--write``) write them."""
-    return golden_plans.main(argv, cases, run, DATA)
+    return golden_plans.main(argv, cases, run, DATA, "tests.planning.golden_many:run")
 
 
 if __name__ == "__main__":

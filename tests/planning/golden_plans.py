@@ -155,9 +155,24 @@ def run_case(name: str, threads: int | None = None, force_parallel: bool = False
          _kernels.LEAN_NODES) = saved
 
 
-def main(argv: list[str], cases=cases, run=run, data: Path = DATA) -> int:
-    """Print the digest of every case, or (``--write``) write them to ``data``."""
-    out = {name: run(name) for name in cases()}
+def main(argv: list[str], cases=cases, run=run, data: Path = DATA,
+         target: str = "tests.planning.golden_plans:run") -> int:
+    """Print the digest of every case, or (``--write``) write them to ``data``.
+
+    Computed as the tests compute them: on a CPU whose numpy has AVX-512 loops, in a child
+    Python with those off (``target``: ``run`` as ``module:function``; golden_numpy.py says
+    why), else in this process. Written here directly, an AVX-512 machine's digests of the
+    shaped cases would be its own numpy's, not the code's, and the tests would fail them.
+    """
+    from . import golden_numpy
+
+    names = list(cases())
+    wide = golden_numpy.wide_features()
+    if wide:
+        got = golden_numpy.in_child(target, [((name,), {}) for name in names], wide)
+        out = dict(zip(names, got))
+    else:
+        out = {name: run(name) for name in names}
     if "--write" in argv:
         data.write_text(json.dumps(out, indent=1, sort_keys=True) + "\n")
         print(f"wrote {data}")

@@ -107,3 +107,27 @@ def test_computed_makes_a_modules_calls_in_one_child_elsewhere(monkeypatch):
                    [((300,), {}), ((200,), {})])
     assert run(200) == 0 and run(300) == 0 and children == [[(300,), (200,)]]
     assert run(100) == 0 and children == [[(300,), (200,)], [(100,)]]  # one not wanted: alone
+
+
+def test_the_writer_computes_the_digests_as_the_comparison_does(monkeypatch, tmp_path):
+    # golden_plans.main (--write) takes the child with numpy's wide loops off where this
+    # CPU has them, as the comparison does, and this process elsewhere
+    from . import golden_plans
+
+    children = []
+
+    def child(target, calls, disable):
+        children.append((target, [a for a, _ in calls], disable))
+        return [{"case": a[0], "where": "child"} for a, _ in calls]
+
+    def here(name):
+        return {"case": name, "where": "here"}
+
+    two = lambda: {"a": None, "b": None}  # noqa: E731
+    monkeypatch.setattr(golden_numpy, "in_child", child)
+    data = tmp_path / "golden.json"
+    for wide, where in ((["X86_V4"], "child"), ([], "here")):
+        monkeypatch.setattr(golden_numpy, "wide_features", lambda wide=wide: wide)
+        assert golden_plans.main(["--write"], two, here, data, "m:f") == 0
+        assert json.loads(data.read_text()) == {n: {"case": n, "where": where} for n in "ab"}
+    assert children == [("m:f", [("a",), ("b",)], ["X86_V4"])]
