@@ -1194,3 +1194,47 @@ def test_slab_march_reuses_its_kept_pools_and_masks_without_a_trace():
     np.testing.assert_array_equal(again, first)
     for slot in ("pool", "flags"):  # the smaller march took the larger buffers left
         assert _kernels._KEPT.bufs[slot] is stale[slot], slot
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_slab_march_places_its_cuts_while_the_balls_are_computed(order, monkeypatch):
+    # fast_marching computes the source balls on another thread while the slab march places
+    # its cuts from the source nodes (``ready``, ``sources``): the start's times and states
+    # are read only after ``ready()`` -- written only there, they give the times of the
+    # complete start (bit for bit at order 2; order 1's cuts may differ: round-off)
+    from fm2uav.eikonal import fmm
+
+    monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)
+    v, src = smooth((160, 140))
+    v = fmm._as_speed(v)
+    src3 = np.array([[src[0], src[1], 0]])
+    shape3 = (160, 140, 1)
+    whole, _ = _parallel.march(v.reshape(-1), _source_start(v, src3, shape3, (1.0,) * 3, 12.0,
+                                                            2.0), shape3, (1.0,) * 3, 2,
+                               order=order)
+    start, init = fmm._source_box(v, src3, shape3, (1.0,) * 3, 12.0, 2.0)
+    calls = []
+
+    def ready():
+        calls.append(len(calls))
+        init()
+
+    late, _ = _parallel.march(v.reshape(-1), start, shape3, (1.0,) * 3, 2, order=order,
+                              ready=ready, sources=src3)
+    assert calls == [0] and (start.state == 2).sum() > 100  # a ball, written in ready()
+    assert_equal_times(whole, late, exact=order == 2)
+
+
+def test_source_balls_in_the_background_wait_and_raise():
+    from fm2uav.eikonal import fmm
+
+    done = []
+    ready = fmm._in_background(lambda: done.append(1))
+    ready()
+    assert done == [1]
+
+    def fail():
+        raise ValueError("ball")
+
+    with pytest.raises(ValueError, match="ball"):
+        fmm._in_background(fail)()

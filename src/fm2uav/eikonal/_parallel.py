@@ -1702,7 +1702,7 @@ def _slab_count(most: int, shape3, G: int, nth: int) -> int:
 
 
 def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2,
-                more: int = 0) -> np.ndarray:
+                more: int = 0, cells=None) -> np.ndarray:
     """Row bounds (``k + 1`` ints) of ``k`` slabs along x, slab ``j`` marched by thread
     ``j % threads``; or of ``more`` slabs (``more + 1`` ints) where the coarse march
     predicts for them a windows' critical path shorter by the factor
@@ -1723,13 +1723,15 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2,
     descents with the shorter critical path when the bins' slabs are shared as
     :func:`_assign` shares them (:func:`_shared_cost`) are taken. Equal slabs when the
     start is not a few point sources (its box over a quarter of the grid) or the grid is
-    too thin for a coarse march.
+    too thin for a coarse march. ``cells`` (int, shape (m, 3)): the coarse march starts from
+    these nodes instead of the start's frozen ones (the sources, while their balls are being
+    computed: :func:`march`'s ``ready``).
     """
     nx = int(shape3[0])
     even = np.linspace(0, nx, k + 1).round().astype(np.int64)
     if k < 2 or threads < 2 or 4 * int(np.prod(start.shape)) > int(np.prod(shape3)):
         return even
-    hist, f = _coarse_histogram(speed, start, shape3, h3)
+    hist, f = _coarse_histogram(speed, start, shape3, h3, cells)
     if hist is None:
         return even
     rows = hist.shape[0]
@@ -1868,11 +1870,11 @@ def _shared_cost(cum, cuts, threads):
     return total
 
 
-def _coarse_histogram(speed, start, shape3, h3):
+def _coarse_histogram(speed, start, shape3, h3, cells=None):
     """Nodes per coarse x-row and time bin of a march over every ``COARSE``-th node
     (``COARSE_3D`` in 3D, along z ``COARSE_3D_Z``) from the start's frozen nodes: ``(hist,
     f)``, ``hist`` of shape ``(coarse rows, SPLIT_BINS)`` and ``f`` the x coarsening;
-    ``(None, f)`` if no estimate."""
+    ``(None, f)`` if no estimate. ``cells``: the nodes to start from instead (int, (m, 3))."""
     three = shape3[2] > 1
     f = _tuning.COARSE_3D if three else _tuning.COARSE
     grid = speed.reshape(shape3)
@@ -1881,12 +1883,14 @@ def _coarse_histogram(speed, start, shape3, h3):
     cshape = coarse.shape
     if cshape[0] < 4:
         return None, f
-    box = np.argwhere(start.state.reshape(start.shape) == _kernels.FROZEN)
-    if len(box) == 0:
+    if cells is None:
+        cells = np.argwhere(start.state.reshape(start.shape) == _kernels.FROZEN)
+        cells = cells + np.asarray(start.lo)
+    if len(cells) == 0:
         return None, f
     # the coarse nodes of the frozen ones (a mask over their box: a source ball on constant
     # speed holds ~33,000 nodes on 2048^2, and np.unique of rows took 38 ms of serial time)
-    cells = (box + np.asarray(start.lo)) // np.array([f, f, fz])
+    cells = np.asarray(cells, dtype=np.int64) // np.array([f, f, fz])
     lo = cells.min(axis=0)
     bshape = tuple(int(n) for n in cells.max(axis=0) - lo + 1)
     frozen = np.zeros(bshape, dtype=bool)
@@ -1919,7 +1923,7 @@ def _coarse_histogram(speed, start, shape3, h3):
 
 
 def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interleave=None,
-          span=None):
+          span=None, ready=None, sources=None):
     """The Fast Marching from ``start`` on ``threads`` slabs in parallel.
 
     Parameters
@@ -1952,6 +1956,13 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         (:func:`fm2uav.eikonal.fast_marching` finds them in its input scan): the plateau
         test needs no pass over the speeds, nor the first window's width (the largest).
         None: found here.
+    ready : callable, optional
+        The start's times and states are still being written (the source balls, on
+        another thread: :func:`fm2uav.eikonal.fmm._source_start`); called, it waits for
+        them. Meanwhile the cuts are placed from the nodes ``sources`` (int, (m, 3)), the
+        box's geometry (``lo``, ``shape``) being final. None: ``start`` is complete.
+    sources : ndarray, int, shape (m, 3), optional
+        With ``ready``: the source nodes.
 
     Returns
     -------
@@ -1992,6 +2003,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         spt2, more_wn = _tuning.MORE_SLABS_3D[order]
         more = _slab_count(nth * spt2, shape3, G, nth)
     early = toucher = None
+    cells = None if ready is None else sources  # the cuts' coarse march starts from these
     if lean and nth > 1:
         # the lean layout's buffers are fresh mappings whose page faults (~0.4 CPU-s for
         # the 42 M nodes of a 1000 x 1000 x 40 terrain) the padding takes; map them at
@@ -2004,7 +2016,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     top_of = speed if span is None else None
     if early is not None:
         with _PageToucher(early[0], early[1], top_of=top_of) as toucher:
-            bounds = slab_bounds(speed, start, shape3, h3, K, nth, more)
+            bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells)
     elif nth > 1:
         # the cuts' coarse march runs on this thread alone: meanwhile a second one finds the
         # top speed (unless given) and faults in the result's pages (a fresh array's: a
@@ -2015,11 +2027,11 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         touch = () if resident else (out[half:], out[:half])
         if touch or top_of is not None:
             with _PageToucher(*touch, top_of=top_of) as toucher:
-                bounds = slab_bounds(speed, start, shape3, h3, K, nth, more)
+                bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells)
         else:
-            bounds = slab_bounds(speed, start, shape3, h3, K, nth, more)
+            bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells)
     else:
-        bounds = slab_bounds(speed, start, shape3, h3, K, nth, more)
+        bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells)
     if bounds.size - 1 != K:  # the more slabs taken, with their windows
         K, wn = bounds.size - 1, more_wn
     bounds = clear_of_sources(bounds, start, shape3,
@@ -2044,6 +2056,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         del early
     plane = ny * nz
     boxes = _start_boxes(start, bounds, nx, G)
+    if ready is not None:  # the source balls (their times and states) are written
+        ready()
     with _threads(nth):
         _pad_slabs(nth, _kernels._readonly(speed), start.T, start.state, boxes, bounds, off, ny,
                    nz, G, Tp, Vp)

@@ -287,7 +287,7 @@ def _box_range(speed, si, sj, sk, ri, rj, rk, nx, ny, nz):
 
 
 # long on purpose: one compiled loop (numba kernel); helpers would add calls in the hot path
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", nogil=True)
 def init_sources(speed, T, state, nx, ny, nz, hx, hy, hz, src, radius, min_radius, max_ratio):
     """Initialise point sources in place: ``T = 0`` (frozen) and the source balls.
 

@@ -6,6 +6,7 @@ finalise (reshape), so input checks live in one place.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Sequence
 from typing import Any
 
@@ -260,8 +261,38 @@ def fast_marching(
     radius = max(SOURCE_INIT_CELLS * max(h), SOURCE_INIT_FRACTION * extent)
     if src.shape[0] > MAX_BALL_SOURCES or not source_ball:
         radius = 0.0
-    start = _source_start(v, src3, shape3, h3, radius, SOURCE_INIT_CELLS * max(h))
+    start, init = _source_box(v, src3, shape3, h3, radius, SOURCE_INIT_CELLS * max(h))
+    if (radius > 0 and stop_at is None and nthreads > 1
+            and _parallel.on_slabs(flat_speed.size, shape3[2] > 1, order)):
+        # the slab march places its cuts from the sources while the balls are computed on
+        # another core (on 2048^2 smooth speed the factored ball takes ~10 ms, the cuts ~4)
+        ready = _in_background(init)
+        return run_march(flat_speed, start, shape, h3, order, stop_at, threads=nthreads,
+                         span=span, ready=ready, sources=src3)
+    init()
     return run_march(flat_speed, start, shape, h3, order, stop_at, threads=nthreads, span=span)
+
+
+def _in_background(fn) -> Any:
+    """Run ``fn()`` on a new thread; returns the call that waits for it (and raises what it
+    raised). ``fn`` must release the GIL to run beside the caller (compiled, ``nogil``)."""
+    failed: list[BaseException] = []
+
+    def run() -> None:
+        try:
+            fn()
+        except BaseException as exc:  # noqa: BLE001 - re-raised by ready()
+            failed.append(exc)
+
+    worker = threading.Thread(target=run, name="fm2uav-source-balls", daemon=True)
+    worker.start()
+
+    def ready() -> None:
+        worker.join()
+        if failed:
+            raise failed[0]
+
+    return ready
 
 
 def _source_start(v: np.ndarray, src3: np.ndarray, shape3: tuple[int, ...],
@@ -274,6 +305,17 @@ def _source_start(v: np.ndarray, src3: np.ndarray, shape3: tuple[int, ...],
     a copy of that box only, so a single source costs memory for its ball, not
     for the grid.
     """
+    start, init = _source_box(v, src3, shape3, h3, radius, min_radius)
+    init()
+    return start
+
+
+def _source_box(v: np.ndarray, src3: np.ndarray, shape3: tuple[int, ...],
+                h3: tuple[float, float, float], radius: float,
+                min_radius: float) -> tuple[_kernels.Start, Any]:
+    """:func:`_source_start` in two steps: the start's box (its times ``inf``, its states
+    0) and the call that writes the sources and their balls into it
+    (:func:`fm2uav.eikonal._sources.init_sources`, which releases the GIL)."""
     reach = np.zeros(3, dtype=np.int64)
     if radius > 0:
         reach[:] = [int(np.floor(radius / hk)) for hk in h3]
@@ -290,11 +332,13 @@ def _source_start(v: np.ndarray, src3: np.ndarray, shape3: tuple[int, ...],
         speed_box = np.ascontiguousarray(v.reshape(shape3)[box]).reshape(-1)
     T = np.full(speed_box.size, np.inf)
     state = np.zeros(speed_box.size, dtype=np.uint8)
-    _sources.init_sources(
-        _kernels._readonly(speed_box), T, state, *bshape, *h3, src3 - lo, radius, min_radius,
-        BALL_MAX_SPEED_RATIO,
-    )
-    return _kernels.Start(tuple(int(a) for a in lo), bshape, T, state)
+    args = (_kernels._readonly(speed_box), T, state, *bshape, *h3, src3 - lo, radius,
+            min_radius, BALL_MAX_SPEED_RATIO)
+
+    def init() -> None:
+        _sources.init_sources(*args)
+
+    return _kernels.Start(tuple(int(a) for a in lo), bshape, T, state), init
 
 
 def run_march(
@@ -306,6 +350,8 @@ def run_march(
     stop_at: Any,
     threads: int = 1,
     span: tuple[float, float] | None = None,
+    ready: Any = None,
+    sources: np.ndarray | None = None,
 ) -> np.ndarray:
     """March from the frozen/band nodes of ``start`` (a :class:`~fm2uav.eikonal._kernels.Start`).
 
@@ -320,6 +366,9 @@ def run_march(
     which sets up on them (:func:`~fm2uav.eikonal._kernels.march`). ``span``: the
     smallest positive and the largest speed [m/s] if the caller knows them (the plateau
     test and the parallel march's first window then need no pass over the speeds).
+    ``ready``, ``sources``: ``start``'s arrays still being written, and the source nodes
+    (:func:`fm2uav.eikonal._parallel.march`); the slab march waits for them after placing
+    its cuts, the others at once.
 
     Returns
     -------
@@ -327,6 +376,10 @@ def run_march(
         Arrival times, shape ``shape``.
     """
     shape3 = shape + (1,) * (3 - len(shape))
+    slabs = threads > 1 and _parallel.on_slabs(flat_speed.size, shape3[2] > 1, order)
+    if ready is not None and (stop_at is not None or not slabs):
+        ready()
+        ready = None
     stops = np.zeros((0, 3), dtype=np.int64)
     if stop_at is not None:
         idx = as_index_array(stop_at, shape, "stop_at")
@@ -334,9 +387,10 @@ def run_march(
         stops[:, : len(shape)] = idx
         if start.frozen_at(stops).all():  # every stop node is a source or in its ball
             return start.frozen_times(shape3).reshape(shape)
-    if threads > 1 and _parallel.on_slabs(flat_speed.size, shape3[2] > 1, order):
+    if slabs:
         T, _ = _parallel.march(flat_speed, start, shape3, h3, threads,
-                               stops[~start.frozen_at(stops)], order=order, span=span)
+                               stops[~start.frozen_at(stops)], order=order, span=span,
+                               ready=ready, sources=sources)
     else:
         T, _ = _kernels.march(flat_speed, start, shape3, h3, order, stops, threads=threads,
                               span=span)
