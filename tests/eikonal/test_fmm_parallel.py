@@ -187,8 +187,8 @@ def test_order_2_on_random_fm2_fields_and_thin_slabs_equals_the_serial_march(blo
         monkeypatch.setattr(_tuning, "SLABS_PER_THREAD",
                             {(d, o): per for d in (2, 3) for o in (1, 2)})
         monkeypatch.setattr(_parallel, "slab_bounds",  # equal slabs of ``rows`` rows
-                            lambda speed, start, shape3, h3, k, t=2, more=0: np.linspace(
-                                0, shape3[0], k + 1).round().astype(np.int64))
+                            lambda speed, start, shape3, h3, k, t=2, more=0, cells=None:
+                            np.linspace(0, shape3[0], k + 1).round().astype(np.int64))
         flat, start, shape3 = _start_h(v, src, h)
         T, stats = _parallel.march(flat, start, shape3, h + (1.0,) * (3 - v.ndim), threads,
                                    order=2)
@@ -312,13 +312,13 @@ def test_balanced_cuts_of_many_slabs_shorten_the_windows_critical_path(shape, ga
     assert_equal_times(serial, T)
     even = np.linspace(0, shape[0], k + 1).round().astype(np.int64)
     assert not np.array_equal(cuts, even)
-    monkeypatch.setattr(_parallel, "slab_bounds", lambda *a: even)
+    monkeypatch.setattr(_parallel, "slab_bounds", lambda *a, **kw: even)
     T, equal = _parallel.march(flat, start, shape3, (1.0,) * 3, 2)
     assert_equal_times(serial, T)
     assert balanced["slabs"] == equal["slabs"] == k
     assert balanced["balance"] > gain * equal["balance"]
     if len(shape) == 2:
-        monkeypatch.setattr(_parallel, "slab_bounds", lambda *a: cuts)
+        monkeypatch.setattr(_parallel, "slab_bounds", lambda *a, **kw: cuts)
         monkeypatch.setattr(_tuning, "DYNAMIC_2D", True)
         T, turn = _parallel.march(flat, start, shape3, (1.0,) * 3, 2)
         assert_equal_times(serial, T)

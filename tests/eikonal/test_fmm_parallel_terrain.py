@@ -61,9 +61,9 @@ def test_terrain_march_with_a_stop_equals_the_serial_march_bit_for_bit(lean, mon
         calls["inf_after"] += 1
         return real_inf_after(nth, T, t)
 
-    def bounds(*args):
+    def bounds(*args, **kw):
         calls["cuts"] += 1
-        return real_bounds(*args)
+        return real_bounds(*args, **kw)
 
     real_inf_after, real_bounds = _parallel._inf_after, _parallel.slab_bounds
     monkeypatch.setattr(_parallel, "_PageToucher", Toucher)
@@ -147,8 +147,8 @@ def test_big_3d_grids_cut_the_slabs_for_sharing_bit_for_bit(lean, monkeypatch):
     seen = []
     real = _parallel.slab_bounds
 
-    def spy(*args):
-        seen.append((args, real(*args)))
+    def spy(*args, **kw):
+        seen.append((args, real(*args, **kw)))
         return seen[-1][1]
 
     monkeypatch.setattr(_parallel, "slab_bounds", spy)

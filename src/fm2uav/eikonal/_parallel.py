@@ -2016,7 +2016,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     top_of = speed if span is None else None
     if early is not None:
         with _PageToucher(early[0], early[1], top_of=top_of) as toucher:
-            bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells)
+            bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells=cells)
     elif nth > 1:
         # the cuts' coarse march runs on this thread alone: meanwhile a second one finds the
         # top speed (unless given) and faults in the result's pages (a fresh array's: a
@@ -2027,11 +2027,11 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         touch = () if resident else (out[half:], out[:half])
         if touch or top_of is not None:
             with _PageToucher(*touch, top_of=top_of) as toucher:
-                bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells)
+                bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells=cells)
         else:
-            bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells)
+            bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells=cells)
     else:
-        bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells)
+        bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells=cells)
     if bounds.size - 1 != K:  # the more slabs taken, with their windows
         K, wn = bounds.size - 1, more_wn
     bounds = clear_of_sources(bounds, start, shape3,
