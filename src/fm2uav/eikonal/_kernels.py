@@ -325,8 +325,11 @@ def _pop_ahead(T, V, pool, nxt, bk, mw, nfree, fh, cur, last, s1, s2, pv):
     With ``s1 > 0`` (the x stride of the padded grid; ``s2`` the y stride in 3D, 0 in
     2D): a scanned bucket's other entries are the next nodes to pop, so the lines their
     expansion reads (:func:`_fetch_around`, ``V`` too if ``pv``) are prefetched while
-    the popped node is expanded; a split prefetches the ``T`` of a block's nodes before
-    it reads them (the check for outdated entries). Where the front is sheared (slow
+    the popped node is expanded (the smallest other entry), and so are those of a level-0
+    bucket's next entry (one key value: on a uniform map the wave reaches the nodes
+    symmetric about a source at one time, far apart in memory; measured 0.80x the time on
+    160^3 constant speed order 1, docs/performance.md); a split prefetches the ``T`` of a
+    block's nodes before it reads them (the check for outdated entries). Where the front is sheared (slow
     air near terrain, ``docs/performance.md``) consecutive pops lie far apart in memory
     and these lines are cold. The queue and the popped nodes are those of :func:`_pop`.
     """
@@ -343,6 +346,12 @@ def _pop_ahead(T, V, pool, nxt, bk, mw, nfree, fh, cur, last, s1, s2, pv):
         if cur - _ONE < _NVAL:  # level 0: one key value, take the last entry (LIFO)
             bp = hb * _BS + cnt - _ONE
             c = pool[bp + bp + _ONE]
+            if s1 != _ZERO:  # the next pop: the entry below (a full block's last if none)
+                if cnt > _ONE:
+                    _fetch_around(T, V, pool[bp + bp - _ONE], s1, s2, pv)
+                elif nxt[hb] != _NIL:
+                    q = _U(nxt[hb]) * _BS + _BS - _ONE
+                    _fetch_around(T, V, pool[q + q + _ONE], s1, s2, pv)
             nfree, fh = _remove(bp, cur, pool, nxt, bk, mw, nfree, fh)
             return c, nfree, fh, cur, last
         if cur == _ZERO or (nxt[hb] == _NIL and cnt <= SCAN_MAX):

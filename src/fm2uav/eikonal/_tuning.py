@@ -107,7 +107,10 @@ SLABS_PER_THREAD = {(2, 1): 4, (3, 1): 4, (2, 2): 4, (3, 2): 2}
 #: FM²-shaped 1.32x / 1.44x, constant 1.09x / 1.37x, smooth 1.18x / 1.27x (4 slabs of
 #: 4096: 1.33x / 1.28x / 0.94x; 3 of 8192: 1.10x / 1.07x), the terrain march 3.86 / 3.29-3.68
 #: s (4 of 4096 3.08-3.22 s, 3 of 8192 3.14 s, 4 of 8192 3.39-3.42 s).
-WINDOW_NODES = {(2, 1): 16384, (3, 1): 8192, (2, 2): 8192, (3, 2): 8192}
+#: 3D order 1 again (session 34, 6 December 2026, after the slab march's kept pools: 160^3, two
+#: threads, alternating processes, medians of 6 rounds of 5; 16384 / 32768 against 8192):
+#: constant 0.915x / 0.871x, FM²-shaped 0.990x / 1.033x, smooth 0.911x / 0.864x: 16384.
+WINDOW_NODES = {(2, 1): 16384, (3, 1): 16384, (2, 2): 8192, (3, 2): 8192}
 #: Share the slabs among the threads anew before every window, longest first by the freezes of the
 #: last window, when that predicts a shorter window than the fixed interleave
 #: (:func:`_parallel._assign`); False: always the interleave. Windows' balance with / without (2
