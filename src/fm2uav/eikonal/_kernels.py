@@ -329,9 +329,10 @@ def _pop_ahead(T, V, pool, nxt, bk, mw, nfree, fh, cur, last, s1, s2, pv):
     bucket's next entry (one key value: on a uniform map the wave reaches the nodes
     symmetric about a source at one time, far apart in memory; measured 0.80x the time on
     160^3 constant speed order 1, docs/performance.md); a split prefetches the ``T`` of a
-    block's nodes before it reads them (the check for outdated entries). Where the front is sheared (slow
-    air near terrain, ``docs/performance.md``) consecutive pops lie far apart in memory
-    and these lines are cold. The queue and the popped nodes are those of :func:`_pop`.
+    block's nodes before it reads them (the check for outdated entries). Where the front
+    is sheared (slow air near terrain, ``docs/performance.md``) consecutive pops lie far
+    apart in memory and these lines are cold. The queue and the popped nodes are those of
+    :func:`_pop`.
     """
     while True:
         if bk[cur + cur] == _NIL:  # also for the sentinel cur == _NOB
