@@ -773,6 +773,33 @@ def test_thin_interleaved_slabs_with_ghosts_on_both_sides(field, monkeypatch):
     assert_equal_times(serial, T)
 
 
+@pytest.mark.parametrize("h", [(1.0, 1.0, 1.0), (1.0, 0.7, 1.3)])
+@pytest.mark.parametrize("field", ["constant", "smooth", "fm2", "plateau"])
+def test_3d_windows_far_rule_and_deferral_on_thin_slabs(field, h, monkeypatch):
+    """The 3D order-1 windows give a far neighbour the one-axis update and defer it as the
+    serial 3D march does: with slabs of one x-plane (ghosts on both sides of every own node)
+    and several sources, the rule on and off give the same times bit for bit, the deferral
+    the same to round-off, on one thread and on two, and they are the serial march's, on
+    every field and on an anisotropic grid."""
+    shape = (23, 19, 17)
+    monkeypatch.setattr(_tuning, "MIN_SLAB_ROWS", 1)
+    monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)
+    monkeypatch.setattr(_tuning, "SLABS_PER_THREAD",  # one x-plane each
+                        {(2, 1): 4, (2, 2): 4, (3, 1): shape[0], (3, 2): 4})
+    monkeypatch.setattr(_tuning, "MORE_SLABS_3D", {})
+    name, v, src = next(f for f in _fields(shape) if f[0] == field)
+    v = _as_speed(v)
+    sources = np.array([src, (11, 3, 8), (12, 15, 2)], dtype=np.int64)
+    sources = sources[[v[tuple(s)] > 0 for s in sources]]
+    start = _source_start(v, sources, shape, h, 2.0, 2.0)
+    flat = v.reshape(-1)
+    T, stats = _both_ways(flat, start, shape, h, monkeypatch)
+    assert stats["slabs"] == shape[0] and stats["reopened"] > 0
+    serial, _ = _kernels.march(flat, start, shape, h, 1, np.zeros((0, 3), dtype=int))
+    assert_equal_times(serial, T)
+    assert np.isfinite(T).sum() == np.isfinite(serial).sum() > 0.5 * v.size
+
+
 @pytest.mark.parametrize("order", [1, 2])
 def test_lean_2d_slabs_keep_separate_float32_arrays(order, monkeypatch):
     seen = _layouts(monkeypatch)

@@ -46,8 +46,9 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
   neighbour's time and speed from one cache line. A uniform map keeps the separate arrays
   and reads no speed (the plateau register). ``march(..., interleave=False)`` forces the
   separate arrays (the tests: the same times bit for bit).
-* **Far neighbours** (2D): a window freezing a node gives its far neighbours the one-axis
-  update along their axis, as the serial march (:data:`FAR_ONE_AXIS`). Valid in a slab
+* **Far neighbours** (order 1, and order 2 in 2D): a window freezing a node gives its far
+  neighbours the one-axis update along their axis, as the serial march
+  (:data:`FAR_ONE_AXIS`). Valid in a slab
   because a far node never has a frozen neighbour: a pop, a node frozen on entry (the
   start) and a ghost (the exchange, its one own neighbour) each update their band and far
   own neighbours when they become frozen, and a re-opened node had done so when it was
@@ -60,8 +61,10 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
   order-2 window defers so too (its far rule is its own, below): there a suspect node's time
   can go *up* when it pops, so the band neighbours it no longer precedes are queued then, and
   its update and repair paths queue a band node they do not lower; still the serial times
-  bit for bit. The 3D windows defer nothing: with the deferral (after the full update, or with the one-axis
-  rule) they measured up to 14 % slower on 160^3 (docs/performance.md, "Deferred entries").
+  bit for bit. The 3D order-1 windows take the rule and the deferral too (across either other
+  axis, :func:`~fm2uav.eikonal._kernels._earlier_band3`, as the serial 3D march): on 160^3 two
+  threads 0.94-0.95x the time (docs/performance.md, session 35); the 3D order-2 window
+  defers nothing.
 * Time windows: every slab pops, with its own queue and in parallel, the nodes
   whose time is below ``t_w``, and lists the nodes it froze in its two boundary rows;
   then (barrier) every slab copies those of its neighbours into its ghosts (not the
@@ -104,7 +107,7 @@ from ._heap import sift_down, sift_up
 from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _ORDER2_MAX_W_RATIO, _U, _ZERO,
                        RESERVE_BLOCKS, BLOCK,
                        _at_plateau, _axis_term, _axis_term_u, _bits, _bucket, _combine,
-                       _earlier_band, _fetch_rows, _from_bits, _prefetch,
+                       _earlier_band, _earlier_band3, _fetch_rows, _from_bits, _prefetch,
                        _pop, _pop_ahead, _push, _rhs, _side_min, _solve_iso, pad_grid,
                        speed_range, unpad_grid)
 
@@ -116,12 +119,12 @@ if "OMP_WAIT_POLICY" not in os.environ:
 
 __all__ = ["march", "on_slabs", "resolve_threads"]
 
-#: 2D: a far neighbour of the node a window freezes gets the one-axis update along their
-#: axis, as in the serial march (valid in a slab: see the window's docstring); False: the
-#: full update (the same times bit for bit; the tests run both).
+#: 2D and 3D order 1 (order 2: 2D): a far neighbour of the node a window freezes gets the
+#: one-axis update along their axis, as in the serial march (valid in a slab: see the window's
+#: docstring); False: the full update (the same times bit for bit; the tests run both).
 FAR_ONE_AXIS = True
-#: 2D, with :data:`FAR_ONE_AXIS`: a far neighbour so updated gets no queue entry while a band
-#: neighbour across the other axis is earlier (**deferred**, as in the serial march; see the
+#: With :data:`FAR_ONE_AXIS`: a far neighbour so updated gets no queue entry while a band
+#: neighbour across another axis is earlier (**deferred**, as in the serial march; see the
 #: window's docstring; order 2 too). False: queued at once. Both end at the serial march's
 #: times (order 1 to round-off, order 2 bit for bit); on a map with exact ties and repairs the
 #: order-1 windows may differ in round-off (the order in which the same times pop), so the far
@@ -415,9 +418,9 @@ def _slab_kernels(three, pairs=False):
         freezes in its first and last own rows go to ``sent[0]`` and ``sent[1]``
         (``ns`` their counts, reset here): the neighbours' exchange reads only those.
 
-        ``far`` (2D): 1 or 2, a far neighbour of the node just frozen gets the one-axis
+        ``far``: 1 or 2, a far neighbour of the node just frozen gets the one-axis
         update along their axis, as in the serial march (0: the full update); 2, and no queue
-        entry while a neighbour across the other axis is in the band earlier (deferred, as in
+        entry while a neighbour across another axis is in the band earlier (deferred, as in
         the serial march: that neighbour is an own node, ghosts hold frozen times or NaN, so
         this slab freezes it first and updates the node again, and :func:`_lower_r` queues a
         band node that an update does not lower). Valid in a slab because no far node has
@@ -478,36 +481,27 @@ def _slab_kernels(three, pairs=False):
                 _note(sent, ns, 1, c)
             # prefetch V apart from T off the plateau (interleaved: the same lines)
             pv = one == _ONE and not (use_u and _at_plateau(U, c))
-            if three:
-                for nb in _nbs(c, sx, sy, three):
-                    y = T[nb]
-                    if y < 0.0 or (y > t and nb >= lo and nb < hi):
-                        # band/far, or frozen later than c in this slab: c may lower it
-                        t_nb = _update(T, V, U, use_u, qp, nb, sx, sy, ih, hh, iso, three)
-                        nfree, fh, cur, rsize = _lower_r(T, V, nb, t_nb, fixed, sx, sy, three,
-                                                         pv, pool, nxt, bk, mw, rkey, ritem,
-                                                         ctl, True, nfree, fh, cur, last,
-                                                         rsize)
-            else:
-                for j in range(4):  # one site for the four neighbours, as the serial march
-                    s = sx if j < 2 else sy
-                    nb = c - s if j & 1 == 0 else c + s
-                    y = T[nb]
-                    if far != 0 and y == -_INF:  # c is its only frozen neighbour (docstring)
-                        q = _rhs(V, U, use_u, qp, nb)
-                        t_nb = t + math.sqrt(q * hh) if iso else t + math.sqrt(q / ih[j >> 1])
-                        if far == 2 and _earlier_band(T, nb, sy if j < 2 else sx, t_nb):
-                            T[nb] = -t_nb  # deferred, as in the serial march
-                            _prefetch_rows(T, V, nb, sx, sy, three, pv)
-                            continue
-                    elif y < 0.0 or (y > t and nb >= lo and nb < hi):
-                        # band/far, or frozen later than c in this slab: c may lower it
-                        t_nb = _update(T, V, U, use_u, qp, nb, sx, sy, ih, hh, iso, three)
-                    else:
+            # one site for the neighbours, as the serial march
+            for j in range(6 if three else 4):
+                s = sx if j < 2 else (sy if j < 4 else one)
+                nb = c - s if j & 1 == 0 else c + s
+                y = T[nb]
+                if far != 0 and y == -_INF:  # c is its only frozen neighbour (docstring)
+                    q = _rhs(V, U, use_u, qp, nb)
+                    t_nb = t + math.sqrt(q * hh) if iso else t + math.sqrt(q / ih[j >> 1])
+                    if far == 2 and (_earlier_band3(T, nb, j, sx, sy, one, t_nb) if three else
+                                     _earlier_band(T, nb, sy if j < 2 else sx, t_nb)):
+                        T[nb] = -t_nb  # deferred, as in the serial march
+                        _prefetch_rows(T, V, nb, sx, sy, three, pv)
                         continue
-                    nfree, fh, cur, rsize = _lower_r(T, V, nb, t_nb, fixed, sx, sy, three, pv,
-                                                     pool, nxt, bk, mw, rkey, ritem, ctl, True,
-                                                     nfree, fh, cur, last, rsize)
+                elif y < 0.0 or (y > t and nb >= lo and nb < hi):
+                    # band/far, or frozen later than c in this slab: c may lower it
+                    t_nb = _update(T, V, U, use_u, qp, nb, sx, sy, ih, hh, iso, three)
+                else:
+                    continue
+                nfree, fh, cur, rsize = _lower_r(T, V, nb, t_nb, fixed, sx, sy, three, pv, pool,
+                                                 nxt, bk, mw, rkey, ritem, ctl, True, nfree, fh,
+                                                 cur, last, rsize)
         _keep_queue(st, nfree, fh, cur, last, rsize)
         ctl[_C_POPS] = pops
 
