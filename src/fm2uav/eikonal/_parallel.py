@@ -48,8 +48,8 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
   separate arrays (the tests: the same times bit for bit).
 * **Far neighbours** (order 1, and order 2 in 2D): a window freezing a node gives its far
   neighbours the one-axis update along their axis, as the serial march
-  (:data:`FAR_ONE_AXIS`). Valid in a slab
-  because a far node never has a frozen neighbour: a pop, a node frozen on entry (the
+  (:data:`FAR_ONE_AXIS`). Valid in a slab because a far node never has a frozen
+  neighbour: a pop, a node frozen on entry (the
   start) and a ghost (the exchange, its one own neighbour) each update their band and far
   own neighbours when they become frozen, and a re-opened node had done so when it was
   frozen first; so the full update of that node reads one frozen neighbour and gives the
@@ -63,8 +63,8 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
   its update and repair paths queue a band node they do not lower; still the serial times
   bit for bit. The 3D order-1 windows take the rule and the deferral too (across either other
   axis, :func:`~fm2uav.eikonal._kernels._earlier_band3`, as the serial 3D march): on 160^3 two
-  threads 0.94-0.95x the time (docs/performance.md, session 35); the 3D order-2 window
-  defers nothing.
+  threads the windows' CPU 0.95x at constant and smooth speed, the wall 0.97-0.99x
+  (docs/performance.md, session 35); the 3D order-2 window defers nothing.
 * Time windows: every slab pops, with its own queue and in parallel, the nodes
   whose time is below ``t_w``, and lists the nodes it froze in its two boundary rows;
   then (barrier) every slab copies those of its neighbours into its ghosts (not the
