@@ -187,7 +187,8 @@ def test_order_2_on_random_fm2_fields_and_thin_slabs_equals_the_serial_march(blo
         monkeypatch.setattr(_tuning, "SLABS_PER_THREAD",
                             {(d, o): per for d in (2, 3) for o in (1, 2)})
         monkeypatch.setattr(_parallel, "slab_bounds",  # equal slabs of ``rows`` rows
-                            lambda speed, start, shape3, h3, k, t=2, more=0, cells=None:
+                            lambda speed, start, shape3, h3, k, t=2, more=0, cells=None,
+                            fewer=0:
                             np.linspace(0, shape3[0], k + 1).round().astype(np.int64))
         flat, start, shape3 = _start_h(v, src, h)
         T, stats = _parallel.march(flat, start, shape3, h + (1.0,) * (3 - v.ndim), threads,
@@ -371,6 +372,71 @@ def test_the_bench_s_3d_fields_get_more_slabs_only_off_centre():
         flat, start, shape3 = _start(v, src)
         got[name] = len(_parallel.slab_bounds(flat, start, shape3, (1.0,) * 3, k, 2, more)) - 1
     assert got == {"fm2": more, "smooth": k}
+
+
+@pytest.mark.parametrize("cost", [0.9, 1.0, 1.1])
+def test_fewer_slabs_only_where_the_coarse_march_predicts_a_shorter_path(cost, monkeypatch):
+    """``slab_bounds(..., k, threads, fewer=m)`` returns ``m`` slabs exactly where the coarse
+    march reaches every coarse node and its critical path with them is at most
+    ``FEWER_SLABS_COST`` times that with ``k`` (then no ``more``), else what it gives without
+    ``fewer``."""
+    monkeypatch.setattr(_tuning, "FEWER_SLABS_COST", cost)
+    shape = (96, 64, 64)
+    walls = np.where(fm2_shaped(shape)[0] > 0.0, 1.0, 0.0)
+    seen = set()
+    for v, src in ((np.ones(shape), (48, 32, 32)), (np.ones(shape), (30, 20, 40)),
+                   (np.ones(shape), (41, 32, 32)), smooth(shape), fm2_shaped(shape),
+                   (walls, (48, 32, 32))):
+        flat, start, shape3 = _start(v, src)
+        ratio = _cost_ratio(flat, start, shape3, 2, 4)  # path with 2 over that with 4
+        open_air = bool(np.all(v[::_tuning.COARSE_3D, ::_tuning.COARSE_3D,
+                                 ::_tuning.COARSE_3D_Z] > 0.0))
+        cuts = _parallel.slab_bounds(flat, start, shape3, (1.0,) * 3, 4, 2, 6, fewer=2)
+        assert cuts[0] == 0 and cuts[-1] == shape3[0]
+        if ratio <= cost and open_air:
+            assert len(cuts) == 3
+        else:
+            assert np.array_equal(cuts, _parallel.slab_bounds(flat, start, shape3,
+                                                              (1.0,) * 3, 4, 2, 6))
+        seen.add((len(cuts) == 3, ratio <= 1.0, open_air))
+    if cost == 1.0:  # the setting takes the centred uniform field only
+        assert (True, True, True) in seen and (False, True, False) in seen
+        assert (False, False, True) in seen
+    # fewer not below k, or none: k
+    assert len(_parallel.slab_bounds(flat, start, shape3, (1.0,) * 3, 4, 2, fewer=4)) == 5
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_a_uniform_3d_march_from_the_centre_takes_a_slab_a_thread_bit_for_bit(order,
+                                                                               monkeypatch):
+    """A uniform speed from the centre (the bench's constant field): one slab per thread,
+    with the slabs' windows, and the serial march's times; the same map with walls from its
+    FM²-shaped field, or a speed that is not uniform, keeps its slabs; so does the setting
+    off."""
+    monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)
+    monkeypatch.setattr(_tuning, "ORDER2_MIN_NODES_3D", 0)
+    shape = (96, 64, 64)
+    walls = fm2_shaped(shape)[0] > 0.0
+    k = _slab_count_for(shape, order)
+    for v, span, want in ((np.ones(shape), (1.0, 1.0), 2), (np.ones(shape), None, k),
+                          (np.where(walls, 1.0, 0.0), (1.0, 1.0), k), (smooth(shape)[0], None, k)):
+        flat, start, shape3 = _start(v, (48, 32, 32))
+        serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, order,
+                                   np.zeros((0, 3), dtype=int))
+        T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, 2, order=order, span=span)
+        assert_equal_times(serial, T, exact=order == 2)
+        if want is not None:
+            assert stats["slabs"] == want
+        monkeypatch.setattr(_tuning, "FEWER_SLABS_3D", False)
+        T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, 2, order=order, span=span)
+        monkeypatch.setattr(_tuning, "FEWER_SLABS_3D", True)
+        assert_equal_times(serial, T, exact=order == 2)
+        assert stats["slabs"] >= k
+
+
+def _slab_count_for(shape, order):
+    """The slabs a 3D march of ``shape`` on two threads asks for (no more, no fewer)."""
+    return _parallel._slab_count(2 * _tuning.SLABS_PER_THREAD[3, order], shape, order, 2)
 
 
 def test_a_3d_order_2_march_on_more_slabs_takes_their_windows_bit_for_bit(monkeypatch):

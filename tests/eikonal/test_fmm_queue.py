@@ -153,7 +153,8 @@ def _drain(ahead, T, V, nodes, seed, s1, s2, steps):
     """A march's queue workload on the band times ``-T[nodes]``: pop the smallest entry,
     skip it if its node is frozen, freeze it, then lower a few pseudo-random band nodes
     to the popped time plus 0 (exact ties) to 1/8 (new entries; the old ones stay behind,
-    outdated). ``ahead``: pop with ``_pop_ahead`` (strides ``s1``, ``s2``), else ``_pop``.
+    outdated). ``ahead``: pop with ``_pop_ahead`` (strides ``s1``, ``s2``; 2: ``scans`` False, the
+    3D order-1 windows' pop), else ``_pop``.
     Returns the popped nodes (outdated entries as ``-1``) in order."""
     nblk = 8 * nodes.size // _kernels.BLOCK + 2 * _kernels.RESERVE_BLOCKS
     pool = np.empty(2 * nblk * _kernels.BLOCK, dtype=np.uint64)
@@ -170,9 +171,9 @@ def _drain(ahead, T, V, nodes, seed, s1, s2, steps):
     out = np.full(steps, -2, dtype=np.int64)
     x = np.uint64(seed)
     for i in range(steps):
-        if ahead:
+        if ahead:  # 1: every prefetch (the serial 3D march), 2: the level-0 one only
             c, nfree, fh, cur, last = _kernels._pop_ahead(T, V, pool, nxt, bk, mw, nfree, fh,
-                                                          cur, last, s1, s2, True)
+                                                          cur, last, s1, s2, True, ahead == 1)
         else:
             c, nfree, fh, cur, last = _kernels._pop(T, pool, nxt, bk, mw, nfree, fh, cur, last)
         if c == np.uint64(0xFFFFFFFF):
@@ -212,8 +213,9 @@ def test_pop_ahead_pops_the_same_nodes_as_pop(s1, s2):
     T0[margin:margin + m] = -times
     V = np.ones(T0.size)
     seqs = [_drain(ahead, T0.copy(), V, nodes, 3, np.uint64(s1), np.uint64(s2), 6 * m)
-            for ahead in (False, True)]
+            for ahead in (0, 1, 2)]
     np.testing.assert_array_equal(seqs[1], seqs[0])
+    np.testing.assert_array_equal(seqs[2], seqs[0])
     popped = seqs[0][seqs[0] >= 0]
     assert np.array_equal(np.sort(popped), nodes.astype(np.int64))  # each node once
     assert (seqs[0] == -1).any() and (seqs[0] == -2).any()  # outdated entries; drained

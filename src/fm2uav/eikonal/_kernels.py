@@ -285,7 +285,7 @@ def _remove(p, b, pool, nxt, bk, mw, nfree, fh):
 @njit(**_OPT)
 def _pop(T, pool, nxt, bk, mw, nfree, fh, cur, last):
     """Remove the entry with the smallest key; returns its node (``_NIL`` if none)."""
-    return _pop_ahead(T, T, pool, nxt, bk, mw, nfree, fh, cur, last, _ZERO, _ZERO, False)
+    return _pop_ahead(T, T, pool, nxt, bk, mw, nfree, fh, cur, last, _ZERO, _ZERO, False, False)
 
 
 @njit(**_OPT)
@@ -319,7 +319,7 @@ def _fetch_around(T, V, e, s1, s2, pv):
 
 
 @njit(**_OPT)
-def _pop_ahead(T, V, pool, nxt, bk, mw, nfree, fh, cur, last, s1, s2, pv):
+def _pop_ahead(T, V, pool, nxt, bk, mw, nfree, fh, cur, last, s1, s2, pv, scans):
     """:func:`_pop`, fetching ahead the lines of the nodes popped next.
 
     With ``s1 > 0`` (the x stride of the padded grid; ``s2`` the y stride in 3D, 0 in
@@ -331,8 +331,9 @@ def _pop_ahead(T, V, pool, nxt, bk, mw, nfree, fh, cur, last, s1, s2, pv):
     160^3 constant speed order 1, docs/performance.md); a split prefetches the ``T`` of a
     block's nodes before it reads them (the check for outdated entries). Where the front
     is sheared (slow air near terrain, ``docs/performance.md``) consecutive pops lie far
-    apart in memory and these lines are cold. The queue and the popped nodes are those of
-    :func:`_pop`.
+    apart in memory and these lines are cold. ``scans`` False: the level-0 bucket's next pop
+    only (the 3D order-1 windows of :mod:`fm2uav.eikonal._parallel`, whose scans' and splits'
+    prefetches measured slower). The queue and the popped nodes are those of :func:`_pop`.
     """
     while True:
         if bk[cur + cur] == _NIL:  # also for the sentinel cur == _NOB
@@ -372,7 +373,7 @@ def _pop_ahead(T, V, pool, nxt, bk, mw, nfree, fh, cur, last, s1, s2, pv):
                     break
                 cnt = _BS
             c = pool[bp + bp + _ONE]
-            if s1 != _ZERO and cur != _ZERO:  # one block: the next pop
+            if scans and s1 != _ZERO and cur != _ZERO:  # one block: the next pop
                 base = hb * _BS
                 m2 = _KEYMAX
                 p2 = bp
@@ -400,7 +401,7 @@ def _pop_ahead(T, V, pool, nxt, bk, mw, nfree, fh, cur, last, s1, s2, pv):
         b = hb
         while True:
             base = b * _BS
-            if s1 != _ZERO:
+            if scans and s1 != _ZERO:
                 for p in range(base, base + cnt):
                     _prefetch(T, pool[p + p + _ONE])
             for p in range(base, base + cnt):
@@ -907,7 +908,7 @@ def _march3d_kernel(order):
                     continue
             else:
                 c, nfree, fh, cur, last = _pop_ahead(T, V, pool, nxt, bk, mw, nfree, fh, cur, last,
-                                                     sx, sy, sep and not use_u)
+                                                     sx, sy, sep and not use_u, True)
                 if c == _NIL:
                     phase = 3
                     break

@@ -459,8 +459,13 @@ def _slab_kernels(three, pairs=False):
             if not _room_r(nfree, rsize, rkey):
                 ctl[_C_STATUS] = 1.0 if nfree < _U(RESERVE_BLOCKS) else 2.0
                 break
-            c, nfree, fh, cur, last, rsize = _deq_r(T, pool, nxt, bk, mw, rkey, ritem, nfree,
-                                                    fh, cur, last, rsize)
+            if rsize > _ZERO:
+                c, rsize = _pop_repair_r(rkey, ritem, rsize)
+            elif three:  # a level-0 bucket's next pop fetched ahead (the serial 3D march's)
+                c, nfree, fh, cur, last = _pop_ahead(T, V, pool, nxt, bk, mw, nfree, fh, cur,
+                                                     last, sx, sy, not use_u, False)
+            else:
+                c, nfree, fh, cur, last = _pop(T, pool, nxt, bk, mw, nfree, fh, cur, last)
             if c == _NIL:
                 break
             x = T[c]
@@ -1012,7 +1017,7 @@ def _slab_kernels2(three, pairs=False):
                 c, rsize = _pop_repair_r(rkey, ritem, rsize)
             elif three:  # fetch the lines the next pops read, as the serial 3D march
                 c, nfree, fh, cur, last = _pop_ahead(T, V, pool, nxt, bk, mw, nfree, fh, cur,
-                                                     last, sx, sy, not use_u)
+                                                     last, sx, sy, not use_u, True)
             else:
                 c, nfree, fh, cur, last = _pop(T, pool, nxt, bk, mw, nfree, fh, cur, last)
             if c == _NIL:
@@ -1696,12 +1701,15 @@ def _slab_count(most: int, shape3, G: int, nth: int) -> int:
 
 
 def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2,
-                more: int = 0, cells=None) -> np.ndarray:
+                more: int = 0, cells=None, fewer: int = 0) -> np.ndarray:
     """Row bounds (``k + 1`` ints) of ``k`` slabs along x, slab ``j`` marched by thread
     ``j % threads``; or of ``more`` slabs (``more + 1`` ints) where the coarse march
     predicts for them a windows' critical path shorter by the factor
     :data:`_tuning.MORE_SLABS_GAIN` (both with the slabs shared as :func:`_assign` shares
-    them, :func:`_shared_cost`).
+    them, :func:`_shared_cost`); or of ``fewer`` slabs (below ``k``, tried first, then no
+    ``more``) where the coarse march reaches every coarse node (no walls) and predicts for
+    them a critical path of at most :data:`_tuning.FEWER_SLABS_COST` times that of the ``k``
+    slabs.
 
     The cuts are placed where a coarse march predicts the best balance: they minimise
     ``sum over time bins of max over threads of the nodes it marches in that bin``, the
@@ -1734,6 +1742,13 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2,
         return even
     cum = np.vstack([np.zeros((1, hist.shape[1]), dtype=np.int64), np.cumsum(hist, axis=0)])
     cuts = _place_cuts(cum, k, gap, threads, shape3)
+    # fewer: only where the coarse march reached every coarse node (no walls seen)
+    if 0 < fewer < k and rows >= fewer * gap and int(hist.sum()) == _coarse_nodes(shape3):
+        alt = _place_cuts(cum, fewer, gap, threads, shape3)
+        if _shared_cost(cum, alt, threads) <= (_tuning.FEWER_SLABS_COST
+                                               * _shared_cost(cum, cuts, threads)):
+            cuts, k, more = alt, fewer, 0
+            even = np.linspace(0, nx, k + 1).round().astype(np.int64)
     if more > k and rows >= more * gap:
         alt = _place_cuts(cum, more, gap, threads, shape3)
         if _shared_cost(cum, cuts, threads) >= (_tuning.MORE_SLABS_GAIN
@@ -1748,6 +1763,14 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2,
     if np.any(np.diff(bounds) < 1):
         return even
     return bounds.astype(np.int64)
+
+
+def _coarse_nodes(shape3) -> int:
+    """The nodes of :func:`_coarse_histogram`'s coarse grid (every ``COARSE``-th node)."""
+    three = shape3[2] > 1
+    f = _tuning.COARSE_3D if three else _tuning.COARSE
+    fz = _tuning.COARSE_3D_Z if three else 1
+    return (-(-int(shape3[0]) // f)) * (-(-int(shape3[1]) // f)) * (-(-int(shape3[2]) // fz))
 
 
 def _place_cuts(cum, k, gap, threads, shape3):
@@ -1933,7 +1956,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     threads : int
         Threads, ``>= 2`` (each marches :data:`_tuning.SLABS_PER_THREAD` slabs, fewer
         where a slab would get fewer than :data:`_tuning.MIN_SLAB_ROWS` rows or
-        :data:`_tuning.MIN_SLAB_NODES` nodes).
+        :data:`_tuning.MIN_SLAB_NODES` nodes; a 3D grid of one speed without walls one
+        where the coarse march predicts no worse a balance, :data:`_tuning.FEWER_SLABS_3D`).
     stop_cells : ndarray, int, shape (m, 3), optional
         Stop once these nodes are frozen and final; nodes later than the latest
         of them are then ``inf``, as in the serial march.
@@ -1996,6 +2020,10 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     if three and not big and not lean and nth > 1 and order in _tuning.MORE_SLABS_3D:
         spt2, more_wn = _tuning.MORE_SLABS_3D[order]
         more = _slab_count(nth * spt2, shape3, G, nth)
+    # one slab per thread on a uniform speed where the coarse march predicts no worse a
+    # balance (_tuning.FEWER_SLABS_3D)
+    fewer = nth if (three and not big and not lean and nth > 1 and _tuning.FEWER_SLABS_3D
+                    and span is not None and span[0] == span[1]) else 0
     early = toucher = None
     cells = None if ready is None else sources  # the cuts' coarse march starts from these
     if lean and nth > 1:
@@ -2010,7 +2038,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     top_of = speed if span is None else None
     if early is not None:
         with _PageToucher(early[0], early[1], top_of=top_of) as toucher:
-            bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells=cells)
+            bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells=cells, fewer=fewer)
     elif nth > 1:
         # the cuts' coarse march runs on this thread alone: meanwhile a second one finds the
         # top speed (unless given) and faults in the result's pages (a fresh array's: a
@@ -2021,13 +2049,14 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         touch = () if resident else (out[half:], out[:half])
         if touch or top_of is not None:
             with _PageToucher(*touch, top_of=top_of) as toucher:
-                bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells=cells)
+                bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells=cells, fewer=fewer)
         else:
-            bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells=cells)
+            bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells=cells, fewer=fewer)
     else:
-        bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells=cells)
-    if bounds.size - 1 != K:  # the more slabs taken, with their windows
-        K, wn = bounds.size - 1, more_wn
+        bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells=cells, fewer=fewer)
+    if bounds.size - 1 != K:  # the more slabs taken, with their windows, or the fewer
+        wn = more_wn if bounds.size - 1 == more else wn
+        K = bounds.size - 1
     bounds = clear_of_sources(bounds, start, shape3,
                               _tuning.SOURCE_CUT_ROWS[3 if three else 2])
     if np.diff(bounds).min() < G:  # only the neighbours' rows are exchanged

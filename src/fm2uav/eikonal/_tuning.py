@@ -226,3 +226,21 @@ LEAN_TIMES_HUGE = False
 #: constant 1.68x / 1.55x, predicted +0.2 % and -0.4 %. Order 1 (1.84-1.98x) keeps its slabs.
 MORE_SLABS_3D = {2: (3, 4096)}
 MORE_SLABS_GAIN = 1.05
+#: Whether a 3D march on slabs (grids below :data:`BIG_3D_NODES`, outside the lean layout)
+#: whose nodes all have one speed takes one slab per thread where the coarse march of
+#: :func:`_parallel.slab_bounds` reaches every coarse node (no walls) and predicts for them a
+#: windows' critical path of at most :data:`FEWER_SLABS_COST` times that of its slabs. On a
+#: uniform speed without walls the wave reaches the nodes symmetric about the source at one
+#: time (a level-0 bucket of up to 48 nodes, megabytes apart); thick slabs keep them apart,
+#: where fetching the next pop ahead pays (:func:`fm2uav.eikonal._kernels._pop_ahead`), and
+#: fewer cuts re-open fewer nodes. Measured (6 December 2026, session 36, 160^3 constant speed,
+#: two threads, medians of 5, one slab a thread / the slabs as before), source (80, 80, 80):
+#: order 1 175.8 / 210.5 ms, order 2 252.7 / 301.7 ms; (75, 80, 80) 178.7 / 210.9, 267.3 /
+#: 310.5; (80, 60, 80) 176.9 / 204.4, 251.4 / 303.2; (70, 80, 80) order 1 189.7 / 206.8 (the
+#: predicted path 1.008x that of 8 slabs), order 2 kept its 4 slabs (1.018x). With the bench's
+#: FM² walls as speed 0 (one speed elsewhere) from the centre one slab a thread took 213.6
+#: against 206.4 ms (predicted 1.000x): walls break the symmetry, hence the coarse march must
+#: reach every coarse node. Where the speeds vary thick slabs cost the windows more CPU (the
+#: smooth field, order 1: 0.419 / 0.362 s), hence one speed only.
+FEWER_SLABS_3D = True
+FEWER_SLABS_COST = 1.01
