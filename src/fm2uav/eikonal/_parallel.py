@@ -1765,11 +1765,18 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2,
     return bounds.astype(np.int64)
 
 
+def _coarse_steps(shape3) -> tuple[int, int]:
+    """The steps of :func:`_coarse_histogram`'s coarse grid: ``(f, fz)``, every ``f``-th node
+    along x and y, every ``fz``-th along z (:data:`_tuning.COARSE`, ``COARSE_3D``,
+    ``COARSE_3D_Z``)."""
+    if shape3[2] > 1:
+        return _tuning.COARSE_3D, _tuning.COARSE_3D_Z
+    return _tuning.COARSE, 1
+
+
 def _coarse_nodes(shape3) -> int:
-    """The nodes of :func:`_coarse_histogram`'s coarse grid (every ``COARSE``-th node)."""
-    three = shape3[2] > 1
-    f = _tuning.COARSE_3D if three else _tuning.COARSE
-    fz = _tuning.COARSE_3D_Z if three else 1
+    """The nodes of :func:`_coarse_histogram`'s coarse grid."""
+    f, fz = _coarse_steps(shape3)
     return (-(-int(shape3[0]) // f)) * (-(-int(shape3[1]) // f)) * (-(-int(shape3[2]) // fz))
 
 
@@ -1892,10 +1899,8 @@ def _coarse_histogram(speed, start, shape3, h3, cells=None):
     (``COARSE_3D`` in 3D, along z ``COARSE_3D_Z``) from the start's frozen nodes: ``(hist,
     f)``, ``hist`` of shape ``(coarse rows, SPLIT_BINS)`` and ``f`` the x coarsening;
     ``(None, f)`` if no estimate. ``cells``: the nodes to start from instead (int, (m, 3))."""
-    three = shape3[2] > 1
-    f = _tuning.COARSE_3D if three else _tuning.COARSE
+    f, fz = _coarse_steps(shape3)
     grid = speed.reshape(shape3)
-    fz = _tuning.COARSE_3D_Z if three else 1
     coarse = np.ascontiguousarray(grid[::f, ::f, ::fz])
     cshape = coarse.shape
     if cshape[0] < 4:
@@ -2036,9 +2041,10 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
                                   interleave, huge_times=_tuning.LEAN_TIMES_HUGE, span=span)
     out = None  # the result (not lean)
     top_of = speed if span is None else None
+    cut = partial(slab_bounds, speed, start, shape3, h3, K, nth, more, cells=cells, fewer=fewer)
     if early is not None:
         with _PageToucher(early[0], early[1], top_of=top_of) as toucher:
-            bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells=cells, fewer=fewer)
+            bounds = cut()
     elif nth > 1:
         # the cuts' coarse march runs on this thread alone: meanwhile a second one finds the
         # top speed (unless given) and faults in the result's pages (a fresh array's: a
@@ -2049,11 +2055,11 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         touch = () if resident else (out[half:], out[:half])
         if touch or top_of is not None:
             with _PageToucher(*touch, top_of=top_of) as toucher:
-                bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells=cells, fewer=fewer)
+                bounds = cut()
         else:
-            bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells=cells, fewer=fewer)
+            bounds = cut()
     else:
-        bounds = slab_bounds(speed, start, shape3, h3, K, nth, more, cells=cells, fewer=fewer)
+        bounds = cut()
     if bounds.size - 1 != K:  # the more slabs taken, with their windows, or the fewer
         wn = more_wn if bounds.size - 1 == more else wn
         K = bounds.size - 1
