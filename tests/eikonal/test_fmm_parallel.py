@@ -434,6 +434,38 @@ def test_a_uniform_3d_march_from_the_centre_takes_a_slab_a_thread_bit_for_bit(or
         assert stats["slabs"] >= k
 
 
+@pytest.mark.parametrize("order", [1, 2])
+def test_a_varying_2d_order_2_march_from_the_centre_takes_a_slab_a_thread_bit_for_bit(
+        order, monkeypatch):
+    """The bench's smooth 2D field from the centre at order 2: one slab per thread (the
+    coarse march sees no walls and predicts no worse a balance), the serial march's times;
+    off-centre, on a uniform speed, with walls, at order 1 or with the setting off the march
+    keeps its slabs."""
+    monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)
+    monkeypatch.setattr(_tuning, "ORDER2_MIN_NODES_2D", 0)
+    shape = (1024, 512)  # the coarse march's prediction needs some size
+    v, centre = smooth(shape)
+    walls = np.where(fm2_shaped(shape, 2)[0] > 0.0, v, 0.0)  # predicted 0.98x: walls decide
+    open_ = np.argwhere(walls > 0.0)
+    near = tuple(open_[np.argmin(np.abs(open_ - centre).sum(axis=1))])  # passable, central
+    k = 2 * _tuning.SLABS_PER_THREAD[2, order]
+    cases = [(v, centre, 2 if order == 2 else k), (v, (307, 170), k),
+             (np.ones(shape), centre, k), (walls, near, k)]
+    for speed, src, want in cases:
+        flat, start, shape3 = _start(speed, src)
+        serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, order,
+                                   np.zeros((0, 3), dtype=int))
+        span = _kernels.speed_range(flat)
+        T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, 2, order=order, span=span)
+        assert_equal_times(serial, T, exact=order == 2)
+        assert stats["slabs"] == want, (src, speed.min(), speed.max())
+    monkeypatch.setattr(_tuning, "FEWER_SLABS_2D", {1: False, 2: False})
+    flat, start, shape3 = _start(v, centre)
+    T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, 2, order=order,
+                               span=_kernels.speed_range(flat))
+    assert stats["slabs"] == k
+
+
 def _slab_count_for(shape, order):
     """The slabs a 3D march of ``shape`` on two threads asks for (no more, no fewer)."""
     return _parallel._slab_count(2 * _tuning.SLABS_PER_THREAD[3, order], shape, order, 2)

@@ -1961,8 +1961,10 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     threads : int
         Threads, ``>= 2`` (each marches :data:`_tuning.SLABS_PER_THREAD` slabs, fewer
         where a slab would get fewer than :data:`_tuning.MIN_SLAB_ROWS` rows or
-        :data:`_tuning.MIN_SLAB_NODES` nodes; a 3D grid of one speed without walls one
-        where the coarse march predicts no worse a balance, :data:`_tuning.FEWER_SLABS_3D`).
+        :data:`_tuning.MIN_SLAB_NODES` nodes; one where the coarse march sees no walls and
+        predicts no worse a balance, on a 3D grid of one speed
+        (:data:`_tuning.FEWER_SLABS_3D`) or a 2D one of varying speed at order 2
+        (:data:`_tuning.FEWER_SLABS_2D`)).
     stop_cells : ndarray, int, shape (m, 3), optional
         Stop once these nodes are frozen and final; nodes later than the latest
         of them are then ``inf``, as in the serial march.
@@ -2025,10 +2027,12 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     if three and not big and not lean and nth > 1 and order in _tuning.MORE_SLABS_3D:
         spt2, more_wn = _tuning.MORE_SLABS_3D[order]
         more = _slab_count(nth * spt2, shape3, G, nth)
-    # one slab per thread on a uniform speed where the coarse march predicts no worse a
-    # balance (_tuning.FEWER_SLABS_3D)
-    fewer = nth if (three and not big and not lean and nth > 1 and _tuning.FEWER_SLABS_3D
-                    and span is not None and span[0] == span[1]) else 0
+    # one slab per thread where the coarse march predicts no worse a balance: 3D on a
+    # uniform speed (_tuning.FEWER_SLABS_3D), 2D order 2 on a varying one (FEWER_SLABS_2D)
+    uniform = None if span is None else bool(span[0] == span[1])
+    fewer = nth if (not big and not lean and nth > 1 and uniform is not None and (
+        (three and _tuning.FEWER_SLABS_3D and uniform)
+        or (not three and _tuning.FEWER_SLABS_2D.get(order, False) and not uniform))) else 0
     early = toucher = None
     cells = None if ready is None else sources  # the cuts' coarse march starts from these
     if lean and nth > 1:

@@ -244,3 +244,19 @@ MORE_SLABS_GAIN = 1.05
 #: smooth field, order 1: 0.419 / 0.362 s), hence one speed only.
 FEWER_SLABS_3D = True
 FEWER_SLABS_COST = 1.01
+#: Per order, whether a 2D march on slabs (outside the lean layout) whose speeds vary (the
+#: interleaved layout) takes one slab per thread on the same terms as
+#: :data:`FEWER_SLABS_3D` (no walls, a critical path of at most :data:`FEWER_SLABS_COST`
+#: times that of its slabs). Measured (6 December 2026, session 37, 2048^2, two threads,
+#: one process alternating the settings, medians of 7; wall, one slab / two / four a
+#: thread): order 2 on the bench's smooth field (centred source, the prediction 0.991x)
+#: 167.1 / 177.8 / 187.8 ms (one thread 233.6 ms: 1.40x against 1.24x); windows' CPU
+#: 243 / 266 / 280 ms over both threads (the serial kernel 202 ms), the nodes re-opened
+#: 45,808 / 48,298 / 66,382. Off-centre (the prediction 1.22-1.29x) one slab a thread
+#: loses: the smooth field from (614, 681) 219.8 / 184.7 / 188.6 ms; FM²-shaped maps
+#: (walls: never taken) seeds 1-3 172.5 / 145.0 / 147.2, 165.0 / 140.7 / 139.3, 170.8 /
+#: 143.5 / 140.1; with a centred source (seed 2) 145.1 / 138.0 / 145.2. A uniform speed
+#: (separate arrays) gains nothing, from the centre 166.4 / 175.9 / 159.5 and 163.5 / - /
+#: 161.5 ms, hence a varying speed only; order 1 gains 1-3 % (smooth 113.1 / 116.0 ms,
+#: constant 89.4 / 89.9) and stays as it is.
+FEWER_SLABS_2D = {1: False, 2: True}
