@@ -301,7 +301,7 @@ def test_balanced_cuts_of_many_slabs_shorten_the_windows_critical_path(shape, ga
     monkeypatch.setattr(_tuning, "WINDOW_NODES", {k: 32768 for k in _tuning.WINDOW_NODES})
     monkeypatch.setattr(_tuning, "DYNAMIC_2D", False)
     # the cuts as slab_bounds places them (not moved off the source: clear_of_sources)
-    monkeypatch.setattr(_tuning, "SOURCE_CUT_ROWS", {2: 0, 3: 0})
+    monkeypatch.setattr(_tuning, "SOURCE_CUT_ROWS", dict.fromkeys(_tuning.SOURCE_CUT_ROWS, 0))
     v, src = fm2_shaped(shape)
     flat, start, shape3 = _start(v, src)
     k = 2 * _tuning.SLABS_PER_THREAD[len(shape), 1]
@@ -435,12 +435,12 @@ def test_a_uniform_3d_march_from_the_centre_takes_a_slab_a_thread_bit_for_bit(or
 
 
 @pytest.mark.parametrize("order", [1, 2])
-def test_a_varying_2d_order_2_march_from_the_centre_takes_a_slab_a_thread_bit_for_bit(
+def test_a_2d_order_2_march_from_the_centre_takes_a_slab_a_thread_bit_for_bit(
         order, monkeypatch):
-    """The bench's smooth 2D field from the centre at order 2: one slab per thread (the
-    coarse march sees no walls and predicts no worse a balance), the serial march's times;
-    off-centre, on a uniform speed, with walls, at order 1 or with the setting off the march
-    keeps its slabs."""
+    """The bench's smooth 2D field and a uniform speed from the centre at order 2: one slab
+    per thread (the coarse march sees no walls and predicts no worse a balance), the serial
+    march's times; off-centre, with walls, at order 1 or with the setting off the march keeps
+    its slabs."""
     monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)
     monkeypatch.setattr(_tuning, "ORDER2_MIN_NODES_2D", 0)
     shape = (1024, 512)  # the coarse march's prediction needs some size
@@ -450,7 +450,7 @@ def test_a_varying_2d_order_2_march_from_the_centre_takes_a_slab_a_thread_bit_fo
     near = tuple(open_[np.argmin(np.abs(open_ - centre).sum(axis=1))])  # passable, central
     k = 2 * _tuning.SLABS_PER_THREAD[2, order]
     cases = [(v, centre, 2 if order == 2 else k), (v, (307, 170), k),
-             (np.ones(shape), centre, k), (walls, near, k)]
+             (np.ones(shape), centre, 2 if order == 2 else k), (walls, near, k)]
     for speed, src, want in cases:
         flat, start, shape3 = _start(speed, src)
         serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, order,
@@ -532,7 +532,7 @@ def test_sharing_the_slabs_anew_raises_the_windows_balance(shape, monkeypatch):
     1.661; 96^3: 1.804 against 1.726), at the same times. (The cuts as slab_bounds places
     them: not moved off the source, :func:`~fm2uav.eikonal._parallel.clear_of_sources`.)"""
     monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)
-    monkeypatch.setattr(_tuning, "SOURCE_CUT_ROWS", {2: 0, 3: 0})
+    monkeypatch.setattr(_tuning, "SOURCE_CUT_ROWS", dict.fromkeys(_tuning.SOURCE_CUT_ROWS, 0))
     v, src = fm2_shaped(shape)
     flat, start, shape3 = _start(v, src)
     serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 1, np.zeros((0, 3), dtype=int))
@@ -1280,7 +1280,7 @@ def test_a_3d_march_moves_the_cut_off_its_centred_source_bit_for_bit(monkeypatch
     clear of the source's row (:func:`~fm2uav.eikonal._parallel.clear_of_sources`), its times the
     serial march's bit for bit."""
     v, src = smooth((48, 40, 36))  # the source at the centre
-    monkeypatch.setitem(_tuning.SOURCE_CUT_ROWS, 3, 5)
+    monkeypatch.setattr(_tuning, "SOURCE_CUT_ROWS", {**_tuning.SOURCE_CUT_ROWS, (3, 1): 5, (3, 2): 5})
     seen = []
     real = _parallel.clear_of_sources
 
@@ -1299,6 +1299,39 @@ def test_a_3d_march_moves_the_cut_off_its_centred_source_bit_for_bit(monkeypatch
         mid = (lo + hi) // 2  # the source's row: the box's middle
         assert mid == src[0] and np.all(np.abs(inner - mid) >= 5)  # every cut clear of it
         assert not np.array_equal(before, after)  # the even cuts had one through the source
+
+
+def test_a_2d_order_2_march_keeps_its_cuts_further_off_its_centred_source(monkeypatch):
+    """2D: order 2 keeps its cuts ``SOURCE_CUT_ROWS[2, 2]`` rows clear of a centred point
+    source's row (a cut a few rows off it took every re-opened node), order 1 its cuts as
+    placed (``[2, 1]``, 0); the times are the serial march's (order 2 bit for bit)."""
+    v, src = smooth((400, 120))  # the source at the centre
+    rows = {1: _tuning.SOURCE_CUT_ROWS[2, 1], 2: _tuning.SOURCE_CUT_ROWS[2, 2]}
+    assert rows[1] == 0 and rows[2] >= 32
+    monkeypatch.setattr(_tuning, "SOURCE_CUT_ROWS", {**_tuning.SOURCE_CUT_ROWS, (2, 2): 30})
+    monkeypatch.setattr(_tuning, "FEWER_SLABS_2D", {1: False, 2: False})
+    seen = {}
+    real = _parallel.clear_of_sources
+
+    def spy(bounds, start, shape3, rows):  # even cuts (one through the source) moved
+        bounds = np.linspace(0, shape3[0], len(bounds)).round().astype(np.int64)
+        out = real(bounds, start, shape3, rows)
+        seen[rows] = (np.array(bounds), out, start.lo[0] + start.shape[0] // 2)
+        return out
+
+    monkeypatch.setattr(_parallel, "clear_of_sources", spy)
+    for order in (1, 2):
+        serial = fast_marching(v, [src], order=order, threads=1)
+        T = fast_marching_parallel(v, [src], order=order)
+        if order == 2:
+            assert np.array_equal(T, serial)
+        else:
+            assert_equal_times(serial.ravel(), T.ravel())
+    assert set(seen) == {0, 30}  # both orders marched on slabs, each with its own rows
+    before, after, mid = seen[30]
+    assert mid == src[0] and np.all(np.abs(after[1:-1] - mid) >= 30)
+    assert np.any(np.abs(before[1:-1] - mid) < 30)  # one of the cuts was moved off
+    assert np.array_equal(seen[0][0], seen[0][1])  # order 1: as placed
 
 
 def test_slab_march_reuses_its_kept_pools_and_masks_without_a_trace():

@@ -1963,7 +1963,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         where a slab would get fewer than :data:`_tuning.MIN_SLAB_ROWS` rows or
         :data:`_tuning.MIN_SLAB_NODES` nodes; one where the coarse march sees no walls and
         predicts no worse a balance, on a 3D grid of one speed
-        (:data:`_tuning.FEWER_SLABS_3D`) or a 2D one of varying speed at order 2
+        (:data:`_tuning.FEWER_SLABS_3D`) or a 2D one at order 2
         (:data:`_tuning.FEWER_SLABS_2D`)).
     stop_cells : ndarray, int, shape (m, 3), optional
         Stop once these nodes are frozen and final; nodes later than the latest
@@ -2028,11 +2028,11 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         spt2, more_wn = _tuning.MORE_SLABS_3D[order]
         more = _slab_count(nth * spt2, shape3, G, nth)
     # one slab per thread where the coarse march predicts no worse a balance: 3D on a
-    # uniform speed (_tuning.FEWER_SLABS_3D), 2D order 2 on a varying one (FEWER_SLABS_2D)
-    uniform = None if span is None else bool(span[0] == span[1])
-    fewer = nth if (not big and not lean and nth > 1 and uniform is not None and (
+    # uniform speed (_tuning.FEWER_SLABS_3D), 2D per order (FEWER_SLABS_2D)
+    uniform = span is not None and span[0] == span[1]
+    fewer = nth if (not big and not lean and nth > 1 and (
         (three and _tuning.FEWER_SLABS_3D and uniform)
-        or (not three and _tuning.FEWER_SLABS_2D.get(order, False) and not uniform))) else 0
+        or (not three and _tuning.FEWER_SLABS_2D.get(order, False)))) else 0
     early = toucher = None
     cells = None if ready is None else sources  # the cuts' coarse march starts from these
     if lean and nth > 1:
@@ -2068,7 +2068,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         wn = more_wn if bounds.size - 1 == more else wn
         K = bounds.size - 1
     bounds = clear_of_sources(bounds, start, shape3,
-                              _tuning.SOURCE_CUT_ROWS[3 if three else 2])
+                              _tuning.SOURCE_CUT_ROWS[3 if three else 2, order])
     if np.diff(bounds).min() < G:  # only the neighbours' rows are exchanged
         bounds = np.linspace(0, nx, K + 1).round().astype(np.int64)
     rows = np.diff(bounds).astype(np.int64)

@@ -190,8 +190,8 @@ EXCHANGE_ALONE_2D = {1: True, 2: False}
 BIG_3D_NODES = 2**24
 BIG_3D_SLABS_PER_THREAD = {1: 4, 2: 4}
 BIG_3D_WINDOW_NODES = {1: 8192, 2: 4096}
-#: The cuts between slabs keep this many rows from a point source's row (keyed by dimension;
-#: :func:`_parallel.clear_of_sources`): a cut through the source runs along the wave, and the nodes
+#: The cuts between slabs keep this many rows from a point source's row (keyed by dimension and
+#: order; :func:`_parallel.clear_of_sources`): a cut through the source runs along the wave, and the nodes
 #: beside its ghosts are re-opened all the way out. Measured (5 December 2026, session 27, 2
 #: threads, the cut through the centre moved, medians of 5 interleaved in one process): 160^3
 #: smooth speed (source at the centre) order 1, 0 / 4 / 8 rows above / 8 below: 352.2 / 376.6 /
@@ -199,8 +199,19 @@ BIG_3D_WINDOW_NODES = {1: 8192, 2: 4096}
 #: 8,894 nodes re-opened, windows' balance 1.966 / 1.953 / 1.928 / 1.928; order 2, 0 / 4 / 8 rows
 #: above: 1.25x / 1.49x / 1.61x, 58,329 / 36,760 / 14,882 re-opened. 2048^2 smooth: 8 rows changed
 #: nothing (order 2: 66,232 / 67,295 re-opened; the other six cuts re-open as many), 32 rows
-#: 43,184, the wall within the spread: 2D keeps its cuts.
-SOURCE_CUT_ROWS = {2: 0, 3: 8}
+#: 43,184, the wall within the spread: 2D keeps its cuts. 2D order 2 on one slab a thread
+#: (:data:`FEWER_SLABS_2D`, session 37, 6 December 2026): its one cut, placed 16 rows from the
+#: bench's smooth source (1040 of 2048) inside the source ball (radius 102 rows), took every
+#: re-opened node (45,808, all in the slab beyond it: the rays cross the cut at a shallow angle
+#: all the way out) and 22 % more CPU than the other slab. 2048^2 two threads, one process
+#: alternating the settings, medians of 7, 0 / 32 / 64 / 96 rows: order 2 smooth 167.6 / 166.1 /
+#: 148.5 / 148.9 ms (one thread 232.3; 45,808 / 31,308 / 17,940 / 12,265 re-opened), constant
+#: (8 slabs) 158.8 / 151.1 / 146.3 / 146.8, constant from (819, 1024) 168.0 / 155.1 / 148.9 /
+#: 152.1, FM²-shaped 145.3 / 145.2 / 146.2 / 146.0, smooth from (614, 681) 187.1 / 184.1 /
+#: 184.6 / 183.9; order 1 loses (0 / 64 / 96: smooth 114.6 / 117.8 / 119.0, constant 92.0 /
+#: 94.7 / 95.5, FM²-shaped 98.9 / 99.1 / 100.0). 3D order 2 keeps 8 (160^3, 8 / 16 / 32: smooth
+#: 355.5 / 368.1 / 407.7, constant 256.6 / 283.8 / 330.4, FM²-shaped 340.6 / 339.9 / 374.2).
+SOURCE_CUT_ROWS = {(2, 1): 0, (2, 2): 64, (3, 1): 8, (3, 2): 8}
 #: Whether the parallel march's lean-layout times (the terrain plan's march: 42 M nodes, 336
 #: MB; :func:`fm2uav.eikonal._kernels._buffers`) are mapped on huge pages, as every other work
 #: buffer. False: small pages. On this virtual machine a fresh huge page's first touch took
@@ -244,19 +255,18 @@ MORE_SLABS_GAIN = 1.05
 #: smooth field, order 1: 0.419 / 0.362 s), hence one speed only.
 FEWER_SLABS_3D = True
 FEWER_SLABS_COST = 1.01
-#: Per order, whether a 2D march on slabs (outside the lean layout) whose speeds vary (the
-#: interleaved layout) takes one slab per thread on the same terms as
-#: :data:`FEWER_SLABS_3D` (no walls, a critical path of at most :data:`FEWER_SLABS_COST`
-#: times that of its slabs). Measured (6 December 2026, session 37, 2048^2, two threads,
-#: one process alternating the settings, medians of 7; wall, one slab / two / four a
-#: thread): order 2 on the bench's smooth field (centred source, the prediction 0.991x)
-#: 167.1 / 177.8 / 187.8 ms (one thread 233.6 ms: 1.40x against 1.24x); windows' CPU
-#: 243 / 266 / 280 ms over both threads (the serial kernel 202 ms), the nodes re-opened
-#: 45,808 / 48,298 / 66,382. Off-centre (the prediction 1.22-1.29x) one slab a thread
-#: loses: the smooth field from (614, 681) 219.8 / 184.7 / 188.6 ms; FM²-shaped maps
-#: (walls: never taken) seeds 1-3 172.5 / 145.0 / 147.2, 165.0 / 140.7 / 139.3, 170.8 /
-#: 143.5 / 140.1; with a centred source (seed 2) 145.1 / 138.0 / 145.2. A uniform speed
-#: (separate arrays) gains nothing, from the centre 166.4 / 175.9 / 159.5 and 163.5 / - /
-#: 161.5 ms, hence a varying speed only; order 1 gains 1-3 % (smooth 113.1 / 116.0 ms,
-#: constant 89.4 / 89.9) and stays as it is.
+#: Per order, whether a 2D march on slabs (outside the lean layout) takes one slab per thread
+#: on the terms of :data:`FEWER_SLABS_3D` (no walls, a critical path of at most
+#: :data:`FEWER_SLABS_COST` times that of its slabs), any speed. Measured (6 December 2026,
+#: session 37, 2048^2, two threads, one process alternating the settings, medians of 7; wall,
+#: one slab / four a thread, the cuts 64 rows off the source, :data:`SOURCE_CUT_ROWS`): order 2
+#: from the centre (the prediction 0.991x / 0.996x) smooth 151.4 / 167.0 ms (one thread
+#: 237.1), constant 135.9 / 145.8 (194.3); off-centre it loses where the prediction says so:
+#: constant from (819, 1024) 164.4 / 150.5 (predicted 1.107x), smooth from (614, 681) 216.6 /
+#: 185.2 (1.237x), the FM²-shaped map 175.8 / 147.9 (walls: never taken); constant from
+#: (921, 1024) 148.8 / 150.4 (1.047x: kept). Before the cuts moved off the source (rows 0) the
+#: smooth field gained as much (167.1 / 187.8 ms: 45,808 / 66,382 re-opened, windows' CPU 243 /
+#: 280 ms over both threads against the serial kernel's 202) but constant speed did not
+#: (166.4 / 159.5). Order 1 gains 1-3 % (smooth 113.1 / 116.0 ms, constant 89.4 / 89.9, rows
+#: 0) and stays as it is.
 FEWER_SLABS_2D = {1: False, 2: True}
