@@ -435,12 +435,11 @@ def test_a_uniform_3d_march_from_the_centre_takes_a_slab_a_thread_bit_for_bit(or
 
 
 @pytest.mark.parametrize("order", [1, 2])
-def test_a_2d_order_2_march_from_the_centre_takes_a_slab_a_thread_bit_for_bit(
+def test_a_2d_march_from_the_centre_takes_a_slab_a_thread_bit_for_bit(
         order, monkeypatch):
-    """The bench's smooth 2D field and a uniform speed from the centre at order 2: one slab
-    per thread (the coarse march sees no walls and predicts no worse a balance), the serial
-    march's times; off-centre, with walls, at order 1 or with the setting off the march keeps
-    its slabs."""
+    """The bench's smooth 2D field and a uniform speed from the centre: one slab per thread
+    (the coarse march sees no walls and predicts no worse a balance), the serial march's
+    times; off-centre, with walls or with the setting off the march keeps its slabs."""
     monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)
     monkeypatch.setattr(_tuning, "ORDER2_MIN_NODES_2D", 0)
     shape = (1024, 512)  # the coarse march's prediction needs some size
@@ -449,8 +448,7 @@ def test_a_2d_order_2_march_from_the_centre_takes_a_slab_a_thread_bit_for_bit(
     open_ = np.argwhere(walls > 0.0)
     near = tuple(open_[np.argmin(np.abs(open_ - centre).sum(axis=1))])  # passable, central
     k = 2 * _tuning.SLABS_PER_THREAD[2, order]
-    cases = [(v, centre, 2 if order == 2 else k), (v, (307, 170), k),
-             (np.ones(shape), centre, 2 if order == 2 else k), (walls, near, k)]
+    cases = [(v, centre, 2), (v, (307, 170), k), (np.ones(shape), centre, 2), (walls, near, k)]
     for speed, src, want in cases:
         flat, start, shape3 = _start(speed, src)
         serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, order,

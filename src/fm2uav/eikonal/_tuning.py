@@ -267,6 +267,7 @@ FEWER_SLABS_COST = 1.01
 #: (921, 1024) 148.8 / 150.4 (1.047x: kept). Before the cuts moved off the source (rows 0) the
 #: smooth field gained as much (167.1 / 187.8 ms: 45,808 / 66,382 re-opened, windows' CPU 243 /
 #: 280 ms over both threads against the serial kernel's 202) but constant speed did not
-#: (166.4 / 159.5). Order 1 gains 1-3 % (smooth 113.1 / 116.0 ms, constant 89.4 / 89.9, rows
-#: 0) and stays as it is.
-FEWER_SLABS_2D = {1: False, 2: True}
+#: (166.4 / 159.5). Order 1 (its cuts as placed, rows 0) gains 1-3 %: smooth 113.1 / 116.0
+#: ms, constant 89.4 / 89.9; a second run 115.1 / 116.7 and 89.7 / 92.5 (one thread 187.1,
+#: 156.3), the FM²-shaped map (walls) 99.6 / 100.5 (noise: the same slabs).
+FEWER_SLABS_2D = {1: True, 2: True}
