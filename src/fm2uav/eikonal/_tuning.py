@@ -211,7 +211,13 @@ BIG_3D_WINDOW_NODES = {1: 8192, 2: 4096}
 #: 184.6 / 183.9; order 1 loses (0 / 64 / 96: smooth 114.6 / 117.8 / 119.0, constant 92.0 /
 #: 94.7 / 95.5, FM²-shaped 98.9 / 99.1 / 100.0). 3D order 2 keeps 8 (160^3, 8 / 16 / 32: smooth
 #: 355.5 / 368.1 / 407.7, constant 256.6 / 283.8 / 330.4, FM²-shaped 340.6 / 339.9 / 374.2).
-SOURCE_CUT_ROWS = {(2, 1): 0, (2, 2): 64, (3, 1): 8, (3, 2): 8}
+#: 3D order 1 (one slab a thread on constant speed since session 36: its one cut re-opens on
+#: one side only) takes 4: 160^3, two threads, medians of 5 / 5 / 7 in three runs, 4 rows over
+#: 8: constant 0.963 / 0.972 / 0.950x, from (80, 60, 80) 0.969 / 0.968 / 0.967x, from (75, 80,
+#: 80) 1.015 / 0.985 / 0.989x, smooth 0.968 / 0.992 / 0.981x, FM²-shaped 0.996 / 1.002 / 0.984x
+#: (6 rows: 0.972 / 0.956, 0.984 / 0.976, 0.974 / 1.018, 0.993 / 0.983, 0.990 / 0.980; 2 rows
+#: from (75, 80, 80) 1.046x).
+SOURCE_CUT_ROWS = {(2, 1): 0, (2, 2): 64, (3, 1): 4, (3, 2): 8}
 #: Whether the parallel march's lean-layout times (the terrain plan's march: 42 M nodes, 336
 #: MB; :func:`fm2uav.eikonal._kernels._buffers`) are mapped on huge pages, as every other work
 #: buffer. False: small pages. On this virtual machine a fresh huge page's first touch took
