@@ -1299,6 +1299,31 @@ def test_a_3d_march_moves_the_cut_off_its_centred_source_bit_for_bit(monkeypatch
         assert not np.array_equal(before, after)  # the even cuts had one through the source
 
 
+def test_a_varying_2d_order_2_march_on_its_slabs_takes_narrower_windows_bit_for_bit(
+        monkeypatch):
+    """2D order 2 on its usual slabs takes ``WINDOW_NODES_2D_VARYING``'s windows where the
+    speeds vary, :data:`WINDOW_NODES`' on a uniform speed; the times are the serial march's
+    bit for bit either way."""
+    monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)
+    monkeypatch.setattr(_tuning, "ORDER2_MIN_NODES_2D", 0)
+    shape = (1024, 512)
+    v, _ = smooth(shape)
+    windows = {}
+    for name, speed in (("varying", v), ("uniform", np.ones(shape))):
+        flat, start, shape3 = _start(speed, (307, 170))  # off-centre: its usual slabs
+        serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, 2, np.zeros((0, 3), dtype=int))
+        for wn in (_tuning.WINDOW_NODES[2, 2], _tuning.WINDOW_NODES[2, 2] // 4):
+            monkeypatch.setattr(_tuning, "WINDOW_NODES_2D_VARYING", {2: wn})
+            T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, 2, order=2,
+                                       span=_kernels.speed_range(flat))
+            assert_equal_times(serial, T, exact=True)
+            assert stats["slabs"] == 2 * _tuning.SLABS_PER_THREAD[2, 2]
+            windows[name, wn] = stats["windows"]
+    wide, narrow = _tuning.WINDOW_NODES[2, 2], _tuning.WINDOW_NODES[2, 2] // 4
+    assert windows["varying", narrow] > 2 * windows["varying", wide]
+    assert windows["uniform", narrow] == windows["uniform", wide]
+
+
 def test_a_2d_order_2_march_keeps_its_cuts_further_off_its_centred_source(monkeypatch):
     """2D: order 2 keeps its cuts ``SOURCE_CUT_ROWS[2, 2]`` rows clear of a centred point
     source's row (a cut a few rows off it took every re-opened node), order 1 its cuts as

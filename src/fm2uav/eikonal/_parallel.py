@@ -2067,6 +2067,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     if bounds.size - 1 != K:  # the more slabs taken, with their windows, or the fewer
         wn = more_wn if bounds.size - 1 == more else wn
         K = bounds.size - 1
+    elif not three and span is not None and not uniform:  # 2D of varying speed, its K slabs
+        wn = _tuning.WINDOW_NODES_2D_VARYING.get(order, wn)
     bounds = clear_of_sources(bounds, start, shape3,
                               _tuning.SOURCE_CUT_ROWS[3 if three else 2, order])
     if np.diff(bounds).min() < G:  # only the neighbours' rows are exchanged

@@ -111,6 +111,14 @@ SLABS_PER_THREAD = {(2, 1): 4, (3, 1): 4, (2, 2): 4, (3, 2): 2}
 #: threads, alternating processes, medians of 6 rounds of 5; 16384 / 32768 against 8192):
 #: constant 0.915x / 0.871x, FM²-shaped 0.990x / 1.033x, smooth 0.911x / 0.864x: 16384.
 WINDOW_NODES = {(2, 1): 16384, (3, 1): 16384, (2, 2): 8192, (3, 2): 8192}
+#: Per order, the window nodes of a 2D march on slabs whose speeds vary (the interleaved
+#: layout) on its usual slabs (not one a thread, :data:`FEWER_SLABS_2D`). Measured (6
+#: December 2026, session 37, 2048^2 order 2, two threads, one process alternating the
+#: settings, medians of 7 / 9; 4096 / 8192 nodes): FM²-shaped seeds 0 / 1 / 3 153.5 / 160.1,
+#: 147.7 / 151.0, 145.4 / 150.8 ms, smooth from (614, 681) 187.6 / 195.3; but constant speed
+#: (separate arrays) from (819, 1024) 165.8 / 160.7 and the smooth field from the centre on
+#: one slab a thread 167.7 / 164.3: those keep :data:`WINDOW_NODES`.
+WINDOW_NODES_2D_VARYING = {2: 4096}
 #: Share the slabs among the threads anew before every window, longest first by the freezes of the
 #: last window, when that predicts a shorter window than the fixed interleave
 #: (:func:`_parallel._assign`); False: always the interleave. Windows' balance with / without (2
