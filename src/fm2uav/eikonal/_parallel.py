@@ -1963,8 +1963,9 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         where a slab would get fewer than :data:`_tuning.MIN_SLAB_ROWS` rows or
         :data:`_tuning.MIN_SLAB_NODES` nodes; one where the coarse march sees no walls and
         predicts no worse a balance, on a 3D grid of one speed
-        (:data:`_tuning.FEWER_SLABS_3D`) or a 2D one at order 2
-        (:data:`_tuning.FEWER_SLABS_2D`)).
+        (:data:`_tuning.FEWER_SLABS_3D`) or any 2D one (:data:`_tuning.FEWER_SLABS_2D`);
+        2D order 2 of varying speed on its usual slabs takes narrower windows,
+        :data:`_tuning.WINDOW_NODES_2D_VARYING`).
     stop_cells : ndarray, int, shape (m, 3), optional
         Stop once these nodes are frozen and final; nodes later than the latest
         of them are then ``inf``, as in the serial march.
