@@ -743,6 +743,25 @@ def _mark(a, c, ctl, slot):
 
 
 @njit(cache=True, inline="always", _nrt=False)
+def _mark_r(a, c, live):
+    """:func:`_mark` with the mask's count ``live`` as a value: the new count."""
+    if not _fbit(a, c):
+        _set_fbit(a, c)
+        live += 1.0
+    return live
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _take_flag_r(a, c, live):
+    """:func:`_take_flag` with the mask's count ``live`` as a value: whether the bit was set,
+    and the new count."""
+    if live > 0.0 and _fbit(a, c):
+        _clear_fbit(a, c)
+        return True, live - 1.0
+    return False, live
+
+
+@njit(cache=True, inline="always", _nrt=False)
 def _take_flag(a, c, ctl, slot):
     """Whether flag bit ``c`` of ``a`` is set, clearing it (and its count) if so; no read
     while no bit of the mask is set (``ctl[slot] == 0``)."""
@@ -917,13 +936,72 @@ def _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf, eidx, eval
 
 @njit(cache=True, inline="always", error_model="numpy", _nrt=False)
 def _recheck_r(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf, eidx, evals, base,
-               pool, nxt, bk, mw, st, rkey, ritem, ctl, requeue, nfree, fh, cur, last, rsize):
-    """:func:`_recheck` from a kernel keeping the queue's state in registers: stored in
-    ``st`` for the call and read back (``nfree, fh, cur, rsize``; a repair is rare)."""
+               pool, nxt, bk, mw, st, rkey, ritem, ctl, requeue, live):
+    """:func:`_recheck` from a kernel keeping the queue's state and the flags' live counts in
+    registers, ``live``: ``(nfree, fh, cur, last, rsize, slive, rlive)`` (the suspect and
+    re-opened masks' counts), stored in ``st`` and ``ctl`` for the call; returns them read back
+    but ``last`` (a repair is rare; a tuple: a call of more than 30 arguments compiles in
+    CPython to one of ``*args``, which numba's inliner refuses)."""
+    nfree, fh, cur, last, rsize, slive, rlive = live
     _keep_queue(st, nfree, fh, cur, last, rsize)
+    ctl[_C_SLIVE] = slive
+    ctl[_C_RLIVE] = rlive
     _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf, eidx, evals, base, pool,
              nxt, bk, mw, st, rkey, ritem, ctl, requeue)
-    return st[_NFREE], st[_FH], st[_CUR], st[_RSIZE]
+    return st[_NFREE], st[_FH], st[_CUR], st[_RSIZE], ctl[_C_SLIVE], ctl[_C_RLIVE]
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)  # a call (rare): compiles once
+def _suspect2(T, V, U, use_u, qp, fixed, c, t, sx, sy, ih, three, rf, pf, eidx, evals, base,
+              pool, nxt, bk, mw, st, rkey, ritem, ctl, dfr):
+    """The suspect node ``c`` popped at ``t`` (order 2): its time from scratch
+    (:func:`_serial_time2`); if that differs, ``c`` is queued at it (not frozen: True) and,
+    if it went up, its band neighbours deferred on its old time (``dfr``, 2D) are queued; a
+    re-opened node raised is pending (``pf``: the stop test must not pass ``t`` before it is
+    frozen again). False: ``t`` stands, ``c`` freezes. The queue's state in ``st``; apart from
+    the window's loop (on 2048^2 FM²-shaped, one slab on one thread: its windows' CPU -1 %)."""
+    sh = _unit(sy, three) >> _ONE
+    t2 = _entry_cap(eidx, evals, base + c,
+                    _serial_time2(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three))
+    if t2 == t:
+        return False
+    if t2 > t and _fbit(rf, c >> sh) and not _fbit(pf, c >> sh):
+        # nodes may still read its old time (>= t): the stop test must not pass t before it
+        # is frozen again
+        _set_fbit(pf, c >> sh)
+        ctl[_C_PEND] += 1.0
+        ctl[_C_RMIN] = min(ctl[_C_RMIN], t)
+    T[c] = -t2
+    if t2 < _INF:
+        _enq(_bits(t2), c, pool, nxt, bk, mw, st, rkey, ritem)
+    if dfr and t2 > t:  # band neighbours deferred on c's old time: queued
+        for nb in _nbs(c, sx, sy, three):
+            y = T[nb]
+            if nb != c and y < 0.0 and y > -_INF and -y < t2:
+                _enq(_bits(-y), nb, pool, nxt, bk, mw, st, rkey, ritem)
+    return True
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)  # a call (rare): compiles once
+def _refrozen2(T, V, U, use_u, qp, c, lo, hi, sx, sy, ih, three, fixed, rf, sf, eidx, evals, base,
+               pool, nxt, bk, mw, st, rkey, ritem, ctl, requeue):
+    """Node ``c`` frozen again (re-opened before, order 2): every own node that may have read
+    its old time gets its time from scratch (:func:`_recheck`), the neighbours and the nodes
+    two away beyond a frozen neighbour, in the window's order (the queue's state in ``st``,
+    the masks' counts in ``ctl``). Apart from the window's loop, which then keeps no test of
+    it (on 2048^2 FM²-shaped, one slab on one thread: its windows' CPU -3 %)."""
+    for j in range(6 if three else 4):
+        s = sx if j < 2 else (sy if j < 4 else _unit(sy, three))
+        nb = c - s if j & 1 == 0 else c + s
+        y = T[nb]
+        if y < 0.0 or (y >= 0.0 and nb >= lo and nb < hi):  # band or far; frozen, own
+            _recheck(T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf, eidx, evals,
+                     base, pool, nxt, bk, mw, st, rkey, ritem, ctl, requeue)
+        if T[nb] >= 0.0:  # the node two away reads c beyond nb
+            d2 = nb + nb - c
+            if d2 >= lo and d2 < hi and T[d2] == T[d2]:  # an own node, not a wall
+                _recheck(T, V, U, use_u, qp, d2, sx, sy, ih, three, fixed, rf, sf, eidx, evals,
+                         base, pool, nxt, bk, mw, st, rkey, ritem, ctl, requeue)
 
 
 @njit(cache=True, inline="always", _nrt=False)
@@ -1007,6 +1085,11 @@ def _slab_kernels2(three, pairs=False):
         cur = st[_CUR]
         last = st[_LAST]
         rsize = st[_RSIZE]
+        # and the per-pop counters too (the stores into T would reload them from ctl)
+        fmax = ctl[_C_FMAX]
+        pend = ctl[_C_PEND]
+        slive = ctl[_C_SLIVE]
+        rlive = ctl[_C_RLIVE]
         while True:
             if not _room2_r(nfree, rsize, rkey):
                 ctl[_C_STATUS] = 1.0 if nfree < _U(RESERVE_BLOCKS + POOL_EXTRA_2) else 2.0
@@ -1034,72 +1117,62 @@ def _slab_kernels2(three, pairs=False):
                                                cur, last, rsize)
                 ctl[_C_NEXT] = min(t, _from_bits(kb))
                 break
-            if _take_flag(sf, c >> sh, ctl, _C_SLIVE):  # suspect: its time may have to go up
-                t2 = _entry_cap(eidx, evals, base + c,
-                                _serial_time2(T, V, U, use_u, qp, fixed, c, sx, sy, ih, three))
-                if t2 != t:
-                    if t2 > t and _fbit(rf, c >> sh) and not _fbit(pf, c >> sh):
-                        # nodes may still read its old time (>= t): the stop test must not
-                        # pass t before it is frozen again
-                        _set_fbit(pf, c >> sh)
-                        ctl[_C_PEND] += 1.0
-                        ctl[_C_RMIN] = min(ctl[_C_RMIN], t)
-                    T[c] = -t2
-                    if t2 < _INF:
-                        nfree, fh, cur, rsize = _enq_r(_bits(t2), c, pool, nxt, bk, mw, rkey,
-                                                       ritem, nfree, fh, cur, last, rsize)
-                    if dfr and t2 > t:  # band neighbours deferred on c's old time: queued
-                        for nb in _nbs(c, sx, sy, three):
-                            y = T[nb]
-                            if nb != c and y < 0.0 and y > -_INF and -y < t2:
-                                nfree, fh, cur, rsize = _enq_r(_bits(-y), nb, pool, nxt, bk, mw,
-                                                               rkey, ritem, nfree, fh, cur,
-                                                               last, rsize)
+            sus, slive = _take_flag_r(sf, c >> sh, slive)
+            if sus:  # suspect: its time may have to go up
+                _keep_queue(st, nfree, fh, cur, last, rsize)
+                ctl[_C_PEND] = pend
+                moved = _suspect2(T, V, U, use_u, qp, fixed, c, t, sx, sy, ih, three, rf, pf,
+                                  eidx, evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl, dfr)
+                nfree, fh, cur, rsize = st[_NFREE], st[_FH], st[_CUR], st[_RSIZE]
+                pend = ctl[_C_PEND]
+                if moved:
                     continue
             T[c] = t
             pops += 1
             # in time order (no node frozen later than c, but on entry): no neighbour of a
             # band node is frozen later than c (:func:`_later_nb` False), as in the serial
             # march; a repair's pop below an earlier freeze is not
-            inorder = t >= ctl[_C_FMAX]
+            inorder = t >= fmax
             if inorder:
-                ctl[_C_FMAX] = t
+                fmax = t
             if c < lo2:
                 _note(sent, ns, 0, c)
             if c >= hi2:
                 _note(sent, ns, 1, c)
-            if ctl[_C_PEND] > 0.0 and _fbit(pf, c >> sh):
+            if pend > 0.0 and _fbit(pf, c >> sh):
                 _clear_fbit(pf, c >> sh)
-                ctl[_C_PEND] -= 1.0
-                if ctl[_C_PEND] == 0.0:
+                pend -= 1.0
+                if pend == 0.0:
                     ctl[_C_RMIN] = _INF
-            # frozen again: every dependant may have read its old time
-            full = _take_flag(rf, c >> sh, ctl, _C_RLIVE)
+            # frozen again: every dependant may have read its old time (from scratch)
+            full, rlive = _take_flag_r(rf, c >> sh, rlive)
+            if full:
+                _keep_queue(st, nfree, fh, cur, last, rsize)
+                ctl[_C_SLIVE] = slive
+                ctl[_C_RLIVE] = rlive
+                _refrozen2(T, V, U, use_u, qp, c, lo, hi, sx, sy, ih, three, fixed, rf, sf, eidx,
+                           evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl, dfr)
+                nfree, fh, cur, rsize = st[_NFREE], st[_FH], st[_CUR], st[_RSIZE]
+                slive, rlive = ctl[_C_SLIVE], ctl[_C_RLIVE]
+                continue
             # prefetch V apart from T off the plateau (interleaved: the same lines)
             pv = one == _ONE and not (use_u and _at_plateau(U, c))
-            for nb in _nbs(c, sx, sy, three):
-                if nb == c:
-                    continue
+            # one site for the neighbours, as the serial march (strides by axis)
+            for j in range(6 if three else 4):
+                s = sx if j < 2 else (sy if j < 4 else one)
+                nb = c - s if j & 1 == 0 else c + s
                 y = T[nb]
-                if y == -_INF and not full:
+                if y == -_INF:
                     # far: c is its only frozen neighbour (every frozen node, ghosts too,
                     # has updated its neighbours), so the update is the one-axis solution
                     # along c's axis, as the full update gives it (the serial 2D march's
-                    # shortcut): two axes' reads and terms saved on a third of the updates
-                    if nb == c - sx or nb == c + sx:
-                        ih_nb = ih[0]
-                        s_o = sy  # (2D) the other axis' stride
-                    elif nb == c - sy or nb == c + sy:
-                        ih_nb = ih[1]
-                        s_o = sx
-                    else:
-                        ih_nb = ih[2]
-                        s_o = sx
+                    # shortcut): two axes' reads and terms saved on a third of the updates;
                     # c2: the node beyond c on that axis (nb's other side is not frozen)
-                    ta, aa = _upwind_term_at(T, V, U, use_u, fixed, nb, t, c, c + c - nb,
-                                             ih_nb, t, sh)
+                    c2 = c + s if j & 1 == 0 else c - s
+                    ta, aa = _upwind_term_at(T, V, U, use_u, fixed, nb, t, c, c2, ih[j >> 1], t,
+                                             sh)
                     t_nb = ta + math.sqrt(_rhs(V, U, use_u, qp, nb) / aa)
-                    if dfr and _earlier_band(T, nb, s_o, t_nb):
+                    if dfr and _earlier_band(T, nb, sy if j < 2 else sx, t_nb):
                         T[nb] = -t_nb  # deferred, as in the order-1 window
                         _prefetch_rows(T, V, nb, sx, sy, three, pv)
                         continue
@@ -1107,14 +1180,14 @@ def _slab_kernels2(three, pairs=False):
                         T, V, nb, t_nb, fixed, sx, sy, three, pv, pool, nxt, bk, mw, rkey,
                         ritem, ctl, not three, nfree, fh, cur, last, rsize)
                 elif y < 0.0:  # band (or far after c froze again): an own node
-                    if full or (not inorder and _later_nb(T, fixed, nb, sx, sy, three, t)):
-                        # c frozen again, or a neighbour frozen later than c (a ghost ahead
-                        # of this slab, a repair): the updates at the later freezes read
+                    if not inorder and _later_nb(T, fixed, nb, sx, sy, three, t):
+                        # a neighbour frozen later than c (a ghost ahead of this slab, a
+                        # repair): the updates at the later freezes read
                         # nodes not frozen then, from scratch now
-                        nfree, fh, cur, rsize = _recheck_r(
+                        nfree, fh, cur, rsize, slive, rlive = _recheck_r(
                             T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf, eidx,
-                            evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl, dfr, nfree, fh,
-                            cur, last, rsize)
+                            evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl, dfr,
+                            (nfree, fh, cur, last, rsize, slive, rlive))
                     else:  # the serial march's update when c froze; a band time that read
                         # nodes out of time order may be too low: a later update above it
                         # marks it suspect
@@ -1125,30 +1198,34 @@ def _slab_kernels2(three, pairs=False):
                                 ritem, ctl, not three, nfree, fh, cur, last, rsize)
                         elif y > -_INF:
                             if tn > -y and _entry_cap(eidx, evals, base + nb, tn) > -y:
-                                _mark(sf, nb >> sh, ctl, _C_SLIVE)
+                                slive = _mark_r(sf, nb >> sh, slive)
                                 ctl[_C_RAISED] += 1.0
                             if dfr:  # it may be deferred: queued again at its time
                                 nfree, fh, cur, rsize = _enq_r(_bits(-y), nb, pool, nxt, bk, mw,
                                                                rkey, ritem, nfree, fh, cur, last,
                                                                rsize)
-                elif y >= 0.0 and nb >= lo and nb < hi and (full or y > t):
+                elif y >= 0.0 and nb >= lo and nb < hi and y > t:
                     # frozen later than c in this slab: c may change it
-                    nfree, fh, cur, rsize = _recheck_r(
+                    nfree, fh, cur, rsize, slive, rlive = _recheck_r(
                         T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf, eidx, evals,
-                        base, pool, nxt, bk, mw, st, rkey, ritem, ctl, dfr, nfree, fh, cur,
-                        last, rsize)
+                        base, pool, nxt, bk, mw, st, rkey, ritem, ctl, dfr,
+                        (nfree, fh, cur, last, rsize, slive, rlive))
                 # the node two away reads c beyond nb when nb is frozen no earlier than c
                 y = T[nb]
-                if y >= 0.0 and (full or t <= y):
+                if y >= 0.0 and t <= y:
                     d2 = nb + nb - c
                     if d2 >= lo and d2 < hi:
                         z = T[d2]
-                        if z < 0.0 or (z >= 0.0 and (full or z > t)):
-                            nfree, fh, cur, rsize = _recheck_r(
+                        if z < 0.0 or z > t:
+                            nfree, fh, cur, rsize, slive, rlive = _recheck_r(
                                 T, V, U, use_u, qp, d2, sx, sy, ih, three, fixed, rf, sf, eidx,
-                                evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl, dfr, nfree,
-                                fh, cur, last, rsize)
+                                evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl, dfr,
+                                (nfree, fh, cur, last, rsize, slive, rlive))
         _keep_queue(st, nfree, fh, cur, last, rsize)
+        ctl[_C_FMAX] = fmax
+        ctl[_C_PEND] = pend
+        ctl[_C_SLIVE] = slive
+        ctl[_C_RLIVE] = rlive
         ctl[_C_POPS] = pops
 
     def start(T, V, U, qp, fixed, sx, sy, ih, pool, nxt, bk, mw, st, rkey, ritem, ctl, c0, c1):
