@@ -1157,10 +1157,16 @@ def _slab_kernels2(three, pairs=False):
                 continue
             # prefetch V apart from T off the plateau (interleaved: the same lines)
             pv = one == _ONE and not (use_u and _at_plateau(U, c))
-            # one site for the neighbours, as the serial march (strides by axis)
+            nbs = _nbs(c, sx, sy, three)
             for j in range(6 if three else 4):
-                s = sx if j < 2 else (sy if j < 4 else one)
-                nb = c - s if j & 1 == 0 else c + s
+                # neighbour j (x-, x+, y-, y+, z-, z+): in 2D from its stride, as the serial
+                # march; in 3D from the tuple (measured faster there: 160^3 FM²-shaped, one
+                # slab on one thread, 0.97x the computed strides' time, 2D 1.03x)
+                if three:
+                    nb = nbs[j]
+                else:
+                    s = sx if j < 2 else sy
+                    nb = c - s if j & 1 == 0 else c + s
                 y = T[nb]
                 if y == -_INF:
                     # far: c is its only frozen neighbour (every frozen node, ghosts too,
@@ -1168,9 +1174,8 @@ def _slab_kernels2(three, pairs=False):
                     # along c's axis, as the full update gives it (the serial 2D march's
                     # shortcut): two axes' reads and terms saved on a third of the updates;
                     # c2: the node beyond c on that axis (nb's other side is not frozen)
-                    c2 = c + s if j & 1 == 0 else c - s
-                    ta, aa = _upwind_term_at(T, V, U, use_u, fixed, nb, t, c, c2, ih[j >> 1], t,
-                                             sh)
+                    ta, aa = _upwind_term_at(T, V, U, use_u, fixed, nb, t, c, c + c - nb,
+                                             ih[j >> 1], t, sh)
                     t_nb = ta + math.sqrt(_rhs(V, U, use_u, qp, nb) / aa)
                     if dfr and _earlier_band(T, nb, sy if j < 2 else sx, t_nb):
                         T[nb] = -t_nb  # deferred, as in the order-1 window
