@@ -1372,8 +1372,12 @@ def _plateau(speed, Vp, shape3, npad, fill=None, mask=True, *, span=None):
     cost 2 % of the march on a map without one). ``fill(vmax, bits)``, if given, sets the
     bits in another layout (the parallel march's slabs) and returns how many.
     ``mask=False``: a uniform grid's plateau only (a mixed grid gets none, its mask unbuilt).
-    ``span``: the speeds' :func:`speed_range` if known (else found here, a pass over them).
+    ``span``: the speeds' :func:`speed_range` if known (else found here, a pass over them);
+    with ``mask=False`` a known span of two speeds answers at once (the sample's strided
+    reads, a cache line each, took 1.36 ms on a 2048^2 FM²-shaped map out of cache).
     """
+    if not mask and span is not None and span[0] != span[1]:
+        return _NO_BITS, 0.0
     sample = speed[::_PLATEAU_STRIDE]
     top = sample.max()
     if not top > 0.0 or np.count_nonzero(sample == top) < 0.8 * PLATEAU_MIN_SHARE * sample.size:
