@@ -1160,8 +1160,8 @@ def _slab_kernels2(three, pairs=False):
             nbs = _nbs(c, sx, sy, three)
             for j in range(6 if three else 4):
                 # neighbour j (x-, x+, y-, y+, z-, z+): in 2D from its stride, as the serial
-                # march; in 3D from the tuple (measured faster there: 160^3 FM²-shaped, one
-                # slab on one thread, 0.97x the computed strides' time, 2D 1.03x)
+                # march; in 3D from the tuple (one slab on one thread, 160^3 FM²-shaped: the
+                # computed strides 1.034x the tuple's time; in 2D they gained 1-3 %)
                 if three:
                     nb = nbs[j]
                 else:
@@ -1184,11 +1184,11 @@ def _slab_kernels2(three, pairs=False):
                     nfree, fh, cur, rsize = _lower_r(
                         T, V, nb, t_nb, fixed, sx, sy, three, pv, pool, nxt, bk, mw, rkey,
                         ritem, ctl, not three, nfree, fh, cur, last, rsize)
-                elif y < 0.0:  # band (or far after c froze again): an own node
+                elif y < 0.0:  # band: an own node
                     if not inorder and _later_nb(T, fixed, nb, sx, sy, three, t):
                         # a neighbour frozen later than c (a ghost ahead of this slab, a
-                        # repair): the updates at the later freezes read
-                        # nodes not frozen then, from scratch now
+                        # repair): the updates at the later freezes read nodes not frozen
+                        # then, from scratch now (c frozen again: _refrozen2 above)
                         nfree, fh, cur, rsize, slive, rlive = _recheck_r(
                             T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf, eidx,
                             evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl, dfr,
