@@ -188,7 +188,7 @@ def test_order_2_on_random_fm2_fields_and_thin_slabs_equals_the_serial_march(blo
                             {(d, o): per for d in (2, 3) for o in (1, 2)})
         monkeypatch.setattr(_parallel, "slab_bounds",  # equal slabs of ``rows`` rows
                             lambda speed, start, shape3, h3, k, t=2, more=0, cells=None,
-                            fewer=0:
+                            fewer=0, order=1:
                             np.linspace(0, shape3[0], k + 1).round().astype(np.int64))
         flat, start, shape3 = _start_h(v, src, h)
         T, stats = _parallel.march(flat, start, shape3, h + (1.0,) * (3 - v.ndim), threads,
@@ -300,6 +300,9 @@ def test_balanced_cuts_of_many_slabs_shorten_the_windows_critical_path(shape, ga
     monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)  # slab counts of 2048^2 and 160^3
     monkeypatch.setattr(_tuning, "WINDOW_NODES", {k: 32768 for k in _tuning.WINDOW_NODES})
     monkeypatch.setattr(_tuning, "DYNAMIC_2D", False)
+    # the coarse march over every 4th node: with every 8th (3D order 1's default, which saves
+    # its serial time) 160 rows leave 20 coarse rows for 8 cuts, little room to place them
+    monkeypatch.setattr(_tuning, "COARSE_3D", {1: 4, 2: 4})
     # the cuts as slab_bounds places them (not moved off the source: clear_of_sources)
     monkeypatch.setattr(_tuning, "SOURCE_CUT_ROWS", dict.fromkeys(_tuning.SOURCE_CUT_ROWS, 0))
     v, src = fm2_shaped(shape)
@@ -389,8 +392,8 @@ def test_fewer_slabs_only_where_the_coarse_march_predicts_a_shorter_path(cost, m
                    (walls, (48, 32, 32))):
         flat, start, shape3 = _start(v, src)
         ratio = _cost_ratio(flat, start, shape3, 2, 4)  # path with 2 over that with 4
-        open_air = bool(np.all(v[::_tuning.COARSE_3D, ::_tuning.COARSE_3D,
-                                 ::_tuning.COARSE_3D_Z] > 0.0))
+        f = _tuning.COARSE_3D[1]  # slab_bounds' order (1)
+        open_air = bool(np.all(v[::f, ::f, ::_tuning.COARSE_3D_Z] > 0.0))
         cuts = _parallel.slab_bounds(flat, start, shape3, (1.0,) * 3, 4, 2, 6, fewer=2)
         assert cuts[0] == 0 and cuts[-1] == shape3[0]
         if ratio <= cost and open_air:

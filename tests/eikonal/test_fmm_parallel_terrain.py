@@ -141,7 +141,7 @@ def test_big_3d_grids_cut_the_slabs_for_sharing_bit_for_bit(lean, monkeypatch):
     h = (15.0, 15.0, 10.0)
     # the coarse march over every node: on a grid this small, a coarser one leaves a few
     # nodes per time bin, and both descents the same cuts
-    monkeypatch.setattr(_tuning, "COARSE_3D", 1)
+    monkeypatch.setattr(_tuning, "COARSE_3D", {1: 1, 2: 1})
     monkeypatch.setattr(_tuning, "COARSE_3D_Z", 1)
     monkeypatch.setitem(_tuning.SLABS_PER_THREAD, (3, 2), 4)  # 8 slabs to place
     seen = []

@@ -1783,7 +1783,7 @@ def _slab_count(most: int, shape3, G: int, nth: int) -> int:
 
 
 def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2,
-                more: int = 0, cells=None, fewer: int = 0) -> np.ndarray:
+                more: int = 0, cells=None, fewer: int = 0, order: int = 1) -> np.ndarray:
     """Row bounds (``k + 1`` ints) of ``k`` slabs along x, slab ``j`` marched by thread
     ``j % threads``; or of ``more`` slabs (``more + 1`` ints) where the coarse march
     predicts for them a windows' critical path shorter by the factor
@@ -1809,13 +1809,14 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2,
     start is not a few point sources (its box over a quarter of the grid) or the grid is
     too thin for a coarse march. ``cells`` (int, shape (m, 3)): the coarse march starts from
     these nodes instead of the start's frozen ones (the sources, while their balls are being
-    computed: :func:`march`'s ``ready``).
+    computed: :func:`march`'s ``ready``). ``order``: the full march's, which sets the coarse
+    march's step in 3D (:data:`_tuning.COARSE_3D`).
     """
     nx = int(shape3[0])
     even = np.linspace(0, nx, k + 1).round().astype(np.int64)
     if k < 2 or threads < 2 or 4 * int(np.prod(start.shape)) > int(np.prod(shape3)):
         return even
-    hist, f = _coarse_histogram(speed, start, shape3, h3, cells)
+    hist, f = _coarse_histogram(speed, start, shape3, h3, cells, order)
     if hist is None:
         return even
     rows = hist.shape[0]
@@ -1825,7 +1826,8 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2,
     cum = np.vstack([np.zeros((1, hist.shape[1]), dtype=np.int64), np.cumsum(hist, axis=0)])
     cuts = _place_cuts(cum, k, gap, threads, shape3)
     # fewer: only where the coarse march reached every coarse node (no walls seen)
-    if 0 < fewer < k and rows >= fewer * gap and int(hist.sum()) == _coarse_nodes(shape3):
+    if (0 < fewer < k and rows >= fewer * gap
+            and int(hist.sum()) == _coarse_nodes(shape3, order)):
         alt = _place_cuts(cum, fewer, gap, threads, shape3)
         if _shared_cost(cum, alt, threads) <= (_tuning.FEWER_SLABS_COST
                                                * _shared_cost(cum, cuts, threads)):
@@ -1847,18 +1849,18 @@ def slab_bounds(speed, start, shape3, h3, k: int, threads: int = 2,
     return bounds.astype(np.int64)
 
 
-def _coarse_steps(shape3) -> tuple[int, int]:
-    """The steps of :func:`_coarse_histogram`'s coarse grid: ``(f, fz)``, every ``f``-th node
-    along x and y, every ``fz``-th along z (:data:`_tuning.COARSE`, ``COARSE_3D``,
-    ``COARSE_3D_Z``)."""
+def _coarse_steps(shape3, order: int = 1) -> tuple[int, int]:
+    """The steps of :func:`_coarse_histogram`'s coarse grid for a march of ``order``:
+    ``(f, fz)``, every ``f``-th node along x and y, every ``fz``-th along z
+    (:data:`_tuning.COARSE`, ``COARSE_3D[order]``, ``COARSE_3D_Z``)."""
     if shape3[2] > 1:
-        return _tuning.COARSE_3D, _tuning.COARSE_3D_Z
+        return _tuning.COARSE_3D[order], _tuning.COARSE_3D_Z
     return _tuning.COARSE, 1
 
 
-def _coarse_nodes(shape3) -> int:
-    """The nodes of :func:`_coarse_histogram`'s coarse grid."""
-    f, fz = _coarse_steps(shape3)
+def _coarse_nodes(shape3, order: int = 1) -> int:
+    """The nodes of :func:`_coarse_histogram`'s coarse grid (a march of ``order``)."""
+    f, fz = _coarse_steps(shape3, order)
     return (-(-int(shape3[0]) // f)) * (-(-int(shape3[1]) // f)) * (-(-int(shape3[2]) // fz))
 
 
@@ -1976,12 +1978,13 @@ def _shared_cost(cum, cuts, threads):
     return total
 
 
-def _coarse_histogram(speed, start, shape3, h3, cells=None):
+def _coarse_histogram(speed, start, shape3, h3, cells=None, order=1):
     """Nodes per coarse x-row and time bin of a march over every ``COARSE``-th node
-    (``COARSE_3D`` in 3D, along z ``COARSE_3D_Z``) from the start's frozen nodes: ``(hist,
-    f)``, ``hist`` of shape ``(coarse rows, SPLIT_BINS)`` and ``f`` the x coarsening;
-    ``(None, f)`` if no estimate. ``cells``: the nodes to start from instead (int, (m, 3))."""
-    f, fz = _coarse_steps(shape3)
+    (``COARSE_3D[order]`` in 3D, along z ``COARSE_3D_Z``; ``order`` the full march's) from
+    the start's frozen nodes: ``(hist, f)``, ``hist`` of shape ``(coarse rows, SPLIT_BINS)``
+    and ``f`` the x coarsening; ``(None, f)`` if no estimate. ``cells``: the nodes to start
+    from instead (int, (m, 3))."""
+    f, fz = _coarse_steps(shape3, order)
     grid = speed.reshape(shape3)
     coarse = np.ascontiguousarray(grid[::f, ::f, ::fz])
     cshape = coarse.shape
@@ -2128,7 +2131,8 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
                                   interleave, huge_times=_tuning.LEAN_TIMES_HUGE, span=span)
     out = None  # the result (not lean)
     top_of = speed if span is None else None
-    cut = partial(slab_bounds, speed, start, shape3, h3, K, nth, more, cells=cells, fewer=fewer)
+    cut = partial(slab_bounds, speed, start, shape3, h3, K, nth, more, cells=cells, fewer=fewer,
+                  order=order)
     if early is not None:
         with _PageToucher(early[0], early[1], top_of=top_of) as toucher:
             bounds = cut()

@@ -145,12 +145,19 @@ SHARE_SLABS = True
 #: 1.03x / 1.14x, constant 1.02x / 1.17x).
 DYNAMIC_2D = True
 #: The split of two slabs is chosen on a march over every ``COARSE``-th node per axis (2D; 3D:
-#: ``COARSE_3D``), ~0.5 % (2D) and ~1.5 % (3D) of the work of the full march (serial time: the
+#: ``COARSE_3D``), ~0.5 % (2D) and ~0.2-1.5 % (3D) of the work of the full march (serial time: the
 #: second thread waits). 2D: the windows' balance on FM²-shaped 2048^2 maps (seeds 0-3, with
 #: :func:`_parallel._assign`) averaged 1.827 / 1.823 / 1.813 / 1.768 with every 8th / 16th / 32nd
 #: node / equal slabs, the coarse march 8 / 2 / 0.5 ms.
 COARSE = 16
-COARSE_3D = 4
+#: 3D keyed by order. Order 1 takes every 8th node: the placing runs on the calling thread while
+#: the other waits, 6.8-10.5 ms on the bench's 160^3 fields with every 4th node against 2.3-2.8
+#: ms with every 8th, for the same cuts or as good (6 December 2026, session 39, two threads,
+#: one process alternating the settings, medians of 9-11: constant 0.973x / 0.970x, smooth
+#: 0.983x, FM²-shaped seeds 0 / 1 / 2 / 3 0.970x / 0.916x / 0.966x / 0.972x). Order 2 keeps
+#: every 4th: there the coarse march also chooses the slab count (:data:`MORE_SLABS_3D`), and
+#: every 5th / 6th / 8th node cost the FM²-shaped field 1.007x / 1.206x / 1.016x (session 38).
+COARSE_3D = {1: 8, 2: 4}
 #: The coarse march's step along z in 3D (a terrain's layers are few: 40).
 COARSE_3D_Z = 4
 #: Whether the cuts are placed for the slabs shared anew before each window (the least share of a
