@@ -124,6 +124,7 @@ def _fmm_parallel(ndim: int) -> Callable[[], None]:
         for shared in (False, True):
             _parallel._descend_cuts(cum, cuts, 1, 2, shared)
         _parallel._shared_cost(cum, cuts, 2)  # the two descents' cuts compared
+        _parallel._time_bins(np.zeros((2, 2)), np.zeros(1), 2)  # the coarse march's bins
 
     return run
 
