@@ -330,6 +330,72 @@ def test_balanced_cuts_of_many_slabs_shorten_the_windows_critical_path(shape, ga
         assert turn["balance"] > 1.03 * balanced["balance"]
 
 
+def _critical_path(cum, cuts, threads, shared):
+    """:func:`_parallel._descend_cuts`' cost, written plainly: per time bin the most nodes a
+    thread gets (slab ``j`` to thread ``j % threads``), or with ``shared`` the least any
+    sharing allows, ``max(busiest slab, all / threads)``; summed over the bins."""
+    per = cum[cuts[1:]] - cum[cuts[:-1]]  # (slabs, bins)
+    if shared:
+        return float(np.maximum(per.max(axis=0), per.sum(axis=0) / threads).sum())
+    owners = np.arange(len(cuts) - 1) % threads
+    return float(np.max([per[owners == t].sum(axis=0) for t in range(threads)], axis=0).sum())
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_cuts_descent_leaves_no_cut_with_a_better_row(seed):
+    """Each inner cut the descent returns is a best row between its neighbours (at least
+    ``gap`` rows from each) for the critical path written plainly here, fixed interleave
+    (the first best row) or shared (no strictly better row), on random histograms with ties,
+    two to four threads; the cuts stay ordered and ``gap`` apart."""
+    rng = np.random.default_rng(seed)
+    for _ in range(12):
+        rows, nb = int(rng.integers(12, 90)), int(rng.integers(1, 40))
+        hist = rng.integers(0, 6, (rows, nb)) * (rng.random((rows, nb)) < 0.4)
+        cum = np.vstack([np.zeros((1, nb), dtype=np.int64), np.cumsum(hist, axis=0)])
+        threads, gap = int(rng.integers(2, 5)), int(rng.integers(1, 3))
+        k = int(rng.integers(2, min(9, rows // gap) + 1))
+        start = np.clip(np.linspace(0, rows, k + 1).round().astype(np.int64), 0, rows)
+        for shared in (False, True):
+            cuts = _parallel._descend_cuts(cum, start.copy(), gap, threads, shared)
+            assert cuts[0] == 0 and cuts[-1] == rows
+            assert np.all(np.diff(cuts) >= min(gap, int(np.diff(start).min())))
+            for i in range(1, k):
+                lo, hi = cuts[i - 1] + gap, cuts[i + 1] - gap
+                if hi < lo:
+                    continue
+                costs = {}
+                for r in range(lo, hi + 1):
+                    trial = cuts.copy()
+                    trial[i] = r
+                    costs[r] = _critical_path(cum, trial, threads, shared)
+                here = _critical_path(cum, cuts, threads, shared)
+                if shared:
+                    assert min(costs.values()) >= here - 1e-9
+                else:
+                    assert cuts[i] == min(costs, key=lambda r: (costs[r], r))
+
+
+def test_time_bins_count_the_edges_below_each_time():
+    """:func:`_parallel._time_bins` gives numpy's ``searchsorted(edges, t, "left")`` per
+    finite time, counted per row and bin, whatever the order of the times (it walks from the
+    last node's bin): ties with the edges, ``inf`` skipped, one bin and many."""
+    rng = np.random.default_rng(3)
+    for _ in range(300):
+        rows, cols = int(rng.integers(1, 30)), int(rng.integers(1, 30))
+        nb = int(rng.integers(1, 300))
+        T = rng.integers(0, 9, (rows, cols)).astype(float)  # ties
+        if rng.random() < 0.5:
+            T += rng.random((rows, cols))
+        T[rng.random((rows, cols)) < 0.2] = np.inf
+        edges = np.sort(rng.choice(T[np.isfinite(T)], nb - 1)) if np.isfinite(T).any() \
+            and nb > 1 else np.sort(rng.integers(0, 9, nb - 1).astype(float))
+        fin = np.isfinite(T)
+        rws = np.broadcast_to(np.arange(rows)[:, None], T.shape)[fin]
+        bins = np.searchsorted(edges, T[fin], side="left")
+        ref = np.bincount(rws * nb + bins, minlength=rows * nb).reshape(rows, nb)
+        assert np.array_equal(_parallel._time_bins(T, edges, nb), ref)
+
+
 def _cost_ratio(flat, start, shape3, k, more):
     """The coarse march's windows' critical path with ``k`` slabs over that with ``more``
     (the slabs shared as :func:`_parallel._assign` shares them), computed here."""
