@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import json
 import os
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -419,13 +420,16 @@ def jit_rows(quick: bool) -> list[dict]:
     ]
 
 
-def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
+def threads_rows(quick: bool, repeats: int = 5, children: int = 2) -> list[dict]:
     """The parallel march (issue 27): ``threads=2`` against ``threads=1``, order 1 and 2.
 
     2048² and 160³ with constant speed (centre source), the smooth field and the
     FM²-shaped field (:mod:`benchmarks.fields`), and the smaller grids around the size
     below which the march stays serial (``PARALLEL_MIN_NODES``). Interleaved in one child,
-    medians of ``repeats`` rounds. Three ratios: wall time (what a user waits; on a busy
+    ``repeats`` rounds, and the same again in ``children`` children one after the other: on
+    this host the ratios swung 5-10 % between runs minutes apart (session 38: 160³ FM²-shaped
+    order 2 1.38x and 1.59x), so a row gives the medians over every child's rounds and its
+    notes each child's ratio. Three ratios: wall time (what a user waits; on a busy
     machine the second thread waits for a core), process CPU time (the work both threads
     do) and serial CPU over the busiest thread's CPU time (from ``/proc/self/task``; an
     upper bound of the idle machine's wall ratio: the threads' waits at the barriers are
@@ -457,7 +461,7 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
         print(json.dumps([march_pair.measure(c, 1, {pair_repeats}) for c in {pair_cases!r}]))
         """
     )
-    res = _child(
+    code = (
         f"""
         import os
         from fm2uav import fast_marching
@@ -503,11 +507,9 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
                     est = (stats["setup"] + stats["drive_cpu"] / stats["balance"]
                            if "balance" in stats else c)
                     runs[th].append((w, c, busiest, est))
-            med = {{th: [statistics.median(r[i] for r in runs[th]) for i in range(4)]
-                    for th in runs}}
             out.append(dict(case=case, field=field, order=order, nodes=int(v.size),
                             parallel=_parallel.on_slabs(v.size, len(shape) == 3, order),
-                            serial=med[1], threads2=med[2], balance=stats.get("balance", 1.0),
+                            serial=runs[1], threads2=runs[2], balance=stats.get("balance", 1.0),
                             setup=stats.get("setup", 0.0)))
         import numba
         try:  # the layer numba ran the parallel regions on (none if every case was serial)
@@ -517,9 +519,15 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
         print(json.dumps(dict(marches=out, layer=layer)))
         """
     )
+    runs = [_child(code) for _ in range(children)]
+    res = runs[0]
     rows = [_pair_row(p, pair_repeats) for p in pairs]
-    for r in res["marches"]:
-        (w1, c1, _, _), (w2, c2, b2, e2) = r["serial"], r["threads2"]
+    for i, r in enumerate(res["marches"]):
+        every = [run["marches"][i] for run in runs]
+        (w1, c1, _, _), (w2, c2, b2, e2) = (
+            [statistics.median(x[j] for m in every for x in m[key]) for j in range(4)]
+            for key in ("serial", "threads2"))
+        each = ", ".join(f"{_wall_ratio(m):.2f}x" for m in every)
         big = r["case"] in ("2048x2048", "160x160x160")
         rows.append({
             "benchmark": "fmm threads",
@@ -527,12 +535,20 @@ def threads_rows(quick: bool, repeats: int = 5) -> list[dict]:
             "ours_s": w2, "peer": "fm2uav 1 thread", "peer_s": w1, "ratio": w1 / w2,
             "bar": ">= 1.6x (issue 27)" if big else ("never slower" if r["parallel"] else ""),
             "notes": (f"{'parallel' if r['parallel'] else 'serial (below its floor, on_slabs)'}; "
+                      f"medians of {children} children x {repeats} rounds, each child {each}; "
                       f"CPU 1 thread {c1:.3f} s, 2 threads {c2:.3f} s (ratio {c1 / c2:.2f}x); "
                       f"busiest thread {b2:.3f} s ({c1 / max(b2, 1e-9):.2f}x); windows' balance "
                       f"{r['balance']:.2f}, set-up {1e3 * r['setup']:.0f} ms: idle-machine "
                       f"estimate {c1 / max(e2, 1e-9):.2f}x; numba threading layer "
                       f"{res['layer']}; load average {os.getloadavg()[0]:.1f}")})
     return rows
+
+
+def _wall_ratio(march: dict) -> float:
+    """One child's wall ratio of a case of :func:`threads_rows`: the median of its rounds on
+    one thread over that on two."""
+    return (statistics.median(r[0] for r in march["serial"])
+            / statistics.median(r[0] for r in march["threads2"]))
 
 
 def _pair_row(pair: dict, repeats: int) -> dict:
