@@ -75,8 +75,8 @@ def test_lean_layout_equals_the_serial_lean_march(shape, order, monkeypatch):
     pad, pad_slabs = _kernels.pad_grid, _parallel._pad_slabs
 
     def spy(pad, who):
-        def run(*args):
-            layouts.append((who, args[-1].dtype))  # the padded 1 / speed^2
+        def run(*args):  # the padded 1 / speed^2 (the slabs': before the slab numbers)
+            layouts.append((who, args[-1 if who == "serial" else -2].dtype))
             return pad(*args)
         return run
 
@@ -89,7 +89,8 @@ def test_lean_layout_equals_the_serial_lean_march(shape, order, monkeypatch):
         serial = fast_marching(v, [src], order=order, threads=1)
         par = fast_marching_parallel(v, [src], order=order)
         assert {dtype for _, dtype in layouts} == {np.dtype(np.float32)}, name
-        assert [who for who, _ in layouts].count("slabs") == 1, name
+        # once, or slab by slab beside the source balls' computing, then the rest
+        assert [who for who, _ in layouts].count("slabs") >= 1, name
         assert_equal_times(serial, par, exact=order == 2)
 
 
@@ -632,7 +633,7 @@ def test_slabs_padded_and_unpadded_in_parallel_as_one_at_a_time(shape, threads):
     assert (boxes[:, 3] > 0).sum() >= 2  # the source ball crosses a cut
     Tp, Vp = np.full(npad, -7.0), np.full(npad, -7.0)  # gaps: -7
     _parallel._pad_slabs(threads, _kernels._readonly(flat), start.T, start.state, boxes,
-                         bounds, off, ny, nz, 1, Tp, Vp)
+                         bounds, off, ny, nz, 1, Tp, Vp, np.arange(len(bounds) - 1))
     Tq, Vq = np.full(npad, -7.0), np.full(npad, -7.0)
     plane = ny * nz
     for k in range(len(bounds) - 1):
@@ -677,9 +678,28 @@ def test_order_2_slabs_have_two_ghost_rows_a_side_with_the_grid_speeds(shape, th
         sizes = (np.diff(bounds) + 2 * G) * sx
         off = np.concatenate([[0], np.cumsum(sizes + 3)[:-1]]).astype(np.int64)
         Tp, Vp = np.full(int(off[-1] + sizes[-1]), -7.0), np.full(int(off[-1] + sizes[-1]), -7.0)
-        _parallel._pad_slabs(threads, _kernels._readonly(flat), start.T, start.state,
-                             _parallel._start_boxes(start, bounds, nx, G), bounds, off, ny, nz,
-                             G, Tp, Vp)
+        boxes = _parallel._start_boxes(start, bounds, nx, G)
+        every = np.arange(len(bounds) - 1)
+        _parallel._pad_slabs(threads, _kernels._readonly(flat), start.T, start.state, boxes,
+                             bounds, off, ny, nz, G, Tp, Vp, every)
+        # padded beside the balls' computing (march's ``ready``): the slabs 3, 0 and 2 one by
+        # one with the start box's nodes far, the rest with it, then the box's own rows of
+        # the first ones filled in: the same padded grids, bit for bit
+        Tb, Vb = np.full(Tp.size, -7.0), np.full(Vp.size, -7.0)
+        beside = np.array([3, 0, 2])
+        for k in beside:
+            _parallel._pad_slabs(1, _kernels._readonly(flat), start.T, start.state,
+                                 np.zeros_like(boxes), bounds, off, ny, nz, G, Tb, Vb,
+                                 np.array([k]))
+        for k in (2, 3):  # slabs of the box: its nodes left far so far
+            assert boxes[k, 3] > 0
+            seg = slice(off[k], off[k] + sizes[k])
+            assert not np.array_equal(Tb[seg], Tp[seg], equal_nan=True)
+        _parallel._pad_slabs(threads, _kernels._readonly(flat), start.T, start.state, boxes,
+                             bounds, off, ny, nz, G, Tb, Vb, np.setdiff1d(every, beside))
+        _parallel._fill_start_rows(_kernels._readonly(flat), start.T, start.state, boxes,
+                                   bounds, off, ny, nz, G, Tb, Vb, beside)
+        assert np.array_equal(Tb, Tp, equal_nan=True) and np.array_equal(Vb, Vp, equal_nan=True)
         shape_p = (-1, ny + 2) if nz == 1 else (-1, ny + 2, nz + 2)
         pads[G] = [(Tp[off[k]:off[k] + sizes[k]].reshape(shape_p).copy(),
                     Vp[off[k]:off[k] + sizes[k]].reshape(shape_p).copy())
@@ -1473,6 +1493,27 @@ def test_slab_march_places_its_cuts_while_the_balls_are_computed(order, monkeypa
                               ready=ready, sources=src3)
     assert calls == [0] and (start.state == 2).sum() > 100  # a ball, written in ready()
     assert_equal_times(whole, late, exact=order == 2)
+    # while ``ready.running()`` says the balls are still computed, the slabs are padded one by
+    # one on the calling thread with the start box's nodes far, filled in after ``ready()``:
+    # every count of slabs so padded (none, some, all: the box's slabs among them) gives the
+    # times of the complete start
+    for beside in (0, 2, 5, 99):
+        start, init = fmm._source_box(v, src3, shape3, (1.0,) * 3, 12.0, 2.0)
+        asked = []
+
+        def ready2():
+            init()
+
+        def running():
+            asked.append(1)
+            return len(asked) <= beside  # noqa: B023
+
+        ready2.running = running
+        T, stats = _parallel.march(v.reshape(-1), start, shape3, (1.0,) * 3, 2, order=order,
+                                   ready=ready2, sources=src3)
+        assert len(asked) == min(beside + 1, stats["slabs"])  # asked before each slab
+        assert (start.state == 2).sum() > 100
+        assert_equal_times(whole, T, exact=order == 2)
 
 
 def test_source_balls_in_the_background_wait_and_raise():

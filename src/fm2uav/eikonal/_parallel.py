@@ -2107,7 +2107,10 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         The start's times and states are still being written (the source balls, on
         another thread: :func:`fm2uav.eikonal.fmm._source_start`); called, it waits for
         them. Meanwhile the cuts are placed from the nodes ``sources`` (int, (m, 3)), the
-        box's geometry (``lo``, ``shape``) being final. None: ``start`` is complete.
+        box's geometry (``lo``, ``shape``) being final, and, while its attribute
+        ``running()`` (if any) says the balls are still being computed, the slabs are padded
+        one by one on this thread with the start box's nodes left far, which are filled in
+        once ``ready()`` returned (:func:`_fill_start_rows`). None: ``start`` is complete.
     sources : ndarray, int, shape (m, 3), optional
         With ``ready``: the source nodes.
 
@@ -2214,11 +2217,33 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         del early
     plane = ny * nz
     boxes = _start_boxes(start, bounds, nx, G)
+    speed_r = _kernels._readonly(speed)
+    beside = np.zeros(0, dtype=np.int64)  # the slabs padded beside the balls' computing
+    running = getattr(ready, "running", None)
+    if running is not None and nth > 1:
+        # the balls take one core (on 2048^2 smooth speed ~8 ms, the cuts ~2.5): pad slab
+        # after slab on this one meanwhile, the start box's nodes far (filled in below)
+        none = np.zeros_like(boxes)
+        done = []
+        with _threads(1):
+            for k in range(K):
+                if not running():
+                    break
+                which = np.array([k], dtype=np.int64)
+                _pad_slabs(1, speed_r, start.T, start.state, none, bounds, off, ny, nz, G, Tp,
+                           Vp, which)
+                done.append(k)
+        beside = np.array(done, dtype=np.int64)
     if ready is not None:  # the source balls (their times and states) are written
         ready()
-    with _threads(nth):
-        _pad_slabs(nth, _kernels._readonly(speed), start.T, start.state, boxes, bounds, off, ny,
-                   nz, G, Tp, Vp)
+    rest = np.setdiff1d(np.arange(K, dtype=np.int64), beside)
+    if rest.size:
+        with _threads(nth):
+            _pad_slabs(nth, speed_r, start.T, start.state, boxes, bounds, off, ny, nz, G, Tp,
+                       Vp, rest)
+    if beside.size:
+        _fill_start_rows(speed_r, start.T, start.state, boxes, bounds, off, ny, nz, G, Tp, Vp,
+                         beside)
     # the start box's own rows in each slab, the only nodes the start reads (nodes of Tp;
     # elements of Tk: times unit)
     b0, b1 = bounds[:-1], bounds[1:]
@@ -2464,17 +2489,18 @@ def _start_boxes(start, bounds, nx, G=1):
 
 
 @njit(cache=True, parallel=True, error_model="numpy")
-def _pad_slabs(nth, speed, Tb, sb, boxes, bounds, off, ny, nz, G, Tp, Vp):
-    """Pad every slab (:func:`fm2uav.eikonal._kernels.pad_grid`) into its place in ``Tp`` /
-    ``Vp`` (slab ``k`` from ``off[k]``, ``G`` ghost x-slabs on each side:
-    :func:`_padded_rows`, :func:`_ghost_rows`), thread ``t`` the slabs ``t, t + nth, ...``
-    (on 2048^2 the padding was 7 of the ~60 ms one thread spent alone)."""
+def _pad_slabs(nth, speed, Tb, sb, boxes, bounds, off, ny, nz, G, Tp, Vp, which):
+    """Pad the slabs ``which`` (:func:`fm2uav.eikonal._kernels.pad_grid`) into their place in
+    ``Tp`` / ``Vp`` (slab ``k`` from ``off[k]``, ``G`` ghost x-slabs on each side:
+    :func:`_padded_rows`, :func:`_ghost_rows`), thread ``t`` the slabs ``which[t], which[t +
+    nth], ...`` (on 2048^2 the padding was 7 of the ~60 ms one thread spent alone)."""
     K = bounds.size - 1
     nx = bounds[K]
     plane = ny * nz
     sx = (ny + 2) if nz == 1 else (ny + 2) * (nz + 2)
     for t in prange(nth):
-        for k in range(t, K, nth):
+        for i in range(t, which.size, nth):
+            k = which[i]
             a, b = bounds[k], bounds[k + 1]
             ra, rb, p0 = _padded_rows(a, b, nx, G)
             bx = boxes[k]
@@ -2483,6 +2509,42 @@ def _pad_slabs(nth, speed, Tb, sb, boxes, bounds, off, ny, nz, G, Tp, Vp):
                      bx[1], bx[2], bx[3], bx[4], bx[5], rb - ra, ny, nz, Tp[seg], Vp[seg])
             if G > 1:
                 _ghost_rows(speed, Tp, Vp, off[k], a, b, nx, ny, nz, G)
+
+
+@njit(cache=True, error_model="numpy")
+def _fill_start_rows(speed, Tb, sb, boxes, bounds, off, ny, nz, G, Tp, Vp, which):
+    """Write the start box's nodes into the own x-slabs of the slabs ``which``
+    (:func:`_pad_slabs` padded those slabs with the box's nodes far while the source balls
+    were computed; the box's runs only, :func:`~fm2uav.eikonal._kernels._box_run`): the
+    padded grid is then the one :func:`_pad_slabs` gives with the box. The ghost x-slabs
+    keep their ``NaN`` (:func:`_ghost_rows`)."""
+    K = bounds.size - 1
+    nx = bounds[K]
+    plane = ny * nz
+    sx = (ny + 2) if nz == 1 else (ny + 2) * (nz + 2)
+    for k in which:
+        bx = boxes[k]
+        if bx[3] == 0:
+            continue
+        a, b = bounds[k], bounds[k + 1]
+        ra, rb, p0 = _padded_rows(a, b, nx, G)
+        seg = slice(off[k] + p0 * sx, off[k] + (p0 + rb - ra + 2) * sx)
+        T = Tp[seg]
+        V = Vp[seg]
+        sp = speed[ra * plane:rb * plane]
+        tb = Tb[bx[6]:bx[7]]
+        st = sb[bx[6]:bx[7]]
+        i0, j0, k0, by, bz = bx[0], bx[1], bx[2], bx[4], bx[5]
+        for i in range(max(i0, a - ra), min(i0 + bx[3], b - ra)):  # own rows only
+            slab = (i + 1) * sx  # the box's runs of that x-slab, as pad_grid lays them
+            if nz == 1:
+                _kernels._box_run(sp, tb, st, i * ny + j0, (i - i0) * by, slab + 1 + j0, by,
+                                  T, V)
+                continue
+            for j in range(j0, j0 + by):
+                _kernels._box_run(sp, tb, st, (i * ny + j) * nz + k0,
+                                  ((i - i0) * by + j - j0) * bz, slab + (j + 1) * (nz + 2) + 1
+                                  + k0, bz, T, V)
 
 
 @njit(cache=True, parallel=True, error_model="numpy")

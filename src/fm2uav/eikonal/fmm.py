@@ -275,7 +275,8 @@ def fast_marching(
 
 def _in_background(fn) -> Any:
     """Run ``fn()`` on a new thread; returns the call that waits for it (and raises what it
-    raised). ``fn`` must release the GIL to run beside the caller (compiled, ``nogil``)."""
+    raised), whose ``running()`` says whether ``fn`` still runs. ``fn`` must release the GIL
+    to run beside the caller (compiled, ``nogil``)."""
     failed: list[BaseException] = []
 
     def run() -> None:
@@ -292,6 +293,7 @@ def _in_background(fn) -> Any:
         if failed:
             raise failed[0]
 
+    ready.running = worker.is_alive  # type: ignore[attr-defined]  # still computing?
     return ready
 
 

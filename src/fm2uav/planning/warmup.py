@@ -125,6 +125,17 @@ def _fmm_parallel(ndim: int) -> Callable[[], None]:
             _parallel._descend_cuts(cum, cuts, 1, 2, shared)
         _parallel._shared_cost(cum, cuts, 2)  # the two descents' cuts compared
         _parallel._time_bins(np.zeros((2, 2)), np.zeros(1), 2)  # the coarse march's bins
+        # the start box's rows padded once the balls are written (a march that padded its
+        # slabs beside them: timing decides), in each layout: the 2D interleaved views, the
+        # separate float64 arrays, the lean layout's float32 V
+        pairs = np.zeros(16)
+        layouts = ((pairs[0::2], pairs[1::2]), (np.zeros(8), np.zeros(8)),
+                   (np.zeros(8), np.zeros(8, dtype=np.float32)))
+        for Tp, Vp in layouts:
+            _parallel._fill_start_rows(
+                _kernels._readonly(np.ones(4)), np.zeros(1), np.zeros(1, dtype=np.uint8),
+                np.zeros((1, 8), dtype=np.int64), np.array([0, 2], dtype=np.int64),
+                np.zeros(1, dtype=np.int64), 2, 1, 1, Tp, Vp, np.zeros(0, dtype=np.int64))
 
     return run
 
