@@ -983,23 +983,30 @@ def _suspect2(T, V, U, use_u, qp, fixed, c, t, sx, sy, ih, three, rf, pf, eidx, 
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)  # a call (rare): compiles once
-def _refrozen2(T, V, U, use_u, qp, c, lo, hi, sx, sy, ih, three, fixed, rf, sf, eidx, evals, base,
-               pool, nxt, bk, mw, st, rkey, ritem, ctl, requeue):
+def _refrozen2(T, V, U, use_u, qp, c, below, lo, hi, sx, sy, ih, three, fixed, rf, sf, eidx,
+               evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl, requeue):
     """Node ``c`` frozen again (re-opened before, order 2): every own node that may have read
     its old time gets its time from scratch (:func:`_recheck`), the neighbours and the nodes
     two away beyond a frozen neighbour, in the window's order (the queue's state in ``st``,
     the masks' counts in ``ctl``). Apart from the window's loop, which then keeps no test of
-    it (on 2048^2 FM²-shaped, one slab on one thread: its windows' CPU -3 %)."""
+    it (on 2048^2 FM²-shaped, one slab on one thread: its windows' CPU -3 %).
+
+    ``below``: ``c``'s new time when it is no later than its old one (not raised since it
+    was re-opened: not pending), else -1. A node frozen earlier than both read neither (each
+    of its updates runs at a neighbour's time below its own, where :func:`_known` hides
+    ``c``): it keeps its time, and is skipped."""
     for j in range(6 if three else 4):
         s = sx if j < 2 else (sy if j < 4 else _unit(sy, three))
         nb = c - s if j & 1 == 0 else c + s
         y = T[nb]
-        if y < 0.0 or (y >= 0.0 and nb >= lo and nb < hi):  # band or far; frozen, own
+        if y < 0.0 or (y >= below and nb >= lo and nb < hi):  # band or far; frozen, own
             _recheck(T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf, eidx, evals,
                      base, pool, nxt, bk, mw, st, rkey, ritem, ctl, requeue)
         if T[nb] >= 0.0:  # the node two away reads c beyond nb
             d2 = nb + nb - c
-            if d2 >= lo and d2 < hi and T[d2] == T[d2]:  # an own node, not a wall
+            # an own node, not a wall, not frozen before c's times
+            if d2 >= lo and d2 < hi and T[d2] == T[d2] and not (T[d2] >= 0.0
+                                                                  and T[d2] < below):
                 _recheck(T, V, U, use_u, qp, d2, sx, sy, ih, three, fixed, rf, sf, eidx, evals,
                          base, pool, nxt, bk, mw, st, rkey, ritem, ctl, requeue)
 
@@ -1023,6 +1030,44 @@ def _unread2(T, fixed, d, g, v, one, sx, sy, three):
             if y >= v and not _bit(fixed, nb >> sh):
                 return False
     return True
+
+
+@njit(cache=True, inline="always", _nrt=False)
+def _none_at_or_after(T, fixed, d, g, v, sx, sy, three):
+    """Whether ``g`` (frozen at ``v``) is not frozen on entry and no neighbour of node ``d``
+    but ``g`` is frozen at ``v`` or later (frozen on entry aside): then no update the serial
+    march makes of ``d`` before ``g``'s freeze reads ``g`` (:func:`_known` hides it below
+    ``v``; a node frozen on entry it shows to every update, the first from the nodes frozen
+    on entry too)."""
+    sh = _unit(sy, three) >> _ONE
+    if _bit(fixed, g >> sh):
+        return False
+    for nb in _nbs(d, sx, sy, three):
+        if nb != g and T[nb] >= v and not _bit(fixed, nb >> sh):  # d itself (2D): band
+            return False
+    return True
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)  # a call: compiles once
+def _ghost_update2(T, V, U, use_u, qp, fixed, d, v, y, sx, sy, ih, three, sf, eidx, evals, base,
+                   pool, nxt, bk, mw, st, rkey, ritem, ctl, requeue):
+    """The exchange's update of the band or far node ``d`` (time ``-y``) next to a ghost
+    frozen first at ``v``, no neighbour of ``d`` frozen at ``v`` or later
+    (:func:`_none_at_or_after`): the serial march's update when the ghost froze, kept if
+    lower, as the window updates a band neighbour of the node it freezes in time order (the
+    same marks: a later time marks it suspect; ``requeue``, 2D: a band node not lowered is
+    queued again, it may be deferred). The same time as :func:`_recheck` from scratch: the
+    band time is the lowest of the updates at its neighbours' earlier freezes."""
+    tn = _update2_at(T, V, U, use_u, qp, fixed, d, sx, sy, ih, three, v)
+    if tn < -y:
+        T[d] = -tn
+        _enq(_bits(tn), d, pool, nxt, bk, mw, st, rkey, ritem)
+    elif y > -_INF:
+        if tn > -y and _entry_cap(eidx, evals, base + d, tn) > -y:
+            _mark(sf, d >> (_unit(sy, three) >> _ONE), ctl, _C_SLIVE)
+            ctl[_C_RAISED] += 1.0
+        if requeue:
+            _enq(_bits(-y), d, pool, nxt, bk, mw, st, rkey, ritem)
 
 
 @njit(cache=True, inline="always", _nrt=False)
@@ -1139,9 +1184,11 @@ def _slab_kernels2(three, pairs=False):
                 _note(sent, ns, 0, c)
             if c >= hi2:
                 _note(sent, ns, 1, c)
+            below = t  # a re-opened node frozen again no later than before (not raised)
             if pend > 0.0 and _fbit(pf, c >> sh):
                 _clear_fbit(pf, c >> sh)
                 pend -= 1.0
+                below = -1.0
                 if pend == 0.0:
                     ctl[_C_RMIN] = _INF
             # frozen again: every dependant may have read its old time (from scratch)
@@ -1150,7 +1197,7 @@ def _slab_kernels2(three, pairs=False):
                 _keep_queue(st, nfree, fh, cur, last, rsize)
                 ctl[_C_SLIVE] = slive
                 ctl[_C_RLIVE] = rlive
-                _refrozen2(T, V, U, use_u, qp, c, lo, hi, sx, sy, ih, three, fixed, rf, sf, eidx,
+                _refrozen2(T, V, U, use_u, qp, c, below, lo, hi, sx, sy, ih, three, fixed, rf, sf, eidx,
                            evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl, dfr)
                 nfree, fh, cur, rsize = st[_NFREE], st[_FH], st[_CUR], st[_RSIZE]
                 slive, rlive = ctl[_C_SLIVE], ctl[_C_RLIVE]
@@ -1300,8 +1347,22 @@ def _slab_kernels2(three, pairs=False):
                             continue
                         if step != sx and T[d] == -_INF:  # far: no frozen neighbour
                             continue
-                        _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf,
-                                 eidx, evals, ebase, pool, nxt, bk, mw, st, rkey, ritem, ctl, dfr)
+                        y = T[d]
+                        if not was >= 0.0 and y < 0.0 and _none_at_or_after(
+                                T, fixed, d, gj, v, sx, sy, three):
+                            # band or far, no update of it run at or after v: the serial
+                            # march updates it when the ghost freezes (one row in), as the
+                            # window does a neighbour of the node it freezes in time order;
+                            # two rows in, nothing it read changed (the node reads the ghost
+                            # only in an update at a neighbour's time no earlier than v)
+                            if step == sx:
+                                _ghost_update2(T, V, U, use_u, qp, fixed, d, v, y, sx, sy, ih,
+                                               three, sf, eidx, evals, ebase, pool, nxt, bk, mw,
+                                               st, rkey, ritem, ctl, dfr)
+                        else:
+                            _recheck(T, V, U, use_u, qp, d, sx, sy, ih, three, fixed, rf, sf,
+                                     eidx, evals, ebase, pool, nxt, bk, mw, st, rkey, ritem, ctl,
+                                     dfr)
                         x = T[d]
                         if x < 0.0 and -x < ctl[_C_NEXT]:  # queued: the next window knows
                             ctl[_C_NEXT] = -x
