@@ -1157,11 +1157,15 @@ def test_slabs_taken_in_turn_are_ordered_by_predicted_work():
         assert np.array_equal(first[nth + 1:], first1[nth + 1:])
 
 
+@pytest.mark.parametrize("stay", [True, False])
 @pytest.mark.parametrize("threads", [2, 3])
-def test_slabs_taken_in_turn_give_the_serial_times(threads, monkeypatch):
-    """2D takes the slabs in turn (the drive gets ``share=2``; 3D keeps the lists): on many
+def test_slabs_taken_in_turn_give_the_serial_times(threads, stay, monkeypatch):
+    """2D takes the slabs in turn (the drive gets ``share=2``, or 3 with each thread first on
+    the slabs it ran last, :data:`_tuning.SLABS_STAY_2D`; 3D keeps the lists): on many
     thin slabs, with repairs, ``stop_at`` and the lists for comparison, the times are the
     serial march's (order 2: bit for bit); every slab is marched whichever thread takes it."""
+    monkeypatch.setattr(_tuning, "SLABS_STAY_2D", stay)
+    dyn = 3 if stay else 2
     monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)
     monkeypatch.setattr(_tuning, "MIN_SLAB_ROWS", 4)
     monkeypatch.setitem(_tuning.SLABS_PER_THREAD, (2, 1), 9)
@@ -1184,7 +1188,7 @@ def test_slabs_taken_in_turn_give_the_serial_times(threads, monkeypatch):
             assert_equal_times(serial, T)
             assert stats["slabs"] == 9 * min(threads, numba.config.NUMBA_NUM_THREADS), name
             assert stats["windows"] > 3, name
-            assert {s for _, s in seen} == {2 if dynamic else 1}
+            assert {s for _, s in seen} == {dyn if dynamic else 1}
             assert 1.0 <= stats["balance"] <= threads + 1e-9
             # every slab marched once in every exchange and window, whoever took it: a slab
             # taken twice, skipped, or a window's counter not reset changes these counts
@@ -1211,7 +1215,7 @@ def test_slabs_taken_in_turn_give_the_serial_times(threads, monkeypatch):
             alone.clear()
             T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, threads, order=2)
             assert_equal_times(serial, T, exact=True)
-            assert {s for _, s in seen} == {2 if dynamic else 1} and set(alone) == {one}
+            assert {s for _, s in seen} == {dyn if dynamic else 1} and set(alone) == {one}
             assert stats["reopened"] > 0 and stats["windows"] > 3
             assert np.all(stats["runs"] == stats["exchanges"] + stats["windows"])
     v3, src3 = fm2_shaped((41, 23, 19), seed=2)
@@ -1281,6 +1285,81 @@ def test_slabs_taken_in_turn_one_thread_after_the_other():
         for k in slabs:
             t = min(range(nth), key=lambda t: (free[t], t))
             free[t] += work[k]
+        assert list(load) == free
+
+
+def _affine_reference(work, owner, nth):
+    """:func:`_parallel._affine` written plainly: the owners and each thread's list."""
+    order = sorted(range(len(work)), key=lambda k: (-work[k], k))
+    fair = sum(work) / nth
+    load = [0.0] * nth
+    owner = [int(o) for o in owner]
+    for k in order:
+        p = owner[k]
+        if load[p] + work[k] > fair:
+            best = min(range(nth), key=lambda t: (load[t], t))
+            if load[best] < load[p]:
+                p = best
+        owner[k] = p
+        load[p] += work[k]
+    return owner, [[k for k in order if owner[k] == t] for t in range(nth)]
+
+
+def test_slabs_stay_with_their_thread_unless_it_has_its_share():
+    """:func:`_parallel._affine` (``share=3``): a slab stays with the thread that ran its
+    last window unless that thread's predicted share would pass ``1 / nth`` of the whole
+    (then to the thread with the least so far, the slabs by decreasing work); each thread's
+    list by decreasing work, its counter at its start. :func:`_parallel._take` (``dyn`` 2):
+    a thread takes its own list first, then the next not taken of the others' from
+    ``t + 1`` on, every slab once, whatever the order of asking; :func:`_parallel._in_turn_affine`:
+    the work each gets when the thread free first takes the next (an event simulation)."""
+    rng = np.random.default_rng(7)
+    for _ in range(200):
+        nth = int(rng.integers(2, 5))
+        K = int(rng.integers(nth, 20))
+        work = (rng.integers(0, 6, size=K) * 100).astype(float)
+        owner = rng.integers(0, nth, size=K).astype(float)
+        want_owner, want_lists = _affine_reference(work, owner, nth)
+        slabs = np.full(K, -1, dtype=np.int64)
+        lists = np.full(nth + 1 + K + nth, -1, dtype=np.int64)
+        load = np.empty(nth)
+        _parallel._affine(work, owner, nth, slabs, lists, load)
+        assert list(owner.astype(int)) == want_owner
+        got = [list(slabs[lists[t]:lists[t + 1]]) for t in range(nth)]
+        assert got == want_lists
+        assert lists[nth] == K and list(lists[-nth:]) == list(lists[:nth])
+        # taking: any order of asking, every slab once; a thread's own list first
+        heads = lists[-nth:].copy()
+        taken = {t: [] for t in range(nth)}
+        done = set()
+        while len(done) < nth:
+            t = int(rng.integers(0, nth))
+            if t in done:
+                continue
+            i = _parallel._take(lists, nth, t, 0, 2)
+            if _parallel._took_all(lists, nth, t, i, K, 2):
+                done.add(t)
+                continue
+            own = heads[t] < lists[t + 1]
+            assert (lists[t] <= i < lists[t + 1]) == bool(own), (t, i)
+            if own:
+                heads[t] += 1
+            else:  # the first of the others' lists from t + 1 on with one left
+                v = next(v for v in [(t + u) % nth for u in range(1, nth)]
+                         if heads[v] < lists[v + 1])
+                assert i == heads[v]
+                heads[v] += 1
+            taken[t].append(int(slabs[i]))
+        assert sorted(sum(taken.values(), [])) == list(range(K))
+        # the idle machine's shares
+        work2 = rng.integers(0, 9, size=K).astype(float)
+        _parallel._in_turn_affine(work2, slabs, lists, nth, load)
+        free, heads = [0.0] * nth, [int(x) for x in lists[:nth]]
+        for _ in range(K):
+            t = min(range(nth), key=lambda t: (free[t], t))
+            v = next(v for v in [(t + u) % nth for u in range(nth)] if heads[v] < lists[v + 1])
+            free[t] += work2[slabs[heads[v]]]
+            heads[v] += 1
         assert list(load) == free
 
 

@@ -153,7 +153,8 @@ _C_RUNS = 7    # the slab's runs in the exchanges and windows (once per region: 
 _C_RLIVE = 8   # order 2: the slab's re-opened bits set (0: none, its pops read no bit)
 _C_SLIVE = 9   # order 2: the slab's suspect bits set (likewise)
 _C_FMAX = 10   # order 2: no node of the slab (ghosts too) frozen later, but on entry
-_C_SIZE = 11
+_C_OWNER = 11  # the thread that ran the slab's last window (share 3, :func:`_affine`)
+_C_SIZE = 12
 
 # slots of the march state ``st`` (uint64), shared with the serial layout
 _NFREE = 2
@@ -684,9 +685,19 @@ def _set_threads(typingctx, n):
 @njit(cache=True, inline="always", _nrt=False)
 def _take(lists, nth, t, i, dyn):
     """The next position in ``slabs`` thread ``t`` runs after position ``i`` (``-1``: its
-    first): with ``dyn`` the next one no thread has taken (the counter ``lists[nth]``),
-    else the next of its own list ``lists[t]:lists[t + 1]``. Past the end: done
-    (:func:`_took_all`)."""
+    first): with ``dyn`` 1 (True) the next one no thread has taken (the counter
+    ``lists[nth]``); 2 the next not taken of its own list ``lists[t]:lists[t + 1]`` (its
+    counter ``lists[lists.size - nth + t]``), then of the other threads' lists, from
+    ``t + 1`` on (the slabs it ran last kept where they run: :func:`_affine`); 0 the next of
+    its own list. Past the end: done (:func:`_took_all`)."""
+    if dyn == 2:
+        h = lists.size - nth
+        for u in range(nth):
+            v = t + u if t + u < nth else t + u - nth
+            j = _fetch_add(lists, h + v)
+            if j < lists[v + 1]:
+                return j
+        return lists.size  # every list taken (past the K slabs)
     if dyn:
         return _fetch_add(lists, nth)
     return lists[t] if i < 0 else i + 1
@@ -694,7 +705,7 @@ def _take(lists, nth, t, i, dyn):
 
 @njit(cache=True, inline="always", _nrt=False)
 def _took_all(lists, nth, t, i, K, dyn):
-    """Whether position ``i`` is past thread ``t``'s slabs (all ``K`` with ``dyn``)."""
+    """Whether position ``i`` is past thread ``t``'s slabs (all ``K`` with ``dyn`` 1 or 2)."""
     return i >= (K if dyn else lists[t + 1])
 
 
@@ -1484,6 +1495,76 @@ def _in_turn(work, slabs, load):
         load[j] += work[slabs[i]]
 
 
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _affine(work, owner, nth, slabs, lists, load):
+    """The slabs of the next window in turn, each thread first on its own (``share=3``,
+    :data:`_tuning.SLABS_STAY_2D`; :func:`_take` with ``dyn`` 2): slab ``k`` stays with
+    ``owner[k]``, the thread that ran its last window, unless that thread's predicted share
+    (``work``, the last window's freezes) would pass ``1 / nth`` of the whole, then it goes
+    to the thread with the least so far (the slabs by decreasing work); ``owner`` is set so.
+    Thread ``t``'s list ``slabs[lists[t]:lists[t + 1]]`` is its slabs by decreasing work,
+    its counter ``lists[lists.size - nth + t]`` at its start; a thread done with its list
+    takes the next of the others'. A slab run on another core than its last window reads
+    its rows and queue from that core's cache: on 2048^2 FM²-shaped two threads' windows
+    took 158 CPU-ms (order 1) taken in turn by the whole order, 150 with the slabs fixed.
+    ``lists[nth + 1:nth + 1 + K]`` is scratch."""
+    K = work.size
+    order = lists[nth + 1:nth + 1 + K]
+    _by_work(work, order)
+    total = 0.0
+    for k in range(K):
+        total += work[k]
+    fair = total / nth
+    for t in range(nth):
+        load[t] = 0.0
+    for i in range(K):
+        k = order[i]
+        p = int(owner[k])
+        if load[p] + work[k] > fair:
+            best = 0
+            for t in range(1, nth):
+                if load[t] < load[best]:
+                    best = t
+            if load[best] < load[p]:
+                p = best
+        owner[k] = p
+        load[p] += work[k]
+    h = lists.size - nth
+    pos = 0
+    for t in range(nth):
+        lists[t] = pos
+        lists[h + t] = pos
+        for i in range(K):
+            if int(owner[order[i]]) == t:
+                slabs[pos] = order[i]
+                pos += 1
+    lists[nth] = pos
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _in_turn_affine(work, slabs, lists, nth, load):
+    """:func:`_in_turn` for :func:`_affine`'s lists: ``load[t]``, the ``work`` thread ``t``
+    gets when the thread free first (ties: the lowest) takes the next slab by :func:`_take`
+    (its own list, then the others' from ``t + 1`` on), each lasting its work. Resets the
+    lists' counters to their starts and consumes them."""
+    h = lists.size - nth
+    for t in range(nth):
+        load[t] = 0.0
+        lists[h + t] = lists[t]
+    for _ in range(lists[nth]):
+        t = 0
+        for u in range(1, nth):
+            if load[u] < load[t]:
+                t = u
+        for u in range(nth):
+            v = t + u if t + u < nth else t + u - nth
+            j = lists[h + v]
+            if j < lists[v + 1]:
+                lists[h + v] = j + 1
+                load[t] += work[slabs[j]]
+                break
+
+
 #: Debug: :func:`march` records where the drive's time goes (``stats["profile"]``, see
 #: :func:`_profile`): each thread's CPU time per parallel region (``clock_gettime``), the
 #: regions' wall time. Off: one branch per region, nothing else.
@@ -1580,7 +1661,9 @@ def _drive_kernel(three, order=1):
         buffer, ``Vp = Tp[1:]``, ``sy = 2``); ``U`` and ``fx`` have a bit per node.
         """
         K = off.size
-        dyn = share == 2  # the slabs taken in turn by the threads (DYNAMIC_2D)
+        # the slabs taken in turn by the threads (DYNAMIC_2D): 1 by one order, 2 each thread
+        # first its own (SLABS_STAY_2D); 0 fixed lists
+        dyn = 2 if share == 3 else (1 if share == 2 else 0)
         prof = win.size > _W_SIZE  # the profile (PROFILE)
         d0 = _clock_ns(1) * 1e-9 if prof else 0.0
         sxi = np.int64(sx)
@@ -1623,8 +1706,10 @@ def _drive_kernel(three, order=1):
         while True:
             # the slabs of each thread for the exchange and the window (from the last
             # window's freezes)
-            if _assign(ctl[:, _C_POPS], nth, slabs, lists, load, share):
+            if _assign(ctl[:, _C_POPS], nth, slabs, lists, load, min(share, 2)):
                 win[8] += 1.0
+            if dyn == 2:
+                _affine(ctl[:, _C_POPS], ctl[:, _C_OWNER], nth, slabs, lists, load)
             # exchange: each slab refreshes its own ghosts and the rows next to them; in 2D
             # on this thread alone if ``alone``, the iterations in turn
             # (:data:`_tuning.EXCHANGE_ALONE_2D`)
@@ -1729,7 +1814,10 @@ def _drive_kernel(three, order=1):
             else:
                 win[0] = win[0] + win[1]
             tw = win[0]
-            if dyn:
+            if dyn == 2:  # each list taken from its first again
+                for t in range(nth):
+                    lists[lists.size - nth + t] = lists[t]
+            elif dyn:
                 lists[nth] = 0  # the window's slabs taken from the first again
             w0 = _clock_ns(1) * 1e-9 if prof else 0.0
             for t in prange(nth):  # thread t runs slabs[lists[t]:lists[t + 1]] (dyn: in turn)
@@ -1738,6 +1826,8 @@ def _drive_kernel(three, order=1):
                 i = _take(lists, nth, t, -1, dyn)
                 while not _took_all(lists, nth, t, i, K, dyn):
                     k = slabs[i]
+                    if dyn == 2:
+                        ctl[k, _C_OWNER] = t
                     if order == 2:
                         o3 = off[k] >> sh >> 3
                         args = (Tp[off[k]:end[k]], Vp[off[k]:end[k]],
@@ -1773,7 +1863,10 @@ def _drive_kernel(three, order=1):
             pops = 0.0
             most = 0.0
             if dyn:  # the idle machine's share: each slab, in the order taken, to the thread
-                _in_turn(ctl[:, _C_POPS], slabs, load)  # free first (as many freezes, as long)
+                if dyn == 2:  # free first (as many freezes, as long)
+                    _in_turn_affine(ctl[:, _C_POPS], slabs, lists, nth, load)
+                else:
+                    _in_turn(ctl[:, _C_POPS], slabs, load)
                 for t in range(nth):
                     pops += load[t]
                     most = max(most, load[t])
@@ -2362,6 +2455,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     ritem = np.empty((K, rcap), dtype=np.uint64)
     ctl = _lined(K, _C_SIZE, np.float64)
     ctl[:, _C_RMIN] = np.inf
+    ctl[:, _C_OWNER] = np.arange(K) % nth  # the interleave, before the first window
     ih = np.array([1.0 / (h * h) for h in h3])
     iso = bool(ih[0] == ih[1] and (not three or ih[1] == ih[2]))
     hh = float(1.0 / ih[0])
@@ -2389,9 +2483,10 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         stop_idx = unit * (off[k] + local)
     drive = _DRIVES[3 if three else 2, G]
     # how the slabs go to the threads (_assign): in turn (2), lists (1), the interleave (0)
-    share = (2 if _tuning.DYNAMIC_2D and not three else 1) if _tuning.SHARE_SLABS else 0
+    share = ((3 if _tuning.SLABS_STAY_2D else 2) if _tuning.DYNAMIC_2D and not three
+             else 1) if _tuning.SHARE_SLABS else 0
     slabs = np.empty(K, dtype=np.int64)  # scratch of _assign: each window's slabs per thread
-    lists = np.empty(nth + 1 + K, dtype=np.int64)
+    lists = np.empty(nth + 1 + K + nth, dtype=np.int64)  # + each list's counter (share 3)
     load = np.empty(nth)
     first = True
     prev = numba.get_num_threads()

@@ -144,6 +144,11 @@ SHARE_SLABS = True
 #: of 8192 nodes, 2 threads over 1, medians of 5: lists / in turn FM²-shaped 1.08x / 1.16x, smooth
 #: 1.03x / 1.14x, constant 1.02x / 1.17x).
 DYNAMIC_2D = True
+#: With :data:`DYNAMIC_2D`: each thread takes first the slabs it ran in the last window, by
+#: decreasing predicted work, then those the others have not taken (:func:`_parallel._affine`):
+#: a slab run on another core than before reads its rows and queue from that core's cache.
+#: Measured: see :func:`_parallel._affine` and docs/performance.md (session 40).
+SLABS_STAY_2D = True
 #: The split of two slabs is chosen on a march over every ``COARSE``-th node per axis (2D; 3D:
 #: ``COARSE_3D``), ~0.5 % (2D) and ~0.2-1.5 % (3D) of the work of the full march (serial time: the
 #: second thread waits). 2D: the windows' balance on FM²-shaped 2048^2 maps (seeds 0-3, with
