@@ -1055,18 +1055,47 @@ def test_interleaved_order_2_slabs_repair_stop_and_grow(monkeypatch):
     assert_equal_times(serial[both], T[both], exact=True)
 
 
-def test_frozen_bits_come_from_the_start_rows_only():
+@pytest.mark.parametrize("three", [False, True])
+def test_start_nodes_come_from_the_start_box_only(three):
+    """:func:`_parallel._start_nodes`: the bits of the nodes frozen on entry and the band
+    nodes on entry (increasing), read in the start box of each slab only, with the slabs'
+    layout (``G`` ghost rows, the y and z ghosts), against every node of the box listed
+    plainly."""
     rng = np.random.default_rng(4)
-    Tp = np.where(rng.random(1000) < 0.3, rng.random(1000), -np.inf)
-    rows = np.array([[13, 130], [400, 401], [700, 700], [993, 1000]])
-    inside = np.zeros(1000, dtype=bool)
-    for a, b in rows:
-        inside[a:b] = True
-    Tp[~inside] = -1.0  # nothing frozen outside the start rows (as on entry)
-    bits = _parallel._frozen_bits(Tp, rows, Tp.size)
-    assert bits.size == Tp.size // 8 + 1
-    assert np.array_equal(np.unpackbits(bits, bitorder="little")[:Tp.size], Tp >= 0.0)
-    assert (Tp >= 0.0).sum() > 30
+    ny, nz = (9, 6) if three else (13, 1)
+    sy = nz + 2 if three else 1
+    sx = (ny + 2) * (nz + 2) if three else ny + 2
+    bounds = np.array([0, 5, 7, 12])
+    for G in (1, 2):
+        rows = np.diff(bounds)
+        sizes = (rows + 2 * G) * sx
+        off = np.concatenate([[0], np.cumsum(-(-sizes // 8) * 8)[:-1]]).astype(np.int64)
+        npad = int(off[-1] + sizes[-1])
+        Tp = rng.choice([-1.0, -np.inf, np.nan], size=npad)  # nothing frozen off the box
+        lo, shape = (3, 2, 1), (6, 5, 4 if three else 1)
+        b0, b1 = bounds[:-1], bounds[1:]
+        i0 = np.clip(lo[0], b0, b1)
+        i1 = np.clip(lo[0] + shape[0], i0, b1)
+        box = []
+        for k in range(len(off)):
+            for i in range(i0[k], i1[k]):
+                for y in range(lo[1], lo[1] + shape[1]):
+                    for z in range(lo[2], lo[2] + shape[2]) if three else [0]:
+                        box.append(off[k] + (i - b0[k] + G) * sx + (y + 1) * sy
+                                   + (z + 1 if three else 0))
+        box = np.array(box)
+        Tp[box] = np.where(rng.random(box.size) < 0.4, rng.random(box.size),
+                           np.where(rng.random(box.size) < 0.5, -rng.random(box.size), -np.inf))
+        z0, z1 = (lo[2], lo[2] + shape[2]) if three else (0, 1)
+        for band in (True, False):
+            bits, nodes = _parallel._start_nodes(
+                Tp, off, i0, i1, b0, G, np.uint64(sx), np.uint64(sy), lo[1], lo[1] + shape[1],
+                z0, z1, 1 if three else 0, npad, band)
+            assert bits.size == npad // 8 + 1
+            assert np.array_equal(np.unpackbits(bits, bitorder="little")[:npad], Tp >= 0.0)
+            want = np.sort(box[(Tp[box] < 0.0) & (Tp[box] > -np.inf)]) if band else []
+            assert list(nodes) == list(want)
+            assert (Tp >= 0.0).sum() > 5 and (len(want) > 5 or not band)
 
 
 def test_cuts_for_shared_slabs_shorten_the_windows_on_an_fm2_map(monkeypatch):
