@@ -25,7 +25,10 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
   layout's buffers, else the result's rows the other thread unpads first —
   :class:`_PageToucher`),
   unless sharing them longest first by the last window's freezes promises a shorter
-  window (:func:`_assign`, before every window). The set-up pads the slabs in parallel
+  window (:func:`_assign`, before every window). The threads take each window's slabs in
+  turn, each first those it ran in the last window (:func:`_affine`,
+  :data:`_tuning.SLABS_STAY_2D` and ``_3D``): a slab that changes cores reads its rows and
+  queue from the other core's cache. The set-up pads the slabs in parallel
   (:func:`_pad_slabs`) and the result is unpadded so (:func:`_unpad_slabs`).
   Each slab is a padded grid of its own, laid out exactly as the
   serial march's (:func:`fm2uav.eikonal._kernels.pad_grid`), one after the other
@@ -1649,9 +1652,11 @@ def _drive_kernel(three, order=1):
         ``fl``: order 2's bit masks, a bit per node (re-opened, suspect, pending; unused by
         order 1), ``eidx``, ``evals`` its nodes in the band on entry (element indices into
         ``Tp``, sorted) and their times; each slab has ``order`` ghost x-slabs on each side.
-        ``slabs`` (K), ``lists`` (nth + 1 + K), ``load`` (nth): scratch of :func:`_assign`
-        (``share``: 0 the interleave, 1 :data:`_tuning.SHARE_SLABS`' lists, 2 taken in turn,
-        :data:`_tuning.DYNAMIC_2D`). ``scan[k]``: the nodes of slab ``k`` the start
+        ``slabs`` (K), ``lists`` (nth + 1 + K + nth), ``load`` (nth): scratch of
+        :func:`_assign` and :func:`_affine` (``share``: 0 the interleave, 1
+        :data:`_tuning.SHARE_SLABS`' lists, 2 taken in turn, :data:`_tuning.DYNAMIC_2D`, 3 in
+        turn each thread first on the slabs it ran last, ``ctl[k, _C_OWNER]``,
+        :data:`_tuning.SLABS_STAY_2D` / ``_3D``). ``scan[k]``: the nodes of slab ``k`` the start
         reads (the start box's rows). ``far``: the far neighbours' one-axis update (2D), with
         their deferral (2; :func:`_slab_kernels`' window).
         ``alone``: the exchanges on this thread only, the slabs in turn (2D).
@@ -2478,8 +2483,12 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         stop_idx = unit * (off[k] + local)
     drive = _DRIVES[3 if three else 2, G]
     # how the slabs go to the threads (_assign): in turn (2), lists (1), the interleave (0)
-    share = ((3 if _tuning.SLABS_STAY_2D else 2) if _tuning.DYNAMIC_2D and not three
-             else 1) if _tuning.SHARE_SLABS else 0
+    if not _tuning.SHARE_SLABS:
+        share = 0
+    elif three:
+        share = 3 if _tuning.SLABS_STAY_3D else 1
+    else:
+        share = (3 if _tuning.SLABS_STAY_2D else 2) if _tuning.DYNAMIC_2D else 1
     slabs = np.empty(K, dtype=np.int64)  # scratch of _assign: each window's slabs per thread
     lists = np.empty(nth + 1 + K + nth, dtype=np.int64)  # + each list's counter (share 3)
     load = np.empty(nth)

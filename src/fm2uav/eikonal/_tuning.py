@@ -149,6 +149,16 @@ DYNAMIC_2D = True
 #: a slab run on another core than before reads its rows and queue from that core's cache.
 #: Measured: see :func:`_parallel._affine` and docs/performance.md (session 40).
 SLABS_STAY_2D = True
+#: 3D: the slabs of each window taken so too, in turn each thread first on its own
+#: (:data:`SLABS_STAY_2D`), instead of the lists of :data:`SHARE_SLABS` (longest first by the
+#: last window, each list fixed for the window). On 160^3 two threads' windows took 418 CPU-ms
+#: with those lists against 405 with the slabs fixed (order 1; order 2 520 / 506). Measured (7
+#: December 2026, session 40, two threads, one process alternating the settings, medians of
+#: 5 / 7 in two runs, on / off): 160^3 FM²-shaped order 1 0.954x / 0.971x (seed 1 0.959x),
+#: order 2 0.988x / 0.983x (seed 2 0.989x), smooth order 1 0.946x, order 2 1.000x, constant
+#: order 1 1.011x (one slab a thread: the same slabs); the 1000 x 1000 x 40 terrain march
+#: (medians of 3) 2.84 / 3.16 s, the times the same bit for bit.
+SLABS_STAY_3D = True
 #: The split of two slabs is chosen on a march over every ``COARSE``-th node per axis (2D; 3D:
 #: ``COARSE_3D``), ~0.5 % (2D) and ~0.2-1.5 % (3D) of the work of the full march (serial time: the
 #: second thread waits). 2D: the windows' balance on FM²-shaped 2048^2 maps (seeds 0-3, with
