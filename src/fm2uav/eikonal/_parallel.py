@@ -1211,8 +1211,8 @@ def _slab_kernels2(three, pairs=False):
                 _keep_queue(st, nfree, fh, cur, last, rsize)
                 ctl[_C_SLIVE] = slive
                 ctl[_C_RLIVE] = rlive
-                _refrozen2(T, V, U, use_u, qp, c, below, lo, hi, sx, sy, ih, three, fixed, rf, sf, eidx,
-                           evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl, dfr)
+                _refrozen2(T, V, U, use_u, qp, c, below, lo, hi, sx, sy, ih, three, fixed, rf,
+                           sf, eidx, evals, base, pool, nxt, bk, mw, st, rkey, ritem, ctl, dfr)
                 nfree, fh, cur, rsize = st[_NFREE], st[_FH], st[_CUR], st[_RSIZE]
                 slive, rlive = ctl[_C_SLIVE], ctl[_C_RLIVE]
                 continue
@@ -1501,7 +1501,7 @@ def _in_turn(work, slabs, load):
 @njit(cache=True, error_model="numpy", _nrt=False)
 def _affine(work, owner, nth, slabs, lists, load):
     """The slabs of the next window in turn, each thread first on its own (``share=3``,
-    :data:`_tuning.SLABS_STAY_2D`; :func:`_take` with ``dyn`` 2): slab ``k`` stays with
+    :data:`_tuning.SLABS_STAY_2D` and ``_3D``; :func:`_take` with ``dyn`` 2): slab ``k`` stays with
     ``owner[k]``, the thread that ran its last window, unless that thread's predicted share
     (``work``, the last window's freezes) would pass ``1 / nth`` of the whole, then it goes
     to the thread with the least so far (the slabs by decreasing work); ``owner`` is set so.
