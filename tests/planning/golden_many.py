@@ -5,7 +5,10 @@ directions were cached and its batch of routes compiled, issue 27 deliverable 5)
 faster code must give the same bytes. Each case is a seeded map, a goal, a few hundred
 starts (some of them failing) and the keyword arguments of ``plan_many``; every route is
 digested from its path, ``w``, length, clearance and altitude profile, every failure from
-its reason and message.
+its reason and message. Rewritten once since, by the update's quadratic solved in
+``T - tau`` instead of ``T`` (session 41, ``_kernels._combine``): the same routes failed,
+the others' points moved by at most 2.0e-9 m and their lengths by at most 7.7e-12 relative
+(2d_city_order2_walls).
 
 Regenerate only when a change of the numbers is intended, and say so in the commit::
 

@@ -210,17 +210,19 @@ def _local_solution(
         return math.inf
     terms.sort(key=lambda term: term[0])
 
-    tau, a = terms[0]
-    t = tau + math.sqrt(rhs / a)  # one-sided solution
-    A, B, C = a, a * tau, a * tau * tau  # sum a, sum a*tau, sum a*tau^2
+    tau0, a = terms[0]
+    t = tau0 + math.sqrt(rhs / a)  # one-sided solution
+    # in s = T - tau0 (coefficients of the size of rhs, not of T^2: no cancellation)
+    A, B, C = a, 0.0, 0.0  # sum a, sum a*d, sum a*d^2 with d = tau - tau0
     for tau, a in terms[1:]:
         if t <= tau:  # causality: this axis is not upwind of the solution
             break
-        A, B, C = A + a, B + a * tau, C + a * tau * tau
+        d = tau - tau0
+        A, B, C = A + a, B + a * d, C + a * d * d
         disc = B * B - A * (C - rhs)
         if disc < 0.0:
             break
-        t = (B + math.sqrt(disc)) / A
+        t = tau0 + (B + math.sqrt(disc)) / A
     return t
 
 
