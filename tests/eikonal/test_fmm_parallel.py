@@ -1721,3 +1721,30 @@ def test_source_balls_in_the_background_wait_and_raise():
 
     with pytest.raises(ValueError, match="ball"):
         fmm._in_background(fail)()
+
+
+@pytest.mark.parametrize("case", [((301, 257), 2), ((97, 41, 37), 1), ((97, 41, 37), 2)])
+@pytest.mark.parametrize("merge", [True, False])
+def test_exchanges_in_the_windows_regions_give_the_same_times(case, merge, monkeypatch):
+    """``_tuning.EXCHANGE_IN_WINDOW``: after the first, each exchange runs in the window's
+    parallel region, a slab's once the windows of it and its neighbours are done: a region a
+    window (the start, the first exchange, then one per window), every slab's exchange taken
+    exactly once a window (its runs: the exchanges plus the windows), and the serial march's
+    times (order 2 bit for bit), as with each exchange in a region of its own."""
+    shape, order = case
+    three = len(shape) == 3
+    monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)
+    monkeypatch.setattr(_tuning, "WINDOW_NODES", dict.fromkeys(_tuning.WINDOW_NODES, 1024))
+    monkeypatch.setattr(_tuning, "EXCHANGE_IN_WINDOW",
+                        {**_tuning.EXCHANGE_IN_WINDOW, (3 if three else 2, order): merge})
+    monkeypatch.setattr(_parallel, "PROFILE", True)
+    v, src = fm2_shaped(shape, seed=2)
+    flat, start, shape3 = _start(v, src)
+    serial, _ = _kernels.march(flat, start, shape3, (1.0,) * 3, order, np.zeros((0, 3), dtype=int))
+    T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, 2, order=order)
+    assert_equal_times(serial, T, exact=order == 2)
+    assert stats["slabs"] >= 4 and stats["windows"] > 40
+    assert stats["exchanges"] == stats["windows"] + 1
+    assert np.all(stats["runs"] == stats["exchanges"] + stats["windows"])
+    regions = stats["profile"]["regions"]
+    assert regions == (stats["windows"] + 2 if merge else 2 * stats["windows"] + 2)

@@ -106,3 +106,27 @@ def test_the_result_pages_probe_times_the_pool_and_a_fresh_array():
     assert [r[0] for r in rows] == ["pool", "fresh"]
     for r in rows:
         assert float(r[1]) > 0 and float(r[2]) >= 0 and float(r[3]) >= 0
+
+
+def test_the_tuning_probe_marches_every_setting_and_says_when_the_times_stay_exact():
+    out = _probe("tuning_ab", "--case", "1100x1000:fm2", "--repeats", "1", "--profile",
+                 "{}", '{"WINDOW_NODES": {"(2, 1)": 65536}}')
+    head, rest = out.split("\n", 1)
+    assert head.startswith("1100x1000:fm2: one thread ")
+    rows = _table(rest, "| setting")
+    assert [r[0] for r in rows] == ["{}", '{"WINDOW_NODES": {"(2, 1)": 65536}}']
+    one = float(head.split("one thread ")[1].split(" ms")[0])
+    for r in rows:
+        two = float(r[1])
+        assert two > 0 and float(r[2].removesuffix("x")) == pytest.approx(one / two, rel=0.02)
+        assert r[7] == "True"  # every setting: the serial march's times bit for bit (order 1
+        # here: its slabs' times are the serial march's bit for bit on this map)
+        assert float(r[8]) > 0 and float(r[10]) > 0 and len(r[12].split(" / ")) == 2
+    assert int(rows[1][4]) < int(rows[0][4])  # wider windows: fewer of them
+    # a name _tuning lacks is refused with the setting that named it; a case too small to
+    # march on slabs is said
+    for args, said in ((["{\"NO_SUCH\": 1}"], "_tuning has no 'NO_SUCH'"),
+                       (["--case", "64x64:fm2", "{}"], "does not march on slabs")):
+        res = subprocess.run([sys.executable, "-m", "benchmarks.tuning_ab", *args], cwd=ROOT,
+                             capture_output=True, text=True, timeout=120)
+        assert res.returncode == 1 and said in res.stderr

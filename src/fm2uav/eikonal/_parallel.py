@@ -665,6 +665,22 @@ def _fetch_add(typingctx, a, i):
 
 
 @intrinsic
+def _load(typingctx, a, i):
+    """``a[i]`` read atomically (int64 array, acquire): a flag another thread sets with
+    :func:`_fetch_add` while this one waits on it (a plain read may be hoisted out of the
+    wait)."""
+    sig = types.int64(a, i)
+
+    def codegen(context, builder, signature, args):
+        aty = signature.args[0]
+        arr = context.make_array(aty)(context, builder, args[0])
+        ptr = cgutils.get_item_pointer(context, builder, aty, arr, [args[1]])
+        return builder.load_atomic(ptr, "acquire", 8)
+
+    return sig, codegen
+
+
+@intrinsic
 def _set_threads(typingctx, n):
     """``numba.set_num_threads(n)`` for the parallel regions this thread starts, by the
     threading layer's symbol as numba's own ``get_num_threads`` calls it (numba's jitted
@@ -1621,7 +1637,10 @@ def _profile(win, nth):
     regions' summed wall time (``*_wall``) and summed busiest thread's CPU time
     (``*_max``: the critical path if the barriers cost nothing); ``drive_wall``: the
     drive's wall time (the serial rest between the regions included); per thread its
-    CPU in the exchanges and in the windows."""
+    CPU in the exchanges and in the windows. With the exchanges in the windows' regions
+    (:data:`_tuning.EXCHANGE_IN_WINDOW`) the exchange figures are the first exchange's, and
+    the windows' include the exchanges after them and a thread's wait for a neighbour's
+    window before an exchange."""
     P = _W_SIZE
     w = win[P:]
     return {"start_max": w[_P_STMAX], "start_wall": w[_P_STWALL],
@@ -1634,9 +1653,63 @@ def _profile(win, nth):
 
 def _drive_kernel(three, order=1):
     """The compiled driver of one dimension and order (the parallel region runs the slabs)."""
+    def exchange(k, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, rows, sx, sy, ih, hh, iso,
+                 pool, nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, far, low):
+        """Slab ``k``'s exchange: its ghosts from both neighbours' boundary rows (frozen in
+        their last window) and its own nodes next to them updated again (the drive's
+        arguments; ``low``: the entry pool's reserve, below which a full queue is the pool's)."""
+        K = off.size
+        sh = 0 if three or sy == 1 else 1  # node index = element index >> sh
+        sxi = np.int64(sx)
+        G = np.int64(order)
+        T = Tp[off[k]:end[k]]
+        V = Vp[off[k]:end[k]]
+        Uk = U[0 if U.size == 1 else off[k] >> sh >> 3:]
+        F = fx[off[k] >> sh >> 3:]
+        R = fl[(off[k] >> sh >> 3) * 4:]
+        S = fl[(off[k] >> sh >> 3) * 4 + 1:]
+        ok = True
+        r = _U(rows[k])
+        if k > 0:
+            o = off[k - 1] + rows[k - 1] * sxi  # last own rows of the slab below
+            if order == 2:
+                args = (T, V, Uk, qp, F, R, S, eidx, evals, _U(off[k]),
+                        Tp[o:o + G * sxi], sent[k - 1, 1],
+                        ns[k - 1, 1], _U(rows[k - 1]) * sx, _ZERO, True, sx, sy, ih,
+                        pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k],
+                        ctl[k], far)
+                ok = _exchange3d_o2(*args) if three else _exchange2d_o2(*args)
+            else:
+                ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k - 1, 1],
+                               ns[k - 1, 1], _U(rows[k - 1]) * sx, _ZERO, sx, sx,
+                               sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
+                               rkey[k], ritem[k], ctl[k])
+        if ok and k < K - 1:
+            o = off[k + 1] + G * sxi  # first own rows of the slab above
+            if order == 2:
+                args = (T, V, Uk, qp, F, R, S, eidx, evals, _U(off[k]),
+                        Tp[o:o + G * sxi], sent[k + 1, 0],
+                        ns[k + 1, 0], _U(G) * sx, (r + _U(G)) * sx, False, sx, sy,
+                        ih, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
+                        ritem[k], ctl[k], far)
+                ok = _exchange3d_o2(*args) if three else _exchange2d_o2(*args)
+            else:
+                ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k + 1, 0],
+                               ns[k + 1, 0], sx, (r + _ONE) * sx, r * sx, sx, sy,
+                               ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
+                               rkey[k], ritem[k], ctl[k])
+        if not ok:
+            ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < low else 2.0
+        _heap_next(T, st[k], ritem[k], ctl[k])
+        ctl[k, _C_RUNS] += 1.0
+
+    exchange.__name__ = exchange.__qualname__ = f"exchange_slab{3 if three else 2}d" + (
+        "_o2" if order == 2 else "")
+    exchange = njit(cache=True, inline="always", error_model="numpy", _nrt=False)(exchange)
+
     def drive(nth, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, rows, sx, sy, ih, hh, iso, pool,
               nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win, first, stops, slabs, lists, load,
-              share, scan, far, alone):
+              share, scan, far, alone, merge, xs):
         """Run windows until every queue is empty; 0 done, 1/2 grow pool/heap and call again.
 
         ``win`` (float64): [0] window end, [1] width, [2] windows run, [3] target pops,
@@ -1660,6 +1733,13 @@ def _drive_kernel(three, order=1):
         reads (the start box's rows). ``far``: the far neighbours' one-axis update (2D), with
         their deferral (2; :func:`_slab_kernels`' window).
         ``alone``: the exchanges on this thread only, the slabs in turn (2D).
+        ``merge`` (not with ``alone``, nor with lists fixed for the window): after the first,
+        each exchange runs in the window's region, a slab's as soon as the windows of it
+        and its neighbours are done (``xs``, int64 (2 K): per slab its window done, its
+        exchange taken), by whichever thread is free: the thread that finishes its slabs
+        first exchanges meanwhile instead of waiting at the region's end, and a region a
+        window is saved. The same exchanges as in a region of their own (each reads its
+        neighbours' rows once their windows are done, as there), so the same times.
 
         ``off``, ``end``, ``sx``, ``sy``, ``scan`` and ``stops`` count elements of ``Tp``:
         nodes in the separate layout, twice that in the 2D interleaved one (``Tp`` the
@@ -1671,8 +1751,6 @@ def _drive_kernel(three, order=1):
         dyn = 2 if share == 3 else (1 if share == 2 else 0)
         prof = win.size > _W_SIZE  # the profile (PROFILE)
         d0 = _clock_ns(1) * 1e-9 if prof else 0.0
-        sxi = np.int64(sx)
-        G = np.int64(order)  # ghost rows on each side of a slab
         low = _U(RESERVE_BLOCKS + (POOL_EXTRA_2 if order == 2 else 0))
         sh = 0 if three or sy == 1 else 1  # node index = element index >> sh
         if first:
@@ -1708,6 +1786,8 @@ def _drive_kernel(three, order=1):
                         win[_W_SIZE + _P_DRIVE] += _clock_ns(1) * 1e-9 - d0
                     return int(ctl[k, _C_STATUS])  # grown, the start runs again
             win[7] = 1.0
+        mrg = merge and dyn != 0 and not alone  # exchanges in the window's region
+        ex = True  # the next exchange in a region of its own (on entry: after the start)
         while True:
             # the slabs of each thread for the exchange and the window (from the last
             # window's freezes)
@@ -1717,69 +1797,34 @@ def _drive_kernel(three, order=1):
                 _affine(ctl[:, _C_POPS], ctl[:, _C_OWNER], nth, slabs, lists, load)
             # exchange: each slab refreshes its own ghosts and the rows next to them; in 2D
             # on this thread alone if ``alone``, the iterations in turn
-            # (:data:`_tuning.EXCHANGE_ALONE_2D`)
-            w0 = _clock_ns(1) * 1e-9 if prof else 0.0
-            if alone:
-                _set_threads(1)
-            for t in prange(nth):  # thread t runs slabs[lists[t]:lists[t + 1]] (dyn: in turn)
-                if prof:
-                    _prof_mark(win, nth, t)
-                i = _take(lists, nth, t, -1, dyn)
-                while not _took_all(lists, nth, t, i, K, dyn):
-                    k = slabs[i]
-                    T = Tp[off[k]:end[k]]
-                    V = Vp[off[k]:end[k]]
-                    Uk = U[0 if U.size == 1 else off[k] >> sh >> 3:]
-                    F = fx[off[k] >> sh >> 3:]
-                    R = fl[(off[k] >> sh >> 3) * 4:]
-                    S = fl[(off[k] >> sh >> 3) * 4 + 1:]
-                    ok = True
-                    r = _U(rows[k])
-                    if k > 0:
-                        o = off[k - 1] + rows[k - 1] * sxi  # last own rows of the slab below
-                        if order == 2:
-                            args = (T, V, Uk, qp, F, R, S, eidx, evals, _U(off[k]),
-                                    Tp[o:o + G * sxi], sent[k - 1, 1],
-                                    ns[k - 1, 1], _U(rows[k - 1]) * sx, _ZERO, True, sx, sy, ih,
-                                    pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k],
-                                    ctl[k], far)
-                            ok = _exchange3d_o2(*args) if three else _exchange2d_o2(*args)
-                        else:
-                            ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k - 1, 1],
-                                           ns[k - 1, 1], _U(rows[k - 1]) * sx, _ZERO, sx, sx,
-                                           sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
-                                           rkey[k], ritem[k], ctl[k])
-                    if ok and k < K - 1:
-                        o = off[k + 1] + G * sxi  # first own rows of the slab above
-                        if order == 2:
-                            args = (T, V, Uk, qp, F, R, S, eidx, evals, _U(off[k]),
-                                    Tp[o:o + G * sxi], sent[k + 1, 0],
-                                    ns[k + 1, 0], _U(G) * sx, (r + _U(G)) * sx, False, sx, sy,
-                                    ih, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
-                                    ritem[k], ctl[k], far)
-                            ok = _exchange3d_o2(*args) if three else _exchange2d_o2(*args)
-                        else:
-                            ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k + 1, 0],
-                                           ns[k + 1, 0], sx, (r + _ONE) * sx, r * sx, sx, sy,
-                                           ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
-                                           rkey[k], ritem[k], ctl[k])
-                    if not ok:
-                        ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < low else 2.0
-                    _heap_next(T, st[k], ritem[k], ctl[k])
-                    ctl[k, _C_RUNS] += 1.0
-                    i = _take(lists, nth, t, i, dyn)
-                if prof:
-                    _prof_done(win, nth, t)
-            if alone:
-                _set_threads(nth)
-            if prof:
-                _prof_region(win, nth, 0, w0)
-            win[9] += 1.0
-            for k in range(K):
-                if ctl[k, _C_STATUS] != 0.0:
+            # (:data:`_tuning.EXCHANGE_ALONE_2D`); merged into the window's region (``mrg``)
+            # but on entry
+            if ex:
+                w0 = _clock_ns(1) * 1e-9 if prof else 0.0
+                if alone:
+                    _set_threads(1)
+                for t in prange(nth):  # thread t runs slabs[lists[t]:lists[t + 1]] (dyn: in turn)
                     if prof:
-                        win[_W_SIZE + _P_DRIVE] += _clock_ns(1) * 1e-9 - d0
-                    return int(ctl[k, _C_STATUS])
+                        _prof_mark(win, nth, t)
+                    i = _take(lists, nth, t, -1, dyn)
+                    while not _took_all(lists, nth, t, i, K, dyn):
+                        exchange(slabs[i], Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, rows,
+                                 sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl,
+                                 sent, ns, far, low)
+                        i = _take(lists, nth, t, i, dyn)
+                    if prof:
+                        _prof_done(win, nth, t)
+                if alone:
+                    _set_threads(nth)
+                if prof:
+                    _prof_region(win, nth, 0, w0)
+                win[9] += 1.0
+                for k in range(K):
+                    if ctl[k, _C_STATUS] != 0.0:
+                        if prof:
+                            win[_W_SIZE + _P_DRIVE] += _clock_ns(1) * 1e-9 - d0
+                        return int(ctl[k, _C_STATUS])
+            ex = not mrg
             # the next window
             tmin = _INF
             empty = True
@@ -1824,6 +1869,8 @@ def _drive_kernel(three, order=1):
                     lists[lists.size - nth + t] = lists[t]
             elif dyn:
                 lists[nth] = 0  # the window's slabs taken from the first again
+            if mrg:
+                xs[:] = 0  # no window done, no exchange taken
             w0 = _clock_ns(1) * 1e-9 if prof else 0.0
             for t in prange(nth):  # thread t runs slabs[lists[t]:lists[t + 1]] (dyn: in turn)
                 if prof:
@@ -1859,12 +1906,33 @@ def _drive_kernel(three, order=1):
                                 bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k], sent[k], ns[k],
                                 far)
                     ctl[k, _C_RUNS] += 1.0
+                    if mrg:
+                        _fetch_add(xs, k)  # its window done (its writes before this)
                     i = _take(lists, nth, t, i, dyn)
+                # merged: the exchanges whose slabs' and neighbours' windows are done, each
+                # taken once, until none is left (every window is taken, so those not done
+                # run on the other threads now)
+                while mrg:
+                    left = False
+                    for k in range(K):
+                        if _load(xs, K + k) != 0:
+                            continue
+                        left = True
+                        if (_load(xs, k) != 0 and (k == 0 or _load(xs, k - 1) != 0)
+                                and (k == K - 1 or _load(xs, k + 1) != 0)
+                                and _fetch_add(xs, K + k) == 0):
+                            exchange(k, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, rows,
+                                     sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem,
+                                     ctl, sent, ns, far, low)
+                    if not left:
+                        break
                 if prof:
                     _prof_done(win, nth, t)
             if prof:
                 _prof_region(win, nth, 1, w0)
             win[2] += 1.0
+            if mrg:
+                win[9] += 1.0
             pops = 0.0
             most = 0.0
             if dyn:  # the idle machine's share: each slab, in the order taken, to the thread
@@ -2492,6 +2560,10 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     slabs = np.empty(K, dtype=np.int64)  # scratch of _assign: each window's slabs per thread
     lists = np.empty(nth + 1 + K + nth, dtype=np.int64)  # + each list's counter (share 3)
     load = np.empty(nth)
+    # the exchanges in the windows' regions (_tuning.EXCHANGE_IN_WINDOW): per slab its
+    # window done and its exchange taken
+    merge = bool(_tuning.EXCHANGE_IN_WINDOW[3 if three else 2, order])
+    xs = np.zeros(2 * K, dtype=np.int64)
     first = True
     prev = numba.get_num_threads()
     numba.set_num_threads(nth)
@@ -2502,7 +2574,7 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
                            pool, nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win, first,
                            stop_idx, slabs, lists, load, share, scan,
                            (1 + int(DEFER)) if FAR_ONE_AXIS else 0,
-                           not three and _tuning.EXCHANGE_ALONE_2D[order])
+                           not three and _tuning.EXCHANGE_ALONE_2D[order], merge, xs)
             first = win[7] == 0.0
             if status == 0:
                 break

@@ -206,6 +206,12 @@ TOUCH_CHUNK = 2 * 2**20
 #: 1.22x / 1.24x and 1.21x / 1.25x, constant 1.30x / 1.27x and 1.27x / 1.32x). Order 1: the
 #: same either way (1.61x / 1.62x, 1.65x / 1.66x). Passed to the drive (not compiled in).
 EXCHANGE_ALONE_2D = {1: True, 2: False}
+#: Keyed by dimension and order: after the first, each exchange runs in the windows' parallel
+#: region, a slab's as soon as the windows of it and its two neighbours are done, on whichever
+#: thread is free (the drive's ``merge``; not where :data:`EXCHANGE_ALONE_2D` holds): the
+#: thread done with its slabs first exchanges while the other finishes, and a region a window
+#: is saved. The times are the same bit for bit. Passed to the drive (not compiled in).
+EXCHANGE_IN_WINDOW = {(2, 1): True, (3, 1): True, (2, 2): True, (3, 2): True}
 #: 3D grids of at least this many nodes (the terrain plan's march: 1000 x 1000 x 40, 42 M with
 #: its padding) take :data:`BIG_3D_SLABS_PER_THREAD` and :data:`BIG_3D_WINDOW_NODES` (keyed by
 #: order) instead of :data:`SLABS_PER_THREAD` and :data:`WINDOW_NODES`: slabs of ~125 rows are
