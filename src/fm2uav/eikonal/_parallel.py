@@ -1651,62 +1651,63 @@ def _profile(win, nth):
             "window_cpu": [float(x) for x in w[_P_THREADS + nth:_P_THREADS + 2 * nth]]}
 
 
+@njit(cache=True, error_model="numpy", _nrt=False)  # a call: K a window
+def _exchange_slab(three, order, k, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, rows, sx, sy,
+                   ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, far):
+    """Slab ``k``'s exchange (``three``: 3D, ``order`` 1 or 2; the other arguments the
+    drive's, :func:`_drive_kernel`): its ghosts from both neighbours' boundary rows (frozen in
+    their last window) and its own nodes next to them updated again. A module-level kernel,
+    not one of the drive's closure: numba keys a closure's cache entry by its values, and a
+    kernel among them pickles differently in every process (the drive compiled again)."""
+    K = off.size
+    low = _U(RESERVE_BLOCKS + (POOL_EXTRA_2 if order == 2 else 0))
+    sh = 0 if three or sy == 1 else 1  # node index = element index >> sh
+    sxi = np.int64(sx)
+    G = np.int64(order)
+    T = Tp[off[k]:end[k]]
+    V = Vp[off[k]:end[k]]
+    Uk = U[0 if U.size == 1 else off[k] >> sh >> 3:]
+    F = fx[off[k] >> sh >> 3:]
+    R = fl[(off[k] >> sh >> 3) * 4:]
+    S = fl[(off[k] >> sh >> 3) * 4 + 1:]
+    ok = True
+    r = _U(rows[k])
+    if k > 0:
+        o = off[k - 1] + rows[k - 1] * sxi  # last own rows of the slab below
+        if order == 2:
+            args = (T, V, Uk, qp, F, R, S, eidx, evals, _U(off[k]),
+                    Tp[o:o + G * sxi], sent[k - 1, 1],
+                    ns[k - 1, 1], _U(rows[k - 1]) * sx, _ZERO, True, sx, sy, ih,
+                    pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k],
+                    ctl[k], far)
+            ok = _exchange3d_o2(*args) if three else _exchange2d_o2(*args)
+        else:
+            ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k - 1, 1],
+                           ns[k - 1, 1], _U(rows[k - 1]) * sx, _ZERO, sx, sx,
+                           sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
+                           rkey[k], ritem[k], ctl[k])
+    if ok and k < K - 1:
+        o = off[k + 1] + G * sxi  # first own rows of the slab above
+        if order == 2:
+            args = (T, V, Uk, qp, F, R, S, eidx, evals, _U(off[k]),
+                    Tp[o:o + G * sxi], sent[k + 1, 0],
+                    ns[k + 1, 0], _U(G) * sx, (r + _U(G)) * sx, False, sx, sy,
+                    ih, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
+                    ritem[k], ctl[k], far)
+            ok = _exchange3d_o2(*args) if three else _exchange2d_o2(*args)
+        else:
+            ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k + 1, 0],
+                           ns[k + 1, 0], sx, (r + _ONE) * sx, r * sx, sx, sy,
+                           ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
+                           rkey[k], ritem[k], ctl[k])
+    if not ok:
+        ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < low else 2.0
+    _heap_next(T, st[k], ritem[k], ctl[k])
+    ctl[k, _C_RUNS] += 1.0
+
+
 def _drive_kernel(three, order=1):
     """The compiled driver of one dimension and order (the parallel region runs the slabs)."""
-    def exchange(k, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, rows, sx, sy, ih, hh, iso,
-                 pool, nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, far, low):
-        """Slab ``k``'s exchange: its ghosts from both neighbours' boundary rows (frozen in
-        their last window) and its own nodes next to them updated again (the drive's
-        arguments; ``low``: the entry pool's reserve, below which a full queue is the pool's)."""
-        K = off.size
-        sh = 0 if three or sy == 1 else 1  # node index = element index >> sh
-        sxi = np.int64(sx)
-        G = np.int64(order)
-        T = Tp[off[k]:end[k]]
-        V = Vp[off[k]:end[k]]
-        Uk = U[0 if U.size == 1 else off[k] >> sh >> 3:]
-        F = fx[off[k] >> sh >> 3:]
-        R = fl[(off[k] >> sh >> 3) * 4:]
-        S = fl[(off[k] >> sh >> 3) * 4 + 1:]
-        ok = True
-        r = _U(rows[k])
-        if k > 0:
-            o = off[k - 1] + rows[k - 1] * sxi  # last own rows of the slab below
-            if order == 2:
-                args = (T, V, Uk, qp, F, R, S, eidx, evals, _U(off[k]),
-                        Tp[o:o + G * sxi], sent[k - 1, 1],
-                        ns[k - 1, 1], _U(rows[k - 1]) * sx, _ZERO, True, sx, sy, ih,
-                        pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k],
-                        ctl[k], far)
-                ok = _exchange3d_o2(*args) if three else _exchange2d_o2(*args)
-            else:
-                ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k - 1, 1],
-                               ns[k - 1, 1], _U(rows[k - 1]) * sx, _ZERO, sx, sx,
-                               sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
-                               rkey[k], ritem[k], ctl[k])
-        if ok and k < K - 1:
-            o = off[k + 1] + G * sxi  # first own rows of the slab above
-            if order == 2:
-                args = (T, V, Uk, qp, F, R, S, eidx, evals, _U(off[k]),
-                        Tp[o:o + G * sxi], sent[k + 1, 0],
-                        ns[k + 1, 0], _U(G) * sx, (r + _U(G)) * sx, False, sx, sy,
-                        ih, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
-                        ritem[k], ctl[k], far)
-                ok = _exchange3d_o2(*args) if three else _exchange2d_o2(*args)
-            else:
-                ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k + 1, 0],
-                               ns[k + 1, 0], sx, (r + _ONE) * sx, r * sx, sx, sy,
-                               ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
-                               rkey[k], ritem[k], ctl[k])
-        if not ok:
-            ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < low else 2.0
-        _heap_next(T, st[k], ritem[k], ctl[k])
-        ctl[k, _C_RUNS] += 1.0
-
-    exchange.__name__ = exchange.__qualname__ = f"exchange_slab{3 if three else 2}d" + (
-        "_o2" if order == 2 else "")
-    exchange = njit(cache=True, inline="always", error_model="numpy", _nrt=False)(exchange)
-
     def drive(nth, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, rows, sx, sy, ih, hh, iso, pool,
               nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win, first, stops, slabs, lists, load,
               share, scan, far, alone, merge, xs):
@@ -1808,9 +1809,9 @@ def _drive_kernel(three, order=1):
                         _prof_mark(win, nth, t)
                     i = _take(lists, nth, t, -1, dyn)
                     while not _took_all(lists, nth, t, i, K, dyn):
-                        exchange(slabs[i], Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, rows,
-                                 sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl,
-                                 sent, ns, far, low)
+                        _exchange_slab(three, order, slabs[i], Tp, Vp, U, qp, fx, fl, eidx,
+                                       evals, off, end, rows, sx, sy, ih, hh, iso, pool, nxt,
+                                       bk, mw, st, rkey, ritem, ctl, sent, ns, far)
                         i = _take(lists, nth, t, i, dyn)
                     if prof:
                         _prof_done(win, nth, t)
@@ -1921,9 +1922,9 @@ def _drive_kernel(three, order=1):
                         if (_load(xs, k) != 0 and (k == 0 or _load(xs, k - 1) != 0)
                                 and (k == K - 1 or _load(xs, k + 1) != 0)
                                 and _fetch_add(xs, K + k) == 0):
-                            exchange(k, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, rows,
-                                     sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem,
-                                     ctl, sent, ns, far, low)
+                            _exchange_slab(three, order, k, Tp, Vp, U, qp, fx, fl, eidx, evals,
+                                           off, end, rows, sx, sy, ih, hh, iso, pool, nxt, bk,
+                                           mw, st, rkey, ritem, ctl, sent, ns, far)
                     if not left:
                         break
                 if prof:
