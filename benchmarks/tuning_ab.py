@@ -77,6 +77,7 @@ def main() -> None:
     ap.add_argument("--profile", action="store_true")
     args = ap.parse_args()
 
+    from benchmarks._march_spy import watch_parallel_march
     from fm2uav import fast_marching
     from fm2uav.eikonal import _parallel, _tuning
 
@@ -84,15 +85,7 @@ def main() -> None:
     defaults = {name: getattr(_tuning, name) for s in settings for name in s}
     v, src, order = _case(args.case)
     _parallel.PROFILE = args.profile
-    seen: dict = {}
-    march = _parallel.march
-
-    def spy(*a, **kw):
-        T, stats = march(*a, **kw)
-        seen.update(stats)
-        return T, stats
-
-    _parallel.march = spy
+    seen = watch_parallel_march()  # each parallel march's statistics
     serial = fast_marching(v, [src], order=order, threads=1)
     walls: list[list[float]] = [[] for _ in settings]
     profiles: list[list[dict]] = [[] for _ in settings]
@@ -127,7 +120,6 @@ def main() -> None:
     finally:
         for name, value in defaults.items():
             setattr(_tuning, name, value)
-        _parallel.march = march
         _parallel.PROFILE = False
     s0 = statistics.median(one)
     print(f"{args.case}: one thread {s0 * 1e3:.1f} ms, medians of {args.repeats}")
