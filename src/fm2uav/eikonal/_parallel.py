@@ -111,7 +111,7 @@ from ._kernels import (_INF, _NB, _NIL, _NW, _ONE, _ORDER2_MAX_W_RATIO, _U, _ZER
                        RESERVE_BLOCKS, BLOCK,
                        _at_plateau, _axis_term, _axis_term_u, _bits, _bucket, _combine,
                        _earlier_band, _earlier_band3, _fetch_rows, _from_bits, _prefetch,
-                       _pop, _pop_ahead, _push, _rhs, _side_min, _solve_iso, pad_grid,
+                       _pad_slab, _pop, _pop_ahead, _push, _rhs, _side_min, _solve_iso,
                        speed_range, unpad_grid)
 
 # threads waiting at a barrier spin briefly, then sleep (:data:`_tuning.SPIN_COUNT`); read
@@ -2769,25 +2769,69 @@ def _start_boxes(start, bounds, nx, G=1):
 
 @njit(cache=True, parallel=True, error_model="numpy")
 def _pad_slabs(nth, speed, Tb, sb, boxes, bounds, off, ny, nz, G, Tp, Vp, which):
-    """Pad the slabs ``which`` (:func:`fm2uav.eikonal._kernels.pad_grid`) into their place in
-    ``Tp`` / ``Vp`` (slab ``k`` from ``off[k]``, ``G`` ghost x-slabs on each side:
-    :func:`_padded_rows`, :func:`_ghost_rows`), thread ``t`` the slabs ``which[t], which[t +
-    nth], ...`` (on 2048^2 the padding was 7 of the ~60 ms one thread spent alone)."""
+    """Pad the slabs ``which`` into their place in ``Tp`` / ``Vp`` (slab ``k`` from
+    ``off[k]``, ``G`` ghost x-slabs on each side, :func:`_pad_slab_rows`), thread ``t`` the
+    ``t``-th share of all their padded x-slabs, from whichever slabs hold them. By x-slabs,
+    not by slabs: the cuts follow the wave, and slab by slab one thread padded 1193 of the
+    2048 rows of the bench's FM²-shaped map (its slabs 160 to 729 rows) while the other
+    waited (as :func:`_unpad_slabs`)."""
     K = bounds.size - 1
     nx = bounds[K]
-    plane = ny * nz
-    sx = (ny + 2) if nz == 1 else (ny + 2) * (nz + 2)
+    total = 0
+    for i in range(which.size):
+        k = which[i]
+        total += bounds[k + 1] - bounds[k] + 2 * G
     for t in prange(nth):
-        for i in range(t, which.size, nth):
+        lo, hi = t * total // nth, (t + 1) * total // nth
+        pos = 0
+        for i in range(which.size):
             k = which[i]
-            a, b = bounds[k], bounds[k + 1]
-            ra, rb, p0 = _padded_rows(a, b, nx, G)
-            bx = boxes[k]
-            seg = slice(off[k] + p0 * sx, off[k] + (p0 + rb - ra + 2) * sx)
-            pad_grid(speed[ra * plane:rb * plane], Tb[bx[6]:bx[7]], sb[bx[6]:bx[7]], bx[0],
-                     bx[1], bx[2], bx[3], bx[4], bx[5], rb - ra, ny, nz, Tp[seg], Vp[seg])
-            if G > 1:
-                _ghost_rows(speed, Tp, Vp, off[k], a, b, nx, ny, nz, G)
+            n = bounds[k + 1] - bounds[k] + 2 * G
+            a, b = max(pos, lo), min(pos + n, hi)
+            if b > a:
+                _pad_slab_rows(speed, Tb, sb, boxes[k], bounds[k], bounds[k + 1], nx, off[k], ny,
+                               nz, G, Tp, Vp, a - pos, b - pos)
+            pos += n
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _pad_slab_rows(speed, Tb, sb, bx, a, b, nx, o, ny, nz, G, Tp, Vp, p0, p1):
+    """The x-slabs ``[p0, p1)`` of slab ``[a, b)``'s padded grid (from ``Tp[o]``, ``G`` ghost
+    x-slabs a side; slab row ``p`` is grid row ``a - G + p``), as the whole slab's padding
+    leaves them: the own rows as :func:`~fm2uav.eikonal._kernels.pad_grid` pads the grid rows
+    :func:`_padded_rows` gives (the start box ``bx``, :func:`_start_boxes`, in their
+    indices), the ghost rows ``NaN`` and, with ``G = 2``, the grid's ``1 / speed^2``
+    [s^2/m^2] where the grid has the row (the order-2 speed check reads it), rounded as
+    ``pad_grid`` rounds it; the ghosts' other speeds are never read and stay unset."""
+    three = nz > 1
+    pz = nz + 2 if three else 1
+    sx = (ny + 2) * pz
+    plane = ny * nz
+    rows = b - a
+    ra, rb, q0 = _padded_rows(a, b, nx, G)
+    seg0 = o + q0 * sx
+    T = Tp[seg0:seg0 + (rb - ra + 2) * sx]
+    V = Vp[seg0:seg0 + (rb - ra + 2) * sx]
+    sp = speed[ra * plane:rb * plane]
+    tb = Tb[bx[6]:bx[7]]
+    st = sb[bx[6]:bx[7]]
+    for p in range(p0, p1):
+        if p >= G and p < rows + G:  # an own row: sub-grid row p - q0 - 1 of pad_grid
+            _pad_slab(sp, tb, st, bx[0], bx[1], bx[2], bx[3], bx[4], bx[5], p - q0 - 1, ny, nz,
+                      T, V)
+            continue
+        base = o + p * sx
+        for j in range(sx):
+            Tp[base + j] = np.nan
+        i = a - G + p
+        if G < 2 or i < 0 or i >= nx:
+            continue
+        for y in range(ny):
+            dst = base + (y + 1) * pz + (1 if three else 0)
+            src = (i * ny + y) * nz
+            for z in range(nz):
+                v = speed[src + z]
+                Vp[dst + z] = 1.0 / (v * v)
 
 
 @njit(cache=True, error_model="numpy")
@@ -2796,7 +2840,7 @@ def _fill_start_rows(speed, Tb, sb, boxes, bounds, off, ny, nz, G, Tp, Vp, which
     (:func:`_pad_slabs` padded those slabs with the box's nodes far while the source balls
     were computed; the box's runs only, :func:`~fm2uav.eikonal._kernels._box_run`): the
     padded grid is then the one :func:`_pad_slabs` gives with the box. The ghost x-slabs
-    keep their ``NaN`` (:func:`_ghost_rows`)."""
+    keep their ``NaN`` (:func:`_pad_slab_rows`)."""
     K = bounds.size - 1
     nx = bounds[K]
     plane = ny * nz
@@ -2857,33 +2901,6 @@ def _padded_rows(a, b, nx, G):
     (``G = 1``: the slab's own rows, ``p0 = 0``)."""
     ra, rb = max(a - G + 1, 0), min(b + G - 1, nx)
     return ra, rb, ra - 1 - a + G
-
-
-@njit(cache=True, error_model="numpy", _nrt=False)
-def _ghost_rows(speed, Tp, Vp, o, a, b, nx, ny, nz, G):
-    """Make the ``G`` x-slabs on each side of slab ``[a, b)`` (its grid from ``Tp[o]``)
-    ghosts (``NaN`` until the exchange) with the grid's ``1 / speed^2`` [s^2/m^2] where the
-    grid has the row (the order-2 speed check reads it), rounded as
-    :func:`~fm2uav.eikonal._kernels.pad_grid` rounds it."""
-    three = nz > 1
-    pz = nz + 2 if three else 1
-    sx = (ny + 2) * pz
-    rows = b - a + 2 * G
-    for p in range(rows):
-        if p >= G and p < rows - G:
-            continue
-        base = o + p * sx
-        for j in range(sx):
-            Tp[base + j] = np.nan
-        i = a - G + p
-        if i < 0 or i >= nx:
-            continue
-        for y in range(ny):
-            dst = base + (y + 1) * pz + (1 if three else 0)
-            src = (i * ny + y) * nz
-            for z in range(nz):
-                v = speed[src + z]
-                Vp[dst + z] = 1.0 / (v * v)
 
 
 def _slab_plateau(speed, vmax, bounds, off, shape3, bits, G=1):
