@@ -381,6 +381,16 @@ def _nbs(c, sx, sy, three):
 
 
 @njit(cache=True, inline="always", _nrt=False)
+def _nb_at(c, j, sx, sy, one):
+    """Neighbour ``j`` of node ``c`` (x-, x+, y-, y+, z-, z+), from its axis' stride (``sx``,
+    ``sy`` or ``one``, the z stride) and side: in 2D (``j < 4``) as the serial march computes
+    it (on 2048^2 1-3 % faster than the tuple of :func:`_nbs`; in 3D the order-2 window reads
+    the tuple, 1.034x faster on 160^3 FM²-shaped)."""
+    s = sx if j < 2 else (sy if j < 4 else one)
+    return c - s if j & 1 == 0 else c + s
+
+
+@njit(cache=True, inline="always", _nrt=False)
 def _unit(sy, three):
     """The elements between two consecutive nodes of a slab's ``T``: 1, or 2 in the 2D
     interleaved layout (node ``c``'s time at ``2 c``, its ``1 / speed^2`` at ``2 c + 1``),
@@ -492,8 +502,7 @@ def _slab_kernels(three, pairs=False):
             pv = one == _ONE and not (use_u and _at_plateau(U, c))
             # one site for the neighbours, as the serial march
             for j in range(6 if three else 4):
-                s = sx if j < 2 else (sy if j < 4 else one)
-                nb = c - s if j & 1 == 0 else c + s
+                nb = _nb_at(c, j, sx, sy, one)
                 y = T[nb]
                 if far != 0 and y == -_INF:  # c is its only frozen neighbour (docstring)
                     q = _rhs(V, U, use_u, qp, nb)
@@ -1026,8 +1035,7 @@ def _refrozen2(T, V, U, use_u, qp, c, below, lo, hi, sx, sy, ih, three, fixed, r
     of its updates runs at a neighbour's time below its own, where :func:`_known` hides
     ``c``): it keeps its time, and is skipped."""
     for j in range(6 if three else 4):
-        s = sx if j < 2 else (sy if j < 4 else _unit(sy, three))
-        nb = c - s if j & 1 == 0 else c + s
+        nb = _nb_at(c, j, sx, sy, _unit(sy, three))
         y = T[nb]
         if y < 0.0 or (y >= below and nb >= lo and nb < hi):  # band or far; frozen, own
             _recheck(T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf, eidx, evals,
@@ -1246,11 +1254,7 @@ def _slab_kernels2(three, pairs=False):
                 # neighbour j (x-, x+, y-, y+, z-, z+): in 2D from its stride, as the serial
                 # march; in 3D from the tuple (one slab on one thread, 160^3 FM²-shaped: the
                 # computed strides 1.034x the tuple's time; in 2D they gained 1-3 %)
-                if three:
-                    nb = nbs[j]
-                else:
-                    s = sx if j < 2 else sy
-                    nb = c - s if j & 1 == 0 else c + s
+                nb = nbs[j] if three else _nb_at(c, j, sx, sy, one)
                 y = T[nb]
                 if y == -_INF:
                     # far: c is its only frozen neighbour (every frozen node, ghosts too,
@@ -1308,11 +1312,7 @@ def _slab_kernels2(three, pairs=False):
                     r = (rare >> (4 * j)) & 7
                     if r == 0:
                         continue
-                    if three:
-                        nb = nbs[j]
-                    else:
-                        s = sx if j < 2 else sy
-                        nb = c - s if j & 1 == 0 else c + s
+                    nb = nbs[j] if three else _nb_at(c, j, sx, sy, one)
                     if r & 3 != 0:
                         nfree, fh, cur, rsize, slive, rlive = _recheck_r(
                             T, V, U, use_u, qp, nb, sx, sy, ih, three, fixed, rf, sf, eidx,
