@@ -2773,7 +2773,7 @@ def _pad_slabs(nth, speed, Tb, sb, boxes, bounds, off, ny, nz, G, Tp, Vp, which)
     ``off[k]``, ``G`` ghost x-slabs on each side, :func:`_pad_slab_rows`), thread ``t`` the
     ``t``-th share of all their padded x-slabs, from whichever slabs hold them. By x-slabs,
     not by slabs: the cuts follow the wave, and slab by slab one thread padded 1193 of the
-    2048 rows of the bench's FM²-shaped map (its slabs 160 to 729 rows) while the other
+    2048 rows of the bench's FM²-shaped map (its slabs 71 to 729 rows) while the other
     waited (as :func:`_unpad_slabs`)."""
     K = bounds.size - 1
     nx = bounds[K]
