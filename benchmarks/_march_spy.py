@@ -6,7 +6,8 @@ import time
 
 
 def watch_parallel_march() -> dict:
-    """Wrap :func:`fm2uav.eikonal._parallel.march` and its windows' drivers; returns the
+    """Wrap :func:`fm2uav.eikonal._parallel.march` and its windows' drivers (the regions'
+    and the pipelines); returns the
     dict that each parallel march then fills: its statistics (``balance``, ``reopened``,
     ...), ``setup`` (the calling thread's CPU time [s] in the march outside the drivers:
     cuts, padding, plateau, unpadding) and ``drive_cpu`` (the process CPU time [s] in the
@@ -33,6 +34,7 @@ def watch_parallel_march() -> dict:
         return run
 
     _parallel.march = spy
-    for key in list(_parallel._DRIVES):
-        _parallel._DRIVES[key] = spy_drive(_parallel._DRIVES[key])
+    for table in (_parallel._DRIVES, _parallel._PIPES):  # the regions' and the pipelines
+        for key in list(table):
+            table[key] = spy_drive(table[key])
     return stats

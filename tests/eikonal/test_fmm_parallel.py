@@ -373,6 +373,7 @@ def test_balanced_cuts_of_many_slabs_shorten_the_windows_critical_path(shape, ga
     share out the wave more evenly either way: 1.782 against 1.735 in turn). 3D: 1.794
     against 1.763 (1.792 against 1.755 while the update was solved in ``T`` itself, whose
     round-off moved the windows' nodes; 7 December 2026)."""
+    monkeypatch.setattr(_tuning, "PIPELINE", {1: False, 2: False})  # the regions' windows
     monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)  # slab counts of 2048^2 and 160^3
     monkeypatch.setattr(_tuning, "WINDOW_NODES", {k: 32768 for k in _tuning.WINDOW_NODES})
     monkeypatch.setattr(_tuning, "DYNAMIC_2D", False)
@@ -677,6 +678,7 @@ def test_sharing_the_slabs_anew_raises_the_windows_balance(shape, monkeypatch):
     slabs shared before each window beats the fixed interleave (1448^2: 1.733 against
     1.661; 96^3: 1.804 against 1.726), at the same times. (The cuts as slab_bounds places
     them: not moved off the source, :func:`~fm2uav.eikonal._parallel.clear_of_sources`.)"""
+    monkeypatch.setattr(_tuning, "PIPELINE", {1: False, 2: False})  # the regions' windows
     monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)
     monkeypatch.setattr(_tuning, "SOURCE_CUT_ROWS", dict.fromkeys(_tuning.SOURCE_CUT_ROWS, 0))
     v, src = fm2_shaped(shape)
@@ -917,13 +919,12 @@ def _layouts(monkeypatch):
     whether times and speeds share one buffer, of every 2D driver call (order 1 and 2)."""
     seen = []
     for order in (1, 2):
-        drive = _parallel._DRIVES[2, order]
+        for table, key in ((_parallel._DRIVES, (2, order)), (_parallel._PIPES, order)):
+            def spy(*args, drive=table[key]):
+                seen.append((int(args[13]), args[2].dtype, np.shares_memory(args[1], args[2])))
+                return drive(*args)
 
-        def spy(*args, drive=drive):
-            seen.append((int(args[13]), args[2].dtype, np.shares_memory(args[1], args[2])))
-            return drive(*args)
-
-        monkeypatch.setitem(_parallel._DRIVES, (2, order), spy)
+            monkeypatch.setitem(table, key, spy)
     return seen
 
 
@@ -1274,6 +1275,7 @@ def test_slabs_taken_in_turn_give_the_serial_times(threads, stay, monkeypatch):
     serial march's (order 2: bit for bit); every slab is marched whichever thread takes it."""
     monkeypatch.setattr(_tuning, "SLABS_STAY_2D", stay)
     monkeypatch.setattr(_tuning, "SLABS_STAY_3D", stay)
+    monkeypatch.setattr(_tuning, "PIPELINE", {1: False, 2: False})  # the regions' sharing
     dyn = 3 if stay else 2
     monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)
     monkeypatch.setattr(_tuning, "MIN_SLAB_ROWS", 4)
@@ -1585,6 +1587,7 @@ def test_a_varying_2d_order_2_march_on_its_slabs_takes_narrower_windows_bit_for_
     """2D order 2 on its usual slabs takes ``WINDOW_NODES_2D_VARYING``'s windows where the
     speeds vary, :data:`WINDOW_NODES`' on a uniform speed; the times are the serial march's
     bit for bit either way."""
+    monkeypatch.setattr(_tuning, "PIPELINE", {1: False, 2: False})  # the regions' windows
     monkeypatch.setattr(_tuning, "MIN_SLAB_NODES", 0)
     monkeypatch.setattr(_tuning, "ORDER2_MIN_NODES_2D", 0)
     shape = (1024, 512)
@@ -1748,3 +1751,90 @@ def test_exchanges_in_the_windows_regions_give_the_same_times(case, merge, monke
     assert np.all(stats["runs"] == stats["exchanges"] + stats["windows"])
     regions = stats["profile"]["regions"]
     assert regions == (stats["windows"] + 2 if merge else 2 * stats["windows"] + 2)
+
+
+
+# ------------------------------------------------ the windows pipelined (2D)
+def _spy_drivers(monkeypatch, order):
+    """Count the calls of the 2D pipeline and of the regions' drive of ``order``."""
+    calls = {"pipe": 0, "drive": 0}
+    for table, key, name in ((_parallel._PIPES, order, "pipe"),
+                             (_parallel._DRIVES, (2, order), "drive")):
+        def spy(*args, f=table[key], name=name):
+            calls[name] += 1
+            return f(*args)
+
+        monkeypatch.setitem(table, key, spy)
+    return calls
+
+
+@pytest.mark.parametrize("threads", [2, 3])
+@pytest.mark.parametrize("order", [1, 2])
+@pytest.mark.parametrize("shape", [(97, 81), (64, 150)])
+def test_pipelined_windows_give_the_serial_times(shape, order, threads, monkeypatch):
+    """Every slab at its own pace (:data:`_tuning.PIPELINE`): a window posts its boundary
+    nodes' times, the neighbours' next exchange reads those while the slab marches on. Thin
+    slabs (6 a thread), tiny queues that grow mid-march (the start, exchanges and windows
+    end early and the next call goes on), every field and spacing: the serial times, order 2
+    bit for bit; and the pipeline, not the windows' regions, ran them."""
+    monkeypatch.setattr(_tuning, "PIPELINE", {1: True, 2: True})
+    monkeypatch.setattr(_tuning, "SLABS_PER_THREAD", dict.fromkeys(_tuning.SLABS_PER_THREAD, 6))
+    calls = _spy_drivers(monkeypatch, order)
+    for small in (False, True):
+        if small:
+            monkeypatch.setattr(_parallel, "POOL_MIN_BLOCKS", 8)
+            monkeypatch.setattr(_parallel, "HEAP_START", 8)
+        for name, v, src in _fields(shape):
+            for h in (1.0, (1.0, 0.7)):
+                serial = fast_marching(v, [src], order=order, spacing=h, threads=1)
+                before = calls["pipe"]
+                par = fast_marching_parallel(v, [src], order=order, spacing=h,
+                                             threads=threads)
+                assert_equal_times(serial, par, exact=order == 2)
+                assert calls["pipe"] > before and calls["drive"] == 0, name
+                if small and name != "constant":
+                    assert calls["pipe"] - before > 1, name  # the queues grew mid-march
+
+
+@pytest.mark.parametrize("order", [1, 2])
+def test_pipelined_windows_repair_what_the_other_slab_reaches_first(order, monkeypatch):
+    """The fast lane across every slab (the repairs' case) with tiny queues, pipelined: the
+    re-opened nodes end at the serial times; the windows and freezes are counted as the
+    regions count them (every window of every slab once)."""
+    monkeypatch.setattr(_tuning, "PIPELINE", {1: True, 2: True})
+    monkeypatch.setattr(_parallel, "POOL_MIN_BLOCKS", 8)
+    monkeypatch.setattr(_parallel, "HEAP_START", 8)
+    calls = _spy_drivers(monkeypatch, order)
+    v = np.full((200, 60), 0.2)
+    v[:, 28:32] = 5.0
+    flat, start, shape3 = _start(v, (2, 30))
+    T, stats = _parallel.march(flat, start, shape3, (1.0,) * 3, 2, order=order)
+    assert calls["pipe"] > 1 and calls["drive"] == 0
+    assert stats["reopened"] > 0 and stats["windows"] > 1
+    assert 1.0 <= stats["balance"] <= 2.0
+    assert stats["exchanges"] == stats["windows"]
+    assert (stats["runs"] >= 2 * stats["windows"]).all()  # a slab ahead ran more
+    serial = fast_marching(v, [(2, 30)], order=order, threads=1, source_ball=False)
+    assert_equal_times(serial.reshape(-1), T, exact=order == 2)
+
+
+def test_stop_nodes_and_3d_take_the_windows_regions(monkeypatch):
+    """Stop nodes end the windows of a region (every slab at one window), and 3D keeps its
+    regions: the pipeline is not taken there, and the times are the serial march's."""
+    monkeypatch.setattr(_tuning, "PIPELINE", {1: True, 2: True})
+    v, src = fm2_shaped((160, 140), seed=2)
+    stop = [(150, 130)]
+    for order in (1, 2):
+        calls = _spy_drivers(monkeypatch, order)
+        serial = fast_marching(v, [src], order=order, threads=1, stop_at=stop)
+        par = fast_marching_parallel(v, [src], order=order, threads=2, stop_at=stop)
+        assert_equal_times(serial, par, exact=order == 2)
+        assert calls["pipe"] == 0 and calls["drive"] > 0
+    v3, src3 = fm2_shaped((40, 36, 30), seed=2)
+    calls = _spy_drivers(monkeypatch, 2)
+    drive3 = _parallel._DRIVES[3, 2]
+    seen = []
+    monkeypatch.setitem(_parallel._DRIVES, (3, 2), lambda *a: seen.append(1) or drive3(*a))
+    assert_equal_times(fast_marching(v3, [src3], order=2, threads=1),
+                       fast_marching_parallel(v3, [src3], order=2, threads=2), exact=True)
+    assert seen and calls["pipe"] == 0

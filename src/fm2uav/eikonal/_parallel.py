@@ -79,6 +79,14 @@ Design (Yang & Stern 2017, domain-decomposition FMM)
   corrections cascade in time order (through the same queues, never a stack).
   ``t_w`` then advances to the smallest queued time plus a width that adapts
   so a window freezes ~``WINDOW_NODES`` nodes.
+* **Pipelined** (2D, :data:`_tuning.PIPELINE`; not toward stop nodes): no barrier between
+  the windows. Each window posts the times of the nodes it froze in its boundary rows into a
+  buffer of its own, two of them by the parity of the window's number (:func:`_post_rows`),
+  and a slab's next exchange reads its neighbours' posts, not their rows: its step (the
+  exchange, then the window) waits for its two neighbours' last windows only, and a thread
+  takes whichever slab may step, first one it ran last (:func:`_pipe_kernel`). Each slab's
+  exchanges read what they would between barriers; the windows' ends are set as the first
+  slab reaches them, the width adapted to the last window every slab has run.
 * Queued times below the radix queue's lower bound (re-opened nodes) go to a
   small binary heap (:mod:`._heap`) that is emptied first: its keys are all
   below the radix queue's, so the slab still pops its exact minimum.
@@ -1677,18 +1685,94 @@ def _profile(win, nth):
 
 
 @njit(cache=True, error_model="numpy", _nrt=False)  # a call: K a window
+def _start_slab(three, order, k, Tp, Vp, U, qp, fx, off, end, sx, sy, ih, hh, iso, pool, nxt,
+                bk, mw, st, rkey, ritem, ctl, scan):
+    """Slab ``k``'s start (the drive's arguments, :func:`_drive_kernel`): its band nodes
+    queued and its frozen ones expanded; ``ctl[k, _C_STATUS]`` set when a queue is full."""
+    sh = 0 if three or sy == 1 else 1  # node index = element index >> sh
+    T = Tp[off[k]:end[k]]
+    V = Vp[off[k]:end[k]]
+    Uk = U[0 if U.size == 1 else off[k] >> sh >> 3:]
+    F = fx[off[k] >> sh >> 3:]
+    c0 = _U(scan[k, 0])
+    c1 = _U(scan[k, 1])
+    if order == 2 and three:
+        ok = _start3d_o2(T, V, Uk, qp, F, sx, sy, ih, pool[k], nxt[k], bk[k], mw[k], st[k],
+                         rkey[k], ritem[k], ctl[k], c0, c1)
+    elif order == 2:
+        ok = _start2d_o2(T, V, Uk, qp, F, sx, sy, ih, pool[k], nxt[k], bk[k], mw[k], st[k],
+                         rkey[k], ritem[k], ctl[k], c0, c1)
+    else:
+        ok = _start(three, T, V, Uk, qp, F, sx, sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k],
+                    st[k], rkey[k], ritem[k], ctl[k], c0, c1)
+    if not ok:
+        low = _U(RESERVE_BLOCKS + (POOL_EXTRA_2 if order == 2 else 0))
+        ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < low else 2.0
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)  # a call: K a window
+def _window_slab(three, order, k, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, sx, sy, ih, hh,
+                 iso, tw, pool, nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, far):
+    """Slab ``k``'s window to ``tw`` (the drive's arguments, :func:`_drive_kernel`; ``sent``,
+    ``ns``: the slab's own boundary lists and counts, which it writes)."""
+    sh = 0 if three or sy == 1 else 1  # node index = element index >> sh
+    o3 = off[k] >> sh >> 3
+    if order == 2:
+        args = (Tp[off[k]:end[k]], Vp[off[k]:end[k]], U[0 if U.size == 1 else o3:], qp, fx[o3:],
+                fl[4 * o3:], fl[4 * o3 + 1:], fl[4 * o3 + 2:], eidx, evals, _U(off[k]), sx, sy,
+                ih, tw, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k], sent,
+                ns, far)
+        if three:
+            _window3d_o2(*args)
+        elif sy == 2:
+            _window2d_o2_pairs(*args)
+        else:
+            _window2d_o2(*args)
+    elif not three and sy == 2:
+        _window2d_pairs(Tp[off[k]:end[k]], Vp[off[k]:end[k]], U[0 if U.size == 1 else o3:], qp,
+                        fx[o3:], sx, sy, ih, hh, iso, tw, pool[k], nxt[k], bk[k], mw[k], st[k],
+                        rkey[k], ritem[k], ctl[k], sent, ns, far)
+    else:
+        _window(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]], U[0 if U.size == 1 else o3:], qp,
+                fx[o3:], sx, sy, ih, hh, iso, tw, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
+                ritem[k], ctl[k], sent, ns, far)
+    ctl[k, _C_RUNS] += 1.0
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)  # a call: K a window
 def _exchange_slab(three, order, k, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, rows, sx, sy,
                    ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, far):
     """Slab ``k``'s exchange (``three``: 3D, ``order`` 1 or 2; the other arguments the
     drive's, :func:`_drive_kernel`): its ghosts from both neighbours' boundary rows (frozen in
-    their last window) and its own nodes next to them updated again. A module-level kernel,
-    not one of the drive's closure: numba keys a closure's cache entry by its values, and a
-    kernel among them pickles differently in every process (the drive compiled again)."""
+    their last window, read in their buffers) and its own nodes next to them updated again
+    (:func:`_exchange_from`). A module-level kernel, not one of the drive's closure: numba
+    keys a closure's cache entry by its values, and a kernel among them pickles differently in
+    every process (the drive compiled again)."""
+    K = off.size
+    n = np.int64(order) * np.int64(sx)
+    lo = off[max(k - 1, 0)] + rows[max(k - 1, 0)] * np.int64(sx)  # last own rows below
+    hi = off[min(k + 1, K - 1)] + n  # first own rows above
+    _exchange_from(three, order, k, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, rows, sx, sy,
+                   ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl, far,
+                   Tp[lo:lo + n], sent[max(k - 1, 0), 1], ns[max(k - 1, 0), 1],
+                   Tp[hi:hi + n], sent[min(k + 1, K - 1), 0], ns[min(k + 1, K - 1), 0])
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)  # a call: K a window
+def _exchange_from(three, order, k, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, rows, sx, sy,
+                   ih, hh, iso, pool, nxt, bk, mw, st, rkey, ritem, ctl, far, src0, sent0, m0,
+                   src1, sent1, m1):
+    """Slab ``k``'s exchange from given boundary rows: ``src0`` the last ``order`` own rows
+    of slab ``k - 1`` (their frozen times; ``sent0[:m0]`` the nodes frozen there in its last
+    window, as in its buffer, all of the rows when ``m0`` exceeds the list's capacity),
+    ``src1``, ``sent1``, ``m1`` the first of slab ``k + 1`` (the drive's buffers, or the
+    copies the pipeline posts, :func:`_post_rows`). Sets ``ctl[k, _C_STATUS]`` when a queue is
+    full (resumable: called again, it goes on) and lowers ``ctl[k, _C_NEXT]`` to the repair heap's
+    smallest time."""
     K = off.size
     low = _U(RESERVE_BLOCKS + (POOL_EXTRA_2 if order == 2 else 0))
     sh = 0 if three or sy == 1 else 1  # node index = element index >> sh
-    sxi = np.int64(sx)
-    G = np.int64(order)
+    G = _U(order)
     T = Tp[off[k]:end[k]]
     V = Vp[off[k]:end[k]]
     Uk = U[0 if U.size == 1 else off[k] >> sh >> 3:]
@@ -1698,33 +1782,26 @@ def _exchange_slab(three, order, k, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end
     ok = True
     r = _U(rows[k])
     if k > 0:
-        o = off[k - 1] + rows[k - 1] * sxi  # last own rows of the slab below
+        base = _U(rows[k - 1]) * sx
         if order == 2:
-            args = (T, V, Uk, qp, F, R, S, eidx, evals, _U(off[k]),
-                    Tp[o:o + G * sxi], sent[k - 1, 1],
-                    ns[k - 1, 1], _U(rows[k - 1]) * sx, _ZERO, True, sx, sy, ih,
-                    pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k],
-                    ctl[k], far)
-            ok = _exchange3d_o2(*args) if three else _exchange2d_o2(*args)
-        else:
-            ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k - 1, 1],
-                           ns[k - 1, 1], _U(rows[k - 1]) * sx, _ZERO, sx, sx,
-                           sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
-                           rkey[k], ritem[k], ctl[k])
-    if ok and k < K - 1:
-        o = off[k + 1] + G * sxi  # first own rows of the slab above
-        if order == 2:
-            args = (T, V, Uk, qp, F, R, S, eidx, evals, _U(off[k]),
-                    Tp[o:o + G * sxi], sent[k + 1, 0],
-                    ns[k + 1, 0], _U(G) * sx, (r + _U(G)) * sx, False, sx, sy,
-                    ih, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
+            args = (T, V, Uk, qp, F, R, S, eidx, evals, _U(off[k]), src0, sent0, m0, base,
+                    _ZERO, True, sx, sy, ih, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
                     ritem[k], ctl[k], far)
             ok = _exchange3d_o2(*args) if three else _exchange2d_o2(*args)
         else:
-            ok = _exchange(three, T, V, Uk, qp, F, Tp[o:o + sxi], sent[k + 1, 0],
-                           ns[k + 1, 0], sx, (r + _ONE) * sx, r * sx, sx, sy,
-                           ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k],
-                           rkey[k], ritem[k], ctl[k])
+            ok = _exchange(three, T, V, Uk, qp, F, src0, sent0, m0, base, _ZERO, sx, sx, sy, ih,
+                           hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k],
+                           ctl[k])
+    if ok and k < K - 1:
+        if order == 2:
+            args = (T, V, Uk, qp, F, R, S, eidx, evals, _U(off[k]), src1, sent1, m1, G * sx,
+                    (r + G) * sx, False, sx, sy, ih, pool[k], nxt[k], bk[k], mw[k], st[k],
+                    rkey[k], ritem[k], ctl[k], far)
+            ok = _exchange3d_o2(*args) if three else _exchange2d_o2(*args)
+        else:
+            ok = _exchange(three, T, V, Uk, qp, F, src1, sent1, m1, sx, (r + _ONE) * sx, r * sx,
+                           sx, sy, ih, hh, iso, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
+                           ritem[k], ctl[k])
     if not ok:
         ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < low else 2.0
     _heap_next(T, st[k], ritem[k], ctl[k])
@@ -1777,31 +1854,14 @@ def _drive_kernel(three, order=1):
         dyn = 2 if share == 3 else (1 if share == 2 else 0)
         prof = win.size > _W_SIZE  # the profile (PROFILE)
         d0 = _clock_ns(1) * 1e-9 if prof else 0.0
-        low = _U(RESERVE_BLOCKS + (POOL_EXTRA_2 if order == 2 else 0))
-        sh = 0 if three or sy == 1 else 1  # node index = element index >> sh
         if first:
             w0 = _clock_ns(1) * 1e-9 if prof else 0.0
             for t in prange(nth):  # thread t runs slabs t, t + nth, ...
                 if prof:
                     _prof_mark(win, nth, t)
                 for k in range(t, K, nth):
-                    T = Tp[off[k]:end[k]]
-                    V = Vp[off[k]:end[k]]
-                    Uk = U[0 if U.size == 1 else off[k] >> sh >> 3:]
-                    F = fx[off[k] >> sh >> 3:]
-                    c0 = _U(scan[k, 0])
-                    c1 = _U(scan[k, 1])
-                    if order == 2 and three:
-                        ok = _start3d_o2(T, V, Uk, qp, F, sx, sy, ih, pool[k], nxt[k], bk[k],
-                                         mw[k], st[k], rkey[k], ritem[k], ctl[k], c0, c1)
-                    elif order == 2:
-                        ok = _start2d_o2(T, V, Uk, qp, F, sx, sy, ih, pool[k], nxt[k], bk[k],
-                                         mw[k], st[k], rkey[k], ritem[k], ctl[k], c0, c1)
-                    else:
-                        ok = _start(three, T, V, Uk, qp, F, sx, sy, ih, hh, iso, pool[k], nxt[k],
-                                    bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k], c0, c1)
-                    if not ok:
-                        ctl[k, _C_STATUS] = 1.0 if st[k, _NFREE] < low else 2.0
+                    _start_slab(three, order, k, Tp, Vp, U, qp, fx, off, end, sx, sy, ih, hh,
+                                iso, pool, nxt, bk, mw, st, rkey, ritem, ctl, scan)
                 if prof:
                     _prof_done(win, nth, t)
             if prof:
@@ -1906,32 +1966,9 @@ def _drive_kernel(three, order=1):
                     k = slabs[i]
                     if dyn == 2:
                         ctl[k, _C_OWNER] = t
-                    if order == 2:
-                        o3 = off[k] >> sh >> 3
-                        args = (Tp[off[k]:end[k]], Vp[off[k]:end[k]],
-                                U[0 if U.size == 1 else o3:], qp, fx[o3:], fl[4 * o3:],
-                                fl[4 * o3 + 1:], fl[4 * o3 + 2:], eidx, evals, _U(off[k]), sx,
-                                sy, ih, tw, pool[k], nxt[k], bk[k], mw[k], st[k], rkey[k],
-                                ritem[k], ctl[k], sent[k], ns[k], far)
-                        if three:
-                            _window3d_o2(*args)
-                        elif sy == 2:
-                            _window2d_o2_pairs(*args)
-                        else:
-                            _window2d_o2(*args)
-                    elif not three and sy == 2:
-                        _window2d_pairs(Tp[off[k]:end[k]], Vp[off[k]:end[k]],
-                                        U[0 if U.size == 1 else off[k] >> sh >> 3:], qp,
-                                        fx[off[k] >> sh >> 3:], sx, sy, ih, hh, iso, tw, pool[k],
-                                        nxt[k], bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k],
-                                        sent[k], ns[k], far)
-                    else:
-                        _window(three, Tp[off[k]:end[k]], Vp[off[k]:end[k]],
-                                U[0 if U.size == 1 else off[k] >> sh >> 3:], qp,
-                                fx[off[k] >> sh >> 3:], sx, sy, ih, hh, iso, tw, pool[k], nxt[k],
-                                bk[k], mw[k], st[k], rkey[k], ritem[k], ctl[k], sent[k], ns[k],
-                                far)
-                    ctl[k, _C_RUNS] += 1.0
+                    _window_slab(three, order, k, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end,
+                                 sx, sy, ih, hh, iso, tw, pool, nxt, bk, mw, st, rkey, ritem, ctl,
+                                 sent[k], ns[k], far)
                     if mrg:
                         _fetch_add(xs, k)  # its window done (its writes before this)
                     i = _take(lists, nth, t, i, dyn)
@@ -1996,6 +2033,217 @@ def _drive_kernel(three, order=1):
 _DRIVES = {(d, o): _drive_kernel(d == 3, o) for d in (2, 3) for o in (1, 2)}
 
 
+# ------------------------------------------------------------------ the windows pipelined
+@intrinsic
+def _add(typingctx, a, i, v):
+    """``a[i] += v`` atomically (int64 array), returning the old value."""
+    sig = types.int64(a, i, v)
+
+    def codegen(context, builder, signature, args):
+        aty = signature.args[0]
+        arr = context.make_array(aty)(context, builder, args[0])
+        ptr = cgutils.get_item_pointer(context, builder, aty, arr, [args[1]])
+        val = context.cast(builder, args[2], signature.args[2], types.int64)
+        return builder.atomic_rmw("add", ptr, val, "seq_cst")
+
+    return sig, codegen
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _post_rows(T, base, n, sent, m, dst):
+    """Copy the nodes of a slab's boundary rows frozen in its window (``sent[:m]``, element
+    indices into the slab's ``T``; all ``n`` elements from ``base`` when ``m`` exceeds the
+    list's capacity) into ``dst`` (at ``c - base``): what its neighbours' exchanges read
+    while it marches on (:func:`_pipe_kernel`)."""
+    if m > _U(sent.size):
+        for j in range(n):
+            dst[j] = T[base + j]
+    else:
+        for i in range(m):
+            dst[np.int64(sent[i]) - base] = T[sent[i]]
+
+
+@njit(cache=True, error_model="numpy", _nrt=False)
+def _tally(win, freezes, nth, a, b):
+    """Windows ``a`` to ``b - 1`` (all slabs ran them; ``freezes[w % R, k]`` slab ``k``'s
+    freezes in window ``w``) into the statistics ``win`` (as :func:`_drive_kernel`'s:
+    ``[5]`` the larger of the busiest slab's freezes and a thread's mean share). Returns the
+    last one's freezes."""
+    R, K = freezes.shape
+    last = 0.0
+    for w in range(a, b):
+        total = 0.0
+        most = 0.0
+        for k in range(K):
+            x = float(freezes[w % R, k])
+            total += x
+            most = max(most, x)
+        win[2] += 1.0
+        win[4] += total
+        win[5] += max(most, total / nth)
+        last = total
+    return last
+
+
+# slots of the pipeline's int64 state ``sync`` after its three rows of K (each slab's windows
+# posted, its claim, its next step's part: 0 the exchange, 1 the window)
+_S_STOP = 0   # a slab's queue ran full: every thread leaves, the caller grows it
+_S_DONE = 1   # every slab was empty after the same exchange
+_S_LOCK = 2   # held while a window's end is set
+_S_NSET = 3   # windows whose end is set
+_S_TALLY = 4  # windows tallied (:func:`_tally`)
+_S_SIZE = 5
+
+
+def _pipe_kernel(three, order=1):
+    """The compiled pipeline of one dimension and order: :func:`_drive_kernel`'s exchanges
+    and windows with no barrier between them."""
+    def pipe(nth, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, rows, sx, sy, ih, hh, iso, pool,
+             nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, post, win, first, scan, far, sync,
+             ends, freezes, quiet):
+        """Run each slab's exchanges and windows in turn until every slab is empty after the
+        same exchange; 0 done, 1/2 grow pool/heap and call again.
+
+        The windows of :func:`_drive_kernel` (``win`` as there), each slab at its own pace:
+        a window posts the times of the nodes it froze in its boundary rows (``post[k, p,
+        side]``, its lists ``sent[k, p]`` and counts ``ns[k, p]``, ``p`` the parity of the
+        window's number), so a slab's step -- its exchange from the neighbours' posts of
+        their last window, then its window -- waits for the two neighbours' last windows
+        only. Step ``s`` of slab ``k`` runs once both posted window ``s - 1`` (the start
+        posts the whole rows as window -1), and a neighbour cannot overwrite those posts
+        before slab ``k`` read them (its step ``s + 1`` waits for slab ``k``'s window ``s``):
+        each slab's exchanges read what they read between barriers, whatever the threads'
+        order. Window ``s`` ends at ``ends[s % R]``, set once, by the first slab to reach
+        it, from the smallest queued time of the slabs and the width adapted to the last
+        window all slabs ran (``freezes[w % R, k]``: slab ``k``'s freezes in window ``w``;
+        ``quiet[w % R]``: the slabs empty after exchange ``w``). Neighbours are at most one
+        window apart, so all slabs ``K - 1``: the rings of ``R >= 2 K + 2`` windows hold.
+        ``sync`` (int64): ``[0, K)`` each slab's windows posted (the start's included),
+        ``[K, 2 K)`` its claim, ``[2 K, 3 K)`` its step's next part (0 the exchange, 1 the
+        window: a full queue ends the call in either, and the next goes on), then the
+        ``_S_*`` slots. A thread takes the slab that its neighbours let step, first one it
+        ran last (``ctl[k, _C_OWNER]``), then of fewest windows, then most freezes last.
+        """
+        K = off.size
+        R = ends.shape[1]
+        G = np.int64(order)
+        n = G * np.int64(sx)
+        cap = _U(sent.shape[3])
+        S0 = 3 * K
+        if first:
+            for t in prange(nth):  # thread t starts slabs t, t + nth, ...; posts their rows
+                for k in range(t, K, nth):
+                    _start_slab(three, order, k, Tp, Vp, U, qp, fx, off, end, sx, sy, ih, hh,
+                                iso, pool, nxt, bk, mw, st, rkey, ritem, ctl, scan)
+                    T = Tp[off[k]:end[k]]
+                    for side in range(2):
+                        ns[k, 1, side] = cap + _ONE  # window -1: the whole rows
+                        b = n if side == 0 else rows[k] * np.int64(sx)
+                        _post_rows(T, b, n, sent[k, 1, side], cap + _ONE, post[k, 1, side])
+            for k in range(K):
+                if ctl[k, _C_STATUS] != 0.0:
+                    return int(ctl[k, _C_STATUS])  # grown, the start runs again
+            win[7] = 1.0
+            for k in range(K):
+                sync[k] = 1  # window -1 posted
+        for t in prange(nth):
+            while _load(sync, S0 + _S_STOP) == 0 and _load(sync, S0 + _S_DONE) == 0:
+                # the slab to step: its neighbours posted its last window, not taken; its own
+                # first, then of fewest windows, then most freezes last
+                k = -1
+                best = 0.0
+                for j in range(K):
+                    p = _load(sync, j)
+                    if ((j > 0 and _load(sync, j - 1) < p) or (j < K - 1 and _load(sync, j + 1) < p)
+                            or _load(sync, K + j) != 0):
+                        continue
+                    key = (0.0 if ctl[j, _C_OWNER] == t else 1e18) + p * 1e9 - ctl[j, _C_POPS]
+                    if k < 0 or key < best:
+                        k = j
+                        best = key
+                if k < 0:
+                    continue
+                if _add(sync, K + k, 1) != 0:  # taken meanwhile
+                    _add(sync, K + k, -1)
+                    continue
+                p = _load(sync, k)
+                if (k > 0 and _load(sync, k - 1) < p) or (k < K - 1 and _load(sync, k + 1) < p):
+                    _add(sync, K + k, -1)  # stepped meanwhile: its neighbours not yet
+                    continue
+                s = p - 1  # this step's window
+                par = s & 1
+                q = par ^ 1  # the neighbours' last window's posts
+                if sync[2 * K + k] == 0:  # the exchange
+                    lo = max(k - 1, 0)
+                    hi = min(k + 1, K - 1)
+                    _exchange_from(three, order, k, Tp, Vp, U, qp, fx, fl, eidx, evals, off,
+                                   end, rows, sx, sy, ih, hh, iso, pool, nxt, bk, mw, st, rkey,
+                                   ritem, ctl, far, post[lo, q, 1], sent[lo, q, 1], ns[lo, q, 1],
+                                   post[hi, q, 0], sent[hi, q, 0], ns[hi, q, 0])
+                    if ctl[k, _C_STATUS] != 0.0:  # a queue full: the next call goes on
+                        _add(sync, S0 + _S_STOP, 1)
+                        _add(sync, K + k, -1)
+                        break
+                    sync[2 * K + k] = 1
+                    empty = st[k, _RSIZE] == _ZERO
+                    for w in range(_NW):
+                        if mw[k, w] != _ZERO:
+                            empty = False
+                    quiet[(s + R // 2) % R] = 0  # free again: every slab is past it
+                    if empty and _add(quiet, s % R, 1) == K - 1:
+                        _add(sync, S0 + _S_DONE, 1)  # every slab empty after exchange s
+                while _load(sync, S0 + _S_NSET) <= s:  # the window's end, set once
+                    if _add(sync, S0 + _S_LOCK, 1) == 0 and _load(sync, S0 + _S_NSET) == s:
+                        tmin = _INF
+                        done = _load(sync, 0)
+                        for j in range(K):
+                            tmin = min(tmin, ctl[j, _C_NEXT])
+                            done = min(done, _load(sync, j))
+                        a = sync[S0 + _S_TALLY]
+                        if done - 1 > a:  # windows all slabs ran since: the width adapts,
+                            # from the last one's width and freezes (not compounded: the
+                            # windows set meanwhile have not told their freezes yet)
+                            f = win[3] / max(_tally(win, freezes, nth, a, done - 1), 1.0)
+                            win[1] = ends[1, (done - 2) % R] * min(2.0, max(0.5, f))
+                            sync[S0 + _S_TALLY] = done - 1
+                        prev = ends[0, (s - 1) % R] if s > 0 else win[0]
+                        ends[0, s % R] = (max(prev, tmin) if tmin < _INF else prev) + win[1]
+                        ends[1, s % R] = win[1]
+                        _add(sync, S0 + _S_NSET, 1)
+                    _add(sync, S0 + _S_LOCK, -1)
+                _window_slab(three, order, k, Tp, Vp, U, qp, fx, fl, eidx, evals, off, end, sx,
+                             sy, ih, hh, iso, ends[0, s % R], pool, nxt, bk, mw, st, rkey, ritem,
+                             ctl, sent[k, par], ns[k, par], far)
+                T = Tp[off[k]:end[k]]
+                _post_rows(T, n, n, sent[k, par, 0], ns[k, par, 0], post[k, par, 0])
+                _post_rows(T, rows[k] * np.int64(sx), n, sent[k, par, 1], ns[k, par, 1],
+                           post[k, par, 1])
+                freezes[s % R, k] = np.int64(ctl[k, _C_POPS])
+                ctl[k, _C_OWNER] = t
+                sync[2 * K + k] = 0
+                if ctl[k, _C_STATUS] != 0.0:  # the window ended early: the next call goes on
+                    _add(sync, S0 + _S_STOP, 1)
+                _add(sync, k, 1)  # window s posted (after its writes)
+                _add(sync, K + k, -1)
+        done = sync[0]
+        for j in range(K):
+            done = min(done, sync[j])
+        a = sync[S0 + _S_TALLY]
+        if done - 1 > a:
+            _tally(win, freezes, nth, a, done - 1)
+            sync[S0 + _S_TALLY] = done - 1
+        sync[S0 + _S_STOP] = 0
+        for k in range(K):
+            if ctl[k, _C_STATUS] != 0.0:
+                return int(ctl[k, _C_STATUS])
+        return 0
+
+    pipe.__name__ = pipe.__qualname__ = f"pipe{3 if three else 2}d" + ("_o2" if order == 2 else "")
+    return njit(cache=True, parallel=True, error_model="numpy")(pipe)
+
+
+#: The pipelines by order (2D: :data:`_tuning.PIPELINE`).
+_PIPES = {o: _pipe_kernel(False, o) for o in (1, 2)}
 
 
 def clear_of_sources(bounds, start, shape3, rows: int) -> np.ndarray:
@@ -2377,10 +2625,12 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
         ``balance``: nodes frozen over the sum of each window's largest thread share, the
         speed-up the windows allow if every freeze cost the same (``threads`` at best; slabs
         taken in turn, :data:`_tuning.DYNAMIC_2D`: the shares an idle machine gives,
-        :func:`_in_turn`, whatever this run's threads took), ``greedy``: the windows whose slabs
-        :func:`_assign` shared longest first, ``exchanges``: the exchanges run, ``runs``:
-        how often each slab was marched in the exchanges and windows (every slab once per
-        region: ``exchanges + windows`` each).
+        :func:`_in_turn`, whatever this run's threads took; pipelined, :data:`_tuning.PIPELINE`:
+        each window's larger of its busiest slab and a thread's mean share), ``greedy``: the
+        windows whose slabs :func:`_assign` shared longest first, ``exchanges``: the exchanges
+        run, ``runs``: how often each slab was marched in the exchanges and windows (every slab
+        once per region: ``exchanges + windows`` each; pipelined, a slab ahead of the others
+        when the march ended ran more).
     """
     import numba
 
@@ -2576,6 +2826,20 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
             local = local * (nz + 2) + cells[:, 2] + 1
         stop_idx = unit * (off[k] + local)
     drive = _DRIVES[3 if three else 2, G]
+    # the windows pipelined (:data:`_tuning.PIPELINE`): no barrier between them, each window
+    # posting its boundary nodes' times for its neighbours (:func:`_pipe_kernel`); not toward
+    # stop nodes, nor with the profile
+    piped = (nth > 1 and not stop_idx.size and not PROFILE
+             and not three and bool(_tuning.PIPELINE[order]))
+    if piped:
+        ring = 2 * K + 2  # windows the slabs may be apart, twice, and more
+        psent = np.empty((K, 2, 2, G * sx), dtype=np.uint64)  # [slab, parity, side]
+        pns = _lined(K, 16, np.uint64, G * sx + 1).reshape(K, 2, 8)
+        post = np.empty((K, 2, 2, unit * G * sx))
+        sync = np.zeros(3 * K + _S_SIZE, dtype=np.int64)
+        ends = np.zeros((2, ring))  # each window's end and width
+        freezes = np.zeros((ring, K), dtype=np.int64)
+        quiet = np.zeros(ring, dtype=np.int64)
     # how the slabs go to the threads (_assign): in turn (2), lists (1), the interleave (0)
     if not _tuning.SHARE_SLABS:
         share = 0
@@ -2595,12 +2859,20 @@ def march(speed, start, shape3, h3, threads, stop_cells=None, order=1, *, interl
     numba.set_num_threads(nth)
     try:
         while True:
-            status = drive(nth, Tk, Vk, U, qp, fixed, fl, eidx, evals, unit * off,
-                           unit * (off + sizes), rows, _U(unit * sx), _U(unit * sy), ih, hh, iso,
-                           pool, nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win, first,
-                           stop_idx, slabs, lists, load, share, scan,
-                           (1 + int(DEFER)) if FAR_ONE_AXIS else 0,
-                           not three and _tuning.EXCHANGE_ALONE_2D[order], merge, xs)
+            far = (1 + int(DEFER)) if FAR_ONE_AXIS else 0
+            if piped:
+                status = _PIPES[G](
+                    nth, Tk, Vk, U, qp, fixed, fl, eidx, evals, unit * off, unit * (off + sizes),
+                    rows, _U(unit * sx), _U(unit * sy), ih, hh, iso, pool, nxt, bk, mw, st, rkey,
+                    ritem, ctl, psent, pns, post, win, first, scan, far, sync, ends, freezes,
+                    quiet)
+                win[9] = win[2]  # an exchange before each window
+            else:
+                status = drive(nth, Tk, Vk, U, qp, fixed, fl, eidx, evals, unit * off,
+                               unit * (off + sizes), rows, _U(unit * sx), _U(unit * sy), ih, hh,
+                               iso, pool, nxt, bk, mw, st, rkey, ritem, ctl, sent, ns, win, first,
+                               stop_idx, slabs, lists, load, share, scan, far,
+                               not three and _tuning.EXCHANGE_ALONE_2D[order], merge, xs)
             first = win[7] == 0.0
             if status == 0:
                 break

@@ -313,3 +313,15 @@ FEWER_SLABS_COST = 1.01
 #: ms, constant 89.4 / 89.9; a second run 115.1 / 116.7 and 89.7 / 92.5 (one thread 187.1,
 #: 156.3), the FM²-shaped map (walls) 99.6 / 100.5 (noise: the same slabs).
 FEWER_SLABS_2D = {1: True, 2: True}
+
+#: 2D, keyed by order: the windows pipelined, no barrier between them: each window posts its
+#: boundary nodes' times for its neighbours' next exchange, so a slab's next window waits for
+#: its two neighbours' last windows only (:func:`_parallel._pipe_kernel`); not toward stop
+#: nodes. False: a parallel region a window (:func:`_parallel._drive_kernel`); 3D always so
+#: (its windows pass 1.6x with their regions). The times are the same (order 2 bit for bit).
+#: Measured (7 December 2026, session 45, 2048^2, two threads, one process alternating the
+#: settings, medians of 11, pipelined / regions): order 2 FM²-shaped 266.6 / 295.5 ms (1.68x /
+#: 1.52x the serial march), its seed 1 240.2 / 247.5, smooth 349.0 / 355.0; order 1 FM²-shaped
+#: 192.3 / 200.5 and 192.7 / 197.0, its seed 1 182.7 / 197.7, smooth 250.4 / 255.8, constant
+#: 227.1 / 225.1 (docs/performance.md, session 45).
+PIPELINE = {1: True, 2: True}

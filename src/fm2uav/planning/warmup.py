@@ -91,26 +91,34 @@ def _fmm_parallel(ndim: int) -> Callable[[], None]:
     specialisations; and the lean float32 ``V`` of grids over ``LEAN_NODES`` padded nodes,
     e.g. a 1000x1000x40 terrain plan, with the page toucher of its buffers), its size floors
     lowered for a 16-node-wide grid while it compiles, stopped at a node as a plan's march
-    (the times after the stop set to inf on the threads); and the descent placing the slab
-    cuts and their comparison (a 16-node grid is too thin to be cut)."""
+    (the times after the stop set to inf on the threads) and to the end (2D: the windows
+    pipelined, :data:`~fm2uav.eikonal._tuning.PIPELINE`); and the descent placing the slab
+    cuts and their comparison."""
     def run() -> None:
         speed = np.ones((16,) * ndim)
         speed[(0,) * ndim] = 0.5  # a plateau with its mask (a uniform grid needs none)
         speeds = (speed, np.ones((16,) * ndim)) if ndim == 2 else (speed,)
         floor, lean = _tuning.PARALLEL_MIN_NODES, _kernels.LEAN_NODES
         floor2 = _tuning.ORDER2_MIN_NODES_3D, _tuning.ORDER2_MIN_NODES_2D
+        slab = _tuning.MIN_SLAB_ROWS, _tuning.MIN_SLAB_NODES
         _tuning.PARALLEL_MIN_NODES = _tuning.ORDER2_MIN_NODES_3D = 0
         _tuning.ORDER2_MIN_NODES_2D = 0
+        # slabs of a few rows: two threads march (the pipelined windows need two)
+        _tuning.MIN_SLAB_ROWS, _tuning.MIN_SLAB_NODES = 4, 0
         try:
             for lean_nodes in (lean, 0):
                 _kernels.LEAN_NODES = lean_nodes
                 for v in speeds:
                     for order in (1, 2) if _tuning.ORDER2 else (1,):
-                        fast_marching(v, [(3,) * ndim], order=order, threads=2,
-                                      stop_at=[(12,) * ndim])
+                        # toward a stop node (the windows' regions) and to the end (2D: the
+                        # pipelined windows, _tuning.PIPELINE)
+                        for stop in ([(12,) * ndim], None):
+                            fast_marching(v, [(3,) * ndim], order=order, threads=2,
+                                          stop_at=stop)
         finally:
             _tuning.PARALLEL_MIN_NODES, _kernels.LEAN_NODES = floor, lean
             _tuning.ORDER2_MIN_NODES_3D, _tuning.ORDER2_MIN_NODES_2D = floor2
+            _tuning.MIN_SLAB_ROWS, _tuning.MIN_SLAB_NODES = slab
         # the page toucher's kernels (the top speed first, then the page faults): on a grid
         # this small its thread may be stopped before its first touch (the cuts are placed
         # at once), so they are compiled here
